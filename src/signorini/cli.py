@@ -1,0 +1,130 @@
+"""Command line: ``signorini run example-6.2 --out results/6.2``.
+
+Each level's history row and VTU file are written (atomically) as soon as the level is done,
+so an interrupted run keeps what it finished; the figures follow at the end.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .adaptive import Level, adaptive
+from .estimator import ETA5_VARIANTS
+from .examples import EXAMPLES, get_example
+from .io import HistoryWriter, write_vtu
+
+__all__ = ["main"]
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="signorini",
+        description="Adaptive P2 finite elements for the frictionless Signorini problem.",
+    )
+    sub = p.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="solve an example on a sequence of meshes")
+    run.add_argument("example", choices=sorted(EXAMPLES))
+    run.add_argument("--uniform", action="store_true",
+                     help="uniform refinement instead of adaptive (Dörfler) refinement")
+    run.add_argument("--theta", type=float, default=0.4, help="Dörfler parameter (default 0.4)")
+    run.add_argument("--max-ndof", type=int, default=100_000,
+                     help="budget of free unknowns (default 100000)")
+    run.add_argument("--tol", type=float, default=0.0, help="stop when eta <= tol")
+    run.add_argument("--max-levels", type=int, default=100)
+    run.add_argument("--eta5", choices=ETA5_VARIANTS, default="consistent",
+                     help="variant of the normal-stress term of the estimator")
+    run.add_argument("--backend", default="auto", help="sparse solver: auto, pardiso, scipy")
+    run.add_argument("--out", type=Path, default=None,
+                     help="output folder (default results/<example>)")
+    run.add_argument("--no-vtu", action="store_true", help="do not write VTU files")
+    run.add_argument("--no-figures", action="store_true", help="do not draw figures")
+    run.add_argument("--quiet", action="store_true", help="no progress lines")
+    fig = sub.add_parser("figures", help="redraw the figures of a finished run")
+    fig.add_argument("example", choices=sorted(EXAMPLES))
+    fig.add_argument("out", type=Path, help="the run's output folder (with history.csv)")
+    return p
+
+
+def _progress(level: Level) -> str:
+    r = level.record
+    line = (f"level {r.level:3d}  ndof {r.ndof:9d}  cells {r.n_cells:8d}  eta {r.eta:.4e}")
+    if not np.isnan(r.error_energy):
+        line += f"  error {r.error_energy:.4e}  eff {r.efficiency:.3f}"
+    line += (f"  pdas {r.pdas_iterations:2d}  active {r.n_active:5d}"
+             f"  [{r.t_assemble + r.t_solve + r.t_estimate + r.t_mark + r.t_refine:.2f}s]")
+    return line
+
+
+def run(args: argparse.Namespace) -> int:
+    problem = get_example(args.example)
+    out: Path = args.out or Path("results") / args.example
+    out.mkdir(parents=True, exist_ok=True)
+    history = HistoryWriter(out / "history.csv")
+    say = (lambda s: None) if args.quiet else (lambda s: print(s, flush=True))
+    mode = "uniform" if args.uniform else f"adaptive, theta={args.theta}"
+    say(f"{problem.name}: {mode}, eta5={args.eta5}, max_ndof={args.max_ndof} -> {out}")
+    last = None
+    for level in adaptive(problem, theta=args.theta, max_ndof=args.max_ndof, tol=args.tol,
+                          max_levels=args.max_levels, uniform=args.uniform, eta5=args.eta5,
+                          backend=args.backend):
+        t0 = time.perf_counter()
+        if not args.no_vtu:
+            write_vtu(out / f"level_{level.record.level:03d}.vtu", level.result, level.estimate)
+        level.record.t_output = time.perf_counter() - t0
+        history.append(level.record.row())
+        say(_progress(level))
+        last = level
+    if last is not None and not args.no_figures:
+        written = _figures(args.example, out, last)
+        say(f"figures: {', '.join(str(p.name) for p in written)}")
+    say(f"solver backend: {last.record.backend}" if last else "no level finished")
+    return 0
+
+
+def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
+    from . import plots
+
+    written = list(plots.make_figures(out / "history.csv", out, example))
+    if last is not None:
+        res = last.result
+        mesh = res.mesh
+        contact = mesh.edges[res.contact.edges]
+        written += plots.plot_mesh(mesh.points, mesh.cells, out / "mesh",
+                                   title=f"{example}: final mesh, {mesh.n_cells} cells",
+                                   highlight=contact)
+        cs = res.contact
+        vert = cs.is_vertex
+        written += plots.plot_deformed(
+            mesh.points, mesh.cells, res.u[: mesh.n_points], out / "deformed",
+            contact_points=res.space.node_points[cs.nodes],
+            pressure=res.pressure, scale=1.0,
+        )
+        del vert
+    return written
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``signorini`` command."""
+    args = _parser().parse_args(argv)
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    try:
+        if args.command == "run":
+            return run(args)
+        if args.command == "figures":
+            written = _figures(args.example, args.out)
+            print("\n".join(str(p) for p in written))
+            return 0
+    except (ValueError, RuntimeError, OSError) as exc:
+        print(f"signorini: error: {exc}", file=sys.stderr)
+        return 2
+    return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,456 @@
+"""Conforming triangular meshes with labelled boundary edges.
+
+Conventions (fixed for the whole package)
+-----------------------------------------
+- ``points (n_points, 2)`` float64, ``cells (n_cells, 3)`` int64, counter-clockwise.
+- Local edge ``k`` of a cell joins its local vertices ``k`` and ``(k + 1) % 3``.
+- Local edge 0 (``cells[:, 0]``–``cells[:, 1]``) is the *refinement edge* of newest vertex
+  bisection and ``cells[:, 2]`` the newest vertex. :meth:`Mesh.from_arrays` puts the longest
+  edge first; refinement keeps the convention.
+- ``edges (n_edges, 2)`` store each undirected edge once, as ``(min, max)`` vertex pair.
+  ``cell2edge (n_cells, 3)`` gives the edge of local edge ``k``; ``edge2cell (n_edges, 2)`` the
+  two cells of an edge, ``-1`` outside the domain (boundary edges have their cell in column 0).
+- The boundary is split into named *parts* (``part_names``); every boundary edge carries the
+  index of its part in ``boundary_part``. What a part means (Dirichlet, Neumann, contact) is the
+  business of :mod:`signorini.problem`, not of the mesh. Parts survive refinement.
+
+A :class:`Mesh` is immutable; derived topology is computed once and cached.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from functools import cached_property
+
+import numpy as np
+
+__all__ = ["Mesh", "MeshError", "boundary_edges", "signed_area"]
+
+
+class MeshError(ValueError):
+    """Raised for a mesh that is not a valid conforming triangulation."""
+
+
+def _first(indices: np.ndarray, limit: int = 5) -> str:
+    """Format the first few entries of an index array for an error message."""
+    shown = ", ".join(str(int(i)) for i in indices[:limit])
+    more = f" (and {indices.size - limit} more)" if indices.size > limit else ""
+    return shown + more
+
+
+def _edge_keys(pairs: np.ndarray, n_points: int) -> np.ndarray:
+    """Unique int64 key of each undirected vertex pair ``(n, 2)``."""
+    lo = np.minimum(pairs[:, 0], pairs[:, 1]).astype(np.int64)
+    hi = np.maximum(pairs[:, 0], pairs[:, 1]).astype(np.int64)
+    return lo * np.int64(n_points) + hi
+
+
+def boundary_edges(cells: np.ndarray) -> np.ndarray:
+    """Edges ``(n_boundary, 2)`` that belong to exactly one cell, oriented counter-clockwise.
+
+    Parameters
+    ----------
+    cells : (n_cells, 3) int array
+        Counter-clockwise triangles.
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    local = cells[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
+    n = int(cells.max()) + 1 if cells.size else 0
+    keys = _edge_keys(local, n)
+    _, first, counts = np.unique(keys, return_index=True, return_counts=True)
+    return local[first[counts == 1]]
+
+
+class Mesh:
+    """An immutable conforming triangulation with named boundary parts.
+
+    Parameters
+    ----------
+    points : (n_points, 2) float array
+        Vertex coordinates.
+    cells : (n_cells, 3) int array
+        Counter-clockwise triangles; local edge 0 is the refinement edge.
+    boundary : (n_boundary, 2) int array
+        Vertex pairs of all boundary edges (any orientation).
+    boundary_part : (n_boundary,) int array
+        Index into ``part_names`` of each boundary edge.
+    part_names : sequence of str
+        Names of the boundary parts; every part must own at least one edge.
+    validate : bool
+        Check the mesh (orientation, degeneracy, conformity, labels). Refinement, which
+        preserves validity by construction, skips it.
+
+    Raises
+    ------
+    MeshError
+        With a message naming the offending cells, edges or points.
+    """
+
+    def __init__(
+        self,
+        points: np.ndarray,
+        cells: np.ndarray,
+        boundary: np.ndarray,
+        boundary_part: np.ndarray,
+        part_names: tuple[str, ...] | list[str],
+        *,
+        validate: bool = True,
+    ) -> None:
+        self.points = np.ascontiguousarray(points, dtype=np.float64)
+        self.cells = np.ascontiguousarray(cells, dtype=np.int64)
+        boundary = np.asarray(boundary, dtype=np.int64)
+        if boundary.ndim == 1 and boundary.size % 2 == 0:  # flat list of pairs, or empty
+            boundary = boundary.reshape(-1, 2)
+        self.boundary = np.ascontiguousarray(boundary)
+        self.boundary_part = np.ascontiguousarray(boundary_part, dtype=np.int64).reshape(-1)
+        self.part_names = tuple(str(p) for p in part_names)
+        for a in (self.points, self.cells, self.boundary, self.boundary_part):
+            a.flags.writeable = False
+        if validate:
+            self._validate()
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_arrays(
+        cls,
+        points: np.ndarray,
+        cells: np.ndarray,
+        parts: Mapping[str, np.ndarray | Callable[[np.ndarray, np.ndarray], np.ndarray]],
+    ) -> Mesh:
+        """Build a mesh from user arrays, putting each cell's longest edge first.
+
+        Parameters
+        ----------
+        points : (n_points, 2) float array
+        cells : (n_cells, 3) int array, counter-clockwise
+        parts : mapping from part name to either an ``(k, 2)`` array of boundary vertex pairs
+            or a predicate ``f(x, y) -> bool array`` evaluated at boundary edge midpoints.
+            Edges claimed by a predicate are those not listed explicitly; a boundary edge
+            claimed by two parts is an error.
+        """
+        points = _as_points(points)
+        cells = _as_cells(cells, len(points))
+        _check_orientation(points, cells)
+        cells = _longest_edge_first(points, cells)
+        bnd = boundary_edges(cells)
+        part_of = np.full(len(bnd), -1, dtype=np.int64)
+        keys = _edge_keys(bnd, len(points))
+        order = np.argsort(keys)
+        names = list(parts)
+        listed = None  # edges named by an explicit list; predicates only claim the others
+        for index in sorted(range(len(names)), key=lambda i: callable(parts[names[i]])):
+            name = names[index]
+            spec = parts[name]
+            if callable(spec):
+                if listed is None:
+                    listed = part_of >= 0
+                mid = 0.5 * (points[bnd[:, 0]] + points[bnd[:, 1]])
+                hit = np.asarray(spec(mid[:, 0], mid[:, 1]), dtype=bool).reshape(-1)
+                if hit.shape != (len(bnd),):
+                    raise MeshError(f"the predicate of boundary part {name!r} must return one "
+                                    f"bool per edge midpoint, got shape {hit.shape}")
+                where = np.flatnonzero(hit & ~listed)
+            else:
+                pairs = np.asarray(spec)
+                if pairs.size == 0:
+                    where = np.zeros(0, dtype=np.int64)
+                else:
+                    if pairs.ndim == 1 and pairs.size % 2 == 0:
+                        pairs = pairs.reshape(-1, 2)
+                    pairs = _as_cells(pairs, len(points), what="boundary edges")
+                    k = _edge_keys(pairs, len(points))
+                    pos = np.searchsorted(keys, k, sorter=order)
+                    pos = np.minimum(pos, len(keys) - 1)
+                    found = keys[order[pos]] == k
+                    if not found.all():
+                        bad = pairs[~found][0]
+                        raise MeshError(f"boundary part {name!r}: ({bad[0]}, {bad[1]}) is not a "
+                                        "boundary edge of the mesh")
+                    where = order[pos]
+            taken = where[part_of[where] >= 0]
+            if taken.size:
+                other = names[part_of[taken[0]]]
+                bad = bnd[taken[0]]
+                raise MeshError(f"boundary edge ({bad[0]}, {bad[1]}) is claimed by both parts "
+                                f"{other!r} and {name!r}")
+            part_of[where] = index
+        return cls(points, cells, bnd, part_of, names)
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def n_points(self) -> int:
+        return self.points.shape[0]
+
+    @property
+    def n_cells(self) -> int:
+        return self.cells.shape[0]
+
+    @property
+    def n_edges(self) -> int:
+        return self.edges.shape[0]
+
+    # ------------------------------------------------------------------ topology
+    @cached_property
+    def _topology(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        local = self.cells[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
+        keys = _edge_keys(local, self.n_points)
+        uniq, first, inverse, counts = np.unique(
+            keys, return_index=True, return_inverse=True, return_counts=True
+        )
+        if counts.max(initial=0) > 2:
+            bad = np.flatnonzero(counts > 2)
+            pairs = local[first[bad]]
+            raise MeshError(
+                f"non-manifold mesh: {bad.size} edge(s) shared by more than two cells, first "
+                f"({pairs[0, 0]}, {pairs[0, 1]})"
+            )
+        edges = np.sort(local[first], axis=1)
+        cell2edge = inverse.reshape(-1, 3)
+        n_edges = uniq.size
+        # edge2cell: column 0 = the first cell seen, column 1 = the other (or -1)
+        owner = np.repeat(np.arange(self.n_cells, dtype=np.int64), 3)
+        edge2cell = np.full((n_edges, 2), -1, dtype=np.int64)
+        edge2cell[:, 0] = owner[first]
+        second = np.ones(inverse.size, dtype=bool)
+        second[first] = False
+        edge2cell[inverse[second], 1] = owner[second]
+        return edges, cell2edge, edge2cell
+
+    @property
+    def edges(self) -> np.ndarray:
+        """``(n_edges, 2)`` vertex pairs, ``min`` first."""
+        return self._topology[0]
+
+    @property
+    def cell2edge(self) -> np.ndarray:
+        """``(n_cells, 3)`` edge index of local edge ``k`` (vertices ``k``, ``k+1``)."""
+        return self._topology[1]
+
+    @property
+    def edge2cell(self) -> np.ndarray:
+        """``(n_edges, 2)`` adjacent cells, ``-1`` outside the domain."""
+        return self._topology[2]
+
+    @cached_property
+    def boundary_edge(self) -> np.ndarray:
+        """``(n_boundary,)`` mesh edge index of each row of :attr:`boundary`."""
+        keys = _edge_keys(self.edges, self.n_points)  # sorted by construction
+        k = _edge_keys(self.boundary, self.n_points)
+        pos = np.minimum(np.searchsorted(keys, k), keys.size - 1)
+        if keys.size == 0 or not np.array_equal(keys[pos], k):
+            bad = np.flatnonzero(keys[pos] != k)
+            raise MeshError(f"boundary edge(s) {_first(bad)} are not edges of the mesh")
+        return pos
+
+    @cached_property
+    def edge_part(self) -> np.ndarray:
+        """``(n_edges,)`` boundary part index of each edge, ``-1`` for interior edges."""
+        part = np.full(self.n_edges, -1, dtype=np.int64)
+        part[self.boundary_edge] = self.boundary_part
+        part.flags.writeable = False
+        return part
+
+    def part_index(self, name: str) -> int:
+        """Index of boundary part ``name``; a clear error if there is none."""
+        try:
+            return self.part_names.index(name)
+        except ValueError:
+            raise MeshError(
+                f"the mesh has no boundary part {name!r}; its parts are {list(self.part_names)}"
+            ) from None
+
+    def part_edges(self, name: str) -> np.ndarray:
+        """Mesh edge indices of boundary part ``name``."""
+        return self.boundary_edge[self.boundary_part == self.part_index(name)]
+
+    def oriented_boundary(self, edge_index: np.ndarray) -> np.ndarray:
+        """Vertex pairs ``(k, 2)`` of boundary edges, counter-clockwise around their cell."""
+        cell = self.edge2cell[edge_index, 0]
+        local = np.argmax(self.cell2edge[cell] == edge_index[:, None], axis=1)
+        a = self.cells[cell, local]
+        b = self.cells[cell, (local + 1) % 3]
+        return np.stack([a, b], axis=1)
+
+    # ------------------------------------------------------------------ geometry
+    @cached_property
+    def area(self) -> np.ndarray:
+        """``(n_cells,)`` signed areas (positive for counter-clockwise cells)."""
+        return signed_area(self.points, self.cells)
+
+    @cached_property
+    def edge_length(self) -> np.ndarray:
+        """``(n_edges,)`` lengths."""
+        d = self.points[self.edges[:, 1]] - self.points[self.edges[:, 0]]
+        return np.hypot(d[:, 0], d[:, 1])
+
+    @cached_property
+    def h(self) -> np.ndarray:
+        """``(n_cells,)`` diameters ``h_T`` (longest edge)."""
+        return self.edge_length[self.cell2edge].max(axis=1)
+
+    @cached_property
+    def edge_midpoints(self) -> np.ndarray:
+        """``(n_edges, 2)`` midpoints."""
+        return 0.5 * (self.points[self.edges[:, 0]] + self.points[self.edges[:, 1]])
+
+    def min_angle(self) -> float:
+        """Smallest interior angle (radians) over all cells."""
+        p = self.points[self.cells]
+        angles = []
+        for k in range(3):
+            u = p[:, (k + 1) % 3] - p[:, k]
+            v = p[:, (k + 2) % 3] - p[:, k]
+            cos = (u * v).sum(1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
+            angles.append(np.arccos(np.clip(cos, -1.0, 1.0)))
+        return float(np.min(angles))
+
+    def part_length(self, name: str) -> float:
+        """Total length of boundary part ``name``."""
+        return float(self.edge_length[self.part_edges(name)].sum())
+
+    def __repr__(self) -> str:
+        return (f"Mesh(n_points={self.n_points}, n_cells={self.n_cells}, "
+                f"parts={list(self.part_names)})")
+
+    # ------------------------------------------------------------------ validation
+    def _validate(self) -> None:
+        points = _as_points(self.points)
+        cells = _as_cells(self.cells, len(points))
+        _as_cells(self.boundary, len(points), what="boundary edges")
+        _check_orientation(points, cells)
+        used = np.zeros(len(points), dtype=bool)
+        used[cells.ravel()] = True
+        if not used.all():
+            raise MeshError(f"unreferenced point(s) {_first(np.flatnonzero(~used))}: every "
+                            "point must be a vertex of some cell")
+        _check_duplicate_points(points)
+        if self.boundary_part.shape != (len(self.boundary),):
+            raise MeshError("boundary_part must have one entry per boundary edge")
+        bad_part = (self.boundary_part < 0) | (self.boundary_part >= len(self.part_names))
+        if bad_part.any():
+            first = self.boundary[np.flatnonzero(bad_part)[0]]
+            raise MeshError(f"{int(bad_part.sum())} boundary edge(s) have no part, first "
+                            f"({first[0]}, {first[1]}); label every boundary edge")
+        for index, name in enumerate(self.part_names):
+            if not np.any(self.boundary_part == index):
+                raise MeshError(f"boundary part {name!r} has no edges")
+        e2c = self.edge2cell  # raises on non-manifold edges
+        is_bnd = e2c[:, 1] < 0
+        self._check_conforming(is_bnd)
+        labelled = np.zeros(self.n_edges, dtype=bool)
+        be = self.boundary_edge
+        if np.any(~is_bnd[be]):
+            bad = self.boundary[np.flatnonzero(~is_bnd[be])[0]]
+            raise MeshError(f"edge ({bad[0]}, {bad[1]}) is labelled as boundary but is shared "
+                            "by two cells")
+        if np.unique(be).size != be.size:
+            raise MeshError("a boundary edge is listed twice")
+        labelled[be] = True
+        missing = np.flatnonzero(is_bnd & ~labelled)
+        if missing.size:
+            e = self.edges[missing[0]]
+            raise MeshError(f"{missing.size} boundary edge(s) without a part, first "
+                            f"({e[0]}, {e[1]}); label every boundary edge")
+
+    def _check_conforming(self, is_bnd: np.ndarray) -> None:
+        """Neighbouring cells must traverse a shared edge in opposite directions, and no vertex
+        may lie inside a boundary edge (a hanging node)."""
+        local = self.cells[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
+        forward = local[:, 0] < local[:, 1]
+        inner = ~is_bnd[self.cell2edge.ravel()]
+        # each interior edge is traversed once forwards and once backwards
+        counts = np.bincount(self.cell2edge.ravel()[inner & forward], minlength=self.n_edges)
+        if np.any(counts[~is_bnd] != 1):
+            bad = np.flatnonzero((counts != 1) & ~is_bnd)[0]
+            e = self.edges[bad]
+            raise MeshError(f"cells overlap or are inconsistently oriented across edge "
+                            f"({e[0]}, {e[1]})")
+        bnd = np.flatnonzero(is_bnd)
+        verts = np.unique(self.edges[bnd])
+        if bnd.size * verts.size > 5e7:  # hanging nodes on huge meshes: check in chunks
+            chunks = np.array_split(bnd, int(bnd.size * verts.size / 5e7) + 1)
+        else:
+            chunks = [bnd]
+        for chunk in chunks:
+            a = self.points[self.edges[chunk, 0]][:, None, :]
+            b = self.points[self.edges[chunk, 1]][:, None, :]
+            p = self.points[verts][None, :, :]
+            ab = b - a
+            length2 = (ab**2).sum(-1)
+            t = ((p - a) * ab).sum(-1) / length2
+            cross = ab[..., 0] * (p - a)[..., 1] - ab[..., 1] * (p - a)[..., 0]
+            tol = 1e-10
+            on = (np.abs(cross) <= tol * length2) & (t > tol) & (t < 1 - tol)
+            if on.any():
+                i, j = np.argwhere(on)[0]
+                e = self.edges[chunk[i]]
+                raise MeshError(f"non-conforming mesh: point {verts[j]} lies inside edge "
+                                f"({e[0]}, {e[1]}) (hanging node)")
+
+
+# ---------------------------------------------------------------------- helpers
+def _as_points(points: np.ndarray) -> np.ndarray:
+    p = np.asarray(points, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise MeshError(f"points must have shape (n_points, 2), got {p.shape}")
+    if not np.isfinite(p).all():
+        raise MeshError(f"point(s) {_first(np.flatnonzero(~np.isfinite(p).all(1)))} have "
+                        "non-finite coordinates")
+    return p
+
+
+def _as_cells(cells: np.ndarray, n_points: int, what: str = "cells") -> np.ndarray:
+    c = np.asarray(cells)
+    width = 3 if what == "cells" else 2
+    if c.ndim != 2 or c.shape[1] != width:
+        raise MeshError(f"{what} must have shape (n, {width}), got {c.shape}")
+    if c.size and not np.issubdtype(c.dtype, np.integer):
+        if not np.all(np.equal(np.mod(c, 1), 0)):
+            raise MeshError(f"{what} must hold integer point indices")
+    c = c.astype(np.int64)
+    if c.size and (c.min() < 0 or c.max() >= n_points):
+        raise MeshError(f"{what} refer to points outside 0..{n_points - 1}")
+    return c
+
+
+def signed_area(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """``(n_cells,)`` signed areas, positive for counter-clockwise cells."""
+    p0, p1, p2 = (points[cells[:, k]] for k in range(3))
+    d1, d2 = p1 - p0, p2 - p0
+    return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+
+
+def _check_orientation(points: np.ndarray, cells: np.ndarray) -> None:
+    if cells.shape[0] == 0:
+        raise MeshError("the mesh has no cells")
+    area = signed_area(points, cells)
+    p = points[cells]
+    h2 = ((p - np.roll(p, 1, axis=1)) ** 2).sum(-1).max(axis=1)
+    degenerate = np.abs(area) <= 1e-12 * h2
+    if degenerate.any():
+        bad = np.flatnonzero(degenerate)
+        raise MeshError(f"degenerate triangle(s) {_first(bad)} (zero area or repeated vertex), "
+                        f"e.g. cell {bad[0]} = {cells[bad[0]].tolist()}")
+    if np.any(area < 0):
+        bad = np.flatnonzero(area < 0)
+        raise MeshError(f"clockwise triangle(s) {_first(bad)}: list each cell's vertices "
+                        "counter-clockwise")
+
+
+def _check_duplicate_points(points: np.ndarray) -> None:
+    scale = max(float(np.ptp(points, axis=0).max()), 1.0)
+    q = np.round(points / (1e-10 * scale)).astype(np.int64)
+    _, inverse, counts = np.unique(q, axis=0, return_inverse=True, return_counts=True)
+    if counts.max() > 1:
+        dup = np.flatnonzero(counts[inverse.reshape(-1)] > 1)
+        raise MeshError(f"duplicate points {_first(dup)} (same coordinates "
+                        f"{points[dup[0]].tolist()})")
+
+
+def _longest_edge_first(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """Rotate each cell's vertices cyclically so that local edge 0 is its longest edge."""
+    p = points[cells]
+    length2 = ((p[:, [1, 2, 0]] - p) ** 2).sum(-1)  # edge k: vertex k -> k+1
+    k = np.argmax(length2, axis=1)
+    rows = np.arange(len(cells))[:, None]
+    return cells[rows, (k[:, None] + np.arange(3)[None, :]) % 3]

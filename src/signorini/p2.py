@@ -1,0 +1,382 @@
+"""The quadratic Lagrange (P2) triangle and affine geometry, vectorized over cells.
+
+Conventions (fixed for the whole package)
+-----------------------------------------
+* Reference triangle with vertices (0, 0), (1, 0), (0, 1); barycentric
+  coordinates ``l0 = 1 - x - y``, ``l1 = x``, ``l2 = y``.
+* Local node order: the 3 vertices, then the midpoints of local edges
+  0 (v0-v1), 1 (v1-v2), 2 (v2-v0) -- the VTK quadratic triangle, meshio's
+  ``triangle6``.  Vertex basis ``l_i (2 l_i - 1)``, midpoint basis
+  ``4 l_a l_b``.
+* Vector fields are interleaved per node: local DOF ``2 * a + c`` is component
+  ``c`` at local node ``a`` (12 per triangle).
+* Affine map ``x = v0 + J xi`` with ``J = [v1 - v0, v2 - v0]`` (columns);
+  counter-clockwise cells have ``det J > 0``.
+* On an edge the three P2 nodes are ordered (start, end, midpoint), with the
+  edge parameter ``t`` in [0, 1] running from start to end.
+
+Arrays of cells are batched: ``vertices`` has shape ``(m, 3, 2)`` (``points[cells]``),
+per-cell coefficients ``u_cell`` shape ``(m, 12)``; reference points ``xi`` shape
+``(q, 2)``.  Gradients are stored last-axis-is-derivative:
+``grad[..., i, j] = d u_i / d x_j``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "REFERENCE_NODES",
+    "basis",
+    "edge_basis",
+    "edge_reference_points",
+    "field_gradients",
+    "field_hessian",
+    "field_values",
+    "grad_basis",
+    "hessian_basis",
+    "inverse_transpose",
+    "jacobian",
+    "physical_gradients",
+    "physical_points",
+]
+
+#: Reference coordinates of the 6 local nodes, shape (6, 2).
+REFERENCE_NODES = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5]])
+REFERENCE_NODES.setflags(write=False)
+
+# gradients of the barycentric coordinates l0, l1, l2 on the reference triangle
+_GRAD_L = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
+# midpoint a = 3 + k lies on local edge k joining vertices k and (k + 1) % 3
+_EDGE_VERTS = ((0, 1), (1, 2), (2, 0))
+
+
+def _as_points(xi: np.ndarray, name: str = "xi") -> np.ndarray:
+    xi = np.asarray(xi, dtype=np.float64)
+    if xi.ndim == 1 and xi.shape == (2,):
+        xi = xi[None, :]
+    if xi.ndim != 2 or xi.shape[1] != 2:
+        raise ValueError(f"{name} must have shape (q, 2), got {xi.shape}")
+    return xi
+
+
+def _barycentric(xi: np.ndarray) -> np.ndarray:
+    """Barycentric coordinates, shape (q, 3)."""
+    return np.column_stack([1.0 - xi[:, 0] - xi[:, 1], xi[:, 0], xi[:, 1]])
+
+
+def basis(xi: np.ndarray) -> np.ndarray:
+    """Values of the 6 reference P2 basis functions.
+
+    Parameters
+    ----------
+    xi : array_like of float, shape (q, 2)
+        Reference points.
+
+    Returns
+    -------
+    ndarray of float64, shape (q, 6)
+        ``phi[p, a]`` = basis function ``a`` at point ``p`` (project node order).
+    """
+    lam = _barycentric(_as_points(xi))
+    out = np.empty((lam.shape[0], 6))
+    out[:, :3] = lam * (2.0 * lam - 1.0)
+    for k, (a, b) in enumerate(_EDGE_VERTS):
+        out[:, 3 + k] = 4.0 * lam[:, a] * lam[:, b]
+    return out
+
+
+def grad_basis(xi: np.ndarray) -> np.ndarray:
+    """Reference gradients of the 6 P2 basis functions.
+
+    Parameters
+    ----------
+    xi : array_like of float, shape (q, 2)
+        Reference points.
+
+    Returns
+    -------
+    ndarray of float64, shape (q, 6, 2)
+        ``g[p, a, j] = d phi_a / d xi_j`` at point ``p``.
+    """
+    lam = _barycentric(_as_points(xi))
+    out = np.empty((lam.shape[0], 6, 2))
+    for i in range(3):
+        out[:, i, :] = (4.0 * lam[:, i] - 1.0)[:, None] * _GRAD_L[i]
+    for k, (a, b) in enumerate(_EDGE_VERTS):
+        out[:, 3 + k, :] = 4.0 * (lam[:, a, None] * _GRAD_L[b] + lam[:, b, None] * _GRAD_L[a])
+    return out
+
+
+def hessian_basis() -> np.ndarray:
+    """Constant reference Hessians of the 6 P2 basis functions.
+
+    Returns
+    -------
+    ndarray of float64, shape (6, 2, 2)
+        ``h[a, j, k] = d^2 phi_a / d xi_j d xi_k``.
+    """
+    out = np.empty((6, 2, 2))
+    for i in range(3):
+        out[i] = 4.0 * np.outer(_GRAD_L[i], _GRAD_L[i])
+    for k, (a, b) in enumerate(_EDGE_VERTS):
+        g = np.outer(_GRAD_L[a], _GRAD_L[b])
+        out[3 + k] = 4.0 * (g + g.T)
+    return out
+
+
+def edge_basis(t: np.ndarray) -> np.ndarray:
+    """P2 basis on an edge in the node order (start, end, midpoint).
+
+    Parameters
+    ----------
+    t : array_like of float, shape (q,)
+        Edge parameters in [0, 1] (0 = start, 1 = end).
+
+    Returns
+    -------
+    ndarray of float64, shape (q, 3)
+        ``(1 - t)(1 - 2 t)``, ``t (2 t - 1)``, ``4 t (1 - t)``.
+    """
+    t = np.asarray(t, dtype=np.float64)
+    if t.ndim != 1:
+        raise ValueError(f"t must have shape (q,), got {t.shape}")
+    return np.column_stack([(1.0 - t) * (1.0 - 2.0 * t), t * (2.0 * t - 1.0), 4.0 * t * (1.0 - t)])
+
+
+def edge_reference_points(local_edge: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Reference coordinates of points on local edges.
+
+    Local edge ``k`` runs from local vertex ``k`` to local vertex ``(k + 1) % 3``
+    (counter-clockwise around the cell); ``t = 0`` is its start.
+
+    Parameters
+    ----------
+    local_edge : array_like of int, shape (k,) or scalar
+        Local edge numbers in {0, 1, 2}.
+    t : array_like of float, shape (q,)
+        Edge parameters in [0, 1].
+
+    Returns
+    -------
+    ndarray of float64, shape (k, q, 2) (or (q, 2) for a scalar ``local_edge``)
+        Reference points.
+    """
+    le = np.asarray(local_edge)
+    if le.size and (not np.issubdtype(le.dtype, np.integer) or le.min() < 0 or le.max() > 2):
+        raise ValueError("local_edge must contain integers in {0, 1, 2}")
+    t = np.asarray(t, dtype=np.float64)
+    if t.ndim != 1:
+        raise ValueError(f"t must have shape (q,), got {t.shape}")
+    start = REFERENCE_NODES[:3][le]  # (..., 2)
+    end = REFERENCE_NODES[:3][(le + 1) % 3]
+    return start[..., None, :] + t[:, None] * (end - start)[..., None, :]
+
+
+def _check_vertices(vertices: np.ndarray) -> np.ndarray:
+    v = np.asarray(vertices, dtype=np.float64)
+    if v.ndim != 3 or v.shape[1:] != (3, 2):
+        raise ValueError(f"vertices must have shape (n_cells, 3, 2), got {v.shape}")
+    if not np.all(np.isfinite(v)):
+        bad = np.flatnonzero(~np.isfinite(v).all(axis=(1, 2)))
+        raise ValueError(f"vertices of {bad.size} cell(s) are not finite (first: cell {bad[0]})")
+    return v
+
+
+def jacobian(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Jacobians of the affine maps from the reference triangle.
+
+    Parameters
+    ----------
+    vertices : array_like of float, shape (m, 3, 2)
+        Cell vertex coordinates (``points[cells]``), counter-clockwise.
+
+    Returns
+    -------
+    J : ndarray of float64, shape (m, 2, 2)
+        ``J[:, :, 0] = v1 - v0``, ``J[:, :, 1] = v2 - v0``.
+    det : ndarray of float64, shape (m,)
+        ``det J`` = twice the cell area, positive.
+
+    Raises
+    ------
+    ValueError
+        On a wrong shape, non-finite coordinates, or cells with ``det J <= 0``
+        (clockwise or degenerate); the message gives how many and the first.
+    """
+    v = _check_vertices(vertices)
+    J = np.stack([v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]], axis=2)
+    det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
+    if not np.all(det > 0.0):
+        bad = np.flatnonzero(~(det > 0.0))
+        raise ValueError(
+            f"{bad.size} cell(s) have a non-positive Jacobian determinant "
+            f"(clockwise or degenerate; first: cell {bad[0]}, det = {det[bad[0]]:.3e})"
+        )
+    return J, det
+
+
+def inverse_transpose(J: np.ndarray, det: np.ndarray | None = None) -> np.ndarray:
+    """Inverse transposes ``J^{-T}`` of a batch of 2x2 Jacobians.
+
+    Parameters
+    ----------
+    J : ndarray of float64, shape (m, 2, 2)
+        Jacobians, as returned by :func:`jacobian`.
+    det : ndarray of float64, shape (m,), optional
+        Their determinants (computed if omitted).
+
+    Returns
+    -------
+    ndarray of float64, shape (m, 2, 2)
+        ``J^{-T}``; physical gradients are ``J^{-T} grad_xi``.
+    """
+    J = np.asarray(J, dtype=np.float64)
+    if J.ndim != 3 or J.shape[1:] != (2, 2):
+        raise ValueError(f"J must have shape (m, 2, 2), got {J.shape}")
+    if det is None:
+        det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
+    inv_det = 1.0 / det
+    out = np.empty_like(J)
+    # J^{-1} = [[d, -b], [-c, a]] / det ; J^{-T} = [[d, -c], [-b, a]] / det
+    out[:, 0, 0] = J[:, 1, 1] * inv_det
+    out[:, 0, 1] = -J[:, 1, 0] * inv_det
+    out[:, 1, 0] = -J[:, 0, 1] * inv_det
+    out[:, 1, 1] = J[:, 0, 0] * inv_det
+    return out
+
+
+def physical_points(vertices: np.ndarray, xi: np.ndarray) -> np.ndarray:
+    """Images of reference points under each cell's affine map.
+
+    Parameters
+    ----------
+    vertices : array_like of float, shape (m, 3, 2)
+        Cell vertices.
+    xi : array_like of float, shape (q, 2)
+        Reference points.
+
+    Returns
+    -------
+    ndarray of float64, shape (m, q, 2)
+        ``x = v0 + J xi``.
+    """
+    v = _check_vertices(vertices)
+    lam = _barycentric(_as_points(xi))
+    return np.einsum("qk,mkd->mqd", lam, v)
+
+
+def physical_gradients(vertices: np.ndarray, xi: np.ndarray) -> np.ndarray:
+    """Physical gradients of the 6 P2 basis functions.
+
+    Parameters
+    ----------
+    vertices : array_like of float, shape (m, 3, 2)
+        Cell vertices, counter-clockwise.
+    xi : array_like of float, shape (q, 2)
+        Reference points.
+
+    Returns
+    -------
+    ndarray of float64, shape (m, q, 6, 2)
+        ``G[c, p, a, :] = J_c^{-T} grad phi_a(xi_p)``.
+    """
+    J, det = jacobian(vertices)
+    jit = inverse_transpose(J, det)
+    return np.einsum("mij,qaj->mqai", jit, grad_basis(xi))
+
+
+def _check_u_cell(u_cell: np.ndarray, m: int | None = None) -> np.ndarray:
+    u = np.asarray(u_cell, dtype=np.float64)
+    if u.ndim != 2 or u.shape[1] != 12:
+        raise ValueError(f"u_cell must have shape (n_cells, 12), got {u.shape}")
+    if m is not None and u.shape[0] != m:
+        raise ValueError(f"u_cell has {u.shape[0]} rows but vertices has {m} cells")
+    return u
+
+
+def _cell_points(xi: np.ndarray, m: int | None = None) -> np.ndarray:
+    """Reference points shared by all cells (q, 2) or given per cell (m, q, 2)."""
+    xi = np.asarray(xi, dtype=np.float64)
+    if xi.ndim == 3:
+        if xi.shape[2] != 2 or (m is not None and xi.shape[0] != m):
+            raise ValueError(
+                f"per-cell reference points must have shape ({m}, q, 2), got {xi.shape}"
+            )
+        return xi
+    return _as_points(xi)
+
+
+def field_values(u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
+    """Values of a P2 vector field at reference points of each cell.
+
+    Parameters
+    ----------
+    u_cell : array_like of float, shape (m, 12)
+        Interleaved local coefficients (``u[cell_dofs]``).
+    xi : array_like of float, shape (q, 2) or (m, q, 2)
+        Reference points, shared by all cells or given per cell.
+
+    Returns
+    -------
+    ndarray of float64, shape (m, q, 2)
+        ``u_h`` at the image of each reference point.
+    """
+    u = _check_u_cell(u_cell).reshape(-1, 6, 2)
+    xi = _cell_points(xi, u.shape[0])
+    if xi.ndim == 3:
+        phi = basis(xi.reshape(-1, 2)).reshape(xi.shape[0], xi.shape[1], 6)
+        return np.einsum("mqa,mac->mqc", phi, u)
+    return np.einsum("qa,mac->mqc", basis(xi), u)
+
+
+def field_gradients(vertices: np.ndarray, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
+    """Gradients of a P2 vector field at reference points of each cell.
+
+    Parameters
+    ----------
+    vertices : array_like of float, shape (m, 3, 2)
+        Cell vertices, counter-clockwise.
+    u_cell : array_like of float, shape (m, 12)
+        Interleaved local coefficients.
+    xi : array_like of float, shape (q, 2) or (m, q, 2)
+        Reference points, shared by all cells or given per cell.
+
+    Returns
+    -------
+    ndarray of float64, shape (m, q, 2, 2)
+        ``grad[c, p, i, j] = d u_i / d x_j``.
+    """
+    J, det = jacobian(vertices)
+    u = _check_u_cell(u_cell, J.shape[0]).reshape(-1, 6, 2)
+    jit = inverse_transpose(J, det)
+    xi = _cell_points(xi, J.shape[0])
+    # reference gradient of u: (m, q, i, k), then map with J^{-T}
+    if xi.ndim == 3:
+        g = grad_basis(xi.reshape(-1, 2)).reshape(xi.shape[0], xi.shape[1], 6, 2)
+        gref = np.einsum("mai,mqak->mqik", u, g)
+    else:
+        gref = np.einsum("mai,qak->mqik", u, grad_basis(xi))
+    return np.einsum("mqik,mjk->mqij", gref, jit)
+
+
+def field_hessian(vertices: np.ndarray, u_cell: np.ndarray) -> np.ndarray:
+    """Constant Hessian of a P2 vector field on each (straight) cell.
+
+    Parameters
+    ----------
+    vertices : array_like of float, shape (m, 3, 2)
+        Cell vertices, counter-clockwise.
+    u_cell : array_like of float, shape (m, 12)
+        Interleaved local coefficients.
+
+    Returns
+    -------
+    ndarray of float64, shape (m, 2, 2, 2)
+        ``H[c, i, j, k] = d^2 u_i / d x_j d x_k``.
+    """
+    J, det = jacobian(vertices)
+    u = _check_u_cell(u_cell, J.shape[0]).reshape(-1, 6, 2)
+    jit = inverse_transpose(J, det)
+    href = np.einsum("mai,ars->mirs", u, hessian_basis())
+    return np.einsum("mirs,mjr,mks->mijk", href, jit, jit)

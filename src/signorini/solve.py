@@ -1,0 +1,242 @@
+"""SOLVE: assemble the discrete Signorini problem (3.2) on a mesh and solve it by PDAS.
+
+The only module that joins assembly, the contact boundary and the algebraic solver.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+
+from .contact import ContactSet, contact_set, node_classes
+from .elasticity import (
+    assemble_body_force,
+    assemble_edge_load,
+    assemble_stiffness,
+    energy_error2,
+    h1_seminorm_error2,
+)
+from .mesh import Mesh
+from .frames import rotate_frames, to_cartesian, to_frames
+from .pdas import PDASResult, solve_pdas
+from .problem import ContactProblem, Dirichlet, Neumann, evaluate_field
+from .space import P2Space
+
+__all__ = ["ContactResult", "solve", "assemble"]
+
+log = logging.getLogger(__name__)
+
+#: quadrature degree for loads and errors with smooth data
+LOAD_DEGREE = 8
+ERROR_DEGREE = 10
+
+
+@dataclass
+class Assembled:
+    """The algebraic problem of one mesh, in rotated (normal, tangential) contact frames."""
+
+    space: P2Space
+    contact: ContactSet
+    K: sp.csr_matrix
+    F: np.ndarray
+    dirichlet: np.ndarray  # DOFs
+    dirichlet_values: np.ndarray
+    seconds: float
+
+
+def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
+    """Stiffness, load and constraints of ``problem`` on ``mesh`` (paper, Section 3).
+
+    The two DOFs of every constrained node are rotated into (normal, tangential) components
+    so that ``u(z)·n ≤ ψ(z)`` becomes a bound on one unknown.
+    """
+    t0 = time.perf_counter()
+    space = P2Space(mesh)
+    n_dofs = space.n_dofs
+    K = assemble_stiffness(space.vertices, space.cell_dofs, n_dofs, problem.material)
+    F = np.zeros(n_dofs)
+    if problem.body_force is not None:
+        F += assemble_body_force(space.vertices, space.cell_dofs, n_dofs,
+                                 lambda x: evaluate_field(problem.body_force, x, "body_force"),
+                                 degree=LOAD_DEGREE)
+    for name in problem.neumann_parts:
+        cond: Neumann = problem.conditions[name]
+        if cond.is_zero:
+            continue
+        edges = mesh.part_edges(name)
+        nodes = space.edge_nodes(edges)
+        dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1, 6)
+        g = cond.field()
+
+        def traction(x, n, g=g, name=name):
+            return evaluate_field(lambda y: g(y, n), x, f"the traction of part {name!r}")
+
+        F += assemble_edge_load(mesh.points[nodes[:, :2]], dofs, n_dofs, traction,
+                                degree=LOAD_DEGREE)
+    # Dirichlet nodes and values (a node on two Dirichlet parts takes the later part's value)
+    nodes_list, values_list = [], []
+    for name in problem.dirichlet_parts:
+        cond: Dirichlet = problem.conditions[name]
+        nodes = space.part_nodes([name])
+        values = evaluate_field(cond.field(), space.node_points[nodes],
+                                f"the Dirichlet value of part {name!r}")
+        nodes_list.append(nodes)
+        values_list.append(values)
+    d_nodes = np.concatenate(nodes_list)
+    d_values = np.concatenate(values_list)
+    d_nodes, last = np.unique(d_nodes[::-1], return_index=True)
+    d_values = d_values[::-1][last]
+    dirichlet = np.column_stack([2 * d_nodes, 2 * d_nodes + 1]).ravel()
+
+    cs = contact_set(problem, space)
+    K, F = rotate_frames(K, F, cs.nodes, cs.normal)
+    return Assembled(space, cs, K, F, dirichlet, d_values.ravel(), time.perf_counter() - t0)
+
+
+@dataclass
+class ContactResult:
+    """The discrete solution of one mesh and everything derived from it.
+
+    Attributes
+    ----------
+    problem : ContactProblem
+    space : P2Space
+    u : (n_nodes, 2) float array
+        Nodal displacements (Cartesian).
+    contact : ContactSet
+    contact_force : (k,) float array
+        Nodal contact forces Λ_z ≥ 0 (3.17).
+    active : (k,) bool array
+        Final active set of the PDAS iteration (``u(z)·n = ψ(z)`` imposed).
+    pdas : PDASResult
+    timings : dict
+        Seconds spent in ``assemble`` and ``solve``.
+    """
+
+    problem: ContactProblem
+    space: P2Space
+    u: np.ndarray
+    contact: ContactSet
+    contact_force: np.ndarray
+    active: np.ndarray
+    pdas: PDASResult
+    n_dirichlet_dofs: int
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def mesh(self) -> Mesh:
+        return self.space.mesh
+
+    @property
+    def ndof(self) -> int:
+        """Free scalar unknowns (the paper's Ndof): all DOFs minus the Dirichlet ones."""
+        return self.space.n_dofs - self.n_dirichlet_dofs
+
+    @property
+    def density(self) -> np.ndarray:
+        """The paper's discrete contact force density ``s_z = Λ_z / m_z`` (4.1)."""
+        return self.contact_force / self.contact.lumped
+
+    @property
+    def pressure(self) -> np.ndarray:
+        """Consistent nodal contact pressure ``p_z = Λ_z / ∫ψ_z`` (DESIGN.md §2)."""
+        return self.contact_force / self.contact.simpson
+
+    @property
+    def total_contact_force(self) -> float:
+        """``Σ_z Λ_z`` (the resultant normal force on Γ_C)."""
+        return float(self.contact_force.sum())
+
+    @cached_property
+    def in_contact(self) -> np.ndarray:
+        """Actual contact nodes ``u_h(z)·n = ψ(z)`` (the converged active set)."""
+        return self.active.copy()
+
+    @cached_property
+    def classes(self) -> np.ndarray:
+        """Full / semi / no contact class of every constrained node (paper, Section 4)."""
+        cs = self.contact
+        loc = cs.local(cs.edge_nodes.ravel()).reshape(-1, 3)
+        gap = cs.edge_normal_gap(self.u)
+        scale = max(float(np.abs(cs.edge_gap).max(initial=0)),
+                    float(np.abs(self.u).max(initial=0)), 1e-300)
+        dirichlet_touch = gap >= -1e-12 * scale
+        edge_in = np.where(loc >= 0, self.active[np.maximum(loc, 0)], dirichlet_touch)
+        return node_classes(cs, self.active, edge_in)
+
+    def errors(self, degree: int = ERROR_DEGREE) -> dict[str, float]:
+        """Energy-norm ``a(e,e)^{1/2}`` and H¹-seminorm errors against the exact solution."""
+        exact = self.problem.exact
+        if exact is None:
+            raise ValueError(f"{self.problem.name} has no exact solution")
+        u_cell = self.space.cell_values(self.u)
+        energy = energy_error2(self.space.vertices, u_cell, exact.gradient,
+                               self.problem.material, degree=degree)
+        h1 = h1_seminorm_error2(self.space.vertices, u_cell, exact.gradient, degree=degree)
+        return {"error_energy": float(np.sqrt(energy.sum())),
+                "error_h1": float(np.sqrt(h1.sum()))}
+
+
+def solve(
+    problem: ContactProblem,
+    mesh: Mesh | None = None,
+    *,
+    u0: np.ndarray | None = None,
+    backend: str = "auto",
+    max_iter: int = 50,
+    fallback: bool = False,
+    assembled: Assembled | None = None,
+) -> ContactResult:
+    """Solve the discrete Signorini problem (3.2) on ``mesh`` by the primal-dual active set
+    method (DESIGN.md §3).
+
+    Parameters
+    ----------
+    problem : ContactProblem
+    mesh : Mesh, optional
+        Defaults to the problem's initial mesh.
+    u0 : (n_nodes, 2) array, optional
+        Warm start (e.g. the previous level's solution prolongated to ``mesh``): its nodes in
+        contact form the initial active set.
+    backend : str
+        Sparse solver backend, see :func:`signorini.linsolve.make_solver`.
+    max_iter : int
+        Bound on PDAS iterations.
+    fallback : bool
+        On PDAS failure, fall back to a convergent method instead of raising.
+    assembled : Assembled, optional
+        Reuse an assembly of the same mesh.
+    """
+    mesh = problem.mesh if mesh is None else mesh
+    if assembled is None:
+        assembled = assemble(problem, mesh)
+    space, cs = assembled.space, assembled.contact
+    x0 = active0 = None
+    if u0 is not None:
+        u0 = np.asarray(u0, dtype=np.float64)
+        if u0.shape != (space.n_nodes, 2):
+            raise ValueError(f"u0 must have shape ({space.n_nodes}, 2), got {u0.shape}")
+        x0 = to_frames(u0.ravel(), cs.nodes, cs.normal)
+        un = cs.normal_displacement(u0)
+        scale = max(float(np.abs(cs.gap).max(initial=0)), float(np.abs(u0).max()), 1e-300)
+        active0 = un - cs.gap >= -1e-10 * scale
+    t0 = time.perf_counter()
+    res = solve_pdas(
+        assembled.K, assembled.F, 2 * cs.nodes, cs.gap,
+        assembled.dirichlet, assembled.dirichlet_values,
+        x0=x0, active0=active0, max_iter=max_iter, backend=backend, fallback=fallback,
+    )
+    seconds = time.perf_counter() - t0
+    u = to_cartesian(res.x, cs.nodes, cs.normal).reshape(-1, 2)
+    log.info("solved %s: %d unknowns, %d PDAS iterations, %d active of %d",
+             problem.name, space.n_dofs, res.iterations, int(res.active.sum()), cs.size)
+    return ContactResult(
+        problem=problem, space=space, u=u, contact=cs, contact_force=res.lam,
+        active=res.active, pdas=res, n_dirichlet_dofs=assembled.dirichlet.size,
+        timings={"assemble": assembled.seconds, "solve": seconds},
+    )
