@@ -106,6 +106,13 @@ def test_refactorization_reuses_analysis(backend):
     for phase in ("time_analysis", "time_factorization", "time_solve"):
         assert getattr(solver, phase) > 0
     solver.close()
+    with pytest.raises(RuntimeError, match="before a successful factorize"):
+        solver.solve(b)
+    # after close() the object starts afresh with a new analysis
+    solver.factorize(A)
+    assert (solver.n_analyses, solver.n_factorizations) == (3, 4)
+    assert rel_residual(A, solver.solve(b), b) < 1e-10
+    solver.close()
 
 
 @pytest.mark.skipif(not HAS_PARDISO, reason="PARDISO not available")

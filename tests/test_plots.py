@@ -84,6 +84,7 @@ def captured(monkeypatch):
             "scales": [(ax.get_xscale(), ax.get_yscale()) for ax in fig.axes],
             "texts": [t.get_text() for ax in fig.axes for t in ax.texts],
             "n_axes": len(fig.axes),
+            "xticks": [list(ax.get_xticks()) for ax in fig.axes],
         })
         return original(fig, path)
 
@@ -295,11 +296,13 @@ def test_contributions_with_vanishing_terms(tmp_path, captured):
 
 
 def test_estimator_figure_and_suffix_kept(tmp_path, captured):
-    h = synthetic_history()
-    h["eta"] = 4.0 * NDOF**-0.75
+    ndof = np.array([150.0, 240.0, 400.0, 700.0, 1200.0, 2000.0])  # only 1.1 decades
+    h = {"ndof": ndof, "eta": 4.0 * ndof**-0.75}
     written = plot_estimator(h, tmp_path / "fig6.3")  # ".3" is not an image suffix
     check_written(written, tmp_path / "fig6.3")
     assert captured[0]["legend"] == [r"$\eta_h$, slope " + "\u22120.75"]
+    # a short log axis gets 2 and 5 times powers of ten as labelled major ticks
+    assert {200.0, 500.0, 1000.0, 2000.0} <= set(captured[0]["xticks"][0])
 
 
 def test_adaptive_vs_uniform_figure(tmp_path, captured):

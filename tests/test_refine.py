@@ -55,8 +55,7 @@ def reachable_shapes(tri: np.ndarray) -> np.ndarray:
     while len(frontier):
         keys = shape_keys(frontier)
         _, first = np.unique(np.round(keys, 8), axis=0, return_index=True)
-        known = [np.abs(classes - keys[i]).max(axis=1, initial=1.0).min(initial=1.0) < 1e-8
-                 for i in first]
+        known = [np.abs(classes - keys[i]).max(axis=1).min(initial=1.0) < 1e-8 for i in first]
         new = first[~np.array(known, dtype=bool)]
         classes = np.vstack([classes, keys[new]])
         a, b, c = (frontier[new, k] for k in range(3))

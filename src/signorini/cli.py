@@ -45,6 +45,9 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--no-vtu", action="store_true", help="do not write VTU files")
     run.add_argument("--no-figures", action="store_true", help="do not draw figures")
     run.add_argument("--quiet", action="store_true", help="no progress lines")
+    run.add_argument("--compare-uniform", action="store_true",
+                     help="also run uniform refinement to the same budget (into OUT/uniform) "
+                          "and plot both")
     fig = sub.add_parser("figures", help="redraw the figures of a finished run")
     fig.add_argument("example", choices=sorted(EXAMPLES))
     fig.add_argument("out", type=Path, help="the run's output folder (with history.csv)")
@@ -83,8 +86,32 @@ def run(args: argparse.Namespace) -> int:
     if last is not None and not args.no_figures:
         written = _figures(args.example, out, last)
         say(f"figures: {', '.join(str(p.name) for p in written)}")
+    if args.compare_uniform and not args.uniform and last is not None:
+        _compare_uniform(args, out, say)
     say(f"solver backend: {last.record.backend}" if last else "no level finished")
     return 0
+
+
+def _compare_uniform(args: argparse.Namespace, out: Path, say) -> None:
+    """Uniform refinement to the same budget, and one plot of both convergence histories."""
+    from . import plots
+
+    problem = get_example(args.example)
+    uni = out / "uniform"
+    history = HistoryWriter(uni / "history.csv")
+    say(f"{problem.name}: uniform refinement for comparison -> {uni}")
+    for level in adaptive(problem, max_ndof=args.max_ndof, uniform=True, eta5=args.eta5,
+                          backend=args.backend, max_levels=args.max_levels):
+        history.append(level.record.row())
+        say(_progress(level))
+    if args.no_figures:
+        return
+    histories = {"adaptive": out / "history.csv", "uniform": uni / "history.csv"}
+    written = plots.plot_adaptive_vs_uniform(histories, out / "adaptive_vs_uniform", key="eta")
+    if problem.exact is not None:
+        written += plots.plot_adaptive_vs_uniform(histories, out / "adaptive_vs_uniform_error",
+                                                  key="error_energy")
+    say(f"figures: {', '.join(str(p.name) for p in written)}")
 
 
 def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
@@ -99,13 +126,15 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
                                    title=f"{example}: final mesh, {mesh.n_cells} cells",
                                    highlight=contact)
         cs = res.contact
-        vert = cs.is_vertex
+        x = res.space.node_points[cs.nodes]
+        # the obstacle surface: each contact point moved by the gap along its normal
+        order = np.lexsort(x.T[::-1])
+        obstacle = (x + cs.gap[:, None] * cs.normal)[order]
         written += plots.plot_deformed(
             mesh.points, mesh.cells, res.u[: mesh.n_points], out / "deformed",
-            contact_points=res.space.node_points[cs.nodes],
-            pressure=res.pressure, scale=1.0,
+            contact_points=x, pressure=res.pressure, scale=1.0, obstacle=obstacle,
+            title=f"{example}: deformed body and contact pressure",
         )
-        del vert
     return written
 
 

@@ -345,17 +345,19 @@ def _cell_nodes(cell_dofs: np.ndarray) -> np.ndarray:
     return ev // 2
 
 
-def _stable_sort_by(keys: np.ndarray, n_keys: int) -> np.ndarray:
-    """Stable argsort of small non-negative integer ``keys`` (counting sort).
+def _counting_sort(
+    keys: np.ndarray, n_keys: int, positions: np.ndarray, ones: np.ndarray
+) -> np.ndarray:
+    """Stable argsort of non-negative integer ``keys < n_keys`` (a counting sort).
 
-    Done by converting ``(key, position)`` pairs to CSR: canonical CSR lists
-    each row's columns in increasing order, i.e. by original position.
+    The pairs ``(key, position)`` are converted to CSR with ``positions =
+    arange(keys.size)``: a CSR matrix in canonical form lists every row's
+    columns in increasing order, i.e. each key's entries by original position.
+    ``ones`` is any array of the same length (the unused values).
     """
-    n = keys.size
-    idx = np.int32 if max(n, n_keys) < np.iinfo(np.int32).max else np.int64
-    pos = np.arange(n, dtype=idx)
-    dummy = np.ones(n, dtype=np.int8)
-    mat = sp.csr_matrix((dummy, (keys.astype(idx, copy=False), pos)), shape=(n_keys, n))
+    mat = sp.csr_matrix((ones, (keys, positions)), shape=(n_keys, keys.size))
+    if not mat.has_sorted_indices:  # canonical form has them; make sure
+        mat.sort_indices()
     return mat.indices
 
 
@@ -386,16 +388,14 @@ def _assemble_node_blocks(
     nodes = cell_nodes.astype(idx, copy=False)
     row = np.repeat(nodes, k, axis=1).ravel()
     col = np.tile(nodes, (1, k)).ravel()
-    # LSD radix sort on (row, col): stable by col, then stable by row
-    perm = _stable_sort_by(col, n_nodes)
-    perm = perm[_stable_sort_by(row[perm], n_nodes)]
+    # LSD radix sort of the pairs on (row, col): stable by col, then stable by row
+    positions = np.arange(n_pairs, dtype=idx)
+    ones = np.ones(n_pairs, dtype=np.int8)
+    perm = _counting_sort(col, n_nodes, positions, ones)
+    perm = perm[_counting_sort(row[perm], n_nodes, positions, ones)]
+    del positions, ones
     rs = row[perm]
     cs = col[perm]
-    if np.any((rs[1:] < rs[:-1]) | ((rs[1:] == rs[:-1]) & (cs[1:] < cs[:-1]))):
-        # never expected; keep a correct (slower) route if the sort was not lexicographic
-        perm = np.lexsort((col, row))
-        rs = row[perm]
-        cs = col[perm]
     new = np.empty(n_pairs, dtype=bool)
     new[0] = True
     np.not_equal(rs[1:], rs[:-1], out=new[1:])

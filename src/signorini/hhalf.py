@@ -80,7 +80,7 @@ _log = logging.getLogger(__name__)
 
 # ---- quadrature and subdivision parameters (module level so tests can tighten them)
 #: (minimum separation / panel length, Gauss points per direction), tried in order
-_FAR_TIERS: tuple[tuple[float, int], ...] = ((16.0, 6), (4.0, 8), (1.0, 12))
+_FAR_TIERS: tuple[tuple[float, int], ...] = ((64.0, 4), (16.0, 6), (4.0, 8), (1.0, 12))
 #: a panel touching a zero run is integrated once the run is this many times longer
 _TOUCH_RUN_RATIO = 2.0
 _TOUCH_RUN_ORDER = 12
@@ -92,7 +92,7 @@ _DUFFY_ORDER = (3, 20)
 #: the angular order is raised until the Gauss error bound is below exp(-_DUFFY_DIGITS)
 _DUFFY_DIGITS = 40.0
 _DUFFY_MAX_ORDER = 400
-#: subdivision depth after which the remaining (tiny, bounded) pairs get the finest rule
+#: subdivision depth; separated pairs (distance > point tolerance) resolve long before
 _MAX_LEVEL = 60
 #: pairs per block (bounds the memory of the tensor rules)
 _BLOCK = 4096
@@ -231,6 +231,15 @@ class PositivePartPieces:
         """Number ``r`` of zero runs."""
         return int(self.run_start.shape[0])
 
+    @property
+    def v_scale(self) -> float:
+        """Largest value of v at the ends and midpoints of the pieces (0.0 if S is empty)."""
+        if self.n_pieces == 0:
+            return 0.0
+        c0, c1, c2 = self.coef.T
+        ends = np.abs(np.concatenate([c0, c0 + c1 + c2, c0 + 0.5 * c1 + 0.25 * c2]))
+        return float(ends.max())
+
 
 def _edge_monomials(w: np.ndarray) -> np.ndarray:
     """``(k, 3)`` coefficients of ``w(s) = a + b s + c s^2`` from (start, mid, end) values."""
@@ -264,9 +273,7 @@ def _roots01(abc: np.ndarray, snap: np.ndarray) -> np.ndarray:
     return roots
 
 
-def _edge_pieces(
-    abc: np.ndarray, snap: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _edge_pieces(abc: np.ndarray, snap: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Cut edges at their roots (see ``_roots01`` for ``snap``).
 
     Returns
@@ -280,8 +287,9 @@ def _edge_pieces(
     """
     n = abc.shape[0]
     roots = _roots01(abc, snap)
-    bp = np.concatenate([np.zeros((n, 1)), np.where(np.isnan(roots), 1.0, roots), np.ones((n, 1))],
-                        axis=1)
+    bp = np.concatenate(
+        [np.zeros((n, 1)), np.where(np.isnan(roots), 1.0, roots), np.ones((n, 1))], axis=1
+    )
     bp.sort(axis=1)
     lo, hi = bp[:, :3], bp[:, 1:]
     keep = hi > lo
@@ -301,7 +309,9 @@ def _zero_runs(
     """Merge zero pieces into maximal straight runs.
 
     Two pieces are merged when they share an end point (same id, ``>= 0``),
-    are parallel and lie on opposite sides of that point.
+    are parallel and lie on opposite sides of that point.  At a point shared
+    by more than two pieces only two of them are considered (the result is
+    still exact, merging only saves work).
     """
     n = start.shape[0]
     if n == 0:
@@ -310,32 +320,43 @@ def _zero_runs(
     d /= np.hypot(*d.T)[:, None]
     ids = np.concatenate([pid0, pid1])
     piece = np.concatenate([np.arange(n), np.arange(n)])
-    other = np.concatenate([end, start])  # the far end seen from the shared point
     valid = ids >= 0
-    ids, piece, other = ids[valid], piece[valid], other[valid]
-    order = np.argsort(ids)
-    ids, piece, other = ids[order], piece[order], other[order]
-    nb = np.flatnonzero(ids[1:] == ids[:-1])
-    pa, pb = piece[nb], piece[nb + 1]
-    point = np.where((pid0[pa] == ids[nb])[:, None], start[pa], end[pa])
+    ids, piece = ids[valid], piece[valid]
+    # the first and the last piece seen at each point (no sort needed)
+    n_ids = int(ids.max()) + 1 if ids.size else 0
+    first = np.full(n_ids, -1, dtype=np.int64)
+    last = np.full(n_ids, -1, dtype=np.int64)
+    first[ids[::-1]] = piece[::-1]
+    last[ids] = piece
+    pts = np.flatnonzero((first >= 0) & (first != last))
+    pa, pb = first[pts], last[pts]
+    at_a = np.where((pid0[pa] == pts)[:, None], start[pa], end[pa])
+    far_a = np.where((pid0[pa] == pts)[:, None], end[pa], start[pa])
+    far_b = np.where((pid0[pb] == pts)[:, None], end[pb], start[pb])
     cross = d[pa, 0] * d[pb, 1] - d[pa, 1] * d[pb, 0]
-    opposite = np.einsum("ij,ij->i", other[nb] - point, other[nb + 1] - point) < 0.0
-    link = (np.abs(cross) <= _PARALLEL_TOL) & opposite & (pa != pb)
-    graph = coo_matrix(
-        (np.ones(int(link.sum())), (pa[link], pb[link])), shape=(n, n)
-    ).tocsr()
-    n_comp, label = connected_components(graph, directed=False)
-    first = np.full(n_comp, n, dtype=np.int64)
-    np.minimum.at(first, label, np.arange(n))
-    ref, dref = start[first], d[first]
-    pts = np.concatenate([start, end])
+    opposite = np.einsum("ij,ij->i", far_a - at_a, far_b - at_a) < 0.0
+    link = (np.abs(cross) <= _PARALLEL_TOL) & opposite
+    graph = coo_matrix((np.ones(int(link.sum())), (pa[link], pb[link])), shape=(n, n))
+    n_comp, label = connected_components(graph.tocsr(), directed=False)
+    # extreme points of each component along its direction (exact input coordinates)
+    rep = np.full(n_comp, n, dtype=np.int64)
+    np.minimum.at(rep, label, np.arange(n))
+    ref, dref = start[rep], d[rep]
+    both = np.concatenate([start, end])
     lab = np.concatenate([label, label])
-    proj = np.einsum("ij,ij->i", pts - ref[lab], dref[lab])
-    order = np.lexsort((proj, lab))
-    lab_sorted = lab[order]
-    lo = np.flatnonzero(np.r_[True, lab_sorted[1:] != lab_sorted[:-1]])
-    hi = np.r_[lo[1:] - 1, lab_sorted.size - 1]
-    return pts[order[lo]].copy(), pts[order[hi]].copy()
+    proj = np.einsum("ij,ij->i", both - ref[lab], dref[lab])
+    lo_val = np.full(n_comp, np.inf)
+    hi_val = np.full(n_comp, -np.inf)
+    np.minimum.at(lo_val, lab, proj)
+    np.maximum.at(hi_val, lab, proj)
+    idx = np.arange(lab.size)
+    lo = np.full(n_comp, lab.size, dtype=np.int64)
+    hi = np.full(n_comp, lab.size, dtype=np.int64)
+    m_lo = proj == lo_val[lab]
+    m_hi = proj == hi_val[lab]
+    np.minimum.at(lo, lab[m_lo], idx[m_lo])
+    np.minimum.at(hi, lab[m_hi], idx[m_hi])
+    return both[lo].copy(), both[hi].copy()
 
 
 def positive_part_pieces(x0, x1, w) -> PositivePartPieces:
@@ -387,8 +408,17 @@ def positive_part_pieces(x0, x1, w) -> PositivePartPieces:
 
     if cand_idx.size == 0:
         return PositivePartPieces(
-            k, np.zeros(0, dtype=np.int64), empty2, empty2, empty2, np.zeros(0),
-            np.zeros((0, 3)), np.zeros((0, 3)), empty2, empty2, float(tol),
+            k,
+            np.zeros(0, dtype=np.int64),
+            empty2,
+            empty2,
+            empty2,
+            np.zeros(0),
+            np.zeros((0, 3)),
+            np.zeros((0, 3)),
+            empty2,
+            empty2,
+            float(tol),
         )
 
     elen = np.hypot(*(x1 - x0).T)
@@ -491,11 +521,11 @@ def _panel_points(pc: PositivePartPieces, idx: np.ndarray, u: np.ndarray):
 
 
 def _panel_nodes(pc: PositivePartPieces, idx: np.ndarray, u: np.ndarray, t: np.ndarray):
-    """Quadrature points ``(n, q, 2)`` and values ``v (n, q)`` at local nodes ``t (q,)``."""
+    """Coordinates ``x, y (n, q)`` and values ``v (n, q)`` at local nodes ``t (q,)``."""
     uu = u[:, :1] + (u[:, 1:] - u[:, :1]) * t
-    A, B = pc.start[idx], pc.end[idx]
-    x = A[:, None, :] * (1.0 - uu)[..., None] + B[:, None, :] * uu[..., None]
-    return x, _polyval(pc.coef[idx], uu)
+    A = pc.start[idx]
+    D = pc.end[idx] - A
+    return A[:, :1] + D[:, :1] * uu, A[:, 1:] + D[:, 1:] * uu, _polyval(pc.coef[idx], uu)
 
 
 def _point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -568,14 +598,15 @@ def _far_pair_integral(pc, p, up, q, uq, n: int) -> np.ndarray:
 
 def _far_pair_kernel(pc, p, up, q, uq, n: int) -> np.ndarray:
     t, wt = _gauss01(n)
-    xp, vp = _panel_nodes(pc, p, up, t)
-    xq, vq = _panel_nodes(pc, q, uq, t)
+    xp, yp, vp = _panel_nodes(pc, p, up, t)
+    xq, yq, vq = _panel_nodes(pc, q, uq, t)
     diff = vp[:, :, None] - vq[:, None, :]
-    dx = xp[:, :, None, :] - xq[:, None, :, :]
-    f = diff * diff / np.einsum("nijk,nijk->nij", dx, dx)
+    d0 = xp[:, :, None] - xq[:, None, :]
+    d1 = yp[:, :, None] - yq[:, None, :]
+    f = diff * diff / (d0 * d0 + d1 * d1)
     lp = (up[:, 1] - up[:, 0]) * pc.length[p]
     lq = (uq[:, 1] - uq[:, 0]) * pc.length[q]
-    return lp * lq * np.einsum("nij,i,j->n", f, wt, wt)
+    return lp * lq * ((f @ wt) @ wt)
 
 
 def _expansion(pc, idx, u, at_end):
@@ -583,11 +614,12 @@ def _expansion(pc, idx, u, at_end):
     lpc = pc.length[idx]
     uc = np.where(at_end, u[:, 1], u[:, 0])
     sigma = np.where(at_end, -1.0, 1.0)
-    c1, c2 = pc.coef[idx, 1], pc.coef[idx, 2]
+    c0, c1, c2 = pc.coef[idx].T
+    vc = c0 + uc * (c1 + uc * c2)
     p1 = sigma * (c1 + 2.0 * c2 * uc) / lpc
     p2 = c2 / lpc**2
     d = sigma[:, None] * (pc.end[idx] - pc.start[idx]) / lpc[:, None]
-    return (u[:, 1] - u[:, 0]) * lpc, p1, p2, d
+    return (u[:, 1] - u[:, 0]) * lpc, vc, p1, p2, d
 
 
 def _duffy_angular_order(a: np.ndarray, b: np.ndarray, cos: np.ndarray) -> np.ndarray:
@@ -611,9 +643,7 @@ def _duffy_angular_order(a: np.ndarray, b: np.ndarray, cos: np.ndarray) -> np.nd
 
 def _duffy_pair_integral(pc, p, up, p_end, q, uq, q_end) -> np.ndarray:
     """Duffy rule on touching panel pairs (see ``_duffy_pair_kernel``)."""
-    return _chunked(
-        lambda *a: _duffy_pair_kernel(pc, *a), p.size, p, up, p_end, q, uq, q_end
-    )
+    return _chunked(lambda *a: _duffy_pair_kernel(pc, *a), p.size, p, up, p_end, q, uq, q_end)
 
 
 def _duffy_pair_kernel(pc, p, up, p_end, q, uq, q_end) -> np.ndarray:
@@ -623,8 +653,15 @@ def _duffy_pair_kernel(pc, p, up, p_end, q, uq, q_end) -> np.ndarray:
     of ``(v(t) - v(s))^2`` cancels that of ``|x - y|^2``; what remains is a
     cubic in ``ρ`` times a smooth rational function of ``z``.
     """
-    a, p1, p2, dp = _expansion(pc, p, up, p_end)
-    b, q1, q2, dq = _expansion(pc, q, uq, q_end)
+    a, vp, p1, p2, dp = _expansion(pc, p, up, p_end)
+    b, vq, q1, q2, dq = _expansion(pc, q, uq, q_end)
+    jump = np.abs(vp - vq)
+    if np.any(jump > _CONTINUITY_RTOL * pc.v_scale):
+        # shared end points were checked on input: this is a point where edges cross
+        raise ValueError(
+            f"H^1/2 quadrature: v jumps by {jump.max():.3e} where two edges meet away "
+            "from a shared end point; the edges of Γ_C probably overlap or cross each other"
+        )
     cos = np.einsum("ij,ij->i", dp, dq)
     order = _duffy_angular_order(a, b, cos)
     out = np.empty(a.size)
@@ -634,9 +671,7 @@ def _duffy_pair_kernel(pc, p, up, p_end, q, uq, q_end) -> np.ndarray:
         sel = np.flatnonzero(order == nz)
         z, wz = _gauss01(int(nz))
         z = z[None, None, :]
-        aa, bb, cc, pp1, pp2, qq1, qq2 = (
-            v[sel, None, None] for v in (a, b, cos, p1, p2, q1, q2)
-        )
+        aa, bb, cc, pp1, pp2, qq1, qq2 = (v[sel, None, None] for v in (a, b, cos, p1, p2, q1, q2))
         num1 = aa * (pp1 + pp2 * aa * r) - bb * z * (qq1 + qq2 * bb * r * z)
         den1 = aa * aa + bb * bb * z * z - 2.0 * aa * bb * z * cc
         num2 = aa * z * (pp1 + pp2 * aa * r * z) - bb * (qq1 + qq2 * bb * r)
@@ -667,6 +702,15 @@ def _cut_at_touch(u: np.ndarray, at_end: np.ndarray, frac: np.ndarray):
     width = u[:, 1] - u[:, 0]
     cut = np.where(at_end, u[:, 1] - width * frac, u[:, 0] + width * frac)
     return np.stack([u[:, 0], cut], axis=1), np.stack([cut, u[:, 1]], axis=1)
+
+
+def _unresolved(count: int) -> None:
+    """Pairs still closer than the point tolerance after ``_MAX_LEVEL`` bisections."""
+    if count:
+        raise ValueError(
+            f"H^1/2 quadrature: {count} panel pairs meet away from their end points; "
+            "the edges of Γ_C probably overlap or cross each other"
+        )
 
 
 def _check_growth(n_active: int) -> None:
@@ -702,9 +746,7 @@ def _cross_edge_block(pc: PositivePartPieces, p: np.ndarray, q: np.ndarray) -> n
             ratio = np.where(touching, 0.0, _segment_distance(ap, bp, aq, bq) / lmax)
         order = _tier_order(ratio)
         if level == _MAX_LEVEL:
-            # tiny leftovers: the integrand is bounded, the finest rule is plenty
-            order[(order == 0) & ~touching] = _FAR_TIERS[-1][1]
-            _log.debug("hhalf: %d panel pairs reached the subdivision limit", order.size)
+            _unresolved(np.count_nonzero((order == 0) & ~touching))
         for n in np.unique(order[order > 0]):
             sel = np.flatnonzero(order == n)
             np.add.at(out, owner[sel], _far_pair_integral(pc, p[sel], up[sel], q[sel], uq[sel], n))
@@ -713,9 +755,7 @@ def _cross_edge_block(pc: PositivePartPieces, p: np.ndarray, q: np.ndarray) -> n
             equal = touching
         sel = np.flatnonzero(equal)
         if sel.size:
-            val = _duffy_pair_integral(
-                pc, p[sel], up[sel], p_end[sel], q[sel], uq[sel], q_end[sel]
-            )
+            val = _duffy_pair_integral(pc, p[sel], up[sel], p_end[sel], q[sel], uq[sel], q_end[sel])
             np.add.at(out, owner[sel], val)
         if level == _MAX_LEVEL:
             break
@@ -775,8 +815,8 @@ def _upper_pair_blocks(m: int, block: int):
 def _zero_run_kernel(pc, p, u, za, zb, n: int) -> np.ndarray:
     """Gauss rule with ``n`` points for ``∫_P v^2 ∫_Z |x - y|^{-2}`` on panels ``u``."""
     t, wt = _gauss01(n)
-    x, v = _panel_nodes(pc, p, u, t)
-    f = _inv_square(x, za[:, None, :], zb[:, None, :])
+    x, y, v = _panel_nodes(pc, p, u, t)
+    f = _inv_square(np.stack([x, y], axis=-1), za[:, None, :], zb[:, None, :])
     lp = (u[:, 1] - u[:, 0]) * pc.length[p]
     return lp * ((v * v * f) @ wt)
 
@@ -794,17 +834,21 @@ def _zero_run_block(pc: PositivePartPieces, p: np.ndarray, z: np.ndarray) -> np.
         lp = (u[:, 1] - u[:, 0]) * pc.length[p]
         lz = np.hypot(*(zb - za).T)
         touching, _, _ = _touch_ends(a, b, za, zb, pc.tol)
-        ratio = np.where(touching, 0.0, _segment_distance(a, b, za, zb) / lp)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(touching, 0.0, _segment_distance(a, b, za, zb) / lp)
         order = _tier_order(ratio)
         order[touching & (lz >= _TOUCH_RUN_RATIO * lp)] = _TOUCH_RUN_ORDER
         if level == _MAX_LEVEL:
-            _log.debug("hhalf: %d (piece, run) pairs reached the subdivision limit", order.size)
-            order[order == 0] = _TOUCH_RUN_ORDER
+            _unresolved(np.count_nonzero(order == 0))
         for n in np.unique(order[order > 0]):
             sel = np.flatnonzero(order == n)
             val = _chunked(
                 lambda *a, n=int(n): _zero_run_kernel(pc, *a, n),
-                sel.size, p[sel], u[sel], za[sel], zb[sel],
+                sel.size,
+                p[sel],
+                u[sel],
+                za[sel],
+                zb[sel],
             )
             np.add.at(out, owner[sel], val)
         split = np.flatnonzero(order == 0)

@@ -778,8 +778,13 @@ class PardisoSolver(SPDSolver):
         return np.ascontiguousarray(x)
 
     def close(self) -> None:
-        """Free PARDISO's internal memory for this handle (phase -1)."""
+        """Free PARDISO's internal memory for this handle (phase -1) and the stored pattern."""
         self._release()
+        self._upos = np.zeros(0, dtype=np.int64)
+        self._ia = np.zeros(1, dtype=np.int32)
+        self._ja = np.zeros(0, dtype=np.int32)
+        self._a = np.zeros(0)
+        self._n_eq = 0
         super().close()
 
     def __del__(self) -> None:

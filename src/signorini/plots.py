@@ -45,6 +45,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Polygon
+from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
 from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
@@ -416,6 +417,21 @@ def _loglog(ax: Any, ylabel: str) -> None:
     ax.set_ylabel(ylabel)
 
 
+def _tidy_log_ticks(ax: Any) -> None:
+    """Label only major ticks; below two decades add 2 and 5 times powers of ten as majors.
+
+    Matplotlib otherwise labels minor ticks on short log axes, and the labels overlap.
+    """
+    for axis, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+        if axis.get_scale() != "log":
+            continue
+        axis.set_minor_formatter(NullFormatter())
+        if lo > 0 and np.log10(hi / lo) < 2.0:
+            axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+            axis.set_major_formatter(LogFormatterSciNotation(
+                labelOnlyBase=False, minor_thresholds=(np.inf, np.inf)))
+
+
 def _plot_quantity(ax: Any, ndof: np.ndarray, values: np.ndarray, key: str, label: str,
                    **kw: Any) -> Any:
     style = STYLES[key]
@@ -474,6 +490,7 @@ def plot_error_and_estimator(history: HistoryLike, path: str | os.PathLike,
         ax.legend(loc="upper right")
         if title:
             ax.set_title(title)
+        _tidy_log_ticks(ax)
         return _save(fig, path)
 
 
@@ -531,6 +548,7 @@ def plot_efficiency(history: HistoryLike, path: str | os.PathLike,
         ax.legend(loc="lower right")
         if title:
             ax.set_title(title)
+        _tidy_log_ticks(ax)
         return _save(fig, path)
 
 
@@ -586,6 +604,7 @@ def plot_contributions(history: HistoryLike, path: str | os.PathLike,
         fig.legend(handles=handles, loc="outside lower center", ncols=2)
         if title:
             ax.set_title(title)
+        _tidy_log_ticks(ax)
         return _save(fig, path)
 
 
@@ -622,6 +641,7 @@ def plot_estimator(history: HistoryLike, path: str | os.PathLike,
         ax.legend(loc="upper right")
         if title:
             ax.set_title(title)
+        _tidy_log_ticks(ax)
         return _save(fig, path)
 
 
@@ -673,6 +693,7 @@ def plot_adaptive_vs_uniform(histories: Mapping[str, HistoryLike], path: str | o
         ax.legend(loc="best")
         if title:
             ax.set_title(title)
+        _tidy_log_ticks(ax)
         return _save(fig, path)
 
 
@@ -905,8 +926,9 @@ def plot_deformed(points: ArrayLike, cells: ArrayLike, displacement: ArrayLike,
             t, tlabel = _contact_coordinate(cp)
             order = np.argsort(t, kind="stable")
             st = STYLES["pressure"]
-            axp.plot(t[order], pr[order], color=st["color"], marker=st["marker"],
-                     markersize=2.5, label=st["label"])
+            axp.plot(t[order], pr[order], color=st["color"],
+                     marker=st["marker"] if t.size <= 80 else "", markersize=2.5,
+                     label=st["label"])
             axp.axhline(0.0, color="0.5", linewidth=0.6)
             axp.grid(True, linestyle="-")
             axp.set_xlabel(tlabel)

@@ -21,8 +21,8 @@ from .elasticity import (
     energy_error2,
     h1_seminorm_error2,
 )
-from .mesh import Mesh
 from .frames import rotate_frames, to_cartesian, to_frames
+from .mesh import Mesh
 from .pdas import PDASResult, solve_pdas
 from .problem import ContactProblem, Dirichlet, Neumann, evaluate_field
 from .space import P2Space

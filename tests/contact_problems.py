@@ -1,0 +1,183 @@
+"""Problems with known discrete solutions, and an independent assembly, for the solver tests.
+
+- :class:`Quadratic`: a quadratic displacement ``u_i = c_i + G_ij x_j + H_ijk x_j x_k / 2`` with
+  its gradient, stress and ``div σ`` in closed form, and its rotated copy.
+- :func:`patch_problem`: a :class:`~signorini.problem.ContactProblem` whose exact solution is
+  a given quadratic (the discrete solution must reproduce it at every node).
+- :func:`contact_patch_field`: a random quadratic with zero tangential and compressive normal
+  stress on the bottom edge ``y = 0`` (normal ``(0, −1)``), so that it solves a Signorini
+  problem with the gap ``ψ = u·n`` and every contact node active.
+- :func:`independent_system`: Cartesian ``K``, ``F`` and Dirichlet data assembled from the mesh
+  with :mod:`signorini.elasticity` only (no rotated frames, no :mod:`signorini.solve`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from signorini.elasticity import (
+    Material,
+    assemble_body_force,
+    assemble_edge_load,
+    assemble_stiffness,
+    stress,
+)
+from signorini.mesh import Mesh
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
+
+
+def rotation(angle_deg: float) -> np.ndarray:
+    """The 2 x 2 counter-clockwise rotation by ``angle_deg`` degrees."""
+    a = np.deg2rad(angle_deg)
+    return np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+
+
+@dataclass(frozen=True)
+class Quadratic:
+    """``u_i(x) = c_i + G_ij x_j + 1/2 H_ijk x_j x_k`` (``H`` symmetric in ``j, k``)."""
+
+    c: np.ndarray  # (2,)
+    G: np.ndarray  # (2, 2)
+    H: np.ndarray  # (2, 2, 2)
+
+    def value(self, x: np.ndarray) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        return (self.c + np.einsum("ij,...j->...i", self.G, x)
+                + 0.5 * np.einsum("ijk,...j,...k->...i", self.H, x, x))
+
+    def gradient(self, x: np.ndarray) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        return self.G + np.einsum("ijk,...k->...ij", self.H, x)
+
+    def div_stress(self, material: Material) -> np.ndarray:
+        """``(div σ(u))_i = (λ + μ) ∂_i div u + μ Δu_i`` (a constant vector)."""
+        grad_div = np.einsum("kki->i", self.H)
+        laplace = np.einsum("ikk->i", self.H)
+        return (material.lam + material.mu) * grad_div + material.mu * laplace
+
+    def rotated(self, R: np.ndarray) -> Quadratic:
+        """The field ``x ↦ R u(Rᵀ x)``."""
+        return Quadratic(R @ self.c, R @ self.G @ R.T,
+                         np.einsum("ia,abc,jb,kc->ijk", R, self.H, R, R))
+
+
+def random_quadratic(rng: np.random.Generator, scale: float = 1.0) -> Quadratic:
+    H = rng.standard_normal((2, 2, 2))
+    H = H + H.transpose(0, 2, 1)
+    return Quadratic(scale * rng.standard_normal(2), scale * rng.standard_normal((2, 2)),
+                     scale * H)
+
+
+def contact_patch_field(rng: np.random.Generator, material: Material,
+                        uniform: bool = False) -> Quadratic:
+    """A random quadratic with ``σ_12 = 0`` and ``σ_22 ≤ −1`` on the line ``y = 0``.
+
+    On ``y = 0``: ``∂_j u_i = G_ij + H_ij0 x``, so ``σ_12 = μ (G_01 + G_10 + (H_010 + H_100) x)``
+    and ``σ_22 = λ G_00 + (λ + 2μ) G_11 + (λ H_000 + (λ + 2μ) H_110) x``. With ``uniform`` the
+    normal stress (and so the contact pressure ``p = −σ_22``) is constant along the line.
+    """
+    lam, mu = material.lam, material.mu
+    q = random_quadratic(rng)
+    c, G, H = q.c.copy(), q.G.copy(), q.H.copy()
+    G[1, 0] = -G[0, 1]
+    H[1, 0, 0] = -H[0, 1, 0]
+    H[0, 0, 1] = H[0, 1, 0]  # keep H symmetric in its last two indices
+    slope = 0.0 if uniform else rng.uniform(-1.0, 1.0)
+    H[1, 1, 0] = H[1, 0, 1] = (slope - lam * H[0, 0, 0]) / (lam + 2 * mu)
+    intercept = -1.0 - abs(slope) - rng.uniform(0.0, 1.0)
+    G[1, 1] = (intercept - lam * G[0, 0]) / (lam + 2 * mu)
+    return Quadratic(c, G, H)
+
+
+def patch_problem(mesh: Mesh, material: Material, u: Quadratic, kinds: dict[str, str],
+                  normal: np.ndarray | None = None) -> ContactProblem:
+    """The problem solved by the quadratic ``u``: ``f = −div σ(u)``, ``g = σ(u) n`` on the parts
+    of kind ``"N"``, ``u_D = u`` on kind ``"D"``, and contact with ``ψ = u·n`` on kind ``"C"``.
+    """
+    f = -u.div_stress(material)
+
+    def traction(x, n):
+        sig = stress(material, u.gradient(x))
+        return np.einsum("...ij,...j->...i", sig, np.broadcast_to(n, x.shape))
+
+    conditions = {}
+    for name, kind in kinds.items():
+        if kind == "D":
+            conditions[name] = Dirichlet(u.value)
+        elif kind == "N":
+            conditions[name] = Neumann(traction)
+        else:
+            n = np.asarray(normal, dtype=float)
+            conditions[name] = Contact(gap=lambda x, n=n: u.value(x) @ n, normal=tuple(n))
+    return ContactProblem(mesh=mesh, material=material, conditions=conditions,
+                          body_force=lambda x: np.broadcast_to(f, x.shape), name="patch")
+
+
+@dataclass
+class System:
+    """Cartesian algebraic problem: ``K (n_dofs, n_dofs)``, ``F (n_dofs,)``, Dirichlet DOFs and
+    values, and the constrained nodes with their normals and gaps."""
+
+    K: object
+    F: np.ndarray
+    dirichlet: np.ndarray
+    dirichlet_values: np.ndarray
+    nodes: np.ndarray
+    normal: np.ndarray
+    gap: np.ndarray
+    node_points: np.ndarray
+
+
+def independent_system(problem: ContactProblem, mesh: Mesh) -> System:
+    """Assemble the discrete problem (3.2) in Cartesian DOFs from the mesh arrays alone."""
+    n_points = mesh.n_points
+    node_points = np.vstack([mesh.points, 0.5 * mesh.points[mesh.edges].sum(axis=1)])
+    n_dofs = 2 * len(node_points)
+    cell_nodes = np.hstack([mesh.cells, n_points + mesh.cell2edge])
+    cell_dofs = (2 * cell_nodes[:, :, None] + np.arange(2)).reshape(-1, 12)
+    vertices = mesh.points[mesh.cells]
+    K = assemble_stiffness(vertices, cell_dofs, n_dofs, problem.material)
+    F = np.zeros(n_dofs)
+    if problem.body_force is not None:
+        F += assemble_body_force(vertices, cell_dofs, n_dofs, problem.body_force, degree=8)
+
+    def part_nodes(name):
+        edges = mesh.part_edges(name)
+        ab = mesh.oriented_boundary(edges)
+        return edges, np.column_stack([ab, n_points + edges])
+
+    for name in problem.neumann_parts:
+        _, nodes = part_nodes(name)
+        g = problem.conditions[name].field()
+        dofs = (2 * nodes[:, :, None] + np.arange(2)).reshape(-1, 6)
+        F += assemble_edge_load(mesh.points[nodes[:, :2]], dofs, n_dofs, g, degree=8)
+    d_nodes = np.unique(np.concatenate([part_nodes(p)[1].ravel()
+                                        for p in problem.dirichlet_parts]))
+    d_vals = np.zeros((d_nodes.size, 2))
+    for name in problem.dirichlet_parts:
+        mine = np.isin(d_nodes, part_nodes(name)[1])
+        d_vals[mine] = np.broadcast_to(problem.conditions[name].field()(node_points[d_nodes[mine]]),
+                                       (int(mine.sum()), 2))
+    c_nodes, c_normal, c_gap = [], [], []
+    for name in problem.contact_parts:
+        edges, nodes = part_nodes(name)
+        d = mesh.points[nodes[:, 1]] - mesh.points[nodes[:, 0]]
+        n = np.array([d[0, 1], -d[0, 0]]) / np.hypot(*d[0])
+        nodes = np.setdiff1d(np.unique(nodes), d_nodes)
+        cond = problem.conditions[name]
+        gap = cond.gap(node_points[nodes]) if callable(cond.gap) else np.full(nodes.size,
+                                                                              cond.gap)
+        c_nodes.append(nodes)
+        c_normal.append(np.broadcast_to(n, (nodes.size, 2)))
+        c_gap.append(np.broadcast_to(gap, nodes.shape))
+    if c_nodes:
+        nodes = np.concatenate(c_nodes)
+        order = np.argsort(nodes)
+        nodes, normal, gap = (nodes[order], np.concatenate(c_normal)[order],
+                              np.concatenate(c_gap)[order])
+    else:
+        nodes, normal, gap = np.zeros(0, int), np.zeros((0, 2)), np.zeros(0)
+    dirichlet = np.column_stack([2 * d_nodes, 2 * d_nodes + 1]).ravel()
+    return System(K.tocsr(), F, dirichlet, d_vals.ravel(), nodes, normal, gap, node_points)
