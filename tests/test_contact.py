@@ -299,3 +299,19 @@ def test_material_checks():
     with pytest.raises(ProblemError, match="material must be a signorini Material"):
         ContactProblem(_square(), (1.0, 1.0), {"left": Dirichlet(), "top": Neumann(),
                                                "bottom": Neumann(), "right": Contact()})
+
+
+def test_contact_parts_meeting_at_a_corner():
+    pb = ContactProblem(_square(), MATERIAL, {"left": Dirichlet(), "top": Neumann(),
+                                              "bottom": Contact(), "right": Contact()})
+    with pytest.raises(ProblemError, match=r"node 2 at \[1\.0, 0\.0\] lies on contact parts "
+                                           "with different normals"):
+        solve(pb)
+
+
+def test_dirichlet_value_returning_nan():
+    pb = ContactProblem(_square(), MATERIAL, {
+        "left": Dirichlet(lambda x: np.full(x.shape, np.nan)), "top": Neumann(),
+        "bottom": Neumann(), "right": Contact()})
+    with pytest.raises(ProblemError, match="Dirichlet value of part 'left' returned NaN"):
+        solve(pb)

@@ -46,8 +46,7 @@ def no_neumann_problem() -> ContactProblem:
 
 
 def part_of_point(x: np.ndarray) -> str | None:
-    """Boundary side of the unit square a point lies on (``None`` inside or at a corner
-    shared with another side is resolved by the caller)."""
+    """Side of the unit square an edge midpoint lies on (``None`` inside)."""
     if abs(x[1]) < 1e-12:
         return "bottom"
     if abs(x[0] - 1) < 1e-12:
@@ -331,7 +330,7 @@ def test_eta6_against_quadrature():
         ref = reference_eta6(result)
         # clearances of the order of round-off at contact nodes give contributions ~1e-17
         atol = 1e-12 * result.density.max() * np.abs(result.u).max()
-        genuine += ref.max() > 1e6 * atol
+        genuine += ref.max() > 1e3 * atol
         print(f"6.2 ndof {result.ndof}: eta6^2 = {ref.sum():.6e} (quad), "
               f"{est.eta2_terms[5]:.6e} (estimator)")
         np.testing.assert_allclose(est.eta2_node[5], ref, rtol=1e-8, atol=atol)

@@ -175,6 +175,8 @@ def test_example_6_2_contact_zone_is_one_interval(levels_6_2):
     assert np.all(d_low <= spacing[:-1] + 1e-12) and np.all(d_low[-2:] <= 0.02)
     assert np.allclose(lows + highs, 1.0, atol=1e-12)  # symmetric mesh: exactly symmetric
     assert 0.16 < lows[-1] < 0.19
+    with pytest.raises(ValueError, match="example-6.2 has no exact solution"):
+        levels_6_2[0].errors()
 
 
 def test_example_6_2_solution_is_symmetric(levels_6_2):

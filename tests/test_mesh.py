@@ -97,6 +97,32 @@ def test_hanging_node() -> None:
         Mesh.from_arrays(p, c, ALL)
 
 
+@pytest.mark.parametrize("turn", [0.5 * np.pi, 0.3, 2.0])
+def test_hanging_node_in_any_direction(turn: float) -> None:
+    rot = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    p = np.array([[0, 0], [2, 0], [1, -1], [1, 0], [1, 1], [0, 1], [2, 1]], dtype=float)
+    c = [[0, 2, 1], [0, 3, 4], [3, 1, 4], [0, 4, 5], [1, 6, 4]]
+    with pytest.raises(MeshError, match=r"point 3 lies inside edge \(0, 1\) \(hanging node\)"):
+        Mesh.from_arrays(p @ rot.T + [5.0, -2.0], c, ALL)
+
+
+@pytest.mark.parametrize("pattern", ["unionjack", "crossed"])
+def test_bisecting_one_cell_alone_leaves_a_hanging_node(pattern: str) -> None:
+    # split each interior-edge cell in turn without touching its neighbour
+    m = rectangle(0, 1, 0, 2, nx=3, ny=3, pattern=pattern)
+    p = m.points @ np.array([[1.0, 0.4], [0.0, 1.0]]).T
+    interior = np.flatnonzero(m.edge2cell[m.cell2edge[:, 0], 1] >= 0)
+    assert interior.size > 10
+    for t in interior[::3]:
+        a, b, c = m.cells[t]
+        q = np.vstack([p, 0.5 * (p[a] + p[b])])
+        n = len(p)
+        cells = np.vstack([np.delete(m.cells, t, axis=0), [[c, a, n], [b, c, n]]])
+        lo, hi = sorted((a, b))
+        with pytest.raises(MeshError, match=rf"point {n} lies inside edge \({lo}, {hi}\)"):
+            Mesh.from_arrays(q, cells, ALL)
+
+
 def test_non_manifold_edge() -> None:
     # three cells on the edge (0, 1): one below, two above
     p = np.array([[0, 0], [1, 0], [0.5, 1], [0.5, -1], [0.2, 2]], dtype=float)
@@ -428,3 +454,13 @@ def test_min_angle_of_rectangle_cells() -> None:
 def test_repr_counts() -> None:
     m = rectangle(nx=2, ny=3)
     assert repr(m) == "Mesh(n_points=12, n_cells=12, parts=['bottom', 'right', 'top', 'left'])"
+
+
+@pytest.mark.parametrize(("nx", "ny"), [(20_000, 1), (1, 20_000)])
+def test_long_boundary_validates(nx: int, ny: int) -> None:
+    # 40 000 boundary edges: the hanging-node check must not compare all pairs
+    m = rectangle(0, nx, 0, ny, nx=nx, ny=ny, pattern="left")
+    assert len(m.boundary) == 2 * (nx + ny)
+    assert m.part_length("bottom") == pytest.approx(nx, rel=1e-12)
+    assert m.part_length("left") == pytest.approx(ny, rel=1e-12)
+    assert m.area.sum() == pytest.approx(nx * ny, rel=1e-12)

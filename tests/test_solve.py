@@ -236,7 +236,8 @@ def test_agrees_with_scipy_trust_constr(name):
     out = minimize(lambda x: 0.5 * x @ (K1 @ x) - b1 @ x, np.zeros(K.shape[0]),
                    jac=lambda x: K1 @ x - b1, hess=lambda x: K1, method="trust-constr",
                    constraints=[LinearConstraint(B, -np.inf, S.gap)],
-                   options={"gtol": 1e-12, "xtol": 1e-14, "maxiter": 3000})
+                   options={"gtol": 1e-12, "xtol": 1e-14, "barrier_tol": 1e-13,
+                            "maxiter": 3000})
     x = x_d.copy()
     x[free] = out.x
     diff = np.abs(x - r.u.ravel()).max() / np.abs(r.u).max()

@@ -219,3 +219,13 @@ def test_prolongate_rejects_wrong_size():
     ref = refine_uniform(mesh)
     with pytest.raises(ValueError, match="u has 8 nodes, the space has 9"):
         space.prolongate(np.zeros((8, 2)), ref)
+
+
+def test_prolongate_rejects_a_refinement_of_another_mesh():
+    space = P2Space(rectangle(nx=2, ny=2))
+    u = np.zeros((space.n_nodes, 2))
+    with pytest.raises(ValueError, match="not a refinement of this space's mesh"):
+        space.prolongate(u, refine_uniform(rectangle(nx=4, ny=4)))  # more cells
+    # same points and cell count, other diagonals: caught geometrically
+    with pytest.raises(ValueError, match="not inside its parent cell"):
+        space.prolongate(u, refine_uniform(rectangle(nx=2, ny=2, pattern="right")))

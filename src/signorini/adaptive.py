@@ -159,9 +159,10 @@ def adaptive(
             if not last and warm_start:
                 u0 = result.space.prolongate(result.u, refinement)
             record.t_refine = time.perf_counter() - t0
-            record.n_marked = int(marked.sum())
             if last:
-                marked = None
+                marked = None  # the budget ends the run: this marking is discarded
+            else:
+                record.n_marked = int(marked.sum())
         log.info("level %d: ndof=%d eta=%.4e pdas=%d", level, record.ndof, record.eta,
                  record.pdas_iterations)
         yield Level(record, result, est, marked)

@@ -65,6 +65,10 @@ def _progress(level: Level) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    if not args.uniform and not 0 < args.theta <= 1:
+        raise ValueError(f"--theta must lie in (0, 1], got {args.theta}")
+    if args.max_ndof <= 0:
+        raise ValueError(f"--max-ndof must be positive, got {args.max_ndof}")
     problem = get_example(args.example)
     out: Path = args.out or Path("results") / args.example
     out.mkdir(parents=True, exist_ok=True)

@@ -20,12 +20,14 @@ with Hooke's law (2.1) ``sigma(v) = lam tr(eps(v)) I + 2 mu eps(v)`` (the paper'
 Assembly
 --------
 The stiffness matrix is assembled at the level of nodes: every pair of nodes
-that share a cell gets one full 2x2 block.  The node-pair pattern is found with
-two stable counting sorts (a least-significant-digit radix sort on
-``(row node, column node)``), the blocks are summed by one sparse product, and
-the block matrix is expanded to scalar CSR.  The result has sorted indices and
+that share a cell gets one full 2x2 block.  The two entries of each block row
+are packed into one complex number, SciPy's COO -> CSR conversion sums the
+duplicates of the resulting (scalar row, node column) matrix, and its data,
+viewed as float64, are the scalar CSR data.  The result has sorted indices and
 a node-block pattern: rows ``2 z`` and ``2 z + 1`` have identical column
 patterns, and columns ``2 w``, ``2 w + 1`` are adjacent (explicit zeros kept).
+At 1.6 M unknowns this takes less memory and time than converting the 144
+scalar entries per cell directly, or sorting node pairs with ``np.unique``.
 """
 
 from __future__ import annotations
@@ -345,33 +347,24 @@ def _cell_nodes(cell_dofs: np.ndarray) -> np.ndarray:
     return ev // 2
 
 
-def _counting_sort(
-    keys: np.ndarray, n_keys: int, positions: np.ndarray, ones: np.ndarray
-) -> np.ndarray:
-    """Stable argsort of non-negative integer ``keys < n_keys`` (a counting sort).
-
-    The pairs ``(key, position)`` are converted to CSR with ``positions =
-    arange(keys.size)``: a CSR matrix in canonical form lists every row's
-    columns in increasing order, i.e. each key's entries by original position.
-    ``ones`` is any array of the same length (the unused values).
-    """
-    mat = sp.csr_matrix((ones, (keys, positions)), shape=(n_keys, keys.size))
-    if not mat.has_sorted_indices:  # canonical form has them; make sure
-        mat.sort_indices()
-    return mat.indices
-
-
 def _assemble_node_blocks(
     cell_nodes: np.ndarray, n_nodes: int, blocks: np.ndarray
 ) -> sp.csr_matrix:
     """Assemble per-cell 2x2 node blocks into a scalar CSR with node-block pattern.
 
+    Each row ``(b_i0, b_i1)`` of a 2x2 block is packed into one complex number
+    ``b_i0 + 1j b_i1``, and the complex matrix with rows ``2 z + i`` (scalar rows)
+    and columns ``w`` (nodes) is built by SciPy's COO -> CSR conversion, which
+    sums duplicates.  Viewed as float64, its data are exactly the scalar CSR data
+    with columns ``2 w, 2 w + 1``; so every coupled node pair gets its full 2x2
+    block, with no further copy of the values.
+
     Parameters
     ----------
-    cell_nodes : ndarray of int64, shape (m, k)
+    cell_nodes : ndarray of int, shape (m, k)
         Global node numbers of the ``k`` local nodes of each cell.
     n_nodes : int
-    blocks : ndarray of float64, shape (m, k, k, 2, 2)
+    blocks : ndarray of float64, shape (m, k, k, 2, 2), C-contiguous
         ``blocks[c, a, b, i, j]`` is added to entry ``(2 z_a + i, 2 z_b + j)``.
 
     Returns
@@ -380,42 +373,28 @@ def _assemble_node_blocks(
         Sorted indices; full 2x2 block for every coupled node pair.
     """
     m, k = cell_nodes.shape
-    n_pairs = m * k * k
     n_dofs = 2 * n_nodes
-    if n_pairs == 0:
-        return sp.csr_matrix((n_dofs, n_dofs))
-    idx = np.int32 if max(n_pairs, n_dofs) < np.iinfo(np.int32).max - 4 else np.int64
+    n_entries = 2 * m * k * k
+    idx = np.int32 if max(n_entries, n_dofs) < np.iinfo(np.int32).max // 2 else np.int64
     nodes = cell_nodes.astype(idx, copy=False)
-    row = np.repeat(nodes, k, axis=1).ravel()
-    col = np.tile(nodes, (1, k)).ravel()
-    # LSD radix sort of the pairs on (row, col): stable by col, then stable by row
-    positions = np.arange(n_pairs, dtype=idx)
-    ones = np.ones(n_pairs, dtype=np.int8)
-    perm = _counting_sort(col, n_nodes, positions, ones)
-    perm = perm[_counting_sort(row[perm], n_nodes, positions, ones)]
-    del positions, ones
-    rs = row[perm]
-    cs = col[perm]
-    new = np.empty(n_pairs, dtype=bool)
-    new[0] = True
-    np.not_equal(rs[1:], rs[:-1], out=new[1:])
-    new[1:] |= cs[1:] != cs[:-1]
-    starts = np.flatnonzero(new)
-    n_blocks = starts.size
-    block_rows = rs[starts]
-    block_cols = cs[starts]
-    node_ptr = np.zeros(n_nodes + 1, dtype=idx)
-    np.cumsum(np.bincount(block_rows, minlength=n_nodes), out=node_ptr[1:])
-    # sum the contributions of each node pair: (n_blocks x n_pairs) 0/1 matrix times values
-    group_ptr = np.empty(n_blocks + 1, dtype=idx)
-    group_ptr[:-1] = starts
-    group_ptr[-1] = n_pairs
-    summation = sp.csr_matrix((np.ones(n_pairs), perm, group_ptr), shape=(n_blocks, n_pairs))
-    summed = summation @ blocks.reshape(n_pairs, 4)
-    bsr = sp.bsr_matrix(
-        (summed.reshape(n_blocks, 2, 2), block_cols, node_ptr), shape=(n_dofs, n_dofs)
+    packed = np.ascontiguousarray(blocks, dtype=np.float64).reshape(-1, 2)
+    packed = packed.view(np.complex128).reshape(-1)  # (c, a, b, i): b_i0 + 1j b_i1
+    rows = np.empty((m, k, k, 2), dtype=idx)
+    rows[..., 0] = 2 * nodes[:, :, None]
+    rows[..., 1] = rows[..., 0] + 1
+    cols = np.broadcast_to(nodes[:, None, :, None], (m, k, k, 2)).reshape(-1)
+    half = sp.csr_matrix((packed, (rows.reshape(-1), cols)), shape=(n_dofs, n_nodes))
+    del rows, cols
+    half.sum_duplicates()  # canonical: summed duplicates, sorted indices
+    if not half.has_sorted_indices:
+        half.sort_indices()
+    indices = np.empty((half.nnz, 2), dtype=half.indices.dtype)
+    np.multiply(half.indices, 2, out=indices[:, 0])
+    np.add(indices[:, 0], 1, out=indices[:, 1])
+    data = np.ascontiguousarray(half.data[: half.nnz]).view(np.float64)
+    out = sp.csr_matrix(
+        (data, indices.reshape(-1), 2 * half.indptr), shape=(n_dofs, n_dofs), copy=False
     )
-    out = bsr.tocsr()
     out.has_sorted_indices = True
     return out
 
@@ -731,24 +710,29 @@ def div_stress(vertices: np.ndarray, u_cell: np.ndarray, material: Material) -> 
 # ---------------------------------------------------------------------------
 
 
-def _error_points(vertices: np.ndarray, u_cell: np.ndarray, degree: int):
+def _error_setup(vertices, u_cell, degree):
     J, det = p2.jacobian(vertices)
-    u = p2._check_u_cell(u_cell, J.shape[0]).reshape(-1, 6, 2)
-    jit = p2.inverse_transpose(J, det)
+    u = p2._check_u_cell(u_cell, J.shape[0])
     xi, w = triangle_rule(degree)
-    x = p2.physical_points(vertices, xi)
-    return u, jit, det, xi, w, x
+    v0 = np.asarray(vertices, dtype=np.float64)[:, 0]
+
+    def point(p: int) -> np.ndarray:  # physical images of quadrature point p, (m, 2)
+        return v0 + J[:, :, 0] * xi[p, 0] + J[:, :, 1] * xi[p, 1]
+
+    return u, J, det, xi, w, point
 
 
 def _grad_error_loop(vertices, u_cell, grad_exact, degree, density):
-    """Sum over quadrature points of density(grad u - grad u_h) * w * det."""
-    u, jit, det, xi, w, x = _error_points(vertices, u_cell, degree)
-    gref = p2.grad_basis(xi)  # (q, 6, 2)
+    """Sum over quadrature points of density(grad u - grad u_h) * w * det, per cell."""
+    u, J, det, xi, w, point = _error_setup(vertices, u_cell, degree)
+    coef = p2.gradient_coefficients(u, p2.inverse_transpose(J, det))  # (m, 3, 2, 2)
     out = np.zeros(det.shape[0])
     for p in range(w.size):
-        gh = np.einsum("mik,mjk->mij", np.einsum("mai,ak->mik", u, gref[p]), jit)
-        ge = _call_checked(grad_exact, "grad_exact", gh.shape, x[:, p])
-        out += w[p] * density(ge - gh)
+        ge = _call_checked(grad_exact, "grad_exact", coef.shape[:1] + (2, 2), point(p))
+        diff = ge - coef[:, 0]
+        diff -= xi[p, 0] * coef[:, 1]
+        diff -= xi[p, 1] * coef[:, 2]
+        out += w[p] * density(diff)
     return out * det
 
 
@@ -837,12 +821,12 @@ def l2_error2(
     -------
     ndarray of float64, shape (m,)
     """
-    u, _, det, xi, w, x = _error_points(vertices, u_cell, degree)
-    phi = p2.basis(xi)
+    u, _, det, xi, w, point = _error_setup(vertices, u_cell, degree)
+    # u_h at all points: (m, 2, 6) @ (6, q) -> (m, 2, q)
+    uh = np.matmul(np.swapaxes(u.reshape(-1, 6, 2), 1, 2), p2.basis(xi).T)
     out = np.zeros(det.shape[0])
     for p in range(w.size):
-        uh = np.einsum("a,mai->mi", phi[p], u)
-        ue = _call_checked(u_exact, "u_exact", uh.shape, x[:, p])
-        d = ue - uh
+        ue = _call_checked(u_exact, "u_exact", uh.shape[:2], point(p))
+        d = ue - uh[:, :, p]
         out += w[p] * np.einsum("mi,mi->m", d, d)
     return out * det

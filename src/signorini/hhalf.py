@@ -1,23 +1,24 @@
-"""The H^{1/2}(Γ_C) norm of the positive part of a piecewise quadratic (estimator term η7).
+r"""The H^{1/2}(Γ_C) norm of the positive part of a piecewise quadratic (estimator term η7).
 
 The last contribution of the residual estimator (Section 5, the definition of
-η7 before (5.1), and Section 6 for a non-zero gap) is
+η7 before (5.1); Section 6 for a non-zero gap) is
 
 .. math::
 
-    \\eta_7^2 = \\|v\\|^2_{H^{1/2}(\\Gamma_C)}, \\qquad v = (u_h \\cdot n - \\psi)^+,
+    \eta_7^2 = \|v\|^2_{H^{1/2}(\Gamma_C)}, \qquad v = (u_h \cdot n - \psi)^+,
 
 with the Sobolev-Slobodeckij norm
 
 .. math::
 
-    \\|v\\|^2_{H^{1/2}(\\Gamma_C)} = \\|v\\|^2_{L^2(\\Gamma_C)}
-        + \\int_{\\Gamma_C}\\int_{\\Gamma_C} \\frac{(v(x) - v(y))^2}{|x - y|^2}
-          \\, ds_x \\, ds_y .
+    \|v\|^2_{H^{1/2}(\Gamma_C)} = \|v\|^2_{L^2(\Gamma_C)}
+        + \int_{\Gamma_C}\int_{\Gamma_C} \frac{(v(x) - v(y))^2}{|x - y|^2}
+          \, ds_x \, ds_y .
 
 Γ_C is given as a list of straight edges ``x0 -> x1`` carrying a quadratic
 ``w`` (values at start, midpoint, end); ``v = max(w, 0)``.  Nothing else about
-the mesh is needed.
+the mesh is needed.  The edges may lie on several straight segments, connected
+or not, but must not cross or overlap (that is detected and reported).
 
 Method (exact up to quadrature round-off, cost driven by the support of v):
 
@@ -25,21 +26,25 @@ Method (exact up to quadrature round-off, cost driven by the support of v):
   polynomial on each piece.  ``S`` is the set of pieces where ``v = w > 0``;
   the rest of Γ_C is merged into maximal straight *zero runs*.
 * The double integral splits into ``∫_S∫_S`` plus
-  ``2 ∫_S v(x)^2 (∫_{Γ_C \\ S} |x - y|^{-2} ds_y) ds_x``.  The inner integral
-  over a straight run is analytic: ``L θ / |(a - x) × (b - x)|`` with ``θ`` the
-  angle the run ``[a, b]`` subtends at ``x`` (which reduces to
-  ``1/(ξ - L) - 1/ξ`` for collinear points).
+  ``2 ∫_S v(x)^2 (∫_{Γ_C \ S} |x - y|^{-2} ds_y) ds_x``.  The inner integral
+  over a straight run ``[a, b]`` is analytic: ``L θ / |(a - x) × (b - x)|``
+  with ``θ`` the angle the run subtends at ``x`` (``1/(ξ - L) - 1/ξ`` for
+  collinear points, evaluated without cancellation).
 * Pairs of pieces of the same edge (same quadratic) use the divided difference
   ``(w(s) - w(s')) / (s - s') = b + c (s + s')``, a polynomial: a 2 x 2
   Gauss rule is exact.
 * Pairs of pieces of different edges are integrated by a vectorized
   hierarchical scheme: well separated panel pairs use tensor Gauss rules whose
   order depends on the separation; panels sharing an end point use a Duffy
-  transformation that makes the integrand smooth; all other pairs are
-  subdivided.  Pieces next to a zero run are subdivided until the run is long
-  compared with the panel; there ``v^2 / t`` is a polynomial and
-  ``t ∫_Z |x - y|^{-2}`` is analytic (``t`` = distance to the common point),
-  so a Gauss rule converges geometrically.
+  transformation that removes the non-smoothness at the common point (its
+  angular order follows from the poles of the transformed integrand); all
+  other pairs are subdivided.  A piece next to a zero run is subdivided until
+  the run is long compared with the panel; there ``v^2 / t`` is a polynomial
+  and ``t ∫_Z |x - y|^{-2}`` is analytic (``t`` = distance to the common
+  point), so a Gauss rule converges geometrically.
+
+Cost: O(k) vectorized work to find S and the runs (k = number of edges), then
+O(|S|^2 + |S| r) panel pairs (r = number of zero runs), processed in blocks.
 
 Per-edge shares ``eta2_edge`` sum to the total: the L² term and the zero-run
 term (both functions of ``x`` alone once the ``y`` integral is done
@@ -874,31 +879,29 @@ def _l2_from_pieces(pc: PositivePartPieces) -> np.ndarray:
 
 
 def _seminorm_from_pieces(pc: PositivePartPieces) -> tuple[float, np.ndarray]:
+    """Squared seminorm and its per-edge shares (see the module notes)."""
     k, m = pc.n_edges, pc.n_pieces
-    eta2 = np.zeros(k)
     if m == 0:
-        return 0.0, eta2
+        return 0.0, np.zeros(k)
+    share = np.zeros(m)  # per piece of S
     # pieces of the same edge (exact)
     ii, jj, mult = _same_edge_pairs(pc)
-    val = mult * _same_edge_integral(pc, ii, jj)
-    eta2 += np.bincount(pc.edge[ii], weights=val, minlength=k)
-    # pieces of different edges: each unordered pair counted twice, half to each edge
+    share += np.bincount(ii, weights=mult * _same_edge_integral(pc, ii, jj), minlength=m)
+    # pieces of different edges: each unordered pair counted twice, half to each piece
     for ii, jj in _upper_pair_blocks(m, _BLOCK):
         keep = pc.edge[ii] != pc.edge[jj]
         ii, jj = ii[keep], jj[keep]
         if ii.size == 0:
             continue
         val = _cross_edge_block(pc, ii, jj)
-        eta2 += np.bincount(pc.edge[ii], weights=val, minlength=k)
-        eta2 += np.bincount(pc.edge[jj], weights=val, minlength=k)
-    # S x (Γ_C \ S), both orders, to the edge of the piece
+        share += np.bincount(ii, weights=val, minlength=m)
+        share += np.bincount(jj, weights=val, minlength=m)
+    # S x (Γ_C \ S), both orders, to the piece in S
     r = pc.n_runs
-    total = m * r
-    for start in range(0, total, _BLOCK):
-        lin = np.arange(start, min(start + _BLOCK, total))
-        ip, iz = np.divmod(lin, r)
-        val = 2.0 * _zero_run_block(pc, ip, iz)
-        eta2 += np.bincount(pc.edge[ip], weights=val, minlength=k)
+    for start in range(0, m * r, _BLOCK):
+        ip, iz = np.divmod(np.arange(start, min(start + _BLOCK, m * r)), r)
+        share += np.bincount(ip, weights=2.0 * _zero_run_block(pc, ip, iz), minlength=m)
+    eta2 = np.bincount(pc.edge, weights=share, minlength=k)
     return float(eta2.sum()), eta2
 
 
@@ -970,8 +973,8 @@ def hhalf_norm2_positive_part(x0, x1, w) -> tuple[float, np.ndarray]:
     Raises
     ------
     ValueError
-        On malformed input, zero-length edges, or a jump of ``max(w, 0)`` at a
-        shared end point.
+        On malformed input, zero-length edges, a jump of ``max(w, 0)`` at a
+        shared end point, or edges that cross or overlap where v > 0.
     """
     pc = positive_part_pieces(x0, x1, w)
     _, eta2 = _seminorm_from_pieces(pc)

@@ -6,6 +6,7 @@ so an interrupted run never leaves a half-written file behind.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io as _io
 import math
@@ -28,6 +29,10 @@ def atomic_write(path: str | os.PathLike, data: bytes) -> Path:
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as fh:
+            # mkstemp makes the file private (0o600); give it the mode open() would
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
@@ -148,10 +153,14 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
     path = Path(path)
     if not path.is_file():
         raise MeshError(f"no mesh file at {path}")
+    said = _io.StringIO()
     try:
-        m = meshio.read(path)
-    except Exception as exc:  # meshio raises many types for foreign files
-        raise MeshError(f"{path} is not a mesh file meshio can read: {exc}") from None
+        # meshio prints its diagnostics and calls sys.exit() on some foreign files
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            m = meshio.read(path)
+    except (Exception, SystemExit) as exc:  # meshio raises many types for foreign files
+        detail = " ".join(said.getvalue().split()) if isinstance(exc, SystemExit) else exc
+        raise MeshError(f"{path} is not a mesh file meshio can read: {detail}") from None
     tri = [(i, b) for i, b in enumerate(m.cells) if b.type in ("triangle", "triangle6")]
     if not tri:
         raise MeshError(f"{path} contains no triangles")

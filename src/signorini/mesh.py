@@ -367,25 +367,38 @@ class Mesh:
                             f"({e[0]}, {e[1]})")
         bnd = np.flatnonzero(is_bnd)
         verts = np.unique(self.edges[bnd])
-        if bnd.size * verts.size > 5e7:  # hanging nodes on huge meshes: check in chunks
-            chunks = np.array_split(bnd, int(bnd.size * verts.size / 5e7) + 1)
-        else:
-            chunks = [bnd]
-        for chunk in chunks:
-            a = self.points[self.edges[chunk, 0]][:, None, :]
-            b = self.points[self.edges[chunk, 1]][:, None, :]
-            p = self.points[verts][None, :, :]
-            ab = b - a
-            length2 = (ab**2).sum(-1)
-            t = ((p - a) * ab).sum(-1) / length2
-            cross = ab[..., 0] * (p - a)[..., 1] - ab[..., 1] * (p - a)[..., 0]
-            tol = 1e-10
-            on = (np.abs(cross) <= tol * length2) & (t > tol) & (t < 1 - tol)
-            if on.any():
-                i, j = np.argwhere(on)[0]
-                e = self.edges[chunk[i]]
-                raise MeshError(f"non-conforming mesh: point {verts[j]} lies inside edge "
-                                f"({e[0]}, {e[1]}) (hanging node)")
+        a = self.points[self.edges[bnd, 0]]
+        b = self.points[self.edges[bnd, 1]]
+        tol = 1e-10
+        margin = 1e-9 * np.hypot(*(b - a).T)
+        # candidates of each edge: the boundary vertices inside its bounding box, found by
+        # sorting along the axis in which the box holds fewer (near-linear, not all pairs)
+        first, count, by_axis = [], [], []
+        for axis in range(2):
+            order = verts[np.argsort(self.points[verts, axis], kind="stable")]
+            coord = self.points[order, axis]
+            lo = np.searchsorted(coord, np.minimum(a[:, axis], b[:, axis]) - margin, "left")
+            hi = np.searchsorted(coord, np.maximum(a[:, axis], b[:, axis]) + margin, "right")
+            first.append(lo)
+            count.append(hi - lo)
+            by_axis.append(order)
+        use_y = count[1] < count[0]
+        n_cand = np.where(use_y, count[1], count[0])
+        edge_of = np.repeat(np.arange(bnd.size), n_cand)
+        pos = np.where(use_y, first[1], first[0])[edge_of] + (
+            np.arange(edge_of.size) - np.repeat(np.cumsum(n_cand) - n_cand, n_cand))
+        cand = np.where(use_y[edge_of], by_axis[1][pos], by_axis[0][pos])
+        ab = (b - a)[edge_of]
+        ap = self.points[cand] - a[edge_of]
+        length2 = (ab**2).sum(-1)
+        t = (ap * ab).sum(-1) / length2
+        cross = ab[:, 0] * ap[:, 1] - ab[:, 1] * ap[:, 0]
+        on = (np.abs(cross) <= tol * length2) & (t > tol) & (t < 1 - tol)
+        if on.any():
+            i = np.flatnonzero(on)[0]
+            e = self.edges[bnd[edge_of[i]]]
+            raise MeshError(f"non-conforming mesh: point {cand[i]} lies inside edge "
+                            f"({e[0]}, {e[1]}) (hanging node)")
 
 
 # ---------------------------------------------------------------------- helpers

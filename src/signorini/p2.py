@@ -33,6 +33,7 @@ __all__ = [
     "field_gradients",
     "field_hessian",
     "field_values",
+    "gradient_coefficients",
     "grad_basis",
     "hessian_basis",
     "inverse_transpose",
@@ -262,8 +263,13 @@ def physical_points(vertices: np.ndarray, xi: np.ndarray) -> np.ndarray:
         ``x = v0 + J xi``.
     """
     v = _check_vertices(vertices)
-    lam = _barycentric(_as_points(xi))
-    return np.einsum("qk,mkd->mqd", lam, v)
+    xi = _as_points(xi)
+    v0 = v[:, None, 0, :]
+    return (
+        v0
+        + xi[None, :, 0, None] * (v[:, None, 1, :] - v0)
+        + xi[None, :, 1, None] * (v[:, None, 2, :] - v0)
+    )
 
 
 def physical_gradients(vertices: np.ndarray, xi: np.ndarray) -> np.ndarray:
@@ -348,16 +354,53 @@ def field_gradients(vertices: np.ndarray, u_cell: np.ndarray, xi: np.ndarray) ->
         ``grad[c, p, i, j] = d u_i / d x_j``.
     """
     J, det = jacobian(vertices)
-    u = _check_u_cell(u_cell, J.shape[0]).reshape(-1, 6, 2)
-    jit = inverse_transpose(J, det)
+    u = _check_u_cell(u_cell, J.shape[0])
     xi = _cell_points(xi, J.shape[0])
-    # reference gradient of u: (m, q, i, k), then map with J^{-T}
+    coef = gradient_coefficients(u, inverse_transpose(J, det))  # (m, 3, 2, 2)
     if xi.ndim == 3:
-        g = grad_basis(xi.reshape(-1, 2)).reshape(xi.shape[0], xi.shape[1], 6, 2)
-        gref = np.einsum("mai,mqak->mqik", u, g)
-    else:
-        gref = np.einsum("mai,qak->mqik", u, grad_basis(xi))
-    return np.einsum("mqik,mjk->mqij", gref, jit)
+        return (
+            coef[:, None, 0]
+            + xi[:, :, 0, None, None] * coef[:, None, 1]
+            + xi[:, :, 1, None, None] * coef[:, None, 2]
+        )
+    return (
+        coef[:, None, 0]
+        + xi[None, :, 0, None, None] * coef[:, None, 1]
+        + xi[None, :, 1, None, None] * coef[:, None, 2]
+    )
+
+
+def gradient_coefficients(u_cell: np.ndarray, inv_t: np.ndarray) -> np.ndarray:
+    """Affine coefficients of the (linear) gradient of a P2 field on each cell.
+
+    On a straight triangle ``grad u_h(x(xi)) = G0 + xi_1 G1 + xi_2 G2``.
+
+    Parameters
+    ----------
+    u_cell : ndarray of float64, shape (m, 12)
+        Interleaved local coefficients.
+    inv_t : ndarray of float64, shape (m, 2, 2)
+        ``J^{-T}`` of each cell (:func:`inverse_transpose`).
+
+    Returns
+    -------
+    ndarray of float64, shape (m, 3, 2, 2)
+        ``[G0, G1, G2]`` with ``G[..., i, j]`` multiplying ``d u_i / d x_j``.
+    """
+    u = np.asarray(u_cell, dtype=np.float64).reshape(-1, 6, 2)
+    jit = np.asarray(inv_t, dtype=np.float64)
+    # reference gradient = ref[0] + xi_1 ref[1] + xi_2 ref[2], ref (3, 6, 2)
+    ref = grad_basis(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]))
+    ref[1:] -= ref[0]
+    # d u_i / d xi_k of each coefficient c: dref[m, i, c, k] = sum_a u[m, a, i] ref[c, a, k]
+    dref = np.tensordot(u, ref, axes=([1], [1]))  # (m, 2, 3, 2)
+    # physical: d u_i / d x_j = sum_k dref[..., k] Jit[j, k]
+    out = np.empty((u.shape[0], 3, 2, 2))
+    for j in range(2):
+        out[:, :, :, j] = np.swapaxes(
+            dref[..., 0] * jit[:, None, None, j, 0] + dref[..., 1] * jit[:, None, None, j, 1], 1, 2
+        )
+    return out
 
 
 def field_hessian(vertices: np.ndarray, u_cell: np.ndarray) -> np.ndarray:

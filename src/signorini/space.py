@@ -109,18 +109,31 @@ class P2Space:
         Returns
         -------
         (n_nodes_new, 2) or (n_nodes_new,) array
+
+        Raises
+        ------
+        ValueError
+            If ``u`` does not have one row per node, or ``refinement`` is not a refinement of
+            this space's mesh.
         """
         u = np.asarray(u, dtype=np.float64)
         if u.shape[0] != self.n_nodes:
             raise ValueError(f"u has {u.shape[0]} nodes, the space has {self.n_nodes}")
         fine = P2Space(refinement.mesh)
-        parent = refinement.parent
+        parent = np.asarray(refinement.parent)
+        if parent.shape != (fine.mesh.n_cells,) or (
+                parent.size and (parent.min() < 0 or parent.max() >= self.mesh.n_cells)):
+            raise ValueError("the refinement is not a refinement of this space's mesh (its parent "
+                             f"cells do not index the {self.mesh.n_cells} cells)")
         P = self.vertices[parent]  # (m, 3, 2)
         X = fine.node_points[fine.cell_nodes]  # (m, 6, 2)
         J = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=-1)  # columns
         rhs = (X - P[:, None, 0, :]).transpose(0, 2, 1)  # (m, 2, 6)
         xi = np.linalg.solve(J, rhs).transpose(0, 2, 1)  # (m, 6, 2)
         bary = np.concatenate([1 - xi.sum(-1, keepdims=True), xi], axis=-1)
+        if bary.min(initial=0.0) < -1e-8:
+            raise ValueError("the refinement is not a refinement of this space's mesh (a new "
+                             "cell is not inside its parent cell)")
         phi = p2_from_barycentric(bary)  # (m, 6, 6): new local node, parent local node
         coarse = u[self.cell_nodes[parent]]  # (m, 6) or (m, 6, 2)
         if u.ndim == 1:
