@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -157,12 +158,12 @@ def test_argument_errors_exit_2(argv, message, capsys):
     [
         (["--theta", "0"], "theta"),
         (["--theta", "nan"], "theta"),
-        (["--max-ndof", "10"], "max_ndof"),
-        (["--max-ndof", "-5"], "max_ndof"),
+        (["--max-ndof", "10"], "max[-_]ndof"),
+        (["--max-ndof", "-5"], "max[-_]ndof"),
     ],
 )
 def test_invalid_values_exit_nonzero(tmp_path, capsys, argv, message):
     code = main(["run", "example-6.2", "--out", str(tmp_path / "x"), "--no-figures", *argv])
     err = capsys.readouterr().err
     assert code != 0
-    assert err.startswith("signorini: error:") and message in err
+    assert err.startswith("signorini: error:") and re.search(message, err)

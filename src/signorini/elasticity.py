@@ -671,6 +671,8 @@ def edge_traction(
         Outward unit normals of those edges.
     """
     v = np.asarray(vertices, dtype=np.float64)
+    if v.ndim != 3 or v.shape[1:] != (3, 2):
+        raise ValueError(f"vertices must have shape (n_cells, 3, 2), got {v.shape}")
     le = np.asarray(local_edge)
     if le.shape != (v.shape[0],):
         raise ValueError(f"local_edge must have shape ({v.shape[0]},), got {le.shape}")

@@ -385,7 +385,7 @@ def gradient_coefficients(u_cell: np.ndarray, inv_t: np.ndarray) -> np.ndarray:
     Returns
     -------
     ndarray of float64, shape (m, 3, 2, 2)
-        ``[G0, G1, G2]`` with ``G[..., i, j]`` multiplying ``d u_i / d x_j``.
+        ``[G0, G1, G2]``; entry ``[i, j]`` of each is a coefficient of ``d u_i / d x_j``.
     """
     u = np.asarray(u_cell, dtype=np.float64).reshape(-1, 6, 2)
     jit = np.asarray(inv_t, dtype=np.float64)
@@ -421,5 +421,6 @@ def field_hessian(vertices: np.ndarray, u_cell: np.ndarray) -> np.ndarray:
     J, det = jacobian(vertices)
     u = _check_u_cell(u_cell, J.shape[0]).reshape(-1, 6, 2)
     jit = inverse_transpose(J, det)
-    href = np.einsum("mai,ars->mirs", u, hessian_basis())
-    return np.einsum("mirs,mjr,mks->mijk", href, jit, jit)
+    href = np.tensordot(u, hessian_basis(), axes=([1], [0]))  # (m, i, r, s)
+    # H_i = J^{-T} href_i J^{-1}
+    return np.matmul(np.matmul(jit[:, None], href), np.swapaxes(jit, 1, 2)[:, None])
