@@ -632,9 +632,11 @@ _PARDISO_ERRORS = {
 @lru_cache(maxsize=1)
 def _pardiso_function() -> Callable[..., None]:
     """The ``pardiso`` symbol of MKL's runtime library (located by ``pypardiso``)."""
-    import pypardiso  # optional dependency, imported on demand
+    # optional dependency, imported on demand; its module-level solver has already located
+    # MKL's runtime library (a directory search that takes about a second), so reuse it
+    from pypardiso.scipy_aliases import pypardiso_solver
 
-    located = pypardiso.PyPardisoSolver().libmkl
+    located = pypardiso_solver.libmkl
     lib = ctypes.CDLL(located._name)
     func = lib.pardiso
     i32p = ctypes.POINTER(ctypes.c_int32)

@@ -1,0 +1,130 @@
+"""Benchmark: Example 6.2, adaptive (θ = 0.4), from the initial mesh to ≥ 10⁶ unknowns.
+
+Per level it prints the unknowns, the time of each phase (assembly, PDAS with its linear
+solves, factorizations and whether the symbolic analysis was reused, estimator, marking,
+refinement, output) and the *floor*: one complete direct solve of that level's stiffness
+matrix (analysis + factorization + solve with a fresh solver), measured in the same run and
+not counted in our total. At the end it prints the ratios of issue #4, each measured in this
+run, and as its last line ``ratio_to_floor=X``.
+
+    python benchmarks/adaptive.py                 # to just above 10⁶ unknowns
+    python benchmarks/adaptive.py --max-ndof 200000
+"""
+
+from __future__ import annotations
+
+import argparse
+import resource
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from signorini import adaptive, example_6_2
+from signorini.io import HistoryWriter, write_vtu
+from signorini.linsolve import eliminate_symmetric, make_solver
+from signorini.solve import assemble
+
+
+def floor_seconds(problem, mesh, backend: str) -> tuple[float, int]:
+    """One analysis + factorization + solve of the level's matrix (Dirichlet DOFs
+    eliminated), with a fresh solver; also the factor's non-zeros when known."""
+    a = assemble(problem, mesh)
+    fixed = np.zeros(a.K.shape[0], dtype=bool)
+    fixed[a.dirichlet] = True
+    x_fixed = np.zeros(a.K.shape[0])
+    x_fixed[a.dirichlet] = a.dirichlet_values
+    K, b = eliminate_symmetric(a.K, a.F, fixed, x_fixed)
+    del a
+    with make_solver(backend, check_symmetry=False) as solver:
+        t0 = time.perf_counter()
+        solver.factorize(K)
+        solver.solve(b)
+        seconds = time.perf_counter() - t0
+        nnz = int(getattr(solver, "factor_nnz", 0))
+    return seconds, nnz
+
+
+def peak_rss_bytes() -> int:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--max-ndof", type=int, default=1_300_000,
+                        help="budget of unknowns (the default ends just above 10^6)")
+    parser.add_argument("--theta", type=float, default=0.4)
+    parser.add_argument("--backend", default="auto")
+    parser.add_argument("--vtu", action="store_true", help="also write a VTU file per level")
+    parser.add_argument("--out", type=Path, default=None, help="folder for history/VTU")
+    args = parser.parse_args()
+    out = args.out or Path(tempfile.mkdtemp(prefix="signorini-bench-"))
+    history = HistoryWriter(out / "history.csv")
+    problem = example_6_2()
+
+    cols = ("level", "ndof", "assemble", "pdas", "solves", "facts", "reused", "estimate",
+            "mark", "refine", "output", "total", "floor", "ratio")
+    print(" ".join(f"{c:>9s}" for c in cols))
+    total = floor = 0.0
+    phases = dict.fromkeys(("assemble", "pdas", "estimate", "mark", "refine", "output"), 0.0)
+    solves_after_5: list[int] = []
+    last_nnz = 0
+    generator = adaptive(problem, theta=args.theta, max_ndof=args.max_ndof,
+                         backend=args.backend)
+    while True:
+        t0 = time.perf_counter()
+        level = next(generator, None)
+        if level is None:
+            break
+        r = level.record
+        t_out = time.perf_counter()
+        history.append(r.row())
+        if args.vtu:
+            write_vtu(out / f"level_{r.level:03d}.vtu", level.result, level.estimate)
+        r.t_output = time.perf_counter() - t_out
+        level_total = time.perf_counter() - t0
+        mesh = level.result.mesh
+        backend = r.backend
+        del level  # free the level before the floor measurement
+        level_floor, last_nnz = floor_seconds(problem, mesh, backend)
+        total += level_total
+        floor += level_floor
+        for key, value in (("assemble", r.t_assemble), ("pdas", r.t_solve),
+                           ("estimate", r.t_estimate), ("mark", r.t_mark),
+                           ("refine", r.t_refine), ("output", r.t_output)):
+            phases[key] += value
+        if r.level >= 5:
+            solves_after_5.append(r.n_solves)
+        reused = "yes" if r.n_analyses == 1 and r.n_factorizations >= 1 else "no"
+        values = (r.level, r.ndof, r.t_assemble, r.t_solve, r.n_solves, r.n_factorizations,
+                  reused, r.t_estimate, r.t_mark, r.t_refine, r.t_output, level_total,
+                  level_floor, level_total / level_floor)
+        print(" ".join(f"{v:9.3f}" if isinstance(v, float) else f"{v!s:>9s}" for v in values),
+              flush=True)
+
+    overhead = phases["estimate"] + phases["mark"] + phases["refine"]
+    factor_bytes = 8 * last_nnz
+    peak = peak_rss_bytes()
+    print()
+    print(f"backend: {backend}; final level: {r.ndof} unknowns, {r.n_cells} cells, "
+          f"eta = {r.eta:.4e}")
+    print(f"total time {total:.2f} s, sum of floors {floor:.2f} s")
+    print("phase totals: " + ", ".join(f"{k} {v:.2f} s" for k, v in phases.items()))
+    if solves_after_5:
+        print(f"PDAS linear solves per level after level 5: {np.mean(solves_after_5):.2f} "
+              f"(target <= 1.5)")
+    print(f"estimator + marking + refinement: {overhead:.2f} s = {100 * overhead / total:.1f} % "
+          "of the total (target <= 20 %)")
+    if factor_bytes:
+        print(f"peak memory {peak / 2**20:.0f} MiB, factor of the last level "
+              f"{factor_bytes / 2**20:.0f} MiB (8 bytes x {last_nnz} non-zeros): "
+              f"ratio {peak / factor_bytes:.2f} (target <= 2)")
+    else:
+        print(f"peak memory {peak / 2**20:.0f} MiB (factor size unknown for {backend})")
+    print(f"history: {out / 'history.csv'}")
+    print(f"ratio_to_floor={total / floor:.3f}")
+
+
+if __name__ == "__main__":
+    main()
