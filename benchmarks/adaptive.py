@@ -25,6 +25,7 @@ from signorini import adaptive, example_6_2
 from signorini.io import HistoryWriter, write_vtu
 from signorini.linsolve import eliminate_symmetric, make_solver
 from signorini.solve import assemble
+from signorini.tuning import retain_freed_memory
 
 
 def floor_seconds(problem, mesh, backend: str) -> tuple[float, int]:
@@ -59,6 +60,7 @@ def main() -> None:
     parser.add_argument("--vtu", action="store_true", help="also write a VTU file per level")
     parser.add_argument("--out", type=Path, default=None, help="folder for history/VTU")
     args = parser.parse_args()
+    retain_freed_memory()
     out = args.out or Path(tempfile.mkdtemp(prefix="signorini-bench-"))
     history = HistoryWriter(out / "history.csv")
     problem = example_6_2()

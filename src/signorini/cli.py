@@ -18,6 +18,7 @@ from .adaptive import Level, adaptive
 from .estimator import ETA5_VARIANTS
 from .examples import EXAMPLES, get_example
 from .io import HistoryWriter, write_vtu
+from .tuning import retain_freed_memory
 
 __all__ = ["main"]
 
@@ -145,6 +146,7 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``signorini`` command."""
     args = _parser().parse_args(argv)
+    retain_freed_memory()  # large meshes: reuse freed pages instead of faulting in new ones
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:
         if args.command == "run":
