@@ -150,6 +150,13 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
                            "parts with different normals; this corner is not supported")
     gap = np.zeros(nodes.size)
     gap[pos[inside]] = edge_gap.ravel()[inside]
+    mismatch = np.abs(gap[pos[inside]] - edge_gap.ravel()[inside])
+    scale = max(float(np.abs(edge_gap).max()), 1e-300)
+    if mismatch.max(initial=0) > 1e-12 * scale:
+        bad = nodes[pos[inside][np.argmax(mismatch)]]
+        raise ProblemError(f"node {bad} at {space.node_points[bad].tolist()} lies on contact "
+                           "parts whose gap functions disagree there; the obstacle must be "
+                           "continuous")
 
     weights = np.column_stack([length / 4, length / 4, length / 2]).ravel()
     simpson = np.column_stack([length / 6, length / 6, 2 * length / 3]).ravel()

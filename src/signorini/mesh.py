@@ -214,6 +214,8 @@ class Mesh:
         second = np.ones(inverse.size, dtype=bool)
         second[first] = False
         edge2cell[inverse[second], 1] = owner[second]
+        for a in (edges, cell2edge, edge2cell):
+            a.flags.writeable = False
         return edges, cell2edge, edge2cell
 
     @property
@@ -240,7 +242,7 @@ class Mesh:
         if keys.size == 0 or not np.array_equal(keys[pos], k):
             bad = np.flatnonzero(keys[pos] != k)
             raise MeshError(f"boundary edge(s) {_first(bad)} are not edges of the mesh")
-        return pos
+        return _frozen(pos)
 
     @cached_property
     def edge_part(self) -> np.ndarray:
@@ -275,23 +277,23 @@ class Mesh:
     @cached_property
     def area(self) -> np.ndarray:
         """``(n_cells,)`` signed areas (positive for counter-clockwise cells)."""
-        return signed_area(self.points, self.cells)
+        return _frozen(signed_area(self.points, self.cells))
 
     @cached_property
     def edge_length(self) -> np.ndarray:
         """``(n_edges,)`` lengths."""
         d = self.points[self.edges[:, 1]] - self.points[self.edges[:, 0]]
-        return np.hypot(d[:, 0], d[:, 1])
+        return _frozen(np.hypot(d[:, 0], d[:, 1]))
 
     @cached_property
     def h(self) -> np.ndarray:
         """``(n_cells,)`` diameters ``h_T`` (longest edge)."""
-        return self.edge_length[self.cell2edge].max(axis=1)
+        return _frozen(self.edge_length[self.cell2edge].max(axis=1))
 
     @cached_property
     def edge_midpoints(self) -> np.ndarray:
         """``(n_edges, 2)`` midpoints."""
-        return 0.5 * (self.points[self.edges[:, 0]] + self.points[self.edges[:, 1]])
+        return _frozen(0.5 * (self.points[self.edges[:, 0]] + self.points[self.edges[:, 1]]))
 
     def min_angle(self) -> float:
         """Smallest interior angle (radians) over all cells."""
@@ -402,6 +404,12 @@ class Mesh:
 
 
 # ---------------------------------------------------------------------- helpers
+def _frozen(a: np.ndarray) -> np.ndarray:
+    """Mark a cached array read-only (a Mesh is immutable)."""
+    a.flags.writeable = False
+    return a
+
+
 def _as_points(points: np.ndarray) -> np.ndarray:
     p = np.asarray(points, dtype=np.float64)
     if p.ndim != 2 or p.shape[1] != 2:

@@ -222,6 +222,8 @@ def solve(
         u0 = np.asarray(u0, dtype=np.float64)
         if u0.shape != (space.n_nodes, 2):
             raise ValueError(f"u0 must have shape ({space.n_nodes}, 2), got {u0.shape}")
+        if not np.isfinite(u0).all():
+            raise ValueError("u0 contains NaN or inf")
         x0 = to_frames(u0.ravel(), cs.nodes, cs.normal)
         un = cs.normal_displacement(u0)
         scale = max(float(np.abs(cs.gap).max(initial=0)), float(np.abs(u0).max()), 1e-300)
