@@ -315,3 +315,33 @@ def test_dirichlet_value_returning_nan():
         "bottom": Neumann(), "right": Contact()})
     with pytest.raises(ProblemError, match="Dirichlet value of part 'left' returned NaN"):
         solve(pb)
+
+
+def _split_right_side():
+    base = rectangle(nx=4, ny=4)
+    tol = 1e-12
+    return Mesh.from_arrays(base.points, base.cells, {
+        "left": lambda x, y: np.abs(x) < tol,
+        "top": lambda x, y: np.abs(y - 1) < tol,
+        "bottom": lambda x, y: np.abs(y) < tol,
+        "right_low": lambda x, y: (np.abs(x - 1) < tol) & (y < 0.5),
+        "right_high": lambda x, y: (np.abs(x - 1) < tol) & (y > 0.5),
+    })
+
+
+def test_collinear_contact_parts_with_disagreeing_gaps():
+    conditions = {"left": Dirichlet((0.1, 0.0)), "top": Neumann(), "bottom": Neumann()}
+    pb = ContactProblem(_split_right_side(), MATERIAL,
+                        {**conditions, "right_low": Contact(gap=0.0),
+                         "right_high": Contact(gap=0.05)})
+    with pytest.raises(ProblemError, match=r"node \d+ at \[1\.0, 0\.5\] lies on contact parts "
+                                           "whose gap functions disagree"):
+        solve(pb)
+    # a continuous obstacle split over two parts gives the solution of the unsplit problem
+    gap = lambda x: -0.2 + 0.5 * np.abs(x[..., 1] - 0.5)  # noqa: E731
+    split = solve(ContactProblem(_split_right_side(), MATERIAL,
+                                 {**conditions, "right_low": Contact(gap=gap),
+                                  "right_high": Contact(gap=gap)}))
+    whole = solve(ContactProblem(rectangle(nx=4, ny=4), MATERIAL,
+                                 {**conditions, "right": Contact(gap=gap)}))
+    assert np.abs(split.u - whole.u).max() <= 1e-13 * np.abs(whole.u).max()

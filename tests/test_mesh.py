@@ -464,3 +464,11 @@ def test_long_boundary_validates(nx: int, ny: int) -> None:
     assert m.part_length("bottom") == pytest.approx(nx, rel=1e-12)
     assert m.part_length("left") == pytest.approx(ny, rel=1e-12)
     assert m.area.sum() == pytest.approx(nx * ny, rel=1e-12)
+
+
+def test_cached_arrays_are_read_only():
+    mesh = rectangle(nx=2, ny=2)
+    for name in ("edges", "cell2edge", "edge2cell", "area", "edge_length", "h",
+                 "edge_midpoints", "boundary_edge", "edge_part", "points", "cells"):
+        with pytest.raises(ValueError, match="read-only"):
+            getattr(mesh, name)[0] = 0

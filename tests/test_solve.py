@@ -345,3 +345,11 @@ def test_u0_of_the_wrong_shape(shape):
     pb = example_6_1()
     with pytest.raises(ValueError, match=r"u0 must have shape \(81, 2\)"):
         solve(pb, u0=np.zeros(shape))
+
+
+def test_u0_with_nan():
+    pb = example_6_1()
+    u0 = np.zeros((81, 2))
+    u0[3, 1] = np.nan
+    with pytest.raises(ValueError, match="u0 contains NaN"):
+        solve(pb, u0=u0)
