@@ -139,11 +139,12 @@ def csr_row_indices(A: sp.csr_matrix) -> np.ndarray:
 
     Returns
     -------
-    rows : (A.nnz,) int64 array
+    rows : (A.nnz,) int32 (int64 for n ≥ 2³¹) array
         ``rows[p]`` is the row of ``A.data[p]`` (the companion of ``A.indices``).
     """
     n = A.shape[0]
-    return np.repeat(np.arange(n, dtype=np.int64), np.diff(A.indptr))
+    dtype = np.int32 if n < np.iinfo(np.int32).max else np.int64
+    return np.repeat(np.arange(n, dtype=dtype), np.diff(A.indptr))
 
 
 def _upper_positions(A: sp.csr_matrix, rows: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
@@ -152,6 +153,8 @@ def _upper_positions(A: sp.csr_matrix, rows: np.ndarray | None = None) -> tuple[
         rows = csr_row_indices(A)
     upper = A.indices >= rows
     positions = np.flatnonzero(upper)
+    if A.nnz < np.iinfo(np.int32).max:
+        positions = positions.astype(np.int32)
     indptr = np.zeros(A.shape[0] + 1, dtype=np.int64)
     np.cumsum(np.bincount(rows[positions], minlength=A.shape[0]), out=indptr[1:])
     return positions, indptr
@@ -229,9 +232,10 @@ class SymmetricEliminator:
         self.shape = A.shape
         self.indptr = A.indptr
         self.indices = A.indices
-        self.rows = csr_row_indices(A)
-        self.is_diagonal = self.indices == self.rows
-        self.diagonal_positions = _diagonal_positions(A, self.rows)
+        rows = csr_row_indices(A)
+        self.is_diagonal = self.indices == rows
+        self.diagonal_positions = _diagonal_positions(A, rows)
+        self.row_lengths = np.diff(self.indptr)  # rows are expanded on demand: less memory
 
     @property
     def n(self) -> int:
@@ -310,7 +314,10 @@ class SymmetricEliminator:
             missing = np.flatnonzero(fixed)[diag_pos < 0]
             raise ValueError(f"no stored diagonal entry in fixed rows {_first(missing)}")
 
-        keep = ~(fixed[self.rows] | fixed[self.indices]) | self.is_diagonal
+        keep = np.repeat(fixed, self.row_lengths)  # fixed row of every stored entry
+        keep |= fixed[self.indices]
+        np.logical_not(keep, out=keep)
+        keep |= self.is_diagonal
         if out is None:
             data = np.where(keep, A.data, 0.0)
             A_elim = sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape)
