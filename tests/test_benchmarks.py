@@ -1,4 +1,4 @@
-"""The benchmark scripts run end to end on a small budget and print their ratios."""
+"""The benchmark and example scripts run end to end on a small budget."""
 
 from __future__ import annotations
 
@@ -33,3 +33,19 @@ def test_retain_freed_memory_on_linux():
     if not sys.platform.startswith("linux"):
         pytest.skip("glibc only")
     assert retain_freed_memory() is True
+
+
+def test_inclined_block_example_runs(tmp_path):
+    """The literate example with a non-axis contact normal runs and touches the foundation
+    without penetrating it."""
+    out = subprocess.run(
+        [sys.executable, str(ROOT / "examples" / "inclined_block.py"), "--max-ndof", "3000",
+         "--out", str(tmp_path)],
+        capture_output=True, text=True, timeout=300, check=True,
+    ).stdout
+    last = out.strip().splitlines()[-1]
+    print(last)
+    force = float(last.split("resultant normal force ")[1].split(";")[0])
+    penetration = float(last.split("largest penetration ")[1])
+    assert force > 10.0 and penetration < 1e-12
+    assert (tmp_path / "solution.vtu").is_file() and (tmp_path / "deformed.png").is_file()
