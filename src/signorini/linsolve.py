@@ -314,10 +314,7 @@ class SymmetricEliminator:
             missing = np.flatnonzero(fixed)[diag_pos < 0]
             raise ValueError(f"no stored diagonal entry in fixed rows {_first(missing)}")
 
-        keep = np.repeat(fixed, self.row_lengths)  # fixed row of every stored entry
-        keep |= fixed[self.indices]
-        np.logical_not(keep, out=keep)
-        keep |= self.is_diagonal
+        keep = self.keep_mask(fixed)
         if out is None:
             data = np.where(keep, A.data, 0.0)
             A_elim = sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape)
@@ -326,9 +323,28 @@ class SymmetricEliminator:
                 raise ValueError("out does not have the sparsity pattern of A")
             np.multiply(A.data, keep, out=out.data)
             A_elim = out
-        b_elim = b - A @ values
+        return A_elim, self._rhs(A, b, fixed, values, diag_pos)
+
+    def keep_mask(self, fixed: np.ndarray) -> np.ndarray:
+        """``(nnz,)`` bool: the stored entries that survive the elimination of ``fixed``
+        (neither in a fixed row nor in a fixed column, or on the diagonal)."""
+        keep = np.repeat(fixed, self.row_lengths)  # fixed row of every stored entry
+        keep |= fixed[self.indices]
+        np.logical_not(keep, out=keep)
+        keep |= self.is_diagonal
+        return keep
+
+    def rhs(self, A: sp.csr_matrix, b: np.ndarray, fixed: np.ndarray,
+            values: np.ndarray) -> np.ndarray:
+        """Right-hand side of the eliminated system, for full-length ``values`` (read on
+        ``fixed`` only, zero elsewhere)."""
+        return self._rhs(A, b, fixed, values, self.diagonal_positions[fixed])
+
+    @staticmethod
+    def _rhs(A, b, fixed, values, diag_pos) -> np.ndarray:
+        b_elim = b - A @ np.where(fixed, values, 0.0)
         b_elim[fixed] = A.data[diag_pos] * values[fixed]
-        return A_elim, b_elim
+        return b_elim
 
 
 def eliminate_symmetric(
@@ -432,7 +448,7 @@ class SPDSolver:
         return same_ptr and (A.indices is self._indices or np.array_equal(A.indices, self._indices))
 
     # -- public interface -------------------------------------------------------------------
-    def factorize(self, A: sp.spmatrix) -> None:
+    def factorize(self, A: sp.spmatrix, keep: np.ndarray | None = None) -> None:
         """Factorize ``A``, reusing the symbolic analysis when the pattern is unchanged.
 
         Parameters
@@ -440,6 +456,10 @@ class SPDSolver:
         A : scipy sparse matrix, shape (n, n)
             Symmetric positive definite, both triangles stored (an explicitly stored zero is
             part of the pattern).
+        keep : (A.nnz,) bool array, optional
+            Factorize ``A`` with the stored entries where ``keep`` is False taken as zero
+            (same pattern), e.g. :meth:`SymmetricEliminator.keep_mask`. Lets a backend
+            gather only what it needs instead of copying the whole matrix.
 
         Raises
         ------
@@ -471,10 +491,14 @@ class SPDSolver:
             self.n_analyses += 1
             self._n = n
             self._indptr = A.indptr.copy()
-            self._indices = A.indices.copy()
+            self._indices = A.indices  # a reference: patterns are not modified in place
+        if keep is not None:
+            keep = np.asarray(keep)
+            if keep.dtype != np.bool_ or keep.shape != (A.nnz,):
+                raise ValueError(f"keep must be a boolean mask of shape ({A.nnz},)")
         self._factorized = False
         t0 = time.perf_counter()
-        self._factorize(A)
+        self._factorize(A, keep)
         self.time_factorization += time.perf_counter() - t0
         self.n_factorizations += 1
         self._factorized = True
@@ -526,7 +550,7 @@ class SPDSolver:
     def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:  # pragma: no cover
         raise NotImplementedError
 
-    def _factorize(self, A: sp.csr_matrix) -> None:  # pragma: no cover
+    def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:  # pragma: no cover
         raise NotImplementedError
 
     def _solve(self, b: np.ndarray) -> np.ndarray:  # pragma: no cover
@@ -573,10 +597,11 @@ class SuperLUSolver(SPDSolver):
     def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
         self._diag_pos = _diagonal_positions(A, rows)
 
-    def _factorize(self, A: sp.csr_matrix) -> None:
+    def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
         self._lu = None
+        data = A.data if keep is None else A.data * keep
         # A is symmetric, so its CSR arrays read as CSC describe A itself (no copy).
-        C = sp.csc_matrix((A.data, A.indices, A.indptr), shape=A.shape)
+        C = sp.csc_matrix((data, A.indices, A.indptr), shape=A.shape)
         try:
             lu = spla.splu(
                 C,
@@ -777,8 +802,10 @@ class PardisoSolver(SPDSolver):
         self._handle_used = True
         self._call(11)
 
-    def _factorize(self, A: sp.csr_matrix) -> None:
+    def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
         np.take(A.data, self._upos, out=self._a)
+        if keep is not None:  # only the upper triangle is gathered: no copy of the matrix
+            self._a *= keep[self._upos]
         self._call(22)
 
     def _solve(self, b: np.ndarray) -> np.ndarray:

@@ -376,7 +376,6 @@ class _System:
         self.K_c = K[c]  # rows of the constrained DOFs, for the multiplier
         self.solver = solver
         self.eliminator = SymmetricEliminator(K)
-        self.work = sp.csr_matrix((K.data.copy(), K.indices, K.indptr), shape=K.shape)
         self.fixed = np.zeros(K.shape[0], dtype=bool)
         self.fixed[d] = True
         self.values = np.zeros(K.shape[0])
@@ -389,9 +388,11 @@ class _System:
         self.fixed[c] = active
         self.values[c] = np.where(active, self.g, 0.0)
         t0 = time.perf_counter()
-        A, b = self.eliminator.apply(self.K, self.F, self.fixed, self.values, out=self.work)
+        keep = self.eliminator.keep_mask(self.fixed)
+        b = self.eliminator.rhs(self.K, self.F, self.fixed, self.values)
         self.time_elimination += time.perf_counter() - t0
-        self.solver.factorize(A)
+        # the solver factorizes K with the eliminated entries dropped: no copy of K
+        self.solver.factorize(self.K, keep=keep)
         x = self.solver.solve(b)
         x[self.fixed] = self.values[self.fixed]
         lam = self.F[c] - self.K_c @ x
