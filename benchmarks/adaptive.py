@@ -65,7 +65,8 @@ def main() -> None:
     history = HistoryWriter(out / "history.csv")
     problem = example_6_2()
 
-    cols = ("level", "ndof", "assemble", "pdas", "solves", "facts", "reused", "estimate",
+    cols = ("level", "ndof", "assemble", "pdas", "solves", "facts", "updates", "reused",
+            "estimate",
             "mark", "refine", "output", "total", "floor", "ratio")
     print(" ".join(f"{c:>9s}" for c in cols))
     total = floor = 0.0
@@ -100,7 +101,7 @@ def main() -> None:
             solves_after_5.append(r.n_solves)
         reused = "yes" if r.n_analyses == 1 and r.n_factorizations >= 1 else "no"
         values = (r.level, r.ndof, r.t_assemble, r.t_solve, r.n_solves, r.n_factorizations,
-                  reused, r.t_estimate, r.t_mark, r.t_refine, r.t_output, level_total,
+                  r.n_updates, reused, r.t_estimate, r.t_mark, r.t_refine, r.t_output, level_total,
                   level_floor, level_total / level_floor)
         print(" ".join(f"{v:9.3f}" if isinstance(v, float) else f"{v!s:>9s}" for v in values),
               flush=True)

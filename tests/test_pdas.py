@@ -160,7 +160,8 @@ def test_kkt_on_random_problems(seed, n, frac_c, frac_d, dense):
     assert (result.lam[~result.active] == 0).all()
     assert (result.lam >= 0).all()
     assert result.n_analyses == 1
-    assert result.n_factorizations == result.n_solves == result.iterations
+    # every iteration either refactorizes or reuses the factor with a low-rank update
+    assert result.n_factorizations + result.n_updates == result.n_solves == result.iterations
 
 
 @settings(max_examples=40, deadline=None)
@@ -245,7 +246,8 @@ def test_solver_reuse_across_calls(backend):
     second = solve_pdas(K, F, c, 0.5 * g, d, xd, solver=solver)
     assert first.n_analyses == 1
     assert second.n_analyses == 0  # same pattern: the analysis is kept by the solver
-    assert solver.n_factorizations == first.iterations + second.iterations
+    assert solver.n_factorizations + first.n_updates + second.n_updates == (
+        first.iterations + second.iterations)
     assert_kkt(first)
     assert_kkt(second)
     assert second.times["analysis"] == 0.0
@@ -424,3 +426,30 @@ def test_no_constraints_is_a_linear_solve():
     result = solve_pdas(K, F, np.zeros(0, dtype=int), np.zeros(0))
     assert result.iterations == 1 and result.active.size == 0
     assert np.abs(K @ result.x - F).max() < 1e-10 * np.abs(F).max()
+
+
+@pytest.mark.parametrize("backend", BACKEND_LIST)
+def test_low_rank_updates_agree_with_refactorization(backend):
+    """Small active-set changes reuse the factorization (Woodbury) with the same result."""
+    rng = np.random.default_rng(21)
+    used = 0
+    for _ in range(6):
+        K, F, c, g, d, xd = random_problem(rng, 120, 12, 6, dense=False)
+        exact = solve_pdas(K, F, c, g, d, xd, backend=backend, max_update=0)
+        updated = solve_pdas(K, F, c, g, d, xd, backend=backend, max_update=12)
+        assert exact.n_updates == 0
+        assert updated.n_factorizations + updated.n_updates == updated.iterations
+        assert np.array_equal(updated.active, exact.active)
+        scale = np.abs(exact.x).max()
+        np.testing.assert_allclose(updated.x, exact.x, rtol=0, atol=1e-10 * scale)
+        assert_kkt(updated)
+        used += updated.n_updates
+    print(f"{backend}: {used} iterations solved by low-rank updates")
+    assert used > 0
+
+
+def test_max_update_validation():
+    rng = np.random.default_rng(3)
+    K, F, c, g, d, xd = random_problem(rng, 10, 3, 1, dense=True)
+    with pytest.raises(ValueError, match="max_update must be a non-negative integer"):
+        solve_pdas(K, F, c, g, d, xd, max_update=-1)

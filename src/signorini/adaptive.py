@@ -52,6 +52,7 @@ class LevelRecord:
     n_solves: int = 0
     n_factorizations: int = 0
     n_analyses: int = 0
+    n_updates: int = 0
     n_active: int = 0
     n_constrained: int = 0
     n_full_contact: int = 0
@@ -180,6 +181,7 @@ def _record(level: int, result: ContactResult, est: Estimate) -> LevelRecord:
         **{f"eta{k + 1}": float(terms[k]) for k in range(7)},
         pdas_iterations=result.pdas.iterations, n_solves=result.pdas.n_solves,
         n_factorizations=result.pdas.n_factorizations, n_analyses=result.pdas.n_analyses,
+        n_updates=result.pdas.n_updates,
         n_active=int(result.active.sum()), n_constrained=result.contact.size,
         n_full_contact=int((classes == FULL_CONTACT).sum()),
         n_semi_contact=int((classes == SEMI_CONTACT).sum()),
