@@ -15,6 +15,7 @@ Section 3). From the nodal contact force ``Λ_z = L(ψ_z n) − a(u_h, ψ_z n)``
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -77,6 +78,12 @@ class ContactSet:
     def dofs(self) -> np.ndarray:
         """Interleaved DOFs ``(k, 2)`` of the constrained nodes."""
         return np.column_stack([2 * self.nodes, 2 * self.nodes + 1])
+
+    @cached_property
+    def edge_local(self) -> np.ndarray:
+        """``(n_ce, 3)`` position in this set of each contact edge's nodes, ``-1`` for
+        Dirichlet nodes."""
+        return self.local(self.edge_nodes.ravel()).reshape(-1, 3)
 
     def local(self, nodes: np.ndarray) -> np.ndarray:
         """Position in this set of global nodes, ``-1`` for nodes that are not constrained."""
@@ -187,7 +194,7 @@ def node_classes(cs: ContactSet, in_contact: np.ndarray, edge_in_contact: np.nda
     (k,) int array of ``NO_CONTACT``, ``SEMI_CONTACT``, ``FULL_CONTACT``.
     """
     edge_full = edge_in_contact.all(axis=1)
-    loc = cs.local(cs.edge_nodes.ravel())
+    loc = cs.edge_local.ravel()
     touching = loc >= 0
     broken = np.bincount(loc[touching], weights=np.repeat(~edge_full, 3)[touching],
                          minlength=cs.size)

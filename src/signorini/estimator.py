@@ -204,7 +204,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
         length = mesh.edge_length[e]
         add_edge_term(3, e, length * np.einsum("q,eqi,eqi->e", wt, st, st), nodes)
         if eta5 == "consistent":
-            loc = cs.local(cs.edge_nodes.ravel()).reshape(-1, 3)
+            loc = cs.edge_local
             p_nodes = np.where(loc >= 0, result.pressure[np.maximum(loc, 0)], 0.0)
             # the contact set's edge nodes are [start, end, midpoint] along the cell's direction
             snn = snn + p_nodes @ edge_basis(t).T
@@ -213,7 +213,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
         # ---- η6: s_p d_p on semi-contact nodes
         wgap = cs.edge_normal_gap(result.u)  # u·n − ψ_h at [start, end, mid]
         thirds = third_integrals(-wgap, length)  # ∫ (ψ − u·n)⁺ φ_p over p's third
-        loc = cs.local(cs.edge_nodes.ravel()).reshape(-1, 3)
+        loc = cs.edge_local
         semi = np.zeros(cs.size, dtype=bool)
         semi[result.classes == SEMI_CONTACT] = True
         use = (loc >= 0) & semi[np.maximum(loc, 0)]

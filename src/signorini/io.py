@@ -12,7 +12,8 @@ import io as _io
 import math
 import os
 import tempfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -22,25 +23,32 @@ from .mesh import Mesh, MeshError, signed_area
 __all__ = ["atomic_write", "write_vtu", "HistoryWriter", "read_mesh"]
 
 
-def atomic_write(path: str | os.PathLike, data: bytes) -> Path:
-    """Write ``data`` to ``path`` atomically."""
+@contextmanager
+def _replacing(path: str | os.PathLike, suffix: str = ".tmp") -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; on success it replaces ``path`` atomically."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=suffix)
+    os.close(fd)
     try:
-        with os.fdopen(fd, "wb") as fh:
-            # mkstemp makes the file private (0o600); give it the mode open() would
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(tmp, 0o666 & ~umask)
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
+        yield Path(tmp)
+        # mkstemp makes the file private (0o600); give it the mode open() would
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    return path
+
+
+def atomic_write(path: str | os.PathLike, data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically."""
+    with _replacing(path) as tmp, open(tmp, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+    return Path(path)
 
 
 def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
@@ -84,18 +92,9 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
                     "active": active, "contact_class": klass},
         cell_data=cell_data,
     )
-    path = Path(path)
-    buf = _io.BytesIO()
-    # meshio writes to a file name; go through a temporary file to stay atomic
-    fd, tmp = tempfile.mkstemp(dir=path.parent if path.parent.exists() else None,
-                               suffix=".vtu")
-    os.close(fd)
-    try:
+    with _replacing(path, suffix=".vtu") as tmp:
         meshio.write(tmp, mesh, file_format="vtu")
-        buf.write(Path(tmp).read_bytes())
-    finally:
-        Path(tmp).unlink(missing_ok=True)
-    return atomic_write(path, buf.getvalue())
+    return Path(path)
 
 
 class HistoryWriter:

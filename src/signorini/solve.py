@@ -113,7 +113,8 @@ class ContactResult:
     contact_force : (k,) float array
         Nodal contact forces Λ_z ≥ 0 (3.17).
     active : (k,) bool array
-        Final active set of the PDAS iteration (``u(z)·n = ψ(z)`` imposed).
+        Final active set of the PDAS iteration (``u(z)·n = ψ(z)`` imposed): the actual
+        contact nodes.
     pdas : PDASResult
     timings : dict
         Seconds spent in ``assemble`` and ``solve``.
@@ -154,15 +155,10 @@ class ContactResult:
         return float(self.contact_force.sum())
 
     @cached_property
-    def in_contact(self) -> np.ndarray:
-        """Actual contact nodes ``u_h(z)·n = ψ(z)`` (the converged active set)."""
-        return self.active.copy()
-
-    @cached_property
     def classes(self) -> np.ndarray:
         """Full / semi / no contact class of every constrained node (paper, Section 4)."""
         cs = self.contact
-        loc = cs.local(cs.edge_nodes.ravel()).reshape(-1, 3)
+        loc = cs.edge_local
         gap = cs.edge_normal_gap(self.u)
         scale = max(float(np.abs(cs.edge_gap).max(initial=0)),
                     float(np.abs(self.u).max(initial=0)), 1e-300)
