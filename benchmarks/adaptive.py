@@ -22,9 +22,9 @@ from pathlib import Path
 import numpy as np
 
 from signorini import adaptive, example_6_2
+from signorini.discrete import assemble
 from signorini.io import HistoryWriter, write_vtu
 from signorini.linsolve import eliminate_symmetric, make_solver
-from signorini.solve import assemble
 from signorini.tuning import retain_freed_memory
 
 

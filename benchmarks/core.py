@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 from signorini import estimate, example_6_2, refine_uniform
-from signorini.solve import assemble, solve
+from signorini.discrete import assemble, solve
 from signorini.tuning import retain_freed_memory
 
 

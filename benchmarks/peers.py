@@ -22,8 +22,8 @@ import time
 import numpy as np
 
 from signorini import example_6_2, rectangle
+from signorini.discrete import solve
 from signorini.elasticity import Material, assemble_stiffness
-from signorini.solve import solve
 from signorini.space import P2Space
 from signorini.tuning import retain_freed_memory
 

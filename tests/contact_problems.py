@@ -8,7 +8,7 @@
   stress on the bottom edge ``y = 0`` (normal ``(0, −1)``), so that it solves a Signorini
   problem with the gap ``ψ = u·n`` and every contact node active.
 - :func:`independent_system`: Cartesian ``K``, ``F`` and Dirichlet data assembled from the mesh
-  with :mod:`signorini.elasticity` only (no rotated frames, no :mod:`signorini.solve`).
+  with :mod:`signorini.elasticity` only (no rotated frames, no :mod:`signorini.discrete`).
 """
 
 from __future__ import annotations

@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 from signorini.cli import main
+from signorini.discrete import solve
 from signorini.estimator import estimate
 from signorini.examples import example_6_1
-from signorini.solve import solve
 
 REQUIRED = ["level", "ndof", "n_cells", "eta", *[f"eta{k}" for k in range(1, 8)],
             "pdas_iterations", "n_active", "error_energy", "efficiency"]

@@ -17,13 +17,13 @@ from signorini.contact import (
     contact_set,
     node_classes,
 )
+from signorini.discrete import solve
 from signorini.elasticity import Material, stress
 from signorini.examples import example_6_1, example_6_2
 from signorini.mesh import Mesh
 from signorini.meshes import rectangle
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
 from signorini.refine import refine_nvb, refine_uniform
-from signorini.solve import solve
 from signorini.space import P2Space
 
 MATERIAL = Material.from_young(10.0, 0.3)

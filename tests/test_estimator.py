@@ -13,13 +13,13 @@ import pytest
 from scipy.integrate import quad
 
 from signorini.contact import FULL_CONTACT, SEMI_CONTACT
+from signorini.discrete import solve
 from signorini.elasticity import Material
 from signorini.estimator import ETA5_VARIANTS, estimate, third_integrals
 from signorini.examples import example_6_1, example_6_2
 from signorini.meshes import rectangle
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
 from signorini.refine import refine_nvb, refine_uniform
-from signorini.solve import solve
 
 EXAMPLES = {"6.1": example_6_1, "6.2": example_6_2}
 

@@ -11,11 +11,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from signorini.discrete import solve
 from signorini.elasticity import Material, stress
 from signorini.examples import EXAMPLES, example_6_1, example_6_2, get_example
 from signorini.problem import Contact, Dirichlet, Neumann
 from signorini.refine import refine_uniform
-from signorini.solve import solve
 
 # 4 x 4 squares and four uniform refinements: up to 33,024 unknowns (Example 6.1: ~4 s, so
 # its tests are marked slow; Example 6.2: ~2 s)

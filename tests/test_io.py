@@ -14,12 +14,12 @@ import pytest
 
 import signorini.io as sio
 from signorini.contact import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
+from signorini.discrete import solve
 from signorini.estimator import estimate
 from signorini.examples import example_6_2
 from signorini.io import HistoryWriter, read_mesh, write_vtu
 from signorini.mesh import MeshError
 from signorini.refine import refine_uniform
-from signorini.solve import solve
 from signorini.space import P2Space
 
 

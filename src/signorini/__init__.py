@@ -7,7 +7,8 @@ The public API, from the mesh to the adaptive loop::
                            adaptive)
 """
 
-from .adaptive import Level, LevelRecord, adaptive
+from .discrete import ContactResult, solve
+from .driver import Level, LevelRecord, adaptive
 from .elasticity import Material
 from .estimator import Estimate, estimate
 from .examples import example_6_1, example_6_2
@@ -18,7 +19,6 @@ from .meshes import rectangle
 from .pdas import PDASConvergenceError
 from .problem import Contact, ContactProblem, Dirichlet, ExactSolution, Neumann, ProblemError
 from .refine import refine_nvb, refine_uniform
-from .solve import ContactResult, solve
 from .space import P2Space
 
 __version__ = "0.1.0"

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .adaptive import Level, adaptive
+from .driver import Level, adaptive
 from .estimator import ETA5_VARIANTS
 from .examples import EXAMPLES, get_example
 from .io import HistoryWriter, write_vtu

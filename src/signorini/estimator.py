@@ -31,12 +31,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .contact import SEMI_CONTACT
+from .discrete import ContactResult
 from .elasticity import div_stress, stress
 from .hhalf import hhalf_norm2_positive_part
 from .p2 import REFERENCE_NODES, edge_basis, field_gradients, physical_points
 from .problem import Neumann, evaluate_field
 from .quadrature import line_rule, triangle_rule
-from .solve import ContactResult
 
 __all__ = ["Estimate", "estimate", "ETA5_VARIANTS", "third_integrals"]
 

@@ -1,4 +1,4 @@
-"""The whole SOLVE pipeline (signorini.solve) against closed forms and independent computations.
+"""The whole SOLVE pipeline (signorini.discrete) against closed forms and independent computations.
 
 - patch tests: quadratic displacements (with and without contact) are reproduced at all nodes;
 - the KKT conditions of (3.2), checked on a Cartesian system assembled here independently;
@@ -22,13 +22,13 @@ from contact_problems import (
 )
 from scipy.optimize import LinearConstraint, minimize, nnls
 
+from signorini.discrete import solve
 from signorini.elasticity import Material
 from signorini.examples import example_6_1, example_6_2
 from signorini.mesh import Mesh
 from signorini.meshes import rectangle
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
 from signorini.refine import refine_nvb, refine_uniform
-from signorini.solve import solve
 
 MATERIAL = Material.from_young(7.0, 0.28)
 EXAMPLES = {"6.1": example_6_1, "6.2": example_6_2}

@@ -1,4 +1,4 @@
-"""Tests of the adaptive loop in :mod:`signorini.adaptive` on the paper's examples (§6)."""
+"""Tests of the adaptive loop in :mod:`signorini.driver` on the paper's examples (§6)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ from dataclasses import fields
 import numpy as np
 import pytest
 
-from signorini.adaptive import Level, LevelRecord, adaptive, free_ndof
 from signorini.contact import FULL_CONTACT
+from signorini.driver import Level, LevelRecord, adaptive, free_ndof
 from signorini.examples import example_6_1, example_6_2
 from signorini.marking import mark_doerfler
 from signorini.refine import refine_nvb

@@ -16,12 +16,12 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from .contact import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
+from .discrete import ContactResult, solve
 from .estimator import Estimate, estimate
 from .marking import mark_doerfler
 from .mesh import Mesh
 from .problem import ContactProblem
 from .refine import refine_nvb, refine_uniform
-from .solve import ContactResult, solve
 from .space import P2Space
 
 __all__ = ["LevelRecord", "Level", "adaptive", "free_ndof"]
