@@ -12,9 +12,11 @@ import numpy as np
 import pytest
 
 from signorini.discrete import solve
-from signorini.elasticity import Material, stress
+from signorini.elasticity import Material, assemble_stiffness, stress
 from signorini.examples import EXAMPLES, example_6_1, example_6_2, get_example
+from signorini.p2 import physical_points
 from signorini.problem import Contact, Dirichlet, Neumann
+from signorini.quadrature import triangle_rule
 from signorini.refine import refine_uniform
 
 # 4 x 4 squares and four uniform refinements: up to 33,024 unknowns (Example 6.1: ~4 s, so
@@ -211,3 +213,25 @@ def test_examples_accept_the_initial_mesh_size():
     pb = example_6_1(nx=2)
     assert pb.mesh.n_cells == 8
     assert isinstance(pb.material, Material)
+
+
+def test_example_6_1_energy_error_obeys_galerkin_orthogonality():
+    """Every constrained node of Example 6.1 is in contact and u·n = 0 on Γ_C exactly, so u_h is
+    the Galerkin projection onto {v_h : v_h·n = 0 on Γ_C} and
+    a(u − u_h, u − u_h) = a(u, u) − a(u_h, u_h): an independent check of the error norm,
+    the loads and the solver together."""
+    problem = example_6_1()
+    mesh = problem.mesh
+    for _ in range(2):
+        r = solve(problem, mesh)
+        space = r.space
+        K = assemble_stiffness(space.vertices, space.cell_dofs, space.n_dofs, problem.material)
+        a_h = r.u.ravel() @ (K @ r.u.ravel())
+        xi, w = triangle_rule(14)
+        G = problem.exact.gradient(physical_points(space.vertices, xi))
+        eps = 0.5 * (G + np.swapaxes(G, -1, -2))
+        a = np.einsum("q,mqij,mqij,m->", w, stress(problem.material, G), eps, 2 * mesh.area)
+        e2 = r.errors()["error_energy"] ** 2
+        print(f"Ndof {r.ndof}: a(e,e) = {e2:.12e}, a(u,u) - a(u_h,u_h) = {a - a_h:.12e}")
+        assert abs(e2 - (a - a_h)) <= 1e-8 * e2
+        mesh = refine_uniform(mesh).mesh
