@@ -139,7 +139,6 @@ def test_bad_theta_exits_with_a_message_and_no_traceback(tmp_path):
     ("argv", "message"),
     [
         (["run", "example-6.2", "--theta", "abc"], "invalid float value"),
-        (["run", "example-9.9"], "invalid choice"),
         (["run", "example-6.2", "--eta5", "other"], "invalid choice"),
         (["run", "example-6.2", "--max-ndof", "many"], "invalid int value"),
         ([], "required"),
@@ -167,3 +166,50 @@ def test_invalid_values_exit_nonzero(tmp_path, capsys, argv, message):
     err = capsys.readouterr().err
     assert code != 0
     assert err.startswith("signorini: error:") and re.search(message, err)
+
+
+@pytest.mark.parametrize(
+    ("name", "message"),
+    [
+        ("example-9.9", r"unknown problem 'example-9.9': give one of \['example-6.1', "),
+        ("missing.py", "no problem file at missing.py"),
+    ],
+)
+def test_unknown_problem_exits_2(tmp_path, capsys, name, message):
+    code = main(["run", name, "--out", str(tmp_path / "x"), "--no-figures"])
+    err = capsys.readouterr().err
+    assert code == 2 and re.search(message, err) and "Traceback" not in err
+
+
+def test_run_a_problem_file(tmp_path, capsys):
+    """A user's Python file defining problem() runs through the same pipeline."""
+    source = tmp_path / "wedge.py"
+    source.write_text(
+        "import numpy as np\n"
+        "from signorini import Contact, ContactProblem, Dirichlet, Material, Neumann, "
+        "rectangle\n"
+        "def problem():\n"
+        "    return ContactProblem(rectangle(nx=2, ny=2), Material.from_young(100.0, 0.25), {\n"
+        "        'top': Dirichlet((0.0, -0.02)), 'left': Neumann(), 'right': Neumann(),\n"
+        "        'bottom': Contact(gap=lambda x: 0.01 * x[..., 0])}, name='wedge')\n"
+    )
+    out = tmp_path / "out"
+    assert main(["run", str(source), "--max-ndof", "1500", "--out", str(out), "--quiet"]) == 0
+    rows = check_history_and_vtu(out)
+    assert float(rows[-1]["contact_force"]) > 0 and int(rows[-1]["n_active"]) > 0
+    assert (out / "wedge_estimator.png").is_file() and (out / "deformed.png").is_file()
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("x = 1\n", "must define a function problem()"),
+        ("def problem():\n    return 42\n", "returned int, not a ContactProblem"),
+    ],
+)
+def test_bad_problem_file(tmp_path, capsys, text, message):
+    source = tmp_path / "bad.py"
+    source.write_text(text)
+    code = main(["run", str(source), "--out", str(tmp_path / "o"), "--no-figures"])
+    err = capsys.readouterr().err
+    assert code == 2 and message in err

@@ -1,5 +1,9 @@
 """Command line: ``signorini run example-6.2 --out results/6.2``.
 
+``run`` takes one of the paper's examples by name, or a Python file of your own that defines
+``problem()`` returning a :class:`~signorini.problem.ContactProblem` (see
+``examples/inclined_block.py``).
+
 Each level's history row and VTU file are written (atomically) as soon as the level is done,
 so an interrupted run keeps what it finished; the figures follow at the end.
 """
@@ -7,6 +11,7 @@ so an interrupted run keeps what it finished; the figures follow at the end.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import logging
 import sys
 import time
@@ -18,6 +23,7 @@ from .driver import Level, adaptive
 from .estimator import ETA5_VARIANTS
 from .examples import EXAMPLES, get_example
 from .io import HistoryWriter, write_vtu
+from .problem import ContactProblem
 from .tuning import retain_freed_memory
 
 __all__ = ["main"]
@@ -29,8 +35,10 @@ def _parser() -> argparse.ArgumentParser:
         description="Adaptive P2 finite elements for the frictionless Signorini problem.",
     )
     sub = p.add_subparsers(dest="command", required=True)
-    run = sub.add_parser("run", help="solve an example on a sequence of meshes")
-    run.add_argument("example", choices=sorted(EXAMPLES))
+    run = sub.add_parser("run", help="solve a problem on a sequence of meshes")
+    run.add_argument("example", metavar="PROBLEM",
+                     help=f"one of {', '.join(sorted(EXAMPLES))}, or a Python file defining "
+                          "problem() -> ContactProblem")
     run.add_argument("--uniform", action="store_true",
                      help="uniform refinement instead of adaptive (Dörfler) refinement")
     run.add_argument("--theta", type=float, default=0.4, help="Dörfler parameter (default 0.4)")
@@ -50,9 +58,37 @@ def _parser() -> argparse.ArgumentParser:
                      help="also run uniform refinement to the same budget (into OUT/uniform) "
                           "and plot both")
     fig = sub.add_parser("figures", help="redraw the figures of a finished run")
-    fig.add_argument("example", choices=sorted(EXAMPLES))
+    fig.add_argument("example", metavar="PROBLEM", help="the problem's name, as for run")
     fig.add_argument("out", type=Path, help="the run's output folder (with history.csv)")
     return p
+
+
+def _label(name: str) -> str:
+    """File-name friendly label of a problem: the example's name or the file's stem."""
+    return name if name in EXAMPLES else Path(name).stem
+
+
+def load_problem(name: str) -> ContactProblem:
+    """A built-in example by name, or ``problem()`` from a Python file."""
+    if name in EXAMPLES:
+        return get_example(name)
+    path = Path(name)
+    if path.suffix != ".py":
+        raise ValueError(f"unknown problem {name!r}: give one of {sorted(EXAMPLES)} or a "
+                         "Python file defining problem()")
+    if not path.is_file():
+        raise ValueError(f"no problem file at {path}")
+    spec = importlib.util.spec_from_file_location(f"signorini_user_{path.stem}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    factory = getattr(module, "problem", None)
+    if not callable(factory):
+        raise ValueError(f"{path} must define a function problem() returning a ContactProblem")
+    problem = factory()
+    if not isinstance(problem, ContactProblem):
+        raise ValueError(f"problem() in {path} returned {type(problem).__name__}, not a "
+                         "ContactProblem")
+    return problem
 
 
 def _progress(level: Level) -> str:
@@ -70,8 +106,9 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--theta must lie in (0, 1], got {args.theta}")
     if args.max_ndof <= 0:
         raise ValueError(f"--max-ndof must be positive, got {args.max_ndof}")
-    problem = get_example(args.example)
-    out: Path = args.out or Path("results") / args.example
+    problem = load_problem(args.example)
+    label = _label(args.example)
+    out: Path = args.out or Path("results") / label
     out.mkdir(parents=True, exist_ok=True)
     history = HistoryWriter(out / "history.csv")
     say = (lambda s: None) if args.quiet else (lambda s: print(s, flush=True))
@@ -89,7 +126,7 @@ def run(args: argparse.Namespace) -> int:
         say(_progress(level))
         last = level
     if last is not None and not args.no_figures:
-        written = _figures(args.example, out, last)
+        written = _figures(label, out, last)
         say(f"figures: {', '.join(str(p.name) for p in written)}")
     if args.compare_uniform and not args.uniform and last is not None:
         _compare_uniform(args, out, say)
@@ -101,7 +138,7 @@ def _compare_uniform(args: argparse.Namespace, out: Path, say) -> None:
     """Uniform refinement to the same budget, and one plot of both convergence histories."""
     from . import plots
 
-    problem = get_example(args.example)
+    problem = load_problem(args.example)
     uni = out / "uniform"
     history = HistoryWriter(uni / "history.csv")
     say(f"{problem.name}: uniform refinement for comparison -> {uni}")
@@ -152,7 +189,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "run":
             return run(args)
         if args.command == "figures":
-            written = _figures(args.example, args.out)
+            written = _figures(_label(args.example), args.out)
             print("\n".join(str(p) for p in written))
             return 0
     except (ValueError, RuntimeError, OSError) as exc:
