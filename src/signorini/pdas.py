@@ -456,7 +456,7 @@ class _System:
         r[self.fixed] = self.diagonal[self.fixed] * x[self.fixed]
         r -= b
         scale = max(np.abs(b).max(), np.abs(self.diagonal).max() * np.abs(x).max(), 1e-300)
-        if np.abs(r).max() > 1e-10 * scale:
+        if np.abs(r).max() > 1e-12 * scale:
             return None
         self.n_updates += 1
         return x
