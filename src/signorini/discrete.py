@@ -21,7 +21,7 @@ from .elasticity import (
     energy_error2,
     h1_seminorm_error2,
 )
-from .frames import rotate_frames, to_cartesian, to_frames
+from .frames import rotate_frames, to_cartesian
 from .linsolve import make_solver
 from .mesh import Mesh
 from .pdas import PDASResult, solve_pdas
@@ -213,14 +213,13 @@ def solve(
     if assembled is None:
         assembled = assemble(problem, mesh)
     space, cs = assembled.space, assembled.contact
-    x0 = active0 = None
+    active0 = None
     if u0 is not None:
         u0 = np.asarray(u0, dtype=np.float64)
         if u0.shape != (space.n_nodes, 2):
             raise ValueError(f"u0 must have shape ({space.n_nodes}, 2), got {u0.shape}")
         if not np.isfinite(u0).all():
             raise ValueError("u0 contains NaN or inf")
-        x0 = to_frames(u0.ravel(), cs.nodes, cs.normal)
         un = cs.normal_displacement(u0)
         scale = max(float(np.abs(cs.gap).max(initial=0)), float(np.abs(u0).max()), 1e-300)
         active0 = un - cs.gap >= -1e-10 * scale
@@ -230,7 +229,7 @@ def solve(
         res = solve_pdas(
             assembled.K, assembled.F, 2 * cs.nodes, cs.gap,
             assembled.dirichlet, assembled.dirichlet_values,
-            x0=x0, active0=active0, max_iter=max_iter, solver=solver, fallback=fallback,
+            active0=active0, max_iter=max_iter, solver=solver, fallback=fallback,
         )
     seconds = time.perf_counter() - t0
     u = to_cartesian(res.x, cs.nodes, cs.normal).reshape(-1, 2)

@@ -214,9 +214,7 @@ class Mesh:
         second = np.ones(inverse.size, dtype=bool)
         second[first] = False
         edge2cell[inverse[second], 1] = owner[second]
-        for a in (edges, cell2edge, edge2cell):
-            a.flags.writeable = False
-        return edges, cell2edge, edge2cell
+        return _frozen(edges), _frozen(cell2edge), _frozen(edge2cell)
 
     @property
     def edges(self) -> np.ndarray:

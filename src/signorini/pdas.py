@@ -386,7 +386,6 @@ class _System:
         self.K_c = K[c]  # rows of the constrained DOFs, for the multiplier
         self.solver = solver
         self.eliminator = SymmetricEliminator(K)
-        self.diagonal = K.diagonal()
         self.fixed = np.zeros(K.shape[0], dtype=bool)
         self.fixed[d] = True
         self.values = np.zeros(K.shape[0])
@@ -451,11 +450,12 @@ class _System:
         except np.linalg.LinAlgError:
             return None
         # residual of the new eliminated system: free rows K x_free, fixed rows diag x
+        diagonal = self.K.data[self.eliminator.diagonal_positions]
         z = np.where(self.fixed, 0.0, x)
         r = self.K @ z
-        r[self.fixed] = self.diagonal[self.fixed] * x[self.fixed]
+        r[self.fixed] = diagonal[self.fixed] * x[self.fixed]
         r -= b
-        scale = max(np.abs(b).max(), np.abs(self.diagonal).max() * np.abs(x).max(), 1e-300)
+        scale = max(np.abs(b).max(), np.abs(diagonal).max() * np.abs(x).max(), 1e-300)
         if np.abs(r).max() > 1e-12 * scale:
             return None
         self.n_updates += 1
