@@ -22,10 +22,10 @@ from pathlib import Path
 import numpy as np
 
 from signorini import adaptive, example_6_2
-from signorini.discrete import assemble
-from signorini.io import HistoryWriter, write_vtu
-from signorini.linsolve import eliminate_symmetric, make_solver
-from signorini.tuning import retain_freed_memory
+from signorini.algebra.linsolve import eliminate_symmetric, make_solver
+from signorini.contact import assemble
+from signorini.output import HistoryWriter, write_vtu
+from signorini.runtime import retain_freed_memory
 
 
 def floor_seconds(problem, mesh, backend: str) -> tuple[float, int]:

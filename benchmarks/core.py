@@ -19,8 +19,8 @@ import time
 import numpy as np
 
 from signorini import estimate, example_6_2, refine_uniform
-from signorini.discrete import assemble, solve
-from signorini.tuning import retain_freed_memory
+from signorini.contact import assemble, solve
+from signorini.runtime import retain_freed_memory
 
 
 def timed(func):

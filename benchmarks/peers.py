@@ -22,10 +22,10 @@ import time
 import numpy as np
 
 from signorini import example_6_2, rectangle
-from signorini.discrete import solve
-from signorini.elasticity import Material, assemble_stiffness
-from signorini.space import P2Space
-from signorini.tuning import retain_freed_memory
+from signorini.contact.solution import solve
+from signorini.fem.elasticity import Material, assemble_stiffness
+from signorini.fem.space import P2Space
+from signorini.runtime import retain_freed_memory
 
 MATERIAL = Material.from_young(500.0, 0.3)
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from signorini import adaptive, example_6_1, example_6_2, plots
-from signorini.io import HistoryWriter
+from signorini.output import HistoryWriter
 
 EXAMPLES = {"example-6.1": example_6_1, "example-6.2": example_6_2}
 

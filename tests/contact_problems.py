@@ -2,13 +2,14 @@
 
 - :class:`Quadratic`: a quadratic displacement ``u_i = c_i + G_ij x_j + H_ijk x_j x_k / 2`` with
   its gradient, stress and ``div σ`` in closed form, and its rotated copy.
-- :func:`patch_problem`: a :class:`~signorini.problem.ContactProblem` whose exact solution is
-  a given quadratic (the discrete solution must reproduce it at every node).
+- :func:`patch_problem`: a :class:`~signorini.problem.ContactProblem` whose exact solution is a
+  given quadratic (the discrete solution must reproduce it at every node).
 - :func:`contact_patch_field`: a random quadratic with zero tangential and compressive normal
   stress on the bottom edge ``y = 0`` (normal ``(0, −1)``), so that it solves a Signorini
   problem with the gap ``ψ = u·n`` and every contact node active.
 - :func:`independent_system`: Cartesian ``K``, ``F`` and Dirichlet data assembled from the mesh
-  with :mod:`signorini.elasticity` only (no rotated frames, no :mod:`signorini.discrete`).
+  with :mod:`signorini.fem.elasticity` only (no rotated frames, no
+  :mod:`signorini.contact.solution`).
 """
 
 from __future__ import annotations
@@ -17,15 +18,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from signorini.elasticity import (
+from signorini.fem.elasticity import (
     Material,
     assemble_body_force,
     assemble_edge_load,
     assemble_stiffness,
     stress,
 )
-from signorini.mesh import Mesh
-from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
+from signorini.mesh.mesh import Mesh
+from signorini.problem.problem import Contact, ContactProblem, Dirichlet, Neumann
 
 
 def rotation(angle_deg: float) -> np.ndarray:

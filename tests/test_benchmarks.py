@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from signorini.tuning import retain_freed_memory
+from signorini.runtime import retain_freed_memory
 
 ROOT = Path(__file__).resolve().parents[1]
 

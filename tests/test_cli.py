@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from signorini.cli import main
-from signorini.discrete import solve
-from signorini.estimator import estimate
+from signorini.contact.solution import solve
+from signorini.estimator.residual import estimate
 from signorini.examples import example_6_1
 
 REQUIRED = ["level", "ndof", "n_cells", "eta", *[f"eta{k}" for k in range(1, 8)],

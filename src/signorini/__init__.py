@@ -7,19 +7,15 @@ The public API, from the mesh to the adaptive loop::
                            adaptive)
 """
 
-from .discrete import ContactResult, solve
-from .driver import Level, LevelRecord, adaptive
-from .elasticity import Material
-from .estimator import Estimate, estimate
+from .algebra import PDASConvergenceError
+from .contact import ContactResult, solve
+from .estimator import Estimate, estimate, mark_doerfler
 from .examples import example_6_1, example_6_2
-from .io import read_mesh, write_vtu
-from .marking import mark_doerfler
-from .mesh import Mesh, MeshError
-from .meshes import rectangle
-from .pdas import PDASConvergenceError
+from .fem import Material, P2Space
+from .loop import Level, LevelRecord, adaptive
+from .mesh import Mesh, MeshError, read_mesh, rectangle, refine_nvb, refine_uniform
+from .output import write_vtu
 from .problem import Contact, ContactProblem, Dirichlet, ExactSolution, Neumann, ProblemError
-from .refine import refine_nvb, refine_uniform
-from .space import P2Space
 
 __version__ = "0.1.0"
 

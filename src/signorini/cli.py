@@ -19,12 +19,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .driver import Level, adaptive
-from .estimator import ETA5_VARIANTS
+from .estimator.residual import ETA5_VARIANTS
 from .examples import EXAMPLES, get_example
-from .io import HistoryWriter, write_vtu
-from .problem import ContactProblem
-from .tuning import retain_freed_memory
+from .loop import Level, adaptive
+from .output import HistoryWriter, write_vtu
+from .problem.problem import ContactProblem
+from .runtime import retain_freed_memory
 
 __all__ = ["main"]
 

@@ -12,9 +12,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .elasticity import Material, stress
-from .meshes import rectangle
-from .problem import Contact, ContactProblem, Dirichlet, ExactSolution, Neumann
+from .fem.elasticity import Material, stress
+from .mesh.builders import rectangle
+from .problem.problem import Contact, ContactProblem, Dirichlet, ExactSolution, Neumann
 
 __all__ = ["example_6_1", "example_6_2", "EXAMPLES", "get_example"]
 

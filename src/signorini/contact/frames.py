@@ -1,0 +1,192 @@
+"""Rotation of the two DOFs of a node into its (normal, tangential) frame.
+
+A contact node ``z`` has a constant outward unit normal ``n = (n1, n2)`` and the tangent
+``t = (-n2, n1)``. With interleaved DOFs (``dof = 2 * node + component``), the Cartesian values
+``u = (x[2z], x[2z + 1])`` and the frame values ``(u.n, u.t)`` are related by the 2 x 2 block
+``Q_z = [n t]``: ``u = Q_z (u.n, u.t)``. ``Q`` is block diagonal with ``Q_z`` at the listed
+nodes and the identity elsewhere, so the constraint ``u(z).n <= gap`` of DESIGN.md section 1
+becomes a bound on the single DOF ``2z`` of the rotated system ``Q^T K Q y = Q^T F``.
+
+:func:`rotate_frames` forms ``Q^T K Q`` directly on the CSR values: a stiffness matrix with
+interleaved DOFs has a 2 x 2 node-block pattern (rows ``2z`` and ``2z + 1`` store the same
+columns, and columns ``2z``, ``2z + 1`` sit next to each other in every row), so the product
+only mixes pairs of stored values.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..algebra.linsolve import as_csr, csr_row_indices
+
+__all__ = ["rotate_frames", "to_cartesian", "to_frames"]
+
+
+def _check_frames(nodes: np.ndarray, normals: np.ndarray, n_dofs: int) -> tuple[np.ndarray, ...]:
+    """Validate ``nodes (k,)`` and unit ``normals (k, 2)``; return them as int64 / float64."""
+    if n_dofs % 2:
+        raise ValueError(f"interleaved 2D DOFs need an even size, got {n_dofs}")
+    nodes = np.asarray(nodes)
+    if nodes.ndim != 1 or not (nodes.size == 0 or np.issubdtype(nodes.dtype, np.integer)):
+        raise ValueError(f"nodes must be a 1D integer array, got dtype {nodes.dtype}")
+    nodes = nodes.astype(np.int64)
+    n_nodes = n_dofs // 2
+    if nodes.size and (nodes.min() < 0 or nodes.max() >= n_nodes):
+        raise ValueError(f"nodes must lie in [0, {n_nodes}), got range "
+                         f"[{nodes.min()}, {nodes.max()}]")
+    if np.unique(nodes).size != nodes.size:
+        raise ValueError("nodes has repeated entries")
+    normals = np.asarray(normals, dtype=np.float64)
+    if normals.shape != (nodes.size, 2):
+        raise ValueError(f"normals must have shape ({nodes.size}, 2), got {normals.shape}")
+    if not np.isfinite(normals).all():
+        raise ValueError("normals has non-finite entries")
+    length = np.hypot(normals[:, 0], normals[:, 1])
+    if nodes.size and np.abs(length - 1.0).max() > 1e-10:
+        k = int(np.argmax(np.abs(length - 1.0)))
+        raise ValueError(f"normals must be unit vectors; normals[{k}] has length {length[k]:.6g}")
+    return nodes, normals
+
+
+def _rotate_pairs(
+    first: np.ndarray, second: np.ndarray, n1: np.ndarray, n2: np.ndarray, values: np.ndarray
+) -> None:
+    """In place: ``(v[first], v[second]) <- (n1 v1 + n2 v2, -n2 v1 + n1 v2)`` (i.e. ``Q^T v``)."""
+    v1 = values[first]
+    v2 = values[second]
+    values[first] = n1 * v1 + n2 * v2
+    values[second] = n1 * v2 - n2 * v1
+
+
+def to_frames(x: np.ndarray, nodes: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Cartesian DOF values to (normal, tangential) values at the listed nodes: ``Q^T x``.
+
+    Parameters
+    ----------
+    x : (n_dofs,) or (n_dofs, k) float array
+        Interleaved Cartesian values.
+    nodes : (m,) int array
+        Nodes to rotate (distinct).
+    normals : (m, 2) float array
+        Unit outward normal at each node.
+
+    Returns
+    -------
+    (n_dofs,) or (n_dofs, k) float array
+        ``y[2z] = u(z).n``, ``y[2z + 1] = u(z).t`` with ``t = (-n2, n1)``; other DOFs copied.
+    """
+    y = np.array(x, dtype=np.float64)
+    nodes, normals = _check_frames(nodes, normals, y.shape[0])
+    shape = (-1,) + (1,) * (y.ndim - 1)
+    n1, n2 = normals[:, 0].reshape(shape), normals[:, 1].reshape(shape)
+    _rotate_pairs(2 * nodes, 2 * nodes + 1, n1, n2, y)
+    return y
+
+
+def to_cartesian(y: np.ndarray, nodes: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """(normal, tangential) values at the listed nodes back to Cartesian values: ``Q y``.
+
+    Parameters
+    ----------
+    y : (n_dofs,) or (n_dofs, k) float array
+    nodes : (m,) int array
+    normals : (m, 2) float array
+
+    Returns
+    -------
+    (n_dofs,) or (n_dofs, k) float array
+        ``x[2z : 2z + 2] = y[2z] n + y[2z + 1] t``; other DOFs copied.
+    """
+    normals = np.asarray(normals, dtype=np.float64)
+    # Q_z^{-1} = Q_z^T is the frame of the reflected normal (n1, -n2).
+    mirrored = normals * np.array([1.0, -1.0]) if normals.ndim == 2 else normals
+    return to_frames(y, nodes, mirrored)
+
+
+def rotate_frames(
+    K: sp.spmatrix,
+    F: np.ndarray,
+    nodes: np.ndarray,
+    normals: np.ndarray,
+    *,
+    copy: bool = True,
+) -> tuple[sp.csr_matrix, np.ndarray]:
+    """Rotate a system ``K x = F`` into node frames: ``(Q^T K Q, Q^T F)``.
+
+    Works on the CSR values only (no sparse product): the column rotation mixes the two
+    adjacent stored values of columns ``2z``, ``2z + 1`` in every row, and the row rotation
+    mixes rows ``2z`` and ``2z + 1`` entry by entry, which store the same columns.
+
+    Parameters
+    ----------
+    K : scipy sparse matrix, shape (n_dofs, n_dofs)
+        With a 2 x 2 node-block pattern at the listed nodes (checked).
+    F : (n_dofs,) float array
+    nodes : (m,) int array
+        Nodes to rotate (distinct).
+    normals : (m, 2) float array
+        Unit outward normal ``n`` at each node; the tangent is ``t = (-n2, n1)``.
+    copy : bool
+        If False and ``K`` is canonical float64 CSR and ``F`` a float64 array, both are
+        overwritten and returned.
+
+    Returns
+    -------
+    K_rot : scipy.sparse.csr_matrix, shape (n_dofs, n_dofs)
+        Same pattern as ``K``.
+    F_rot : (n_dofs,) float array
+
+    Raises
+    ------
+    ValueError
+        On bad shapes or normals, or if the pattern is not node-blocked at a listed node.
+    """
+    K = as_csr(K, "K")
+    n = K.shape[0]
+    F_in = np.asarray(F)
+    if F_in.shape != (n,):
+        raise ValueError(f"F must have shape ({n},), got {F_in.shape}")
+    nodes, normals = _check_frames(nodes, normals, n)
+    if copy:
+        K = K.copy()
+    F_rot = np.array(F_in, dtype=np.float64) if copy else np.asarray(F_in, dtype=np.float64)
+    n1, n2 = normals[:, 0], normals[:, 1]
+
+    indptr, indices = K.indptr, K.indices
+    # Row rotation: rows 2z and 2z + 1 must store the same columns.
+    start0, start1, end1 = indptr[2 * nodes], indptr[2 * nodes + 1], indptr[2 * nodes + 2]
+    length = start1 - start0
+    bad = np.flatnonzero(length != end1 - start1)
+    if bad.size == 0:
+        offset = np.arange(length.sum()) - np.repeat(np.cumsum(length) - length, length)
+        pos0 = np.repeat(start0, length) + offset
+        pos1 = pos0 + np.repeat(length, length)
+        mismatch = indices[pos0] != indices[pos1]
+        if mismatch.any():
+            which = np.repeat(np.arange(nodes.size), length)[mismatch]
+            bad = np.unique(which)
+    if bad.size:
+        raise ValueError(
+            f"K has no 2x2 node-block pattern: rows 2z, 2z+1 of node {nodes[bad[0]]} store "
+            "different columns"
+        )
+    # Column rotation: in every row, column 2z is stored and followed by column 2z + 1.
+    which_node = np.full(n // 2, -1, dtype=np.int64)
+    which_node[nodes] = np.arange(nodes.size)
+    col_node = which_node[indices >> 1]
+    first = np.flatnonzero((col_node >= 0) & (indices % 2 == 0))
+    second = first + 1
+    rows = csr_row_indices(K)
+    ok = (second < K.nnz) & (indices[np.minimum(second, K.nnz - 1)] == indices[first] + 1)
+    ok &= rows[np.minimum(second, K.nnz - 1)] == rows[first]
+    if not ok.all() or 2 * first.size != np.count_nonzero(col_node >= 0):
+        raise ValueError(
+            "K has no 2x2 node-block pattern: columns 2z and 2z+1 of a rotated node are not "
+            "stored side by side in every row"
+        )
+    data = K.data
+    _rotate_pairs(first, second, n1[col_node[first]], n2[col_node[first]], data)
+    _rotate_pairs(pos0, pos1, np.repeat(n1, length), np.repeat(n2, length), data)
+    _rotate_pairs(2 * nodes, 2 * nodes + 1, n1, n2, F_rot)
+    return K, F_rot

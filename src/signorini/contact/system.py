@@ -1,0 +1,86 @@
+"""The algebraic contact problem of one mesh (paper, Section 3): stiffness, load, Dirichlet
+data and the constrained nodes, with the contact nodes rotated into (normal, tangential)
+frames.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..fem.elasticity import assemble_body_force, assemble_edge_load, assemble_stiffness
+from ..fem.space import P2Space
+from ..mesh.mesh import Mesh
+from ..problem.problem import ContactProblem, Dirichlet, Neumann, evaluate_field
+from .contact_set import ContactSet, contact_set
+from .frames import rotate_frames
+
+__all__ = ["Assembled", "assemble", "LOAD_DEGREE"]
+
+#: quadrature degree for loads with smooth data
+LOAD_DEGREE = 8
+
+
+@dataclass
+class Assembled:
+    """The algebraic problem of one mesh, in rotated (normal, tangential) contact frames."""
+
+    space: P2Space
+    contact: ContactSet
+    K: sp.csr_matrix
+    F: np.ndarray
+    dirichlet: np.ndarray  # DOFs
+    dirichlet_values: np.ndarray
+    seconds: float
+
+
+def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
+    """Stiffness, load and constraints of ``problem`` on ``mesh`` (paper, Section 3).
+
+    The two DOFs of every constrained node are rotated into (normal, tangential) components
+    so that ``u(z)·n ≤ ψ(z)`` becomes a bound on one unknown.
+    """
+    t0 = time.perf_counter()
+    space = P2Space(mesh)
+    n_dofs = space.n_dofs
+    K = assemble_stiffness(space.vertices, space.cell_dofs, n_dofs, problem.material)
+    F = np.zeros(n_dofs)
+    if problem.body_force is not None:
+        F += assemble_body_force(space.vertices, space.cell_dofs, n_dofs,
+                                 lambda x: evaluate_field(problem.body_force, x, "body_force"),
+                                 degree=LOAD_DEGREE)
+    for name in problem.neumann_parts:
+        cond: Neumann = problem.conditions[name]
+        if cond.is_zero:
+            continue
+        edges = mesh.part_edges(name)
+        nodes = space.edge_nodes(edges)
+        dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1, 6)
+        g = cond.field()
+
+        def traction(x, n, g=g, name=name):
+            return evaluate_field(lambda y: g(y, n), x, f"the traction of part {name!r}")
+
+        F += assemble_edge_load(mesh.points[nodes[:, :2]], dofs, n_dofs, traction,
+                                degree=LOAD_DEGREE)
+    # Dirichlet nodes and values (a node on two Dirichlet parts takes the later part's value)
+    nodes_list, values_list = [], []
+    for name in problem.dirichlet_parts:
+        cond: Dirichlet = problem.conditions[name]
+        nodes = space.part_nodes([name])
+        values = evaluate_field(cond.field(), space.node_points[nodes],
+                                f"the Dirichlet value of part {name!r}")
+        nodes_list.append(nodes)
+        values_list.append(values)
+    d_nodes = np.concatenate(nodes_list)
+    d_values = np.concatenate(values_list)
+    d_nodes, last = np.unique(d_nodes[::-1], return_index=True)
+    d_values = d_values[::-1][last]
+    dirichlet = np.column_stack([2 * d_nodes, 2 * d_nodes + 1]).ravel()
+
+    cs = contact_set(problem, space)
+    K, F = rotate_frames(K, F, cs.nodes, cs.normal)
+    return Assembled(space, cs, K, F, dirichlet, d_values.ravel(), time.perf_counter() - t0)

@@ -1,0 +1,146 @@
+"""The conforming P2 Lagrange space on a mesh: nodes, DOF maps, interpolation, prolongation.
+
+Global P2 nodes are the mesh vertices (node index = point index) followed by the edge
+midpoints (node index = ``n_points + edge index``). Vector DOFs are interleaved:
+``dof = 2 * node + component``. Local node order on a cell: its three vertices, then the
+midpoints of local edges 0, 1, 2 (the order of VTK's quadratic triangle / meshio ``triangle6``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from functools import cached_property
+
+import numpy as np
+
+from ..mesh.mesh import Mesh
+from ..mesh.refine import Refinement
+
+__all__ = ["P2Space", "p2_from_barycentric"]
+
+
+def p2_from_barycentric(bary: np.ndarray) -> np.ndarray:
+    """P2 basis values ``(..., 6)`` at points given by barycentric coordinates ``(..., 3)``."""
+    l0, l1, l2 = bary[..., 0], bary[..., 1], bary[..., 2]
+    return np.stack(
+        [l0 * (2 * l0 - 1), l1 * (2 * l1 - 1), l2 * (2 * l2 - 1),
+         4 * l0 * l1, 4 * l1 * l2, 4 * l2 * l0],
+        axis=-1,
+    )
+
+
+class P2Space:
+    """Vector-valued continuous P2 finite elements on a :class:`~signorini.mesh.Mesh`.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    """
+
+    def __init__(self, mesh: Mesh) -> None:
+        self.mesh = mesh
+
+    @property
+    def n_nodes(self) -> int:
+        return self.mesh.n_points + self.mesh.n_edges
+
+    @property
+    def n_dofs(self) -> int:
+        return 2 * self.n_nodes
+
+    @cached_property
+    def cell_nodes(self) -> np.ndarray:
+        """``(n_cells, 6)`` global node of each local node."""
+        return np.hstack([self.mesh.cells, self.mesh.n_points + self.mesh.cell2edge])
+
+    @cached_property
+    def cell_dofs(self) -> np.ndarray:
+        """``(n_cells, 12)`` interleaved global DOFs (local DOF ``2 * node + component``)."""
+        n = self.cell_nodes
+        return np.stack([2 * n, 2 * n + 1], axis=-1).reshape(len(n), 12)
+
+    @cached_property
+    def node_points(self) -> np.ndarray:
+        """``(n_nodes, 2)`` coordinates of the P2 nodes."""
+        return np.vstack([self.mesh.points, self.mesh.edge_midpoints])
+
+    @cached_property
+    def vertices(self) -> np.ndarray:
+        """``(n_cells, 3, 2)`` vertex coordinates of each cell."""
+        return self.mesh.points[self.mesh.cells]
+
+    def edge_nodes(self, edge_index: np.ndarray) -> np.ndarray:
+        """``(k, 3)`` nodes ``[start, end, midpoint]`` of boundary edges, counter-clockwise."""
+        edge_index = np.asarray(edge_index, dtype=np.int64)
+        ab = self.mesh.oriented_boundary(edge_index)
+        return np.column_stack([ab, self.mesh.n_points + edge_index])
+
+    def part_nodes(self, names: Iterable[str]) -> np.ndarray:
+        """Sorted nodes on the closure of the named boundary parts (vertices and midpoints)."""
+        edges = np.concatenate([self.mesh.part_edges(n) for n in names] or [np.zeros(0, int)])
+        nodes = np.concatenate([self.mesh.edges[edges].ravel(), self.mesh.n_points + edges])
+        return np.unique(nodes)
+
+    def interpolate(self, func: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+        """Nodal interpolant ``(n_nodes, 2)`` of a vector field ``func(x (n, 2)) -> (n, 2)``."""
+        values = np.asarray(func(self.node_points), dtype=np.float64)
+        if values.shape != (self.n_nodes, 2):
+            raise ValueError(f"the function to interpolate must return shape ({self.n_nodes}, 2)"
+                             f" for {self.n_nodes} points, got {values.shape}")
+        return values
+
+    def cell_values(self, u: np.ndarray) -> np.ndarray:
+        """Per-cell interleaved coefficients ``(n_cells, 12)`` of nodal values ``(n_nodes, 2)``."""
+        return np.asarray(u).reshape(-1)[self.cell_dofs]
+
+    def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
+        """Exact interpolation of a P2 field of this space on the refined mesh.
+
+        Each new node lies in the parent cell of some new cell; the parent's quadratic is
+        evaluated there, so P2 functions are reproduced exactly (DESIGN.md §6).
+
+        Parameters
+        ----------
+        u : (n_nodes, 2) or (n_nodes,) array
+            Nodal values on this space (vector or scalar field).
+        refinement : Refinement
+            The refinement of ``self.mesh``.
+
+        Returns
+        -------
+        (n_nodes_new, 2) or (n_nodes_new,) array
+
+        Raises
+        ------
+        ValueError
+            If ``u`` does not have one row per node, or ``refinement`` is not a refinement of
+            this space's mesh.
+        """
+        u = np.asarray(u, dtype=np.float64)
+        if u.shape[0] != self.n_nodes:
+            raise ValueError(f"u has {u.shape[0]} nodes, the space has {self.n_nodes}")
+        fine = P2Space(refinement.mesh)
+        parent = np.asarray(refinement.parent)
+        if parent.shape != (fine.mesh.n_cells,) or (
+                parent.size and (parent.min() < 0 or parent.max() >= self.mesh.n_cells)):
+            raise ValueError("the refinement is not a refinement of this space's mesh (its parent "
+                             f"cells do not index the {self.mesh.n_cells} cells)")
+        P = self.vertices[parent]  # (m, 3, 2)
+        X = fine.node_points[fine.cell_nodes]  # (m, 6, 2)
+        J = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=-1)  # columns
+        rhs = (X - P[:, None, 0, :]).transpose(0, 2, 1)  # (m, 2, 6)
+        xi = np.linalg.solve(J, rhs).transpose(0, 2, 1)  # (m, 6, 2)
+        bary = np.concatenate([1 - xi.sum(-1, keepdims=True), xi], axis=-1)
+        if bary.min(initial=0.0) < -1e-8:
+            raise ValueError("the refinement is not a refinement of this space's mesh (a new "
+                             "cell is not inside its parent cell)")
+        phi = p2_from_barycentric(bary)  # (m, 6, 6): new local node, parent local node
+        coarse = u[self.cell_nodes[parent]]  # (m, 6) or (m, 6, 2)
+        if u.ndim == 1:
+            vals = np.einsum("mij,mj->mi", phi, coarse)
+            out = np.empty(fine.n_nodes)
+        else:
+            vals = np.einsum("mij,mjc->mic", phi, coarse)
+            out = np.empty((fine.n_nodes,) + u.shape[1:])
+        out[fine.cell_nodes.ravel()] = vals.reshape((-1,) + u.shape[1:])
+        return out

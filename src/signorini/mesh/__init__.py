@@ -1,0 +1,10 @@
+"""The mesh layer: the immutable triangulation with named boundary parts, built-in meshes,
+meshes read from files, and newest vertex bisection (the REFINE step)."""
+
+from .builders import rectangle
+from .gmsh import read_mesh
+from .mesh import Mesh, MeshError
+from .refine import Refinement, refine_nvb, refine_uniform
+
+__all__ = ["Mesh", "MeshError", "Refinement", "read_mesh", "rectangle", "refine_nvb",
+           "refine_uniform"]

@@ -1,0 +1,474 @@
+"""Tests of :mod:`signorini.mesh.mesh`: validation, topology, geometry, boundary parts."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial import Delaunay
+
+from signorini.mesh.builders import rectangle
+from signorini.mesh.mesh import Mesh, MeshError, boundary_edges
+
+
+def everything(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    return np.ones_like(x, dtype=bool)
+
+
+ALL = {"all": everything}
+
+# unit square split along its diagonal 0-2
+SQUARE_P = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+SQUARE_C = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def square4() -> tuple[np.ndarray, np.ndarray]:
+    """Unit square cut into four triangles through its centre."""
+    p = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5]], dtype=float)
+    c = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+    return p, c
+
+
+def hexfan() -> tuple[np.ndarray, np.ndarray]:
+    """Regular hexagon fanned around its centre, with one more triangle on a side."""
+    t = np.arange(6) * np.pi / 3
+    p = np.vstack([[0.0, 0.0], np.column_stack([np.cos(t), np.sin(t)]), [[1.5, 0.8]]])
+    c = [[0, 1 + k, 1 + (k + 1) % 6] for k in range(6)] + [[1, 7, 2]]
+    return p, np.array(c)
+
+
+def jittered_delaunay(n: int = 7, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Delaunay triangulation (scipy) of a jittered grid on the unit square, made CCW."""
+    rng = np.random.default_rng(seed)
+    s = np.linspace(0.0, 1.0, n)
+    x, y = np.meshgrid(s, s)
+    p = np.column_stack([x.ravel(), y.ravel()])
+    inner = (p > 0).all(1) & (p < 1).all(1)
+    p[inner] += rng.uniform(-0.3, 0.3, size=(inner.sum(), 2)) / (n - 1)
+    c = Delaunay(p).simplices.astype(np.int64)
+    d1, d2 = p[c[:, 1]] - p[c[:, 0]], p[c[:, 2]] - p[c[:, 0]]
+    cw = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0] < 0
+    c[cw] = c[cw][:, [0, 2, 1]]
+    return p, c
+
+
+HAND_MESHES = {
+    "square2": lambda: (SQUARE_P, SQUARE_C),
+    "square4": square4,
+    "hexfan": hexfan,
+    "delaunay": jittered_delaunay,
+}
+
+
+# ---------------------------------------------------------------------------- validation
+def test_degenerate_triangle() -> None:
+    p = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [0.0, 1.0]])
+    with pytest.raises(MeshError, match=r"degenerate triangle\(s\) 1 .*cell 1 = \[0, 1, 2\]"):
+        Mesh.from_arrays(p, [[0, 1, 3], [0, 1, 2]], ALL)
+
+
+def test_repeated_vertex_is_degenerate() -> None:
+    with pytest.raises(MeshError, match="degenerate triangle.*repeated vertex"):
+        Mesh.from_arrays(SQUARE_P, [[0, 1, 1], [0, 2, 3]], ALL)
+
+
+def test_clockwise_triangle() -> None:
+    with pytest.raises(MeshError, match=r"clockwise triangle\(s\) 1: .*counter-clockwise"):
+        Mesh.from_arrays(SQUARE_P, [[0, 1, 2], [0, 3, 2]], ALL)
+
+
+def test_duplicate_points() -> None:
+    # two triangles that touch along the diagonal, but through copies of its end points
+    p = np.vstack([SQUARE_P, SQUARE_P[[0, 2]]])
+    with pytest.raises(MeshError, match=r"duplicate points 0, 2, 4, 5"):
+        Mesh.from_arrays(p, [[0, 1, 2], [4, 5, 3]], ALL)
+
+
+def test_unreferenced_points() -> None:
+    p = np.vstack([SQUARE_P, [[5.0, 5.0], [6.0, 5.0]]])
+    with pytest.raises(MeshError, match=r"unreferenced point\(s\) 4, 5"):
+        Mesh.from_arrays(p, SQUARE_C, ALL)
+
+
+def test_hanging_node() -> None:
+    # one triangle below the segment (0,0)-(2,0), four above it that use its midpoint 3
+    p = np.array([[0, 0], [2, 0], [1, -1], [1, 0], [1, 1], [0, 1], [2, 1]], dtype=float)
+    c = [[0, 2, 1], [0, 3, 4], [3, 1, 4], [0, 4, 5], [1, 6, 4]]
+    with pytest.raises(MeshError, match=r"point 3 lies inside edge \(0, 1\) \(hanging node\)"):
+        Mesh.from_arrays(p, c, ALL)
+
+
+@pytest.mark.parametrize("turn", [0.5 * np.pi, 0.3, 2.0])
+def test_hanging_node_in_any_direction(turn: float) -> None:
+    rot = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    p = np.array([[0, 0], [2, 0], [1, -1], [1, 0], [1, 1], [0, 1], [2, 1]], dtype=float)
+    c = [[0, 2, 1], [0, 3, 4], [3, 1, 4], [0, 4, 5], [1, 6, 4]]
+    with pytest.raises(MeshError, match=r"point 3 lies inside edge \(0, 1\) \(hanging node\)"):
+        Mesh.from_arrays(p @ rot.T + [5.0, -2.0], c, ALL)
+
+
+@pytest.mark.parametrize("pattern", ["unionjack", "crossed"])
+def test_bisecting_one_cell_alone_leaves_a_hanging_node(pattern: str) -> None:
+    # split each interior-edge cell in turn without touching its neighbour
+    m = rectangle(0, 1, 0, 2, nx=3, ny=3, pattern=pattern)
+    p = m.points @ np.array([[1.0, 0.4], [0.0, 1.0]]).T
+    interior = np.flatnonzero(m.edge2cell[m.cell2edge[:, 0], 1] >= 0)
+    assert interior.size > 10
+    for t in interior[::3]:
+        a, b, c = m.cells[t]
+        q = np.vstack([p, 0.5 * (p[a] + p[b])])
+        n = len(p)
+        cells = np.vstack([np.delete(m.cells, t, axis=0), [[c, a, n], [b, c, n]]])
+        lo, hi = sorted((a, b))
+        with pytest.raises(MeshError, match=rf"point {n} lies inside edge \({lo}, {hi}\)"):
+            Mesh.from_arrays(q, cells, ALL)
+
+
+def test_non_manifold_edge() -> None:
+    # three cells on the edge (0, 1): one below, two above
+    p = np.array([[0, 0], [1, 0], [0.5, 1], [0.5, -1], [0.2, 2]], dtype=float)
+    with pytest.raises(MeshError, match=r"non-manifold mesh: 1 edge\(s\).*first \(0, 1\)"):
+        Mesh.from_arrays(p, [[0, 1, 2], [1, 0, 3], [0, 1, 4]], ALL)
+
+
+def test_overlapping_cells() -> None:
+    # both cells lie above (0, 1): the edge is traversed twice in the same direction
+    p = np.array([[0, 0], [1, 0], [0, 1], [1, 1]], dtype=float)
+    m = Mesh.from_arrays(p, [[0, 1, 2], [1, 3, 2]], ALL)
+    with pytest.raises(MeshError, match=r"inconsistently oriented across edge \(0, 1\)"):
+        Mesh(p, [[0, 1, 2], [0, 1, 3]], m.boundary, m.boundary_part, m.part_names)
+
+
+def test_boundary_edges_without_part_from_arrays() -> None:
+    with pytest.raises(MeshError, match=r"3 boundary edge\(s\) have no part.*label every"):
+        Mesh.from_arrays(SQUARE_P, SQUARE_C, {"bottom": lambda x, y: y < 1e-12})
+
+
+def test_boundary_edges_without_part_constructor() -> None:
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
+    keep = np.any(np.sort(m.boundary, axis=1) != [2, 3], axis=1)
+    assert keep.sum() == 3
+    with pytest.raises(MeshError, match=r"1 boundary edge\(s\) without a part, first \(2, 3\)"):
+        Mesh(SQUARE_P, SQUARE_C, m.boundary[keep], m.boundary_part[keep], ["all"])
+
+
+def test_part_index_out_of_range() -> None:
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
+    with pytest.raises(MeshError, match=r"4 boundary edge\(s\) have no part"):
+        Mesh(SQUARE_P, SQUARE_C, m.boundary, m.boundary_part + 1, ["all"])
+
+
+@pytest.mark.parametrize("empty", [lambda x, y: x > 5, [], np.zeros((0, 2), dtype=int)])
+def test_part_without_edges(empty) -> None:
+    with pytest.raises(MeshError, match=r"boundary part 'ghost' has no edges"):
+        Mesh.from_arrays(SQUARE_P, SQUARE_C, {"all": everything, "ghost": empty})
+
+
+def test_part_without_edges_constructor() -> None:
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
+    with pytest.raises(MeshError, match=r"boundary part 'x' has no edges"):
+        Mesh(SQUARE_P, SQUARE_C, m.boundary, m.boundary_part, ["all", "x"])
+
+
+def test_part_lists_interior_edge() -> None:
+    with pytest.raises(MeshError, match=r"part 'diag': \(2, 0\) is not a boundary edge"):
+        Mesh.from_arrays(SQUARE_P, SQUARE_C, {"diag": [[2, 0]], "rest": everything})
+
+
+def test_constructor_labels_interior_edge() -> None:
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
+    b = np.vstack([m.boundary, [[0, 2]]])
+    with pytest.raises(MeshError, match=r"edge \(0, 2\) is labelled as boundary but is shared"):
+        Mesh(SQUARE_P, SQUARE_C, b, np.append(m.boundary_part, 0), ["all"])
+
+
+def test_constructor_edge_not_in_mesh() -> None:
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
+    b = np.vstack([m.boundary, [[1, 3]]])
+    with pytest.raises(MeshError, match=r"boundary edge\(s\) 4 are not edges of the mesh"):
+        Mesh(SQUARE_P, SQUARE_C, b, np.append(m.boundary_part, 0), ["all"])
+
+
+def test_constructor_boundary_edge_twice() -> None:
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
+    b = np.vstack([m.boundary, m.boundary[:1, ::-1]])
+    with pytest.raises(MeshError, match="a boundary edge is listed twice"):
+        Mesh(SQUARE_P, SQUARE_C, b, np.append(m.boundary_part, 0), ["all"])
+
+
+def test_constructor_boundary_index_out_of_range() -> None:
+    # (0, 6) has the same key as the edge (1, 2) when n_points = 4: it must not pass
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
+    b = m.boundary.copy()
+    b[np.flatnonzero(np.sort(b, axis=1)[:, 0] == 1)[0]] = [0, 6]
+    with pytest.raises(MeshError, match=r"boundary edges refer to points outside 0\.\.3"):
+        Mesh(SQUARE_P, SQUARE_C, b, m.boundary_part, ["all"])
+
+
+@pytest.mark.parametrize(
+    "mapping",
+    [{"a": [[0, 1]], "b": [[1, 0]]}, {"a": everything, "b": everything},
+     {"a": [[0, 1], [1, 2]], "b": [[3, 2], [2, 1]], "c": everything}],
+)
+def test_edge_claimed_by_two_parts(mapping) -> None:
+    with pytest.raises(MeshError, match=r"boundary edge \(\d, \d\) is claimed by both parts "
+                                        r"'a' and 'b'"):
+        Mesh.from_arrays(SQUARE_P, SQUARE_C, mapping)
+
+
+def test_predicate_claims_only_unlisted_edges() -> None:
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, {"rest": everything, "contact": [[1, 0]]})
+    assert m.part_names == ("rest", "contact")
+    assert m.part_length("contact") == pytest.approx(1.0, abs=1e-15)
+    assert m.part_length("rest") == pytest.approx(3.0, abs=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("points", "cells", "match"),
+    [
+        (SQUARE_P[:, :1], SQUARE_C, r"points must have shape \(n_points, 2\), got \(4, 1\)"),
+        (SQUARE_P.ravel(), SQUARE_C, r"points must have shape \(n_points, 2\), got \(8,\)"),
+        (SQUARE_P, SQUARE_C[:, :2], r"cells must have shape \(n, 3\), got \(2, 2\)"),
+        (SQUARE_P, SQUARE_C.ravel(), r"cells must have shape \(n, 3\), got \(6,\)"),
+        (SQUARE_P, SQUARE_C + 1, r"cells refer to points outside 0\.\.3"),
+        (SQUARE_P, SQUARE_C - 1, r"cells refer to points outside 0\.\.3"),
+        (SQUARE_P, SQUARE_C + 0.5, "cells must hold integer point indices"),
+        (SQUARE_P, SQUARE_C[:0], "the mesh has no cells"),
+        (np.where([[0, 0], [0, 0], [0, 1], [0, 0]], np.nan, SQUARE_P), SQUARE_C,
+         r"point\(s\) 2 have non-finite coordinates"),
+        (np.where([[0, 0], [1, 0], [0, 0], [0, 0]], np.inf, SQUARE_P), SQUARE_C,
+         r"point\(s\) 1 have non-finite coordinates"),
+    ],
+)
+def test_bad_arrays(points, cells, match) -> None:
+    with pytest.raises(MeshError, match=match):
+        Mesh.from_arrays(points, cells, ALL)
+
+
+@pytest.mark.parametrize(
+    ("spec", "match"),
+    [
+        ([[0, 1, 2]], r"boundary edges must have shape \(n, 2\), got \(1, 3\)"),
+        ([[0, 9]], r"boundary edges refer to points outside 0\.\.3"),
+        (lambda x, y: True, r"predicate of boundary part 'a' must return one bool per edge "),
+    ],
+)
+def test_bad_part_specs(spec, match) -> None:
+    with pytest.raises(MeshError, match=match):
+        Mesh.from_arrays(SQUARE_P, SQUARE_C, {"a": spec})
+
+
+def test_constructor_bad_boundary_shape() -> None:
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
+    with pytest.raises(MeshError, match=r"boundary edges must have shape \(n, 2\)"):
+        Mesh(SQUARE_P, SQUARE_C, m.boundary.ravel()[:7], m.boundary_part, ["all"])
+    with pytest.raises(MeshError, match="boundary_part must have one entry per boundary edge"):
+        Mesh(SQUARE_P, SQUARE_C, m.boundary, m.boundary_part[:3], ["all"])
+
+
+def test_mesh_error_is_value_error() -> None:
+    assert issubclass(MeshError, ValueError)
+    with pytest.raises(ValueError, match="clockwise"):
+        Mesh.from_arrays(SQUARE_P, [[0, 2, 1], [0, 2, 3]], ALL)
+
+
+def test_unknown_part_name() -> None:
+    m = rectangle()
+    with pytest.raises(MeshError, match=r"no boundary part 'contact'; its parts are \['bottom'"):
+        m.part_edges("contact")
+
+
+# ---------------------------------------------------------------------------- positive cases
+def test_from_arrays_with_predicates() -> None:
+    p, c = jittered_delaunay(6, seed=3)
+    parts = {
+        "bottom": lambda x, y: y < 1e-12,
+        "right": lambda x, y: x > 1 - 1e-12,
+        "top": lambda x, y: y > 1 - 1e-12,
+        "left": lambda x, y: x < 1e-12,
+    }
+    m = Mesh.from_arrays(p, c, parts)
+    assert m.part_names == ("bottom", "right", "top", "left")
+    for name in m.part_names:
+        assert m.part_length(name) == pytest.approx(1.0, rel=1e-14)
+        assert m.part_edges(name).size == 5  # 6 points per side
+    mid = m.edge_midpoints
+    assert np.all(mid[m.part_edges("bottom"), 1] == 0.0)
+    assert np.all(mid[m.part_edges("left"), 0] == 0.0)
+    assert m.area.sum() == pytest.approx(1.0, rel=1e-14)
+
+
+def test_from_arrays_with_edge_lists() -> None:
+    p, c = square4()
+    # lists in either orientation, one of them flat
+    m = Mesh.from_arrays(p, c, {"south": [[1, 0]], "east": [1, 2], "rest": [[2, 3], [0, 3]]})
+    expect = {"south": {0, 1}, "east": {1, 2}, "rest": {2, 3, 0}}
+    for name, verts in expect.items():
+        e = m.edges[m.part_edges(name)]
+        assert set(e.ravel().tolist()) == verts
+    assert m.part_length("rest") == pytest.approx(2.0, abs=1e-15)
+    assert m.edge_part[m.edge2cell[:, 1] >= 0].tolist() == [-1] * 4
+    assert sorted(m.edge_part[m.edge2cell[:, 1] < 0].tolist()) == [0, 1, 2, 2]
+
+
+def test_mesh_is_immutable() -> None:
+    m = rectangle(nx=2, ny=2)
+    for a in (m.points, m.cells, m.boundary, m.boundary_part, m.edge_part):
+        with pytest.raises(ValueError, match="read-only"):
+            a[0] = 0
+
+
+# ---------------------------------------------------------------------------- topology
+def brute_force_edges(cells: np.ndarray) -> dict[frozenset, list[tuple[int, int]]]:
+    """Map each undirected edge to its (cell, local edge) occurrences."""
+    out: dict[frozenset, list[tuple[int, int]]] = {}
+    for t, cell in enumerate(cells.tolist()):
+        for k in range(3):
+            out.setdefault(frozenset((cell[k], cell[(k + 1) % 3])), []).append((t, k))
+    return out
+
+
+@pytest.mark.parametrize("name", sorted(HAND_MESHES))
+def test_topology_matches_brute_force(name: str) -> None:
+    p, c = HAND_MESHES[name]()
+    m = Mesh.from_arrays(p, c, ALL)
+    ref = brute_force_edges(m.cells)
+    assert m.n_edges == len(ref) == m.edges.shape[0]
+    assert m.edges.dtype == np.int64 and m.cell2edge.dtype == np.int64
+    assert np.all(m.edges[:, 0] < m.edges[:, 1])
+    assert {frozenset(e) for e in m.edges.tolist()} == set(ref)
+    for e, pair in enumerate(m.edges.tolist()):
+        occ = ref[frozenset(pair)]
+        # cell2edge: local edge k of cell t is this edge for every occurrence (t, k)
+        assert all(m.cell2edge[t, k] == e for t, k in occ)
+        cells = set(m.edge2cell[e].tolist()) - {-1}
+        assert cells == {t for t, _ in occ}
+        if len(occ) == 1:
+            assert m.edge2cell[e, 0] == occ[0][0] and m.edge2cell[e, 1] == -1
+        else:
+            assert len(occ) == 2 and m.edge2cell[e, 1] >= 0
+    # Euler: V - E + F = 1 for a triangulated disc
+    assert m.n_points - m.n_edges + m.n_cells == 1
+
+
+@pytest.mark.parametrize("name", sorted(HAND_MESHES))
+def test_local_edge_k_joins_vertices_k_and_k_plus_1(name: str) -> None:
+    p, c = HAND_MESHES[name]()
+    m = Mesh.from_arrays(p, c, ALL)
+    for k in range(3):
+        got = np.sort(m.edges[m.cell2edge[:, k]], axis=1)
+        want = np.sort(m.cells[:, [k, (k + 1) % 3]], axis=1)
+        assert np.array_equal(got, want)
+
+
+@pytest.mark.parametrize("name", sorted(HAND_MESHES))
+def test_boundary_edges_have_one_cell(name: str) -> None:
+    p, c = HAND_MESHES[name]()
+    m = Mesh.from_arrays(p, c, ALL)
+    counts = np.bincount(m.cell2edge.ravel(), minlength=m.n_edges)
+    on_boundary = m.edge2cell[:, 1] == -1
+    assert np.array_equal(on_boundary, counts == 1)
+    assert np.all(m.edge2cell[:, 0] >= 0)
+    assert np.array_equal(np.sort(m.boundary_edge), np.flatnonzero(on_boundary))
+    assert np.array_equal(m.edge_part >= 0, on_boundary)
+    # boundary_edges() gives each boundary edge once, in its cell's counter-clockwise order
+    be = boundary_edges(m.cells)
+    assert len(be) == on_boundary.sum()
+    directed = {(cell[k], cell[(k + 1) % 3]) for cell in m.cells.tolist() for k in range(3)}
+    assert all(tuple(e) in directed for e in be.tolist())
+
+
+def test_from_arrays_puts_longest_edge_first() -> None:
+    rng = np.random.default_rng(7)
+    p, c = jittered_delaunay(8, seed=1)
+    shift = rng.integers(0, 3, size=len(c))
+    rolled = c[np.arange(len(c))[:, None], (np.arange(3)[None, :] + shift[:, None]) % 3]
+    m = Mesh.from_arrays(p, rolled, ALL)
+    q = m.points[m.cells]
+    length = np.linalg.norm(q[:, [1, 2, 0]] - q, axis=2)  # edge k: vertex k -> k + 1
+    assert np.all(length[:, 0] >= length.max(axis=1))
+    # each cell is a cyclic rotation of the input cell (same vertices, same orientation)
+    rotations = np.stack([np.roll(rolled, -s, axis=1) for s in range(3)])
+    assert np.all((rotations == m.cells[None]).all(axis=2).any(axis=0))
+    assert np.all(m.area > 0)
+
+
+def test_oriented_boundary_is_counter_clockwise() -> None:
+    m = rectangle(-1.0, 2.0, 0.5, 1.5, nx=3, ny=2, pattern="crossed")
+    outward = {"bottom": (0, -1), "right": (1, 0), "top": (0, 1), "left": (-1, 0)}
+    for name, normal in outward.items():
+        pairs = m.oriented_boundary(m.part_edges(name))
+        t = m.points[pairs[:, 1]] - m.points[pairs[:, 0]]
+        n = np.column_stack([t[:, 1], -t[:, 0]]) / np.linalg.norm(t, axis=1)[:, None]
+        assert np.allclose(n, normal, atol=1e-15)
+    # the whole oriented boundary encloses the area positively (shoelace formula)
+    pairs = m.oriented_boundary(m.boundary_edge)
+    a, b = m.points[pairs[:, 0]], m.points[pairs[:, 1]]
+    assert 0.5 * np.sum(a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]) == pytest.approx(3.0, rel=1e-14)
+
+
+@pytest.mark.parametrize("name", sorted(HAND_MESHES))
+def test_oriented_boundary_keeps_cell_on_the_left(name: str) -> None:
+    p, c = HAND_MESHES[name]()
+    m = Mesh.from_arrays(p, c, ALL)
+    e = m.boundary_edge
+    pairs = m.oriented_boundary(e)
+    assert np.array_equal(np.sort(pairs, axis=1), m.edges[e])
+    third = m.cells[m.edge2cell[e, 0]].sum(axis=1) - pairs.sum(axis=1)
+    a, b, x = m.points[pairs[:, 0]], m.points[pairs[:, 1]], m.points[third]
+    cross = (b - a)[:, 0] * (x - a)[:, 1] - (b - a)[:, 1] * (x - a)[:, 0]
+    assert np.all(cross > 0)
+
+
+# ---------------------------------------------------------------------------- geometry
+def test_geometry_closed_form() -> None:
+    p, c = hexfan()
+    m = Mesh.from_arrays(p, c, ALL)
+    hexagon = 6 * np.sqrt(3) / 4
+    u, v = p[7] - p[1], p[2] - p[1]
+    extra = 0.5 * abs(u[0] * v[1] - u[1] * v[0])
+    assert m.area.sum() == pytest.approx(hexagon + extra, rel=1e-14)
+    assert np.allclose(m.area[:6], np.sqrt(3) / 4, rtol=1e-14)
+    # all hexagon edges have length 1
+    fan = m.cell2edge[:6].ravel()
+    assert np.allclose(m.edge_length[fan], 1.0, rtol=1e-14)
+    assert np.allclose(m.h[:6], 1.0, rtol=1e-14)
+    assert m.h[6] == pytest.approx(max(np.linalg.norm(p[7] - p[1]), np.linalg.norm(p[7] - p[2]),
+                                       1.0), rel=1e-14)
+    assert np.allclose(m.edge_midpoints, p[m.edges].mean(axis=1), rtol=0, atol=1e-15)
+    # the equilateral fan has min angle 60 degrees; the extra triangle is smaller
+    # law of cosines on the extra triangle (1, 7, 2): side s[k] is opposite vertex k
+    q = p[[1, 7, 2]]
+    s = [np.linalg.norm(q[(k + 1) % 3] - q[(k + 2) % 3]) for k in range(3)]
+    ang = [np.arccos((s[(k + 1) % 3] ** 2 + s[(k + 2) % 3] ** 2 - s[k] ** 2)
+                     / (2 * s[(k + 1) % 3] * s[(k + 2) % 3])) for k in range(3)]
+    assert sum(ang) == pytest.approx(np.pi)
+    assert m.min_angle() == pytest.approx(min(min(ang), np.pi / 3), rel=1e-12)
+
+
+def test_min_angle_of_rectangle_cells() -> None:
+    m = rectangle(0, 3, 0, 1, nx=2, ny=2, pattern="right")  # cells 1.5 x 0.5
+    assert m.min_angle() == pytest.approx(np.arctan(0.5 / 1.5), rel=1e-14)
+    assert np.allclose(m.h, np.hypot(1.5, 0.5), rtol=1e-14)
+
+
+def test_repr_counts() -> None:
+    m = rectangle(nx=2, ny=3)
+    assert repr(m) == "Mesh(n_points=12, n_cells=12, parts=['bottom', 'right', 'top', 'left'])"
+
+
+@pytest.mark.parametrize(("nx", "ny"), [(20_000, 1), (1, 20_000)])
+def test_long_boundary_validates(nx: int, ny: int) -> None:
+    # 40 000 boundary edges: the hanging-node check must not compare all pairs
+    m = rectangle(0, nx, 0, ny, nx=nx, ny=ny, pattern="left")
+    assert len(m.boundary) == 2 * (nx + ny)
+    assert m.part_length("bottom") == pytest.approx(nx, rel=1e-12)
+    assert m.part_length("left") == pytest.approx(ny, rel=1e-12)
+    assert m.area.sum() == pytest.approx(nx * ny, rel=1e-12)
+
+
+def test_cached_arrays_are_read_only():
+    mesh = rectangle(nx=2, ny=2)
+    for name in ("edges", "cell2edge", "edge2cell", "area", "edge_length", "h",
+                 "edge_midpoints", "boundary_edge", "edge_part", "points", "cells"):
+        with pytest.raises(ValueError, match="read-only"):
+            getattr(mesh, name)[0] = 0

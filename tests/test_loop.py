@@ -1,0 +1,249 @@
+"""Tests of the adaptive loop in :mod:`signorini.loop` on the paper's examples (§6)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import fields
+
+import numpy as np
+import pytest
+
+from signorini.contact.contact_set import FULL_CONTACT
+from signorini.estimator.marking import mark_doerfler
+from signorini.examples import example_6_1, example_6_2
+from signorini.loop import Level, LevelRecord, adaptive, free_ndof
+from signorini.mesh.refine import refine_nvb
+
+
+# ---------------------------------------------------------------------------- helpers
+def fitted_slope(ndof, values, last: int) -> float:
+    """Least-squares slope of log(values) against log(ndof) over the last ``last`` levels."""
+    x = np.log(np.asarray(ndof, dtype=float)[-last:])
+    y = np.log(np.asarray(values, dtype=float)[-last:])
+    return float(np.polyfit(x, y, 1)[0])
+
+
+def ndof_at(eta_target: float, ndof, eta) -> float:
+    """Unknowns at which a decreasing history first reaches ``eta_target`` (log-log
+    interpolation between the two levels around it)."""
+    ndof, eta = np.asarray(ndof, dtype=float), np.asarray(eta, dtype=float)
+    below = np.flatnonzero(eta <= eta_target)
+    assert below.size and below[0] > 0, "the target is not bracketed by the history"
+    i = below[0]
+    t = np.log(eta[i - 1] / eta_target) / np.log(eta[i - 1] / eta[i])
+    return float(np.exp(np.log(ndof[i - 1]) + t * np.log(ndof[i] / ndof[i - 1])))
+
+
+def dirichlet_nodes_by_coordinates(points: np.ndarray, side: str) -> int:
+    x, y = points[:, 0], points[:, 1]
+    on = {"top": np.abs(y - 1) < 1e-12, "left": np.abs(x) < 1e-12}[side]
+    return int(on.sum())
+
+
+def check_record(level: Level, has_exact: bool) -> None:
+    """Every field of the record is filled and agrees with the level's solution."""
+    r, res, est = level.record, level.result, level.estimate
+    row = r.row()
+    assert set(row) >= {f.name for f in fields(LevelRecord)} - {"extra"}
+    for key, value in row.items():
+        assert value is not None, key
+        if key in ("error_energy", "error_h1", "efficiency") and not has_exact:
+            assert math.isnan(value), key
+        elif isinstance(value, float):
+            assert math.isfinite(value), key
+    assert r.ndof == res.ndof and r.ndof_total == res.space.n_dofs
+    assert r.n_cells == res.mesh.n_cells
+    assert r.eta == est.eta > 0
+    np.testing.assert_array_equal([getattr(r, f"eta{k}") for k in range(1, 8)], est.eta_terms)
+    assert r.pdas_iterations >= 1 and r.n_solves >= 1 and r.n_factorizations >= 1
+    assert r.n_analyses >= 0
+    assert r.n_active == int(res.active.sum()) and r.n_constrained == res.contact.size
+    assert r.n_full_contact + r.n_semi_contact + r.n_no_contact == r.n_constrained
+    assert r.n_full_contact == int((res.classes == FULL_CONTACT).sum())
+    assert r.contact_force == pytest.approx(res.contact_force.sum(), rel=1e-14)
+    assert r.contact_force > 0
+    assert isinstance(r.backend, str) and r.backend
+    assert r.t_assemble > 0 and r.t_solve > 0 and r.t_estimate > 0
+    if level.marked is not None:
+        assert r.n_marked == int(level.marked.sum()) > 0
+        assert r.t_mark > 0 and r.t_refine > 0
+    if has_exact:
+        assert r.error_energy > 0 and r.error_h1 > 0
+        assert r.efficiency == pytest.approx(r.eta / r.error_energy, rel=1e-14)
+
+
+# ---------------------------------------------------------------------------- loop control
+def test_budget_is_never_exceeded_and_used_up():
+    problem = example_6_2()
+    max_ndof = 3000
+    levels = list(adaptive(problem, max_ndof=max_ndof, theta=0.4))
+    ndof = [lv.record.ndof for lv in levels]
+    print(f"adaptive, budget {max_ndof}: ndof {ndof}")
+    assert max(ndof) <= max_ndof
+    assert all(b > a for a, b in zip(ndof, ndof[1:], strict=False))
+    assert all(lv.marked is not None for lv in levels[:-1]) and levels[-1].marked is None
+    # the loop stopped because one more step would have broken the budget
+    last = levels[-1]
+    refined = refine_nvb(last.result.mesh, mark_doerfler(last.estimate.eta2, 0.4)).mesh
+    assert free_ndof(problem, refined) > max_ndof
+    # uniform refinement: Ndof = 2 (n_nodes − Dirichlet nodes), n_cells = 32 · 4^level
+    uniform = list(adaptive(problem, max_ndof=2112, uniform=True))
+    assert [lv.record.ndof for lv in uniform] == [144, 544, 2112]
+    assert [lv.record.n_cells for lv in uniform] == [32, 128, 512]
+    for lv in uniform:
+        pts = lv.result.space.node_points
+        assert lv.record.ndof == 2 * (len(pts) - dirichlet_nodes_by_coordinates(pts, "left"))
+
+
+def test_stops_at_tolerance_and_after_max_levels():
+    problem = example_6_2()
+    tol = 60.0
+    levels = list(adaptive(problem, tol=tol, max_ndof=10**6))
+    eta = [lv.record.eta for lv in levels]
+    print(f"tol {tol}: eta {np.round(eta, 2)}")
+    assert eta[-1] <= tol and all(e > tol for e in eta[:-1])
+    assert levels[-1].marked is None
+    levels = list(adaptive(problem, max_levels=3, max_ndof=10**6))
+    assert [lv.record.level for lv in levels] == [0, 1, 2] and levels[-1].marked is None
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [({"theta": 0.0}, "theta"), ({"theta": 1.5}, "theta"), ({"theta": float("nan")}, "theta"),
+     ({"max_ndof": 0}, "max_ndof"), ({"max_ndof": 100}, "initial mesh")],
+)
+def test_bad_arguments_raise(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        next(adaptive(example_6_2(), **kwargs))
+
+
+def test_warm_start_needs_few_pdas_solves():
+    """Example 6.2: from level 5 on, the prolongated solution's contact set is nearly right,
+    so PDAS needs at most 2 solves per level on average (cold starts need several)."""
+    problem = example_6_2()
+    solves = {}
+    for warm in (True, False):
+        levels = list(adaptive(problem, max_ndof=8000, warm_start=warm))
+        solves[warm] = np.array([lv.record.n_solves for lv in levels])
+    warm_mean, cold_mean = solves[True][6:].mean(), solves[False][6:].mean()
+    print(f"PDAS solves per level after level 5: warm {warm_mean:.2f} {solves[True].tolist()}, "
+          f"cold {cold_mean:.2f} {solves[False].tolist()}")
+    assert len(solves[True]) > 10
+    assert warm_mean <= 2.0
+    assert cold_mean >= 2 * warm_mean
+
+
+@pytest.mark.parametrize(("example", "has_exact"), [(example_6_1, True), (example_6_2, False)])
+def test_records_have_every_field_filled(example, has_exact):
+    levels = list(adaptive(example(), max_ndof=2500))
+    assert len(levels) >= 4
+    for lv in levels:
+        check_record(lv, has_exact)
+    assert [lv.record.level for lv in levels] == list(range(len(levels)))
+
+
+def test_free_ndof_counts_non_dirichlet_unknowns():
+    problem = example_6_1()
+    for lv in adaptive(problem, max_ndof=800):
+        pts = lv.result.space.node_points
+        expected = 2 * (len(pts) - dirichlet_nodes_by_coordinates(pts, "top"))
+        assert free_ndof(problem, lv.result.mesh) == lv.record.ndof == expected
+
+
+# ---------------------------------------------------------------------------- Example 6.1
+@pytest.mark.slow
+def test_example_6_1_adaptive_rates_and_efficiency():
+    """Adaptive Example 6.1 to ~1e5 unknowns: error and η_h ~ Ndof^{-1}, a steady
+    efficiency index and full contact everywhere (η6 = η7 = 0)."""
+    max_ndof = 100_000
+    recs = []
+    for lv in adaptive(example_6_1(), max_ndof=max_ndof):
+        r = lv.record
+        recs.append(r)
+        assert r.eta6 == 0.0 and r.eta7 == 0.0
+        assert r.n_full_contact == r.n_constrained > 0
+        assert r.ndof <= max_ndof
+    ndof = [r.ndof for r in recs]
+    err = [r.error_energy for r in recs]
+    eta = [r.eta for r in recs]
+    eff = np.array([r.efficiency for r in recs])
+    s_err, s_eta = fitted_slope(ndof, err, 8), fitted_slope(ndof, eta, 8)
+    print(f"Example 6.1 adaptive: {len(recs)} levels, Ndof {ndof[0]}..{ndof[-1]}, "
+          f"slopes over the last 8 levels: error {s_err:.3f}, eta {s_eta:.3f}; "
+          f"efficiency {eff.min():.2f}..{eff.max():.2f} (max/min {eff.max() / eff.min():.3f})")
+    assert ndof[-1] > max_ndof / 2
+    assert s_err <= -0.9 and s_eta <= -0.9
+    assert eff.max() / eff.min() < 3
+
+
+# ---------------------------------------------------------------------------- Example 6.2
+@pytest.fixture(scope="module")
+def run_6_2():
+    """Example 6.2 adaptive to 6e4 unknowns and uniform to 4e4."""
+    adaptive_levels = list(adaptive(example_6_2(), max_ndof=60_000))
+    uniform_levels = list(adaptive(example_6_2(), max_ndof=40_000, uniform=True))
+    return adaptive_levels, uniform_levels
+
+
+@pytest.mark.slow
+def test_example_6_2_adaptive_rate_and_gain_over_uniform(run_6_2):
+    adaptive_levels, uniform_levels = run_6_2
+    ndof = [lv.record.ndof for lv in adaptive_levels]
+    eta = [lv.record.eta for lv in adaptive_levels]
+    u_ndof = [lv.record.ndof for lv in uniform_levels]
+    u_eta = [lv.record.eta for lv in uniform_levels]
+    s_eta = fitted_slope(ndof, eta, 8)
+    s_uniform = fitted_slope(u_ndof, u_eta, 2)
+    print(f"Example 6.2 adaptive: Ndof {ndof[-1]}, eta {eta[-1]:.4f}, slope over the last 8 "
+          f"levels {s_eta:.3f}; uniform: Ndof {u_ndof[-1]}, eta {u_eta[-1]:.4f}, last slope "
+          f"{s_uniform:.3f}")
+    assert s_eta <= -0.9
+    for target_level in (-2, -1):
+        target = u_eta[target_level]
+        n_adaptive = ndof_at(target, ndof, eta)
+        n_uniform = u_ndof[target_level]
+        print(f"eta = {target:.4f}: uniform needs {n_uniform} unknowns, adaptive "
+              f"{n_adaptive:.0f} (ratio {n_uniform / n_adaptive:.1f})")
+        assert n_uniform >= 3 * n_adaptive
+
+
+@pytest.mark.slow
+def test_example_6_2_refines_at_the_singular_points(run_6_2):
+    """The smallest cells gather where Γ_D meets Γ_N, (0, 0) and (0, 1), at the two ends of
+    the contact zone on x = 1, and at the kink of the obstacle ψ at (1, 1/2)."""
+    final = run_6_2[0][-1].result
+    mesh = final.mesh
+    cs = final.contact
+    y = final.space.node_points[cs.nodes, 1]
+    in_contact = np.sort(y[final.active])
+    y_lo, y_hi = in_contact[0], in_contact[-1]
+    # the contact zone is one interval, symmetric about y = 1/2
+    inside = (y > y_lo) & (y < y_hi)
+    assert final.active[inside].all()
+    assert abs(y_lo + y_hi - 1) < 1e-9
+    corners = np.array([[0, 0], [0, 1], [1, y_lo], [1, y_hi]])
+    kink = np.array([[1.0, 0.5]])
+    centre = mesh.points[mesh.cells].mean(axis=1)
+    area = mesh.area
+    smallest = np.argsort(area)[: mesh.n_cells // 100]
+
+    def radius(points):
+        d = np.linalg.norm(centre[smallest, None, :] - points[None], axis=2).min(axis=1)
+        return float(d.max())
+
+    r4, r5 = radius(corners), radius(np.vstack([corners, kink]))
+    print(f"contact zone y in [{y_lo:.5f}, {y_hi:.5f}]; the {smallest.size} smallest cells lie "
+          f"within r = {r5:.2e} of the 4 points and the kink (r = {r4:.3f} without the kink)")
+    assert r5 < 0.01
+
+    def finest_near(point, radius=0.05):
+        near = np.linalg.norm(centre - point, axis=1) < radius
+        return float(area[near].min())
+
+    control = np.array([[0.5, 0.0], [0.5, 1.0], [0.0, 0.5], [0.5, 0.5], [1.0, 0.05],
+                        [1.0, 0.33], [1.0, 0.67]])
+    coarse = min(finest_near(p) for p in control)
+    for p in np.vstack([corners, kink]):
+        fine = finest_near(p)
+        print(f"smallest cell near {np.round(p, 4)}: {fine:.2e} (away from them: {coarse:.2e})")
+        assert fine <= coarse / 20
