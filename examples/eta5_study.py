@@ -1,4 +1,4 @@
-"""The η5 question settled by measurement (DESIGN.md §5, docs/eta5.md).
+"""The η5 question settled by measurement (docs/method.md, *Estimator*, docs/eta5.md).
 
 Runs both variants of the estimator's normal-stress term η5 (``paper``: the full normal
 stress on Γ_C as printed; ``consistent``: balanced by the discrete pressure) on both of the

@@ -11,7 +11,7 @@ import pytest
 from signorini.contact.contact_set import FULL_CONTACT
 from signorini.estimator.marking import mark_doerfler
 from signorini.examples import example_6_1, example_6_2
-from signorini.loop import Level, LevelRecord, adaptive, free_ndof
+from signorini.loop import Level, LevelRecord, adaptive
 from signorini.mesh.refine import refine_nvb
 
 
@@ -85,7 +85,7 @@ def test_budget_is_never_exceeded_and_used_up():
     # the loop stopped because one more step would have broken the budget
     last = levels[-1]
     refined = refine_nvb(last.result.mesh, mark_doerfler(last.estimate.eta2, 0.4)).mesh
-    assert free_ndof(problem, refined) > max_ndof
+    assert problem.free_ndof(refined) > max_ndof
     # uniform refinement: Ndof = 2 (n_nodes − Dirichlet nodes), n_cells = 32 · 4^level
     uniform = list(adaptive(problem, max_ndof=2112, uniform=True))
     assert [lv.record.ndof for lv in uniform] == [144, 544, 2112]
@@ -147,7 +147,7 @@ def test_free_ndof_counts_non_dirichlet_unknowns():
     for lv in adaptive(problem, max_ndof=800):
         pts = lv.result.space.node_points
         expected = 2 * (len(pts) - dirichlet_nodes_by_coordinates(pts, "top"))
-        assert free_ndof(problem, lv.result.mesh) == lv.record.ndof == expected
+        assert problem.free_ndof(lv.result.mesh) == lv.record.ndof == expected
 
 
 # ---------------------------------------------------------------------------- Example 6.1

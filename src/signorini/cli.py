@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .estimator.marking import check_theta
 from .estimator.residual import ETA5_VARIANTS
 from .examples import EXAMPLES, get_example
 from .loop import Level, adaptive
@@ -102,8 +103,8 @@ def _progress(level: Level) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    if not args.uniform and not 0 < args.theta <= 1:
-        raise ValueError(f"--theta must lie in (0, 1], got {args.theta}")
+    if not args.uniform:
+        check_theta(args.theta, "--theta")
     if args.max_ndof <= 0:
         raise ValueError(f"--max-ndof must be positive, got {args.max_ndof}")
     problem = load_problem(args.example)

@@ -17,14 +17,13 @@ import numpy as np
 
 from .contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
 from .contact.solution import ContactResult, solve
-from .estimator.marking import mark_doerfler
+from .estimator.marking import check_theta, mark_doerfler
 from .estimator.residual import Estimate, estimate
-from .fem.space import P2Space
 from .mesh.mesh import Mesh
 from .mesh.refine import refine_nvb, refine_uniform
 from .problem.problem import ContactProblem
 
-__all__ = ["LevelRecord", "Level", "adaptive", "free_ndof"]
+__all__ = ["LevelRecord", "Level", "adaptive"]
 
 log = logging.getLogger(__name__)
 
@@ -87,12 +86,6 @@ class Level:
     marked: np.ndarray | None  # cells marked for refinement (None on the last level)
 
 
-def free_ndof(problem: ContactProblem, mesh: Mesh) -> int:
-    """Free scalar unknowns of the P2 space on ``mesh`` (the paper's Ndof)."""
-    space = P2Space(mesh)
-    return space.n_dofs - 2 * space.part_nodes(problem.dirichlet_parts).size
-
-
 def adaptive(
     problem: ContactProblem,
     *,
@@ -130,13 +123,13 @@ def adaptive(
     mesh : Mesh, optional
         Initial mesh (default: the problem's).
     """
-    if not uniform and not 0 < theta <= 1:
-        raise ValueError(f"theta must lie in (0, 1], got {theta}")
+    if not uniform:
+        theta = check_theta(theta)
     if max_ndof <= 0:
         raise ValueError(f"max_ndof must be positive, got {max_ndof}")
     mesh = problem.mesh if mesh is None else mesh
-    if free_ndof(problem, mesh) > max_ndof:
-        raise ValueError(f"the initial mesh already has {free_ndof(problem, mesh)} unknowns, "
+    if problem.free_ndof(mesh) > max_ndof:
+        raise ValueError(f"the initial mesh already has {problem.free_ndof(mesh)} unknowns, "
                          f"more than max_ndof={max_ndof}")
     u0 = None
     for level in range(max_levels):
@@ -156,7 +149,7 @@ def adaptive(
             t0 = time.perf_counter()
             refinement = refine_uniform(mesh) if uniform else refine_nvb(mesh, marked)
             next_mesh = refinement.mesh
-            last = free_ndof(problem, next_mesh) > max_ndof
+            last = problem.free_ndof(next_mesh) > max_ndof
             if not last and warm_start:
                 u0 = result.space.prolongate(result.u, refinement)
             record.t_refine = time.perf_counter() - t0

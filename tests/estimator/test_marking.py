@@ -1,4 +1,4 @@
-"""Tests of Dörfler marking in :mod:`signorini.estimator.marking` (DESIGN.md §6)."""
+"""Tests of Dörfler marking in :mod:`signorini.estimator.marking` (docs/method.md, *Marking and refinement*)."""
 
 from __future__ import annotations
 

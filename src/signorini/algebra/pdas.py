@@ -1,6 +1,6 @@
 """Primal-dual active set (PDAS) method for a bound-constrained quadratic program.
 
-The discrete Signorini problem of DESIGN.md sections 2-3, once the contact DOFs are rotated into
+The discrete Signorini problem of docs/method.md, *Discrete problem* and *Solver*, once the contact DOFs are rotated into
 their normal frames (:mod:`signorini.frames`), is the algebraic problem
 
 .. math::
@@ -566,7 +566,7 @@ def solve_pdas(
         Starting from the exact active set costs one linear solve.
     c : float, optional
         The positive constant of the active set rule; default the mean diagonal of ``K`` over
-        the constrained DOFs (DESIGN.md section 3).
+        the constrained DOFs (docs/method.md, *Solver*).
     max_iter : int
         Bound on PDAS iterations (linear solves).
     solver : SPDSolver, optional

@@ -3,7 +3,7 @@
 Constrained nodes are all P2 nodes (vertices and midpoints) on the closure of Γ_C that are
 not Dirichlet nodes; the discrete constraint is ``u_h(z)·n ≤ ψ(z)`` (paper, the set K^h of
 Section 3). From the nodal contact force ``Λ_z = L(ψ_z n) − a(u_h, ψ_z n)`` (3.5), (3.9),
-(3.17) we derive (DESIGN.md §2)
+(3.17) we derive (docs/method.md, *Discrete problem*)
 
 - the paper's contact force density ``s_z = Λ_z / m_z`` (4.1), with the lumped weights
   ``m_z = ∫ φ_z`` of the half-edge hats of Q^h (3.6): ``|e|/4`` per edge at a vertex,
@@ -108,7 +108,7 @@ def _locate(sorted_nodes: np.ndarray, query: np.ndarray) -> np.ndarray:
 
 
 def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
-    """Collect the constrained nodes of ``space`` for ``problem`` (DESIGN.md §2).
+    """Collect the constrained nodes of ``space`` for ``problem`` (docs/method.md, *Discrete problem*).
 
     Raises
     ------
@@ -138,7 +138,7 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
         cond: Contact = problem.conditions[p]
         edge_gap[sel] = cond.gap_values(x[sel], p)
 
-    dirichlet = space.part_nodes(problem.dirichlet_parts)
+    dirichlet = problem.dirichlet_nodes(space)
     nodes = np.setdiff1d(np.unique(edge_nodes), dirichlet)
     if nodes.size == 0:
         raise ProblemError("every node of the contact boundary is a Dirichlet node")

@@ -59,7 +59,7 @@ class ContactResult:
     contact_force: np.ndarray
     active: np.ndarray
     pdas: PDASResult
-    n_dirichlet_dofs: int
+    dirichlet_nodes: np.ndarray
     timings: dict = field(default_factory=dict)
 
     @property
@@ -69,7 +69,7 @@ class ContactResult:
     @property
     def ndof(self) -> int:
         """Free scalar unknowns (the paper's Ndof): all DOFs minus the Dirichlet ones."""
-        return self.space.n_dofs - self.n_dirichlet_dofs
+        return self.space.n_dofs - 2 * self.dirichlet_nodes.size
 
     @property
     def density(self) -> np.ndarray:
@@ -78,7 +78,7 @@ class ContactResult:
 
     @property
     def pressure(self) -> np.ndarray:
-        """Consistent nodal contact pressure ``p_z = Λ_z / ∫ψ_z`` (DESIGN.md §2)."""
+        """Consistent nodal contact pressure ``p_z = Λ_z / ∫ψ_z`` (docs/method.md, *Discrete problem*)."""
         return self.contact_force / self.contact.simpson
 
     @property
@@ -122,7 +122,7 @@ def solve(
     assembled: Assembled | None = None,
 ) -> ContactResult:
     """Solve the discrete Signorini problem (3.2) on ``mesh`` by the primal-dual active set
-    method (DESIGN.md §3).
+    method (docs/method.md, *Solver*).
 
     Parameters
     ----------
@@ -169,6 +169,6 @@ def solve(
              problem.name, space.n_dofs, res.iterations, int(res.active.sum()), cs.size)
     return ContactResult(
         problem=problem, space=space, u=u, contact=cs, contact_force=res.lam,
-        active=res.active, pdas=res, n_dirichlet_dofs=assembled.dirichlet.size,
+        active=res.active, pdas=res, dirichlet_nodes=assembled.dirichlet[::2] // 2,
         timings={"assemble": assembled.seconds, "solve": seconds},
     )

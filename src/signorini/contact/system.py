@@ -66,19 +66,14 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
 
         F += assemble_edge_load(mesh.points[nodes[:, :2]], dofs, n_dofs, traction,
                                 degree=LOAD_DEGREE)
-    # Dirichlet nodes and values (a node on two Dirichlet parts takes the later part's value)
-    nodes_list, values_list = [], []
+    # Dirichlet values (a node on two Dirichlet parts takes the later part's value)
+    d_nodes = problem.dirichlet_nodes(space)
+    d_values = np.empty((d_nodes.size, 2))
     for name in problem.dirichlet_parts:
         cond: Dirichlet = problem.conditions[name]
         nodes = space.part_nodes([name])
-        values = evaluate_field(cond.field(), space.node_points[nodes],
-                                f"the Dirichlet value of part {name!r}")
-        nodes_list.append(nodes)
-        values_list.append(values)
-    d_nodes = np.concatenate(nodes_list)
-    d_values = np.concatenate(values_list)
-    d_nodes, last = np.unique(d_nodes[::-1], return_index=True)
-    d_values = d_values[::-1][last]
+        d_values[np.searchsorted(d_nodes, nodes)] = evaluate_field(
+            cond.field(), space.node_points[nodes], f"the Dirichlet value of part {name!r}")
     dirichlet = np.column_stack([2 * d_nodes, 2 * d_nodes + 1]).ravel()
 
     cs = contact_set(problem, space)

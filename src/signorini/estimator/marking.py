@@ -1,4 +1,4 @@
-"""MARK: Dörfler (bulk) marking (DESIGN.md §6).
+"""MARK: Dörfler (bulk) marking (docs/method.md, *Marking and refinement*).
 
 References
 ----------
@@ -10,7 +10,17 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["mark_doerfler"]
+__all__ = ["check_theta", "mark_doerfler"]
+
+
+def check_theta(theta: float, name: str = "theta") -> float:
+    """The Dörfler parameter as a float in (0, 1]; a ``ValueError`` naming ``name`` otherwise."""
+    if isinstance(theta, bool) or not isinstance(theta, int | float | np.floating | np.integer):
+        raise ValueError(f"{name} must be a number in (0, 1], got {theta!r}")
+    theta = float(theta)
+    if not 0.0 < theta <= 1.0:
+        raise ValueError(f"{name} must lie in (0, 1], got {theta}")
+    return theta
 
 
 def mark_doerfler(eta2: np.ndarray, theta: float = 0.4) -> np.ndarray:
@@ -31,12 +41,7 @@ def mark_doerfler(eta2: np.ndarray, theta: float = 0.4) -> np.ndarray:
     -------
     (n_cells,) bool array
     """
-    try:
-        theta = float(theta)
-    except (TypeError, ValueError):
-        raise ValueError(f"theta must be a number in (0, 1], got {theta!r}") from None
-    if not 0.0 < theta <= 1.0:
-        raise ValueError(f"theta must lie in (0, 1], got {theta}")
+    theta = check_theta(theta)
     eta2 = np.asarray(eta2, dtype=np.float64)
     if eta2.ndim != 1:
         raise ValueError(f"eta2 must be one indicator per cell (1-d), got shape {eta2.shape}")

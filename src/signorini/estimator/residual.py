@@ -1,6 +1,6 @@
 """ESTIMATE: the residual a posteriori error estimator η_h of the paper (Section 5, (5.1)).
 
-For every non-Dirichlet P2 node p (DESIGN.md §5), with ``h_p = max_{T ∈ ω_p} h_T``:
+For every non-Dirichlet P2 node p (docs/method.md, *Estimator*), with ``h_p = max_{T ∈ ω_p} h_T``:
 
 ==== =========================================================== =====================
 η1   ``h_p² ‖f + div σ(u_h)‖²_{ω_p}``                               all free nodes
@@ -35,6 +35,7 @@ from ..contact.solution import ContactResult
 from ..fem.elasticity import div_stress, stress
 from ..fem.p2 import REFERENCE_NODES, edge_basis, field_gradients, physical_points
 from ..fem.quadrature import line_rule, triangle_rule
+from ..mesh.geometry import segment_normals
 from ..problem.problem import Neumann, evaluate_field
 from .hhalf import hhalf_norm2_positive_part
 
@@ -101,7 +102,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
         The discrete solution.
     eta5 : {"consistent", "paper"}
         ``"paper"`` is η5 as printed (the full normal stress on Γ_C); ``"consistent"``
-        balances it by the discrete pressure, ``σ_nn(u_h) + p_h`` (DESIGN.md §5).
+        balances it by the discrete pressure, ``σ_nn(u_h) + p_h`` (docs/method.md, *Estimator*).
     """
     if eta5 not in ETA5_VARIANTS:
         raise ValueError(f"eta5 must be one of {ETA5_VARIANTS}, got {eta5!r}")
@@ -113,7 +114,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     u_cell = space.cell_values(result.u)
 
     free = np.ones(n_nodes, dtype=bool)
-    free[space.part_nodes(problem.dirichlet_parts)] = False
+    free[result.dirichlet_nodes] = False
     h_p = np.zeros(n_nodes)
     np.maximum.at(h_p, cell_nodes.ravel(), np.repeat(mesh.h, 6))
     h_p = np.where(free, h_p, 0.0)  # Dirichlet nodes carry no term
@@ -138,7 +139,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     sig_v = stress(material, field_gradients(V, u_cell, REFERENCE_NODES[:3]))  # (m, 3, 2, 2)
     edges, e2c = mesh.edges, mesh.edge2cell
     n_points = mesh.n_points
-    local = _edge_local_index(mesh)  # (n_edges, 2)
+    local = mesh.edge_local  # (n_edges, 2)
     t, wt = line_rule(7)
 
     def traction(cell: np.ndarray, k: np.ndarray, tt: np.ndarray) -> np.ndarray:
@@ -146,10 +147,8 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
         s0 = sig_v[cell, k]
         s1 = sig_v[cell, (k + 1) % 3]
         sig = (1 - tt)[None, :, None, None] * s0[:, None] + tt[None, :, None, None] * s1[:, None]
-        a = mesh.points[mesh.cells[cell, k]]
-        b = mesh.points[mesh.cells[cell, (k + 1) % 3]]
-        d = b - a
-        n = np.column_stack([d[:, 1], -d[:, 0]]) / np.hypot(d[:, 0], d[:, 1])[:, None]
+        _, n = segment_normals(mesh.points[mesh.cells[cell, k]],
+                               mesh.points[mesh.cells[cell, (k + 1) % 3]])
         return np.einsum("eqij,ej->eqi", sig, n)
 
     def edge_nodes_of(e: np.ndarray) -> np.ndarray:
@@ -184,8 +183,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
             ab = mesh.cells[e2c[e, 0][:, None], (local[e, 0][:, None] + [0, 1]) % 3]
             a, b = mesh.points[ab[:, 0]], mesh.points[ab[:, 1]]
             x = a[:, None] + tn[None, :, None] * (b - a)[:, None]
-            d = b - a
-            n = (np.column_stack([d[:, 1], -d[:, 0]]) / np.hypot(d[:, 0], d[:, 1])[:, None])
+            _, n = segment_normals(a, b)
             g = cond.field()
             sn = sn - evaluate_field(lambda y, n=n, g=g: g(y, n[:, None, :]), x,
                                      f"the traction of part {name!r}")
@@ -231,20 +229,8 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     return Estimate(eta2_cell=eta2_cell, eta2_node=eta2_node, eta5=eta5)
 
 
-def _edge_local_index(mesh) -> np.ndarray:
-    """``(n_edges, 2)`` local index of each edge in ``edge2cell[:, 0]`` / ``[:, 1]``."""
-    c2e = mesh.cell2edge
-    cells = np.repeat(np.arange(mesh.n_cells), 3)
-    k = np.tile(np.arange(3), mesh.n_cells)
-    e = c2e.ravel()
-    slot = (mesh.edge2cell[e, 0] != cells).astype(np.int64)
-    out = np.full((mesh.n_edges, 2), -1, dtype=np.int64)
-    out[e, slot] = k
-    return out
-
-
 def third_integrals(v: np.ndarray, length: np.ndarray) -> np.ndarray:
-    """∫ v⁺ φ_p over the thirds γ̃_p of each edge (DESIGN.md §5, paper (4.12)).
+    """∫ v⁺ φ_p over the thirds γ̃_p of each edge (docs/method.md, *Estimator*, paper (4.12)).
 
     Parameters
     ----------

@@ -40,6 +40,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
+from ..mesh.geometry import segment_normals
 from . import p2
 from .quadrature import line_rule, triangle_rule
 
@@ -525,12 +526,11 @@ def edge_normals(edge_vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"edge_vertices must have shape (k, 2, 2), got {ev.shape}")
     if not np.all(np.isfinite(ev)):
         raise ValueError("edge_vertices contain non-finite coordinates")
-    d = ev[:, 1] - ev[:, 0]
-    length = np.hypot(d[:, 0], d[:, 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        length, normal = segment_normals(ev[:, 0], ev[:, 1])
     if np.any(length <= 0.0):
         bad = np.flatnonzero(length <= 0.0)
         raise ValueError(f"{bad.size} edge(s) have zero length (first: edge {bad[0]})")
-    normal = np.column_stack([d[:, 1], -d[:, 0]]) / length[:, None]
     return length, normal
 
 

@@ -232,6 +232,19 @@ class Mesh:
         return self._topology[2]
 
     @cached_property
+    def edge_local(self) -> np.ndarray:
+        """``(n_edges, 2)`` local index ``k`` of each edge in its cells ``edge2cell[:, 0]`` and
+        ``edge2cell[:, 1]`` (``-1`` outside the domain): ``cell2edge[edge2cell[e, s],
+        edge_local[e, s]] == e``."""
+        cells = np.repeat(np.arange(self.n_cells), 3)
+        k = np.tile(np.arange(3), self.n_cells)
+        e = self.cell2edge.ravel()
+        slot = (self.edge2cell[e, 0] != cells).astype(np.int64)
+        out = np.full((self.n_edges, 2), -1, dtype=np.int64)
+        out[e, slot] = k
+        return _frozen(out)
+
+    @cached_property
     def boundary_edge(self) -> np.ndarray:
         """``(n_boundary,)`` mesh edge index of each row of :attr:`boundary`."""
         keys = _edge_keys(self.edges, self.n_points)  # sorted by construction
@@ -266,7 +279,7 @@ class Mesh:
     def oriented_boundary(self, edge_index: np.ndarray) -> np.ndarray:
         """Vertex pairs ``(k, 2)`` of boundary edges, counter-clockwise around their cell."""
         cell = self.edge2cell[edge_index, 0]
-        local = np.argmax(self.cell2edge[cell] == edge_index[:, None], axis=1)
+        local = self.edge_local[edge_index, 0]
         a = self.cells[cell, local]
         b = self.cells[cell, (local + 1) % 3]
         return np.stack([a, b], axis=1)

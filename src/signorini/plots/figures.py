@@ -855,7 +855,7 @@ def plot_deformed(points: ArrayLike, cells: ArrayLike, displacement: ArrayLike,
     contact_points : (k, 2) float array, optional
         Reference coordinates of the contact nodes (needed with ``pressure``).
     pressure : (k,) float array, optional
-        Contact pressure at ``contact_points`` (e.g. ``p_z`` of DESIGN.md §2).
+        Contact pressure at ``contact_points`` (e.g. ``p_z`` of docs/method.md, *Discrete problem*).
     scale : float, default 1.0
         Magnification of the displacement in the drawing.
     obstacle : (j, 2) float array, optional

@@ -1,6 +1,6 @@
 """Problem definitions: material, data and boundary conditions of a Signorini problem.
 
-The strong form (paper, Section 2; DESIGN.md §1)::
+The strong form (paper, Section 2; docs/method.md, *The continuous problem*)::
 
     −div σ(u) = f in Ω,   u = u_D on Γ_D,   σ(u) n = g on Γ_N,
     u·n ≤ ψ,  σ_nn ≤ 0,  (u·n − ψ) σ_nn = 0,  σ_t = 0 on Γ_C.
@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..fem.elasticity import Material
+from ..fem.space import P2Space
+from ..mesh.geometry import segment_normals
 from ..mesh.mesh import Mesh
 
 __all__ = ["Dirichlet", "Neumann", "Contact", "ExactSolution", "ContactProblem", "ProblemError"]
@@ -179,13 +181,21 @@ class ContactProblem:
     def contact_parts(self) -> list[str]:
         return [n for n, c in self.conditions.items() if isinstance(c, Contact)]
 
+    def dirichlet_nodes(self, space: P2Space) -> np.ndarray:
+        """Sorted P2 nodes of ``space`` on the closure of Γ_D: both their DOFs are prescribed."""
+        return space.part_nodes(self.dirichlet_parts)
+
+    def free_ndof(self, mesh: Mesh) -> int:
+        """Free scalar unknowns on ``mesh``, the paper's Ndof: all P2 DOFs minus the Dirichlet
+        DOFs (docs/method.md, *Data conventions*)."""
+        space = P2Space(mesh)
+        return space.n_dofs - 2 * self.dirichlet_nodes(space).size
+
     def _segment_normal(self, name: str) -> np.ndarray:
         """Outward unit normal of a straight contact part, checked against a given one."""
         mesh = self.mesh
         ab = mesh.oriented_boundary(mesh.part_edges(name))
-        d = mesh.points[ab[:, 1]] - mesh.points[ab[:, 0]]
-        length = np.hypot(d[:, 0], d[:, 1])
-        n = np.column_stack([d[:, 1], -d[:, 0]]) / length[:, None]
+        _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
         mean = n.mean(axis=0)
         mean /= np.linalg.norm(mean)
         if np.abs(n - mean).max() > 1e-8:

@@ -1,0 +1,33 @@
+"""Geometry of straight segments: lengths and unit normals.
+
+The one place where an edge's normal is computed. For a segment traversed from ``a`` to
+``b`` the normal is the right-hand one, ``(d_y, −d_x) / |d|`` with ``d = b − a``: it points
+out of a counter-clockwise cell whose local edge runs from ``a`` to ``b``, so it is the
+outward normal of every boundary edge taken in its cell's counter-clockwise order.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["segment_normals"]
+
+
+def segment_normals(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Lengths and right-hand unit normals of the segments ``a → b``.
+
+    Parameters
+    ----------
+    a, b : (..., 2) float arrays
+        Start and end points.
+
+    Returns
+    -------
+    length : (...) float array
+    normal : (..., 2) float array
+        ``(d_y, −d_x) / |d|``, ``d = b − a``; outward for a counter-clockwise cell.
+    """
+    d = np.asarray(b, dtype=np.float64) - np.asarray(a, dtype=np.float64)
+    length = np.hypot(d[..., 0], d[..., 1])
+    normal = np.stack([d[..., 1], -d[..., 0]], axis=-1) / length[..., None]
+    return length, normal
