@@ -1,4 +1,5 @@
-"""The paper's numerical experiments as ready-made problems (paper, Section 6; docs/method.md, *The paper's examples*).
+"""The paper's numerical experiments as ready-made problems (paper, Section 6; docs/method.md, *The
+paper's examples*).
 
 Initial meshes (the paper does not give its own): the unit square cut into 4 × 4 squares, each
 split into two triangles with the diagonals of a "union jack" pattern (32 triangles), which is

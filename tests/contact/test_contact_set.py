@@ -1,7 +1,8 @@
 """The discrete contact boundary (:mod:`signorini.contact.contact_set`) and problem validation.
 
 Constrained nodes, the lumped and Simpson weights, the contact force density ``s_z`` (4.1) and
-the consistent pressure ``p_z`` (docs/method.md, *Discrete problem*), node classes (Section 4), and bad input.
+the consistent pressure ``p_z`` (docs/method.md, *Discrete problem*), node classes (Section 4), and
+bad input.
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""Tests of Dörfler marking in :mod:`signorini.estimator.marking` (docs/method.md, *Marking and refinement*)."""
+"""Tests of Dörfler marking in :mod:`signorini.estimator.marking` (docs/method.md, *Marking and
+refinement*)."""
 
 from __future__ import annotations
 

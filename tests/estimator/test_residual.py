@@ -1,4 +1,5 @@
-"""Tests of the residual estimator in :mod:`signorini.estimator.residual` (paper §5, docs/method.md, *Estimator*).
+"""Tests of the residual estimator in :mod:`signorini.estimator.residual` (paper §5, docs/method.md,
+*Estimator*).
 
 The reference values are computed here without the package's element machinery: on every
 cell the discrete displacement is refitted as a quadratic in monomials of (x, y) from its six

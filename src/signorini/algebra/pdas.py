@@ -1,6 +1,7 @@
 """Primal-dual active set (PDAS) method for a bound-constrained quadratic program.
 
-The discrete Signorini problem of docs/method.md, *Discrete problem* and *Solver*, once the contact DOFs are rotated into
+The discrete Signorini problem of docs/method.md, *Discrete problem* and *Solver*, once the contact
+DOFs are rotated into
 their normal frames (:mod:`signorini.frames`), is the algebraic problem
 
 .. math::

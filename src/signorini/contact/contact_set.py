@@ -108,7 +108,8 @@ def _locate(sorted_nodes: np.ndarray, query: np.ndarray) -> np.ndarray:
 
 
 def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
-    """Collect the constrained nodes of ``space`` for ``problem`` (docs/method.md, *Discrete problem*).
+    """Collect the constrained nodes of ``space`` for ``problem`` (docs/method.md, *Discrete
+    problem*).
 
     Raises
     ------

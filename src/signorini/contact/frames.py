@@ -4,7 +4,8 @@ A contact node ``z`` has a constant outward unit normal ``n = (n1, n2)`` and the
 ``t = (-n2, n1)``. With interleaved DOFs (``dof = 2 * node + component``), the Cartesian values
 ``u = (x[2z], x[2z + 1])`` and the frame values ``(u.n, u.t)`` are related by the 2 x 2 block
 ``Q_z = [n t]``: ``u = Q_z (u.n, u.t)``. ``Q`` is block diagonal with ``Q_z`` at the listed
-nodes and the identity elsewhere, so the constraint ``u(z).n <= gap`` of docs/method.md, *The continuous problem*
+nodes and the identity elsewhere, so the constraint ``u(z).n <= gap`` of docs/method.md, *The
+continuous problem*
 becomes a bound on the single DOF ``2z`` of the rotated system ``Q^T K Q y = Q^T F``.
 
 :func:`rotate_frames` forms ``Q^T K Q`` directly on the CSR values: a stiffness matrix with

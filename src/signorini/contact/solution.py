@@ -78,7 +78,8 @@ class ContactResult:
 
     @property
     def pressure(self) -> np.ndarray:
-        """Consistent nodal contact pressure ``p_z = Λ_z / ∫ψ_z`` (docs/method.md, *Discrete problem*)."""
+        """Consistent nodal contact pressure ``p_z = Λ_z / ∫ψ_z`` (docs/method.md, *Discrete
+        problem*)."""
         return self.contact_force / self.contact.simpson
 
     @property

@@ -97,7 +97,8 @@ class P2Space:
         """Exact interpolation of a P2 field of this space on the refined mesh.
 
         Each new node lies in the parent cell of some new cell; the parent's quadratic is
-        evaluated there, so P2 functions are reproduced exactly (docs/method.md, *Marking and refinement*).
+        evaluated there, so P2 functions are reproduced exactly (docs/method.md, *Marking and
+        refinement*).
 
         Parameters
         ----------
