@@ -53,8 +53,12 @@ def peak_rss_bytes() -> int:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--max-ndof", type=int, default=1_300_000,
-                        help="budget of unknowns (the default ends just above 10^6)")
+    parser.add_argument(
+        "--max-ndof",
+        type=int,
+        default=1_300_000,
+        help="budget of unknowns (the default ends just above 10^6)",
+    )
     parser.add_argument("--theta", type=float, default=0.4)
     parser.add_argument("--backend", default="auto")
     parser.add_argument("--vtu", action="store_true", help="also write a VTU file per level")
@@ -65,16 +69,29 @@ def main() -> None:
     history = HistoryWriter(out / "history.csv")
     problem = example_6_2()
 
-    cols = ("level", "ndof", "assemble", "pdas", "solves", "facts", "updates", "reused",
-            "estimate",
-            "mark", "refine", "output", "total", "floor", "ratio")
+    cols = (
+        "level",
+        "ndof",
+        "assemble",
+        "pdas",
+        "solves",
+        "facts",
+        "updates",
+        "reused",
+        "estimate",
+        "mark",
+        "refine",
+        "output",
+        "total",
+        "floor",
+        "ratio",
+    )
     print(" ".join(f"{c:>9s}" for c in cols))
     total = floor = 0.0
     phases = dict.fromkeys(("assemble", "pdas", "estimate", "mark", "refine", "output"), 0.0)
     solves_after_5: list[int] = []
     last_nnz = 0
-    generator = adaptive(problem, theta=args.theta, max_ndof=args.max_ndof,
-                         backend=args.backend)
+    generator = adaptive(problem, theta=args.theta, max_ndof=args.max_ndof, backend=args.backend)
     while True:
         t0 = time.perf_counter()
         level = next(generator, None)
@@ -93,36 +110,64 @@ def main() -> None:
         level_floor, last_nnz = floor_seconds(problem, mesh, backend)
         total += level_total
         floor += level_floor
-        for key, value in (("assemble", r.t_assemble), ("pdas", r.t_solve),
-                           ("estimate", r.t_estimate), ("mark", r.t_mark),
-                           ("refine", r.t_refine), ("output", r.t_output)):
+        for key, value in (
+            ("assemble", r.t_assemble),
+            ("pdas", r.t_solve),
+            ("estimate", r.t_estimate),
+            ("mark", r.t_mark),
+            ("refine", r.t_refine),
+            ("output", r.t_output),
+        ):
             phases[key] += value
         if r.level >= 5:
             solves_after_5.append(r.n_solves)
         reused = "yes" if r.n_analyses == 1 and r.n_factorizations >= 1 else "no"
-        values = (r.level, r.ndof, r.t_assemble, r.t_solve, r.n_solves, r.n_factorizations,
-                  r.n_updates, reused, r.t_estimate, r.t_mark, r.t_refine, r.t_output, level_total,
-                  level_floor, level_total / level_floor)
-        print(" ".join(f"{v:9.3f}" if isinstance(v, float) else f"{v!s:>9s}" for v in values),
-              flush=True)
+        values = (
+            r.level,
+            r.ndof,
+            r.t_assemble,
+            r.t_solve,
+            r.n_solves,
+            r.n_factorizations,
+            r.n_updates,
+            reused,
+            r.t_estimate,
+            r.t_mark,
+            r.t_refine,
+            r.t_output,
+            level_total,
+            level_floor,
+            level_total / level_floor,
+        )
+        print(
+            " ".join(f"{v:9.3f}" if isinstance(v, float) else f"{v!s:>9s}" for v in values),
+            flush=True,
+        )
 
     overhead = phases["estimate"] + phases["mark"] + phases["refine"]
     factor_bytes = 8 * last_nnz
     peak = peak_rss_bytes()
     print()
-    print(f"backend: {backend}; final level: {r.ndof} unknowns, {r.n_cells} cells, "
-          f"eta = {r.eta:.4e}")
+    print(
+        f"backend: {backend}; final level: {r.ndof} unknowns, {r.n_cells} cells, eta = {r.eta:.4e}"
+    )
     print(f"total time {total:.2f} s, sum of floors {floor:.2f} s")
     print("phase totals: " + ", ".join(f"{k} {v:.2f} s" for k, v in phases.items()))
     if solves_after_5:
-        print(f"PDAS linear solves per level after level 5: {np.mean(solves_after_5):.2f} "
-              f"(target <= 1.5)")
-    print(f"estimator + marking + refinement: {overhead:.2f} s = {100 * overhead / total:.1f} % "
-          "of the total (target <= 20 %)")
+        print(
+            f"PDAS linear solves per level after level 5: {np.mean(solves_after_5):.2f} "
+            f"(target <= 1.5)"
+        )
+    print(
+        f"estimator + marking + refinement: {overhead:.2f} s = {100 * overhead / total:.1f} % "
+        "of the total (target <= 20 %)"
+    )
     if factor_bytes:
-        print(f"peak memory {peak / 2**20:.0f} MiB, factor of the last level "
-              f"{factor_bytes / 2**20:.0f} MiB (8 bytes x {last_nnz} non-zeros): "
-              f"ratio {peak / factor_bytes:.2f} (target <= 2)")
+        print(
+            f"peak memory {peak / 2**20:.0f} MiB, factor of the last level "
+            f"{factor_bytes / 2**20:.0f} MiB (8 bytes x {last_nnz} non-zeros): "
+            f"ratio {peak / factor_bytes:.2f} (target <= 2)"
+        )
     else:
         print(f"peak memory {peak / 2**20:.0f} MiB (factor size unknown for {backend})")
     print(f"history: {out / 'history.csv'}")

@@ -40,8 +40,10 @@ def main() -> None:
     parser.add_argument("--backend", default="auto")
     args = parser.parse_args()
     retain_freed_memory()
-    print(f"{'unknowns':>10s} {'refine':>14s} {'assemble':>14s} {'PDAS solve':>20s} "
-          f"{'estimate':>14s} {'peak MiB':>9s}")
+    print(
+        f"{'unknowns':>10s} {'refine':>14s} {'assemble':>14s} {'PDAS solve':>20s} "
+        f"{'estimate':>14s} {'peak MiB':>9s}"
+    )
     for size in args.sizes:
         # the mesh before the last uniform refinement: about a quarter of the unknowns
         n = max(2, int(round((np.sqrt(size / 2) - 1) / 4)))
@@ -49,6 +51,7 @@ def main() -> None:
         problem = example_6_2(nx=n)
         coarse = problem.mesh
         _ = coarse.edges  # topology of the coarse mesh is not part of the refinement
+
         def refine(coarse=coarse):
             ref = refine_uniform(coarse)
             _ = ref.mesh.edges  # the refined mesh's topology, needed by everything after
@@ -58,13 +61,19 @@ def main() -> None:
         mesh = ref.mesh
         t_asm, assembled = timed(lambda mesh=mesh, p=problem: assemble(p, mesh))
         ndof = assembled.space.n_dofs
-        t_pdas, result = timed(lambda a=assembled, mesh=mesh, p=problem:
-                               solve(p, mesh, assembled=a, backend=args.backend))
+        t_pdas, result = timed(
+            lambda a=assembled, mesh=mesh, p=problem: solve(
+                p, mesh, assembled=a, backend=args.backend
+            )
+        )
         t_est, _ = timed(lambda r=result: estimate(r))
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-        print(f"{ndof:10d} {rate(t_ref, ndof):>14s} {rate(t_asm, ndof):>14s} "
-              f"{rate(t_pdas, ndof):>14s} ({result.pdas.iterations:2d} it) "
-              f"{rate(t_est, ndof):>14s} {peak:9.0f}", flush=True)
+        print(
+            f"{ndof:10d} {rate(t_ref, ndof):>14s} {rate(t_asm, ndof):>14s} "
+            f"{rate(t_pdas, ndof):>14s} ({result.pdas.iterations:2d} it) "
+            f"{rate(t_est, ndof):>14s} {peak:9.0f}",
+            flush=True,
+        )
         backend = result.pdas.backend
         del assembled, result, ref, mesh
     print(f"sparse solver backend: {backend}")

@@ -48,8 +48,9 @@ def n_for_unknowns(unknowns: int) -> int:
 def ours_assembly(mesh, repeat: int) -> tuple[float, int]:
     space = P2Space(mesh)
     _ = space.cell_dofs  # DOF map outside the timing, as for the peers
-    t, K = best_of(repeat, lambda: assemble_stiffness(space.vertices, space.cell_dofs,
-                                                      space.n_dofs, MATERIAL))
+    t, K = best_of(
+        repeat, lambda: assemble_stiffness(space.vertices, space.cell_dofs, space.n_dofs, MATERIAL)
+    )
     return t, K.shape[0]
 
 
@@ -77,8 +78,10 @@ def ngsolve_assembly(mesh, repeat: int) -> tuple[float, int] | None:
     def run():
         with ngs.TaskManager():
             a = ngs.BilinearForm(fes, symmetric=False)
-            a += (2 * mu * ngs.InnerProduct(eps(u), eps(v))
-                  + lam * ngs.Trace(eps(u)) * ngs.Trace(eps(v))) * ngs.dx
+            a += (
+                2 * mu * ngs.InnerProduct(eps(u), eps(v))
+                + lam * ngs.Trace(eps(u)) * ngs.Trace(eps(v))
+            ) * ngs.dx
             a.Assemble()
         return a
 
@@ -109,7 +112,8 @@ def skfem_pipeline(problem) -> tuple[float, np.ndarray, np.ndarray, int]:
     t0 = time.perf_counter()
     mesh = problem.mesh
     m = MeshTri(mesh.points.T.copy(), mesh.cells.T.copy()).with_boundaries(
-        {"left": lambda x: np.isclose(x[0], 0.0), "right": lambda x: np.isclose(x[0], 1.0)})
+        {"left": lambda x: np.isclose(x[0], 0.0), "right": lambda x: np.isclose(x[0], 1.0)}
+    )
     basis = Basis(m, ElementVector(ElementTriP2()))
     K = asm(linear_elasticity(problem.material.lam, problem.material.mu), basis).tocsr()
     f = np.zeros(basis.N)
@@ -154,8 +158,10 @@ def main() -> None:
     solve_size = args.solve_unknowns or (100_000 if args.quick else 400_000)
 
     print(f"assembly of P2 plane-strain stiffness (best of {args.repeat}), seconds")
-    print(f"{'unknowns':>10s} {'signorini':>10s} {'NGSolve':>10s} {'skfem':>10s} "
-          f"{'NGS/ours':>9s} {'skfem/ours':>10s}")
+    print(
+        f"{'unknowns':>10s} {'signorini':>10s} {'NGSolve':>10s} {'skfem':>10s} "
+        f"{'NGS/ours':>9s} {'skfem/ours':>10s}"
+    )
     for size in sizes:
         n = n_for_unknowns(size)
         mesh = rectangle(nx=n, ny=n, pattern="right")
@@ -164,19 +170,27 @@ def main() -> None:
         skf = skfem_assembly(mesh, args.repeat) if size <= 400_000 or not args.quick else None
         t_ngs = ngs[0] if ngs else float("nan")
         t_skf = skf[0] if skf else float("nan")
-        print(f"{ndof:10d} {ours:10.3f} {t_ngs:10.3f} {t_skf:10.3f} {t_ngs / ours:9.2f} "
-              f"{t_skf / ours:10.2f}", flush=True)
+        print(
+            f"{ndof:10d} {ours:10.3f} {t_ngs:10.3f} {t_skf:10.3f} {t_ngs / ours:9.2f} "
+            f"{t_skf / ours:10.2f}",
+            flush=True,
+        )
 
     n = n_for_unknowns(solve_size)
     n += n % 2  # even: the mesh stays symmetric
     problem = example_6_2(nx=n)
-    print(f"\none complete solve of Example 6.2, cold start, mesh {n} x {n} "
-          f"({2 * (2 * n + 1) ** 2} unknowns)")
+    print(
+        f"\none complete solve of Example 6.2, cold start, mesh {n} x {n} "
+        f"({2 * (2 * n + 1) ** 2} unknowns)"
+    )
     t0 = time.perf_counter()
     ours = solve(problem)
     t_ours = time.perf_counter() - t0
-    print(f"signorini: {t_ours:.2f} s ({ours.pdas.iterations} PDAS iterations, "
-          f"{ours.pdas.n_analyses} analysis, backend {ours.pdas.backend})", flush=True)
+    print(
+        f"signorini: {t_ours:.2f} s ({ours.pdas.iterations} PDAS iterations, "
+        f"{ours.pdas.n_analyses} analysis, backend {ours.pdas.backend})",
+        flush=True,
+    )
     try:
         t_skf, doflocs, x, iters = skfem_pipeline(problem)
     except ImportError:
@@ -187,8 +201,10 @@ def main() -> None:
     ux = dict(zip(map(tuple, np.round(pts, 12)), ours.u[:, 0], strict=True))
     theirs = np.round(doflocs[:, ::2].T, 12)
     diff = max(abs(ux[tuple(p)] - v) for p, v in zip(theirs[:2000], x[::2][:2000], strict=True))
-    print(f"scikit-fem + spsolve: {t_skf:.2f} s ({iters} PDAS iterations); "
-          f"max |u_x difference| on 2000 nodes {diff:.1e}")
+    print(
+        f"scikit-fem + spsolve: {t_skf:.2f} s ({iters} PDAS iterations); "
+        f"max |u_x difference| on 2000 nodes {diff:.1e}"
+    )
     print(f"speed-up of one level's complete solve: {t_skf / t_ours:.1f}x")
 
 

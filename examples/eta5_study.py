@@ -34,9 +34,12 @@ def run(name: str, variant: str, uniform: bool, max_ndof: int, out: Path) -> Pat
 def summary(path: Path, last: int) -> dict[str, float]:
     """Fitted slopes over the last levels and the efficiency range."""
     h = plots.read_history(path)
-    out = {"ndof": int(h["ndof"][-1]), "eta": float(h["eta"][-1]),
-           "slope_eta": plots.fitted_slope(h["ndof"], h["eta"], last=last),
-           "slope_eta5": plots.fitted_slope(h["ndof"], h["eta5"], last=last)}
+    out = {
+        "ndof": int(h["ndof"][-1]),
+        "eta": float(h["eta"][-1]),
+        "slope_eta": plots.fitted_slope(h["ndof"], h["eta"], last=last),
+        "slope_eta5": plots.fitted_slope(h["ndof"], h["eta5"], last=last),
+    }
     err = h.get("error_energy")
     if err is not None and np.isfinite(err).any():
         out["slope_error"] = plots.fitted_slope(h["ndof"], err, last=last)
@@ -62,21 +65,32 @@ def main() -> None:
                 s = summary(path, last=3 if uniform else 6)
                 rows.append((name, mode, variant, s))
                 print(name, mode, variant, {k: round(v, 4) for k, v in s.items()}, flush=True)
-        plots.plot_adaptive_vs_uniform(histories, args.out / f"{name}_eta", key="eta",
-                                       title=f"{name}: $\\eta_h$ for both $\\eta_5$ variants")
+        plots.plot_adaptive_vs_uniform(
+            histories,
+            args.out / f"{name}_eta",
+            key="eta",
+            title=f"{name}: $\\eta_h$ for both $\\eta_5$ variants",
+        )
         if name == "example-6.1":
-            plots.plot_adaptive_vs_uniform(histories, args.out / f"{name}_error",
-                                           key="error_energy",
-                                           title=f"{name}: energy error")
+            plots.plot_adaptive_vs_uniform(
+                histories,
+                args.out / f"{name}_error",
+                key="error_energy",
+                title=f"{name}: energy error",
+            )
     print()
-    print("| example | refinement | η5 | final Ndof | slope η_h | slope η5 | slope error "
-          "| efficiency min–max |")
+    print(
+        "| example | refinement | η5 | final Ndof | slope η_h | slope η5 | slope error "
+        "| efficiency min–max |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for name, mode, variant, s in rows:
         err = f"{s['slope_error']:.2f}" if "slope_error" in s else "—"
         eff = f"{s['eff_min']:.1f}–{s['eff_max']:.1f}" if "eff_min" in s else "—"
-        print(f"| {name} | {mode} | {variant} | {s['ndof']} | {s['slope_eta']:.2f} "
-              f"| {s['slope_eta5']:.2f} | {err} | {eff} |")
+        print(
+            f"| {name} | {mode} | {variant} | {s['ndof']} | {s['slope_eta']:.2f} "
+            f"| {s['slope_eta5']:.2f} | {err} | {eff} |"
+        )
 
 
 if __name__ == "__main__":

@@ -37,8 +37,7 @@ def block(nx: int = 8, ny: int = 2) -> Mesh:
     """The tilted block: a structured rectangle, rotated, with its four sides named."""
     flat = rectangle(0.0, 2.0, 0.0, 0.5, nx=nx, ny=ny)
     # the part names travel with the edges: rebuild from the rotated points and flat edges
-    parts = {name: flat.boundary[flat.boundary_part == k]
-             for k, name in enumerate(flat.part_names)}
+    parts = {name: flat.boundary[flat.boundary_part == k] for k, name in enumerate(flat.part_names)}
     return Mesh.from_arrays(flat.points @ ROTATION.T, flat.cells, parts)
 
 
@@ -70,22 +69,38 @@ def main() -> None:
     last = None
     for level in adaptive(problem(), theta=0.4, max_ndof=args.max_ndof):
         r = level.record
-        print(f"level {r.level:2d}  ndof {r.ndof:7d}  eta {r.eta:.3e}  "
-              f"contact force {r.contact_force:9.4f}  active {r.n_active}/{r.n_constrained}")
+        print(
+            f"level {r.level:2d}  ndof {r.ndof:7d}  eta {r.eta:.3e}  "
+            f"contact force {r.contact_force:9.4f}  active {r.n_active}/{r.n_constrained}"
+        )
         last = level
 
     result = last.result
     write_vtu(args.out / "solution.vtu", result, last.estimate)
     mesh, cs = result.mesh, result.contact
     x = result.space.node_points[cs.nodes]
-    plots.plot_mesh(mesh.points, mesh.cells, args.out / "mesh",
-                    highlight=mesh.edges[cs.edges], title="adaptive mesh")
-    plots.plot_deformed(mesh.points, mesh.cells, result.u[: mesh.n_points],
-                        args.out / "deformed", contact_points=x, pressure=result.pressure,
-                        scale=5.0, title="deformed (×5) and contact pressure")
+    plots.plot_mesh(
+        mesh.points,
+        mesh.cells,
+        args.out / "mesh",
+        highlight=mesh.edges[cs.edges],
+        title="adaptive mesh",
+    )
+    plots.plot_deformed(
+        mesh.points,
+        mesh.cells,
+        result.u[: mesh.n_points],
+        args.out / "deformed",
+        contact_points=x,
+        pressure=result.pressure,
+        scale=5.0,
+        title="deformed (×5) and contact pressure",
+    )
     # the pressure balances the load: Σ Λ_z equals the normal reaction of the foundation
-    print(f"resultant normal force {result.total_contact_force:.4f}; "
-          f"largest penetration {np.max(cs.normal_displacement(result.u) - cs.gap):.2e}")
+    print(
+        f"resultant normal force {result.total_contact_force:.4f}; "
+        f"largest penetration {np.max(cs.normal_displacement(result.u) - cs.gap):.2e}"
+    )
 
 
 if __name__ == "__main__":

@@ -45,8 +45,11 @@ class Quadratic:
 
     def value(self, x: np.ndarray) -> np.ndarray:
         x = np.asarray(x, dtype=float)
-        return (self.c + np.einsum("ij,...j->...i", self.G, x)
-                + 0.5 * np.einsum("ijk,...j,...k->...i", self.H, x, x))
+        return (
+            self.c
+            + np.einsum("ij,...j->...i", self.G, x)
+            + 0.5 * np.einsum("ijk,...j,...k->...i", self.H, x, x)
+        )
 
     def gradient(self, x: np.ndarray) -> np.ndarray:
         x = np.asarray(x, dtype=float)
@@ -60,19 +63,20 @@ class Quadratic:
 
     def rotated(self, R: np.ndarray) -> Quadratic:
         """The field ``x ↦ R u(Rᵀ x)``."""
-        return Quadratic(R @ self.c, R @ self.G @ R.T,
-                         np.einsum("ia,abc,jb,kc->ijk", R, self.H, R, R))
+        return Quadratic(
+            R @ self.c, R @ self.G @ R.T, np.einsum("ia,abc,jb,kc->ijk", R, self.H, R, R)
+        )
 
 
 def random_quadratic(rng: np.random.Generator, scale: float = 1.0) -> Quadratic:
     H = rng.standard_normal((2, 2, 2))
     H = H + H.transpose(0, 2, 1)
-    return Quadratic(scale * rng.standard_normal(2), scale * rng.standard_normal((2, 2)),
-                     scale * H)
+    return Quadratic(scale * rng.standard_normal(2), scale * rng.standard_normal((2, 2)), scale * H)
 
 
-def contact_patch_field(rng: np.random.Generator, material: Material,
-                        uniform: bool = False) -> Quadratic:
+def contact_patch_field(
+    rng: np.random.Generator, material: Material, uniform: bool = False
+) -> Quadratic:
     """A random quadratic with ``σ_12 = 0`` and ``σ_22 ≤ −1`` on the line ``y = 0``.
 
     On ``y = 0``: ``∂_j u_i = G_ij + H_ij0 x``, so ``σ_12 = μ (G_01 + G_10 + (H_010 + H_100) x)``
@@ -92,8 +96,13 @@ def contact_patch_field(rng: np.random.Generator, material: Material,
     return Quadratic(c, G, H)
 
 
-def patch_problem(mesh: Mesh, material: Material, u: Quadratic, kinds: dict[str, str],
-                  normal: np.ndarray | None = None) -> ContactProblem:
+def patch_problem(
+    mesh: Mesh,
+    material: Material,
+    u: Quadratic,
+    kinds: dict[str, str],
+    normal: np.ndarray | None = None,
+) -> ContactProblem:
     """The problem solved by the quadratic ``u``: ``f = −div σ(u)``, ``g = σ(u) n`` on the parts
     of kind ``"N"``, ``u_D = u`` on kind ``"D"``, and contact with ``ψ = u·n`` on kind ``"C"``.
     """
@@ -112,8 +121,13 @@ def patch_problem(mesh: Mesh, material: Material, u: Quadratic, kinds: dict[str,
         else:
             n = np.asarray(normal, dtype=float)
             conditions[name] = Contact(gap=lambda x, n=n: u.value(x) @ n, normal=tuple(n))
-    return ContactProblem(mesh=mesh, material=material, conditions=conditions,
-                          body_force=lambda x: np.broadcast_to(f, x.shape), name="patch")
+    return ContactProblem(
+        mesh=mesh,
+        material=material,
+        conditions=conditions,
+        body_force=lambda x: np.broadcast_to(f, x.shape),
+        name="patch",
+    )
 
 
 @dataclass
@@ -154,13 +168,13 @@ def independent_system(problem: ContactProblem, mesh: Mesh) -> System:
         g = problem.conditions[name].field()
         dofs = (2 * nodes[:, :, None] + np.arange(2)).reshape(-1, 6)
         F += assemble_edge_load(mesh.points[nodes[:, :2]], dofs, n_dofs, g, degree=8)
-    d_nodes = np.unique(np.concatenate([part_nodes(p)[1].ravel()
-                                        for p in problem.dirichlet_parts]))
+    d_nodes = np.unique(np.concatenate([part_nodes(p)[1].ravel() for p in problem.dirichlet_parts]))
     d_vals = np.zeros((d_nodes.size, 2))
     for name in problem.dirichlet_parts:
         mine = np.isin(d_nodes, part_nodes(name)[1])
-        d_vals[mine] = np.broadcast_to(problem.conditions[name].field()(node_points[d_nodes[mine]]),
-                                       (int(mine.sum()), 2))
+        d_vals[mine] = np.broadcast_to(
+            problem.conditions[name].field()(node_points[d_nodes[mine]]), (int(mine.sum()), 2)
+        )
     c_nodes, c_normal, c_gap = [], [], []
     for name in problem.contact_parts:
         edges, nodes = part_nodes(name)
@@ -168,16 +182,18 @@ def independent_system(problem: ContactProblem, mesh: Mesh) -> System:
         n = np.array([d[0, 1], -d[0, 0]]) / np.hypot(*d[0])
         nodes = np.setdiff1d(np.unique(nodes), d_nodes)
         cond = problem.conditions[name]
-        gap = cond.gap(node_points[nodes]) if callable(cond.gap) else np.full(nodes.size,
-                                                                              cond.gap)
+        gap = cond.gap(node_points[nodes]) if callable(cond.gap) else np.full(nodes.size, cond.gap)
         c_nodes.append(nodes)
         c_normal.append(np.broadcast_to(n, (nodes.size, 2)))
         c_gap.append(np.broadcast_to(gap, nodes.shape))
     if c_nodes:
         nodes = np.concatenate(c_nodes)
         order = np.argsort(nodes)
-        nodes, normal, gap = (nodes[order], np.concatenate(c_normal)[order],
-                              np.concatenate(c_gap)[order])
+        nodes, normal, gap = (
+            nodes[order],
+            np.concatenate(c_normal)[order],
+            np.concatenate(c_gap)[order],
+        )
     else:
         nodes, normal, gap = np.zeros(0, int), np.zeros((0, 2)), np.zeros(0)
     dirichlet = np.column_stack([2 * d_nodes, 2 * d_nodes + 1]).ravel()

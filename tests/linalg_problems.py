@@ -15,10 +15,12 @@ import scipy.sparse as sp
 def grid_edges(nx: int, ny: int) -> np.ndarray:
     """Edges ``(n_edges, 2)`` of the 4-neighbour graph on an ``nx x ny`` grid of nodes."""
     idx = np.arange(nx * ny).reshape(nx, ny)
-    return np.vstack([
-        np.column_stack([idx[:-1, :].ravel(), idx[1:, :].ravel()]),
-        np.column_stack([idx[:, :-1].ravel(), idx[:, 1:].ravel()]),
-    ])
+    return np.vstack(
+        [
+            np.column_stack([idx[:-1, :].ravel(), idx[1:, :].ravel()]),
+            np.column_stack([idx[:, :-1].ravel(), idx[:, 1:].ravel()]),
+        ]
+    )
 
 
 def block_spd(nx: int, ny: int, rng: np.random.Generator, shift: float = 1e-2) -> sp.csr_matrix:
@@ -30,17 +32,26 @@ def block_spd(nx: int, ny: int, rng: np.random.Generator, shift: float = 1e-2) -
     edges = grid_edges(nx, ny)
     M = rng.standard_normal((len(edges), 2, 2))
     C = M @ M.transpose(0, 2, 1) + 0.1 * np.eye(2)
+    C = 0.5 * (C + C.transpose(0, 2, 1))  # exactly symmetric
     a, b = edges[:, 0], edges[:, 1]
-    blocks = np.concatenate([C, C, -C, -C])
-    brow = np.concatenate([a, b, a, b])
-    bcol = np.concatenate([a, b, b, a])
+    # an explicit zero 2x2 block per node keeps the pattern node-blocked even for a single
+    # node (no edge); the shift is then added to the stored diagonal
+    nodes = np.arange(nx * ny)
+    blocks = np.concatenate([C, C, -C, -C, np.zeros((nodes.size, 2, 2))])
+    brow = np.concatenate([a, b, a, b, nodes])
+    bcol = np.concatenate([a, b, b, a, nodes])
     comp = np.arange(2)
     rows = (2 * brow[:, None, None] + comp[None, :, None]).repeat(2, axis=2)
     cols = (2 * bcol[:, None, None] + comp[None, None, :]).repeat(2, axis=1)
     n = 2 * nx * ny
     K = sp.coo_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(n, n)).tocsr()
-    K = K + shift * sp.identity(n, format="csr")
     K.sum_duplicates()
+    K.setdiag(K.diagonal() + shift)
+    # duplicates are summed in an unspecified order: average with the transpose (same
+    # pattern, explicit zeros kept) so that K is symmetric to the last bit
+    Kt = sp.csr_matrix(K.T)
+    Kt.sort_indices()
+    K.data = 0.5 * (K.data + Kt.data)
     return sp.csr_matrix(K)
 
 
@@ -81,11 +92,16 @@ def p2_elasticity(
     dl = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])  # reference gradients of l0, l1, l2
     Ke = np.zeros((len(cells), 12, 12))
     for l0, l1, l2 in ((2 / 3, 1 / 6, 1 / 6), (1 / 6, 2 / 3, 1 / 6), (1 / 6, 1 / 6, 2 / 3)):
-        g = np.array([
-            (4 * l0 - 1) * dl[0], (4 * l1 - 1) * dl[1], (4 * l2 - 1) * dl[2],
-            4 * (l1 * dl[0] + l0 * dl[1]), 4 * (l2 * dl[1] + l1 * dl[2]),
-            4 * (l0 * dl[2] + l2 * dl[0]),
-        ])
+        g = np.array(
+            [
+                (4 * l0 - 1) * dl[0],
+                (4 * l1 - 1) * dl[1],
+                (4 * l2 - 1) * dl[2],
+                4 * (l1 * dl[0] + l0 * dl[1]),
+                4 * (l2 * dl[1] + l1 * dl[2]),
+                4 * (l0 * dl[2] + l2 * dl[0]),
+            ]
+        )
         G = np.einsum("cij,kj->cki", jit, g)  # physical gradients (n_cells, 6, 2)
         B = np.zeros((len(cells), 3, 12))
         B[:, 0, 0::2] = G[:, :, 0]

@@ -16,9 +16,18 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.mark.slow
 def test_adaptive_benchmark_prints_ratio_to_floor(tmp_path):
     out = subprocess.run(
-        [sys.executable, str(ROOT / "benchmarks" / "adaptive.py"), "--max-ndof", "5000",
-         "--out", str(tmp_path)],
-        capture_output=True, text=True, timeout=300, check=True,
+        [
+            sys.executable,
+            str(ROOT / "benchmarks" / "adaptive.py"),
+            "--max-ndof",
+            "5000",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=True,
     ).stdout
     lines = out.strip().splitlines()
     print("\n".join(lines[-8:]))
@@ -39,9 +48,18 @@ def test_inclined_block_example_runs(tmp_path):
     """The literate example with a non-axis contact normal runs and touches the foundation
     without penetrating it."""
     out = subprocess.run(
-        [sys.executable, str(ROOT / "examples" / "inclined_block.py"), "--max-ndof", "3000",
-         "--out", str(tmp_path)],
-        capture_output=True, text=True, timeout=300, check=True,
+        [
+            sys.executable,
+            str(ROOT / "examples" / "inclined_block.py"),
+            "--max-ndof",
+            "3000",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=True,
     ).stdout
     last = out.strip().splitlines()[-1]
     print(last)

@@ -19,8 +19,17 @@ from signorini.contact.solution import solve
 from signorini.estimator.residual import estimate
 from signorini.examples import example_6_1
 
-REQUIRED = ["level", "ndof", "n_cells", "eta", *[f"eta{k}" for k in range(1, 8)],
-            "pdas_iterations", "n_active", "error_energy", "efficiency"]
+REQUIRED = [
+    "level",
+    "ndof",
+    "n_cells",
+    "eta",
+    *[f"eta{k}" for k in range(1, 8)],
+    "pdas_iterations",
+    "n_active",
+    "error_energy",
+    "efficiency",
+]
 
 
 def read_history(path: Path) -> tuple[list[str], list[dict[str, str]]]:
@@ -51,8 +60,9 @@ def check_history_and_vtu(out: Path) -> list[dict[str, str]]:
 
 def test_run_example_6_1_uniform(tmp_path, capsys):
     out = tmp_path / "u61"
-    code = main(["run", "example-6.1", "--uniform", "--max-ndof", "3000", "--out", str(out),
-                 "--no-figures"])
+    code = main(
+        ["run", "example-6.1", "--uniform", "--max-ndof", "3000", "--out", str(out), "--no-figures"]
+    )
     printed = capsys.readouterr()
     assert code == 0, printed.err
     rows = check_history_and_vtu(out)
@@ -78,8 +88,22 @@ def test_run_example_6_1_uniform(tmp_path, capsys):
 @pytest.mark.slow  # ~10 s of drawing
 def test_run_draws_figures_and_figures_command_redraws_them(tmp_path, capsys):
     out = tmp_path / "f61"
-    assert main(["run", "example-6.1", "--uniform", "--max-ndof", "600", "--out", str(out),
-                 "--no-vtu", "--quiet"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                "example-6.1",
+                "--uniform",
+                "--max-ndof",
+                "600",
+                "--out",
+                str(out),
+                "--no-vtu",
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     pictures = sorted(p.name for p in out.glob("*.png"))
     print(pictures)
     assert {"mesh.png", "deformed.png"} <= set(pictures) and len(pictures) >= 4
@@ -91,8 +115,19 @@ def test_run_draws_figures_and_figures_command_redraws_them(tmp_path, capsys):
 
 def test_run_example_6_2_adaptive(tmp_path, capsys):
     out = tmp_path / "a62"
-    code = main(["run", "example-6.2", "--max-ndof", "1500", "--theta", "0.5", "--out",
-                 str(out), "--no-figures"])
+    code = main(
+        [
+            "run",
+            "example-6.2",
+            "--max-ndof",
+            "1500",
+            "--theta",
+            "0.5",
+            "--out",
+            str(out),
+            "--no-figures",
+        ]
+    )
     printed = capsys.readouterr()
     assert code == 0, printed.err
     rows = check_history_and_vtu(out)
@@ -108,8 +143,22 @@ def test_run_example_6_2_adaptive(tmp_path, capsys):
 
 def test_run_options_eta5_no_vtu_quiet(tmp_path, capsys):
     out = tmp_path / "p61"
-    code = main(["run", "example-6.1", "--uniform", "--max-ndof", "600", "--eta5", "paper",
-                 "--no-vtu", "--no-figures", "--quiet", "--out", str(out)])
+    code = main(
+        [
+            "run",
+            "example-6.1",
+            "--uniform",
+            "--max-ndof",
+            "600",
+            "--eta5",
+            "paper",
+            "--no-vtu",
+            "--no-figures",
+            "--quiet",
+            "--out",
+            str(out),
+        ]
+    )
     printed = capsys.readouterr()
     assert code == 0 and printed.out == ""
     assert os.listdir(out) == ["history.csv"]
@@ -123,9 +172,21 @@ def test_run_options_eta5_no_vtu_quiet(tmp_path, capsys):
 def test_bad_theta_exits_with_a_message_and_no_traceback(tmp_path):
     out = tmp_path / "bad"
     proc = subprocess.run(
-        [sys.executable, "-m", "signorini.cli", "run", "example-6.2", "--theta", "2",
-         "--out", str(out), "--no-figures"],
-        capture_output=True, text=True, timeout=120,
+        [
+            sys.executable,
+            "-m",
+            "signorini.cli",
+            "run",
+            "example-6.2",
+            "--theta",
+            "2",
+            "--out",
+            str(out),
+            "--no-figures",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
         env={**os.environ, "MPLBACKEND": "Agg"},
     )
     print(f"exit {proc.returncode}; stderr: {proc.stderr.strip()}")

@@ -108,8 +108,10 @@ def test_example_6_1_contact_force_and_pressure(levels_6_1):
         assert r.active.all() and r.pdas.kkt.max < 1e-12
     p_err = np.array(p_err)
     for r, f, e in zip(levels_6_1, force, p_err, strict=True):
-        print(f"Ndof {r.ndof:6d}  ΣΛ = {f:.10f}  |ΣΛ − 4.5| = {abs(f - 4.5):.2e}  "
-              f"max |p_z − 3(2 − x)| = {e:.2e}")
+        print(
+            f"Ndof {r.ndof:6d}  ΣΛ = {f:.10f}  |ΣΛ − 4.5| = {abs(f - 4.5):.2e}  "
+            f"max |p_z − 3(2 − x)| = {e:.2e}"
+        )
     assert np.all(np.diff(np.abs(force - 4.5)) < 0)
     assert abs(force[-1] - 4.5) < 1e-6
     # p_z → p at the nodes like h² (each uniform refinement divides the error by about 4)
@@ -156,9 +158,11 @@ def test_example_6_2_contact_zone_is_one_interval(levels_6_2):
         lows.append(y[idx[0]])
         highs.append(y[idx[-1]])
         force.append(r.total_contact_force)
-        print(f"Ndof {r.ndof:6d}: contact zone [{lows[-1]:.6f}, {highs[-1]:.6f}] "
-              f"({idx.size} of {y.size} nodes, spacing {spacing:.5f}), ΣΛ = {force[-1]:.8f}, "
-              f"{r.pdas.iterations} PDAS iterations")
+        print(
+            f"Ndof {r.ndof:6d}: contact zone [{lows[-1]:.6f}, {highs[-1]:.6f}] "
+            f"({idx.size} of {y.size} nodes, spacing {spacing:.5f}), ΣΛ = {force[-1]:.8f}, "
+            f"{r.pdas.iterations} PDAS iterations"
+        )
         assert idx[-1] - idx[0] + 1 == idx.size, "the active set has a gap"
         assert lows[-1] < 0.5 < highs[-1]
         assert abs((lows[-1] - 0.5) + (highs[-1] - 0.5)) <= spacing + 1e-12
@@ -171,8 +175,9 @@ def test_example_6_2_contact_zone_is_one_interval(levels_6_2):
     d_force = np.abs(np.diff(force))
     d_low = np.abs(np.diff(lows))
     print("successive changes of ΣΛ:", np.array2string(d_force, precision=4))
-    print("successive changes of the lower end:", d_low, "of the upper end:",
-          np.abs(np.diff(highs)))
+    print(
+        "successive changes of the lower end:", d_low, "of the upper end:", np.abs(np.diff(highs))
+    )
     assert np.all(np.diff(d_force) < 0), "the total contact force does not settle"
     assert np.all(d_low <= spacing[:-1] + 1e-12) and np.all(d_low[-2:] <= 0.02)
     assert np.allclose(lows + highs, 1.0, atol=1e-12)  # symmetric mesh: exactly symmetric
@@ -186,6 +191,7 @@ def test_example_6_2_solution_is_symmetric(levels_6_2):
     u_y(x, 1 − y) = −u_y(x, y)."""
     r = levels_6_2[2]
     x = r.space.node_points
+
     def code(p):  # node coordinates are multiples of 1/64 here: exact integer codes
         k = np.round(p * 256).astype(np.int64)
         return k[:, 0] * 1024 + k[:, 1]

@@ -109,8 +109,13 @@ def test_stops_at_tolerance_and_after_max_levels():
 
 @pytest.mark.parametrize(
     ("kwargs", "message"),
-    [({"theta": 0.0}, "theta"), ({"theta": 1.5}, "theta"), ({"theta": float("nan")}, "theta"),
-     ({"max_ndof": 0}, "max_ndof"), ({"max_ndof": 100}, "initial mesh")],
+    [
+        ({"theta": 0.0}, "theta"),
+        ({"theta": 1.5}, "theta"),
+        ({"theta": float("nan")}, "theta"),
+        ({"max_ndof": 0}, "max_ndof"),
+        ({"max_ndof": 100}, "initial mesh"),
+    ],
 )
 def test_bad_arguments_raise(kwargs, message):
     with pytest.raises(ValueError, match=message):
@@ -126,8 +131,10 @@ def test_warm_start_needs_few_pdas_solves():
         levels = list(adaptive(problem, max_ndof=8000, warm_start=warm))
         solves[warm] = np.array([lv.record.n_solves for lv in levels])
     warm_mean, cold_mean = solves[True][6:].mean(), solves[False][6:].mean()
-    print(f"PDAS solves per level after level 5: warm {warm_mean:.2f} {solves[True].tolist()}, "
-          f"cold {cold_mean:.2f} {solves[False].tolist()}")
+    print(
+        f"PDAS solves per level after level 5: warm {warm_mean:.2f} {solves[True].tolist()}, "
+        f"cold {cold_mean:.2f} {solves[False].tolist()}"
+    )
     assert len(solves[True]) > 10
     assert warm_mean <= 2.0
     assert cold_mean >= 2 * warm_mean
@@ -168,9 +175,11 @@ def test_example_6_1_adaptive_rates_and_efficiency():
     eta = [r.eta for r in recs]
     eff = np.array([r.efficiency for r in recs])
     s_err, s_eta = fitted_slope(ndof, err, 8), fitted_slope(ndof, eta, 8)
-    print(f"Example 6.1 adaptive: {len(recs)} levels, Ndof {ndof[0]}..{ndof[-1]}, "
-          f"slopes over the last 8 levels: error {s_err:.3f}, eta {s_eta:.3f}; "
-          f"efficiency {eff.min():.2f}..{eff.max():.2f} (max/min {eff.max() / eff.min():.3f})")
+    print(
+        f"Example 6.1 adaptive: {len(recs)} levels, Ndof {ndof[0]}..{ndof[-1]}, "
+        f"slopes over the last 8 levels: error {s_err:.3f}, eta {s_eta:.3f}; "
+        f"efficiency {eff.min():.2f}..{eff.max():.2f} (max/min {eff.max() / eff.min():.3f})"
+    )
     assert ndof[-1] > max_ndof / 2
     assert s_err <= -0.9 and s_eta <= -0.9
     assert eff.max() / eff.min() < 3
@@ -194,16 +203,20 @@ def test_example_6_2_adaptive_rate_and_gain_over_uniform(run_6_2):
     u_eta = [lv.record.eta for lv in uniform_levels]
     s_eta = fitted_slope(ndof, eta, 8)
     s_uniform = fitted_slope(u_ndof, u_eta, 2)
-    print(f"Example 6.2 adaptive: Ndof {ndof[-1]}, eta {eta[-1]:.4f}, slope over the last 8 "
-          f"levels {s_eta:.3f}; uniform: Ndof {u_ndof[-1]}, eta {u_eta[-1]:.4f}, last slope "
-          f"{s_uniform:.3f}")
+    print(
+        f"Example 6.2 adaptive: Ndof {ndof[-1]}, eta {eta[-1]:.4f}, slope over the last 8 "
+        f"levels {s_eta:.3f}; uniform: Ndof {u_ndof[-1]}, eta {u_eta[-1]:.4f}, last slope "
+        f"{s_uniform:.3f}"
+    )
     assert s_eta <= -0.9
     for target_level in (-2, -1):
         target = u_eta[target_level]
         n_adaptive = ndof_at(target, ndof, eta)
         n_uniform = u_ndof[target_level]
-        print(f"eta = {target:.4f}: uniform needs {n_uniform} unknowns, adaptive "
-              f"{n_adaptive:.0f} (ratio {n_uniform / n_adaptive:.1f})")
+        print(
+            f"eta = {target:.4f}: uniform needs {n_uniform} unknowns, adaptive "
+            f"{n_adaptive:.0f} (ratio {n_uniform / n_adaptive:.1f})"
+        )
         assert n_uniform >= 3 * n_adaptive
 
 
@@ -232,16 +245,19 @@ def test_example_6_2_refines_at_the_singular_points(run_6_2):
         return float(d.max())
 
     r4, r5 = radius(corners), radius(np.vstack([corners, kink]))
-    print(f"contact zone y in [{y_lo:.5f}, {y_hi:.5f}]; the {smallest.size} smallest cells lie "
-          f"within r = {r5:.2e} of the 4 points and the kink (r = {r4:.3f} without the kink)")
+    print(
+        f"contact zone y in [{y_lo:.5f}, {y_hi:.5f}]; the {smallest.size} smallest cells lie "
+        f"within r = {r5:.2e} of the 4 points and the kink (r = {r4:.3f} without the kink)"
+    )
     assert r5 < 0.01
 
     def finest_near(point, radius=0.05):
         near = np.linalg.norm(centre - point, axis=1) < radius
         return float(area[near].min())
 
-    control = np.array([[0.5, 0.0], [0.5, 1.0], [0.0, 0.5], [0.5, 0.5], [1.0, 0.05],
-                        [1.0, 0.33], [1.0, 0.67]])
+    control = np.array(
+        [[0.5, 0.0], [0.5, 1.0], [0.0, 0.5], [0.5, 0.5], [1.0, 0.05], [1.0, 0.33], [1.0, 0.67]]
+    )
     coarse = min(finest_near(p) for p in control)
     for p in np.vstack([corners, kink]):
         fine = finest_near(p)

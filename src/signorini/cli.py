@@ -37,27 +37,41 @@ def _parser() -> argparse.ArgumentParser:
     )
     sub = p.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="solve a problem on a sequence of meshes")
-    run.add_argument("example", metavar="PROBLEM",
-                     help=f"one of {', '.join(sorted(EXAMPLES))}, or a Python file defining "
-                          "problem() -> ContactProblem")
-    run.add_argument("--uniform", action="store_true",
-                     help="uniform refinement instead of adaptive (Dörfler) refinement")
+    run.add_argument(
+        "example",
+        metavar="PROBLEM",
+        help=f"one of {', '.join(sorted(EXAMPLES))}, or a Python file defining "
+        "problem() -> ContactProblem",
+    )
+    run.add_argument(
+        "--uniform",
+        action="store_true",
+        help="uniform refinement instead of adaptive (Dörfler) refinement",
+    )
     run.add_argument("--theta", type=float, default=0.4, help="Dörfler parameter (default 0.4)")
-    run.add_argument("--max-ndof", type=int, default=100_000,
-                     help="budget of free unknowns (default 100000)")
+    run.add_argument(
+        "--max-ndof", type=int, default=100_000, help="budget of free unknowns (default 100000)"
+    )
     run.add_argument("--tol", type=float, default=0.0, help="stop when eta <= tol")
     run.add_argument("--max-levels", type=int, default=100)
-    run.add_argument("--eta5", choices=ETA5_VARIANTS, default="consistent",
-                     help="variant of the normal-stress term of the estimator")
+    run.add_argument(
+        "--eta5",
+        choices=ETA5_VARIANTS,
+        default="consistent",
+        help="variant of the normal-stress term of the estimator",
+    )
     run.add_argument("--backend", default="auto", help="sparse solver: auto, pardiso, scipy")
-    run.add_argument("--out", type=Path, default=None,
-                     help="output folder (default results/<example>)")
+    run.add_argument(
+        "--out", type=Path, default=None, help="output folder (default results/<example>)"
+    )
     run.add_argument("--no-vtu", action="store_true", help="do not write VTU files")
     run.add_argument("--no-figures", action="store_true", help="do not draw figures")
     run.add_argument("--quiet", action="store_true", help="no progress lines")
-    run.add_argument("--compare-uniform", action="store_true",
-                     help="also run uniform refinement to the same budget (into OUT/uniform) "
-                          "and plot both")
+    run.add_argument(
+        "--compare-uniform",
+        action="store_true",
+        help="also run uniform refinement to the same budget (into OUT/uniform) and plot both",
+    )
     fig = sub.add_parser("figures", help="redraw the figures of a finished run")
     fig.add_argument("example", metavar="PROBLEM", help="the problem's name, as for run")
     fig.add_argument("out", type=Path, help="the run's output folder (with history.csv)")
@@ -75,8 +89,10 @@ def load_problem(name: str) -> ContactProblem:
         return get_example(name)
     path = Path(name)
     if path.suffix != ".py":
-        raise ValueError(f"unknown problem {name!r}: give one of {sorted(EXAMPLES)} or a "
-                         "Python file defining problem()")
+        raise ValueError(
+            f"unknown problem {name!r}: give one of {sorted(EXAMPLES)} or a "
+            "Python file defining problem()"
+        )
     if not path.is_file():
         raise ValueError(f"no problem file at {path}")
     spec = importlib.util.spec_from_file_location(f"signorini_user_{path.stem}", path)
@@ -87,18 +103,21 @@ def load_problem(name: str) -> ContactProblem:
         raise ValueError(f"{path} must define a function problem() returning a ContactProblem")
     problem = factory()
     if not isinstance(problem, ContactProblem):
-        raise ValueError(f"problem() in {path} returned {type(problem).__name__}, not a "
-                         "ContactProblem")
+        raise ValueError(
+            f"problem() in {path} returned {type(problem).__name__}, not a ContactProblem"
+        )
     return problem
 
 
 def _progress(level: Level) -> str:
     r = level.record
-    line = (f"level {r.level:3d}  ndof {r.ndof:9d}  cells {r.n_cells:8d}  eta {r.eta:.4e}")
+    line = f"level {r.level:3d}  ndof {r.ndof:9d}  cells {r.n_cells:8d}  eta {r.eta:.4e}"
     if not np.isnan(r.error_energy):
         line += f"  error {r.error_energy:.4e}  eff {r.efficiency:.3f}"
-    line += (f"  pdas {r.pdas_iterations:2d}  active {r.n_active:5d}"
-             f"  [{r.t_assemble + r.t_solve + r.t_estimate + r.t_mark + r.t_refine:.2f}s]")
+    line += (
+        f"  pdas {r.pdas_iterations:2d}  active {r.n_active:5d}"
+        f"  [{r.t_assemble + r.t_solve + r.t_estimate + r.t_mark + r.t_refine:.2f}s]"
+    )
     return line
 
 
@@ -116,9 +135,16 @@ def run(args: argparse.Namespace) -> int:
     mode = "uniform" if args.uniform else f"adaptive, theta={args.theta}"
     say(f"{problem.name}: {mode}, eta5={args.eta5}, max_ndof={args.max_ndof} -> {out}")
     last = None
-    for level in adaptive(problem, theta=args.theta, max_ndof=args.max_ndof, tol=args.tol,
-                          max_levels=args.max_levels, uniform=args.uniform, eta5=args.eta5,
-                          backend=args.backend):
+    for level in adaptive(
+        problem,
+        theta=args.theta,
+        max_ndof=args.max_ndof,
+        tol=args.tol,
+        max_levels=args.max_levels,
+        uniform=args.uniform,
+        eta5=args.eta5,
+        backend=args.backend,
+    ):
         t0 = time.perf_counter()
         if not args.no_vtu:
             write_vtu(out / f"level_{level.record.level:03d}.vtu", level.result, level.estimate)
@@ -143,8 +169,14 @@ def _compare_uniform(args: argparse.Namespace, out: Path, say) -> None:
     uni = out / "uniform"
     history = HistoryWriter(uni / "history.csv")
     say(f"{problem.name}: uniform refinement for comparison -> {uni}")
-    for level in adaptive(problem, max_ndof=args.max_ndof, uniform=True, eta5=args.eta5,
-                          backend=args.backend, max_levels=args.max_levels):
+    for level in adaptive(
+        problem,
+        max_ndof=args.max_ndof,
+        uniform=True,
+        eta5=args.eta5,
+        backend=args.backend,
+        max_levels=args.max_levels,
+    ):
         history.append(level.record.row())
         say(_progress(level))
     if args.no_figures:
@@ -152,8 +184,9 @@ def _compare_uniform(args: argparse.Namespace, out: Path, say) -> None:
     histories = {"adaptive": out / "history.csv", "uniform": uni / "history.csv"}
     written = plots.plot_adaptive_vs_uniform(histories, out / "adaptive_vs_uniform", key="eta")
     if problem.exact is not None:
-        written += plots.plot_adaptive_vs_uniform(histories, out / "adaptive_vs_uniform_error",
-                                                  key="error_energy")
+        written += plots.plot_adaptive_vs_uniform(
+            histories, out / "adaptive_vs_uniform_error", key="error_energy"
+        )
     say(f"figures: {', '.join(str(p.name) for p in written)}")
 
 
@@ -165,17 +198,27 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
         res = last.result
         mesh = res.mesh
         contact = mesh.edges[res.contact.edges]
-        written += plots.plot_mesh(mesh.points, mesh.cells, out / "mesh",
-                                   title=f"{example}: final mesh, {mesh.n_cells} cells",
-                                   highlight=contact)
+        written += plots.plot_mesh(
+            mesh.points,
+            mesh.cells,
+            out / "mesh",
+            title=f"{example}: final mesh, {mesh.n_cells} cells",
+            highlight=contact,
+        )
         cs = res.contact
         x = res.space.node_points[cs.nodes]
         # the obstacle surface: each contact point moved by the gap along its normal
         order = np.lexsort(x.T[::-1])
         obstacle = (x + cs.gap[:, None] * cs.normal)[order]
         written += plots.plot_deformed(
-            mesh.points, mesh.cells, res.u[: mesh.n_points], out / "deformed",
-            contact_points=x, pressure=res.pressure, scale=1.0, obstacle=obstacle,
+            mesh.points,
+            mesh.cells,
+            res.u[: mesh.n_points],
+            out / "deformed",
+            contact_points=x,
+            pressure=res.pressure,
+            scale=1.0,
+            obstacle=obstacle,
             title=f"{example}: deformed body and contact pressure",
         )
     return written

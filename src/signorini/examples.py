@@ -98,8 +98,7 @@ def example_6_2(nx: int = 4) -> ContactProblem:
             "left": Dirichlet((0.1, 0.0)),
             "top": Neumann((0.0, 0.0)),
             "bottom": Neumann((0.0, 0.0)),
-            "right": Contact(gap=lambda x: -0.2 + 0.5 * np.abs(x[..., 1] - 0.5),
-                             normal=(1.0, 0.0)),
+            "right": Contact(gap=lambda x: -0.2 + 0.5 * np.abs(x[..., 1] - 0.5), normal=(1.0, 0.0)),
         },
         name="example-6.2",
     )

@@ -129,8 +129,10 @@ def adaptive(
         raise ValueError(f"max_ndof must be positive, got {max_ndof}")
     mesh = problem.mesh if mesh is None else mesh
     if problem.free_ndof(mesh) > max_ndof:
-        raise ValueError(f"the initial mesh already has {problem.free_ndof(mesh)} unknowns, "
-                         f"more than max_ndof={max_ndof}")
+        raise ValueError(
+            f"the initial mesh already has {problem.free_ndof(mesh)} unknowns, "
+            f"more than max_ndof={max_ndof}"
+        )
     u0 = None
     for level in range(max_levels):
         result = solve(problem, mesh, u0=u0, backend=backend)
@@ -143,8 +145,9 @@ def adaptive(
         marked = None
         if not last:
             t0 = time.perf_counter()
-            marked = (np.ones(mesh.n_cells, dtype=bool) if uniform
-                      else mark_doerfler(est.eta2, theta))
+            marked = (
+                np.ones(mesh.n_cells, dtype=bool) if uniform else mark_doerfler(est.eta2, theta)
+            )
             record.t_mark = time.perf_counter() - t0
             t0 = time.perf_counter()
             refinement = refine_uniform(mesh) if uniform else refine_nvb(mesh, marked)
@@ -157,8 +160,13 @@ def adaptive(
                 marked = None  # the budget ends the run: this marking is discarded
             else:
                 record.n_marked = int(marked.sum())
-        log.info("level %d: ndof=%d eta=%.4e pdas=%d", level, record.ndof, record.eta,
-                 record.pdas_iterations)
+        log.info(
+            "level %d: ndof=%d eta=%.4e pdas=%d",
+            level,
+            record.ndof,
+            record.eta,
+            record.pdas_iterations,
+        )
         yield Level(record, result, est, marked)
         if last:
             return
@@ -169,18 +177,26 @@ def _record(level: int, result: ContactResult, est: Estimate) -> LevelRecord:
     terms = est.eta_terms
     classes = result.classes
     rec = LevelRecord(
-        level=level, ndof=result.ndof, ndof_total=result.space.n_dofs,
-        n_cells=result.mesh.n_cells, eta=est.eta,
+        level=level,
+        ndof=result.ndof,
+        ndof_total=result.space.n_dofs,
+        n_cells=result.mesh.n_cells,
+        eta=est.eta,
         **{f"eta{k + 1}": float(terms[k]) for k in range(7)},
-        pdas_iterations=result.pdas.iterations, n_solves=result.pdas.n_solves,
-        n_factorizations=result.pdas.n_factorizations, n_analyses=result.pdas.n_analyses,
+        pdas_iterations=result.pdas.iterations,
+        n_solves=result.pdas.n_solves,
+        n_factorizations=result.pdas.n_factorizations,
+        n_analyses=result.pdas.n_analyses,
         n_updates=result.pdas.n_updates,
-        n_active=int(result.active.sum()), n_constrained=result.contact.size,
+        n_active=int(result.active.sum()),
+        n_constrained=result.contact.size,
         n_full_contact=int((classes == FULL_CONTACT).sum()),
         n_semi_contact=int((classes == SEMI_CONTACT).sum()),
         n_no_contact=int((classes == NO_CONTACT).sum()),
-        contact_force=result.total_contact_force, backend=result.pdas.backend,
-        t_assemble=result.timings["assemble"], t_solve=result.timings["solve"],
+        contact_force=result.total_contact_force,
+        backend=result.pdas.backend,
+        t_assemble=result.timings["assemble"],
+        t_solve=result.timings["solve"],
     )
     if result.problem.exact is not None:
         err = result.errors()

@@ -25,12 +25,14 @@ BACKEND_LIST = available_backends()
 
 # A 4 x 4 SPD problem on which plain PDAS (c = mean diagonal) cycles: found by a random search
 # over matrices with one decimal; the bounds are on all four DOFs.
-CYCLING_K = np.array([
-    [2.4, -1.2, -2.4, 1.8],
-    [-1.2, 4.6, 4.2, -3.8],
-    [-2.4, 4.2, 5.2, -2.8],
-    [1.8, -3.8, -2.8, 7.0],
-])
+CYCLING_K = np.array(
+    [
+        [2.4, -1.2, -2.4, 1.8],
+        [-1.2, 4.6, 4.2, -3.8],
+        [-2.4, 4.2, 5.2, -2.8],
+        [1.8, -3.8, -2.8, 7.0],
+    ]
+)
 CYCLING_F = np.array([0.0, 0.8, -0.1, -0.5])
 CYCLING_G = np.array([0.3, 0.4, -0.1, 1.4])
 
@@ -77,7 +79,7 @@ def random_problem(rng, n, m, n_dirichlet=0, dense=True):
         n = K.shape[0]
     perm = rng.permutation(n)
     c = perm[:m]
-    d = perm[m:m + n_dirichlet]
+    d = perm[m : m + n_dirichlet]
     F = rng.standard_normal(n)
     g = 0.3 * rng.standard_normal(m)
     xd = 0.2 * rng.standard_normal(n_dirichlet)
@@ -165,8 +167,9 @@ def test_kkt_on_random_problems(seed, n, frac_c, frac_d, dense):
 
 
 @settings(max_examples=40, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), n=st.integers(2, 12), m=st.integers(1, 8),
-       n_d=st.integers(0, 2))
+@given(
+    seed=st.integers(0, 2**32 - 1), n=st.integers(2, 12), m=st.integers(1, 8), n_d=st.integers(0, 2)
+)
 def test_matches_brute_force(seed, n, m, n_d):
     m = min(m, n)
     n_d = min(n_d, n - m)
@@ -206,8 +209,12 @@ def test_matches_scipy_slsqp():
     for i, gi in zip(c, g, strict=True):
         bounds[i] = (None, gi)
     ref = so.minimize(
-        lambda x: 0.5 * x @ Kd @ x - F @ x, np.zeros(n), jac=lambda x: Kd @ x - F,
-        method="SLSQP", bounds=bounds, options={"ftol": 1e-14, "maxiter": 500},
+        lambda x: 0.5 * x @ Kd @ x - F @ x,
+        np.zeros(n),
+        jac=lambda x: Kd @ x - F,
+        method="SLSQP",
+        bounds=bounds,
+        options={"ftol": 1e-14, "maxiter": 500},
     )
     assert ref.success
     result = solve_pdas(K, F, c, g)
@@ -247,7 +254,8 @@ def test_solver_reuse_across_calls(backend):
     assert first.n_analyses == 1
     assert second.n_analyses == 0  # same pattern: the analysis is kept by the solver
     assert solver.n_factorizations + first.n_updates + second.n_updates == (
-        first.iterations + second.iterations)
+        first.iterations + second.iterations
+    )
     assert_kkt(first)
     assert_kkt(second)
     assert second.times["analysis"] == 0.0
@@ -352,9 +360,11 @@ def test_elastic_block_on_inclined_foundation():
     A[rows, np.searchsorted(idx, 2 * bottom)] = normal[0]
     A[rows, np.searchsorted(idx, 2 * bottom + 1)] = normal[1]
     ref = so.minimize(
-        lambda y: 0.5 * y @ Kff @ y - f @ y, np.zeros(idx.size), jac=lambda y: Kff @ y - f,
-        method="SLSQP", constraints=[{"type": "ineq", "fun": lambda y: gap - A @ y,
-                                      "jac": lambda y: -A}],
+        lambda y: 0.5 * y @ Kff @ y - f @ y,
+        np.zeros(idx.size),
+        jac=lambda y: Kff @ y - f,
+        method="SLSQP",
+        constraints=[{"type": "ineq", "fun": lambda y: gap - A @ y, "jac": lambda y: -A}],
         options={"ftol": 1e-15, "maxiter": 1000},
     )
     assert ref.success
@@ -398,8 +408,7 @@ def small():
 )
 def test_bad_input_names_the_argument(small, change, message):
     K, F, c, g, d, xd = small
-    params = {"K": K, "F": F, "constrained": c, "gap": g, "dirichlet": d,
-              "dirichlet_values": xd}
+    params = {"K": K, "F": F, "constrained": c, "gap": g, "dirichlet": d, "dirichlet_values": xd}
     change(params)
     with pytest.raises(ValueError, match=message):
         solve_pdas(**params)

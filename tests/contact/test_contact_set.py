@@ -45,9 +45,15 @@ def graded_mesh(seed: int, steps: int = 6, x1: float = 2.0) -> Mesh:
 def block_problem(mesh: Mesh, gap=0.0) -> ContactProblem:
     """Contact on the bottom, Dirichlet on top, free sides."""
     return ContactProblem(
-        mesh=mesh, material=MATERIAL,
-        conditions={"top": Dirichlet((0.0, -0.1)), "left": Neumann(), "right": Neumann(),
-                    "bottom": Contact(gap=gap)})
+        mesh=mesh,
+        material=MATERIAL,
+        conditions={
+            "top": Dirichlet((0.0, -0.1)),
+            "left": Neumann(),
+            "right": Neumann(),
+            "bottom": Contact(gap=gap),
+        },
+    )
 
 
 # ------------------------------------------------------------------------- constrained nodes
@@ -73,9 +79,11 @@ def test_weights_sum_to_the_contact_length(seed):
     mesh = graded_mesh(seed)
     cs = contact_set(block_problem(mesh), P2Space(mesh))
     lengths = mesh.edge_length[mesh.part_edges("bottom")]
-    print(f"seed {seed}: {cs.size} constrained nodes, edge lengths "
-          f"{lengths.min():.4f}..{lengths.max():.4f}, Σm = {cs.lumped.sum():.15f}, "
-          f"Σw = {cs.simpson.sum():.15f}")
+    print(
+        f"seed {seed}: {cs.size} constrained nodes, edge lengths "
+        f"{lengths.min():.4f}..{lengths.max():.4f}, Σm = {cs.lumped.sum():.15f}, "
+        f"Σw = {cs.simpson.sum():.15f}"
+    )
     assert lengths.min() < lengths.max() / 3  # a graded contact boundary
     assert cs.lumped.sum() == pytest.approx(2.0, rel=1e-14)
     assert cs.simpson.sum() == pytest.approx(2.0, rel=1e-14)
@@ -88,9 +96,16 @@ def test_weights_sum_to_the_contact_length(seed):
 def test_dirichlet_nodes_are_not_constrained():
     mesh = rectangle(0, 1, 0, 1, nx=4, ny=4)
     space = P2Space(mesh)
-    pb = ContactProblem(mesh=mesh, material=MATERIAL,
-                        conditions={"left": Dirichlet(), "top": Neumann(), "right": Neumann(),
-                                    "bottom": Contact(gap=0.01)})
+    pb = ContactProblem(
+        mesh=mesh,
+        material=MATERIAL,
+        conditions={
+            "left": Dirichlet(),
+            "top": Neumann(),
+            "right": Neumann(),
+            "bottom": Contact(gap=0.01),
+        },
+    )
     cs = contact_set(pb, space)
     x = space.node_points[cs.nodes]
     assert cs.size == 8  # 9 nodes on the bottom minus the corner (0, 0)
@@ -107,15 +122,22 @@ def test_uniform_pressure_density_and_pressure(seed):
     rng = np.random.default_rng(seed)
     mesh = graded_mesh(seed, x1=1.5)
     u = contact_patch_field(rng, MATERIAL, uniform=True)
-    pb = patch_problem(mesh, MATERIAL, u, {"top": "D", "left": "N", "right": "N", "bottom": "C"},
-                       normal=np.array([0.0, -1.0]))
+    pb = patch_problem(
+        mesh,
+        MATERIAL,
+        u,
+        {"top": "D", "left": "N", "right": "N", "bottom": "C"},
+        normal=np.array([0.0, -1.0]),
+    )
     r = solve(pb)
     p = -stress(MATERIAL, u.gradient(np.array([0.7, 0.0])))[1, 1]
     v = r.contact.is_vertex
-    print(f"seed {seed}: p = {p:.6f}, p_z in [{r.pressure.min():.12f}, {r.pressure.max():.12f}],"
-          f" max |s_z/p − 2/3| at vertices {np.abs(r.density[v] / p - 2 / 3).max():.1e}, "
-          f"max |s_z/p − 4/3| at midpoints {np.abs(r.density[~v] / p - 4 / 3).max():.1e}, "
-          f"ΣΛ = {r.total_contact_force:.12f}")
+    print(
+        f"seed {seed}: p = {p:.6f}, p_z in [{r.pressure.min():.12f}, {r.pressure.max():.12f}],"
+        f" max |s_z/p − 2/3| at vertices {np.abs(r.density[v] / p - 2 / 3).max():.1e}, "
+        f"max |s_z/p − 4/3| at midpoints {np.abs(r.density[~v] / p - 4 / 3).max():.1e}, "
+        f"ΣΛ = {r.total_contact_force:.12f}"
+    )
     assert p > 1.0 and r.active.all()
     assert np.allclose(r.pressure, p, rtol=1e-10)
     assert np.allclose(r.density[v], 2 * p / 3, rtol=1e-10)
@@ -129,15 +151,22 @@ def test_pressure_exact_for_linear_pressures(seed):
     rng = np.random.default_rng(seed)
     mesh = graded_mesh(seed)
     u = contact_patch_field(rng, MATERIAL)
-    pb = patch_problem(mesh, MATERIAL, u, {"top": "D", "left": "N", "right": "N", "bottom": "C"},
-                       normal=np.array([0.0, -1.0]))
+    pb = patch_problem(
+        mesh,
+        MATERIAL,
+        u,
+        {"top": "D", "left": "N", "right": "N", "bottom": "C"},
+        normal=np.array([0.0, -1.0]),
+    )
     r = solve(pb)
     x = r.space.node_points[r.contact.nodes]
     p = -stress(MATERIAL, u.gradient(x))[:, 1, 1]
     err = np.abs(r.pressure - p).max() / np.abs(p).max()
     total = 0.5 * (p[np.argmin(x[:, 0])] + p[np.argmax(x[:, 0])]) * 2.0  # ∫ of a linear p
-    print(f"seed {seed}: p from {p.min():.4f} to {p.max():.4f}, max |p_z − p(z)|/max p = "
-          f"{err:.1e}, ΣΛ = {r.total_contact_force:.12f} vs ∫p = {total:.12f}")
+    print(
+        f"seed {seed}: p from {p.min():.4f} to {p.max():.4f}, max |p_z − p(z)|/max p = "
+        f"{err:.1e}, ΣΛ = {r.total_contact_force:.12f} vs ∫p = {total:.12f}"
+    )
     assert np.ptp(p) > 0.05 * np.abs(p).max()  # really non-uniform
     assert err < 1e-10
     assert r.total_contact_force == pytest.approx(total, rel=1e-10)
@@ -149,8 +178,9 @@ def test_pressure_exact_for_linear_pressures(seed):
 def classes_by_definition(cs, in_contact):
     """Paper, Section 4, written out edge by edge (plain loops; small meshes only)."""
     where = {int(z): k for k, z in enumerate(cs.nodes)}
-    full_edge = [all(z in where and in_contact[where[z]] for z in map(int, e))
-                 for e in cs.edge_nodes]
+    full_edge = [
+        all(z in where and in_contact[where[z]] for z in map(int, e)) for e in cs.edge_nodes
+    ]
     out = np.full(cs.size, NO_CONTACT)
     for k, z in enumerate(cs.nodes):
         if in_contact[k]:
@@ -173,10 +203,11 @@ def test_node_classes_follow_the_definition(seed):
     expect = classes_by_definition(cs, in_contact)
     print(f"seed {seed}: {np.bincount(got, minlength=3)} (no, semi, full)")
     assert np.array_equal(got, expect)
-    assert np.array_equal(node_classes(cs, np.ones(cs.size, bool), np.ones_like(edge_in)),
-                          np.full(cs.size, FULL_CONTACT))
-    assert np.all(node_classes(cs, np.zeros(cs.size, bool), np.zeros_like(edge_in))
-                  == NO_CONTACT)
+    assert np.array_equal(
+        node_classes(cs, np.ones(cs.size, bool), np.ones_like(edge_in)),
+        np.full(cs.size, FULL_CONTACT),
+    )
+    assert np.all(node_classes(cs, np.zeros(cs.size, bool), np.zeros_like(edge_in)) == NO_CONTACT)
 
 
 def test_example_6_1_every_node_full_contact():
@@ -221,35 +252,54 @@ def _square():
 
 def test_part_without_condition():
     with pytest.raises(ProblemError, match=r"boundary part\(s\) \['left'\] have no condition"):
-        ContactProblem(_square(), MATERIAL, {"top": Dirichlet(), "right": Neumann(),
-                                             "bottom": Contact()})
+        ContactProblem(
+            _square(), MATERIAL, {"top": Dirichlet(), "right": Neumann(), "bottom": Contact()}
+        )
 
 
 def test_condition_on_unknown_part():
     with pytest.raises(ProblemError, match=r"parts the mesh does not have: \['side'\]"):
-        ContactProblem(_square(), MATERIAL, {"top": Dirichlet(), "right": Neumann(),
-                                             "left": Neumann(), "bottom": Contact(),
-                                             "side": Neumann()})
+        ContactProblem(
+            _square(),
+            MATERIAL,
+            {
+                "top": Dirichlet(),
+                "right": Neumann(),
+                "left": Neumann(),
+                "bottom": Contact(),
+                "side": Neumann(),
+            },
+        )
 
 
 def test_no_dirichlet_part():
     with pytest.raises(ProblemError, match="needs a Dirichlet part"):
-        ContactProblem(_square(), MATERIAL, {"top": Neumann(), "right": Neumann(),
-                                             "left": Neumann(), "bottom": Contact()})
+        ContactProblem(
+            _square(),
+            MATERIAL,
+            {"top": Neumann(), "right": Neumann(), "left": Neumann(), "bottom": Contact()},
+        )
 
 
 def test_condition_of_wrong_type():
     with pytest.raises(ProblemError, match="must be Dirichlet, Neumann or Contact"):
-        ContactProblem(_square(), MATERIAL, {"top": Dirichlet(), "right": Neumann(),
-                                             "left": Neumann(), "bottom": (0.0, 0.0)})
+        ContactProblem(
+            _square(),
+            MATERIAL,
+            {"top": Dirichlet(), "right": Neumann(), "left": Neumann(), "bottom": (0.0, 0.0)},
+        )
 
 
 def test_curved_contact_part():
     m = _square()
-    mesh = Mesh.from_arrays(m.points, m.cells, {
-        "corner": lambda x, y: (np.abs(y) < 1e-12) | (np.abs(x - 1) < 1e-12),
-        "rest": lambda x, y: (np.abs(y - 1) < 1e-12) | (np.abs(x) < 1e-12),
-    })
+    mesh = Mesh.from_arrays(
+        m.points,
+        m.cells,
+        {
+            "corner": lambda x, y: (np.abs(y) < 1e-12) | (np.abs(x - 1) < 1e-12),
+            "rest": lambda x, y: (np.abs(y - 1) < 1e-12) | (np.abs(x) < 1e-12),
+        },
+    )
     with pytest.raises(ProblemError, match="'corner' is not straight"):
         ContactProblem(mesh, MATERIAL, {"rest": Dirichlet(), "corner": Contact()})
 
@@ -257,37 +307,72 @@ def test_curved_contact_part():
 @pytest.mark.parametrize("normal", [(-1.0, 0.0), (0.0, -1.0), (1.0, 0.1)])
 def test_normal_that_is_not_the_outward_normal(normal):
     with pytest.raises(ProblemError, match="is not its outward normal"):
-        ContactProblem(_square(), MATERIAL, {"left": Dirichlet(), "top": Neumann(),
-                                             "bottom": Neumann(),
-                                             "right": Contact(normal=normal)})
+        ContactProblem(
+            _square(),
+            MATERIAL,
+            {
+                "left": Dirichlet(),
+                "top": Neumann(),
+                "bottom": Neumann(),
+                "right": Contact(normal=normal),
+            },
+        )
 
 
 def test_zero_normal():
     with pytest.raises(ProblemError, match="non-zero finite vector"):
-        ContactProblem(_square(), MATERIAL, {"left": Dirichlet(), "top": Neumann(),
-                                             "bottom": Neumann(),
-                                             "right": Contact(normal=(0.0, 0.0))})
+        ContactProblem(
+            _square(),
+            MATERIAL,
+            {
+                "left": Dirichlet(),
+                "top": Neumann(),
+                "bottom": Neumann(),
+                "right": Contact(normal=(0.0, 0.0)),
+            },
+        )
 
 
 def test_outward_normal_accepted_unnormalised():
-    pb = ContactProblem(_square(), MATERIAL, {"left": Dirichlet(), "top": Neumann(),
-                                              "bottom": Neumann(),
-                                              "right": Contact(normal=(3.0, 0.0))})
+    pb = ContactProblem(
+        _square(),
+        MATERIAL,
+        {
+            "left": Dirichlet(),
+            "top": Neumann(),
+            "bottom": Neumann(),
+            "right": Contact(normal=(3.0, 0.0)),
+        },
+    )
     assert np.allclose(pb.contact_normals["right"], [1.0, 0.0])
 
 
 def test_gap_returning_nan():
-    pb = ContactProblem(_square(), MATERIAL, {
-        "left": Dirichlet(), "top": Neumann(), "bottom": Neumann(),
-        "right": Contact(gap=lambda x: np.where(x[..., 1] > 0.5, np.nan, 0.0))})
+    pb = ContactProblem(
+        _square(),
+        MATERIAL,
+        {
+            "left": Dirichlet(),
+            "top": Neumann(),
+            "bottom": Neumann(),
+            "right": Contact(gap=lambda x: np.where(x[..., 1] > 0.5, np.nan, 0.0)),
+        },
+    )
     with pytest.raises(ProblemError, match="gap function of contact part 'right' returned NaN"):
         solve(pb)
 
 
 def test_gap_of_wrong_shape():
-    pb = ContactProblem(_square(), MATERIAL, {
-        "left": Dirichlet(), "top": Neumann(), "bottom": Neumann(),
-        "right": Contact(gap=lambda x: x)})
+    pb = ContactProblem(
+        _square(),
+        MATERIAL,
+        {
+            "left": Dirichlet(),
+            "top": Neumann(),
+            "bottom": Neumann(),
+            "right": Contact(gap=lambda x: x),
+        },
+    )
     with pytest.raises(ProblemError, match="gap function of contact part 'right' must return"):
         solve(pb)
 
@@ -298,22 +383,38 @@ def test_material_checks():
     with pytest.raises(ValueError, match=r"Poisson's ratio nu must be < 0\.5"):
         Material.from_young(1.0, 0.7)
     with pytest.raises(ProblemError, match="material must be a signorini Material"):
-        ContactProblem(_square(), (1.0, 1.0), {"left": Dirichlet(), "top": Neumann(),
-                                               "bottom": Neumann(), "right": Contact()})
+        ContactProblem(
+            _square(),
+            (1.0, 1.0),
+            {"left": Dirichlet(), "top": Neumann(), "bottom": Neumann(), "right": Contact()},
+        )
 
 
 def test_contact_parts_meeting_at_a_corner():
-    pb = ContactProblem(_square(), MATERIAL, {"left": Dirichlet(), "top": Neumann(),
-                                              "bottom": Contact(), "right": Contact()})
-    with pytest.raises(ProblemError, match=r"node 2 at \[1\.0, 0\.0\] lies on contact parts "
-                                           "with different normals"):
+    pb = ContactProblem(
+        _square(),
+        MATERIAL,
+        {"left": Dirichlet(), "top": Neumann(), "bottom": Contact(), "right": Contact()},
+    )
+    with pytest.raises(
+        ProblemError,
+        match=r"node 2 at \[1\.0, 0\.0\] lies on contact parts "
+        "with different normals",
+    ):
         solve(pb)
 
 
 def test_dirichlet_value_returning_nan():
-    pb = ContactProblem(_square(), MATERIAL, {
-        "left": Dirichlet(lambda x: np.full(x.shape, np.nan)), "top": Neumann(),
-        "bottom": Neumann(), "right": Contact()})
+    pb = ContactProblem(
+        _square(),
+        MATERIAL,
+        {
+            "left": Dirichlet(lambda x: np.full(x.shape, np.nan)),
+            "top": Neumann(),
+            "bottom": Neumann(),
+            "right": Contact(),
+        },
+    )
     with pytest.raises(ProblemError, match="Dirichlet value of part 'left' returned NaN"):
         solve(pb)
 
@@ -321,28 +422,42 @@ def test_dirichlet_value_returning_nan():
 def _split_right_side():
     base = rectangle(nx=4, ny=4)
     tol = 1e-12
-    return Mesh.from_arrays(base.points, base.cells, {
-        "left": lambda x, y: np.abs(x) < tol,
-        "top": lambda x, y: np.abs(y - 1) < tol,
-        "bottom": lambda x, y: np.abs(y) < tol,
-        "right_low": lambda x, y: (np.abs(x - 1) < tol) & (y < 0.5),
-        "right_high": lambda x, y: (np.abs(x - 1) < tol) & (y > 0.5),
-    })
+    return Mesh.from_arrays(
+        base.points,
+        base.cells,
+        {
+            "left": lambda x, y: np.abs(x) < tol,
+            "top": lambda x, y: np.abs(y - 1) < tol,
+            "bottom": lambda x, y: np.abs(y) < tol,
+            "right_low": lambda x, y: (np.abs(x - 1) < tol) & (y < 0.5),
+            "right_high": lambda x, y: (np.abs(x - 1) < tol) & (y > 0.5),
+        },
+    )
 
 
 def test_collinear_contact_parts_with_disagreeing_gaps():
     conditions = {"left": Dirichlet((0.1, 0.0)), "top": Neumann(), "bottom": Neumann()}
-    pb = ContactProblem(_split_right_side(), MATERIAL,
-                        {**conditions, "right_low": Contact(gap=0.0),
-                         "right_high": Contact(gap=0.05)})
-    with pytest.raises(ProblemError, match=r"node \d+ at \[1\.0, 0\.5\] lies on contact parts "
-                                           "whose gap functions disagree"):
+    pb = ContactProblem(
+        _split_right_side(),
+        MATERIAL,
+        {**conditions, "right_low": Contact(gap=0.0), "right_high": Contact(gap=0.05)},
+    )
+    with pytest.raises(
+        ProblemError,
+        match=r"node \d+ at \[1\.0, 0\.5\] lies on contact parts "
+        "whose gap functions disagree",
+    ):
         solve(pb)
     # a continuous obstacle split over two parts gives the solution of the unsplit problem
     gap = lambda x: -0.2 + 0.5 * np.abs(x[..., 1] - 0.5)  # noqa: E731
-    split = solve(ContactProblem(_split_right_side(), MATERIAL,
-                                 {**conditions, "right_low": Contact(gap=gap),
-                                  "right_high": Contact(gap=gap)}))
-    whole = solve(ContactProblem(rectangle(nx=4, ny=4), MATERIAL,
-                                 {**conditions, "right": Contact(gap=gap)}))
+    split = solve(
+        ContactProblem(
+            _split_right_side(),
+            MATERIAL,
+            {**conditions, "right_low": Contact(gap=gap), "right_high": Contact(gap=gap)},
+        )
+    )
+    whole = solve(
+        ContactProblem(rectangle(nx=4, ny=4), MATERIAL, {**conditions, "right": Contact(gap=gap)})
+    )
     assert np.abs(split.u - whole.u).max() <= 1e-13 * np.abs(whole.u).max()

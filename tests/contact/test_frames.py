@@ -16,7 +16,7 @@ def dense_Q(n_dofs, nodes, normals):
     """Reference: the full block-diagonal rotation matrix with columns [n t] at each node."""
     Q = np.eye(n_dofs)
     for z, (n1, n2) in zip(nodes, normals, strict=True):
-        Q[2 * z:2 * z + 2, 2 * z:2 * z + 2] = [[n1, -n2], [n2, n1]]
+        Q[2 * z : 2 * z + 2, 2 * z : 2 * z + 2] = [[n1, -n2], [n2, n1]]
     return Q
 
 
@@ -26,8 +26,12 @@ def random_normals(rng, k):
 
 
 @settings(max_examples=30, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), nx=st.integers(1, 6), ny=st.integers(1, 6),
-       frac=st.floats(0.0, 1.0))
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    nx=st.integers(1, 6),
+    ny=st.integers(1, 6),
+    frac=st.floats(0.0, 1.0),
+)
 def test_rotation_equals_dense_product(seed, nx, ny, frac):
     rng = np.random.default_rng(seed)
     K = block_spd(nx, ny, rng)
@@ -77,12 +81,16 @@ def test_in_place():
 
 def test_not_block_pattern_raises():
     # column 2 stored without column 3 in row 0 (and symmetric): node 1 is not node-blocked
-    A = sp.csr_matrix(np.array([
-        [4.0, 1.0, 1.0, 0.0],
-        [1.0, 4.0, 1.0, 1.0],
-        [1.0, 1.0, 4.0, 1.0],
-        [0.0, 1.0, 1.0, 4.0],
-    ]))
+    A = sp.csr_matrix(
+        np.array(
+            [
+                [4.0, 1.0, 1.0, 0.0],
+                [1.0, 4.0, 1.0, 1.0],
+                [1.0, 1.0, 4.0, 1.0],
+                [0.0, 1.0, 1.0, 4.0],
+            ]
+        )
+    )
     with pytest.raises(ValueError, match="2x2 node-block pattern"):
         rotate_frames(A, np.zeros(4), [1], [[0.0, 1.0]])
     # node 0: rows 0 and 1 store different columns

@@ -42,8 +42,11 @@ def nvb_mesh(mesh: Mesh, seed: int, steps: int = 3, targets: np.ndarray | None =
     if targets is None:
         lo, hi = mesh.points.min(0), mesh.points.max(0)
         t, side = rng.random(2), rng.integers(0, 4, size=2)
-        unit = np.where(side[:, None] % 2 == 0, np.column_stack([t, side // 2]),
-                        np.column_stack([1 - side // 2, t]))  # a point on each of two sides
+        unit = np.where(
+            side[:, None] % 2 == 0,
+            np.column_stack([t, side // 2]),
+            np.column_stack([1 - side // 2, t]),
+        )  # a point on each of two sides
         targets = lo + (hi - lo) * unit
     for step in range(steps):
         c = mesh.points[mesh.cells].mean(axis=1)
@@ -65,16 +68,22 @@ def example_mesh(problem, kind: str, seed: int = 0) -> Mesh:
 
 def rotated_mesh(mesh: Mesh, R: np.ndarray, sides: dict[str, object]) -> Mesh:
     """The mesh with points ``R x``; parts chosen by predicates on the unrotated coordinates."""
+
     def part(pred):
         return lambda x, y: pred(*(np.column_stack([x, y]) @ R).T)
 
-    return Mesh.from_arrays(mesh.points @ R.T, mesh.cells,
-                            {name: part(p) for name, p in sides.items()})
+    return Mesh.from_arrays(
+        mesh.points @ R.T, mesh.cells, {name: part(p) for name, p in sides.items()}
+    )
 
 
 def square_sides(x1: float = 1.0, y1: float = 1.0, tol: float = 1e-9) -> dict[str, object]:
-    return {"bottom": lambda x, y: np.abs(y) < tol, "right": lambda x, y: np.abs(x - x1) < tol,
-            "top": lambda x, y: np.abs(y - y1) < tol, "left": lambda x, y: np.abs(x) < tol}
+    return {
+        "bottom": lambda x, y: np.abs(y) < tol,
+        "right": lambda x, y: np.abs(x - x1) < tol,
+        "top": lambda x, y: np.abs(y - y1) < tol,
+        "left": lambda x, y: np.abs(x) < tol,
+    }
 
 
 # --------------------------------------------------------------------------------- patch tests
@@ -100,13 +109,20 @@ def test_contact_patch_test(angle):
     base = nvb_mesh(refine_uniform(rectangle(0, 2, 0, 1, nx=4, ny=2)).mesh, int(angle) + 7)
     mesh = rotated_mesh(base, R, square_sides(x1=2.0))
     u = contact_patch_field(rng, MATERIAL).rotated(R)
-    pb = patch_problem(mesh, MATERIAL, u, {"top": "D", "left": "N", "right": "N", "bottom": "C"},
-                       normal=R @ [0.0, -1.0])
+    pb = patch_problem(
+        mesh,
+        MATERIAL,
+        u,
+        {"top": "D", "left": "N", "right": "N", "bottom": "C"},
+        normal=R @ [0.0, -1.0],
+    )
     r = solve(pb)
     exact = u.value(r.space.node_points)
     err = np.abs(r.u - exact).max() / np.abs(exact).max()
-    print(f"angle {angle}: {r.contact.size} constrained nodes, {int(r.active.sum())} active, "
-          f"max nodal error / max |u| = {err:.1e}, min Λ = {r.contact_force.min():.3e}")
+    print(
+        f"angle {angle}: {r.contact.size} constrained nodes, {int(r.active.sum())} active, "
+        f"max nodal error / max |u| = {err:.1e}, min Λ = {r.contact_force.min():.3e}"
+    )
     assert r.contact.size >= 17
     assert r.active.all()
     assert np.all(r.contact_force > 0)
@@ -117,10 +133,13 @@ def test_large_gap_equals_the_neumann_problem():
     """With an obstacle out of reach Γ_C is traction free: Λ = 0 and u solves the Neumann
     problem (solved here with scipy directly)."""
     mesh = nvb_mesh(rectangle(nx=4, ny=4), 3)
-    conditions = {"left": Dirichlet((0.05, 0.02)), "top": Neumann((0.3, -0.2)),
-                  "bottom": Neumann()}
-    pb = ContactProblem(mesh, MATERIAL, {**conditions, "right": Contact(gap=10.0)},
-                        body_force=lambda x: np.stack([x[..., 1], -x[..., 0]], axis=-1))
+    conditions = {"left": Dirichlet((0.05, 0.02)), "top": Neumann((0.3, -0.2)), "bottom": Neumann()}
+    pb = ContactProblem(
+        mesh,
+        MATERIAL,
+        {**conditions, "right": Contact(gap=10.0)},
+        body_force=lambda x: np.stack([x[..., 1], -x[..., 0]], axis=-1),
+    )
     r = solve(pb)
     S = independent_system(pb, mesh)
     free = np.setdiff1d(np.arange(S.F.size), S.dirichlet)
@@ -128,8 +147,10 @@ def test_large_gap_equals_the_neumann_problem():
     x[S.dirichlet] = S.dirichlet_values
     x[free] = spla.spsolve(S.K[free][:, free].tocsc(), (S.F - S.K @ x)[free])
     err = np.abs(r.u.ravel() - x).max() / np.abs(x).max()
-    print(f"large gap: {r.pdas.iterations} PDAS iteration(s), difference to the linear solve "
-          f"{err:.1e}")
+    print(
+        f"large gap: {r.pdas.iterations} PDAS iteration(s), difference to the linear solve "
+        f"{err:.1e}"
+    )
     assert not r.active.any() and np.all(r.contact_force == 0)
     assert r.pdas.iterations == 1
     assert err < 1e-10
@@ -150,14 +171,18 @@ def kkt(system, u):
     other = np.ones(u.shape[0], dtype=bool)
     other[system.nodes] = False
     other[system.dirichlet[::2] // 2] = False
-    return lam, {
-        "primal u·n − ψ ≤ 0": max(slack.max(), 0) / disp,
-        "dual Λ ≥ 0": max(-lam.min(), 0) / force,
-        "complementarity": np.abs(lam * slack).max() / (force * disp),
-        "tangential": np.abs(np.einsum("kc,kc->k", rz, tangent)).max() / force,
-        "interior": np.abs(res.reshape(-1, 2)[other]).max() / force,
-        "dirichlet": np.abs(x[system.dirichlet] - system.dirichlet_values).max() / disp,
-    }, force
+    return (
+        lam,
+        {
+            "primal u·n − ψ ≤ 0": max(slack.max(), 0) / disp,
+            "dual Λ ≥ 0": max(-lam.min(), 0) / force,
+            "complementarity": np.abs(lam * slack).max() / (force * disp),
+            "tangential": np.abs(np.einsum("kc,kc->k", rz, tangent)).max() / force,
+            "interior": np.abs(res.reshape(-1, 2)[other]).max() / force,
+            "dirichlet": np.abs(x[system.dirichlet] - system.dirichlet_values).max() / disp,
+        },
+        force,
+    )
 
 
 @pytest.mark.parametrize("kind", ["initial", "uniform", "nvb"])
@@ -171,9 +196,11 @@ def test_kkt_on_an_independent_system(name, kind):
     assert np.allclose(S.normal, r.contact.normal) and np.allclose(S.gap, r.contact.gap)
     lam, res, force = kkt(S, r.u)
     worst = max(res.values())
-    print(f"Example {name}, {kind} mesh ({r.ndof} unknowns, {int(r.active.sum())}/"
-          f"{r.contact.size} active): worst KKT residual {worst:.1e}; "
-          + ", ".join(f"{k} {v:.0e}" for k, v in res.items()))
+    print(
+        f"Example {name}, {kind} mesh ({r.ndof} unknowns, {int(r.active.sum())}/"
+        f"{r.contact.size} active): worst KKT residual {worst:.1e}; "
+        + ", ".join(f"{k} {v:.0e}" for k, v in res.items())
+    )
     assert worst < 1e-10
     assert np.abs(lam - r.contact_force).max() < 1e-10 * force
     # Λ > 0 exactly on the active set (no degenerate node in these examples)
@@ -185,12 +212,17 @@ def test_kkt_two_contact_parts_and_a_dirichlet_corner(seed):
     """A block between two obstacles (bottom and top, non-constant gaps) touching both;
     Γ_C meets Γ_D at two corners, whose nodes are not constrained."""
     mesh = nvb_mesh(rectangle(0, 2, 0, 1, nx=4, ny=2), seed)
-    pb = ContactProblem(mesh, MATERIAL, {
-        "left": Dirichlet((0.1, -0.01)),
-        "right": Neumann((0.4, 0.2)),
-        "bottom": Contact(gap=lambda x: 0.01 + 0.02 * x[..., 0] ** 2),
-        "top": Contact(gap=lambda x: -0.01 - 0.04 * x[..., 0]),
-    }, body_force=lambda x: np.array([0.0, -0.2]))
+    pb = ContactProblem(
+        mesh,
+        MATERIAL,
+        {
+            "left": Dirichlet((0.1, -0.01)),
+            "right": Neumann((0.4, 0.2)),
+            "bottom": Contact(gap=lambda x: 0.01 + 0.02 * x[..., 0] ** 2),
+            "top": Contact(gap=lambda x: -0.01 - 0.04 * x[..., 0]),
+        },
+        body_force=lambda x: np.array([0.0, -0.2]),
+    )
     r = solve(pb)
     S = independent_system(pb, mesh)
     assert np.array_equal(S.nodes, r.contact.nodes)
@@ -199,9 +231,11 @@ def test_kkt_two_contact_parts_and_a_dirichlet_corner(seed):
     lam, res, force = kkt(S, r.u)
     worst = max(res.values())
     n_bottom = int(np.sum(r.active & (r.contact.normal[:, 1] < 0)))
-    print(f"seed {seed}: {r.ndof} unknowns, active {n_bottom} on the bottom and "
-          f"{int(r.active.sum()) - n_bottom} on the top of {r.contact.size}, "
-          f"worst KKT residual {worst:.1e}")
+    print(
+        f"seed {seed}: {r.ndof} unknowns, active {n_bottom} on the bottom and "
+        f"{int(r.active.sum()) - n_bottom} on the top of {r.contact.size}, "
+        f"worst KKT residual {worst:.1e}"
+    )
     assert 0 < n_bottom < r.active.sum() < r.contact.size  # both obstacles touched, not all
     assert worst < 1e-10
     assert np.abs(lam - r.contact_force).max() < 1e-10 * force
@@ -221,8 +255,9 @@ def reduced_qp(system):
     index[free] = np.arange(free.sum())
     k = system.nodes.size
     cols = index[(2 * system.nodes[:, None] + np.arange(2)).ravel()]
-    B = sp.csr_matrix((system.normal.ravel(), (np.repeat(np.arange(k), 2), cols)),
-                      shape=(k, int(free.sum())))
+    B = sp.csr_matrix(
+        (system.normal.ravel(), (np.repeat(np.arange(k), 2), cols)), shape=(k, int(free.sum()))
+    )
     return K, b, B, free, x_d
 
 
@@ -234,16 +269,22 @@ def test_agrees_with_scipy_trust_constr(name):
     K, b, B, free, x_d = reduced_qp(S)
     scale = K.diagonal().mean()
     K1, b1 = K / scale, b / scale
-    out = minimize(lambda x: 0.5 * x @ (K1 @ x) - b1 @ x, np.zeros(K.shape[0]),
-                   jac=lambda x: K1 @ x - b1, hess=lambda x: K1, method="trust-constr",
-                   constraints=[LinearConstraint(B, -np.inf, S.gap)],
-                   options={"gtol": 1e-12, "xtol": 1e-14, "barrier_tol": 1e-13,
-                            "maxiter": 3000})
+    out = minimize(
+        lambda x: 0.5 * x @ (K1 @ x) - b1 @ x,
+        np.zeros(K.shape[0]),
+        jac=lambda x: K1 @ x - b1,
+        hess=lambda x: K1,
+        method="trust-constr",
+        constraints=[LinearConstraint(B, -np.inf, S.gap)],
+        options={"gtol": 1e-12, "xtol": 1e-14, "barrier_tol": 1e-13, "maxiter": 3000},
+    )
     x = x_d.copy()
     x[free] = out.x
     diff = np.abs(x - r.u.ravel()).max() / np.abs(r.u).max()
-    print(f"Example {name}: {K.shape[0]} unknowns, trust-constr {out.nit} iterations "
-          f"(status {out.status}), max |u_qp − u_pdas| / max |u| = {diff:.1e}")
+    print(
+        f"Example {name}: {K.shape[0]} unknowns, trust-constr {out.nit} iterations "
+        f"(status {out.status}), max |u_qp − u_pdas| / max |u| = {diff:.1e}"
+    )
     assert diff < 1e-6
 
 
@@ -266,8 +307,10 @@ def test_agrees_with_exact_dual_nnls(name, kind):
     x[free] = Kib - KiBt @ lam
     du = np.abs(x - r.u.ravel()).max() / np.abs(r.u).max()
     dl = np.abs(lam - r.contact_force).max() / np.abs(lam).max()
-    print(f"Example {name}, {kind}: {K.shape[0]} unknowns, {lam.size} constraints: "
-          f"max |Δu|/max|u| = {du:.1e}, max |ΔΛ|/max Λ = {dl:.1e}")
+    print(
+        f"Example {name}, {kind}: {K.shape[0]} unknowns, {lam.size} constraints: "
+        f"max |Δu|/max|u| = {du:.1e}, max |ΔΛ|/max Λ = {dl:.1e}"
+    )
     assert du < 1e-10 and dl < 1e-9
     assert np.array_equal(lam > 0, r.active)
 
@@ -280,10 +323,14 @@ def rotated_example_6_2(mesh: Mesh, angle: float) -> ContactProblem:
     return ContactProblem(
         mesh=rotated_mesh(mesh, R, square_sides()),
         material=pb.material,
-        conditions={"left": Dirichlet(tuple(R @ [0.1, 0.0])), "top": Neumann(),
-                    "bottom": Neumann(),
-                    "right": Contact(gap=lambda x: gap(x @ R), normal=tuple(R @ [1.0, 0.0]))},
-        name="example-6.2-rotated")
+        conditions={
+            "left": Dirichlet(tuple(R @ [0.1, 0.0])),
+            "top": Neumann(),
+            "bottom": Neumann(),
+            "right": Contact(gap=lambda x: gap(x @ R), normal=tuple(R @ [1.0, 0.0])),
+        },
+        name="example-6.2-rotated",
+    )
 
 
 @pytest.mark.parametrize("kind", ["initial", "nvb"])
@@ -298,9 +345,11 @@ def test_rotation_invariance(kind):
     assert np.array_equal(rot.contact.nodes, ref.contact.nodes)
     du = np.abs(rot.u - ref.u @ R.T).max() / np.abs(ref.u).max()
     dl = np.abs(rot.contact_force - ref.contact_force).max() / ref.contact_force.max()
-    print(f"{kind} mesh, rotated by {angle}°: max |u_rot − R u| / max |u| = {du:.1e}, "
-          f"max |ΔΛ| / max Λ = {dl:.1e}, active {int(ref.active.sum())} = "
-          f"{int(rot.active.sum())}")
+    print(
+        f"{kind} mesh, rotated by {angle}°: max |u_rot − R u| / max |u| = {du:.1e}, "
+        f"max |ΔΛ| / max Λ = {dl:.1e}, active {int(ref.active.sum())} = "
+        f"{int(rot.active.sum())}"
+    )
     assert np.array_equal(rot.active, ref.active)
     assert du < 1e-10 and dl < 1e-10
     assert np.allclose(rot.contact.normal, R @ [1.0, 0.0], atol=1e-15)
@@ -314,8 +363,10 @@ def test_warm_start_from_the_solution_takes_one_iteration(name, kind):
     mesh = example_mesh(pb, kind, seed=2)
     r = solve(pb, mesh)
     again = solve(pb, mesh, u0=r.u)
-    print(f"Example {name}, {kind}: cold start {r.pdas.iterations} iterations, warm start "
-          f"{again.pdas.iterations}")
+    print(
+        f"Example {name}, {kind}: cold start {r.pdas.iterations} iterations, warm start "
+        f"{again.pdas.iterations}"
+    )
     assert again.pdas.iterations == 1
     assert np.array_equal(again.active, r.active)
     assert np.abs(again.u - r.u).max() <= 1e-12 * np.abs(r.u).max()
@@ -328,8 +379,10 @@ def test_warm_start_after_refinement_saves_iterations():
     u0 = coarse.space.prolongate(coarse.u, ref)
     cold = solve(pb, ref.mesh)
     warm = solve(pb, ref.mesh, u0=u0)
-    print(f"Example 6.2 after one refinement: cold {cold.pdas.iterations}, warm "
-          f"{warm.pdas.iterations} iterations")
+    print(
+        f"Example 6.2 after one refinement: cold {cold.pdas.iterations}, warm "
+        f"{warm.pdas.iterations} iterations"
+    )
     assert warm.pdas.iterations < cold.pdas.iterations
     assert np.abs(warm.u - cold.u).max() <= 1e-12 * np.abs(cold.u).max()
 

@@ -14,7 +14,8 @@ from signorini.estimator.marking import mark_doerfler
 
 indicators = st.lists(
     st.floats(min_value=0.0, max_value=1e6, allow_nan=False, allow_infinity=False),
-    min_size=1, max_size=200,
+    min_size=1,
+    max_size=200,
 ).map(np.array)
 thetas = st.floats(min_value=0.0, max_value=1.0, exclude_min=True)
 

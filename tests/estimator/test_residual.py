@@ -39,8 +39,12 @@ def no_neumann_problem() -> ContactProblem:
     return ContactProblem(
         mesh=rectangle(nx=4, ny=4),
         material=Material.from_lame(1.0, 1.0),
-        conditions={"top": Dirichlet(), "left": Dirichlet(), "right": Dirichlet(),
-                    "bottom": Contact(gap=0.0)},
+        conditions={
+            "top": Dirichlet(),
+            "left": Dirichlet(),
+            "right": Dirichlet(),
+            "bottom": Contact(gap=0.0),
+        },
         body_force=lambda x: np.stack([0.3 * x[..., 1], -1.0 - x[..., 0]], axis=-1),
         name="clamped",
     )
@@ -62,8 +66,12 @@ def part_of_point(x: np.ndarray) -> str | None:
 def dirichlet_node_mask(problem: ContactProblem, points: np.ndarray) -> np.ndarray:
     """Nodes on the closure of the Dirichlet sides of the unit square, from coordinates."""
     x, y = points[:, 0], points[:, 1]
-    on = {"bottom": np.abs(y) < 1e-12, "right": np.abs(x - 1) < 1e-12,
-          "top": np.abs(y - 1) < 1e-12, "left": np.abs(x) < 1e-12}
+    on = {
+        "bottom": np.abs(y) < 1e-12,
+        "right": np.abs(x - 1) < 1e-12,
+        "top": np.abs(y - 1) < 1e-12,
+        "left": np.abs(x) < 1e-12,
+    }
     mask = np.zeros(len(points), dtype=bool)
     for name, cond in problem.conditions.items():
         if isinstance(cond, Dirichlet):
@@ -186,10 +194,15 @@ def reference_node_terms(result, eta5: str) -> np.ndarray:
                 st = sn - snn[:, None] * n
                 if eta5 == "consistent":
                     t = gt
-                    snn = snn + (pressure[ia] * (1 - t) * (1 - 2 * t)
-                                 + pressure[ib] * t * (2 * t - 1) + pressure[im] * 4 * t * (1 - t))
-                terms = [(3, length * np.sum(gw * (st**2).sum(axis=1))),
-                         (4, length * np.sum(gw * snn**2))]
+                    snn = snn + (
+                        pressure[ia] * (1 - t) * (1 - 2 * t)
+                        + pressure[ib] * t * (2 * t - 1)
+                        + pressure[im] * 4 * t * (1 - t)
+                    )
+                terms = [
+                    (3, length * np.sum(gw * (st**2).sum(axis=1))),
+                    (4, length * np.sum(gw * snn**2)),
+                ]
         for term, J in terms:
             for p in (ia, ib, im):
                 out[term, p] += J
@@ -220,14 +233,23 @@ def reference_eta6(result) -> np.ndarray:
             un = ua * (1 - t) * (1 - 2 * t) + ub * t * (2 * t - 1) + um * 4 * t * (1 - t)
             return max(float(gap((a + t * (b - a))[None])[0]) - un, 0.0)
 
-        pieces = {ia: [(0, 1 / 3, lambda t: 1 - 2 * t)], ib: [(2 / 3, 1, lambda t: 2 * t - 1)],
-                  im: [(1 / 3, 1 / 2, lambda t: 2 * t), (1 / 2, 2 / 3, lambda t: 2 - 2 * t)]}
+        pieces = {
+            ia: [(0, 1 / 3, lambda t: 1 - 2 * t)],
+            ib: [(2 / 3, 1, lambda t: 2 * t - 1)],
+            im: [(1 / 3, 1 / 2, lambda t: 2 * t), (1 / 2, 2 / 3, lambda t: 2 - 2 * t)],
+        }
         for p, parts in pieces.items():
             if p not in semi:
                 continue
             for lo, hi, phi in parts:
-                val, _ = quad(lambda t, phi=phi: clearance(t) * phi(t), lo, hi, epsabs=1e-15,
-                              epsrel=1e-12, limit=200)
+                val, _ = quad(
+                    lambda t, phi=phi: clearance(t) * phi(t),
+                    lo,
+                    hi,
+                    epsabs=1e-15,
+                    epsrel=1e-12,
+                    limit=200,
+                )
                 out[p] += s[p] * length * val
     return out
 
@@ -254,8 +276,9 @@ def test_indicator_bookkeeping(name, seed):
     assert est.eta2_terms.sum() == pytest.approx(est.eta**2, rel=1e-13)
     np.testing.assert_allclose(est.eta_terms, [est.as_dict()[f"eta{k}"] for k in range(1, 8)])
     # each η_k², k ≤ 6, is the sum of its node contributions
-    np.testing.assert_allclose(est.eta2_node.sum(axis=1), est.eta2_terms[:6], rtol=1e-12,
-                               atol=1e-14 * est.eta**2)
+    np.testing.assert_allclose(
+        est.eta2_node.sum(axis=1), est.eta2_terms[:6], rtol=1e-12, atol=1e-14 * est.eta**2
+    )
     # node contributions vanish at Dirichlet nodes and where a term does not apply
     X = result.space.node_points
     dirichlet = dirichlet_node_mask(problem, X)
@@ -314,8 +337,9 @@ def test_node_terms_against_independent_computation(name, steps, eta5):
         err = np.abs(est.eta2_node[k] - ref[k]).max() / scale
         print(f"{name} steps={steps} {eta5}: eta{k + 1} node max rel. deviation {err:.2e}")
         rtol = 1e-9  # the Neumann data of Example 6.1 is not polynomial: fine rules on both sides
-        np.testing.assert_allclose(est.eta2_node[k], ref[k], rtol=rtol, atol=rtol * scale / 100,
-                                   err_msg=f"eta{k + 1}")
+        np.testing.assert_allclose(
+            est.eta2_node[k], ref[k], rtol=rtol, atol=rtol * scale / 100, err_msg=f"eta{k + 1}"
+        )
 
 
 def test_eta6_against_quadrature():
@@ -330,8 +354,10 @@ def test_eta6_against_quadrature():
         # clearances of the order of round-off at contact nodes give contributions ~1e-17
         atol = 1e-12 * result.density.max() * np.abs(result.u).max()
         genuine += ref.max() > 1e3 * atol
-        print(f"6.2 ndof {result.ndof}: eta6^2 = {ref.sum():.6e} (quad), "
-              f"{est.eta2_terms[5]:.6e} (estimator)")
+        print(
+            f"6.2 ndof {result.ndof}: eta6^2 = {ref.sum():.6e} (quad), "
+            f"{est.eta2_terms[5]:.6e} (estimator)"
+        )
         np.testing.assert_allclose(est.eta2_node[5], ref, rtol=1e-8, atol=atol)
     assert genuine >= 3
 
@@ -350,9 +376,12 @@ def test_eta7_bounds_penetration_l2_norm():
         l2 = 0.0
         max_w = 0.0
         for (wa, wb, wm), le in zip(w, length, strict=True):
+
             def pos(t, wa=wa, wb=wb, wm=wm):
-                return max(wa * (1 - t) * (1 - 2 * t) + wb * t * (2 * t - 1)
-                           + wm * 4 * t * (1 - t), 0.0)
+                return max(
+                    wa * (1 - t) * (1 - 2 * t) + wb * t * (2 * t - 1) + wm * 4 * t * (1 - t), 0.0
+                )
+
             l2 += le * quad(lambda t, pos=pos: pos(t) ** 2, 0, 1, epsabs=1e-20, limit=200)[0]
             max_w = max(max_w, max(pos(t) for t in np.linspace(0, 1, 401)))
         eta7_2 = est.eta2_terms[6]
@@ -377,12 +406,22 @@ def quad_thirds(v: np.ndarray, length: float) -> np.ndarray:
     roots = np.roots([2 * a + 2 * b - 4 * m, -3 * a - b + 4 * m, a])
     roots = [float(r.real) for r in roots if abs(r.imag) < 1e-14 and 0 < r.real < 1]
     out = np.zeros(3)
-    hats = [(0, 0, 1 / 3, lambda t: 1 - 2 * t), (1, 2 / 3, 1, lambda t: 2 * t - 1),
-            (2, 1 / 3, 1 / 2, lambda t: 2 * t), (2, 1 / 2, 2 / 3, lambda t: 2 - 2 * t)]
+    hats = [
+        (0, 0, 1 / 3, lambda t: 1 - 2 * t),
+        (1, 2 / 3, 1, lambda t: 2 * t - 1),
+        (2, 1 / 3, 1 / 2, lambda t: 2 * t),
+        (2, 1 / 2, 2 / 3, lambda t: 2 - 2 * t),
+    ]
     for col, lo, hi, phi in hats:
         pts = [r for r in roots if lo < r < hi] or None
-        val, _ = quad(lambda t, phi=phi: max(f(t), 0.0) * phi(t), lo, hi, points=pts,
-                      epsabs=1e-14, epsrel=1e-13)
+        val, _ = quad(
+            lambda t, phi=phi: max(f(t), 0.0) * phi(t),
+            lo,
+            hi,
+            points=pts,
+            epsabs=1e-14,
+            epsrel=1e-13,
+        )
         out[col] += val
     return out * length
 
@@ -409,16 +448,26 @@ def test_third_integrals_random_quadratics_against_quad():
     t = np.array([0.0, 1.0, 0.5])
     by_roots = sign[:, None] * (t[None] - r1[:, None]) * (t[None] - r2[:, None])
     linear = rng.normal(size=(50, 2)) @ np.array([[1.0, 0.0, 0.5], [0.0, 1.0, 0.5]])
-    v = np.vstack([by_roots, rng.normal(size=(100, 3)), linear,
-                   [[0.0, 0.0, 0.0], [1.0, 1.0, -0.5], [0.0, 0.0, 1.0]]])
+    v = np.vstack(
+        [
+            by_roots,
+            rng.normal(size=(100, 3)),
+            linear,
+            [[0.0, 0.0, 0.0], [1.0, 1.0, -0.5], [0.0, 0.0, 1.0]],
+        ]
+    )
     length = rng.uniform(0.01, 2.0, len(v))
     out = third_integrals(v, length)
     ref = np.array([quad_thirds(vi, li) for vi, li in zip(v, length, strict=True)])
     crossings = sum(
         np.any(np.diff(np.sign(_quadratic(vi)(np.linspace(lo, hi, 50)))) != 0)
-        for vi in v for lo, hi in ((0, 1 / 3), (1 / 3, 2 / 3), (2 / 3, 1)))
-    print(f"{len(v)} quadratics, {crossings} sign changes inside a third, max abs deviation "
-          f"{np.abs(out - ref).max():.2e}")
+        for vi in v
+        for lo, hi in ((0, 1 / 3), (1 / 3, 2 / 3), (2 / 3, 1))
+    )
+    print(
+        f"{len(v)} quadratics, {crossings} sign changes inside a third, max abs deviation "
+        f"{np.abs(out - ref).max():.2e}"
+    )
     assert crossings > 100
     np.testing.assert_allclose(out, ref, rtol=1e-10, atol=1e-13)
 
@@ -439,18 +488,21 @@ def test_eta5_variants_on_uniform_meshes_example_6_1():
         result = solve(problem, mesh)
         ests = {v: estimate(result, eta5=v) for v in ETA5_VARIANTS}
         other = [0, 1, 2, 3, 5, 6]
-        np.testing.assert_array_equal(ests["paper"].eta2_cell[other],
-                                      ests["consistent"].eta2_cell[other])
+        np.testing.assert_array_equal(
+            ests["paper"].eta2_cell[other], ests["consistent"].eta2_cell[other]
+        )
         ndof.append(result.ndof)
         for v in ETA5_VARIANTS:
             eta5[v].append(ests[v].eta_terms[4])
             eta[v].append(ests[v].eta)
         mesh = refine_uniform(mesh).mesh
     s_paper, s_cons = slope(ndof, eta5["paper"]), slope(ndof, eta5["consistent"])
-    print(f"Ndof {ndof}\n eta5 paper {np.round(eta5['paper'], 5)} slope {s_paper:.3f}\n"
-          f" eta5 consistent {np.array(eta5['consistent'])} slope {s_cons:.3f}\n"
-          f" eta slopes: paper {slope(ndof, eta['paper']):.3f}, "
-          f"consistent {slope(ndof, eta['consistent']):.3f}")
+    print(
+        f"Ndof {ndof}\n eta5 paper {np.round(eta5['paper'], 5)} slope {s_paper:.3f}\n"
+        f" eta5 consistent {np.array(eta5['consistent'])} slope {s_cons:.3f}\n"
+        f" eta slopes: paper {slope(ndof, eta['paper']):.3f}, "
+        f"consistent {slope(ndof, eta['consistent']):.3f}"
+    )
     assert -0.30 <= s_paper <= -0.20
     assert s_cons <= -0.9
     assert slope(ndof, eta["consistent"]) <= -0.9

@@ -19,8 +19,9 @@ def local_monomials(x: np.ndarray, centre: np.ndarray, h: np.ndarray) -> np.ndar
     return np.stack([np.ones_like(a), a, b, a * a, a * b, b * b], axis=-1)
 
 
-def evaluate_on_cells(space: P2Space, u: np.ndarray, cells: np.ndarray,
-                      x: np.ndarray) -> np.ndarray:
+def evaluate_on_cells(
+    space: P2Space, u: np.ndarray, cells: np.ndarray, x: np.ndarray
+) -> np.ndarray:
     """Values of the P2 field ``u (n_nodes, ...)`` of ``space`` at points ``x (m, q, 2)`` lying
     in ``cells (m,)``.
 
@@ -69,7 +70,7 @@ def test_node_points_vertices_then_midpoints():
     assert space.n_dofs == 2 * space.n_nodes
     assert np.array_equal(space.node_points[: mesh.n_points], mesh.points)
     mid = 0.5 * (mesh.points[mesh.edges[:, 0]] + mesh.points[mesh.edges[:, 1]])
-    assert np.allclose(space.node_points[mesh.n_points:], mid, atol=1e-15)
+    assert np.allclose(space.node_points[mesh.n_points :], mid, atol=1e-15)
     # per cell: local node 3 + k is the midpoint of local vertices k and k + 1
     v = mesh.points[mesh.cells]
     x = space.node_points[space.cell_nodes]
@@ -119,8 +120,10 @@ def test_interpolate_reproduces_quadratics_inside_cells():
     space = P2Space(rectangle(0, 1, 0, 2, nx=2, ny=3, pattern="left"))
 
     def q(x):
-        return np.stack([1 + x[..., 0] ** 2 - 3 * x[..., 0] * x[..., 1],
-                         x[..., 1] ** 2 - 2 * x[..., 0]], axis=-1)
+        return np.stack(
+            [1 + x[..., 0] ** 2 - 3 * x[..., 0] * x[..., 1], x[..., 1] ** 2 - 2 * x[..., 0]],
+            axis=-1,
+        )
 
     u = space.interpolate(q)
     assert u.shape == (space.n_nodes, 2)
@@ -133,12 +136,15 @@ def test_interpolate_reproduces_quadratics_inside_cells():
     assert err < 1e-12
 
 
-@pytest.mark.parametrize("bad", [
-    lambda x: x[:, 0],                      # scalar field
-    lambda x: np.zeros((len(x), 3)),        # three components
-    lambda x: np.array([1.0, 2.0]),         # one vector for all points
-    lambda x: x[:-1],                       # one value short
-])
+@pytest.mark.parametrize(
+    "bad",
+    [
+        lambda x: x[:, 0],  # scalar field
+        lambda x: np.zeros((len(x), 3)),  # three components
+        lambda x: np.array([1.0, 2.0]),  # one vector for all points
+        lambda x: x[:-1],  # one value short
+    ],
+)
 def test_interpolate_rejects_wrong_shapes(bad):
     space = P2Space(rectangle(nx=1, ny=1))
     with pytest.raises(ValueError, match=r"must return shape \(9, 2\)"):
@@ -170,10 +176,13 @@ def test_prolongation_exact_over_random_nvb_refinements(seed):
     bary = rng.dirichlet(np.ones(3), size=(space.mesh.n_cells, 4))
     y = np.einsum("mqa,mac->mqc", bary, space.vertices)
     cells = np.arange(space.mesh.n_cells)
-    err_in = np.abs(evaluate_on_cells(space, u, cells, y)
-                    - evaluate_on_cells(space0, u0, ancestor, y)).max()
-    print(f"seed {seed}: {coarse.n_cells} -> {space.mesh.n_cells} cells, prolongation errors "
-          f"nodes {err_u:.1e} (vector) {err_s:.1e} (scalar), inside cells {err_in:.1e}")
+    err_in = np.abs(
+        evaluate_on_cells(space, u, cells, y) - evaluate_on_cells(space0, u0, ancestor, y)
+    ).max()
+    print(
+        f"seed {seed}: {coarse.n_cells} -> {space.mesh.n_cells} cells, prolongation errors "
+        f"nodes {err_u:.1e} (vector) {err_s:.1e} (scalar), inside cells {err_in:.1e}"
+    )
     assert max(err_u, err_s, err_in) < 1e-11
     # the data changed: a non-trivial refinement of a non-trivial field
     assert space.mesh.n_cells > 2 * coarse.n_cells
@@ -184,8 +193,10 @@ def test_prolongation_exact_under_uniform_refinement():
     space = P2Space(mesh)
 
     def q(x):
-        return np.stack([x[..., 0] * x[..., 1] - 0.5 * x[..., 1] ** 2 + 2,
-                         3 * x[..., 0] ** 2 + x[..., 1]], axis=-1)
+        return np.stack(
+            [x[..., 0] * x[..., 1] - 0.5 * x[..., 1] ** 2 + 2, 3 * x[..., 0] ** 2 + x[..., 1]],
+            axis=-1,
+        )
 
     u = space.interpolate(q)
     for _ in range(2):
@@ -206,8 +217,9 @@ def test_prolongation_is_not_interpolation_of_a_cubic():
         return np.stack([x[..., 0] ** 3, x[..., 1] ** 3], axis=-1)
 
     ref = refine_uniform(mesh)
-    diff = np.abs(space.prolongate(space.interpolate(cubic), ref)
-                  - P2Space(ref.mesh).interpolate(cubic)).max()
+    diff = np.abs(
+        space.prolongate(space.interpolate(cubic), ref) - P2Space(ref.mesh).interpolate(cubic)
+    ).max()
     # the P2 interpolation error of x³ at quarter points of an edge of length h = 0.5 is
     # |x³ − I x³| = h³ |t (t − 1/2)(t − 1)| = h³ · 3/64 at t = 1/4
     assert diff == pytest.approx(0.5**3 * 3 / 64, rel=1e-12)

@@ -25,8 +25,12 @@ def test_counts_area_and_parts(pattern: str, nx: int, ny: int, box) -> None:
     assert m.area.sum() == pytest.approx((x1 - x0) * (y1 - y0), rel=1e-13)
     assert np.all(m.area > 0)
     assert m.part_names == ("bottom", "right", "top", "left")
-    for name, length, count in [("bottom", x1 - x0, nx), ("top", x1 - x0, nx),
-                                ("left", y1 - y0, ny), ("right", y1 - y0, ny)]:
+    for name, length, count in [
+        ("bottom", x1 - x0, nx),
+        ("top", x1 - x0, nx),
+        ("left", y1 - y0, ny),
+        ("right", y1 - y0, ny),
+    ]:
         assert m.part_length(name) == pytest.approx(length, rel=1e-13)
         assert m.part_edges(name).size == count
     mid = m.edge_midpoints
@@ -37,8 +41,9 @@ def test_counts_area_and_parts(pattern: str, nx: int, ny: int, box) -> None:
     # every grid square is covered exactly: the cells whose centroid lies in it fill it
     dx, dy = (x1 - x0) / nx, (y1 - y0) / ny
     centroid = m.points[m.cells].mean(axis=1)
-    square = (np.floor((centroid[:, 0] - x0) / dx) * ny
-              + np.floor((centroid[:, 1] - y0) / dy)).astype(int)
+    square = (
+        np.floor((centroid[:, 0] - x0) / dx) * ny + np.floor((centroid[:, 1] - y0) / dy)
+    ).astype(int)
     covered = np.bincount(square, weights=m.area, minlength=nx * ny)
     assert np.allclose(covered, dx * dy, rtol=1e-12)
     assert np.all(np.bincount(square, minlength=nx * ny) == per_square)
@@ -73,8 +78,17 @@ def test_crossed_cells_meet_at_square_centres() -> None:
     assert m.min_angle() == pytest.approx(np.pi / 4, rel=1e-14)
 
 
-def cell_keys(m, x0: float, y0: float, dx: float, dy: float,
-              mirror_x: bool = False, mirror_y: bool = False, nx: int = 0, ny: int = 0) -> set:
+def cell_keys(
+    m,
+    x0: float,
+    y0: float,
+    dx: float,
+    dy: float,
+    mirror_x: bool = False,
+    mirror_y: bool = False,
+    nx: int = 0,
+    ny: int = 0,
+) -> set:
     """Cells as frozensets of vertex coordinates on the half-step integer grid."""
     q = np.rint(2 * (m.points - [x0, y0]) / [dx, dy]).astype(np.int64)
     assert np.allclose(q * [dx, dy] / 2 + [x0, y0], m.points, atol=1e-12)

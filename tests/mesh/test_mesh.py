@@ -206,12 +206,18 @@ def test_constructor_boundary_index_out_of_range() -> None:
 
 @pytest.mark.parametrize(
     "mapping",
-    [{"a": [[0, 1]], "b": [[1, 0]]}, {"a": everything, "b": everything},
-     {"a": [[0, 1], [1, 2]], "b": [[3, 2], [2, 1]], "c": everything}],
+    [
+        {"a": [[0, 1]], "b": [[1, 0]]},
+        {"a": everything, "b": everything},
+        {"a": [[0, 1], [1, 2]], "b": [[3, 2], [2, 1]], "c": everything},
+    ],
 )
 def test_edge_claimed_by_two_parts(mapping) -> None:
-    with pytest.raises(MeshError, match=r"boundary edge \(\d, \d\) is claimed by both parts "
-                                        r"'a' and 'b'"):
+    with pytest.raises(
+        MeshError,
+        match=r"boundary edge \(\d, \d\) is claimed by both parts "
+        r"'a' and 'b'",
+    ):
         Mesh.from_arrays(SQUARE_P, SQUARE_C, mapping)
 
 
@@ -233,10 +239,16 @@ def test_predicate_claims_only_unlisted_edges() -> None:
         (SQUARE_P, SQUARE_C - 1, r"cells refer to points outside 0\.\.3"),
         (SQUARE_P, SQUARE_C + 0.5, "cells must hold integer point indices"),
         (SQUARE_P, SQUARE_C[:0], "the mesh has no cells"),
-        (np.where([[0, 0], [0, 0], [0, 1], [0, 0]], np.nan, SQUARE_P), SQUARE_C,
-         r"point\(s\) 2 have non-finite coordinates"),
-        (np.where([[0, 0], [1, 0], [0, 0], [0, 0]], np.inf, SQUARE_P), SQUARE_C,
-         r"point\(s\) 1 have non-finite coordinates"),
+        (
+            np.where([[0, 0], [0, 0], [0, 1], [0, 0]], np.nan, SQUARE_P),
+            SQUARE_C,
+            r"point\(s\) 2 have non-finite coordinates",
+        ),
+        (
+            np.where([[0, 0], [1, 0], [0, 0], [0, 0]], np.inf, SQUARE_P),
+            SQUARE_C,
+            r"point\(s\) 1 have non-finite coordinates",
+        ),
     ],
 )
 def test_bad_arrays(points, cells, match) -> None:
@@ -432,15 +444,21 @@ def test_geometry_closed_form() -> None:
     fan = m.cell2edge[:6].ravel()
     assert np.allclose(m.edge_length[fan], 1.0, rtol=1e-14)
     assert np.allclose(m.h[:6], 1.0, rtol=1e-14)
-    assert m.h[6] == pytest.approx(max(np.linalg.norm(p[7] - p[1]), np.linalg.norm(p[7] - p[2]),
-                                       1.0), rel=1e-14)
+    assert m.h[6] == pytest.approx(
+        max(np.linalg.norm(p[7] - p[1]), np.linalg.norm(p[7] - p[2]), 1.0), rel=1e-14
+    )
     assert np.allclose(m.edge_midpoints, p[m.edges].mean(axis=1), rtol=0, atol=1e-15)
     # the equilateral fan has min angle 60 degrees; the extra triangle is smaller
     # law of cosines on the extra triangle (1, 7, 2): side s[k] is opposite vertex k
     q = p[[1, 7, 2]]
     s = [np.linalg.norm(q[(k + 1) % 3] - q[(k + 2) % 3]) for k in range(3)]
-    ang = [np.arccos((s[(k + 1) % 3] ** 2 + s[(k + 2) % 3] ** 2 - s[k] ** 2)
-                     / (2 * s[(k + 1) % 3] * s[(k + 2) % 3])) for k in range(3)]
+    ang = [
+        np.arccos(
+            (s[(k + 1) % 3] ** 2 + s[(k + 2) % 3] ** 2 - s[k] ** 2)
+            / (2 * s[(k + 1) % 3] * s[(k + 2) % 3])
+        )
+        for k in range(3)
+    ]
     assert sum(ang) == pytest.approx(np.pi)
     assert m.min_angle() == pytest.approx(min(min(ang), np.pi / 3), rel=1e-12)
 
@@ -468,7 +486,18 @@ def test_long_boundary_validates(nx: int, ny: int) -> None:
 
 def test_cached_arrays_are_read_only():
     mesh = rectangle(nx=2, ny=2)
-    for name in ("edges", "cell2edge", "edge2cell", "area", "edge_length", "h",
-                 "edge_midpoints", "boundary_edge", "edge_part", "points", "cells"):
+    for name in (
+        "edges",
+        "cell2edge",
+        "edge2cell",
+        "area",
+        "edge_length",
+        "h",
+        "edge_midpoints",
+        "boundary_edge",
+        "edge_part",
+        "points",
+        "cells",
+    ):
         with pytest.raises(ValueError, match="read-only"):
             getattr(mesh, name)[0] = 0

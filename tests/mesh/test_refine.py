@@ -97,16 +97,18 @@ def check_refinement(old: Mesh, ref: Refinement, marked: np.ndarray | None) -> N
     # every new point is the midpoint of one bisected old edge
     bisected = edge_point >= 0
     assert np.array_equal(np.sort(edge_point[bisected]), np.arange(old.n_points, new.n_points))
-    assert np.allclose(new.points[edge_point[bisected]], old.edge_midpoints[bisected],
-                       rtol=0, atol=1e-14)
+    assert np.allclose(
+        new.points[edge_point[bisected]], old.edge_midpoints[bisected], rtol=0, atol=1e-14
+    )
     # the bisected edges form a closed set: a cell with a bisected edge has its refinement
     # edge bisected
     cut = bisected[old.cell2edge]
     assert np.all(cut[:, 0] | ~cut.any(axis=1))
     # areas: total, and per parent
     assert new.area.sum() == pytest.approx(old.area.sum(), rel=1e-13)
-    assert np.allclose(np.bincount(parent, weights=new.area, minlength=old.n_cells), old.area,
-                       rtol=1e-12, atol=0)
+    assert np.allclose(
+        np.bincount(parent, weights=new.area, minlength=old.n_cells), old.area, rtol=1e-12, atol=0
+    )
     for name in old.part_names:
         assert new.part_length(name) == pytest.approx(old.part_length(name), rel=1e-13)
     # a cell with k bisected edges has k + 1 children; unrefined cells are kept as they are
@@ -229,8 +231,11 @@ def test_uniform_quadruples_cells_and_halves_h(pattern, x1, y1, nx, ny) -> None:
 
 
 def test_uniform_on_a_sheared_mesh_keeps_area_ratio() -> None:
-    m = affine_copy(rectangle(nx=3, ny=2, pattern="unionjack"),
-                    np.array([[1.0, 0.7], [0.2, 1.5]]), np.array([3.0, -1.0]))
+    m = affine_copy(
+        rectangle(nx=3, ny=2, pattern="unionjack"),
+        np.array([[1.0, 0.7], [0.2, 1.5]]),
+        np.array([3.0, -1.0]),
+    )
     r = refine_uniform(m)
     check_refinement(m, r, None)
     assert np.allclose(r.mesh.area, m.area[r.parent] / 4, rtol=1e-12)
@@ -305,8 +310,12 @@ def starting_meshes(draw) -> Mesh:
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(mesh=starting_meshes(), steps=st.integers(1, 4), fraction=st.floats(0.0, 0.6),
-       seed=st.integers(0, 2**32 - 1))
+@given(
+    mesh=starting_meshes(),
+    steps=st.integers(1, 4),
+    fraction=st.floats(0.0, 0.6),
+    seed=st.integers(0, 2**32 - 1),
+)
 def test_nvb_properties(mesh: Mesh, steps: int, fraction: float, seed: int) -> None:
     rng = np.random.default_rng(seed)
     classes = reachable_shapes(mesh.points[mesh.cells])
@@ -329,8 +338,12 @@ def test_nvb_properties(mesh: Mesh, steps: int, fraction: float, seed: int) -> N
 
 @pytest.mark.parametrize(
     ("pattern", "matrix"),
-    [("unionjack", [[1.0, 0.0], [0.0, 1.0]]), ("right", [[2.0, 0.9], [0.0, 0.7]]),
-     ("crossed", [[1.0, -0.5], [0.3, 1.2]]), ("left", [[0.4, 0.0], [0.0, 2.5]])],
+    [
+        ("unionjack", [[1.0, 0.0], [0.0, 1.0]]),
+        ("right", [[2.0, 0.9], [0.0, 0.7]]),
+        ("crossed", [[1.0, -0.5], [0.3, 1.2]]),
+        ("left", [[0.4, 0.0], [0.0, 2.5]]),
+    ],
 )
 def test_shapes_stay_in_a_finite_family(pattern: str, matrix) -> None:
     m0 = affine_copy(rectangle(nx=2, ny=2, pattern=pattern), np.array(matrix), np.zeros(2))
@@ -369,8 +382,10 @@ def test_refine_a_hundred_thousand_cells() -> None:
     start = time.perf_counter()
     r = refine_nvb(m, marked)
     elapsed = time.perf_counter() - start
-    print(f"refine_nvb on {m.n_cells} cells ({marked.sum()} marked): {elapsed:.3f} s, "
-          f"{r.mesh.n_cells} cells after")
+    print(
+        f"refine_nvb on {m.n_cells} cells ({marked.sum()} marked): {elapsed:.3f} s, "
+        f"{r.mesh.n_cells} cells after"
+    )
     # one call refines every marked cell and leaves a valid mesh: no second pass needed
     children = np.bincount(r.parent, minlength=m.n_cells)
     assert np.all(children[marked] >= 2)

@@ -52,8 +52,9 @@ def test_write_vtu_reads_back(tmp_path, solved):
     xy = m.points[:, :2]
     np.testing.assert_array_equal(m.points[:, 2], 0.0)
     for k in range(3):
-        np.testing.assert_allclose(xy[tri[:, 3 + k]],
-                                   0.5 * (xy[tri[:, k]] + xy[tri[:, (k + 1) % 3]]), atol=1e-15)
+        np.testing.assert_allclose(
+            xy[tri[:, 3 + k]], 0.5 * (xy[tri[:, k]] + xy[tri[:, (k + 1) % 3]]), atol=1e-15
+        )
     np.testing.assert_array_equal(xy, space.node_points)
     # point data
     pd = m.point_data
@@ -75,10 +76,13 @@ def test_write_vtu_reads_back(tmp_path, solved):
     assert eta2.shape == (result.mesh.n_cells,)
     assert eta2.sum() == pytest.approx(est.eta**2, rel=1e-13)
     for k in range(7):
-        assert m.cell_data[f"eta2_{k + 1}"][0].sum() == pytest.approx(est.eta2_terms[k],
-                                                                       rel=1e-13, abs=1e-300)
-    print(f"VTU: {len(xy)} nodes, {len(tri)} triangle6 cells, sum eta2 = {eta2.sum():.10e}, "
-          f"eta^2 = {est.eta**2:.10e}")
+        assert m.cell_data[f"eta2_{k + 1}"][0].sum() == pytest.approx(
+            est.eta2_terms[k], rel=1e-13, abs=1e-300
+        )
+    print(
+        f"VTU: {len(xy)} nodes, {len(tri)} triangle6 cells, sum eta2 = {eta2.sum():.10e}, "
+        f"eta^2 = {est.eta**2:.10e}"
+    )
 
 
 def test_write_vtu_without_estimate_and_overwrite(tmp_path, solved):
@@ -104,8 +108,10 @@ def test_written_files_follow_the_umask(tmp_path, solved):
             fh.write("x")
     finally:
         os.umask(old)
-    modes = {name: stat.S_IMODE(os.stat(tmp_path / name).st_mode)
-             for name in ("s.vtu", "h.csv", "plain.txt")}
+    modes = {
+        name: stat.S_IMODE(os.stat(tmp_path / name).st_mode)
+        for name in ("s.vtu", "h.csv", "plain.txt")
+    }
     print({k: oct(v) for k, v in modes.items()})
     assert modes == {"s.vtu": 0o644, "h.csv": 0o644, "plain.txt": 0o644}
 
@@ -122,12 +128,28 @@ def test_history_writer_rewrites_a_parsable_file_after_each_append(tmp_path):
     path = tmp_path / "history.csv"
     history = HistoryWriter(path)
     rows = [
-        {"level": 0, "ndof": 144, "eta": 310.85036363636, "error_energy": math.nan,
-         "backend": "pardiso"},
-        {"level": 1, "ndof": 152, "eta": 1.2345678901234567e-300, "error_energy": 0.1 + 0.2,
-         "backend": "scipy"},
-        {"level": 2, "ndof": 10**12, "eta": 2.0**0.5, "error_energy": 7.0, "backend": "a,b",
-         "extra_column": 3.5},
+        {
+            "level": 0,
+            "ndof": 144,
+            "eta": 310.85036363636,
+            "error_energy": math.nan,
+            "backend": "pardiso",
+        },
+        {
+            "level": 1,
+            "ndof": 152,
+            "eta": 1.2345678901234567e-300,
+            "error_energy": 0.1 + 0.2,
+            "backend": "scipy",
+        },
+        {
+            "level": 2,
+            "ndof": 10**12,
+            "eta": 2.0**0.5,
+            "error_energy": 7.0,
+            "backend": "a,b",
+            "extra_column": 3.5,
+        },
     ]
     for i, row in enumerate(rows):
         history.append(row)
@@ -175,8 +197,7 @@ def gmsh_square(mesh, *, order: int = 1, with_lines: bool = True):
     names = {name: i + 1 for i, name in enumerate(mesh.part_names)}
     space = P2Space(mesh)
     if order == 1:
-        points, cells, flip, kinds = mesh.points, mesh.cells.copy(), [0, 2, 1], ("triangle",
-                                                                                 "line")
+        points, cells, flip, kinds = mesh.points, mesh.cells.copy(), [0, 2, 1], ("triangle", "line")
     else:
         points, cells = space.node_points, space.cell_nodes.copy()
         flip, kinds = [0, 2, 1, 5, 4, 3], ("triangle6", "line3")
@@ -186,17 +207,20 @@ def gmsh_square(mesh, *, order: int = 1, with_lines: bool = True):
     physical = [np.full(len(cells), 10)]
     if with_lines:
         edges = [mesh.part_edges(n) for n in mesh.part_names]
-        lines = np.vstack([space.edge_nodes(e)[:, :order + 1] for e in edges])
-        tags = np.concatenate([np.full(e.size, names[n])
-                               for n, e in zip(mesh.part_names, edges, strict=True)])
+        lines = np.vstack([space.edge_nodes(e)[:, : order + 1] for e in edges])
+        tags = np.concatenate(
+            [np.full(e.size, names[n]) for n, e in zip(mesh.part_names, edges, strict=True)]
+        )
         blocks.append((kinds[1], lines))
         physical.append(tags)
     field_data = {n: np.array([t, 1]) for n, t in names.items()}
     field_data["domain"] = np.array([10, 2])
-    return meshio.Mesh(np.column_stack([points, np.zeros(len(points))]), blocks,
-                       cell_data={"gmsh:physical": physical,
-                                  "gmsh:geometrical": [p.copy() for p in physical]},
-                       field_data=field_data)
+    return meshio.Mesh(
+        np.column_stack([points, np.zeros(len(points))]),
+        blocks,
+        cell_data={"gmsh:physical": physical, "gmsh:geometrical": [p.copy() for p in physical]},
+        field_data=field_data,
+    )
 
 
 @pytest.mark.parametrize(("order", "binary"), [(1, False), (1, True), (2, False)])
@@ -227,8 +251,9 @@ def test_read_mesh_from_gmsh_file(tmp_path, order, binary):
 
 def test_read_mesh_without_physical_lines_raises(tmp_path):
     path = tmp_path / "bare.msh"
-    meshio.write(path, gmsh_square(example_6_2().mesh, with_lines=False), file_format="gmsh22",
-                 binary=False)
+    meshio.write(
+        path, gmsh_square(example_6_2().mesh, with_lines=False), file_format="gmsh22", binary=False
+    )
     with pytest.raises(MeshError, match="no tagged boundary"):
         read_mesh(path)
 

@@ -77,15 +77,17 @@ def captured(monkeypatch):
 
     def spy(fig, path):
         legends = list(fig.legends) + [ax.get_legend() for ax in fig.axes if ax.get_legend()]
-        seen.append({
-            "legend": [t.get_text() for lg in legends for t in lg.get_texts()],
-            "xlabel": [ax.get_xlabel() for ax in fig.axes],
-            "ylabel": [ax.get_ylabel() for ax in fig.axes],
-            "scales": [(ax.get_xscale(), ax.get_yscale()) for ax in fig.axes],
-            "texts": [t.get_text() for ax in fig.axes for t in ax.texts],
-            "n_axes": len(fig.axes),
-            "xticks": [list(ax.get_xticks()) for ax in fig.axes],
-        })
+        seen.append(
+            {
+                "legend": [t.get_text() for lg in legends for t in lg.get_texts()],
+                "xlabel": [ax.get_xlabel() for ax in fig.axes],
+                "ylabel": [ax.get_ylabel() for ax in fig.axes],
+                "scales": [(ax.get_xscale(), ax.get_yscale()) for ax in fig.axes],
+                "texts": [t.get_text() for ax in fig.axes for t in ax.texts],
+                "n_axes": len(fig.axes),
+                "xticks": [list(ax.get_xticks()) for ax in fig.axes],
+            }
+        )
         return original(fig, path)
 
     monkeypatch.setattr(plots, "_save", spy)
@@ -103,8 +105,7 @@ def test_fitted_slope_recovers_minus_one(const):
 
 def test_fitted_slope_uses_only_the_last_points():
     # rate -1/2 on the first three levels, -1 on the last three (continuous at NDOF[2])
-    values = np.where(np.arange(NDOF.size) <= 2, NDOF**-0.5,
-                      NDOF[2] ** 0.5 / NDOF)
+    values = np.where(np.arange(NDOF.size) <= 2, NDOF**-0.5, NDOF[2] ** 0.5 / NDOF)
     assert abs(fitted_slope(NDOF, values, last=3) + 1.0) < 1e-12
     assert abs(fitted_slope(NDOF[:3], values[:3], last=3) + 0.5) < 1e-12
     expected = np.polyfit(np.log(NDOF), np.log(values), 1)[0]
@@ -152,12 +153,33 @@ def test_fitted_slope_rejects_bad_input(ndof, values, last, match):
 # --------------------------------------------------------------------------------------------
 def test_read_history_round_trip(tmp_path):
     rows = [
-        {"level": 0, "ndof": 146, "eta": 0.125, "error_energy": float("nan"),
-         "backend": "scipy", "eta6": 0.0, "note": ""},
-        {"level": 1, "ndof": 402, "eta": 0.0441, "error_energy": 0.03125,
-         "backend": "pardiso", "eta6": 1.5e-17, "note": "x"},
-        {"level": 2, "ndof": 1118, "eta": 0.0157, "error_energy": "",
-         "backend": "pardiso", "eta6": 0.0, "note": ""},
+        {
+            "level": 0,
+            "ndof": 146,
+            "eta": 0.125,
+            "error_energy": float("nan"),
+            "backend": "scipy",
+            "eta6": 0.0,
+            "note": "",
+        },
+        {
+            "level": 1,
+            "ndof": 402,
+            "eta": 0.0441,
+            "error_energy": 0.03125,
+            "backend": "pardiso",
+            "eta6": 1.5e-17,
+            "note": "x",
+        },
+        {
+            "level": 2,
+            "ndof": 1118,
+            "eta": 0.0157,
+            "error_energy": "",
+            "backend": "pardiso",
+            "eta6": 0.0,
+            "note": "",
+        },
     ]
     path = tmp_path / "history.csv"
     with path.open("w", newline="") as fh:
@@ -262,8 +284,10 @@ def test_error_and_estimator_figure(tmp_path, captured):
     (info,) = captured
     assert info["scales"] == [("log", "log")]
     assert info["xlabel"] == [r"$N_{\mathrm{dof}}$"]
-    assert info["legend"] == [r"$\|u-u_h\|_a$, slope " + "\u22121.00",
-                              r"$\eta_h$, slope " + "\u22121.00"]
+    assert info["legend"] == [
+        r"$\|u-u_h\|_a$, slope " + "\u22121.00",
+        r"$\eta_h$, slope " + "\u22121.00",
+    ]
     assert "1" in info["texts"] and "\u22121" in info["texts"]
     assert plt.get_fignums() == []  # nothing left open in pyplot
 
@@ -307,10 +331,13 @@ def test_estimator_figure_and_suffix_kept(tmp_path, captured):
 
 def test_adaptive_vs_uniform_figure(tmp_path, captured):
     adaptive = synthetic_history()
-    uniform = {"ndof": np.array([150, 560, 2200, 8700]), "eta": 2.0 * np.array(
-        [150, 560, 2200, 8700.0]) ** -(2.0 / 3.0)}
-    written = plot_adaptive_vs_uniform({"adaptive": adaptive, "uniform": uniform},
-                                       tmp_path / "cmp", key="eta")
+    uniform = {
+        "ndof": np.array([150, 560, 2200, 8700]),
+        "eta": 2.0 * np.array([150, 560, 2200, 8700.0]) ** -(2.0 / 3.0),
+    }
+    written = plot_adaptive_vs_uniform(
+        {"adaptive": adaptive, "uniform": uniform}, tmp_path / "cmp", key="eta"
+    )
     check_written(written, tmp_path / "cmp")
     assert captured[0]["legend"] == ["adaptive, slope \u22121.00", "uniform, slope \u22120.67"]
 
@@ -344,8 +371,16 @@ def test_deformed_figure_with_pressure_and_obstacle(tmp_path, captured):
     pressure = 1.0 - np.abs(right[:, 1] - 0.5)
     y = np.linspace(0.0, 1.0, 11)
     obstacle = np.column_stack([1.0 - 0.2 + 0.5 * np.abs(y - 0.5), y])
-    written = plot_deformed(p, c, u_p2, tmp_path / "deformed", contact_points=right,
-                            pressure=pressure, scale=3.0, obstacle=obstacle)
+    written = plot_deformed(
+        p,
+        c,
+        u_p2,
+        tmp_path / "deformed",
+        contact_points=right,
+        pressure=pressure,
+        scale=3.0,
+        obstacle=obstacle,
+    )
     check_written(written, tmp_path / "deformed")
     (info,) = captured
     assert info["xlabel"][:2] == [r"$x$", r"$y$"]  # pressure against y on x = 1
@@ -361,8 +396,7 @@ def test_bad_inputs_raise_value_errors(tmp_path):
     with pytest.raises(ValueError, match="lacks column"):
         plot_estimator({"ndof": NDOF}, tmp_path / "x")
     with pytest.raises(ValueError, match="no positive finite error_energy"):
-        plot_error_and_estimator({**h, "error_energy": np.full(NDOF.size, np.nan)},
-                                 tmp_path / "x")
+        plot_error_and_estimator({**h, "error_energy": np.full(NDOF.size, np.nan)}, tmp_path / "x")
     with pytest.raises(ValueError, match="different lengths"):
         plot_estimator({"ndof": NDOF, "eta": 1 / NDOF[:-1]}, tmp_path / "x")
     with pytest.raises(ValueError, match="ndof must be positive"):
@@ -386,8 +420,9 @@ def test_bad_inputs_raise_value_errors(tmp_path):
     with pytest.raises(ValueError, match="together"):
         plot_deformed(p, c, np.zeros_like(p), tmp_path / "x", pressure=np.ones(3))
     with pytest.raises(ValueError, match="pressure must have shape"):
-        plot_deformed(p, c, np.zeros_like(p), tmp_path / "x", contact_points=p[:3],
-                      pressure=np.ones(4))
+        plot_deformed(
+            p, c, np.zeros_like(p), tmp_path / "x", contact_points=p[:3], pressure=np.ones(4)
+        )
     with pytest.raises(ValueError, match="not a file path"):
         plot_estimator(h, "")
     assert not any(tmp_path.iterdir())
@@ -407,8 +442,14 @@ def test_contact_coordinate_is_arclength_on_a_slanted_boundary():
 
 @pytest.mark.parametrize(
     ("name", "kind"),
-    [("example-6.1", "6.1"), ("6.2", "6.2"), ("ex6_1", "6.1"), ("example_6_2", "6.2"),
-     ("example-6.12", None), ("square", None)],
+    [
+        ("example-6.1", "6.1"),
+        ("6.2", "6.2"),
+        ("ex6_1", "6.1"),
+        ("example_6_2", "6.2"),
+        ("example-6.12", None),
+        ("square", None),
+    ],
 )
 def test_example_names(name, kind):
     assert plots._example_kind(name) == kind
@@ -428,8 +469,10 @@ def write_csv(path: Path, h: dict[str, np.ndarray]) -> Path:
 @pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "figures"),
-    [("example-6.1", ["error_estimator", "efficiency", "contributions"]),
-     ("example-6.2", ["estimator", "contributions"])],
+    [
+        ("example-6.1", ["error_estimator", "efficiency", "contributions"]),
+        ("example-6.2", ["estimator", "contributions"]),
+    ],
 )
 def test_make_figures(tmp_path, name, figures):
     h = synthetic_history()
@@ -438,8 +481,7 @@ def test_make_figures(tmp_path, name, figures):
         h["efficiency"][:] = np.nan
     csv_path = write_csv(tmp_path / "history.csv", h)
     written = make_figures(csv_path, tmp_path / "figs", name)
-    expected = [tmp_path / "figs" / f"{name}_{f}.{ext}" for f in figures for ext in ("png",
-                                                                                    "pdf")]
+    expected = [tmp_path / "figs" / f"{name}_{f}.{ext}" for f in figures for ext in ("png", "pdf")]
     assert written == expected
     for i in range(0, len(written), 2):
-        check_written(written[i:i + 2], written[i].with_suffix(""))
+        check_written(written[i : i + 2], written[i].with_suffix(""))

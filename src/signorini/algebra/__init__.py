@@ -4,5 +4,4 @@ their backends, and the primal-dual active set method (PDAS) for bound constrain
 from .linsolve import available_backends, make_solver
 from .pdas import PDASConvergenceError, PDASResult, solve_pdas
 
-__all__ = ["PDASConvergenceError", "PDASResult", "available_backends", "make_solver",
-           "solve_pdas"]
+__all__ = ["PDASConvergenceError", "PDASResult", "available_backends", "make_solver", "solve_pdas"]

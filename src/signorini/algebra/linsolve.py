@@ -334,8 +334,9 @@ class SymmetricEliminator:
         keep |= self.is_diagonal
         return keep
 
-    def rhs(self, A: sp.csr_matrix, b: np.ndarray, fixed: np.ndarray,
-            values: np.ndarray) -> np.ndarray:
+    def rhs(
+        self, A: sp.csr_matrix, b: np.ndarray, fixed: np.ndarray, values: np.ndarray
+    ) -> np.ndarray:
         """Right-hand side of the eliminated system, for full-length ``values`` (read on
         ``fixed`` only, zero elsewhere)."""
         return self._rhs(A, b, fixed, values, self.diagonal_positions[fixed])

@@ -134,8 +134,7 @@ class KKTResiduals:
     @property
     def max(self) -> float:
         """The largest of the five relative residuals."""
-        return max(self.primal, self.dual, self.complementarity, self.stationarity,
-                   self.dirichlet)
+        return max(self.primal, self.dual, self.complementarity, self.stationarity, self.dirichlet)
 
 
 @dataclass
@@ -303,8 +302,7 @@ def _kkt(
     r = F - K @ x
     absK = sp.csr_matrix((np.abs(K.data), K.indices, K.indptr), shape=K.shape)
     force = max(np.abs(F).max(initial=0.0), (absK @ np.abs(x)).max(initial=0.0))
-    disp = max(np.abs(x).max(initial=0.0), np.abs(g).max(initial=0.0),
-               np.abs(xd).max(initial=0.0))
+    disp = max(np.abs(x).max(initial=0.0), np.abs(g).max(initial=0.0), np.abs(xd).max(initial=0.0))
     force = force if force > 0 else 1.0
     disp = disp if disp > 0 else 1.0
     lam = r[c]
@@ -436,7 +434,7 @@ class _System:
         ``E = U Vᵀ`` for ``U = [P_D, E_{:,D}]``, ``V = [E_{:,D} − P_D E_DD, P_D]``.
         """
         n, k = self.K.shape[0], changed.size
-        E = (self._columns(self.fixed, changed) - self._columns(self.factored, changed))
+        E = self._columns(self.fixed, changed) - self._columns(self.factored, changed)
         E = E.toarray()  # (n, k): k is small
         P = np.zeros((n, k))
         P[changed, np.arange(k)] = 1.0
@@ -487,13 +485,15 @@ def _primal_active_set(
     previous = work.copy()
     for _ in range(max_iter):
         x_star, lam = system.solve(work)
-        history.append(PDASStep(
-            iteration=len(history) + 1,
-            method="primal-active-set",
-            n_active=int(work.sum()),
-            n_added=int((work & ~previous).sum()),
-            n_removed=int((previous & ~work).sum()),
-        ))
+        history.append(
+            PDASStep(
+                iteration=len(history) + 1,
+                method="primal-active-set",
+                n_active=int(work.sum()),
+                n_added=int((work & ~previous).sum()),
+                n_removed=int((previous & ~work).sum()),
+            )
+        )
         previous = work.copy()
         step = x_star[c] - x[c]
         moving = ~work & (step > 0)
@@ -601,8 +601,11 @@ def solve_pdas(
     n, m = K.shape[0], cons.size
     if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
         raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
-    if (isinstance(max_update, bool) or not isinstance(max_update, (int, np.integer))
-            or max_update < 0):
+    if (
+        isinstance(max_update, bool)
+        or not isinstance(max_update, (int, np.integer))
+        or max_update < 0
+    ):
         raise ValueError(f"max_update must be a non-negative integer, got {max_update!r}")
     if c is None:
         c_scale = float(K.diagonal()[cons].mean()) if m else 1.0
@@ -633,8 +636,11 @@ def solve_pdas(
 
     try:
         system = _System(K, F, cons, g, d, xd, solver, max_update=max_update)
-        scale = max(np.abs(F).max(initial=0.0), c_scale * np.abs(g).max(initial=0.0),
-                    c_scale * np.abs(xd).max(initial=0.0))
+        scale = max(
+            np.abs(F).max(initial=0.0),
+            c_scale * np.abs(g).max(initial=0.0),
+            c_scale * np.abs(xd).max(initial=0.0),
+        )
         threshold = _ACTIVE_RTOL * scale
         history: list[PDASStep] = []
         seen = {active.tobytes(): 1}  # active set -> iteration that used it
@@ -644,21 +650,26 @@ def solve_pdas(
         for it in range(1, max_iter + 1):
             x, lam = system.solve(active)
             lam = np.where(active, lam, 0.0)
-            history.append(PDASStep(
-                iteration=it,
-                method="pdas",
-                n_active=int(active.sum()),
-                n_added=int((active & ~previous).sum()),
-                n_removed=int((previous & ~active).sum()),
-            ))
+            history.append(
+                PDASStep(
+                    iteration=it,
+                    method="pdas",
+                    n_active=int(active.sum()),
+                    n_added=int((active & ~previous).sum()),
+                    n_removed=int((previous & ~active).sum()),
+                )
+            )
             logger.debug("PDAS %s", history[-1])
             new_active = lam + c_scale * (x[cons] - g) > threshold
             if np.array_equal(new_active, active):
                 break
             key = new_active.tobytes()
             if key in seen:
-                failure = ("cycling", f"PDAS cycles: the active set computed in iteration {it} "
-                           f"is the one iteration {seen[key]} used")
+                failure = (
+                    "cycling",
+                    f"PDAS cycles: the active set computed in iteration {it} "
+                    f"is the one iteration {seen[key]} used",
+                )
                 break
             seen[key] = it + 1
             previous, active = active, new_active
@@ -670,7 +681,10 @@ def solve_pdas(
             if not fallback:
                 raise PDASConvergenceError(
                     message + " (pass fallback=True to finish with a primal active set method)",
-                    history, reason, x=x, active=active,
+                    history,
+                    reason,
+                    x=x,
+                    active=active,
                 )
             logger.warning("%s; finishing with the primal active set method", message)
             force = max(np.abs(F).max(initial=0.0), np.abs(K @ x).max(initial=0.0), 1e-300)
@@ -694,7 +708,11 @@ def solve_pdas(
     times["total"] = time.perf_counter() - t_start
     logger.info(
         "%s finished after %d solves (|A| = %d of %d), KKT residual %.2e",
-        method, len(history), int(active.sum()), m, kkt.max,
+        method,
+        len(history),
+        int(active.sum()),
+        m,
+        kkt.max,
     )
     return PDASResult(
         x=x,

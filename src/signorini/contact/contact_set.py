@@ -22,8 +22,14 @@ import numpy as np
 from ..fem.space import P2Space
 from ..problem.problem import Contact, ContactProblem, ProblemError
 
-__all__ = ["ContactSet", "contact_set", "NO_CONTACT", "SEMI_CONTACT", "FULL_CONTACT",
-           "node_classes"]
+__all__ = [
+    "ContactSet",
+    "contact_set",
+    "NO_CONTACT",
+    "SEMI_CONTACT",
+    "FULL_CONTACT",
+    "node_classes",
+]
 
 NO_CONTACT, SEMI_CONTACT, FULL_CONTACT = 0, 1, 2
 
@@ -121,9 +127,20 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     empty_i = np.zeros(0, dtype=np.int64)
     if not parts:
         z2 = np.zeros((0, 2))
-        return ContactSet(empty_i, z2, np.zeros(0), np.zeros(0), np.zeros(0),
-                          np.zeros(0, bool), empty_i, np.zeros((0, 3), np.int64), empty_i,
-                          parts, np.zeros((0, 3)), z2)
+        return ContactSet(
+            empty_i,
+            z2,
+            np.zeros(0),
+            np.zeros(0),
+            np.zeros(0),
+            np.zeros(0, bool),
+            empty_i,
+            np.zeros((0, 3), np.int64),
+            empty_i,
+            parts,
+            np.zeros((0, 3)),
+            z2,
+        )
     edge_lists = [mesh.part_edges(p) for p in parts]
     edges = np.concatenate(edge_lists)
     edge_part = np.repeat(np.arange(len(parts)), [e.size for e in edge_lists])
@@ -152,33 +169,46 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     normal = np.zeros((nodes.size, 2))
     normal[pos[inside]] = flat_normal[inside]
     if np.abs(normal[pos[inside]] - flat_normal[inside]).max(initial=0) > 1e-12:
-        bad = nodes[pos[inside][np.abs(normal[pos[inside]] - flat_normal[inside]).max(1)
-                                > 1e-12][0]]
-        raise ProblemError(f"node {bad} at {space.node_points[bad].tolist()} lies on contact "
-                           "parts with different normals; this corner is not supported")
+        bad = nodes[
+            pos[inside][np.abs(normal[pos[inside]] - flat_normal[inside]).max(1) > 1e-12][0]
+        ]
+        raise ProblemError(
+            f"node {bad} at {space.node_points[bad].tolist()} lies on contact "
+            "parts with different normals; this corner is not supported"
+        )
     gap = np.zeros(nodes.size)
     gap[pos[inside]] = edge_gap.ravel()[inside]
     mismatch = np.abs(gap[pos[inside]] - edge_gap.ravel()[inside])
     scale = max(float(np.abs(edge_gap).max()), 1e-300)
     if mismatch.max(initial=0) > 1e-12 * scale:
         bad = nodes[pos[inside][np.argmax(mismatch)]]
-        raise ProblemError(f"node {bad} at {space.node_points[bad].tolist()} lies on contact "
-                           "parts whose gap functions disagree there; the obstacle must be "
-                           "continuous")
+        raise ProblemError(
+            f"node {bad} at {space.node_points[bad].tolist()} lies on contact "
+            "parts whose gap functions disagree there; the obstacle must be "
+            "continuous"
+        )
 
     weights = np.column_stack([length / 4, length / 4, length / 2]).ravel()
     simpson = np.column_stack([length / 6, length / 6, 2 * length / 3]).ravel()
     lumped = np.bincount(pos[inside], weights=weights[inside], minlength=nodes.size)
     w = np.bincount(pos[inside], weights=simpson[inside], minlength=nodes.size)
     return ContactSet(
-        nodes=nodes, normal=normal, gap=gap, lumped=lumped, simpson=w,
-        is_vertex=nodes < mesh.n_points, edges=edges, edge_nodes=edge_nodes,
-        edge_part=edge_part, parts=parts, edge_gap=edge_gap, edge_normal=edge_normal,
+        nodes=nodes,
+        normal=normal,
+        gap=gap,
+        lumped=lumped,
+        simpson=w,
+        is_vertex=nodes < mesh.n_points,
+        edges=edges,
+        edge_nodes=edge_nodes,
+        edge_part=edge_part,
+        parts=parts,
+        edge_gap=edge_gap,
+        edge_normal=edge_normal,
     )
 
 
-def node_classes(cs: ContactSet, in_contact: np.ndarray, edge_in_contact: np.ndarray
-                 ) -> np.ndarray:
+def node_classes(cs: ContactSet, in_contact: np.ndarray, edge_in_contact: np.ndarray) -> np.ndarray:
     """Full / semi / no contact class of each constrained node (paper, Section 4).
 
     Parameters
@@ -197,8 +227,9 @@ def node_classes(cs: ContactSet, in_contact: np.ndarray, edge_in_contact: np.nda
     edge_full = edge_in_contact.all(axis=1)
     loc = cs.edge_local.ravel()
     touching = loc >= 0
-    broken = np.bincount(loc[touching], weights=np.repeat(~edge_full, 3)[touching],
-                         minlength=cs.size)
+    broken = np.bincount(
+        loc[touching], weights=np.repeat(~edge_full, 3)[touching], minlength=cs.size
+    )
     classes = np.full(cs.size, NO_CONTACT, dtype=np.int64)
     classes[in_contact] = SEMI_CONTACT
     classes[in_contact & (broken == 0)] = FULL_CONTACT

@@ -34,8 +34,9 @@ def _check_frames(nodes: np.ndarray, normals: np.ndarray, n_dofs: int) -> tuple[
     nodes = nodes.astype(np.int64)
     n_nodes = n_dofs // 2
     if nodes.size and (nodes.min() < 0 or nodes.max() >= n_nodes):
-        raise ValueError(f"nodes must lie in [0, {n_nodes}), got range "
-                         f"[{nodes.min()}, {nodes.max()}]")
+        raise ValueError(
+            f"nodes must lie in [0, {n_nodes}), got range [{nodes.min()}, {nodes.max()}]"
+        )
     if np.unique(nodes).size != nodes.size:
         raise ValueError("nodes has repeated entries")
     normals = np.asarray(normals, dtype=np.float64)

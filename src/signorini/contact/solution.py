@@ -93,8 +93,9 @@ class ContactResult:
         cs = self.contact
         loc = cs.edge_local
         gap = cs.edge_normal_gap(self.u)
-        scale = max(float(np.abs(cs.edge_gap).max(initial=0)),
-                    float(np.abs(self.u).max(initial=0)), 1e-300)
+        scale = max(
+            float(np.abs(cs.edge_gap).max(initial=0)), float(np.abs(self.u).max(initial=0)), 1e-300
+        )
         dirichlet_touch = gap >= -1e-12 * scale
         edge_in = np.where(loc >= 0, self.active[np.maximum(loc, 0)], dirichlet_touch)
         return node_classes(cs, self.active, edge_in)
@@ -105,11 +106,11 @@ class ContactResult:
         if exact is None:
             raise ValueError(f"{self.problem.name} has no exact solution")
         u_cell = self.space.cell_values(self.u)
-        energy = energy_error2(self.space.vertices, u_cell, exact.gradient,
-                               self.problem.material, degree=degree)
+        energy = energy_error2(
+            self.space.vertices, u_cell, exact.gradient, self.problem.material, degree=degree
+        )
         h1 = h1_seminorm_error2(self.space.vertices, u_cell, exact.gradient, degree=degree)
-        return {"error_energy": float(np.sqrt(energy.sum())),
-                "error_h1": float(np.sqrt(h1.sum()))}
+        return {"error_energy": float(np.sqrt(energy.sum())), "error_h1": float(np.sqrt(h1.sum()))}
 
 
 def solve(
@@ -160,16 +161,35 @@ def solve(
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
     with make_solver(backend, check_symmetry=False) as solver:
         res = solve_pdas(
-            assembled.K, assembled.F, 2 * cs.nodes, cs.gap,
-            assembled.dirichlet, assembled.dirichlet_values,
-            active0=active0, max_iter=max_iter, solver=solver, fallback=fallback,
+            assembled.K,
+            assembled.F,
+            2 * cs.nodes,
+            cs.gap,
+            assembled.dirichlet,
+            assembled.dirichlet_values,
+            active0=active0,
+            max_iter=max_iter,
+            solver=solver,
+            fallback=fallback,
         )
     seconds = time.perf_counter() - t0
     u = to_cartesian(res.x, cs.nodes, cs.normal).reshape(-1, 2)
-    log.info("solved %s: %d unknowns, %d PDAS iterations, %d active of %d",
-             problem.name, space.n_dofs, res.iterations, int(res.active.sum()), cs.size)
+    log.info(
+        "solved %s: %d unknowns, %d PDAS iterations, %d active of %d",
+        problem.name,
+        space.n_dofs,
+        res.iterations,
+        int(res.active.sum()),
+        cs.size,
+    )
     return ContactResult(
-        problem=problem, space=space, u=u, contact=cs, contact_force=res.lam,
-        active=res.active, pdas=res, dirichlet_nodes=assembled.dirichlet[::2] // 2,
+        problem=problem,
+        space=space,
+        u=u,
+        contact=cs,
+        contact_force=res.lam,
+        active=res.active,
+        pdas=res,
+        dirichlet_nodes=assembled.dirichlet[::2] // 2,
         timings={"assemble": assembled.seconds, "solve": seconds},
     )

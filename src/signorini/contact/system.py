@@ -49,9 +49,13 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     K = assemble_stiffness(space.vertices, space.cell_dofs, n_dofs, problem.material)
     F = np.zeros(n_dofs)
     if problem.body_force is not None:
-        F += assemble_body_force(space.vertices, space.cell_dofs, n_dofs,
-                                 lambda x: evaluate_field(problem.body_force, x, "body_force"),
-                                 degree=LOAD_DEGREE)
+        F += assemble_body_force(
+            space.vertices,
+            space.cell_dofs,
+            n_dofs,
+            lambda x: evaluate_field(problem.body_force, x, "body_force"),
+            degree=LOAD_DEGREE,
+        )
     for name in problem.neumann_parts:
         cond: Neumann = problem.conditions[name]
         if cond.is_zero:
@@ -64,8 +68,9 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
         def traction(x, n, g=g, name=name):
             return evaluate_field(lambda y: g(y, n), x, f"the traction of part {name!r}")
 
-        F += assemble_edge_load(mesh.points[nodes[:, :2]], dofs, n_dofs, traction,
-                                degree=LOAD_DEGREE)
+        F += assemble_edge_load(
+            mesh.points[nodes[:, :2]], dofs, n_dofs, traction, degree=LOAD_DEGREE
+        )
     # Dirichlet values (a node on two Dirichlet parts takes the later part's value)
     d_nodes = problem.dirichlet_nodes(space)
     d_values = np.empty((d_nodes.size, 2))
@@ -73,7 +78,8 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
         cond: Dirichlet = problem.conditions[name]
         nodes = space.part_nodes([name])
         d_values[np.searchsorted(d_nodes, nodes)] = evaluate_field(
-            cond.field(), space.node_points[nodes], f"the Dirichlet value of part {name!r}")
+            cond.field(), space.node_points[nodes], f"the Dirichlet value of part {name!r}"
+        )
     dirichlet = np.column_stack([2 * d_nodes, 2 * d_nodes + 1]).ravel()
 
     cs = contact_set(problem, space)

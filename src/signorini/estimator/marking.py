@@ -57,5 +57,5 @@ def mark_doerfler(eta2: np.ndarray, theta: float = 0.4) -> np.ndarray:
     cumulative = np.cumsum(eta2[order])
     # first index where the running sum reaches θ·total (guard against round-off at the end)
     k = int(np.searchsorted(cumulative, theta * total * (1 - 1e-14), side="left")) + 1
-    marked[order[:min(k, eta2.size)]] = True
+    marked[order[: min(k, eta2.size)]] = True
     return marked

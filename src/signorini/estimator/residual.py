@@ -132,8 +132,9 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
         r = evaluate_field(problem.body_force, x, "body_force") + divs[:, None, :]
         R = 2 * mesh.area * np.einsum("q,mqc,mqc->m", w, r, r)
     eta2_cell[0] = R * (h_p[cell_nodes] ** 2).sum(axis=1)
-    eta2_node[0] = h_p**2 * np.bincount(cell_nodes.ravel(), weights=np.repeat(R, 6),
-                                        minlength=n_nodes)
+    eta2_node[0] = h_p**2 * np.bincount(
+        cell_nodes.ravel(), weights=np.repeat(R, 6), minlength=n_nodes
+    )
 
     # ---- stresses on edges: σ(u_h) is linear on each cell, known from its vertex values
     sig_v = stress(material, field_gradients(V, u_cell, REFERENCE_NODES[:3]))  # (m, 3, 2, 2)
@@ -147,8 +148,9 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
         s0 = sig_v[cell, k]
         s1 = sig_v[cell, (k + 1) % 3]
         sig = (1 - tt)[None, :, None, None] * s0[:, None] + tt[None, :, None, None] * s1[:, None]
-        _, n = segment_normals(mesh.points[mesh.cells[cell, k]],
-                               mesh.points[mesh.cells[cell, (k + 1) % 3]])
+        _, n = segment_normals(
+            mesh.points[mesh.cells[cell, k]], mesh.points[mesh.cells[cell, (k + 1) % 3]]
+        )
         return np.einsum("eqij,ej->eqi", sig, n)
 
     def edge_nodes_of(e: np.ndarray) -> np.ndarray:
@@ -168,7 +170,8 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     # ---- η2: stress jumps on interior edges
     inner = np.flatnonzero(e2c[:, 1] >= 0)
     jump = traction(e2c[inner, 0], local[inner, 0], t) + traction(
-        e2c[inner, 1], local[inner, 1], 1 - t)
+        e2c[inner, 1], local[inner, 1], 1 - t
+    )
     J2 = mesh.edge_length[inner] * np.einsum("q,eqi,eqi->e", wt, jump, jump)
     add_edge_term(1, inner, J2, edge_nodes_of(inner))
 
@@ -185,8 +188,9 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
             x = a[:, None] + tn[None, :, None] * (b - a)[:, None]
             _, n = segment_normals(a, b)
             g = cond.field()
-            sn = sn - evaluate_field(lambda y, n=n, g=g: g(y, n[:, None, :]), x,
-                                     f"the traction of part {name!r}")
+            sn = sn - evaluate_field(
+                lambda y, n=n, g=g: g(y, n[:, None, :]), x, f"the traction of part {name!r}"
+            )
         J3 = mesh.edge_length[e] * np.einsum("q,eqi,eqi->e", wn, sn, sn)
         add_edge_term(2, e, J3, edge_nodes_of(e))
 
@@ -250,8 +254,12 @@ def third_integrals(v: np.ndarray, length: np.ndarray) -> np.ndarray:
     c0, c1, c2 = a, -3 * a - b + 4 * m, 2 * a + 2 * b - 4 * m
     # sub-intervals where φ is linear: [0,1/3]: φ_start = 1 − 2t; [2/3,1]: φ_end = 2t − 1;
     # [1/3,1/2]: φ_mid = 2t; [1/2,2/3]: φ_mid = 2 − 2t
-    pieces = [(0.0, 1 / 3, 0, (1.0, -2.0)), (2 / 3, 1.0, 1, (-1.0, 2.0)),
-              (1 / 3, 0.5, 2, (0.0, 2.0)), (0.5, 2 / 3, 2, (2.0, -2.0))]
+    pieces = [
+        (0.0, 1 / 3, 0, (1.0, -2.0)),
+        (2 / 3, 1.0, 1, (-1.0, 2.0)),
+        (1 / 3, 0.5, 2, (0.0, 2.0)),
+        (0.5, 2 / 3, 2, (2.0, -2.0)),
+    ]
     gt, gw = np.polynomial.legendre.leggauss(3)  # exact for degree 5 ≥ 3 (quadratic × linear)
     roots = _roots_in_unit(c0, c1, c2)  # (k, 2), NaN where none
     out = np.zeros(v.shape)

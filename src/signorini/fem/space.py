@@ -23,8 +23,14 @@ def p2_from_barycentric(bary: np.ndarray) -> np.ndarray:
     """P2 basis values ``(..., 6)`` at points given by barycentric coordinates ``(..., 3)``."""
     l0, l1, l2 = bary[..., 0], bary[..., 1], bary[..., 2]
     return np.stack(
-        [l0 * (2 * l0 - 1), l1 * (2 * l1 - 1), l2 * (2 * l2 - 1),
-         4 * l0 * l1, 4 * l1 * l2, 4 * l2 * l0],
+        [
+            l0 * (2 * l0 - 1),
+            l1 * (2 * l1 - 1),
+            l2 * (2 * l2 - 1),
+            4 * l0 * l1,
+            4 * l1 * l2,
+            4 * l2 * l0,
+        ],
         axis=-1,
     )
 
@@ -85,8 +91,10 @@ class P2Space:
         """Nodal interpolant ``(n_nodes, 2)`` of a vector field ``func(x (n, 2)) -> (n, 2)``."""
         values = np.asarray(func(self.node_points), dtype=np.float64)
         if values.shape != (self.n_nodes, 2):
-            raise ValueError(f"the function to interpolate must return shape ({self.n_nodes}, 2)"
-                             f" for {self.n_nodes} points, got {values.shape}")
+            raise ValueError(
+                f"the function to interpolate must return shape ({self.n_nodes}, 2)"
+                f" for {self.n_nodes} points, got {values.shape}"
+            )
         return values
 
     def cell_values(self, u: np.ndarray) -> np.ndarray:
@@ -123,9 +131,12 @@ class P2Space:
         fine = P2Space(refinement.mesh)
         parent = np.asarray(refinement.parent)
         if parent.shape != (fine.mesh.n_cells,) or (
-                parent.size and (parent.min() < 0 or parent.max() >= self.mesh.n_cells)):
-            raise ValueError("the refinement is not a refinement of this space's mesh (its parent "
-                             f"cells do not index the {self.mesh.n_cells} cells)")
+            parent.size and (parent.min() < 0 or parent.max() >= self.mesh.n_cells)
+        ):
+            raise ValueError(
+                "the refinement is not a refinement of this space's mesh (its parent "
+                f"cells do not index the {self.mesh.n_cells} cells)"
+            )
         P = self.vertices[parent]  # (m, 3, 2)
         X = fine.node_points[fine.cell_nodes]  # (m, 6, 2)
         J = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=-1)  # columns
@@ -133,8 +144,10 @@ class P2Space:
         xi = np.linalg.solve(J, rhs).transpose(0, 2, 1)  # (m, 6, 2)
         bary = np.concatenate([1 - xi.sum(-1, keepdims=True), xi], axis=-1)
         if bary.min(initial=0.0) < -1e-8:
-            raise ValueError("the refinement is not a refinement of this space's mesh (a new "
-                             "cell is not inside its parent cell)")
+            raise ValueError(
+                "the refinement is not a refinement of this space's mesh (a new "
+                "cell is not inside its parent cell)"
+            )
         phi = p2_from_barycentric(bary)  # (m, 6, 6): new local node, parent local node
         coarse = u[self.cell_nodes[parent]]  # (m, 6) or (m, 6, 2)
         if u.ndim == 1:

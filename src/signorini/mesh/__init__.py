@@ -6,5 +6,12 @@ from .gmsh import read_mesh
 from .mesh import Mesh, MeshError
 from .refine import Refinement, refine_nvb, refine_uniform
 
-__all__ = ["Mesh", "MeshError", "Refinement", "read_mesh", "rectangle", "refine_nvb",
-           "refine_uniform"]
+__all__ = [
+    "Mesh",
+    "MeshError",
+    "Refinement",
+    "read_mesh",
+    "rectangle",
+    "refine_nvb",
+    "refine_uniform",
+]

@@ -55,15 +55,16 @@ def rectangle(
         centre = np.column_stack([xs[i] + 0.5 * (xs[1] - xs[0]), ys[j] + 0.5 * (ys[1] - ys[0])])
         m = len(points) + np.arange(len(a))
         points = np.vstack([points, centre])
-        cells = np.concatenate([np.column_stack(t) for t in
-                                ((a, b, m), (b, c, m), (c, d, m), (d, a, m))])
+        cells = np.concatenate(
+            [np.column_stack(t) for t in ((a, b, m), (b, c, m), (c, d, m), (d, a, m))]
+        )
     else:
         if pattern == "right":
             flip = np.zeros(len(a), dtype=bool)
         elif pattern == "left":
             flip = np.ones(len(a), dtype=bool)
         else:  # union jack: diagonals point towards the centre of the rectangle
-            flip = ((i < nx / 2) == (j < ny / 2))
+            flip = (i < nx / 2) == (j < ny / 2)
             flip = ~flip
         # diagonal a-c (no flip) or b-d (flip)
         t1 = np.where(flip[:, None], np.column_stack([a, b, d]), np.column_stack([a, b, c]))

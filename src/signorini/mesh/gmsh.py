@@ -69,16 +69,18 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
             name = names.get(int(tag), f"part{int(tag)}")
             pairs = renumber[block.data[tags[i] == tag][:, :2]]
             if np.any(pairs < 0):
-                raise MeshError(f"boundary group {name!r} uses points that are not vertices "
-                                "of any triangle")
+                raise MeshError(
+                    f"boundary group {name!r} uses points that are not vertices of any triangle"
+                )
             groups.setdefault(name, []).append(pairs)
     if not groups:
-        raise MeshError(f"{path} has no tagged boundary lines (physical groups); the boundary "
-                        "parts cannot be named")
+        raise MeshError(
+            f"{path} has no tagged boundary lines (physical groups); the boundary "
+            "parts cannot be named"
+        )
     if parts is not None:
         missing = [p for p in parts if p not in groups]
         if missing:
-            raise MeshError(f"{path} has no boundary group(s) {missing}; it has "
-                            f"{sorted(groups)}")
+            raise MeshError(f"{path} has no boundary group(s) {missing}; it has {sorted(groups)}")
         groups = {p: groups[p] for p in parts}
     return Mesh.from_arrays(points, cells, {k: np.concatenate(v) for k, v in groups.items()})

@@ -147,8 +147,10 @@ class Mesh:
                 mid = 0.5 * (points[bnd[:, 0]] + points[bnd[:, 1]])
                 hit = np.asarray(spec(mid[:, 0], mid[:, 1]), dtype=bool).reshape(-1)
                 if hit.shape != (len(bnd),):
-                    raise MeshError(f"the predicate of boundary part {name!r} must return one "
-                                    f"bool per edge midpoint, got shape {hit.shape}")
+                    raise MeshError(
+                        f"the predicate of boundary part {name!r} must return one "
+                        f"bool per edge midpoint, got shape {hit.shape}"
+                    )
                 where = np.flatnonzero(hit & ~listed)
             else:
                 pairs = np.asarray(spec)
@@ -164,15 +166,19 @@ class Mesh:
                     found = keys[order[pos]] == k
                     if not found.all():
                         bad = pairs[~found][0]
-                        raise MeshError(f"boundary part {name!r}: ({bad[0]}, {bad[1]}) is not a "
-                                        "boundary edge of the mesh")
+                        raise MeshError(
+                            f"boundary part {name!r}: ({bad[0]}, {bad[1]}) is not a "
+                            "boundary edge of the mesh"
+                        )
                     where = order[pos]
             taken = where[part_of[where] >= 0]
             if taken.size:
                 other = names[part_of[taken[0]]]
                 bad = bnd[taken[0]]
-                raise MeshError(f"boundary edge ({bad[0]}, {bad[1]}) is claimed by both parts "
-                                f"{other!r} and {name!r}")
+                raise MeshError(
+                    f"boundary edge ({bad[0]}, {bad[1]}) is claimed by both parts "
+                    f"{other!r} and {name!r}"
+                )
             part_of[where] = index
         return cls(points, cells, bnd, part_of, names)
 
@@ -322,8 +328,9 @@ class Mesh:
         return float(self.edge_length[self.part_edges(name)].sum())
 
     def __repr__(self) -> str:
-        return (f"Mesh(n_points={self.n_points}, n_cells={self.n_cells}, "
-                f"parts={list(self.part_names)})")
+        return (
+            f"Mesh(n_points={self.n_points}, n_cells={self.n_cells}, parts={list(self.part_names)})"
+        )
 
     # ------------------------------------------------------------------ validation
     def _validate(self) -> None:
@@ -334,16 +341,20 @@ class Mesh:
         used = np.zeros(len(points), dtype=bool)
         used[cells.ravel()] = True
         if not used.all():
-            raise MeshError(f"unreferenced point(s) {_first(np.flatnonzero(~used))}: every "
-                            "point must be a vertex of some cell")
+            raise MeshError(
+                f"unreferenced point(s) {_first(np.flatnonzero(~used))}: every "
+                "point must be a vertex of some cell"
+            )
         _check_duplicate_points(points)
         if self.boundary_part.shape != (len(self.boundary),):
             raise MeshError("boundary_part must have one entry per boundary edge")
         bad_part = (self.boundary_part < 0) | (self.boundary_part >= len(self.part_names))
         if bad_part.any():
             first = self.boundary[np.flatnonzero(bad_part)[0]]
-            raise MeshError(f"{int(bad_part.sum())} boundary edge(s) have no part, first "
-                            f"({first[0]}, {first[1]}); label every boundary edge")
+            raise MeshError(
+                f"{int(bad_part.sum())} boundary edge(s) have no part, first "
+                f"({first[0]}, {first[1]}); label every boundary edge"
+            )
         for index, name in enumerate(self.part_names):
             if not np.any(self.boundary_part == index):
                 raise MeshError(f"boundary part {name!r} has no edges")
@@ -354,16 +365,19 @@ class Mesh:
         be = self.boundary_edge
         if np.any(~is_bnd[be]):
             bad = self.boundary[np.flatnonzero(~is_bnd[be])[0]]
-            raise MeshError(f"edge ({bad[0]}, {bad[1]}) is labelled as boundary but is shared "
-                            "by two cells")
+            raise MeshError(
+                f"edge ({bad[0]}, {bad[1]}) is labelled as boundary but is shared by two cells"
+            )
         if np.unique(be).size != be.size:
             raise MeshError("a boundary edge is listed twice")
         labelled[be] = True
         missing = np.flatnonzero(is_bnd & ~labelled)
         if missing.size:
             e = self.edges[missing[0]]
-            raise MeshError(f"{missing.size} boundary edge(s) without a part, first "
-                            f"({e[0]}, {e[1]}); label every boundary edge")
+            raise MeshError(
+                f"{missing.size} boundary edge(s) without a part, first "
+                f"({e[0]}, {e[1]}); label every boundary edge"
+            )
 
     def _check_conforming(self, is_bnd: np.ndarray) -> None:
         """Neighbouring cells must traverse a shared edge in opposite directions, and no vertex
@@ -376,8 +390,9 @@ class Mesh:
         if np.any(counts[~is_bnd] != 1):
             bad = np.flatnonzero((counts != 1) & ~is_bnd)[0]
             e = self.edges[bad]
-            raise MeshError(f"cells overlap or are inconsistently oriented across edge "
-                            f"({e[0]}, {e[1]})")
+            raise MeshError(
+                f"cells overlap or are inconsistently oriented across edge ({e[0]}, {e[1]})"
+            )
         bnd = np.flatnonzero(is_bnd)
         verts = np.unique(self.edges[bnd])
         a = self.points[self.edges[bnd, 0]]
@@ -399,7 +414,8 @@ class Mesh:
         n_cand = np.where(use_y, count[1], count[0])
         edge_of = np.repeat(np.arange(bnd.size), n_cand)
         pos = np.where(use_y, first[1], first[0])[edge_of] + (
-            np.arange(edge_of.size) - np.repeat(np.cumsum(n_cand) - n_cand, n_cand))
+            np.arange(edge_of.size) - np.repeat(np.cumsum(n_cand) - n_cand, n_cand)
+        )
         cand = np.where(use_y[edge_of], by_axis[1][pos], by_axis[0][pos])
         ab = (b - a)[edge_of]
         ap = self.points[cand] - a[edge_of]
@@ -410,8 +426,10 @@ class Mesh:
         if on.any():
             i = np.flatnonzero(on)[0]
             e = self.edges[bnd[edge_of[i]]]
-            raise MeshError(f"non-conforming mesh: point {cand[i]} lies inside edge "
-                            f"({e[0]}, {e[1]}) (hanging node)")
+            raise MeshError(
+                f"non-conforming mesh: point {cand[i]} lies inside edge "
+                f"({e[0]}, {e[1]}) (hanging node)"
+            )
 
 
 # ---------------------------------------------------------------------- helpers
@@ -426,8 +444,9 @@ def _as_points(points: np.ndarray) -> np.ndarray:
     if p.ndim != 2 or p.shape[1] != 2:
         raise MeshError(f"points must have shape (n_points, 2), got {p.shape}")
     if not np.isfinite(p).all():
-        raise MeshError(f"point(s) {_first(np.flatnonzero(~np.isfinite(p).all(1)))} have "
-                        "non-finite coordinates")
+        raise MeshError(
+            f"point(s) {_first(np.flatnonzero(~np.isfinite(p).all(1)))} have non-finite coordinates"
+        )
     return p
 
 
@@ -461,12 +480,15 @@ def _check_orientation(points: np.ndarray, cells: np.ndarray) -> None:
     degenerate = np.abs(area) <= 1e-12 * h2
     if degenerate.any():
         bad = np.flatnonzero(degenerate)
-        raise MeshError(f"degenerate triangle(s) {_first(bad)} (zero area or repeated vertex), "
-                        f"e.g. cell {bad[0]} = {cells[bad[0]].tolist()}")
+        raise MeshError(
+            f"degenerate triangle(s) {_first(bad)} (zero area or repeated vertex), "
+            f"e.g. cell {bad[0]} = {cells[bad[0]].tolist()}"
+        )
     if np.any(area < 0):
         bad = np.flatnonzero(area < 0)
-        raise MeshError(f"clockwise triangle(s) {_first(bad)}: list each cell's vertices "
-                        "counter-clockwise")
+        raise MeshError(
+            f"clockwise triangle(s) {_first(bad)}: list each cell's vertices counter-clockwise"
+        )
 
 
 def _check_duplicate_points(points: np.ndarray) -> None:
@@ -475,8 +497,9 @@ def _check_duplicate_points(points: np.ndarray) -> None:
     _, inverse, counts = np.unique(q, axis=0, return_inverse=True, return_counts=True)
     if counts.max() > 1:
         dup = np.flatnonzero(counts[inverse.reshape(-1)] > 1)
-        raise MeshError(f"duplicate points {_first(dup)} (same coordinates "
-                        f"{points[dup[0]].tolist()})")
+        raise MeshError(
+            f"duplicate points {_first(dup)} (same coordinates {points[dup[0]].tolist()})"
+        )
 
 
 def _longest_edge_first(points: np.ndarray, cells: np.ndarray) -> np.ndarray:

@@ -111,8 +111,7 @@ def _as_cell_mask(mesh: Mesh, marked: np.ndarray) -> np.ndarray:
     marked = np.asarray(marked)
     if marked.dtype == bool:
         if marked.shape != (mesh.n_cells,):
-            raise ValueError(f"a boolean marking needs shape ({mesh.n_cells},), got "
-                             f"{marked.shape}")
+            raise ValueError(f"a boolean marking needs shape ({mesh.n_cells},), got {marked.shape}")
         return marked
     if marked.size and not np.issubdtype(marked.dtype, np.integer):
         raise ValueError("marked must be a boolean mask or an array of cell indices")
@@ -165,11 +164,13 @@ def _bisect(mesh: Mesh, marked_edges: np.ndarray) -> Refinement:
     mid = edge_point[be]
     split = mid >= 0
     bnd = mesh.boundary
-    new_boundary = np.concatenate([
-        bnd[~split],
-        np.column_stack([bnd[split, 0], mid[split]]),
-        np.column_stack([mid[split], bnd[split, 1]]),
-    ])
+    new_boundary = np.concatenate(
+        [
+            bnd[~split],
+            np.column_stack([bnd[split, 0], mid[split]]),
+            np.column_stack([mid[split], bnd[split, 1]]),
+        ]
+    )
     part = mesh.boundary_part
     new_part = np.concatenate([part[~split], part[split], part[split]])
     refined = Mesh(points, new_cells, new_boundary, new_part, mesh.part_names, validate=False)

@@ -49,8 +49,13 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     mesh = meshio.Mesh(
         points,
         [("triangle6", space.cell_nodes)],
-        point_data={"displacement": disp, "pressure": pressure, "contact_force": force,
-                    "active": active, "contact_class": klass},
+        point_data={
+            "displacement": disp,
+            "pressure": pressure,
+            "contact_force": force,
+            "active": active,
+            "contact_class": klass,
+        },
         cell_data=cell_data,
     )
     with replacing(path, suffix=".vtu") as tmp:

@@ -178,20 +178,22 @@ def read_history(path: str | os.PathLike) -> dict[str, np.ndarray]:
     body = rows[1:]
     for i, r in enumerate(body, start=2):
         if len(r) != len(header):
-            raise ValueError(f"{path}: line {i} has {len(r)} fields, the header has "
-                             f"{len(header)}")
+            raise ValueError(f"{path}: line {i} has {len(r)} fields, the header has {len(header)}")
     columns = list(zip(*body, strict=True)) if body else [()] * len(header)
     return {h: _parse_column(h, list(c)) for h, c in zip(header, columns, strict=True)}
 
 
-def _history(history: HistoryLike, required: Sequence[str],
-             optional: Sequence[str] = ()) -> dict[str, np.ndarray]:
+def _history(
+    history: HistoryLike, required: Sequence[str], optional: Sequence[str] = ()
+) -> dict[str, np.ndarray]:
     """Float columns ``required`` (all) and ``optional`` (when present) of a history."""
     if isinstance(history, (str, os.PathLike)):
         history = read_history(history)
     if not isinstance(history, Mapping):
-        raise ValueError("a history must be a mapping from column name to 1-d array, or the "
-                         f"path of a CSV file; got {type(history).__name__}")
+        raise ValueError(
+            "a history must be a mapping from column name to 1-d array, or the "
+            f"path of a CSV file; got {type(history).__name__}"
+        )
     missing = [k for k in required if k not in history]
     if missing:
         raise ValueError(f"the history lacks column(s) {missing}; it has {sorted(history)}")
@@ -257,8 +259,10 @@ def fitted_slope(ndof: ArrayLike, values: ArrayLike, last: int = 3) -> float:
     except (TypeError, ValueError):
         raise ValueError("ndof and values must be numeric arrays") from None
     if x.ndim != 1 or y.ndim != 1 or x.shape != y.shape:
-        raise ValueError(f"ndof and values must be 1-d arrays of equal length, got shapes "
-                         f"{x.shape} and {y.shape}")
+        raise ValueError(
+            f"ndof and values must be 1-d arrays of equal length, got shapes "
+            f"{x.shape} and {y.shape}"
+        )
     keep = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
     lx, ly = np.log(x[keep])[-last:], np.log(y[keep])[-last:]
     if lx.size < 2:
@@ -282,9 +286,15 @@ def _slope_label(label: str, ndof: np.ndarray, values: np.ndarray, last: int) ->
         return label
 
 
-def add_slope_triangle(ax: Any, ndof: ArrayLike, curves: Sequence[ArrayLike],
-                       slope: float = -1.0, where: float = 0.55, size: float = 0.22,
-                       color: str = "0.25") -> Polygon | None:
+def add_slope_triangle(
+    ax: Any,
+    ndof: ArrayLike,
+    curves: Sequence[ArrayLike],
+    slope: float = -1.0,
+    where: float = 0.55,
+    size: float = 0.22,
+    color: str = "0.25",
+) -> Polygon | None:
     """Draw a slope triangle just below the curves of a log-log plot.
 
     The hypotenuse has the given slope (in decades per decade); the horizontal leg is labelled
@@ -313,17 +323,25 @@ def add_slope_triangle(ax: Any, ndof: ArrayLike, curves: Sequence[ArrayLike],
         The triangle, or None when no curve has two valid points.
     """
     x = np.asarray(ndof, dtype=np.float64)
-    return _place_triangle(ax, [(x, np.asarray(c, dtype=np.float64)) for c in curves],
-                           slope, where, size, color)
+    return _place_triangle(
+        ax, [(x, np.asarray(c, dtype=np.float64)) for c in curves], slope, where, size, color
+    )
 
 
-def _place_triangle(ax: Any, series: Sequence[tuple[np.ndarray, np.ndarray]], slope: float,
-                    where: float = 0.55, size: float = 0.22,
-                    color: str = "0.25") -> Polygon | None:
+def _place_triangle(
+    ax: Any,
+    series: Sequence[tuple[np.ndarray, np.ndarray]],
+    slope: float,
+    where: float = 0.55,
+    size: float = 0.22,
+    color: str = "0.25",
+) -> Polygon | None:
     """:func:`add_slope_triangle` for curves ``(x, y)`` with their own abscissae."""
     if not (0.0 <= where <= 1.0 and 0.0 < size <= 1.0 and np.isfinite(slope)):
-        raise ValueError(f"need 0 <= where <= 1, 0 < size <= 1 and a finite slope, got "
-                         f"where={where}, size={size}, slope={slope}")
+        raise ValueError(
+            f"need 0 <= where <= 1, 0 < size <= 1 and a finite slope, got "
+            f"where={where}, size={size}, slope={slope}"
+        )
     logs = []
     for x, y in series:
         if x.shape != y.shape:
@@ -359,13 +377,25 @@ def _place_triangle(ax: Any, series: Sequence[tuple[np.ndarray, np.ndarray]], sl
     verts = 10.0 ** np.array([[x0, y0], [x1, y1], list(corner)])
     tri = Polygon(verts, closed=True, fill=False, edgecolor=color, linewidth=0.9, zorder=3)
     ax.add_patch(tri)
-    ax.annotate("1", xy=(10 ** ((x0 + x1) / 2), 10 ** min(y0, y1)), xytext=(0, -2),
-                textcoords="offset points", ha="center", va="top", color=color)
+    ax.annotate(
+        "1",
+        xy=(10 ** ((x0 + x1) / 2), 10 ** min(y0, y1)),
+        xytext=(0, -2),
+        textcoords="offset points",
+        ha="center",
+        va="top",
+        color=color,
+    )
     left = corner[0] == x0
-    ax.annotate(_fmt_number(slope, 0) if float(slope).is_integer() else _fmt_number(slope),
-                xy=(10 ** corner[0], 10 ** ((y0 + y1) / 2)), xytext=(-3 if left else 3, 0),
-                textcoords="offset points", ha="right" if left else "left", va="center",
-                color=color)
+    ax.annotate(
+        _fmt_number(slope, 0) if float(slope).is_integer() else _fmt_number(slope),
+        xy=(10 ** corner[0], 10 ** ((y0 + y1) / 2)),
+        xytext=(-3 if left else 3, 0),
+        textcoords="offset points",
+        ha="right" if left else "left",
+        va="center",
+        color=color,
+    )
     return tri
 
 
@@ -428,23 +458,27 @@ def _tidy_log_ticks(ax: Any) -> None:
         axis.set_minor_formatter(NullFormatter())
         if lo > 0 and np.log10(hi / lo) < 2.0:
             axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
-            axis.set_major_formatter(LogFormatterSciNotation(
-                labelOnlyBase=False, minor_thresholds=(np.inf, np.inf)))
+            axis.set_major_formatter(
+                LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(np.inf, np.inf))
+            )
 
 
-def _plot_quantity(ax: Any, ndof: np.ndarray, values: np.ndarray, key: str, label: str,
-                   **kw: Any) -> Any:
+def _plot_quantity(
+    ax: Any, ndof: np.ndarray, values: np.ndarray, key: str, label: str, **kw: Any
+) -> Any:
     style = STYLES[key]
-    (line,) = ax.plot(ndof, _positive(values), color=style["color"], marker=style["marker"],
-                      label=label, **kw)
+    (line,) = ax.plot(
+        ndof, _positive(values), color=style["color"], marker=style["marker"], label=label, **kw
+    )
     return line
 
 
 # ---------------------------------------------------------------------------------------------
 # Section 6 figures
 # ---------------------------------------------------------------------------------------------
-def plot_error_and_estimator(history: HistoryLike, path: str | os.PathLike,
-                             title: str | None = None, last: int = 3) -> list[Path]:
+def plot_error_and_estimator(
+    history: HistoryLike, path: str | os.PathLike, title: str | None = None, last: int = 3
+) -> list[Path]:
     """Fig. 6.1(a): energy error and estimator ``η_h`` (5.1) against ``N_dof``, log-log.
 
     The legend gives the slope of each curve fitted over the last ``last`` levels
@@ -476,16 +510,22 @@ def plot_error_and_estimator(history: HistoryLike, path: str | os.PathLike,
     h = _history(history, ("ndof", "eta", "error_energy"))
     ndof, eta, err = h["ndof"], h["eta"], h["error_energy"]
     if not np.any(np.isfinite(err) & (err > 0)):
-        raise ValueError("the history has no positive finite error_energy value; plot the "
-                         "estimator alone with plot_estimator")
+        raise ValueError(
+            "the history has no positive finite error_energy value; plot the "
+            "estimator alone with plot_estimator"
+        )
     with mpl.rc_context(_RC):
         fig = _new_figure()
         ax = fig.add_subplot()
         _loglog(ax, "error, estimator")
-        _plot_quantity(ax, ndof, err, "error_energy",
-                       _slope_label(STYLES["error_energy"]["label"], ndof, err, last))
-        _plot_quantity(ax, ndof, eta, "eta", _slope_label(STYLES["eta"]["label"], ndof, eta,
-                                                           last))
+        _plot_quantity(
+            ax,
+            ndof,
+            err,
+            "error_energy",
+            _slope_label(STYLES["error_energy"]["label"], ndof, err, last),
+        )
+        _plot_quantity(ax, ndof, eta, "eta", _slope_label(STYLES["eta"]["label"], ndof, eta, last))
         add_slope_triangle(ax, ndof, [err, eta], slope=-1.0)
         ax.legend(loc="upper right")
         if title:
@@ -494,8 +534,9 @@ def plot_error_and_estimator(history: HistoryLike, path: str | os.PathLike,
         return _save(fig, path)
 
 
-def plot_efficiency(history: HistoryLike, path: str | os.PathLike,
-                    title: str | None = None) -> list[Path]:
+def plot_efficiency(
+    history: HistoryLike, path: str | os.PathLike, title: str | None = None
+) -> list[Path]:
     """Fig. 6.1(b): efficiency index ``η_h / ‖u − u_h‖_a`` against ``N_dof`` (log x axis).
 
     Parameters
@@ -526,8 +567,10 @@ def plot_efficiency(history: HistoryLike, path: str | os.PathLike,
             quotient = h["eta"] / h["error_energy"]
         eff = np.where(np.isfinite(eff), eff, quotient)
     elif "efficiency" not in h:
-        raise ValueError("the history needs an 'efficiency' column or both 'eta' and "
-                         f"'error_energy'; it has {sorted(h)}")
+        raise ValueError(
+            "the history needs an 'efficiency' column or both 'eta' and "
+            f"'error_energy'; it has {sorted(h)}"
+        )
     eff = np.where(np.isfinite(eff) & (eff > 0), eff, np.nan)
     if np.all(np.isnan(eff)):
         raise ValueError("the history has no positive finite efficiency index")
@@ -540,8 +583,9 @@ def plot_efficiency(history: HistoryLike, path: str | os.PathLike,
         ax.grid(True, which="minor", axis="x", linestyle=":", alpha=0.3)
         ax.plot(ndof, eff, color=style["color"], marker=style["marker"], label=style["label"])
         mean = float(np.nanmean(eff))
-        ax.axhline(mean, color="0.5", linestyle="--", linewidth=0.8,
-                   label=f"mean {_fmt_number(mean)}")
+        ax.axhline(
+            mean, color="0.5", linestyle="--", linewidth=0.8, label=f"mean {_fmt_number(mean)}"
+        )
         ax.set_ylim(0.0, 1.2 * float(np.nanmax(eff)))
         ax.set_xlabel(NDOF_LABEL)
         ax.set_ylabel(r"efficiency index $\eta_h/\|u-u_h\|_a$")
@@ -552,8 +596,9 @@ def plot_efficiency(history: HistoryLike, path: str | os.PathLike,
         return _save(fig, path)
 
 
-def plot_contributions(history: HistoryLike, path: str | os.PathLike,
-                       title: str | None = None, last: int = 3) -> list[Path]:
+def plot_contributions(
+    history: HistoryLike, path: str | os.PathLike, title: str | None = None, last: int = 3
+) -> list[Path]:
     """Figs. 6.2 / 6.4: the estimator contributions ``η_1 … η_7`` of (5.1) against ``N_dof``.
 
     Terms that vanish on every level (e.g. ``η_6``, ``η_7`` in Example 6.1, where the whole
@@ -592,12 +637,12 @@ def plot_contributions(history: HistoryLike, path: str | os.PathLike,
             v = h[key]
             label = STYLES[key]["label"]
             if np.any(np.isfinite(v) & (v > 0)):
-                handles.append(_plot_quantity(ax, ndof, v, key,
-                                              _slope_label(label, ndof, v, last)))
+                handles.append(_plot_quantity(ax, ndof, v, key, _slope_label(label, ndof, v, last)))
                 drawn.append(v)
             elif np.any(v == 0):
-                handles.append(Line2D([], [], linestyle="none", marker="",
-                                      label=label[:-1] + r" \equiv 0$"))
+                handles.append(
+                    Line2D([], [], linestyle="none", marker="", label=label[:-1] + r" \equiv 0$")
+                )
             else:
                 log.warning("estimator contribution %s has no known value; skipped", key)
         add_slope_triangle(ax, ndof, drawn, slope=-1.0)
@@ -608,8 +653,9 @@ def plot_contributions(history: HistoryLike, path: str | os.PathLike,
         return _save(fig, path)
 
 
-def plot_estimator(history: HistoryLike, path: str | os.PathLike,
-                   title: str | None = None, last: int = 3) -> list[Path]:
+def plot_estimator(
+    history: HistoryLike, path: str | os.PathLike, title: str | None = None, last: int = 3
+) -> list[Path]:
     """Fig. 6.3(a): the estimator ``η_h`` (5.1) against ``N_dof``, log-log, slope −1 triangle.
 
     Parameters
@@ -635,8 +681,7 @@ def plot_estimator(history: HistoryLike, path: str | os.PathLike,
         fig = _new_figure()
         ax = fig.add_subplot()
         _loglog(ax, r"$\eta_h$")
-        _plot_quantity(ax, ndof, eta, "eta", _slope_label(STYLES["eta"]["label"], ndof, eta,
-                                                           last))
+        _plot_quantity(ax, ndof, eta, "eta", _slope_label(STYLES["eta"]["label"], ndof, eta, last))
         add_slope_triangle(ax, ndof, [eta], slope=-1.0)
         ax.legend(loc="upper right")
         if title:
@@ -645,9 +690,14 @@ def plot_estimator(history: HistoryLike, path: str | os.PathLike,
         return _save(fig, path)
 
 
-def plot_adaptive_vs_uniform(histories: Mapping[str, HistoryLike], path: str | os.PathLike,
-                             key: str = "eta", title: str | None = None, last: int = 3,
-                             reference_slope: float | None = -1.0) -> list[Path]:
+def plot_adaptive_vs_uniform(
+    histories: Mapping[str, HistoryLike],
+    path: str | os.PathLike,
+    key: str = "eta",
+    title: str | None = None,
+    last: int = 3,
+    reference_slope: float | None = -1.0,
+) -> list[Path]:
     """Several runs of one quantity on one log-log plot, each with its fitted slope.
 
     Meant for adaptive against uniform refinement, or runs with different estimator
@@ -684,12 +734,17 @@ def plot_adaptive_vs_uniform(histories: Mapping[str, HistoryLike], path: str | o
         ax = fig.add_subplot()
         _loglog(ax, ylabel)
         for i, (label, h) in enumerate(runs.items()):
-            ax.plot(h["ndof"], _positive(h[key]), color=_RUN_COLORS[i % len(_RUN_COLORS)],
-                    marker=_RUN_MARKERS[i % len(_RUN_MARKERS)],
-                    label=_slope_label(label, h["ndof"], h[key], last))
+            ax.plot(
+                h["ndof"],
+                _positive(h[key]),
+                color=_RUN_COLORS[i % len(_RUN_COLORS)],
+                marker=_RUN_MARKERS[i % len(_RUN_MARKERS)],
+                label=_slope_label(label, h["ndof"], h[key], last),
+            )
         if reference_slope is not None:
-            _place_triangle(ax, [(h["ndof"], h[key]) for h in runs.values()],
-                            slope=float(reference_slope))
+            _place_triangle(
+                ax, [(h["ndof"], h[key]) for h in runs.values()], slope=float(reference_slope)
+            )
         ax.legend(loc="best")
         if title:
             ax.set_title(title)
@@ -715,8 +770,9 @@ def _mesh_arrays(points: ArrayLike, cells: ArrayLike) -> tuple[np.ndarray, np.nd
     if not np.issubdtype(c.dtype, np.integer):
         raise ValueError(f"cells must be an integer array, got dtype {c.dtype}")
     if c.min() < 0 or c.max() >= p.shape[0]:
-        raise ValueError(f"cells refer to vertices outside 0..{p.shape[0] - 1} "
-                         f"(range {c.min()}..{c.max()})")
+        raise ValueError(
+            f"cells refer to vertices outside 0..{p.shape[0] - 1} (range {c.min()}..{c.max()})"
+        )
     return p, c.astype(np.int64)
 
 
@@ -725,8 +781,10 @@ def _edge_pairs(edges: ArrayLike, n_points: int, what: str) -> np.ndarray:
     if e.size == 0:
         return np.zeros((0, 2), dtype=np.int64)
     if e.ndim != 2 or e.shape[1] != 2 or not np.issubdtype(e.dtype, np.integer):
-        raise ValueError(f"{what} must be an integer (k, 2) array of vertex pairs, got shape "
-                         f"{e.shape} and dtype {e.dtype}")
+        raise ValueError(
+            f"{what} must be an integer (k, 2) array of vertex pairs, got shape "
+            f"{e.shape} and dtype {e.dtype}"
+        )
     if e.min() < 0 or e.max() >= n_points:
         raise ValueError(f"{what} refer to vertices outside 0..{n_points - 1}")
     return e.astype(np.int64)
@@ -737,10 +795,14 @@ def _line_width(n_cells: int) -> float:
     return float(np.clip(0.8 * np.sqrt(400.0 / max(n_cells, 1)), 0.1, 0.8))
 
 
-def plot_mesh(points: ArrayLike, cells: ArrayLike, path: str | os.PathLike,
-              title: str | None = None,
-              highlight: ArrayLike | Mapping[str, ArrayLike] | None = None,
-              highlight_label: str = r"contact boundary $\Gamma_C$") -> list[Path]:
+def plot_mesh(
+    points: ArrayLike,
+    cells: ArrayLike,
+    path: str | os.PathLike,
+    title: str | None = None,
+    highlight: ArrayLike | Mapping[str, ArrayLike] | None = None,
+    highlight_label: str = r"contact boundary $\Gamma_C$",
+) -> list[Path]:
     """Fig. 6.3(b): a triangulation, thin lines, equal aspect, with boundary edges highlighted.
 
     Parameters
@@ -768,22 +830,28 @@ def plot_mesh(points: ArrayLike, cells: ArrayLike, path: str | os.PathLike,
     if highlight is None:
         groups: dict[str, np.ndarray] = {}
     elif isinstance(highlight, Mapping):
-        groups = {str(k): _edge_pairs(v, len(p), f"highlight[{k!r}]")
-                  for k, v in highlight.items()}
+        groups = {str(k): _edge_pairs(v, len(p), f"highlight[{k!r}]") for k, v in highlight.items()}
     else:
         groups = {highlight_label: _edge_pairs(highlight, len(p), "highlight")}
     big = c.shape[0] > 20000
     with mpl.rc_context(_RC):
         fig = _new_figure(height=SINGLE_COLUMN)
         ax = fig.add_subplot()
-        ax.triplot(Triangulation(p[:, 0], p[:, 1], c), color="0.15",
-                   linewidth=_line_width(c.shape[0]), rasterized=big)
+        ax.triplot(
+            Triangulation(p[:, 0], p[:, 1], c),
+            color="0.15",
+            linewidth=_line_width(c.shape[0]),
+            rasterized=big,
+        )
         for i, (label, e) in enumerate(groups.items()):
             if e.shape[0] == 0:
                 continue
             color = _HIGHLIGHT_COLORS[i % len(_HIGHLIGHT_COLORS)]
-            ax.add_collection(LineCollection(p[e], colors=color, linewidths=2.0, label=label,
-                                             zorder=4, capstyle="round"))
+            ax.add_collection(
+                LineCollection(
+                    p[e], colors=color, linewidths=2.0, label=label, zorder=4, capstyle="round"
+                )
+            )
         ax.set_aspect("equal")
         ax.set_xlabel(r"$x$")
         ax.set_ylabel(r"$y$")
@@ -804,8 +872,10 @@ def _vertex_displacement(displacement: ArrayLike, n_points: int) -> np.ndarray:
     if u.ndim == 1 and u.size % 2 == 0:
         u = u.reshape(-1, 2)
     if u.ndim != 2 or u.shape[1] != 2 or u.shape[0] < n_points:
-        raise ValueError(f"displacement must have shape (m, 2) or (2 m,) with m >= n_points = "
-                         f"{n_points}, got {np.shape(displacement)}")
+        raise ValueError(
+            f"displacement must have shape (m, 2) or (2 m,) with m >= n_points = "
+            f"{n_points}, got {np.shape(displacement)}"
+        )
     u = u[:n_points]
     if not np.all(np.isfinite(u)):
         raise ValueError("displacement contains NaN or inf")
@@ -828,11 +898,18 @@ def _contact_coordinate(cp: np.ndarray) -> tuple[np.ndarray, str]:
     return t - t.min(), r"$s$ (along $\Gamma_C$)"
 
 
-def plot_deformed(points: ArrayLike, cells: ArrayLike, displacement: ArrayLike,
-                  path: str | os.PathLike, contact_points: ArrayLike | None = None,
-                  pressure: ArrayLike | None = None, scale: float = 1.0,
-                  obstacle: ArrayLike | None = None, title: str | None = None,
-                  show_mesh: bool = True) -> list[Path]:
+def plot_deformed(
+    points: ArrayLike,
+    cells: ArrayLike,
+    displacement: ArrayLike,
+    path: str | os.PathLike,
+    contact_points: ArrayLike | None = None,
+    pressure: ArrayLike | None = None,
+    scale: float = 1.0,
+    obstacle: ArrayLike | None = None,
+    title: str | None = None,
+    show_mesh: bool = True,
+) -> list[Path]:
     """The deformed body coloured by ``|u_h|``, and the contact pressure along ``Γ_C``.
 
     The body is drawn at ``points + scale * displacement`` (vertices only; the P2 solution is
@@ -883,8 +960,9 @@ def plot_deformed(points: ArrayLike, cells: ArrayLike, displacement: ArrayLike,
         if cp.ndim != 2 or cp.shape[1] != 2 or cp.shape[0] == 0:
             raise ValueError(f"contact_points must have shape (k >= 1, 2), got {cp.shape}")
         if pr.shape != (cp.shape[0],):
-            raise ValueError(f"pressure must have shape ({cp.shape[0]},) to match "
-                             f"contact_points, got {pr.shape}")
+            raise ValueError(
+                f"pressure must have shape ({cp.shape[0]},) to match contact_points, got {pr.shape}"
+            )
     if obstacle is not None:
         obs = np.asarray(obstacle, dtype=np.float64)
         if obs.ndim != 2 or obs.shape[1] != 2 or obs.shape[0] < 2:
@@ -900,18 +978,29 @@ def plot_deformed(points: ArrayLike, cells: ArrayLike, displacement: ArrayLike,
             fig = _new_figure(height=4.8)
             ax, axp = fig.subplots(2, 1, gridspec_kw={"height_ratios": [2.4, 1.0]})
         tri = Triangulation(q[:, 0], q[:, 1], c)
-        image = ax.tripcolor(tri, magnitude, shading="gouraud", cmap="viridis",
-                             rasterized=big)
+        image = ax.tripcolor(tri, magnitude, shading="gouraud", cmap="viridis", rasterized=big)
         if show_mesh:
-            ax.triplot(tri, color="white", alpha=0.35, linewidth=0.5 * _line_width(c.shape[0]),
-                       rasterized=big)
-        ref = LineCollection(p[boundary_edges(c)], colors="0.4", linewidths=0.8,
-                             linestyles="--", label="reference", zorder=2)
+            ax.triplot(
+                tri,
+                color="white",
+                alpha=0.35,
+                linewidth=0.5 * _line_width(c.shape[0]),
+                rasterized=big,
+            )
+        ref = LineCollection(
+            p[boundary_edges(c)],
+            colors="0.4",
+            linewidths=0.8,
+            linestyles="--",
+            label="reference",
+            zorder=2,
+        )
         ax.add_collection(ref)
         if obstacle is not None:
             st = STYLES["obstacle"]
-            ax.plot(obs[:, 0], obs[:, 1], color=st["color"], linewidth=2.0, label=st["label"],
-                    zorder=5)
+            ax.plot(
+                obs[:, 0], obs[:, 1], color=st["color"], linewidth=2.0, label=st["label"], zorder=5
+            )
         ax.set_aspect("equal")
         ax.autoscale_view()
         ax.set_xlabel(r"$x$")
@@ -919,16 +1008,24 @@ def plot_deformed(points: ArrayLike, cells: ArrayLike, displacement: ArrayLike,
         cax = ax.inset_axes((1.04, 0.0, 0.05, 1.0))  # follows the equal-aspect box
         fig.colorbar(image, cax=cax, label=r"$|u_h|$")
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=2, frameon=False)
-        heading = title if title else ("deformed body" + (f" (displacement \u00d7{scale:g})"
-                                                          if scale != 1.0 else ""))
+        heading = (
+            title
+            if title
+            else ("deformed body" + (f" (displacement \u00d7{scale:g})" if scale != 1.0 else ""))
+        )
         ax.set_title(heading)
         if pressure is not None:
             t, tlabel = _contact_coordinate(cp)
             order = np.argsort(t, kind="stable")
             st = STYLES["pressure"]
-            axp.plot(t[order], pr[order], color=st["color"],
-                     marker=st["marker"] if t.size <= 80 else "", markersize=2.5,
-                     label=st["label"])
+            axp.plot(
+                t[order],
+                pr[order],
+                color=st["color"],
+                marker=st["marker"] if t.size <= 80 else "",
+                markersize=2.5,
+                label=st["label"],
+            )
             axp.axhline(0.0, color="0.5", linewidth=0.6)
             axp.grid(True, linestyle="-")
             axp.set_xlabel(tlabel)
@@ -944,8 +1041,9 @@ def _example_kind(name: str) -> str | None:
     return f"6.{m.group(1)}" if m else None
 
 
-def make_figures(history_path: str | os.PathLike, out_dir: str | os.PathLike,
-                 example_name: str) -> list[Path]:
+def make_figures(
+    history_path: str | os.PathLike, out_dir: str | os.PathLike, example_name: str
+) -> list[Path]:
     """The convergence figures of one example, drawn from its ``history.csv``.
 
     - Example 6.1 (names like ``"example-6.1"``, ``"6.1"``): error and estimator

@@ -42,8 +42,10 @@ def evaluate_field(func: VectorField, x: np.ndarray, what: str) -> np.ndarray:
         try:
             values = np.broadcast_to(values, expected).copy()
         except ValueError:
-            raise ProblemError(f"{what} must return shape {expected} for points of shape "
-                               f"{np.shape(x)}, got {values.shape}") from None
+            raise ProblemError(
+                f"{what} must return shape {expected} for points of shape "
+                f"{np.shape(x)}, got {values.shape}"
+            ) from None
     if not np.isfinite(values).all():
         raise ProblemError(f"{what} returned NaN or inf")
     return values
@@ -99,8 +101,10 @@ class Contact:
                 try:
                     values = np.broadcast_to(values, x.shape[:-1]).copy()
                 except ValueError:
-                    raise ProblemError(f"the gap function of contact part {part!r} must return "
-                                       f"shape {x.shape[:-1]}, got {values.shape}") from None
+                    raise ProblemError(
+                        f"the gap function of contact part {part!r} must return "
+                        f"shape {x.shape[:-1]}, got {values.shape}"
+                    ) from None
         else:
             values = np.full(x.shape[:-1], float(self.gap))
         if not np.isfinite(values).all():
@@ -149,23 +153,31 @@ class ContactProblem:
         if not isinstance(mesh, Mesh):
             raise ProblemError(f"mesh must be a signorini Mesh, got {type(mesh).__name__}")
         if not isinstance(self.material, Material):
-            raise ProblemError("material must be a signorini Material (Material.from_young or "
-                               "Material.from_lame)")
+            raise ProblemError(
+                "material must be a signorini Material (Material.from_young or Material.from_lame)"
+            )
         unknown = sorted(set(self.conditions) - set(mesh.part_names))
         if unknown:
-            raise ProblemError(f"conditions name boundary parts the mesh does not have: "
-                               f"{unknown}; its parts are {list(mesh.part_names)}")
+            raise ProblemError(
+                f"conditions name boundary parts the mesh does not have: "
+                f"{unknown}; its parts are {list(mesh.part_names)}"
+            )
         missing = [p for p in mesh.part_names if p not in self.conditions]
         if missing:
-            raise ProblemError(f"boundary part(s) {missing} have no condition; give each part "
-                               "Dirichlet(...), Neumann(...) or Contact(...)")
+            raise ProblemError(
+                f"boundary part(s) {missing} have no condition; give each part "
+                "Dirichlet(...), Neumann(...) or Contact(...)"
+            )
         for name, cond in self.conditions.items():
             if not isinstance(cond, Dirichlet | Neumann | Contact):
-                raise ProblemError(f"the condition of part {name!r} must be Dirichlet, Neumann or "
-                                   f"Contact, got {type(cond).__name__}")
+                raise ProblemError(
+                    f"the condition of part {name!r} must be Dirichlet, Neumann or "
+                    f"Contact, got {type(cond).__name__}"
+                )
         if not self.dirichlet_parts:
-            raise ProblemError("the problem needs a Dirichlet part (meas Γ_D > 0) to rule out "
-                               "rigid body motions")
+            raise ProblemError(
+                "the problem needs a Dirichlet part (meas Γ_D > 0) to rule out rigid body motions"
+            )
         normals = {name: self._segment_normal(name) for name in self.contact_parts}
         object.__setattr__(self, "contact_normals", normals)
 
@@ -199,16 +211,21 @@ class ContactProblem:
         mean = n.mean(axis=0)
         mean /= np.linalg.norm(mean)
         if np.abs(n - mean).max() > 1e-8:
-            raise ProblemError(f"contact part {name!r} is not straight: its edges' outward "
-                               "normals differ; split it into straight parts")
+            raise ProblemError(
+                f"contact part {name!r} is not straight: its edges' outward "
+                "normals differ; split it into straight parts"
+            )
         given = self.conditions[name].normal
         if given is not None:
             g = np.asarray(given, dtype=np.float64).reshape(2)
             if not np.isfinite(g).all() or np.linalg.norm(g) == 0:
-                raise ProblemError(f"the normal of contact part {name!r} must be a non-zero "
-                                   "finite vector")
+                raise ProblemError(
+                    f"the normal of contact part {name!r} must be a non-zero finite vector"
+                )
             g = g / np.linalg.norm(g)
             if np.abs(g - mean).max() > 1e-6:
-                raise ProblemError(f"the normal {tuple(given)} given for contact part {name!r} "
-                                   f"is not its outward normal {tuple(np.round(mean, 12))}")
+                raise ProblemError(
+                    f"the normal {tuple(given)} given for contact part {name!r} "
+                    f"is not its outward normal {tuple(np.round(mean, 12))}"
+                )
         return mean
