@@ -1,6 +1,6 @@
-"""Files a run leaves behind: VTU solutions, the CSV history, all written atomically."""
+"""Files a run leaves behind: VTU solutions and the CSV history, all written atomically."""
 
-from .history import HistoryWriter
+from .history import HistoryWriter, fitted_slope, read_history
 from .vtu import write_vtu
 
-__all__ = ["HistoryWriter", "write_vtu"]
+__all__ = ["HistoryWriter", "fitted_slope", "read_history", "write_vtu"]

@@ -1,0 +1,98 @@
+"""Reading Gmsh meshes (:mod:`signorini.mesh.gmsh`)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import meshio
+import numpy as np
+import pytest
+
+from signorini.contact.solution import solve
+from signorini.estimator.residual import estimate
+from signorini.examples import example_6_2
+from signorini.fem.space import P2Space
+from signorini.mesh import read_mesh
+from signorini.mesh.mesh import MeshError
+
+
+def gmsh_square(mesh, *, order: int = 1, with_lines: bool = True):
+    """A meshio Mesh of ``mesh`` with named physical line groups, as Gmsh writes it: an extra
+    geometry point no triangle uses, every other triangle clockwise, a physical surface;
+    ``order=2`` gives quadratic triangles and lines (midpoint nodes)."""
+    names = {name: i + 1 for i, name in enumerate(mesh.part_names)}
+    space = P2Space(mesh)
+    if order == 1:
+        points, cells, flip, kinds = mesh.points, mesh.cells.copy(), [0, 2, 1], ("triangle", "line")
+    else:
+        points, cells = space.node_points, space.cell_nodes.copy()
+        flip, kinds = [0, 2, 1, 5, 4, 3], ("triangle6", "line3")
+    cells[::2] = cells[::2][:, flip]
+    points = np.vstack([points, [[2.0, 2.0]]])
+    blocks = [(kinds[0], cells)]
+    physical = [np.full(len(cells), 10)]
+    if with_lines:
+        edges = [mesh.part_edges(n) for n in mesh.part_names]
+        lines = np.vstack([space.edge_nodes(e)[:, : order + 1] for e in edges])
+        tags = np.concatenate(
+            [np.full(e.size, names[n]) for n, e in zip(mesh.part_names, edges, strict=True)]
+        )
+        blocks.append((kinds[1], lines))
+        physical.append(tags)
+    field_data = {n: np.array([t, 1]) for n, t in names.items()}
+    field_data["domain"] = np.array([10, 2])
+    return meshio.Mesh(
+        np.column_stack([points, np.zeros(len(points))]),
+        blocks,
+        cell_data={"gmsh:physical": physical, "gmsh:geometrical": [p.copy() for p in physical]},
+        field_data=field_data,
+    )
+
+
+@pytest.mark.parametrize(("order", "binary"), [(1, False), (1, True), (2, False)])
+def test_read_mesh_from_gmsh_file(tmp_path, order, binary):
+    problem = example_6_2()
+    original = problem.mesh
+    path = tmp_path / "square.msh"
+    meshio.write(path, gmsh_square(original, order=order), file_format="gmsh22", binary=binary)
+    mesh = read_mesh(path)
+    assert set(mesh.part_names) == {"bottom", "right", "top", "left"}
+    assert mesh.n_points == original.n_points and mesh.n_cells == original.n_cells
+    assert np.all(mesh.area > 0) and mesh.area.sum() == pytest.approx(1.0, rel=1e-14)
+    side = {"bottom": (1, 0.0), "right": (0, 1.0), "top": (1, 1.0), "left": (0, 0.0)}
+    for name, (axis, value) in side.items():
+        pts = mesh.points[mesh.edges[mesh.part_edges(name)]]
+        np.testing.assert_array_equal(pts[..., axis], value)
+        assert mesh.part_length(name) == pytest.approx(1.0, rel=1e-14)
+    # the same problem on the mesh read back gives the same discrete solution
+    again = dataclasses.replace(problem, mesh=mesh)
+    eta_file, eta_orig = estimate(solve(again)).eta, estimate(solve(problem)).eta
+    print(f"eta on the mesh read back {eta_file:.12e}, on the built-in mesh {eta_orig:.12e}")
+    assert eta_file == pytest.approx(eta_orig, rel=1e-10)
+    # the parts can be requested by name; an absent one is named in the error
+    assert set(read_mesh(path, parts=["bottom", "right", "top", "left"]).part_names) == set(side)
+    with pytest.raises(MeshError, match="contact"):
+        read_mesh(path, parts=["bottom", "contact"])
+
+
+def test_read_mesh_without_physical_lines_raises(tmp_path):
+    path = tmp_path / "bare.msh"
+    meshio.write(
+        path, gmsh_square(example_6_2().mesh, with_lines=False), file_format="gmsh22", binary=False
+    )
+    with pytest.raises(MeshError, match="no tagged boundary"):
+        read_mesh(path)
+
+
+@pytest.mark.parametrize("name", ["notes.txt", "fake.msh", "fake.vtu"])
+def test_read_mesh_rejects_a_text_file(tmp_path, name):
+    path = tmp_path / name
+    path.write_text("this is not a mesh\n1 2 3\n")
+    with pytest.raises(MeshError, match="not a mesh file") as info:
+        read_mesh(path)
+    assert name in str(info.value)
+
+
+def test_read_mesh_missing_file(tmp_path):
+    with pytest.raises(MeshError, match="no mesh file"):
+        read_mesh(tmp_path / "absent.msh")

@@ -1,0 +1,99 @@
+"""Discrete solutions as quadratic-triangle VTU files (:mod:`signorini.output.vtu`)."""
+
+from __future__ import annotations
+
+import os
+import stat
+
+import meshio
+import numpy as np
+import pytest
+
+from signorini.contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
+from signorini.contact.solution import solve
+from signorini.estimator.residual import estimate
+from signorini.examples import example_6_2
+from signorini.mesh.refine import refine_uniform
+from signorini.output import write_vtu
+
+
+@pytest.fixture(scope="module")
+def solved():
+    """Example 6.2 on the initial mesh: full, semi and no contact nodes all occur."""
+    result = solve(example_6_2())
+    return result, estimate(result)
+
+
+def files_in(folder) -> list[str]:
+    return sorted(os.listdir(folder))
+
+
+def test_write_vtu_reads_back(tmp_path, solved):
+    result, est = solved
+    path = write_vtu(tmp_path / "out" / "solution.vtu", result, est)
+    assert path == tmp_path / "out" / "solution.vtu"
+    assert files_in(tmp_path / "out") == ["solution.vtu"]  # no temporary file left behind
+    m = meshio.read(path)
+    space = result.space
+    # one block of quadratic triangles, P2 local order = VTK order: vertices, then the
+    # midpoints of v0-v1, v1-v2, v2-v0 (checked on the coordinates read back)
+    assert [b.type for b in m.cells] == ["triangle6"]
+    tri = m.cells[0].data
+    np.testing.assert_array_equal(tri, space.cell_nodes)
+    xy = m.points[:, :2]
+    np.testing.assert_array_equal(m.points[:, 2], 0.0)
+    for k in range(3):
+        np.testing.assert_allclose(
+            xy[tri[:, 3 + k]], 0.5 * (xy[tri[:, k]] + xy[tri[:, (k + 1) % 3]]), atol=1e-15
+        )
+    np.testing.assert_array_equal(xy, space.node_points)
+    # point data
+    pd = m.point_data
+    np.testing.assert_array_equal(pd["displacement"][:, :2], result.u)
+    np.testing.assert_array_equal(pd["displacement"][:, 2], 0.0)
+    cs = result.contact
+    off = np.setdiff1d(np.arange(space.n_nodes), cs.nodes)
+    np.testing.assert_array_equal(pd["pressure"][cs.nodes], result.pressure)
+    np.testing.assert_array_equal(pd["pressure"][off], 0.0)
+    np.testing.assert_array_equal(pd["contact_force"][cs.nodes], result.contact_force)
+    np.testing.assert_array_equal(pd["active"][cs.nodes], result.active.astype(int))
+    np.testing.assert_array_equal(pd["active"][off], 0)
+    np.testing.assert_array_equal(pd["contact_class"][cs.nodes], result.classes)
+    np.testing.assert_array_equal(pd["contact_class"][off], -1)
+    assert set(pd["contact_class"][cs.nodes]) == {NO_CONTACT, SEMI_CONTACT, FULL_CONTACT}
+    assert pd["pressure"].max() > 0
+    # cell data: indicators summing to η², term by term
+    eta2 = m.cell_data["eta2"][0]
+    assert eta2.shape == (result.mesh.n_cells,)
+    assert eta2.sum() == pytest.approx(est.eta**2, rel=1e-13)
+    for k in range(7):
+        assert m.cell_data[f"eta2_{k + 1}"][0].sum() == pytest.approx(
+            est.eta2_terms[k], rel=1e-13, abs=1e-300
+        )
+    print(
+        f"VTU: {len(xy)} nodes, {len(tri)} triangle6 cells, sum eta2 = {eta2.sum():.10e}, "
+        f"eta^2 = {est.eta**2:.10e}"
+    )
+
+
+def test_write_vtu_without_estimate_and_overwrite(tmp_path, solved):
+    result, _ = solved
+    path = tmp_path / "a.vtu"
+    write_vtu(path, result)
+    first = meshio.read(path)
+    assert not first.cell_data
+    fine = solve(example_6_2(), refine_uniform(result.mesh).mesh)
+    write_vtu(path, fine)  # replaced in place
+    assert len(meshio.read(path).cells[0].data) == fine.mesh.n_cells
+    assert files_in(tmp_path) == ["a.vtu"]
+
+
+def test_vtu_file_follows_the_umask(tmp_path, solved):
+    """A VTU file is an ordinary file: mode 0o666 minus the umask, like ``open(..., "w")``."""
+    old = os.umask(0o027)
+    try:
+        write_vtu(tmp_path / "s.vtu", solved[0])
+    finally:
+        os.umask(old)
+    mode = stat.S_IMODE(os.stat(tmp_path / "s.vtu").st_mode)
+    assert mode == 0o640, oct(mode)
