@@ -102,7 +102,7 @@ def main() -> None:
         history.append(r.row())
         if args.vtu:
             write_vtu(out / f"level_{r.level:03d}.vtu", level.result, level.estimate)
-        r.t_output = time.perf_counter() - t_out
+        t_output = time.perf_counter() - t_out
         level_total = time.perf_counter() - t0
         mesh = level.result.mesh
         backend = r.backend
@@ -116,7 +116,7 @@ def main() -> None:
             ("estimate", r.t_estimate),
             ("mark", r.t_mark),
             ("refine", r.t_refine),
-            ("output", r.t_output),
+            ("output", t_output),
         ):
             phases[key] += value
         if r.level >= 5:
@@ -134,7 +134,7 @@ def main() -> None:
             r.t_estimate,
             r.t_mark,
             r.t_refine,
-            r.t_output,
+            t_output,
             level_total,
             level_floor,
             level_total / level_floor,

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from signorini import adaptive, example_6_1, example_6_2, plots
-from signorini.output import HistoryWriter
+from signorini.output import HistoryWriter, fitted_slope, read_history
 
 EXAMPLES = {"example-6.1": example_6_1, "example-6.2": example_6_2}
 
@@ -33,16 +33,16 @@ def run(name: str, variant: str, uniform: bool, max_ndof: int, out: Path) -> Pat
 
 def summary(path: Path, last: int) -> dict[str, float]:
     """Fitted slopes over the last levels and the efficiency range."""
-    h = plots.read_history(path)
+    h = read_history(path)
     out = {
         "ndof": int(h["ndof"][-1]),
         "eta": float(h["eta"][-1]),
-        "slope_eta": plots.fitted_slope(h["ndof"], h["eta"], last=last),
-        "slope_eta5": plots.fitted_slope(h["ndof"], h["eta5"], last=last),
+        "slope_eta": fitted_slope(h["ndof"], h["eta"], last=last),
+        "slope_eta5": fitted_slope(h["ndof"], h["eta_5"], last=last),
     }
     err = h.get("error_energy")
     if err is not None and np.isfinite(err).any():
-        out["slope_error"] = plots.fitted_slope(h["ndof"], err, last=last)
+        out["slope_error"] = fitted_slope(h["ndof"], err, last=last)
         eff = h["efficiency"]
         out["eff_min"], out["eff_max"] = float(np.nanmin(eff)), float(np.nanmax(eff))
     return out

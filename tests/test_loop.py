@@ -13,16 +13,10 @@ from signorini.estimator.marking import mark_doerfler
 from signorini.examples import example_6_1, example_6_2
 from signorini.loop import Level, LevelRecord, adaptive
 from signorini.mesh.refine import refine_nvb
+from signorini.output import fitted_slope
 
 
 # ---------------------------------------------------------------------------- helpers
-def fitted_slope(ndof, values, last: int) -> float:
-    """Least-squares slope of log(values) against log(ndof) over the last ``last`` levels."""
-    x = np.log(np.asarray(ndof, dtype=float)[-last:])
-    y = np.log(np.asarray(values, dtype=float)[-last:])
-    return float(np.polyfit(x, y, 1)[0])
-
-
 def ndof_at(eta_target: float, ndof, eta) -> float:
     """Unknowns at which a decreasing history first reaches ``eta_target`` (log-log
     interpolation between the two levels around it)."""
@@ -44,7 +38,8 @@ def check_record(level: Level, has_exact: bool) -> None:
     """Every field of the record is filled and agrees with the level's solution."""
     r, res, est = level.record, level.result, level.estimate
     row = r.row()
-    assert set(row) >= {f.name for f in fields(LevelRecord)} - {"extra"}
+    assert set(row) == {f.name for f in fields(LevelRecord)} - {"extra"}
+    assert not any(k.startswith("t_output") for k in row)  # output timing is the writer's
     for key, value in row.items():
         assert value is not None, key
         if key in ("error_energy", "error_h1", "efficiency") and not has_exact:
@@ -54,15 +49,23 @@ def check_record(level: Level, has_exact: bool) -> None:
     assert r.ndof == res.ndof and r.ndof_total == res.space.n_dofs
     assert r.n_cells == res.mesh.n_cells
     assert r.eta == est.eta > 0
-    np.testing.assert_array_equal([getattr(r, f"eta{k}") for k in range(1, 8)], est.eta_terms)
+    terms = [row[f"eta_{k}"] for k in range(1, 8)]
+    np.testing.assert_array_equal(terms, est.eta_terms)
+    assert math.fsum(t * t for t in terms) == pytest.approx(r.eta**2, rel=1e-12)
+    pdas = res.pdas
+    assert (r.pdas_iterations, r.n_solves, r.n_factorizations) == (
+        pdas.iterations,
+        pdas.n_solves,
+        pdas.n_factorizations,
+    )
+    assert (r.n_analyses, r.n_updates) == (pdas.n_analyses, pdas.n_updates)
     assert r.pdas_iterations >= 1 and r.n_solves >= 1 and r.n_factorizations >= 1
-    assert r.n_analyses >= 0
     assert r.n_active == int(res.active.sum()) and r.n_constrained == res.contact.size
     assert r.n_full_contact + r.n_semi_contact + r.n_no_contact == r.n_constrained
     assert r.n_full_contact == int((res.classes == FULL_CONTACT).sum())
     assert r.contact_force == pytest.approx(res.contact_force.sum(), rel=1e-14)
     assert r.contact_force > 0
-    assert isinstance(r.backend, str) and r.backend
+    assert r.backend == pdas.backend != ""
     assert r.t_assemble > 0 and r.t_solve > 0 and r.t_estimate > 0
     if level.marked is not None:
         assert r.n_marked == int(level.marked.sum()) > 0
@@ -167,7 +170,7 @@ def test_example_6_1_adaptive_rates_and_efficiency():
     for lv in adaptive(example_6_1(), max_ndof=max_ndof):
         r = lv.record
         recs.append(r)
-        assert r.eta6 == 0.0 and r.eta7 == 0.0
+        assert r.eta_6 == 0.0 and r.eta_7 == 0.0
         assert r.n_full_contact == r.n_constrained > 0
         assert r.ndof <= max_ndof
     ndof = [r.ndof for r in recs]
@@ -181,7 +184,8 @@ def test_example_6_1_adaptive_rates_and_efficiency():
         f"efficiency {eff.min():.2f}..{eff.max():.2f} (max/min {eff.max() / eff.min():.3f})"
     )
     assert ndof[-1] > max_ndof / 2
-    assert s_err <= -0.9 and s_eta <= -0.9
+    assert s_err <= -0.9, f"error: observed rate {s_err:.3f} over the last 8 levels, not -1"
+    assert s_eta <= -0.9, f"eta: observed rate {s_eta:.3f} over the last 8 levels, not -1"
     assert eff.max() / eff.min() < 3
 
 
@@ -208,7 +212,9 @@ def test_example_6_2_adaptive_rate_and_gain_over_uniform(run_6_2):
         f"levels {s_eta:.3f}; uniform: Ndof {u_ndof[-1]}, eta {u_eta[-1]:.4f}, last slope "
         f"{s_uniform:.3f}"
     )
-    assert s_eta <= -0.9
+    assert s_eta <= -0.9, f"eta: observed rate {s_eta:.3f} over the last 8 levels, not -1"
+    # the singularities cap uniform refinement near Ndof^(-1/2) (measured: -0.47)
+    assert -0.6 <= s_uniform <= -0.35, f"uniform eta: observed rate {s_uniform:.3f}"
     for target_level in (-2, -1):
         target = u_eta[target_level]
         n_adaptive = ndof_at(target, ndof, eta)

@@ -15,6 +15,7 @@ import importlib.util
 import logging
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -121,6 +122,23 @@ def _progress(level: Level) -> str:
     return line
 
 
+def _write_levels(
+    levels: Iterator[Level], history: HistoryWriter, vtu_dir: Path | None, say
+) -> Level | None:
+    """Write each level as soon as it is done: its VTU file (into ``vtu_dir``, unless None),
+    then its history row with the seconds that file took as ``t_output``. Returns the last
+    level (None if there was none)."""
+    last = None
+    for level in levels:
+        t0 = time.perf_counter()
+        if vtu_dir is not None:
+            write_vtu(vtu_dir / f"level_{level.record.level:03d}.vtu", level.result, level.estimate)
+        history.append({**level.record.row(), "t_output": time.perf_counter() - t0})
+        say(_progress(level))
+        last = level
+    return last
+
+
 def run(args: argparse.Namespace) -> int:
     if not args.uniform:
         check_theta(args.theta, "--theta")
@@ -134,8 +152,7 @@ def run(args: argparse.Namespace) -> int:
     say = (lambda s: None) if args.quiet else (lambda s: print(s, flush=True))
     mode = "uniform" if args.uniform else f"adaptive, theta={args.theta}"
     say(f"{problem.name}: {mode}, eta5={args.eta5}, max_ndof={args.max_ndof} -> {out}")
-    last = None
-    for level in adaptive(
+    levels = adaptive(
         problem,
         theta=args.theta,
         max_ndof=args.max_ndof,
@@ -144,14 +161,8 @@ def run(args: argparse.Namespace) -> int:
         uniform=args.uniform,
         eta5=args.eta5,
         backend=args.backend,
-    ):
-        t0 = time.perf_counter()
-        if not args.no_vtu:
-            write_vtu(out / f"level_{level.record.level:03d}.vtu", level.result, level.estimate)
-        level.record.t_output = time.perf_counter() - t0
-        history.append(level.record.row())
-        say(_progress(level))
-        last = level
+    )
+    last = _write_levels(levels, history, None if args.no_vtu else out, say)
     if last is not None and not args.no_figures:
         written = _figures(label, out, last)
         say(f"figures: {', '.join(str(p.name) for p in written)}")
@@ -169,16 +180,15 @@ def _compare_uniform(args: argparse.Namespace, out: Path, say) -> None:
     uni = out / "uniform"
     history = HistoryWriter(uni / "history.csv")
     say(f"{problem.name}: uniform refinement for comparison -> {uni}")
-    for level in adaptive(
+    levels = adaptive(
         problem,
         max_ndof=args.max_ndof,
         uniform=True,
         eta5=args.eta5,
         backend=args.backend,
         max_levels=args.max_levels,
-    ):
-        history.append(level.record.row())
-        say(_progress(level))
+    )
+    _write_levels(levels, history, None, say)
     if args.no_figures:
         return
     histories = {"adaptive": out / "history.csv", "uniform": uni / "history.csv"}

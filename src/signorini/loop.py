@@ -30,20 +30,28 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class LevelRecord:
-    """One row of the convergence history."""
+    """One row of the convergence history: what the numerics measured on one level.
+
+    ``eta`` is the estimator η_h of (5.1) and ``eta_1`` … ``eta_7`` its contributions,
+    unsquared, with ``eta² = eta_1² + … + eta_7²`` (docs/method.md, *Estimator*; the
+    squared per-cell indicators are :attr:`Estimate.eta2 <signorini.Estimate.eta2>`).
+    ``ndof`` is the paper's number of free unknowns, ``t_*`` are seconds spent in each
+    step of the loop. A caller writing the row adds its own columns to the dict
+    :meth:`row` returns (the command line adds its output time ``t_output``).
+    """
 
     level: int
     ndof: int
     ndof_total: int
     n_cells: int
     eta: float
-    eta1: float
-    eta2: float
-    eta3: float
-    eta4: float
-    eta5: float
-    eta6: float
-    eta7: float
+    eta_1: float
+    eta_2: float
+    eta_3: float
+    eta_4: float
+    eta_5: float
+    eta_6: float
+    eta_7: float
     error_energy: float = math.nan
     error_h1: float = math.nan
     efficiency: float = math.nan
@@ -65,7 +73,6 @@ class LevelRecord:
     t_estimate: float = 0.0
     t_mark: float = 0.0
     t_refine: float = 0.0
-    t_output: float = 0.0
     extra: dict = field(default_factory=dict)
 
     def row(self) -> dict:
@@ -102,7 +109,9 @@ def adaptive(
     """Run SOLVE → ESTIMATE → MARK → REFINE, yielding each finished level.
 
     Stops after the level whose refinement would exceed ``max_ndof`` free unknowns, when
-    ``η_h ≤ tol``, or after ``max_levels`` levels.
+    ``η_h ≤ tol``, or after ``max_levels`` levels. The four steps stay in this one function
+    (about 50 lines of code) so that the loop reads top to bottom as in docs/method.md,
+    *Marking and refinement*.
 
     Parameters
     ----------
@@ -113,15 +122,30 @@ def adaptive(
         Budget of free unknowns: no level exceeds it.
     tol : float
         Stop once the estimator reaches this value.
+    max_levels : int
+        Stop after this many levels.
     uniform : bool
         Refine every cell (NVB with all edges bisected) instead of Dörfler marking.
     eta5 : {"consistent", "paper"}
+        Variant of the estimator's η5 (docs/method.md, *Estimator*).
     backend : str
         Sparse solver backend.
     warm_start : bool
         Start each PDAS from the previous level's prolongated solution and contact set.
     mesh : Mesh, optional
         Initial mesh (default: the problem's).
+
+    Yields
+    ------
+    Level
+        The record, solution, estimate and marked cells of each level, as soon as it is
+        done.
+
+    Raises
+    ------
+    ValueError
+        For ``theta`` outside (0, 1], a non-positive ``max_ndof`` or an initial mesh with
+        more than ``max_ndof`` unknowns.
     """
     if not uniform:
         theta = check_theta(theta)
@@ -182,7 +206,7 @@ def _record(level: int, result: ContactResult, est: Estimate) -> LevelRecord:
         ndof_total=result.space.n_dofs,
         n_cells=result.mesh.n_cells,
         eta=est.eta,
-        **{f"eta{k + 1}": float(terms[k]) for k in range(7)},
+        **{f"eta_{k + 1}": float(terms[k]) for k in range(7)},
         pdas_iterations=result.pdas.iterations,
         n_solves=result.pdas.n_solves,
         n_factorizations=result.pdas.n_factorizations,

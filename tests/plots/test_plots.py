@@ -30,7 +30,7 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 NDOF = np.array([150.0, 420.0, 1100.0, 2900.0, 7600.0, 20000.0])
 
 
-def synthetic_history(zero_terms: tuple[str, ...] = ("eta6", "eta7")) -> dict[str, np.ndarray]:
+def synthetic_history(zero_terms: tuple[str, ...] = ("eta_6", "eta_7")) -> dict[str, np.ndarray]:
     """eta = 3 / ndof, error = 2 / ndof, eta_k = c_k / ndof (zero for ``zero_terms``)."""
     n = NDOF.size
     h = {
@@ -45,7 +45,7 @@ def synthetic_history(zero_terms: tuple[str, ...] = ("eta6", "eta7")) -> dict[st
         "n_active": np.arange(n) * 4,
     }
     for k in range(1, 8):
-        h[f"eta{k}"] = np.zeros(n) if f"eta{k}" in zero_terms else (0.3 * k) / NDOF
+        h[f"eta_{k}"] = np.zeros(n) if f"eta_{k}" in zero_terms else (0.3 * k) / NDOF
     return h
 
 
@@ -307,8 +307,8 @@ def test_efficiency_figure_from_csv_path(tmp_path, captured):
 
 
 def test_contributions_with_vanishing_terms(tmp_path, captured):
-    h = synthetic_history(zero_terms=("eta6", "eta7"))
-    h["eta4"][2] = 0.0  # a single zero leaves a gap, not an error
+    h = synthetic_history(zero_terms=("eta_6", "eta_7"))
+    h["eta_4"][2] = 0.0  # a single zero leaves a gap, not an error
     written = plot_contributions(h, tmp_path / "contrib")
     check_written(written, tmp_path / "contrib")
     (info,) = captured

@@ -76,19 +76,19 @@ STYLES: dict[str, dict[str, str]] = {
     "error_h1": {"color": "#17becf", "marker": "x", "label": r"$|u-u_h|_{H^1}$"},
     "eta": {"color": "#d62728", "marker": "s", "label": r"$\eta_h$"},
     "efficiency": {"color": "#222222", "marker": "o", "label": r"$\eta_h/\|u-u_h\|_a$"},
-    "eta1": {"color": "#ff7f0e", "marker": "^", "label": r"$\eta_1$"},
-    "eta2": {"color": "#2ca02c", "marker": "v", "label": r"$\eta_2$"},
-    "eta3": {"color": "#9467bd", "marker": "<", "label": r"$\eta_3$"},
-    "eta4": {"color": "#8c564b", "marker": ">", "label": r"$\eta_4$"},
-    "eta5": {"color": "#e377c2", "marker": "D", "label": r"$\eta_5$"},
-    "eta6": {"color": "#7f7f7f", "marker": "p", "label": r"$\eta_6$"},
-    "eta7": {"color": "#bcbd22", "marker": "h", "label": r"$\eta_7$"},
+    "eta_1": {"color": "#ff7f0e", "marker": "^", "label": r"$\eta_1$"},
+    "eta_2": {"color": "#2ca02c", "marker": "v", "label": r"$\eta_2$"},
+    "eta_3": {"color": "#9467bd", "marker": "<", "label": r"$\eta_3$"},
+    "eta_4": {"color": "#8c564b", "marker": ">", "label": r"$\eta_4$"},
+    "eta_5": {"color": "#e377c2", "marker": "D", "label": r"$\eta_5$"},
+    "eta_6": {"color": "#7f7f7f", "marker": "p", "label": r"$\eta_6$"},
+    "eta_7": {"color": "#bcbd22", "marker": "h", "label": r"$\eta_7$"},
     "pressure": {"color": "#08306b", "marker": "o", "label": r"$p_h$"},
     "contact": {"color": "#d62728", "marker": "", "label": r"$\Gamma_C$"},
     "obstacle": {"color": "#333333", "marker": "", "label": "obstacle"},
 }
 
-CONTRIBUTIONS = tuple(f"eta{k}" for k in range(1, 8))
+CONTRIBUTIONS = tuple(f"eta_{k}" for k in range(1, 8))
 
 # Colours / markers of the runs compared in plot_adaptive_vs_uniform, in order.
 _RUN_COLORS = ("#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2")
@@ -609,7 +609,7 @@ def plot_contributions(
     Parameters
     ----------
     history : mapping of str to (n_levels,) array, or path of a CSV history
-        Needs ``ndof`` and at least one of ``eta1`` … ``eta7`` (absent ones are skipped).
+        Needs ``ndof`` and at least one of ``eta_1`` … ``eta_7`` (absent ones are skipped).
     path : str or os.PathLike
         Output path without extension.
     title : str, optional
@@ -626,7 +626,7 @@ def plot_contributions(
     h = _history(history, ("ndof",), CONTRIBUTIONS)
     keys = [k for k in CONTRIBUTIONS if k in h]
     if not keys:
-        raise ValueError("the history has none of the columns eta1 ... eta7")
+        raise ValueError("the history has none of the columns eta_1 ... eta_7")
     ndof = h["ndof"]
     with mpl.rc_context(_RC):
         fig = _new_figure(height=3.3)
@@ -711,7 +711,7 @@ def plot_adaptive_vs_uniform(
     path : str or os.PathLike
         Output path without extension.
     key : str, default "eta"
-        Column to compare (e.g. ``"eta"``, ``"error_energy"``, ``"eta5"``).
+        Column to compare (e.g. ``"eta"``, ``"error_energy"``, ``"eta_5"``).
     title : str, optional
         Axes title.
     last : int, default 3
