@@ -1,4 +1,44 @@
-"""Figures of the paper's Section 6 (and a few more), drawn from plain data on disk."""
+"""Figures of the paper's Section 6 (and a few more), drawn from plain data on disk.
 
-from .figures import *  # noqa: F403
-from .figures import __all__  # noqa: F401
+Every function takes dictionaries of arrays or arrays, never the package's solver objects,
+so that a figure can be redrawn from the files a run leaves (``history.csv``, meshes).
+
+- :mod:`.style`: colours, markers and labels of every quantity, figure creation and saving;
+- :mod:`.convergence`: the figures against ``N_dof`` (Figs. 6.1, 6.2, 6.3(a), 6.4);
+- :mod:`.slopes`: fitted slopes in legends and slope triangles;
+- :mod:`.mesh`: a triangulation (Fig. 6.3(b)); :mod:`.deformed`: the deformed body and the
+  contact pressure;
+- :mod:`.report`: the figures a finished run gets, chosen by what its history contains.
+
+:func:`read_history` and :func:`fitted_slope` belong to :mod:`signorini.output.history` and
+are re-exported here.
+"""
+
+from ..output.history import fitted_slope, read_history
+from .convergence import (
+    plot_adaptive_vs_uniform,
+    plot_contributions,
+    plot_efficiency,
+    plot_error_and_estimator,
+    plot_estimator,
+)
+from .deformed import plot_deformed
+from .mesh import plot_mesh
+from .report import make_figures
+from .slopes import add_slope_triangle
+from .style import STYLES
+
+__all__ = [
+    "STYLES",
+    "read_history",
+    "fitted_slope",
+    "add_slope_triangle",
+    "plot_error_and_estimator",
+    "plot_efficiency",
+    "plot_contributions",
+    "plot_estimator",
+    "plot_mesh",
+    "plot_deformed",
+    "plot_adaptive_vs_uniform",
+    "make_figures",
+]

@@ -1,0 +1,180 @@
+"""Slopes on log-log convergence plots: fitted slopes in legends and reference triangles.
+
+The triangle's geometry (:func:`triangle_vertices`) is plain NumPy on the curves' decimal
+logarithms; :func:`add_slope_triangle` draws it with its two leg labels.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from matplotlib.patches import Polygon
+from numpy.typing import ArrayLike
+
+from ..output.history import fitted_slope
+from .style import format_number
+
+__all__ = ["add_slope_triangle", "draw_slope_triangle", "slope_label", "triangle_vertices"]
+
+
+def slope_label(label: str, ndof: np.ndarray, values: np.ndarray, last: int) -> str:
+    """``label`` followed by the fitted slope over the last ``last`` levels (two decimals),
+    or ``label`` alone when there is no slope (:func:`~signorini.output.fitted_slope`)."""
+    try:
+        return f"{label}, slope {format_number(fitted_slope(ndof, values, last))}"
+    except ValueError:
+        return label
+
+
+def _valid_logs(series: Sequence[tuple[np.ndarray, np.ndarray]]) -> list[tuple[np.ndarray, ...]]:
+    """``(log10 x, log10 y)`` of each curve's positive finite points sorted by x; curves
+    with fewer than two such points are dropped."""
+    logs = []
+    for x, y in series:
+        if x.shape != y.shape:
+            raise ValueError(f"abscissae {x.shape} and ordinates {y.shape} differ in shape")
+        ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
+        if np.count_nonzero(ok) >= 2:
+            order = np.argsort(x[ok], kind="stable")
+            logs.append((np.log10(x[ok][order]), np.log10(y[ok][order])))
+    return logs
+
+
+def triangle_vertices(
+    series: Sequence[tuple[np.ndarray, np.ndarray]],
+    slope: float,
+    where: float = 0.55,
+    size: float = 0.22,
+) -> np.ndarray | None:
+    """Corners of a slope triangle lying just below curves ``(x, y)`` on log-log axes.
+
+    The hypotenuse has the given slope (decades per decade). The triangle is centred at the
+    fraction ``where`` of the curves' log x range, its horizontal leg spans the fraction
+    ``size`` of it (between 0.15 and 1 decade), and it is pushed down until it lies below
+    every curve by a gap of ``max(0.12, 6 %`` of the log y range``)`` decades. Where no curve
+    covers the triangle's x range, the curves are extended flat from their ends.
+
+    Parameters
+    ----------
+    series : sequence of ((n,) float array, (n,) float array)
+        The curves; zero, negative and non-finite points are ignored.
+    slope : float
+        Slope of the hypotenuse.
+    where, size : float
+        Centre and width of the triangle as fractions of the log x range.
+
+    Returns
+    -------
+    (3, 2) float array or None
+        Start and end of the hypotenuse, then the right-angle corner, in data coordinates;
+        None when no curve has two valid points.
+    """
+    if not (0.0 <= where <= 1.0 and 0.0 < size <= 1.0 and np.isfinite(slope)):
+        raise ValueError(
+            f"need 0 <= where <= 1, 0 < size <= 1 and a finite slope, got "
+            f"where={where}, size={size}, slope={slope}"
+        )
+    logs = _valid_logs(series)
+    if not logs:
+        return None
+    lo = min(a[0] for a, _ in logs)
+    hi = max(a[-1] for a, _ in logs)
+    span = hi - lo
+    run = float(np.clip(size * span, 0.15, 1.0)) if span > 0 else 0.3
+    x0 = lo + where * span - run / 2
+    x1 = x0 + run
+    yspan = max(b.max() for _, b in logs) - min(b.min() for _, b in logs)
+    gap = max(0.12, 0.06 * yspan)
+    t = np.linspace(x0, x1, 9)
+    # Highest start y0 with y0 + slope (t - x0) <= curve(t) - gap for every curve and every t
+    # inside that curve's range (clamped to the curves' ends if no curve covers any t).
+    bounds = []
+    for a, b in logs:
+        inside = (t >= a[0]) & (t <= a[-1])
+        if inside.any():
+            ti = t[inside]
+            bounds.append(np.min(np.interp(ti, a, b) - gap - slope * (ti - x0)))
+    if not bounds:
+        bounds = [np.min(np.interp(t, a, b) - gap - slope * (t - x0)) for a, b in logs]
+    y0 = float(min(bounds))
+    y1 = y0 + slope * run
+    corner = (x1, y0) if slope > 0 else (x0, y1)
+    return 10.0 ** np.array([[x0, y0], [x1, y1], list(corner)])
+
+
+def draw_slope_triangle(
+    ax: Any,
+    series: Sequence[tuple[np.ndarray, np.ndarray]],
+    slope: float,
+    where: float = 0.55,
+    size: float = 0.22,
+    color: str = "0.25",
+) -> Polygon | None:
+    """:func:`add_slope_triangle` for curves ``(x, y)`` with their own abscissae."""
+    verts = triangle_vertices(series, slope, where, size)
+    if verts is None:
+        return None
+    (x0, y0), (x1, y1), corner = verts
+    tri = Polygon(verts, closed=True, fill=False, edgecolor=color, linewidth=0.9, zorder=3)
+    ax.add_patch(tri)
+    ax.annotate(
+        "1",
+        xy=(np.sqrt(x0 * x1), min(y0, y1)),
+        xytext=(0, -2),
+        textcoords="offset points",
+        ha="center",
+        va="top",
+        color=color,
+    )
+    left = corner[0] == x0
+    ax.annotate(
+        format_number(slope, 0) if float(slope).is_integer() else format_number(slope),
+        xy=(corner[0], np.sqrt(y0 * y1)),
+        xytext=(-3 if left else 3, 0),
+        textcoords="offset points",
+        ha="right" if left else "left",
+        va="center",
+        color=color,
+    )
+    return tri
+
+
+def add_slope_triangle(
+    ax: Any,
+    ndof: ArrayLike,
+    curves: Sequence[ArrayLike],
+    slope: float = -1.0,
+    where: float = 0.55,
+    size: float = 0.22,
+    color: str = "0.25",
+) -> Polygon | None:
+    """Draw a slope triangle just below the curves of a log-log plot.
+
+    The hypotenuse has the given slope (in decades per decade); the horizontal leg is labelled
+    ``1`` and the vertical leg with the slope. Placement: :func:`triangle_vertices`.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Axes with logarithmic x and y scales.
+    ndof : (n,) array_like of float
+        Abscissae shared by the curves.
+    curves : sequence of (n,) array_like of float
+        Ordinates; zero or NaN entries are ignored.
+    slope : float, default -1.0
+        Slope of the hypotenuse.
+    where, size : float
+        Centre and width of the triangle as fractions of the log ``ndof`` range.
+    color : str
+        Colour of the triangle and its labels.
+
+    Returns
+    -------
+    matplotlib.patches.Polygon or None
+        The triangle, or None when no curve has two valid points.
+    """
+    x = np.asarray(ndof, dtype=np.float64)
+    series = [(x, np.asarray(c, dtype=np.float64)) for c in curves]
+    return draw_slope_triangle(ax, series, slope, where, size, color)

@@ -1,0 +1,161 @@
+"""The look shared by every figure: styles, figure creation, saving and log axes.
+
+- Figures are built on the Agg canvas without pyplot, so no figure is left open in pyplot's
+  registry, nothing is shown and the caller's pyplot backend is untouched. Styling is applied
+  through a local ``rc_context`` (:data:`RC`); the global ``rcParams`` are not changed.
+- Each quantity keeps its colour, marker and label in every figure (:data:`STYLES`).
+- :func:`save_figure` writes ``<path>.png`` (150 dpi) and ``<path>.pdf`` and creates the
+  parent folders. A ``.png`` or ``.pdf`` suffix on ``path`` is dropped; any other suffix is
+  kept (``fig6.1`` gives ``fig6.1.png``).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
+
+__all__ = [
+    "STYLES",
+    "CONTRIBUTIONS",
+    "RC",
+    "DPI",
+    "SINGLE_COLUMN",
+    "NDOF_LABEL",
+    "new_figure",
+    "save_figure",
+    "positive",
+    "log_log_axes",
+    "tidy_log_ticks",
+    "format_number",
+]
+
+log = logging.getLogger(__name__)
+
+#: The history columns of the estimator's contributions η_1 … η_7 (paper, (5.1)).
+CONTRIBUTIONS = tuple(f"eta_{k}" for k in range(1, 8))
+
+#: Colour, marker and label of every plotted quantity (keyed by its history column), the
+#: same in all figures.
+STYLES: dict[str, dict[str, str]] = {
+    "error_energy": {"color": "#1f77b4", "marker": "o", "label": r"$\|u-u_h\|_a$"},
+    "error_h1": {"color": "#17becf", "marker": "x", "label": r"$|u-u_h|_{H^1}$"},
+    "eta": {"color": "#d62728", "marker": "s", "label": r"$\eta_h$"},
+    "efficiency": {"color": "#222222", "marker": "o", "label": r"$\eta_h/\|u-u_h\|_a$"},
+    "eta_1": {"color": "#ff7f0e", "marker": "^", "label": r"$\eta_1$"},
+    "eta_2": {"color": "#2ca02c", "marker": "v", "label": r"$\eta_2$"},
+    "eta_3": {"color": "#9467bd", "marker": "<", "label": r"$\eta_3$"},
+    "eta_4": {"color": "#8c564b", "marker": ">", "label": r"$\eta_4$"},
+    "eta_5": {"color": "#e377c2", "marker": "D", "label": r"$\eta_5$"},
+    "eta_6": {"color": "#7f7f7f", "marker": "p", "label": r"$\eta_6$"},
+    "eta_7": {"color": "#bcbd22", "marker": "h", "label": r"$\eta_7$"},
+    "pressure": {"color": "#08306b", "marker": "o", "label": r"$p_h$"},
+    "contact": {"color": "#d62728", "marker": "", "label": r"$\Gamma_C$"},
+    "obstacle": {"color": "#333333", "marker": "", "label": "obstacle"},
+}
+
+NDOF_LABEL = r"$N_{\mathrm{dof}}$"
+SINGLE_COLUMN = 3.5  # inches
+DPI = 150
+
+#: Local matplotlib settings of every figure.
+RC: dict[str, Any] = {
+    "font.size": 8,
+    "axes.labelsize": 9,
+    "axes.titlesize": 9,
+    "legend.fontsize": 7,
+    "xtick.labelsize": 8,
+    "ytick.labelsize": 8,
+    "lines.linewidth": 1.2,
+    "lines.markersize": 4,
+    "grid.linewidth": 0.4,
+    "grid.alpha": 0.45,
+    "legend.framealpha": 0.9,
+    "legend.handlelength": 2.0,
+    "mathtext.fontset": "dejavusans",
+    "axes.unicode_minus": True,
+    "pdf.fonttype": 42,
+    "ps.fonttype": 42,
+    "savefig.dpi": DPI,
+}
+
+
+def format_number(value: float, digits: int = 2) -> str:
+    """``value`` with ``digits`` decimals and a typographic minus sign."""
+    return f"{value:.{digits}f}".replace("-", "\u2212")
+
+
+def _stem(path: str | os.PathLike) -> Path:
+    p = Path(path)
+    if p.suffix.lower() in (".png", ".pdf"):
+        p = p.with_suffix("")
+    if not p.name or p.name in (".", ".."):
+        raise ValueError(f"not a file path for a figure: {str(path)!r}")
+    return p
+
+
+def new_figure(width: float = SINGLE_COLUMN, height: float = 2.7) -> Figure:
+    """A figure of ``width`` × ``height`` inches on its own Agg canvas (no pyplot)."""
+    fig = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def save_figure(fig: Figure, path: str | os.PathLike) -> list[Path]:
+    """Write ``<path>.png`` and ``<path>.pdf`` and release the figure's artists.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The PNG and the PDF file, in this order.
+    """
+    stem = _stem(path)
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    written = [stem.with_name(stem.name + ".png"), stem.with_name(stem.name + ".pdf")]
+    try:
+        fig.savefig(written[0], dpi=DPI)
+        fig.savefig(written[1], metadata={"CreationDate": None})
+    finally:
+        fig.clear()
+    log.info("wrote %s", ", ".join(str(p) for p in written))
+    return written
+
+
+def positive(values: np.ndarray) -> np.ndarray:
+    """Copy with zero, negative and non-finite entries replaced by NaN (gaps on log axes)."""
+    out = np.array(values, dtype=np.float64)
+    out[~(np.isfinite(out) & (out > 0))] = np.nan
+    return out
+
+
+def log_log_axes(ax: Any, ylabel: str, log_y: bool = True) -> None:
+    """Logarithmic ``N_dof`` axis (and y axis unless ``log_y`` is False) with grids."""
+    ax.set_xscale("log")
+    if log_y:
+        ax.set_yscale("log")
+    ax.grid(True, which="major", linestyle="-")
+    ax.grid(True, which="minor", axis="both" if log_y else "x", linestyle=":", alpha=0.3)
+    ax.set_xlabel(NDOF_LABEL)
+    ax.set_ylabel(ylabel)
+
+
+def tidy_log_ticks(ax: Any) -> None:
+    """Label only major ticks; below two decades add 2 and 5 times powers of ten as majors.
+
+    Matplotlib otherwise labels minor ticks on short log axes, and the labels overlap.
+    """
+    for axis, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+        if axis.get_scale() != "log":
+            continue
+        axis.set_minor_formatter(NullFormatter())
+        if lo > 0 and np.log10(hi / lo) < 2.0:
+            axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+            axis.set_major_formatter(
+                LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(np.inf, np.inf))
+            )

@@ -1,0 +1,83 @@
+"""The deformed body and the contact pressure (:mod:`signorini.plots.deformed`)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from signorini.mesh.builders import rectangle
+from signorini.plots import plot_deformed
+from signorini.plots.deformed import contact_coordinate
+
+from .figure_checks import check_written
+
+
+def test_deformed_figure_with_pressure_and_obstacle(tmp_path, captured):
+    mesh = rectangle(nx=6, ny=6)
+    p, c = mesh.points, mesh.cells
+    u = np.column_stack([0.05 * p[:, 1], -0.02 * p[:, 0]])
+    u_p2 = np.vstack([u, np.full((10, 2), 99.0)])  # P2 rows after the vertices are ignored
+    right = p[np.isclose(p[:, 0], 1.0)]
+    pressure = 1.0 - np.abs(right[:, 1] - 0.5)
+    written = plot_deformed(
+        p, c, u_p2, tmp_path / "deformed", contact_points=right, pressure=pressure, scale=3.0
+    )
+    check_written(written, tmp_path / "deformed")
+    (info,) = captured
+    assert info["legend"] == ["reference"]
+    assert info["titles"][0] == "deformed body (displacement \u00d73)"
+    # the body is drawn at p + 3 u: x in [0, 1.15], y in [-0.06, 1]
+    lim = info["data_lim"][0]
+    assert (lim.x0, lim.y0, lim.x1, lim.y1) == pytest.approx((0.0, -0.06, 1.15, 1.0))
+    # the reference boundary is the mesh's boundary, undeformed
+    boundary = np.array(info["segments"]["reference"])
+
+    def unordered(segments):
+        return sorted(tuple(sorted(map(tuple, np.round(s, 12)))) for s in segments)
+
+    assert unordered(boundary) == unordered(p[mesh.boundary])
+    # the pressure is drawn against y on x = 1, in order
+    x, y = info["lines"]["$p_h$"]
+    order = np.argsort(right[:, 1])
+    np.testing.assert_array_equal(x, right[order, 1])
+    np.testing.assert_array_equal(y, pressure[order])
+    assert info["xlabel"][:2] == [r"$x$", r"$y$"]
+
+
+def test_deformed_figure_with_obstacle_only(tmp_path, captured):
+    mesh = rectangle(nx=2, ny=2)
+    y = np.linspace(0.0, 1.0, 11)
+    obstacle = np.column_stack([1.0 - 0.2 + 0.5 * np.abs(y - 0.5), y])
+    u = np.zeros(2 * mesh.n_points)  # interleaved layout
+    plot_deformed(mesh.points, mesh.cells, u, tmp_path / "d", obstacle=obstacle, title="t")
+    (info,) = captured
+    assert info["legend"] == ["reference", "obstacle"] and info["titles"][0] == "t"
+    np.testing.assert_array_equal(np.column_stack(info["lines"]["obstacle"]), obstacle)
+
+
+def test_deformed_figure_rejects_bad_arrays(tmp_path):
+    mesh = rectangle(nx=2, ny=2)
+    p, c = mesh.points, mesh.cells
+    with pytest.raises(ValueError, match="displacement"):
+        plot_deformed(p, c, np.zeros((3, 2)), tmp_path / "x")
+    with pytest.raises(ValueError, match="together"):
+        plot_deformed(p, c, np.zeros_like(p), tmp_path / "x", pressure=np.ones(3))
+    with pytest.raises(ValueError, match="pressure must have shape"):
+        plot_deformed(
+            p, c, np.zeros_like(p), tmp_path / "x", contact_points=p[:3], pressure=np.ones(4)
+        )
+    assert not any(tmp_path.iterdir())
+
+
+def test_contact_coordinate_is_arclength_on_a_slanted_boundary():
+    s = np.array([0.0, 0.3, 0.45, 1.0])
+    d = np.array([3.0, 4.0]) / 5.0
+    pts = np.array([2.0, -1.0]) + s[:, None] * d
+    order = np.array([2, 0, 3, 1])
+    t, label = contact_coordinate(pts[order])
+    np.testing.assert_allclose(t, s[order], atol=1e-14)
+    assert label.startswith("$s$")
+    t, label = contact_coordinate(np.column_stack([s, np.zeros(4)]))
+    assert label == r"$x$" and np.array_equal(t, s)
+    t, label = contact_coordinate(np.column_stack([np.ones(4), s]))
+    assert label == r"$y$" and np.array_equal(t, s)
