@@ -13,10 +13,11 @@ import pytest
 
 from signorini.contact.solution import solve
 from signorini.examples import EXAMPLES, example_6_1, example_6_2, get_example
-from signorini.fem.elasticity import Material, assemble_stiffness, stress
+from signorini.fem.elasticity import assemble_stiffness, stress
 from signorini.fem.p2 import physical_points
 from signorini.fem.quadrature import triangle_rule
 from signorini.mesh.refine import refine_uniform
+from signorini.output import fitted_slope
 from signorini.problem.problem import Contact, Dirichlet, Neumann
 
 # 4 x 4 squares and four uniform refinements: up to 33,024 unknowns (Example 6.1: ~4 s, so
@@ -41,11 +42,6 @@ def levels_6_1():
 @pytest.fixture(scope="module")
 def levels_6_2():
     return uniform_levels(example_6_2(), LEVELS)
-
-
-def fitted_slope(ndof, values):
-    """Least-squares slope of log(values) against log(ndof)."""
-    return float(np.polyfit(np.log(ndof), np.log(values), 1)[0])
 
 
 # -------------------------------------------------------------------------------- Example 6.1
@@ -87,8 +83,8 @@ def test_example_6_1_converges_like_ndof_to_the_minus_one(levels_6_1):
     h1 = np.array([e["error_h1"] for e in errs])
     for r, e, s in zip(ndof, energy, h1, strict=True):
         print(f"Ndof {r:6d}  energy error {e:.4e}  H1 error {s:.4e}")
-    slope_e = fitted_slope(ndof[-3:], energy[-3:])
-    slope_h = fitted_slope(ndof[-3:], h1[-3:])
+    slope_e = fitted_slope(ndof, energy, last=3)
+    slope_h = fitted_slope(ndof, h1, last=3)
     print(f"fitted slopes over the last three levels: energy {slope_e:.4f}, H1 {slope_h:.4f}")
     assert ndof[-1] > 30_000
     assert -1.1 <= slope_e <= -0.9, f"energy error slope {slope_e:.3f}, expected -1"
@@ -215,10 +211,36 @@ def test_get_example():
         get_example("example-6.3")
 
 
-def test_examples_accept_the_initial_mesh_size():
-    pb = example_6_1(nx=2)
-    assert pb.mesh.n_cells == 8
-    assert isinstance(pb.material, Material)
+@pytest.mark.parametrize("example", [example_6_1, example_6_2])
+def test_initial_mesh_size(example):
+    """``nx`` × ``nx`` squares, each cut in two by a union-jack diagonal: 2 nx² cells of
+    area 1/(2 nx²) on the grid of spacing 1/nx, mirror-symmetric about both centre lines,
+    each side one boundary part of nx edges; the problem's data do not depend on nx."""
+    default = example()
+
+    def cells_as_points(points, cells):
+        return sorted(tuple(sorted(map(tuple, np.round(points[c], 12)))) for c in cells)
+
+    for nx in (2, 4, 6):
+        pb = example(nx=nx)
+        mesh = pb.mesh
+        assert (mesh.n_cells, mesh.n_points) == (2 * nx**2, (nx + 1) ** 2)
+        np.testing.assert_allclose(mesh.points * nx, np.round(mesh.points * nx), atol=1e-12)
+        np.testing.assert_allclose(mesh.area, 0.5 / nx**2, rtol=1e-13)
+        cells = cells_as_points(mesh.points, mesh.cells)
+        for mirror in ([-1.0, 1.0], [1.0, -1.0]):
+            flipped = (mesh.points - 0.5) * mirror + 0.5
+            assert cells_as_points(flipped, mesh.cells) == cells
+        for name in ("left", "right", "top", "bottom"):
+            assert mesh.part_edges(name).size == nx
+        assert pb.material == default.material and pb.conditions.keys() == default.conditions.keys()
+
+
+def test_example_6_1_error_falls_with_the_initial_mesh_size():
+    """Halving h of the initial mesh divides the energy error by about 4 (P2, smooth u)."""
+    errors = [solve(example_6_1(nx=nx)).errors()["error_energy"] for nx in (4, 8)]
+    print(f"energy error nx=4 {errors[0]:.4e}, nx=8 {errors[1]:.4e}")
+    assert 3.5 < errors[0] / errors[1] < 4.5, f"ratio {errors[0] / errors[1]:.3f}, expected 4"
 
 
 def test_example_6_1_energy_error_obeys_galerkin_orthogonality():

@@ -1,10 +1,11 @@
-"""The paper's numerical experiments as ready-made problems (paper, Section 6; docs/method.md, *The
-paper's examples*).
+"""The paper's numerical experiments as ready-made problems.
 
-Initial meshes (the paper does not give its own): the unit square cut into 4 × 4 squares, each
-split into two triangles with the diagonals of a "union jack" pattern (32 triangles), which is
-mirror-symmetric about both centre lines; Example 6.2 is symmetric about y = 1/2 and so is its
-discrete solution on this mesh and on every mesh NVB makes from it with symmetric marking.
+Paper, Section 6; the data and what the discrete solutions show: docs/method.md, *The paper's
+examples*. Initial meshes (the paper does not give its own): the unit square cut into 4 × 4
+squares, each split into two triangles with the diagonals of a "union jack" pattern (32
+triangles), which is mirror-symmetric about both centre lines; Example 6.2 is symmetric about
+y = 1/2 and so is its discrete solution on this mesh and on every mesh NVB makes from it with
+symmetric marking.
 """
 
 from __future__ import annotations
@@ -58,7 +59,20 @@ def example_6_1(nx: int = 4) -> ContactProblem:
     """Example 6.1: known solution, contact everywhere on the bottom (n = (0, −1), ψ = 0).
 
     Ω = (0,1)², Γ_D = top (u = 0), Γ_N = left and right with g = σ(u) n,
-    Γ_C = bottom, μ = λ = 1, f = −div σ(u), u = (y²(y−1), (x−2) y (1−y) eʸ).
+    Γ_C = bottom, μ = λ = 1, f = −div σ(u), u = (y²(y−1), (x−2) y (1−y) eʸ)
+    (paper, Section 6; docs/method.md, *The paper's examples*). Every constrained node is in
+    full contact, so η6 = η7 = 0, and the total contact force is ∫ 3(2 − x) dx = 4.5.
+
+    Parameters
+    ----------
+    nx : int, default 4
+        The initial mesh cuts Ω into ``nx × nx`` squares with "union jack" diagonals
+        (``2 nx²`` triangles).
+
+    Returns
+    -------
+    ContactProblem
+        Named ``"example-6.1"``, with its :class:`ExactSolution`.
     """
     material = Material.from_lame(1.0, 1.0)
     displacement, gradient, div_stress = _exact_6_1()
@@ -89,7 +103,20 @@ def example_6_2(nx: int = 4) -> ContactProblem:
     """Example 6.2: a square pushed against the obstacle ψ(y) = −0.2 + 0.5|y − 0.5|.
 
     Ω = (0,1)², Γ_D = {x = 0} with u = (0.1, 0), Γ_N = top and bottom with g = 0,
-    Γ_C = {x = 1}, n = e1, f = 0, E = 500, ν = 0.3.
+    Γ_C = {x = 1}, n = e1, f = 0, E = 500, ν = 0.3 (paper, Section 6; docs/method.md,
+    *The paper's examples*). No exact solution is known; the contact zone is one interval
+    around y = 1/2.
+
+    Parameters
+    ----------
+    nx : int, default 4
+        The initial mesh cuts Ω into ``nx × nx`` squares with "union jack" diagonals
+        (``2 nx²`` triangles).
+
+    Returns
+    -------
+    ContactProblem
+        Named ``"example-6.2"``, without an exact solution.
     """
     return ContactProblem(
         mesh=rectangle(nx=nx, ny=nx, pattern="unionjack"),
@@ -104,6 +131,7 @@ def example_6_2(nx: int = 4) -> ContactProblem:
     )
 
 
+#: The paper's examples by the name the command line takes (``signorini run example-6.2``).
 EXAMPLES: dict[str, Callable[..., ContactProblem]] = {
     "example-6.1": example_6_1,
     "example-6.2": example_6_2,
@@ -111,7 +139,13 @@ EXAMPLES: dict[str, Callable[..., ContactProblem]] = {
 
 
 def get_example(name: str) -> ContactProblem:
-    """The named example problem; a clear error for an unknown name."""
+    """The example named ``name`` (a key of :data:`EXAMPLES`) on its default initial mesh.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name; the message lists the known ones.
+    """
     try:
         return EXAMPLES[name]()
     except KeyError:
