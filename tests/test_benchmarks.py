@@ -8,8 +8,6 @@ from pathlib import Path
 
 import pytest
 
-from signorini.runtime import retain_freed_memory
-
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -36,12 +34,6 @@ def test_adaptive_benchmark_prints_ratio_to_floor(tmp_path):
     assert ratio > 0.5  # our level includes the floor's work: it cannot be much cheaper
     assert "PDAS linear solves per level after level 5" in out
     assert (tmp_path / "history.csv").is_file()
-
-
-def test_retain_freed_memory_on_linux():
-    if not sys.platform.startswith("linux"):
-        pytest.skip("glibc only")
-    assert retain_freed_memory() is True
 
 
 def test_inclined_block_example_runs(tmp_path):
