@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from signorini import adaptive, example_6_2
-from signorini.algebra.linsolve import eliminate_symmetric, make_solver
+from signorini.algebra import eliminate_symmetric, make_solver
 from signorini.contact import assemble
 from signorini.output import HistoryWriter, write_vtu
 from signorini.runtime import retain_freed_memory

@@ -4,9 +4,13 @@
 - ``random_spd_dense``: a dense random SPD matrix.
 - ``p2_elasticity``: P2 plane-strain stiffness on a structured triangulation of the unit
   square, assembled here independently of :mod:`signorini`, with interleaved DOFs.
+- ``random_problem``, ``brute_force_qp``, ``CYCLING_*``: bound-constrained QPs and their exact
+  solution by enumeration of the active sets.
 """
 
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 import scipy.sparse as sp
@@ -127,3 +131,66 @@ def rigid_motions(node_xy: np.ndarray) -> np.ndarray:
     R[0::2, 2] = -node_xy[:, 1]
     R[1::2, 2] = node_xy[:, 0]
     return R
+
+
+# A 4 x 4 SPD problem on which plain PDAS (c = mean diagonal) cycles: found by a random search
+# over matrices with one decimal; the bounds are on all four DOFs.
+CYCLING_K = np.array(
+    [
+        [2.4, -1.2, -2.4, 1.8],
+        [-1.2, 4.6, 4.2, -3.8],
+        [-2.4, 4.2, 5.2, -2.8],
+        [1.8, -3.8, -2.8, 7.0],
+    ]
+)
+CYCLING_F = np.array([0.0, 0.8, -0.1, -0.5])
+CYCLING_G = np.array([0.3, 0.4, -0.1, 1.4])
+
+
+def brute_force_qp(K, F, c, g, d=(), xd=()):
+    """Exact minimizer by enumerating all 2^m active sets (dense, independent of the package).
+
+    For each candidate set S the bounds on S are equalities, the rest is dropped; the unique
+    KKT point (strict convexity) is the candidate that is feasible with non-negative
+    multipliers. Returns (x, multiplier, active).
+    """
+    K = np.asarray(K.toarray() if sp.issparse(K) else K, dtype=float)
+    n = K.shape[0]
+    c = np.asarray(c)
+    d = np.asarray(d, dtype=int)
+    best = None
+    for bits in itertools.product([False, True], repeat=c.size):
+        S = np.array(bits, dtype=bool)
+        fixed = np.zeros(n, dtype=bool)
+        fixed[d] = True
+        fixed[c[S]] = True
+        x = np.zeros(n)
+        x[d] = xd
+        x[c[S]] = g[S]
+        free = ~fixed
+        rhs = F[free] - K[np.ix_(free, fixed)] @ x[fixed]
+        x[free] = np.linalg.solve(K[np.ix_(free, free)], rhs)
+        multiplier = F[c] - K[c] @ x
+        scale = np.abs(F).max() + np.abs(K).max() * np.abs(x).max() + 1e-300
+        if (x[c] - g <= 1e-10 * (np.abs(g).max() + np.abs(x).max() + 1e-300)).all() and (
+            multiplier[S] >= -1e-10 * scale
+        ).all():
+            assert best is None or np.allclose(best[0], x, atol=1e-8), "two KKT points"
+            best = (x, np.where(S, multiplier, 0.0), S)
+    assert best is not None
+    return best
+
+
+def random_problem(rng, n, m, n_dirichlet=0, dense=True):
+    if dense:
+        K = sp.csr_matrix(random_spd_dense(n, rng))
+    else:
+        K = block_spd(n // 2, 1, rng, shift=0.05)
+        n = K.shape[0]
+    perm = rng.permutation(n)
+    c = perm[:m]
+    d = perm[m : m + n_dirichlet]
+    F = rng.standard_normal(n)
+    g = 0.3 * rng.standard_normal(m)
+    xd = 0.2 * rng.standard_normal(n_dirichlet)
+    return K, F, c, g, d, xd

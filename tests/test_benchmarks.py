@@ -2,17 +2,21 @@
 
 from __future__ import annotations
 
+import csv
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-@pytest.mark.slow
-def test_adaptive_benchmark_prints_ratio_to_floor(tmp_path):
+def test_adaptive_benchmark_reports_consistent_counts_and_floor(tmp_path):
+    """benchmarks/adaptive.py on a 5000-unknown budget: its table agrees with the history it
+    writes, each level's ratio is its total over its floor, the summary lines follow from the
+    table, and the run ends on the known level of Example 6.2."""
     out = subprocess.run(
         [
             sys.executable,
@@ -28,12 +32,46 @@ def test_adaptive_benchmark_prints_ratio_to_floor(tmp_path):
         check=True,
     ).stdout
     lines = out.strip().splitlines()
-    print("\n".join(lines[-8:]))
+    header = lines[0].split()
+    end = lines.index("")  # the table ends at the first blank line
+    table = [dict(zip(header, line.split(), strict=True)) for line in lines[1:end]]
+    with open(tmp_path / "history.csv", newline="") as f:
+        history = list(csv.DictReader(f))
+    assert [int(row["level"]) for row in table] == list(range(len(history)))
+    for row, record in zip(table, history, strict=True):
+        assert row["ndof"] == record["ndof"]
+        for printed, column in (
+            ("solves", "n_solves"),
+            ("facts", "n_factorizations"),
+            ("updates", "n_updates"),
+        ):
+            assert row[printed] == record[column], (row["level"], printed)
+        assert int(row["solves"]) == int(row["facts"]) + int(row["updates"])
+        assert row["reused"] == "yes" and record["n_analyses"] == "1"
+        total, floor, ratio = (float(row[k]) for k in ("total", "floor", "ratio"))
+        assert floor > 0 and np.isfinite(ratio)
+        # the printed values are rounded to 1 ms
+        low, high = (total - 5e-4) / (floor + 5e-4), (total + 5e-4) / max(floor - 5e-4, 1e-12)
+        assert low <= ratio <= high, (row["level"], total, floor, ratio)
+    ndof = [int(row["ndof"]) for row in table]
+    assert ndof == sorted(ndof) and ndof[-1] == 4876  # Example 6.2, theta = 0.4
+    summary = {line.split(":")[0]: line for line in lines if ":" in line}
+    backend = summary["backend"].split()[1].rstrip(";")
+    assert {record["backend"] for record in history} == {backend}
+    assert f"final level: {ndof[-1]} unknowns" in summary["backend"]
+    eta = float(summary["backend"].split("eta = ")[1])
+    assert eta == pytest.approx(float(history[-1]["eta"]), rel=1e-4)
+    assert eta == pytest.approx(7.2295, rel=1e-4)
+    solves = [int(row["solves"]) for row in table if int(row["level"]) >= 5]
+    mean = float(summary["PDAS linear solves per level after level 5"].split(": ")[1].split()[0])
+    assert mean == pytest.approx(np.mean(solves), abs=5e-3)
+    # ratio_to_floor: the last line, the ratio of the two sums printed above it
     assert lines[-1].startswith("ratio_to_floor=")
     ratio = float(lines[-1].split("=")[1])
-    assert ratio > 0.5  # our level includes the floor's work: it cannot be much cheaper
-    assert "PDAS linear solves per level after level 5" in out
-    assert (tmp_path / "history.csv").is_file()
+    words = next(line for line in lines if line.startswith("total time ")).split()
+    total, floors = float(words[2]), float(words[7])  # "total time T s, sum of floors S s"
+    assert np.isfinite(ratio) and ratio > 0
+    assert (total - 5e-3) / (floors + 5e-3) <= ratio <= (total + 5e-3) / (floors - 5e-3)
 
 
 def test_inclined_block_example_runs(tmp_path):

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..algebra.linsolve import as_csr, csr_row_indices
+from ..algebra.sparse import as_csr, csr_row_indices
 
 __all__ = ["rotate_frames", "to_cartesian", "to_frames"]
 

@@ -13,8 +13,9 @@ from functools import cached_property
 
 import numpy as np
 
-from ..algebra.linsolve import make_solver
-from ..algebra.pdas import PDASResult, solve_pdas
+from ..algebra.backends import make_solver
+from ..algebra.pdas import solve_pdas
+from ..algebra.result import PDASResult
 from ..fem.elasticity import energy_error2, h1_seminorm_error2
 from ..fem.space import P2Space
 from ..mesh.mesh import Mesh
@@ -187,7 +188,7 @@ def solve(
         space=space,
         u=u,
         contact=cs,
-        contact_force=res.lam,
+        contact_force=res.multiplier,
         active=res.active,
         pdas=res,
         dirichlet_nodes=assembled.dirichlet[::2] // 2,

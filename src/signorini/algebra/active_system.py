@@ -1,0 +1,143 @@
+"""The linear system of one active set, solved by refactorization or a low-rank update.
+
+Each active set iteration (docs/method.md, *Solver*) solves the QP's equality problem with the
+Dirichlet DOFs and the active constrained DOFs fixed, eliminated symmetrically in place
+(:mod:`.elimination`), so all systems share ``K``'s pattern and the solver's symbolic analysis.
+When only a few DOFs change (the free boundary moving by a node), the previous factorization is
+reused with a Woodbury correction.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from .elimination import SymmetricEliminator
+from .qp import BoundQP
+from .solvers import SPDSolver
+
+__all__ = ["ActiveSetSystem"]
+
+
+class ActiveSetSystem:
+    """The fixed-pattern linear systems of one call: eliminate, factorize, solve.
+
+    When the fixed set differs from the factorized one in at most ``max_update`` DOFs, the
+    new system is solved with the existing factorization and a Woodbury correction of rank
+    at most ``2 k`` (k changed DOFs) instead of a new factorization; the result is checked by
+    its residual and the system refactorized if the check fails.
+
+    Parameters
+    ----------
+    qp : BoundQP
+    solver : SPDSolver
+        Factorizes the eliminated matrices; its first factorization here checks the pattern
+        of ``K`` (and analyses it if new), the later ones only refactorize.
+    max_update : int
+        Largest change of the fixed set solved by a low-rank update (0: never).
+
+    Attributes
+    ----------
+    time_elimination : float
+        Seconds spent forming right-hand sides.
+    n_updates : int
+        Solves done by a low-rank update instead of a factorization.
+    """
+
+    def __init__(self, qp: BoundQP, solver: SPDSolver, max_update: int = 0) -> None:
+        self.qp = qp
+        K, F, c = qp.K, qp.F, qp.constrained
+        self.K, self.F, self.c, self.g = K, F, c, qp.gap
+        self.K_c = K[c]  # rows of the constrained DOFs, for the multiplier
+        self.solver = solver
+        self.eliminator = SymmetricEliminator(K)
+        self.fixed = np.zeros(K.shape[0], dtype=bool)
+        self.fixed[qp.dirichlet] = True
+        self.values = np.zeros(K.shape[0])
+        self.values[qp.dirichlet] = qp.dirichlet_values
+        self.time_elimination = 0.0
+        self.max_update = max_update
+        self.factored: np.ndarray | None = None  # fixed mask of the current factorization
+        self.n_updates = 0
+
+    def solve(self, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Minimizer with ``x_c = g`` on ``active`` and the residual of the constrained rows.
+
+        Parameters
+        ----------
+        active : (m,) bool array
+            Constrained DOFs held at their bound.
+
+        Returns
+        -------
+        x : (n,) float array
+        multiplier : (m,) float array
+            ``F_c - (K x)_c`` on every constrained DOF (not masked by ``active``).
+        """
+        c = self.c
+        self.fixed[c] = active
+        self.values[c] = np.where(active, self.g, 0.0)
+        t0 = time.perf_counter()
+        b = self.eliminator.rhs(self.K, self.F, self.fixed, self.values)
+        self.time_elimination += time.perf_counter() - t0
+        x = None
+        if self.factored is not None and self.max_update > 0:
+            changed = np.flatnonzero(self.fixed != self.factored)
+            if 0 < changed.size <= self.max_update:
+                x = self._solve_updated(b, changed)
+        if x is None:
+            keep = self.eliminator.keep_mask(self.fixed)
+            # the solver factorizes K with the eliminated entries dropped: no copy of K
+            if self.factored is None:
+                self.solver.factorize(self.K, keep=keep)
+            else:
+                self.solver.refactorize(keep)
+            self.factored = self.fixed.copy()
+            x = self.solver.solve(b)
+        x[self.fixed] = self.values[self.fixed]
+        return x, self.F[c] - self.K_c @ x
+
+    def _columns(self, fixed: np.ndarray, cols: np.ndarray) -> sp.csc_matrix:
+        """Columns ``cols`` of the matrix eliminated for ``fixed`` (symmetric: rows of K)."""
+        rows = self.K[cols].tocoo()  # row r of K is column cols[r]
+        j = cols[rows.row]
+        ok = ~fixed[rows.col] & ~fixed[j]  # entries that survive the elimination
+        data = np.where(ok, rows.data, 0.0)
+        on_diag = rows.col == j
+        data[on_diag] = rows.data[on_diag]
+        return sp.csc_matrix((data, (rows.col, rows.row)), shape=(self.K.shape[0], cols.size))
+
+    def _solve_updated(self, b: np.ndarray, changed: np.ndarray) -> np.ndarray | None:
+        """Solve with the current factor and a Woodbury correction, or None if unreliable.
+
+        With ``E = A_new − A_old`` supported on the rows and columns ``D = changed``,
+        ``E = U Vᵀ`` for ``U = [P_D, E_{:,D}]``, ``V = [E_{:,D} − P_D E_DD, P_D]``.
+        """
+        n, k = self.K.shape[0], changed.size
+        E = self._columns(self.fixed, changed) - self._columns(self.factored, changed)
+        E = E.toarray()  # (n, k): k is small
+        P = np.zeros((n, k))
+        P[changed, np.arange(k)] = 1.0
+        E_dd = E[changed]
+        U = np.hstack([P, E])
+        V = np.hstack([E - P @ E_dd, P])
+        Z = self.solver.solve(np.column_stack([b, U]))  # A_old⁻¹ [b, U] in one call
+        y, W = Z[:, 0], Z[:, 1:]
+        capacitance = np.eye(2 * k) + V.T @ W
+        try:
+            x = y - W @ np.linalg.solve(capacitance, V.T @ y)
+        except np.linalg.LinAlgError:
+            return None
+        # residual of the new eliminated system: free rows K x_free, fixed rows diag x
+        diagonal = self.K.data[self.eliminator.diagonal_positions]
+        z = np.where(self.fixed, 0.0, x)
+        r = self.K @ z
+        r[self.fixed] = diagonal[self.fixed] * x[self.fixed]
+        r -= b
+        scale = max(np.abs(b).max(), np.abs(diagonal).max() * np.abs(x).max(), 1e-300)
+        if np.abs(r).max() > 1e-12 * scale:
+            return None
+        self.n_updates += 1
+        return x

@@ -1,0 +1,298 @@
+"""MKL PARDISO as an SPD solver, called through ``ctypes``.
+
+Real symmetric positive definite mode (``mtype = 2``, sparse Cholesky) on the upper triangle in
+0-based CSR form, with the phases called separately: 11 (analysis, once per pattern), 22
+(numerical factorization), 33 (solve).
+
+MKL's single dynamic library ``mkl_rt`` is found through public routes only, in this order:
+the files of the installed ``mkl`` distribution (``importlib.metadata``; the ``fast`` extra
+installs it with ``pypardiso``), the ``lib`` folder of the Python prefix (conda), and
+:func:`ctypes.util.find_library`. :func:`pardiso_problem` loads it, solves a 2 x 2 system, and
+says why PARDISO cannot be used (``None`` when it can); :func:`~.backends.make_solver` turns
+that reason into a warning or an error.
+
+pydiso's ``MKLPardisoSolver`` (the same MKL calls from Cython, with the analysis reused) was
+measured against this module on the matrices PDAS factorizes (``benchmarks/pardiso_wrappers.py``,
+figures in its docstring): at 10⁶ unknowns its refactorizations take 1.11 times as long, its
+analysis twice as long (its constructor analyses with its own settings first) and its peak
+memory is 1.4 times ours, so it is not used.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import importlib.metadata
+import re
+import sys
+from collections.abc import Callable
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+
+from .solvers import BackendUnavailableError, FactorizationError, SPDSolver
+from .sparse import upper_positions
+
+__all__ = ["PardisoSolver", "mkl_runtime_candidates", "pardiso_function", "pardiso_problem"]
+
+#: File names of MKL's single dynamic library on Linux, macOS and Windows.
+_MKL_RT = re.compile(r"(lib)?mkl_rt(\.\d+)*\.(so(\.\d+)*|dylib|dll)")
+
+
+# PARDISO error codes (MKL reference manual, "pardiso"), with what they mean here.
+_PARDISO_ERRORS = {
+    -1: "input inconsistent",
+    -2: "not enough memory",
+    -3: "reordering problem",
+    -4: "zero or negative pivot: the matrix is singular or not positive definite",
+    -5: "unclassified (internal) error",
+    -6: "reordering failed",
+    -7: "diagonal matrix is singular",
+    -8: "32-bit integer overflow problem",
+    -9: "not enough memory for out-of-core solver",
+    -10: "error opening out-of-core files",
+    -11: "read/write error with out-of-core files",
+    -12: "pardiso_64 called from 32-bit library",
+    -13: "interrupted by the progress callback",
+    -15: "internal error during iterative refinement or reordering",
+}
+
+
+def mkl_runtime_candidates() -> list[str]:
+    """Paths (or a loader name) of MKL's single dynamic library ``mkl_rt``, best first.
+
+    Returns
+    -------
+    list of str
+        From the installed ``mkl`` distribution's file list, then the Python prefix's ``lib``
+        (``Library/bin`` on Windows) folder, then the system loader's search; may be empty.
+    """
+    candidates: list[str] = []
+    try:
+        dist = importlib.metadata.distribution("mkl")
+    except importlib.metadata.PackageNotFoundError:
+        dist = None
+    if dist is not None:
+        files = [f for f in dist.files or () if _MKL_RT.fullmatch(Path(f).name)]
+        candidates += [str(Path(dist.locate_file(f)).resolve()) for f in files]
+    for folder in (Path(sys.prefix, "lib"), Path(sys.prefix, "Library", "bin")):
+        if folder.is_dir():
+            candidates += [str(p) for p in sorted(folder.iterdir()) if _MKL_RT.fullmatch(p.name)]
+    found = ctypes.util.find_library("mkl_rt")
+    if found:
+        candidates.append(found)
+    return list(dict.fromkeys(candidates))  # without repetitions, order kept
+
+
+@lru_cache(maxsize=1)
+def pardiso_function() -> Callable[..., None]:
+    """The ``pardiso`` symbol of MKL's runtime library, with its argument types.
+
+    Returns
+    -------
+    callable
+        The C function ``pardiso`` (64-bit handle ``pt``, 32-bit integers).
+
+    Raises
+    ------
+    BackendUnavailableError
+        If no candidate of :func:`mkl_runtime_candidates` loads and exports ``pardiso``; the
+        message lists what was tried.
+    """
+    tried = []
+    for path in mkl_runtime_candidates():
+        try:
+            func = ctypes.CDLL(path).pardiso
+        except (OSError, AttributeError) as err:  # not loadable, or no pardiso symbol
+            tried.append(f"{path}: {err}")
+            continue
+        i32p = ctypes.POINTER(ctypes.c_int32)
+        func.argtypes = [
+            ctypes.POINTER(ctypes.c_int64),  # pt: internal handle, 64 pointers
+            i32p,  # maxfct
+            i32p,  # mnum
+            i32p,  # mtype
+            i32p,  # phase
+            i32p,  # n
+            ctypes.c_void_p,  # a
+            i32p,  # ia
+            i32p,  # ja
+            i32p,  # perm
+            i32p,  # nrhs
+            i32p,  # iparm
+            i32p,  # msglvl
+            ctypes.c_void_p,  # b
+            ctypes.c_void_p,  # x
+            i32p,  # error
+        ]
+        func.restype = None
+        return func
+    detail = "; ".join(tried) if tried else "no file found"
+    raise BackendUnavailableError(
+        f"MKL's runtime library mkl_rt could not be loaded ({detail}); install it with "
+        "`pip install signorini[fast]` (or `pip install mkl`)"
+    )
+
+
+class PardisoSolver(SPDSolver):
+    """SPD solver on MKL PARDISO (sparse Cholesky) with the analysis done once per pattern.
+
+    The upper triangle (diagonal included) is handed to PARDISO in 0-based CSR form; its
+    positions in the full matrix are found once per pattern, so a refactorization only gathers
+    values. Settings (``iparm``, 0-based): user values (``[0] = 1``), nested dissection
+    ordering from parallel METIS (``[1] = 3``), no iterative refinement by default (``[7] = 0``),
+    double precision, in-core, 0-based indices (``[34] = 1``). A zero or negative pivot stops
+    the factorization with error -4, reported as :class:`FactorizationError` with the equation.
+
+    MKL is found by :func:`pardiso_function`; when it cannot be loaded the constructor raises
+    :class:`~.solvers.BackendUnavailableError`. The MKL handle is freed by :meth:`close` (also
+    called on garbage collection and at the end of a ``with`` block).
+
+    Parameters
+    ----------
+    A : scipy sparse matrix, optional
+    check_symmetry : bool
+    """
+
+    backend = "pardiso"
+    reuses_analysis = True
+
+    def __init__(self, A: sp.spmatrix | None = None, *, check_symmetry: bool = True) -> None:
+        self._func = pardiso_function()
+        self._pt = np.zeros(64, dtype=np.int64)
+        self._handle_used = False
+        iparm = np.zeros(64, dtype=np.int32)
+        iparm[0] = 1  # use the values below, not the defaults
+        iparm[1] = 3  # nested dissection ordering, parallel (OpenMP) METIS: analysis 2.0–2.4 s
+        #               against 2.9–3.5 s serial at 10⁶ unknowns, same factor
+        iparm[7] = 0  # iterative refinement steps (none unless pivots are perturbed)
+        iparm[9] = 8  # pivot perturbation 1e-8 (only for indefinite types)
+        iparm[17] = -1  # report the number of non-zeros of the factor in iparm[17]
+        iparm[26] = 0  # no matrix checker (indices are sorted and checked here)
+        iparm[27] = 0  # double precision
+        iparm[34] = 1  # 0-based indexing
+        iparm[59] = 0  # in-core
+        self._iparm = iparm
+        self._upos = np.zeros(0, dtype=np.int64)
+        self._ia = np.zeros(1, dtype=np.int32)
+        self._ja = np.zeros(0, dtype=np.int32)
+        self._a = np.zeros(0)
+        self._n_eq = 0
+        super().__init__(A, check_symmetry=check_symmetry)
+
+    @property
+    def factor_nnz(self) -> int:
+        """Non-zeros in the Cholesky factor (reported by the last analysis)."""
+        return int(self._iparm[17])
+
+    def _call(self, phase: int, b: np.ndarray | None = None, x: np.ndarray | None = None) -> None:
+        nrhs = 1 if b is None or b.ndim == 1 else b.shape[1]
+        error = ctypes.c_int32(0)
+        i32 = ctypes.c_int32
+        i32p = ctypes.POINTER(ctypes.c_int32)
+        self._func(
+            self._pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)),
+            ctypes.byref(i32(1)),
+            ctypes.byref(i32(1)),
+            ctypes.byref(i32(2)),  # real symmetric positive definite
+            ctypes.byref(i32(phase)),
+            ctypes.byref(i32(self._n_eq)),
+            self._a.ctypes.data,
+            self._ia.ctypes.data_as(i32p),
+            self._ja.ctypes.data_as(i32p),
+            None,
+            ctypes.byref(i32(nrhs)),
+            self._iparm.ctypes.data_as(i32p),
+            ctypes.byref(i32(0)),
+            None if b is None else b.ctypes.data,
+            None if x is None else x.ctypes.data,
+            ctypes.byref(error),
+        )
+        if error.value != 0:
+            code = int(error.value)
+            meaning = _PARDISO_ERRORS.get(code, "unknown error")
+            equation = None
+            if code == -4 and phase == 22 and self._iparm[29] > 0:
+                equation = int(self._iparm[29]) - 1
+                meaning += f" (at equation {equation})"
+            raise FactorizationError(
+                f"PARDISO phase {phase} failed with error {code}: {meaning}",
+                backend=self.backend,
+                code=code,
+                equation=equation,
+            )
+
+    def _release(self) -> None:
+        if self._handle_used:
+            self._handle_used = False
+            try:
+                self._call(-1)
+            finally:
+                self._pt[:] = 0
+
+    def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
+        self._release()
+        positions, indptr = upper_positions(A, rows)
+        if positions.size >= 2**31 - 1:
+            raise ValueError("the upper triangle has too many entries for 32-bit PARDISO")
+        self._upos = positions
+        self._ia = indptr.astype(np.int32)
+        self._ja = A.indices[positions].astype(np.int32)
+        self._a = A.data[positions]
+        self._n_eq = A.shape[0]
+        self._handle_used = True
+        self._call(11)
+
+    def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
+        np.take(A.data, self._upos, out=self._a)
+        if keep is not None:  # only the upper triangle is gathered: no copy of the matrix
+            self._a *= keep[self._upos]
+        self._call(22)
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        b = np.asfortranarray(b)
+        x = np.zeros_like(b, order="F")
+        self._call(33, b, x)
+        return np.ascontiguousarray(x)
+
+    def close(self) -> None:
+        """Free PARDISO's internal memory for this handle (phase -1) and the stored pattern."""
+        self._release()
+        self._upos = np.zeros(0, dtype=np.int64)
+        self._ia = np.zeros(1, dtype=np.int32)
+        self._ja = np.zeros(0, dtype=np.int32)
+        self._a = np.zeros(0)
+        self._n_eq = 0
+        super().close()
+
+    def __del__(self) -> None:
+        try:
+            self._release()
+        except Exception:  # never raise from a finalizer
+            pass
+
+
+@lru_cache(maxsize=1)
+def pardiso_problem() -> str | None:
+    """Why PARDISO cannot be used here, or ``None`` when it loads and solves a 2 x 2 SPD system.
+
+    Cached: the library is probed once per process.
+
+    Returns
+    -------
+    str or None
+        The reason (library not found or not loadable, a PARDISO error on the test system, or
+        a wrong solution).
+    """
+    A = sp.csr_matrix(np.array([[4.0, 1.0], [1.0, 3.0]]))
+    b = np.array([1.0, 2.0])
+    try:
+        with PardisoSolver(A) as solver:
+            x = solver.solve(b)
+    except (BackendUnavailableError, FactorizationError) as err:
+        return str(err)
+    if not np.allclose(A @ x, b, rtol=1e-12, atol=0):
+        return f"PARDISO solved a 2 x 2 test system wrongly (x = {x})"
+    return None

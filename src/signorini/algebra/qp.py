@@ -1,0 +1,149 @@
+"""The bound-constrained quadratic program that PDAS solves, checked once at the public entry.
+
+.. math::
+
+    \\min_x \\tfrac12 x^T K x - F^T x
+    \\quad\\text{subject to}\\quad x_c \\le g,\\quad x_d = x_D,
+
+the discrete Signorini problem of docs/method.md, *Discrete problem*, once the contact DOFs are
+rotated into their normal frames (:mod:`signorini.contact.frames`). :func:`check_qp` turns the
+arguments of :func:`~.pdas.solve_pdas` and :func:`~.kkt.kkt_residuals` into a :class:`BoundQP`
+or raises a :class:`ValueError` naming the argument; everything after it trusts the data.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .sparse import as_csr
+
+__all__ = ["BoundQP", "check_qp", "check_vector"]
+
+
+@dataclass(frozen=True)
+class BoundQP:
+    """Checked data of ``min 1/2 x^T K x - F^T x`` subject to ``x_c <= g``, ``x_d = x_D``.
+
+    Attributes
+    ----------
+    K : scipy.sparse.csr_matrix, shape (n, n)
+        Canonical float64 CSR.
+    F : (n,) float array
+    constrained : (m,) int64 array
+        The bounded DOFs ``c``, distinct.
+    gap : (m,) float array
+        The bounds ``g``, in the order of ``constrained``.
+    dirichlet : (n_d,) int64 array
+        The fixed DOFs ``d``, distinct and disjoint from ``constrained``.
+    dirichlet_values : (n_d,) float array
+        ``x_D``, in the order of ``dirichlet``.
+    """
+
+    K: sp.csr_matrix
+    F: np.ndarray
+    constrained: np.ndarray
+    gap: np.ndarray
+    dirichlet: np.ndarray
+    dirichlet_values: np.ndarray
+
+    @property
+    def n(self) -> int:
+        """Number of unknowns."""
+        return self.K.shape[0]
+
+
+def check_qp(
+    K: object,
+    F: object,
+    constrained: object,
+    gap: object,
+    dirichlet: object = None,
+    dirichlet_values: object = None,
+) -> BoundQP:
+    """Check and normalise the data of the bound-constrained QP.
+
+    Parameters
+    ----------
+    K : scipy sparse matrix, shape (n, n)
+    F : (n,) float array
+    constrained : (m,) int array or (n,) bool mask
+    gap : float or (m,) float array
+    dirichlet : (n_d,) int array or (n,) bool mask, optional
+    dirichlet_values : float, (n_d,) or (n,) float array, optional
+        Default 0.
+
+    Returns
+    -------
+    BoundQP
+
+    Raises
+    ------
+    ValueError
+        Naming the argument: wrong shape or type, non-finite values, indices out of range or
+        repeated, ``constrained`` meeting ``dirichlet``.
+    """
+    K = as_csr(K, "K")
+    n = K.shape[0]
+    F = check_vector(F, n, "F")
+    c = _index_array(constrained, n, "constrained")
+    g = check_vector(gap, c.size, "gap", allow_scalar=True)
+    if dirichlet is None:
+        d = np.zeros(0, dtype=np.int64)
+    else:
+        d = _index_array(dirichlet, n, "dirichlet")
+    overlap = np.intersect1d(c, d)
+    if overlap.size:
+        raise ValueError(
+            f"constrained and dirichlet overlap in {overlap.size} DOFs (first: {overlap[0]})"
+        )
+    if dirichlet_values is None:
+        xd = np.zeros(d.size)
+    else:
+        vals = np.asarray(dirichlet_values, dtype=np.float64)
+        if vals.shape == (n,) and d.size != n:
+            vals = vals[d]
+        xd = check_vector(vals, d.size, "dirichlet_values", allow_scalar=True)
+    return BoundQP(K, F, c, g, d, xd)
+
+
+def check_vector(v: object, n: int, name: str, *, allow_scalar: bool = False) -> np.ndarray:
+    """A finite float64 vector of length ``n`` (a scalar is broadcast if allowed).
+
+    Raises
+    ------
+    ValueError
+        Naming ``name``, if ``v`` is not real, has another shape, or non-finite entries.
+    """
+    try:
+        arr = np.asarray(v, dtype=np.float64)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{name} must be a real array: {err}") from None
+    if arr.ndim == 0 and allow_scalar:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,):
+        raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
+    if not np.isfinite(arr).all():
+        raise ValueError(f"{name} has non-finite (NaN or inf) entries")
+    return arr
+
+
+def _index_array(idx: object, n: int, name: str) -> np.ndarray:
+    """Distinct DOF indices from an int array or a length-n bool mask."""
+    arr = np.asarray(idx)
+    if arr.dtype == np.bool_:
+        if arr.shape != (n,):
+            raise ValueError(f"{name} as a boolean mask must have shape ({n},), got {arr.shape}")
+        return np.flatnonzero(arr)
+    if arr.ndim != 1:
+        raise ValueError(f"{name} must be a 1D index array, got shape {arr.shape}")
+    if arr.size and not np.issubdtype(arr.dtype, np.integer):
+        raise ValueError(f"{name} must hold integer DOF indices, got dtype {arr.dtype}")
+    arr = arr.astype(np.int64)
+    if arr.size and (arr.min() < 0 or arr.max() >= n):
+        raise ValueError(f"{name} has indices outside [0, {n}): [{arr.min()}, {arr.max()}]")
+    if np.unique(arr).size != arr.size:
+        raise ValueError(f"{name} has repeated indices")
+    return arr

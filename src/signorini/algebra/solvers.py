@@ -1,0 +1,260 @@
+"""The interface of a sparse SPD direct solver that keeps its symbolic analysis.
+
+PDAS solves one linear system per iteration, and all of them have the *same* sparsity pattern
+(:mod:`.elimination`). A sparse direct solver can therefore do its symbolic analysis
+(fill-reducing ordering, elimination tree, storage of the factor) once and only repeat the
+numerical factorization. :class:`SPDSolver` checks the matrix, detects pattern changes, counts
+and times the phases; a backend (:mod:`.superlu`, :mod:`.pardiso`) supplies three hooks:
+``_analyze``, ``_factorize``, ``_solve``. :func:`~.backends.make_solver` picks the backend.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from .sparse import as_csr, csr_row_indices, diagonal_positions, list_indices, symmetry_defect
+
+__all__ = ["BackendUnavailableError", "FactorizationError", "SPDSolver"]
+
+
+class FactorizationError(np.linalg.LinAlgError):
+    """The matrix could not be factorized as symmetric positive definite.
+
+    A subclass of :class:`numpy.linalg.LinAlgError` (itself a :class:`ValueError`).
+
+    Attributes
+    ----------
+    backend : str
+        The backend that failed.
+    code : int or None
+        The backend's error code (PARDISO's ``error``), if any.
+    equation : int or None
+        0-based index of the equation where a non-positive pivot was met, if known.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        backend: str = "",
+        code: int | None = None,
+        equation: int | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.backend = backend
+        self.code = code
+        self.equation = equation
+
+
+class BackendUnavailableError(RuntimeError):
+    """A solver backend that was asked for cannot be loaded here; the message says why."""
+
+
+class SPDSolver:
+    """Factorization of a sparse symmetric positive definite matrix with a fixed pattern.
+
+    :meth:`factorize` compares the pattern of the new matrix with the last one; only when it
+    differs is the symbolic analysis redone. The counters and timers below accumulate over the
+    life of the object.
+
+    Parameters
+    ----------
+    A : scipy sparse matrix, shape (n, n), optional
+        Factorized right away if given.
+    check_symmetry : bool
+        Check ``max |A - A^T| <= 1e-12 max |A|`` at each analysis (costs one transpose).
+
+    Attributes
+    ----------
+    backend : str
+        ``"pardiso"`` or ``"scipy"``.
+    reuses_analysis : bool
+        Whether a refactorization with the same pattern skips the symbolic analysis.
+    n_analyses, n_factorizations, n_solves : int
+        Symbolic analyses, numerical factorizations and solve calls (one per call, whatever the
+        number of right-hand sides).
+    time_analysis, time_factorization, time_solve : float
+        Seconds spent in each phase (wall clock).
+    """
+
+    backend: str = ""
+    reuses_analysis: bool = False
+
+    def __init__(self, A: sp.spmatrix | None = None, *, check_symmetry: bool = True) -> None:
+        self.check_symmetry = check_symmetry
+        self.n_analyses = 0
+        self.n_factorizations = 0
+        self.n_solves = 0
+        self.time_analysis = 0.0
+        self.time_factorization = 0.0
+        self.time_solve = 0.0
+        self._indptr: np.ndarray | None = None
+        self._indices: np.ndarray | None = None
+        self._matrix: sp.csr_matrix | None = None  # the matrix of the last factorize()
+        self._n = 0
+        self._factorized = False
+        if A is not None:
+            self.factorize(A)
+
+    # -- bookkeeping ------------------------------------------------------------------------
+    @property
+    def n(self) -> int:
+        """Size of the analysed matrix (0 before the first factorization)."""
+        return self._n
+
+    @property
+    def stats(self) -> dict[str, float | int | str]:
+        """Counters and timers as a dictionary."""
+        return {
+            "backend": self.backend,
+            "n_analyses": self.n_analyses,
+            "n_factorizations": self.n_factorizations,
+            "n_solves": self.n_solves,
+            "time_analysis": self.time_analysis,
+            "time_factorization": self.time_factorization,
+            "time_solve": self.time_solve,
+        }
+
+    def same_pattern(self, A: sp.csr_matrix) -> bool:
+        """Whether canonical CSR ``A`` has the pattern of the last analysis."""
+        if self._indptr is None or A.shape != (self._n, self._n):
+            return False
+        if A.nnz != self._indices.size:
+            return False
+        same_ptr = A.indptr is self._indptr or np.array_equal(A.indptr, self._indptr)
+        return same_ptr and (A.indices is self._indices or np.array_equal(A.indices, self._indices))
+
+    # -- public interface -------------------------------------------------------------------
+    def factorize(self, A: sp.spmatrix, keep: np.ndarray | None = None) -> None:
+        """Factorize ``A``, reusing the symbolic analysis when the pattern is unchanged.
+
+        Parameters
+        ----------
+        A : scipy sparse matrix, shape (n, n)
+            Symmetric positive definite, both triangles stored (an explicitly stored zero is
+            part of the pattern).
+        keep : (A.nnz,) bool array, optional
+            Factorize ``A`` with the stored entries where ``keep`` is False taken as zero
+            (same pattern), e.g. :meth:`SymmetricEliminator.keep_mask`. Lets a backend
+            gather only what it needs instead of copying the whole matrix.
+
+        Raises
+        ------
+        ValueError
+            If ``A`` is not a square finite sparse matrix, not symmetric, or misses a diagonal
+            entry.
+        FactorizationError
+            If the matrix is singular or not positive definite.
+        """
+        A = as_csr(A)
+        if not self.same_pattern(A):
+            rows = csr_row_indices(A)
+            self._check_new_pattern(A, rows)
+            self._factorized = False
+            t0 = time.perf_counter()
+            self._analyze(A, rows)
+            self.time_analysis += time.perf_counter() - t0
+            self.n_analyses += 1
+            self._n = A.shape[0]
+            self._indptr = A.indptr.copy()
+            self._indices = A.indices  # a reference: patterns are not modified in place
+        if keep is not None:
+            keep = np.asarray(keep)
+            if keep.dtype != np.bool_ or keep.shape != (A.nnz,):
+                raise ValueError(f"keep must be a boolean mask of shape ({A.nnz},)")
+        self._matrix = A
+        self._numeric(keep)
+
+    def refactorize(self, keep: np.ndarray) -> None:
+        """Factorize the matrix of the last :meth:`factorize` again, with another ``keep``.
+
+        The matrix and its pattern were checked by :meth:`factorize` and are not checked again,
+        nor is ``keep``: this is the step an active set iteration repeats.
+
+        Parameters
+        ----------
+        keep : (nnz,) bool array
+            As in :meth:`factorize`.
+        """
+        if self._matrix is None:
+            raise RuntimeError("refactorize() called before factorize()")
+        self._numeric(keep)
+
+    def _check_new_pattern(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
+        """Reject an empty matrix, a missing diagonal entry and (if asked) an unsymmetric one."""
+        if A.shape[0] == 0:
+            raise ValueError("A is empty (shape (0, 0))")
+        missing = np.flatnonzero(diagonal_positions(A, rows) < 0)
+        if missing.size:
+            raise ValueError(
+                f"A must store every diagonal entry; rows {list_indices(missing)} have none"
+            )
+        if self.check_symmetry:
+            defect = symmetry_defect(A)
+            if defect > 1e-12:
+                raise ValueError(f"A is not symmetric: max|A - A^T| / max|A| = {defect:.3e}")
+
+    def _numeric(self, keep: np.ndarray | None) -> None:
+        """The numerical factorization of the current matrix, counted and timed."""
+        self._factorized = False
+        t0 = time.perf_counter()
+        self._factorize(self._matrix, keep)
+        self.time_factorization += time.perf_counter() - t0
+        self.n_factorizations += 1
+        self._factorized = True
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """Solve ``A x = b`` with the current factorization.
+
+        Parameters
+        ----------
+        b : (n,) or (n, k) float array
+
+        Returns
+        -------
+        x : float array, same shape as ``b``
+        """
+        if not self._factorized:
+            raise RuntimeError("solve() called before a successful factorize()")
+        b = np.asarray(b, dtype=np.float64)
+        if b.ndim not in (1, 2) or b.shape[0] != self._n:
+            raise ValueError(f"b must have shape ({self._n},) or ({self._n}, k), got {b.shape}")
+        if not np.isfinite(b).all():
+            raise ValueError("b has non-finite (NaN or inf) entries")
+        if b.ndim == 2 and b.shape[1] == 0:
+            return np.zeros_like(b)
+        t0 = time.perf_counter()
+        x = self._solve(b)
+        self.time_solve += time.perf_counter() - t0
+        self.n_solves += 1
+        return x
+
+    def close(self) -> None:
+        """Release the factorization (the object can factorize again afterwards)."""
+        self._factorized = False
+        self._indptr = self._indices = self._matrix = None
+
+    def __enter__(self) -> SPDSolver:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return (
+            f"{type(self).__name__}(n={self._n}, analyses={self.n_analyses}, "
+            f"factorizations={self.n_factorizations}, solves={self.n_solves})"
+        )
+
+    # -- backend hooks ----------------------------------------------------------------------
+    def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:  # pragma: no cover
+        raise NotImplementedError
+
+    def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:  # pragma: no cover
+        raise NotImplementedError
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:  # pragma: no cover
+        raise NotImplementedError

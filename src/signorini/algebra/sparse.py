@@ -1,0 +1,133 @@
+"""Helpers on sparse matrices in canonical CSR form: checks, row indices, triangles, diagonals.
+
+Every function here takes a square matrix and knows nothing of where it came from; the
+solvers (:mod:`.solvers`, :mod:`.pardiso`), the symmetric elimination (:mod:`.elimination`)
+and the node rotations of :mod:`signorini.contact.frames` build on them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = [
+    "as_csr",
+    "csr_row_indices",
+    "diagonal_positions",
+    "list_indices",
+    "symmetry_defect",
+    "upper_positions",
+    "upper_triangle",
+]
+
+
+def as_csr(A: object, name: str = "A") -> sp.csr_matrix:
+    """Check a square float64 sparse matrix and return it in canonical CSR form.
+
+    A matrix that already is canonical float64 CSR is returned as it is (no copy), so its
+    index arrays keep their identity and pattern comparisons stay cheap.
+
+    Parameters
+    ----------
+    A : scipy sparse matrix or array, shape (n, n)
+    name : str
+        Name used in error messages.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix
+        Sorted indices, no duplicates, float64 values.
+
+    Raises
+    ------
+    ValueError
+        If ``A`` is not sparse, not square, or has non-finite values.
+    """
+    if not sp.issparse(A):
+        raise ValueError(f"{name} must be a scipy sparse matrix, got {type(A).__name__}")
+    if A.ndim != 2 or A.shape[0] != A.shape[1]:
+        raise ValueError(f"{name} must be square, got shape {A.shape}")
+    if A.dtype != np.float64:
+        if not (np.issubdtype(A.dtype, np.floating) or np.issubdtype(A.dtype, np.integer)):
+            raise ValueError(f"{name} must have real values, got dtype {A.dtype}")
+        A = A.astype(np.float64)
+    if not (isinstance(A, sp.csr_matrix) and A.has_canonical_format):
+        A = sp.csr_matrix(A)
+        A.sum_duplicates()
+    if not np.isfinite(A.data).all():
+        raise ValueError(f"{name} has non-finite (NaN or inf) entries")
+    return A
+
+
+def csr_row_indices(A: sp.csr_matrix) -> np.ndarray:
+    """Row index of every stored entry of a CSR matrix.
+
+    Parameters
+    ----------
+    A : scipy.sparse.csr_matrix, shape (n, n)
+
+    Returns
+    -------
+    rows : (A.nnz,) int32 (int64 for n ≥ 2³¹) array
+        ``rows[p]`` is the row of ``A.data[p]`` (the companion of ``A.indices``).
+    """
+    n = A.shape[0]
+    dtype = np.int32 if n < np.iinfo(np.int32).max else np.int64
+    return np.repeat(np.arange(n, dtype=dtype), np.diff(A.indptr))
+
+
+def upper_positions(A: sp.csr_matrix, rows: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+    """Positions in ``A.data`` of the upper triangle (with diagonal) and its CSR ``indptr``."""
+    if rows is None:
+        rows = csr_row_indices(A)
+    upper = A.indices >= rows
+    positions = np.flatnonzero(upper)
+    if A.nnz < np.iinfo(np.int32).max:
+        positions = positions.astype(np.int32)
+    indptr = np.zeros(A.shape[0] + 1, dtype=np.int64)
+    np.cumsum(np.bincount(rows[positions], minlength=A.shape[0]), out=indptr[1:])
+    return positions, indptr
+
+
+def upper_triangle(A: sp.spmatrix) -> sp.csr_matrix:
+    """Upper triangle (diagonal included) of a square sparse matrix, in CSR form.
+
+    A vectorized mask on the stored entries (``indices >= row``), which keeps explicitly stored
+    zeros. On a 200 978 x 200 978 P2 elasticity matrix (4.6 M entries) it took 26 ms against
+    35 ms for ``scipy.sparse.triu``; the solvers go one step further and keep the positions of
+    the upper entries, so a refactorization only gathers ``A.data[positions]`` (6 ms).
+
+    Parameters
+    ----------
+    A : scipy sparse matrix, shape (n, n)
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (n, n)
+    """
+    A = as_csr(A)
+    positions, indptr = upper_positions(A)
+    return sp.csr_matrix((A.data[positions], A.indices[positions], indptr), shape=A.shape)
+
+
+def diagonal_positions(A: sp.csr_matrix, rows: np.ndarray) -> np.ndarray:
+    """Position in ``A.data`` of each diagonal entry, ``-1`` where it is not stored."""
+    pos = np.full(A.shape[0], -1, dtype=np.int64)
+    on_diag = np.flatnonzero(A.indices == rows)
+    pos[rows[on_diag]] = on_diag
+    return pos
+
+
+def list_indices(indices: np.ndarray, limit: int = 5) -> str:
+    """The first ``limit`` of ``indices`` as text, for error messages."""
+    shown = ", ".join(str(int(i)) for i in indices[:limit])
+    return shown + (f" (and {indices.size - limit} more)" if indices.size > limit else "")
+
+
+def symmetry_defect(A: sp.csr_matrix) -> float:
+    """``max |A - A^T| / max |A|`` (0 for an empty matrix)."""
+    scale = float(np.abs(A.data).max()) if A.nnz else 0.0
+    if scale == 0.0:
+        return 0.0
+    D = A - A.T
+    return float(np.abs(D.data).max()) / scale if D.nnz else 0.0

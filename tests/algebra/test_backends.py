@@ -1,0 +1,75 @@
+"""Choice of backend (signorini.algebra.backends): "auto", explicit names, loud fallback."""
+
+from __future__ import annotations
+
+import importlib.metadata
+import warnings
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from signorini.algebra import (
+    BACKENDS,
+    BackendUnavailableError,
+    SolverFallbackWarning,
+    available_backends,
+    backends,
+    make_solver,
+    pardiso,
+    solve_pdas,
+)
+
+
+@pytest.fixture
+def broken_pardiso(monkeypatch):
+    """PARDISO cannot load (no MKL found), with every cache cleared before and after."""
+
+    def clear():
+        pardiso.pardiso_function.cache_clear()
+        pardiso.pardiso_problem.cache_clear()
+        backends._warn_fallback.cache_clear()
+
+    clear()
+    monkeypatch.setattr(pardiso, "mkl_runtime_candidates", lambda: [])
+    yield
+    clear()
+
+
+def test_auto_takes_pardiso_when_mkl_is_installed():
+    try:
+        importlib.metadata.distribution("mkl")
+    except importlib.metadata.PackageNotFoundError:
+        pytest.skip("the mkl distribution is not installed")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no fallback warning either
+        solver = make_solver()
+    assert solver.backend == "pardiso" and solver.reuses_analysis
+    assert available_backends() == ("pardiso", "scipy")
+
+
+def test_unknown_backend_lists_valid():
+    with pytest.raises(ValueError, match="unknown backend 'mumps'.*auto, pardiso, scipy"):
+        make_solver("mumps")
+    assert BACKENDS == ("pardiso", "scipy")
+
+
+def test_auto_falls_back_to_superlu_with_one_warning(broken_pardiso):
+    with pytest.warns(SolverFallbackWarning, match="falling back to SuperLU: .*mkl_rt") as caught:
+        solver = make_solver("auto")
+    assert len(caught) == 1 and caught[0].filename == __file__  # points at the caller
+    assert solver.backend == "scipy" and not solver.reuses_analysis
+    assert available_backends() == ("scipy",)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # once per process: a second fallback is silent
+        result = solve_pdas(sp.identity(3, format="csr"), np.ones(3), [0], 0.5)
+    assert result.backend == "scipy"  # the history's backend column reports what was used
+    assert np.array_equal(result.x, [0.5, 1.0, 1.0])
+
+
+def test_explicit_pardiso_raises_when_unavailable(broken_pardiso):
+    with pytest.raises(BackendUnavailableError, match="pardiso backend is not usable here: MKL"):
+        make_solver("pardiso")
+    with pytest.raises(RuntimeError, match="no file found"):
+        solve_pdas(sp.identity(3, format="csr"), np.ones(3), [0], 0.5, backend="pardiso")
+    assert make_solver("scipy").backend == "scipy"  # asked for by name: no warning needed

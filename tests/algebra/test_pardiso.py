@@ -1,0 +1,125 @@
+"""MKL PARDISO backend (signorini.algebra.pardiso): finding MKL, pattern reuse, failures."""
+
+from __future__ import annotations
+
+import ctypes.util
+import importlib.metadata
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from linalg_problems import block_spd
+
+from signorini.algebra import (
+    BackendUnavailableError,
+    FactorizationError,
+    SymmetricEliminator,
+    available_backends,
+    pardiso,
+)
+from signorini.algebra.pardiso import PardisoSolver, mkl_runtime_candidates, pardiso_problem
+
+HAS_PARDISO = "pardiso" in available_backends()
+
+
+def _mkl_distribution():
+    try:
+        return importlib.metadata.distribution("mkl")
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
+@pytest.fixture
+def pardiso_probe_reset():
+    """Clear the cached library and probe before and after the test."""
+
+    def clear():
+        pardiso.pardiso_function.cache_clear()
+        pardiso.pardiso_problem.cache_clear()
+
+    clear()
+    yield
+    clear()
+
+
+def test_mkl_is_found_in_the_installed_distribution():
+    dist = _mkl_distribution()
+    if dist is None:
+        pytest.skip("the mkl distribution is not installed")
+    files = {Path(dist.locate_file(f)).resolve() for f in dist.files}
+    first = Path(mkl_runtime_candidates()[0])
+    assert first in files and first.name.startswith("libmkl_rt")
+    assert pardiso_problem() is None and HAS_PARDISO
+
+
+def test_pypardiso_is_not_imported():
+    code = "import sys, signorini.algebra as a; a.make_solver(); print('pypardiso' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_missing_library_is_reported(monkeypatch, pardiso_probe_reset):
+    monkeypatch.setattr(pardiso, "mkl_runtime_candidates", lambda: [])
+    reason = pardiso_problem()
+    assert reason is not None and "mkl_rt could not be loaded (no file found)" in reason
+    with pytest.raises(BackendUnavailableError, match="no file found"):
+        PardisoSolver()
+
+
+def test_unloadable_and_symbolless_libraries_are_reported(
+    tmp_path, monkeypatch, pardiso_probe_reset
+):
+    garbage = tmp_path / "libmkl_rt.so.3"
+    garbage.write_bytes(b"not a shared library")
+    libm = ctypes.util.find_library("m")
+    if libm is None:
+        pytest.skip("no C math library to stand in for a library without pardiso")
+    monkeypatch.setattr(pardiso, "mkl_runtime_candidates", lambda: [str(garbage), libm])
+    reason = pardiso_problem()
+    assert reason is not None
+    assert str(garbage) in reason and libm in reason and "pardiso" in reason
+
+
+def test_wrong_solution_is_reported(monkeypatch, pardiso_probe_reset):
+    if not HAS_PARDISO:
+        pytest.skip("PARDISO not available")
+    monkeypatch.setattr(PardisoSolver, "_solve", lambda self, b: np.zeros_like(b))
+    assert "solved a 2 x 2 test system wrongly" in pardiso_problem()
+
+
+@pytest.mark.skipif(not HAS_PARDISO, reason="PARDISO not available")
+def test_pattern_reuse_with_explicit_zeros():
+    # Elimination zeroes values but keeps them stored: PARDISO must analyse only once.
+    rng = np.random.default_rng(11)
+    K = block_spd(8, 8, rng, shift=0.0)  # singular: constant vectors per component are null
+    n = K.shape[0]
+    F = rng.standard_normal(n)
+    solver = PardisoSolver()
+    elim = SymmetricEliminator(K)
+    for k in range(4):
+        fixed = np.zeros(n, dtype=bool)
+        fixed[:2] = True  # removes the null space (constant vectors)
+        fixed[rng.choice(n, 10 + k, replace=False)] = True
+        values = rng.standard_normal(n)
+        A, b = elim.apply(K, F, fixed, values)
+        solver.factorize(A)
+        x = solver.solve(b)
+        assert np.linalg.norm(A @ x - b) < 1e-10 * np.linalg.norm(b)
+        assert np.allclose(x[fixed], values[fixed], rtol=1e-12, atol=1e-12)
+    assert solver.n_analyses == 1
+    assert solver.n_factorizations == 4
+    assert solver.factor_nnz >= (A.nnz + n) // 2
+    solver.close()
+    solver.close()  # idempotent
+
+
+@pytest.mark.skipif(not HAS_PARDISO, reason="PARDISO not available")
+def test_negative_pivot_names_the_equation():
+    rng = np.random.default_rng(5)
+    A = block_spd(6, 6, rng).tolil()
+    A[17, 17] = -50.0
+    with pytest.raises(FactorizationError, match="PARDISO phase 22 failed with error -4") as info:
+        PardisoSolver(A.tocsr())
+    assert info.value.code == -4 and info.value.backend == "pardiso"
