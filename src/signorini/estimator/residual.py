@@ -37,7 +37,7 @@ from ..fem.p2 import REFERENCE_NODES, edge_basis, field_gradients, physical_poin
 from ..fem.quadrature import line_rule, triangle_rule
 from ..mesh.geometry import segment_normals
 from ..problem.problem import Neumann, evaluate_field
-from .hhalf import hhalf_norm2_positive_part
+from .h_half_norm import hhalf_norm2_positive_part
 
 __all__ = ["Estimate", "estimate", "ETA5_VARIANTS", "third_integrals"]
 
@@ -227,7 +227,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
         # ---- η7: H^{1/2}(Γ_C) norm of the penetration (u_h·n − ψ)⁺
         x0 = mesh.points[cs.edge_nodes[:, 0]]
         x1 = mesh.points[cs.edge_nodes[:, 1]]
-        _, share = hhalf_norm2_positive_part(x0, x1, wgap[:, [0, 2, 1]])
+        _, share = hhalf_norm2_positive_part(x0, x1, wgap)
         np.add.at(eta2_cell[6], e2c[e, 0], share)
 
     return Estimate(eta2_cell=eta2_cell, eta2_node=eta2_node, eta5=eta5)
