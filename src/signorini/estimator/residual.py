@@ -21,9 +21,9 @@ interpolant, so that (u_h·n − ψ) is a quadratic on each edge (exact for gaps
 piecewise quadratic with kinks at nodes, as in Example 6.2).
 
 Each term is one function of :mod:`signorini.estimator.terms` (arrays in, integrals out):
-η1 ``eta1_interior_residual``, η2 ``eta2_stress_jump``, η3 ``eta3_neumann_residual``,
-η4 ``eta4_tangential_stress``, η5 ``eta5_normal_stress``, η6 ``eta6_complementarity``,
-η7 ``eta7_penetration``; :func:`estimate` is the table that feeds them, by name. Every node
+η1 ``interior_residual``, η2 ``stress_jump``, η3 ``neumann_residual``,
+η4 ``tangential_stress``, η5 ``normal_stress``, η6 ``complementarity``,
+η7 ``penetration``; :func:`estimate` is the table that feeds them, by name. Every node
 term is a sum of cell or edge integrals; each cell receives its share (edge terms split
 equally between the edge's cells, ``terms.spread_edge_integrals``), so the element
 indicators sum exactly to η_h².
@@ -47,17 +47,17 @@ from .terms import (
     EdgeSet,
     TermShares,
     boundary_cell_shares,
+    complementarity,
     edge_traction,
-    eta1_interior_residual,
-    eta2_stress_jump,
-    eta3_neumann_residual,
-    eta4_tangential_stress,
-    eta5_normal_stress,
-    eta6_complementarity,
-    eta7_penetration,
+    interior_residual,
+    neumann_residual,
+    normal_stress,
+    penetration,
     spread_cell_integrals,
     spread_edge_integrals,
     spread_node_parts,
+    stress_jump,
+    tangential_stress,
 )
 
 __all__ = ["ETA5_VARIANTS", "TERMS", "Estimate", "estimate"]
@@ -152,7 +152,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     jump = _from_both_sides(mesh, traction, inner.index, t)
     neumann = _edge_set(mesh, _part_edges(mesh, problem.neumann_parts))
     t_n, w_n = line_rule(NEUMANN_DEGREE)
-    neumann_residual = _neumann_residual(problem, mesh, traction, t_n)
+    misfit = _traction_misfit(problem, mesh, traction, t_n)
     contact = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
     contact_traction = _on_boundary(mesh, traction, contact.index, t)
     normal = cs.edge_normal
@@ -165,25 +165,21 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
 
     shares = {
         "eta1": spread_cell_integrals(
-            eta1_interior_residual(mesh.area, div_sigma, f, w_cell), space.cell_nodes, h_p
+            interior_residual(mesh.area, div_sigma, f, w_cell), space.cell_nodes, h_p
         ),
-        "eta2": on_edges(inner, eta2_stress_jump(*jump, w, inner.length)),
-        "eta3": on_edges(neumann, eta3_neumann_residual(neumann_residual, w_n, neumann.length)),
-        "eta4": on_edges(
-            contact, eta4_tangential_stress(contact_traction, normal, w, contact.length)
-        ),
+        "eta2": on_edges(inner, stress_jump(*jump, w, inner.length)),
+        "eta3": on_edges(neumann, neumann_residual(misfit, w_n, neumann.length)),
+        "eta4": on_edges(contact, tangential_stress(contact_traction, normal, w, contact.length)),
         "eta5": on_edges(
-            contact, eta5_normal_stress(contact_traction, normal, t, w, contact.length, pressure)
+            contact, normal_stress(contact_traction, normal, t, w, contact.length, pressure)
         ),
         "eta6": spread_node_parts(
             contact,
-            eta6_complementarity(gap, _semi_contact_density(result), contact.length),
+            complementarity(gap, _semi_contact_density(result), contact.length),
             n_nodes,
             n_cells,
         ),
-        "eta7": TermShares(
-            None, boundary_cell_shares(contact, eta7_penetration(x0, x1, gap), n_cells)
-        ),
+        "eta7": TermShares(None, boundary_cell_shares(contact, penetration(x0, x1, gap), n_cells)),
     }
     return Estimate(
         eta2_cell=np.stack([shares[name].cell for name in TERMS]),
@@ -238,7 +234,7 @@ def _from_both_sides(mesh, traction, e: np.ndarray, t: np.ndarray):
     return traction(c[:, 0], k[:, 0], t), traction(c[:, 1], k[:, 1], 1 - t)
 
 
-def _neumann_residual(problem: ContactProblem, mesh, traction, t: np.ndarray) -> np.ndarray:
+def _traction_misfit(problem: ContactProblem, mesh, traction, t: np.ndarray) -> np.ndarray:
     """``σ(u_h) n − g`` ``(k, q, 2)`` on the Neumann edges (part after part) at points ``t``."""
     out = []
     for name in problem.neumann_parts:

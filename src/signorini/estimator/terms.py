@@ -5,17 +5,20 @@ per edge (η2–η5, η7) or per edge node (η6); the distributing helpers turn 
 contributions ``η_{k,p}²`` and cell shares. :func:`signorini.estimator.residual.estimate`
 is the table that calls them; docs/method.md, *Estimator*, states the choices.
 
-====  ===========================================  ======================================
-term  function                                     integral
-====  ===========================================  ======================================
-η1    :func:`eta1_interior_residual`               ``‖f + div σ(u_h)‖²_T`` per cell
-η2    :func:`eta2_stress_jump`                     ``‖⟦σ(u_h)⟧‖²_e`` per interior edge
-η3    :func:`eta3_neumann_residual`                ``‖σ(u_h)n − g‖²_e`` per Neumann edge
-η4    :func:`eta4_tangential_stress`               ``‖σ_t(u_h)‖²_e`` per contact edge
-η5    :func:`eta5_normal_stress`                   ``‖σ_nn(u_h) [+ p_h]‖²_e``
-η6    :func:`eta6_complementarity`                 ``s_p ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p`` per node
-η7    :func:`eta7_penetration`                     share of ``‖(u_h·n − ψ)⁺‖²_{H^{1/2}}``
-====  ===========================================  ======================================
+====  ===========================  ================================================
+term  function                     integral
+====  ===========================  ================================================
+η1    :func:`interior_residual`    ``‖f + div σ(u_h)‖²_T`` per cell
+η2    :func:`stress_jump`          ``‖⟦σ(u_h)⟧‖²_e`` per interior edge
+η3    :func:`neumann_residual`     ``‖σ(u_h)n − g‖²_e`` per Neumann edge
+η4    :func:`tangential_stress`    ``‖σ_t(u_h)‖²_e`` per contact edge
+η5    :func:`normal_stress`        ``‖σ_nn(u_h) [+ p_h]‖²_e`` per contact edge
+η6    :func:`complementarity`      ``s_p ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p`` per edge node
+η7    :func:`penetration`          share of ``‖(u_h·n − ψ)⁺‖²_{H^{1/2}(Γ_C)}``
+====  ===========================  ================================================
+
+The functions carry the names of what they measure; ``estimate`` files their results under
+the term names ``"eta1"`` … ``"eta7"`` (``eta2…`` names elsewhere are squared indicators).
 """
 
 from __future__ import annotations
@@ -34,13 +37,13 @@ __all__ = [
     "EdgeSet",
     "TermShares",
     "edge_traction",
-    "eta1_interior_residual",
-    "eta2_stress_jump",
-    "eta3_neumann_residual",
-    "eta4_tangential_stress",
-    "eta5_normal_stress",
-    "eta6_complementarity",
-    "eta7_penetration",
+    "interior_residual",
+    "stress_jump",
+    "neumann_residual",
+    "tangential_stress",
+    "normal_stress",
+    "complementarity",
+    "penetration",
     "boundary_cell_shares",
     "spread_cell_integrals",
     "spread_edge_integrals",
@@ -197,7 +200,7 @@ def edge_traction(
 # --------------------------------------------------------------------------- the terms
 
 
-def eta1_interior_residual(
+def interior_residual(
     area: np.ndarray,
     div_sigma: np.ndarray,
     f: np.ndarray | None = None,
@@ -225,7 +228,7 @@ def eta1_interior_residual(
     return 2 * area * np.einsum("q,mqc,mqc->m", w, r, r)
 
 
-def eta2_stress_jump(
+def stress_jump(
     traction_0: np.ndarray, traction_1: np.ndarray, w: np.ndarray, length: np.ndarray
 ) -> np.ndarray:
     """``‖⟦σ(u_h)⟧‖²_e`` per interior edge (η2).
@@ -243,13 +246,13 @@ def eta2_stress_jump(
     return length * np.einsum("q,eqi,eqi->e", w, jump, jump)
 
 
-def eta3_neumann_residual(residual: np.ndarray, w: np.ndarray, length: np.ndarray) -> np.ndarray:
+def neumann_residual(residual: np.ndarray, w: np.ndarray, length: np.ndarray) -> np.ndarray:
     """``‖σ(u_h) n − g‖²_e`` per Neumann edge (η3), from ``residual (k, q, 2)`` at the
     points of the weights ``w (q,)``."""
     return length * np.einsum("q,eqi,eqi->e", w, residual, residual)
 
 
-def eta4_tangential_stress(
+def tangential_stress(
     traction: np.ndarray, normal: np.ndarray, w: np.ndarray, length: np.ndarray
 ) -> np.ndarray:
     """``‖σ_t(u_h)‖²_e`` per contact edge (η4).
@@ -268,7 +271,7 @@ def eta4_tangential_stress(
     return length * np.einsum("q,eqi,eqi->e", w, st, st)
 
 
-def eta5_normal_stress(
+def normal_stress(
     traction: np.ndarray,
     normal: np.ndarray,
     t: np.ndarray,
@@ -296,7 +299,7 @@ def eta5_normal_stress(
     return length * (w * snn**2).sum(axis=1)
 
 
-def eta6_complementarity(gap: np.ndarray, density: np.ndarray, length: np.ndarray) -> np.ndarray:
+def complementarity(gap: np.ndarray, density: np.ndarray, length: np.ndarray) -> np.ndarray:
     """``s_p d_p`` with ``d_p = ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p``, per contact edge node (η6).
 
     Parameters
@@ -315,7 +318,7 @@ def eta6_complementarity(gap: np.ndarray, density: np.ndarray, length: np.ndarra
     return density * third_integrals(-gap, length)
 
 
-def eta7_penetration(x0: np.ndarray, x1: np.ndarray, gap: np.ndarray) -> np.ndarray:
+def penetration(x0: np.ndarray, x1: np.ndarray, gap: np.ndarray) -> np.ndarray:
     """Each contact edge's share of ``η7² = ‖(u_h·n − ψ_h)⁺‖²_{H^{1/2}(Γ_C)}``.
 
     Parameters
