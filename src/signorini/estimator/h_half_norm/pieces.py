@@ -249,6 +249,24 @@ def _zero_runs(
     return both[lo].copy(), both[hi].copy()
 
 
+def _zero_set_runs(x0, x1, pid, rest, zedge, zs, z_lo, z_hi) -> tuple[np.ndarray, np.ndarray]:
+    """The maximal straight runs of ``Γ_C \\ S``: the edges ``rest`` where ``w ≤ 0`` and
+    the non-positive pieces ``[z_lo, z_hi]`` (parameters ``zs``) of the edges ``zedge``.
+
+    ``pid (2k,)`` are the point ids of the edges' start and end points; a piece keeps the
+    id of an edge end point it reaches, so runs are merged across edges.
+    """
+    k = x0.shape[0]
+    zpid0 = np.where(zs[:, 0] == 0.0, pid[zedge], -1)
+    zpid1 = np.where(zs[:, 1] == 1.0, pid[k + zedge], -1)
+    return _zero_runs(
+        np.concatenate([x0[rest], z_lo]),
+        np.concatenate([x1[rest], z_hi]),
+        np.concatenate([pid[rest], zpid0]),
+        np.concatenate([pid[k + rest], zpid1]),
+    )
+
+
 def _no_pieces(k: int, tol: float) -> PositivePartPieces:
     """``S`` empty: nothing to integrate (the zero runs are not needed either)."""
     empty2 = np.zeros((0, 2))
@@ -317,18 +335,9 @@ def positive_part_pieces(x0, x1, w, *, validate: bool = True) -> PositivePartPie
     s0, ds = sp[:, 0], sp[:, 1] - sp[:, 0]
     coef = np.stack([ea + s0 * (eb + s0 * ec), (eb + 2.0 * ec * s0) * ds, ec * ds * ds], axis=1)
 
-    # zero set: whole non-candidate edges plus the non-positive pieces of candidates
-    rest = np.flatnonzero(~cand)
-    zsel = ~positive
-    zedge = edge_all[zsel]
-    zs = s[zsel]
-    zpid0 = np.where(zs[:, 0] == 0.0, pid[zedge], -1)
-    zpid1 = np.where(zs[:, 1] == 1.0, pid[k + zedge], -1)
-    run_start, run_end = _zero_runs(
-        np.concatenate([x0[rest], pt_lo[zsel]]),
-        np.concatenate([x1[rest], pt_hi[zsel]]),
-        np.concatenate([pid[rest], zpid0]),
-        np.concatenate([pid[k + rest], zpid1]),
+    zero = ~positive
+    run_start, run_end = _zero_set_runs(
+        x0, x1, pid, np.flatnonzero(~cand), edge_all[zero], s[zero], pt_lo[zero], pt_hi[zero]
     )
     return PositivePartPieces(
         n_edges=k,
