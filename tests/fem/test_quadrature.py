@@ -5,7 +5,7 @@ from math import factorial
 import numpy as np
 import pytest
 
-from signorini.fem.quadrature import exact_degree, line_rule, triangle_rule
+from signorini.fem.quadrature import exact_degree, gauss_legendre, line_rule, triangle_rule
 
 
 def monomial_triangle(a: int, b: int) -> float:
@@ -86,6 +86,34 @@ def test_line_rule_integrates_a_shifted_polynomial():
     # int_0^1 (3 t - 1)^7 dt = (2^8 - (-1)^8) / (3 * 8)
     t, w = line_rule(7)
     assert abs(np.sum(w * (3 * t - 1) ** 7) - (2**8 - 1) / 24) < 1e-12
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 7, 20, 400])
+def test_gauss_legendre_exact_to_degree_2n_minus_1(n):
+    t, w = gauss_legendre(n)
+    assert t.shape == w.shape == (n,)
+    assert np.all(w > 0) and abs(w.sum() - 1.0) < 1e-13
+    assert np.all((t > 0) & (t < 1)) and np.all(np.diff(t) > 0)
+    # Legendre polynomials shifted to [0, 1]: ∫ P_k = 0 for 1 <= k <= 2n - 1, and
+    # ∫ P_{2n} = 0 is missed (P_{2n} = c q² + lower terms, q the node polynomial)
+    for k in (1, n, 2 * n - 1):
+        pk = np.polynomial.legendre.Legendre.basis(k)(2 * t - 1)
+        assert abs(np.sum(w * pk)) < 1e-13, k
+    p2n = np.polynomial.legendre.Legendre.basis(2 * n)(2 * t - 1)
+    assert abs(np.sum(w * p2n)) > 1e-3
+
+
+def test_line_rule_is_gauss_legendre_with_degree_over_two_plus_one_points():
+    for degree in range(12):
+        t, w = line_rule(degree)
+        tg, wg = gauss_legendre(degree // 2 + 1)
+        assert t is tg and w is wg  # one cached rule, the same arrays
+
+
+@pytest.mark.parametrize("bad", [0, -2, 2.0, "3", None, False])
+def test_bad_number_of_gauss_points_raises(bad):
+    with pytest.raises(ValueError, match="number of Gauss points"):
+        gauss_legendre(bad)
 
 
 @pytest.mark.parametrize("bad", [-1, 1.5, "3", None, True])

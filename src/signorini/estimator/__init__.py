@@ -1,5 +1,11 @@
-"""ESTIMATE and MARK: the residual estimator η_h with its terms η1…η7 (paper, Section 5), the
-H^{1/2}(Γ_C) norm it needs, and Dörfler marking."""
+"""ESTIMATE and MARK (paper, Section 5; docs/method.md, *Estimator*).
+
+- ``residual``: :class:`Estimate` and :func:`estimate`, the table of the terms of (5.1).
+- ``terms``: one function per term η1 … η7 and the helpers that distribute them to nodes
+  and cells.
+- ``h_half_norm``: the H^{1/2}(Γ_C) norm of the penetration (η7).
+- ``marking``: Dörfler marking.
+"""
 
 from .marking import mark_doerfler
 from .residual import Estimate, estimate

@@ -1,5 +1,8 @@
 """Quadrature rules on the reference triangle and on the unit interval.
 
+The one owner of Gauss-Legendre points on [0, 1]: :func:`gauss_legendre` by number of
+points, :func:`line_rule` by polynomial degree.
+
 The reference triangle is ``T = {(x, y) : x >= 0, y >= 0, x + y <= 1}`` with
 vertices (0, 0), (1, 0), (0, 1) and area 1/2; the reference interval is [0, 1].
 
@@ -26,24 +29,25 @@ References
 from __future__ import annotations
 
 import operator
-from functools import lru_cache
+from functools import cache, lru_cache
 
 import numpy as np
 from scipy.special import roots_jacobi
 
-__all__ = ["exact_degree", "line_rule", "triangle_rule"]
+__all__ = ["exact_degree", "gauss_legendre", "line_rule", "triangle_rule"]
 
 
-def _check_degree(degree: int) -> int:
-    """Return ``degree`` as a Python int, or raise ``ValueError``."""
+def _check_integer(degree: int, what: str = "quadrature degree", minimum: int = 0) -> int:
+    """Return ``degree`` as a Python int ``>= minimum``, or raise ``ValueError`` naming ``what``."""
+    message = f"{what} must be an integer >= {minimum}, got {degree!r}"
     if isinstance(degree, bool | np.bool_):
-        raise ValueError(f"quadrature degree must be an integer >= 0, got {degree!r}")
+        raise ValueError(message)
     try:
         deg = operator.index(degree)
     except TypeError:
-        raise ValueError(f"quadrature degree must be an integer >= 0, got {degree!r}") from None
-    if deg < 0:
-        raise ValueError(f"quadrature degree must be an integer >= 0, got {deg}")
+        raise ValueError(message) from None
+    if deg < minimum:
+        raise ValueError(message)
     return deg
 
 
@@ -70,7 +74,7 @@ def exact_degree(degree: int) -> int:
     int
         The precise polynomial degree of the rule.
     """
-    deg = _check_degree(degree)
+    deg = _check_integer(degree)
     if deg <= 1:
         return 1
     if deg in (2, 3):
@@ -113,9 +117,7 @@ def _triangle_rule(deg: int) -> tuple[np.ndarray, np.ndarray]:
         xj, wj = roots_jacobi(n, 1.0, 0.0)
         s = 0.5 * (1.0 + xj)
         ws = 0.25 * wj
-        xl, wl = np.polynomial.legendre.leggauss(n)
-        t = 0.5 * (1.0 + xl)
-        wt = 0.5 * wl
+        t, wt = _gauss_legendre(n)
         S, T = np.meshgrid(s, t, indexing="ij")
         xi = np.column_stack([S.ravel(), (T * (1.0 - S)).ravel()])
         w = np.outer(ws, wt).ravel()
@@ -144,18 +146,41 @@ def triangle_rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
     ValueError
         If ``degree`` is not a non-negative integer.
     """
-    return _triangle_rule(_check_degree(degree))
+    return _triangle_rule(_check_integer(degree))
 
 
-@lru_cache(maxsize=64)
-def _line_rule(deg: int) -> tuple[np.ndarray, np.ndarray]:
-    n = deg // 2 + 1
+@cache
+def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
     x, w = np.polynomial.legendre.leggauss(n)
     return _frozen(0.5 * (1.0 + x), 0.5 * w)
 
 
+def gauss_legendre(n_points: int) -> tuple[np.ndarray, np.ndarray]:
+    """The ``n_points``-point Gauss-Legendre rule on [0, 1].
+
+    Parameters
+    ----------
+    n_points : int
+        Number of points, ``>= 1``; polynomials of degree ``<= 2 n_points - 1`` are
+        integrated exactly.
+
+    Returns
+    -------
+    t : ndarray of float64, shape (n_points,)
+        Points in (0, 1), increasing.
+    w : ndarray of float64, shape (n_points,)
+        Positive weights summing to 1.
+
+    Raises
+    ------
+    ValueError
+        If ``n_points`` is not an integer ``>= 1``.
+    """
+    return _gauss_legendre(_check_integer(n_points, "number of Gauss points", minimum=1))
+
+
 def line_rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre rule on [0, 1].
+    """Gauss-Legendre rule on [0, 1] for a polynomial degree.
 
     Parameters
     ----------
@@ -176,4 +201,4 @@ def line_rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
     ValueError
         If ``degree`` is not a non-negative integer.
     """
-    return _line_rule(_check_degree(degree))
+    return _gauss_legendre(_check_integer(degree) // 2 + 1)

@@ -1,0 +1,383 @@
+"""The seven terms of the residual estimator (paper, Section 5, (5.1)), one function each.
+
+Every term function takes arrays and returns the paper's integrals, one per cell (η1),
+per edge (η2–η5, η7) or per edge node (η6); the distributing helpers turn them into node
+contributions ``η_{k,p}²`` and cell shares. :func:`signorini.estimator.residual.estimate`
+is the table that calls them; docs/method.md, *Estimator*, states the choices.
+
+====  ===========================  ================================================
+term  function                     integral
+====  ===========================  ================================================
+η1    :func:`interior_residual`    ``‖f + div σ(u_h)‖²_T`` per cell
+η2    :func:`stress_jump`          ``‖⟦σ(u_h)⟧‖²_e`` per interior edge
+η3    :func:`neumann_residual`     ``‖σ(u_h)n − g‖²_e`` per Neumann edge
+η4    :func:`tangential_stress`    ``‖σ_t(u_h)‖²_e`` per contact edge
+η5    :func:`normal_stress`        ``‖σ_nn(u_h) [+ p_h]‖²_e`` per contact edge
+η6    :func:`complementarity`      ``s_p ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p`` per edge node
+η7    :func:`penetration`          share of ``‖(u_h·n − ψ)⁺‖²_{H^{1/2}(Γ_C)}``
+====  ===========================  ================================================
+
+The functions carry the names of what they measure; ``estimate`` files their results under
+the term names ``"eta1"`` … ``"eta7"`` (``eta2…`` names elsewhere are squared indicators).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..fem.edge_trace import evaluate, monomial_coefficients, roots_in_unit_interval
+from ..fem.p2 import edge_basis
+from ..fem.quadrature import gauss_legendre
+from ..mesh.geometry import segment_normals
+from .h_half_norm import hhalf_norm2_positive_part
+
+__all__ = [
+    "EdgeSet",
+    "TermShares",
+    "edge_traction",
+    "interior_residual",
+    "stress_jump",
+    "neumann_residual",
+    "tangential_stress",
+    "normal_stress",
+    "complementarity",
+    "penetration",
+    "boundary_cell_shares",
+    "spread_cell_integrals",
+    "spread_edge_integrals",
+    "spread_node_parts",
+    "third_integrals",
+]
+
+
+class EdgeSet(NamedTuple):
+    """The edges a term integrates over.
+
+    Attributes
+    ----------
+    index : (k,) int array
+        Mesh edge numbers.
+    nodes : (k, 3) int array
+        P2 nodes of each edge: its two vertices, then its midpoint.
+    cells : (k, 2) int array
+        The edge's cells (``edge2cell`` rows, ``-1`` outside the domain).
+    length : (k,) float array
+    """
+
+    index: np.ndarray
+    nodes: np.ndarray
+    cells: np.ndarray
+    length: np.ndarray
+
+
+class TermShares(NamedTuple):
+    """One term's contributions: ``node (n_nodes,)`` the ``η_{k,p}²`` (``None`` for the
+    global η7) and ``cell (n_cells,)`` each cell's share, summing to ``η_k²``."""
+
+    node: np.ndarray | None
+    cell: np.ndarray
+
+
+# --------------------------------------------------------------------------- distribution
+
+
+def spread_cell_integrals(R: np.ndarray, cell_nodes: np.ndarray, h_p: np.ndarray) -> TermShares:
+    """Cell integrals ``R_T`` enter ``η_{k,p}²`` with weight ``h_p²`` for each node p of T.
+
+    Parameters
+    ----------
+    R : (n_cells,) float array
+    cell_nodes : (n_cells, 6) int array
+    h_p : (n_nodes,) float array
+        Node mesh sizes, zero at Dirichlet nodes.
+
+    Returns
+    -------
+    TermShares
+        ``node = h_p² Σ_{T ∋ p} R_T``, ``cell = R_T Σ_{p ∈ T} h_p²``.
+    """
+    node = h_p**2 * np.bincount(cell_nodes.ravel(), weights=np.repeat(R, 6), minlength=h_p.size)
+    return TermShares(node, R * (h_p[cell_nodes] ** 2).sum(axis=1))
+
+
+def spread_edge_integrals(
+    edges: EdgeSet, J: np.ndarray, h_p: np.ndarray, n_cells: int
+) -> TermShares:
+    """Edge integrals ``J_e`` enter ``η_{k,p}²`` with weight ``h_p`` for each node p of e.
+
+    Each edge's total ``Σ_{p ∈ e} h_p J_e`` is split equally between its cells.
+
+    Parameters
+    ----------
+    edges : EdgeSet
+    J : (k,) float array
+    h_p : (n_nodes,) float array
+        Node mesh sizes, zero at Dirichlet nodes.
+    n_cells : int
+
+    Returns
+    -------
+    TermShares
+    """
+    node_part = h_p[edges.nodes] * J[:, None]
+    node = np.zeros(h_p.size)
+    np.add.at(node, edges.nodes.ravel(), node_part.ravel())
+    total = node_part.sum(axis=1)
+    c0, c1 = edges.cells[:, 0], edges.cells[:, 1]
+    two = c1 >= 0
+    cell = np.zeros(n_cells)
+    np.add.at(cell, c0, np.where(two, 0.5, 1.0) * total)
+    np.add.at(cell, c1[two], 0.5 * total[two])
+    return TermShares(node, cell)
+
+
+def spread_node_parts(edges: EdgeSet, parts: np.ndarray, n_nodes: int, n_cells: int) -> TermShares:
+    """Per-node parts ``(k, 3)`` of boundary edges to their nodes, each edge's total to its
+    cell.
+
+    Parameters
+    ----------
+    edges : EdgeSet
+        Boundary edges (one cell each); ``parts`` columns follow ``edges.nodes``.
+    parts : (k, 3) float array
+    n_nodes, n_cells : int
+
+    Returns
+    -------
+    TermShares
+    """
+    node = np.zeros(n_nodes)
+    np.add.at(node, edges.nodes.ravel(), parts.ravel())
+    return TermShares(node, boundary_cell_shares(edges, parts.sum(axis=1), n_cells))
+
+
+def boundary_cell_shares(edges: EdgeSet, values: np.ndarray, n_cells: int) -> np.ndarray:
+    """Values ``(k,)`` of boundary edges to their cells: ``(n_cells,)``."""
+    out = np.zeros(n_cells)
+    np.add.at(out, edges.cells[:, 0], values)
+    return out
+
+
+# --------------------------------------------------------------------------- σ(u_h) n on edges
+
+
+def edge_traction(
+    sigma_vertex: np.ndarray,
+    points: np.ndarray,
+    cells: np.ndarray,
+    cell: np.ndarray,
+    k: np.ndarray,
+    t: np.ndarray,
+) -> np.ndarray:
+    """``σ(u_h) n`` along local edge ``k`` of ``cell``, n the cell's outward normal.
+
+    σ(u_h) is linear on each cell (P2 displacements), so it is interpolated from its
+    values at the vertices.
+
+    Parameters
+    ----------
+    sigma_vertex : (n_cells, 3, 2, 2) float array
+        σ(u_h) of each cell at its vertices.
+    points, cells : mesh arrays
+    cell, k : (m,) int arrays
+        Cell and local edge of each edge.
+    t : (q,) float array
+        Parameters along the edge, in the cell's counter-clockwise direction.
+
+    Returns
+    -------
+    (m, q, 2) float array
+    """
+    s0 = sigma_vertex[cell, k]
+    s1 = sigma_vertex[cell, (k + 1) % 3]
+    sig = (1 - t)[None, :, None, None] * s0[:, None] + t[None, :, None, None] * s1[:, None]
+    _, n = segment_normals(points[cells[cell, k]], points[cells[cell, (k + 1) % 3]])
+    return np.einsum("eqij,ej->eqi", sig, n)
+
+
+# --------------------------------------------------------------------------- the terms
+
+
+def interior_residual(
+    area: np.ndarray,
+    div_sigma: np.ndarray,
+    f: np.ndarray | None = None,
+    w: np.ndarray | None = None,
+) -> np.ndarray:
+    """``R_T = ‖f + div σ(u_h)‖²_T`` per cell (η1).
+
+    Parameters
+    ----------
+    area : (n_cells,) float array
+    div_sigma : (n_cells, 2) float array
+        ``div σ(u_h)``, constant on each cell.
+    f : (n_cells, q, 2) float array, optional
+        The body force at the quadrature points; ``None`` for ``f = 0``.
+    w : (q,) float array, optional
+        Quadrature weights on the reference triangle (summing to 1/2).
+
+    Returns
+    -------
+    (n_cells,) float array
+    """
+    if f is None:
+        return area * (div_sigma**2).sum(axis=1)
+    r = f + div_sigma[:, None, :]
+    return 2 * area * np.einsum("q,mqc,mqc->m", w, r, r)
+
+
+def stress_jump(
+    traction_0: np.ndarray, traction_1: np.ndarray, w: np.ndarray, length: np.ndarray
+) -> np.ndarray:
+    """``‖⟦σ(u_h)⟧‖²_e`` per interior edge (η2).
+
+    Parameters
+    ----------
+    traction_0, traction_1 : (k, q, 2) float arrays
+        ``σ(u_h) n`` from each of the edge's cells with its own outward normal, at the same
+        points (so the jump is their sum).
+    w : (q,) float array
+        Weights on [0, 1].
+    length : (k,) float array
+    """
+    jump = traction_0 + traction_1
+    return length * np.einsum("q,eqi,eqi->e", w, jump, jump)
+
+
+def neumann_residual(residual: np.ndarray, w: np.ndarray, length: np.ndarray) -> np.ndarray:
+    """``‖σ(u_h) n − g‖²_e`` per Neumann edge (η3), from ``residual (k, q, 2)`` at the
+    points of the weights ``w (q,)``."""
+    return length * np.einsum("q,eqi,eqi->e", w, residual, residual)
+
+
+def tangential_stress(
+    traction: np.ndarray, normal: np.ndarray, w: np.ndarray, length: np.ndarray
+) -> np.ndarray:
+    """``‖σ_t(u_h)‖²_e`` per contact edge (η4).
+
+    Parameters
+    ----------
+    traction : (k, q, 2) float array
+        ``σ(u_h) n`` at the points of ``w``.
+    normal : (k, 2) float array
+        The contact part's outward unit normal.
+    w : (q,) float array
+    length : (k,) float array
+    """
+    snn = np.einsum("eqi,ei->eq", traction, normal)
+    st = traction - snn[..., None] * normal[:, None, :]
+    return length * np.einsum("q,eqi,eqi->e", w, st, st)
+
+
+def normal_stress(
+    traction: np.ndarray,
+    normal: np.ndarray,
+    t: np.ndarray,
+    w: np.ndarray,
+    length: np.ndarray,
+    pressure: np.ndarray | None = None,
+) -> np.ndarray:
+    """``‖σ_nn(u_h)‖²_e`` (``paper``) or ``‖σ_nn(u_h) + p_h‖²_e`` (``consistent``) (η5).
+
+    Parameters
+    ----------
+    traction : (k, q, 2) float array
+        ``σ(u_h) n`` at the points ``t``.
+    normal : (k, 2) float array
+    t, w : (q,) float arrays
+        Quadrature points and weights on [0, 1], in the edge's counter-clockwise direction.
+    length : (k,) float array
+    pressure : (k, 3) float array, optional
+        The nodal pressures ``p_z`` at ``[start, end, midpoint]`` (0 at Dirichlet nodes);
+        ``p_h`` is their quadratic interpolant. ``None`` for the ``paper`` variant.
+    """
+    snn = np.einsum("eqi,ei->eq", traction, normal)
+    if pressure is not None:
+        snn = snn + pressure @ edge_basis(t).T
+    return length * (w * snn**2).sum(axis=1)
+
+
+def complementarity(gap: np.ndarray, density: np.ndarray, length: np.ndarray) -> np.ndarray:
+    """``s_p d_p`` with ``d_p = ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p``, per contact edge node (η6).
+
+    Parameters
+    ----------
+    gap : (k, 3) float array
+        ``u_h·n − ψ_h`` at ``[start, end, midpoint]``.
+    density : (k, 3) float array
+        ``s_p`` at the same nodes where p is a semi-contact node, else 0.
+    length : (k,) float array
+
+    Returns
+    -------
+    (k, 3) float array
+        Each node's part from this edge.
+    """
+    return density * third_integrals(-gap, length)
+
+
+def penetration(x0: np.ndarray, x1: np.ndarray, gap: np.ndarray) -> np.ndarray:
+    """Each contact edge's share of ``η7² = ‖(u_h·n − ψ_h)⁺‖²_{H^{1/2}(Γ_C)}``.
+
+    Parameters
+    ----------
+    x0, x1 : (k, 2) float arrays
+        Start and end points of the contact edges.
+    gap : (k, 3) float array
+        ``u_h·n − ψ_h`` at ``[start, end, midpoint]``.
+
+    Returns
+    -------
+    (k,) float array
+    """
+    _, share = hhalf_norm2_positive_part(x0, x1, gap, validate=False)
+    return share
+
+
+# --------------------------------------------------------------------------- η6's integrals
+
+#: sub-intervals of [0, 1] where a half-edge hat φ of Q^h (3.6) is linear:
+#: ``(lo, hi, column, (φ(0), φ'))`` with column 0, 1, 2 = start, end, midpoint
+_HAT_PIECES = (
+    (0.0, 1 / 3, 0, (1.0, -2.0)),
+    (2 / 3, 1.0, 1, (-1.0, 2.0)),
+    (1 / 3, 0.5, 2, (0.0, 2.0)),
+    (0.5, 2 / 3, 2, (2.0, -2.0)),
+)
+
+
+def third_integrals(v: np.ndarray, length: np.ndarray) -> np.ndarray:
+    """∫ v⁺ φ_p over the thirds γ̃_p of each edge (docs/method.md, *Estimator*, paper (4.12)).
+
+    Exact: each linear piece of φ is cut at the roots of v, and on each sub-interval the
+    product of the quadratic and the linear hat is integrated by a 3-point Gauss rule
+    (degree 5 ≥ 3).
+
+    Parameters
+    ----------
+    v : (k, 3) float array
+        A quadratic on each edge, by its values at ``[start, end, midpoint]``.
+    length : (k,) float array
+
+    Returns
+    -------
+    (k, 3) float array
+        ``[∫_{start third} v⁺ φ_start, ∫_{end third} v⁺ φ_end, ∫_{middle third} v⁺ φ_mid]``
+        where φ are the half-edge hats of Q^h (3.6).
+    """
+    v = np.asarray(v, dtype=np.float64)
+    coef = monomial_coefficients(v)
+    roots = roots_in_unit_interval(coef)  # (k, 2), NaN where none
+    gt, gw = gauss_legendre(3)
+    out = np.zeros(v.shape)
+    for lo, hi, col, (p0, p1) in _HAT_PIECES:
+        r = np.where(np.isnan(roots), lo, np.clip(roots, lo, hi))
+        bounds = np.sort(np.column_stack([np.full(len(v), lo), r, np.full(len(v), hi)]), axis=1)
+        for j in range(3):
+            x0, x1 = bounds[:, j : j + 1], bounds[:, j + 1 : j + 2]
+            tq = x0 + (x1 - x0) * gt
+            vq = evaluate(coef, tq)
+            out[:, col] += (x1 - x0)[:, 0] * (gw * np.maximum(vq, 0.0) * (p0 + p1 * tq)).sum(axis=1)
+    return out * np.asarray(length)[:, None]
