@@ -277,7 +277,7 @@ def test_indicator_bookkeeping(name, seed):
     # element indicators sum to η_h², term by term and in total
     assert est.eta2.sum() == pytest.approx(est.eta**2, rel=1e-13)
     assert est.eta2_terms.sum() == pytest.approx(est.eta**2, rel=1e-13)
-    np.testing.assert_allclose(est.eta_terms, [est.as_dict()[f"eta{k}"] for k in range(1, 8)])
+    np.testing.assert_allclose(est.eta_terms, [est.as_dict()[f"eta_{k}"] for k in range(1, 8)])
     # each η_k², k ≤ 6, is the sum of its node contributions
     np.testing.assert_allclose(
         est.eta2_node.sum(axis=1), est.eta2_terms[:6], rtol=1e-12, atol=1e-14 * est.eta**2
@@ -289,7 +289,7 @@ def test_indicator_bookkeeping(name, seed):
     np.testing.assert_array_equal(est.eta2_node[:, dirichlet], 0.0)
     if problem.body_force is not None:
         assert np.all(
-            est.eta2_node[ROW["eta1"], ~dirichlet] > 0
+            est.eta2_node[ROW["eta_1"], ~dirichlet] > 0
         )  # f + div σ(u_h) ≠ 0 on every patch
     cs = result.contact
     on_contact = np.zeros(n_nodes, dtype=bool)
@@ -298,13 +298,13 @@ def test_indicator_bookkeeping(name, seed):
     neumann[result.space.part_nodes(problem.neumann_parts)] = True
     semi = np.zeros(n_nodes, dtype=bool)
     semi[cs.nodes[result.classes == SEMI_CONTACT]] = True
-    np.testing.assert_array_equal(est.eta2_node[ROW["eta3"], ~neumann], 0.0)
-    np.testing.assert_array_equal(est.eta2_node[ROW["eta4"] : ROW["eta5"] + 1, ~on_contact], 0.0)
-    np.testing.assert_array_equal(est.eta2_node[ROW["eta6"], ~semi], 0.0)
+    np.testing.assert_array_equal(est.eta2_node[ROW["eta_3"], ~neumann], 0.0)
+    np.testing.assert_array_equal(est.eta2_node[ROW["eta_4"] : ROW["eta_5"] + 1, ~on_contact], 0.0)
+    np.testing.assert_array_equal(est.eta2_node[ROW["eta_6"], ~semi], 0.0)
     # η7 lives on the cells along Γ_C
     touching = np.zeros(mesh.n_cells, dtype=bool)
     touching[mesh.edge2cell[cs.edges, 0]] = True
-    np.testing.assert_array_equal(est.eta2_cell[ROW["eta7"], ~touching], 0.0)
+    np.testing.assert_array_equal(est.eta2_cell[ROW["eta_7"], ~touching], 0.0)
     print(f"{name} seed {seed}: eta = {est.eta:.6e}, terms = {np.round(est.eta_terms, 6)}")
 
 
@@ -314,10 +314,10 @@ def test_eta3_vanishes_without_neumann_parts():
         result = solve(problem, random_nvb(problem.mesh, seed))
         est = estimate(result)
         terms = est.as_dict()
-        assert terms["eta3"] == 0.0
-        np.testing.assert_array_equal(est.eta2_cell[ROW["eta3"]], 0.0)
-        np.testing.assert_array_equal(est.eta2_node[ROW["eta3"]], 0.0)
-        assert terms["eta1"] > 0 and terms["eta2"] > 0
+        assert terms["eta_3"] == 0.0
+        np.testing.assert_array_equal(est.eta2_cell[ROW["eta_3"]], 0.0)
+        np.testing.assert_array_equal(est.eta2_node[ROW["eta_3"]], 0.0)
+        assert terms["eta_1"] > 0 and terms["eta_2"] > 0
 
 
 def test_full_contact_has_no_eta6_eta7():
@@ -326,7 +326,7 @@ def test_full_contact_has_no_eta6_eta7():
     result = solve(problem, random_nvb(problem.mesh, 5))
     assert np.all(result.classes == FULL_CONTACT)
     est = estimate(result)
-    assert est.as_dict()["eta6"] == 0.0 and est.as_dict()["eta7"] == 0.0
+    assert est.as_dict()["eta_6"] == 0.0 and est.as_dict()["eta_7"] == 0.0
 
 
 # ---------------------------------------------------------------------------- independent values
@@ -344,7 +344,7 @@ def test_node_terms_against_independent_computation(name, steps, eta5):
         print(f"{name} steps={steps} {eta5}: eta{k + 1} node max rel. deviation {err:.2e}")
         rtol = 1e-9  # the Neumann data of Example 6.1 is not polynomial: fine rules on both sides
         np.testing.assert_allclose(
-            est.eta2_node[k], ref[k], rtol=rtol, atol=rtol * scale / 100, err_msg=f"eta{k + 1}"
+            est.eta2_node[k], ref[k], rtol=rtol, atol=rtol * scale / 100, err_msg=f"eta_{k + 1}"
         )
 
 
@@ -362,9 +362,9 @@ def test_eta6_against_quadrature():
         genuine += ref.max() > 1e3 * atol
         print(
             f"6.2 ndof {result.ndof}: eta6^2 = {ref.sum():.6e} (quad), "
-            f"{est.eta2_terms[ROW['eta6']]:.6e} (estimator)"
+            f"{est.eta2_terms[ROW['eta_6']]:.6e} (estimator)"
         )
-        np.testing.assert_allclose(est.eta2_node[ROW["eta6"]], ref, rtol=1e-8, atol=atol)
+        np.testing.assert_allclose(est.eta2_node[ROW["eta_6"]], ref, rtol=1e-8, atol=atol)
     assert genuine >= 3
 
 
@@ -401,7 +401,7 @@ def test_eta7_from_independently_built_edge_data():
         est = estimate(result)
         x0, x1, w, edges = independent_penetration(result)
         total, share = hhalf_norm2_positive_part(x0, x1, w)
-        eta7_2 = est.eta2_terms[ROW["eta7"]]
+        eta7_2 = est.eta2_terms[ROW["eta_7"]]
         cells = np.zeros(result.mesh.n_cells)
         np.add.at(cells, result.mesh.edge2cell[edges, 0], share)
         l2 = 0.0
@@ -419,7 +419,7 @@ def test_eta7_from_independently_built_edge_data():
         print(f"ndof {result.ndof}: eta7^2 = {eta7_2:.4e}, L2 part {l2:.4e}, max w+ {max_w:.2e}")
         assert eta7_2 == pytest.approx(total, rel=1e-12, abs=1e-300)
         np.testing.assert_allclose(
-            est.eta2_cell[ROW["eta7"]], cells, rtol=1e-10, atol=1e-14 * total
+            est.eta2_cell[ROW["eta_7"]], cells, rtol=1e-10, atol=1e-14 * total
         )
         assert l2_norm2_positive_part(x0, x1, w)[0] == pytest.approx(l2, rel=1e-9, abs=1e-300)
         assert eta7_2 >= l2 * (1 - 1e-9)
@@ -444,13 +444,13 @@ def test_eta5_variants_on_uniform_meshes_example_6_1():
     for _ in range(4):
         result = solve(problem, mesh)
         ests = {v: estimate(result, eta5=v) for v in ETA5_VARIANTS}
-        other = [ROW[name] for name in TERMS if name != "eta5"]
+        other = [ROW[name] for name in TERMS if name != "eta_5"]
         np.testing.assert_array_equal(
             ests["paper"].eta2_cell[other], ests["consistent"].eta2_cell[other]
         )
         ndof.append(result.ndof)
         for v in ETA5_VARIANTS:
-            eta5[v].append(ests[v].as_dict()["eta5"])
+            eta5[v].append(ests[v].as_dict()["eta_5"])
             eta[v].append(ests[v].eta)
         mesh = refine_uniform(mesh).mesh
     s_paper, s_cons = slope(ndof, eta5["paper"]), slope(ndof, eta5["consistent"])
@@ -491,6 +491,6 @@ def test_problem_without_contact_has_no_contact_terms():
     )
     est = estimate(solve(problem))
     terms = est.as_dict()
-    assert [terms[f"eta{k}"] for k in (4, 5, 6, 7)] == [0.0] * 4
-    assert terms["eta1"] > 0 and terms["eta3"] > 0
+    assert [terms[f"eta_{k}"] for k in (4, 5, 6, 7)] == [0.0] * 4
+    assert terms["eta_1"] > 0 and terms["eta_3"] > 0
     assert est.eta2.sum() == pytest.approx(est.eta**2, rel=1e-14)

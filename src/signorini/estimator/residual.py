@@ -64,7 +64,7 @@ __all__ = ["ETA5_VARIANTS", "TERMS", "Estimate", "estimate"]
 
 ETA5_VARIANTS = ("consistent", "paper")
 #: the terms of (5.1), in the row order of ``Estimate.eta2_cell`` and ``Estimate.eta2_node``
-TERMS = ("eta1", "eta2", "eta3", "eta4", "eta5", "eta6", "eta7")
+TERMS = ("eta_1", "eta_2", "eta_3", "eta_4", "eta_5", "eta_6", "eta_7")
 #: line quadrature degree for the polynomial edge terms η2, η4, η5 (σ(u_h) is linear)
 EDGE_DEGREE = 7
 #: line quadrature degree for the Neumann residual with non-polynomial data g: finer, so
@@ -114,7 +114,7 @@ class Estimate:
         return float(np.sqrt(self.eta2_cell.sum()))
 
     def as_dict(self) -> dict[str, float]:
-        """``{"eta": η_h, "eta1": η1, …, "eta7": η7}``."""
+        """``{"eta": η_h, "eta_1": η1, …, "eta_7": η7}``, the names of the history columns."""
         out = {"eta": self.eta}
         out.update({name: float(v) for name, v in zip(TERMS, self.eta_terms, strict=True)})
         return out
@@ -164,22 +164,22 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
         return spread_edge_integrals(edges, J, h_p, n_cells)
 
     shares = {
-        "eta1": spread_cell_integrals(
+        "eta_1": spread_cell_integrals(
             interior_residual(mesh.area, div_sigma, f, w_cell), space.cell_nodes, h_p
         ),
-        "eta2": on_edges(inner, stress_jump(*jump, w, inner.length)),
-        "eta3": on_edges(neumann, neumann_residual(misfit, w_n, neumann.length)),
-        "eta4": on_edges(contact, tangential_stress(contact_traction, normal, w, contact.length)),
-        "eta5": on_edges(
+        "eta_2": on_edges(inner, stress_jump(*jump, w, inner.length)),
+        "eta_3": on_edges(neumann, neumann_residual(misfit, w_n, neumann.length)),
+        "eta_4": on_edges(contact, tangential_stress(contact_traction, normal, w, contact.length)),
+        "eta_5": on_edges(
             contact, normal_stress(contact_traction, normal, t, w, contact.length, pressure)
         ),
-        "eta6": spread_node_parts(
+        "eta_6": spread_node_parts(
             contact,
             complementarity(gap, _semi_contact_density(result), contact.length),
             n_nodes,
             n_cells,
         ),
-        "eta7": TermShares(None, boundary_cell_shares(contact, penetration(x0, x1, gap), n_cells)),
+        "eta_7": TermShares(None, boundary_cell_shares(contact, penetration(x0, x1, gap), n_cells)),
     }
     return Estimate(
         eta2_cell=np.stack([shares[name].cell for name in TERMS]),

@@ -18,7 +18,7 @@ term  function                     integral
 ====  ===========================  ================================================
 
 The functions carry the names of what they measure; ``estimate`` files their results under
-the term names ``"eta1"`` … ``"eta7"`` (``eta2…`` names elsewhere are squared indicators).
+the term names ``"eta_1"`` … ``"eta_7"`` (``eta2…`` names elsewhere are squared indicators).
 """
 
 from __future__ import annotations
