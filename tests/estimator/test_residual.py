@@ -17,10 +17,10 @@ from signorini.contact.contact_set import FULL_CONTACT, SEMI_CONTACT
 from signorini.contact.solution import solve
 from signorini.estimator.residual import ETA5_VARIANTS, estimate, third_integrals
 from signorini.examples import example_6_1, example_6_2
-from signorini.fem.elasticity import Material
+from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle
 from signorini.mesh.refine import refine_nvb, refine_uniform
-from signorini.problem.problem import Contact, ContactProblem, Dirichlet, Neumann
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
 
 EXAMPLES = {"6.1": example_6_1, "6.2": example_6_2}
 

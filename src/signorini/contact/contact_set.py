@@ -20,7 +20,9 @@ from functools import cached_property
 import numpy as np
 
 from ..fem.space import P2Space
-from ..problem.problem import Contact, ContactProblem, ProblemError
+from ..problem.conditions import Contact
+from ..problem.fields import ProblemError, evaluate_field
+from ..problem.problem import ContactProblem
 
 __all__ = [
     "ContactSet",
@@ -154,7 +156,9 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     for i, p in enumerate(parts):
         sel = edge_part == i
         cond: Contact = problem.conditions[p]
-        edge_gap[sel] = cond.gap_values(x[sel], p)
+        edge_gap[sel] = evaluate_field(
+            cond.gap_field(), x[sel], f"the gap function of contact part {p!r}", shape=()
+        )
 
     dirichlet = problem.dirichlet_nodes(space)
     nodes = np.setdiff1d(np.unique(edge_nodes), dirichlet)

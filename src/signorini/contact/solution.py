@@ -15,9 +15,10 @@ import numpy as np
 
 from ..algebra.linsolve import make_solver
 from ..algebra.pdas import PDASResult, solve_pdas
-from ..fem.elasticity import energy_error2, h1_seminorm_error2
+from ..fem.norms import energy_error2, h1_seminorm_error2
 from ..fem.space import P2Space
 from ..mesh.mesh import Mesh
+from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
 from .frames import to_cartesian
@@ -106,10 +107,13 @@ class ContactResult:
         if exact is None:
             raise ValueError(f"{self.problem.name} has no exact solution")
         u_cell = self.space.cell_values(self.u)
-        energy = energy_error2(
-            self.space.vertices, u_cell, exact.gradient, self.problem.material, degree=degree
-        )
-        h1 = h1_seminorm_error2(self.space.vertices, u_cell, exact.gradient, degree=degree)
+
+        def gradient(x: np.ndarray) -> np.ndarray:
+            return evaluate_field(exact.gradient, x, "the exact gradient", shape=(2, 2))
+
+        vertices, material = self.space.vertices, self.problem.material
+        energy = energy_error2(vertices, u_cell, gradient, material, degree=degree)
+        h1 = h1_seminorm_error2(vertices, u_cell, gradient, degree=degree)
         return {"error_energy": float(np.sqrt(energy.sum())), "error_h1": float(np.sqrt(h1.sum()))}
 
 

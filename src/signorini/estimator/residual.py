@@ -32,11 +32,13 @@ import numpy as np
 
 from ..contact.contact_set import SEMI_CONTACT
 from ..contact.solution import ContactResult
-from ..fem.elasticity import div_stress, stress
+from ..fem.material import stress
 from ..fem.p2 import REFERENCE_NODES, edge_basis, field_gradients, physical_points
+from ..fem.postprocess import div_stress
 from ..fem.quadrature import line_rule, triangle_rule
 from ..mesh.geometry import segment_normals
-from ..problem.problem import Neumann, evaluate_field
+from ..problem.conditions import Neumann
+from ..problem.fields import evaluate_field
 from .hhalf import hhalf_norm2_positive_part
 
 __all__ = ["Estimate", "estimate", "ETA5_VARIANTS", "third_integrals"]
