@@ -19,7 +19,7 @@ from signorini.algebra.pdas import (
     kkt_residuals,
     solve_pdas,
 )
-from signorini.contact.frames import rotate_frames, to_cartesian
+from signorini.contact.node_frames import rotate_frames, to_cartesian
 
 BACKEND_LIST = available_backends()
 

@@ -71,8 +71,8 @@ def test_weights_on_a_uniform_mesh():
     end = np.isclose(x[:, 0], 0) | np.isclose(x[:, 0], 1)
     expect_m = np.where(cs.is_vertex, np.where(end, h / 4, h / 2), h / 2)
     expect_w = np.where(cs.is_vertex, np.where(end, h / 6, h / 3), 2 * h / 3)
-    assert np.allclose(cs.lumped, expect_m, rtol=1e-14)
-    assert np.allclose(cs.simpson, expect_w, rtol=1e-14)
+    assert np.allclose(cs.hat_integral, expect_m, rtol=1e-14)
+    assert np.allclose(cs.basis_integral, expect_w, rtol=1e-14)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -82,16 +82,16 @@ def test_weights_sum_to_the_contact_length(seed):
     lengths = mesh.edge_length[mesh.part_edges("bottom")]
     print(
         f"seed {seed}: {cs.size} constrained nodes, edge lengths "
-        f"{lengths.min():.4f}..{lengths.max():.4f}, Σm = {cs.lumped.sum():.15f}, "
-        f"Σw = {cs.simpson.sum():.15f}"
+        f"{lengths.min():.4f}..{lengths.max():.4f}, Σm = {cs.hat_integral.sum():.15f}, "
+        f"Σw = {cs.basis_integral.sum():.15f}"
     )
     assert lengths.min() < lengths.max() / 3  # a graded contact boundary
-    assert cs.lumped.sum() == pytest.approx(2.0, rel=1e-14)
-    assert cs.simpson.sum() == pytest.approx(2.0, rel=1e-14)
+    assert cs.hat_integral.sum() == pytest.approx(2.0, rel=1e-14)
+    assert cs.basis_integral.sum() == pytest.approx(2.0, rel=1e-14)
     # ∫ψ_z of the P2 basis is |e|/6 per edge at a vertex, 2|e|/3 at a midpoint
     mid = ~cs.is_vertex
-    assert np.allclose(cs.simpson[mid], 4 / 3 * cs.lumped[mid], rtol=1e-14)
-    assert np.allclose(cs.simpson[~mid], 2 / 3 * cs.lumped[~mid], rtol=1e-14)
+    assert np.allclose(cs.basis_integral[mid], 4 / 3 * cs.hat_integral[mid], rtol=1e-14)
+    assert np.allclose(cs.basis_integral[~mid], 2 / 3 * cs.hat_integral[~mid], rtol=1e-14)
 
 
 def test_dirichlet_nodes_are_not_constrained():
@@ -111,8 +111,8 @@ def test_dirichlet_nodes_are_not_constrained():
     x = space.node_points[cs.nodes]
     assert cs.size == 8  # 9 nodes on the bottom minus the corner (0, 0)
     assert np.all(x[:, 0] > 0.1) and np.allclose(x[:, 1], 0)
-    # the corner's share of the first edge is missing from the lumped weights
-    assert cs.lumped.sum() == pytest.approx(1 - 0.25 / 4, rel=1e-14)
+    # the corner's share of the first edge is missing from m_z
+    assert cs.hat_integral.sum() == pytest.approx(1 - 0.25 / 4, rel=1e-14)
     assert cs.edge_gap.shape == (4, 3) and np.allclose(cs.edge_gap, 0.01)
 
 
@@ -144,7 +144,7 @@ def test_uniform_pressure_density_and_pressure(seed):
     assert np.allclose(r.density[v], 2 * p / 3, rtol=1e-10)
     assert np.allclose(r.density[~v], 4 * p / 3, rtol=1e-10)
     assert r.total_contact_force == pytest.approx(p * 1.5, rel=1e-10)
-    assert r.contact.lumped.sum() == pytest.approx(1.5, rel=1e-14)
+    assert r.contact.hat_integral.sum() == pytest.approx(1.5, rel=1e-14)
 
 
 @pytest.mark.parametrize("seed", [5, 6])

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from contact_problems import independent_system, patch_problem, random_quadratic
 
-from signorini.contact.frames import rotate_frames
+from signorini.contact.node_frames import rotate_frames
 from signorini.contact.system import assemble
 from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle

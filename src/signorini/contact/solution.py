@@ -21,7 +21,7 @@ from ..mesh.mesh import Mesh
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
-from .frames import to_cartesian
+from .node_frames import to_cartesian
 from .system import Assembled, assemble
 
 __all__ = ["ContactResult", "solve"]
@@ -75,13 +75,13 @@ class ContactResult:
     @property
     def density(self) -> np.ndarray:
         """The paper's discrete contact force density ``s_z = Λ_z / m_z`` (4.1)."""
-        return self.contact_force / self.contact.lumped
+        return self.contact_force / self.contact.hat_integral
 
     @property
     def pressure(self) -> np.ndarray:
-        """Consistent nodal contact pressure ``p_z = Λ_z / ∫ψ_z`` (docs/method.md, *Discrete
-        problem*)."""
-        return self.contact_force / self.contact.simpson
+        """Consistent nodal contact pressure ``p_z = Λ_z / w_z``, ``w_z = ∫ψ_z`` (docs/method.md,
+        *Discrete problem*)."""
+        return self.contact_force / self.contact.basis_integral
 
     @property
     def total_contact_force(self) -> float:

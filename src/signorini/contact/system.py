@@ -19,7 +19,7 @@ from ..problem.conditions import Dirichlet, Neumann
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, contact_set
-from .frames import rotate_frames
+from .node_frames import rotate_frames
 
 __all__ = ["Assembled", "assemble", "LOAD_DEGREE"]
 
@@ -89,5 +89,5 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     dirichlet = np.column_stack([2 * d_nodes, 2 * d_nodes + 1]).ravel()
 
     cs = contact_set(problem, space)
-    K, F = rotate_frames(K, F, cs.nodes, cs.normal)
+    K, F = rotate_frames(K, F, cs.nodes, cs.normal, copy=False, validate=False)
     return Assembled(space, cs, K, F, dirichlet, d_values.ravel(), time.perf_counter() - t0)
