@@ -77,9 +77,9 @@ def _stiffness_basis(lam: float, mu: float, dof_order: bool) -> np.ndarray:
     return out
 
 
-def _geometric_factors(vertices: np.ndarray) -> np.ndarray:
-    """The 10 independent ``det J * Jit[i, k] * Jit[j, l]``, shape (m, 10)."""
-    J, det = p2.jacobian(vertices)
+def _geometric_factors(J: np.ndarray, det: np.ndarray) -> np.ndarray:
+    """The 10 independent ``det J * Jit[i, k] * Jit[j, l]`` of Jacobians ``J (m, 2, 2)`` with
+    determinants ``det (m,)``, shape (m, 10)."""
     jit = p2.inverse_transpose(J, det)
     out = np.empty((J.shape[0], len(_P_PAIRS)))
     for s, ((i, j, k, el), _) in enumerate(_P_PAIRS):
@@ -88,9 +88,11 @@ def _geometric_factors(vertices: np.ndarray) -> np.ndarray:
     return out
 
 
-def _element_matrices(vertices: np.ndarray, material: Material, dof_order: bool) -> np.ndarray:
+def _element_matrices(
+    J: np.ndarray, det: np.ndarray, material: Material, dof_order: bool
+) -> np.ndarray:
     """Element stiffness, shape (m, 144): (a, b, i, j) layout, or (a, i, b, j) if ``dof_order``."""
-    fac = _geometric_factors(vertices)
+    fac = _geometric_factors(J, det)
     return fac @ _stiffness_basis(material.lam, material.mu, dof_order)
 
 
@@ -114,7 +116,8 @@ def element_stiffness(vertices: np.ndarray, material: Material) -> np.ndarray:
         Symmetric positive semidefinite matrices, interleaved local DOF order
         ``2 * local_node + component``.
     """
-    return _element_matrices(vertices, material, dof_order=True).reshape(-1, 12, 12)
+    J, det = p2.jacobian(vertices)
+    return _element_matrices(J, det, material, dof_order=True).reshape(-1, 12, 12)
 
 
 def _assemble_node_blocks(
@@ -171,9 +174,9 @@ def _assemble_node_blocks(
 
 def _checked_input(
     vertices: np.ndarray, cell_dofs: np.ndarray, n_dofs: int, material: Material
-) -> tuple[np.ndarray, np.ndarray, int]:
-    """Validate the raw arrays of :func:`assemble_stiffness`; return vertices, cell nodes and
-    ``n_dofs``."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
+    """Validate the raw arrays of :func:`assemble_stiffness`; return the Jacobians and their
+    determinants, the cell nodes and ``n_dofs``."""
     try:
         n = int(n_dofs)
     except (TypeError, ValueError):
@@ -190,7 +193,7 @@ def _checked_input(
     if not np.all(np.isfinite(v)):
         bad = np.flatnonzero(~np.isfinite(v).all(axis=(1, 2)))
         raise ValueError(f"vertices of {bad.size} cell(s) are not finite (first: cell {bad[0]})")
-    _, det = p2.jacobian(v)
+    J, det = p2.jacobian(v)
     if not np.all(det > 0.0):
         bad = np.flatnonzero(~(det > 0.0))
         raise ValueError(
@@ -214,7 +217,7 @@ def _checked_input(
             "cell_dofs must be interleaved: cell_dofs[:, 2a] = 2 * node_a and "
             "cell_dofs[:, 2a + 1] = 2 * node_a + 1"
         )
-    return v, ev.astype(np.int64, copy=False) // 2, n
+    return J, det, ev.astype(np.int64, copy=False) // 2, n
 
 
 def assemble_stiffness(
@@ -257,10 +260,10 @@ def assemble_stiffness(
         :class:`Material`.
     """
     if validate:
-        v, nodes, n = _checked_input(vertices, cell_dofs, n_dofs, material)
+        J, det, nodes, n = _checked_input(vertices, cell_dofs, n_dofs, material)
     else:
-        v = np.asarray(vertices, dtype=np.float64)
+        J, det = p2.jacobian(vertices)
         nodes = np.asarray(cell_dofs, dtype=np.int64)[:, 0::2] // 2
         n = int(n_dofs)
-    blocks = _element_matrices(v, material, dof_order=False).reshape(-1, 6, 6, 2, 2)
+    blocks = _element_matrices(J, det, material, dof_order=False).reshape(-1, 6, 6, 2, 2)
     return _assemble_node_blocks(nodes, n // 2, blocks)
