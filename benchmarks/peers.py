@@ -23,8 +23,9 @@ import numpy as np
 
 from signorini import example_6_2, rectangle
 from signorini.contact.solution import solve
-from signorini.fem.elasticity import Material, assemble_stiffness
+from signorini.fem.material import Material
 from signorini.fem.space import P2Space
+from signorini.fem.stiffness import assemble_stiffness
 from signorini.runtime import retain_freed_memory
 
 MATERIAL = Material.from_young(500.0, 0.3)

@@ -1,15 +1,16 @@
 """Problems with known discrete solutions, and an independent assembly, for the solver tests.
 
 - :class:`Quadratic`: a quadratic displacement ``u_i = c_i + G_ij x_j + H_ijk x_j x_k / 2`` with
-  its gradient, stress and ``div σ`` in closed form, and its rotated copy.
+  its gradient, Hessian, stress and ``div σ`` in closed form (Hooke's law written out here, not
+  taken from the package), and its rotated copy.
 - :func:`patch_problem`: a :class:`~signorini.problem.ContactProblem` whose exact solution is a
   given quadratic (the discrete solution must reproduce it at every node).
 - :func:`contact_patch_field`: a random quadratic with zero tangential and compressive normal
   stress on the bottom edge ``y = 0`` (normal ``(0, −1)``), so that it solves a Signorini
   problem with the gap ``ψ = u·n`` and every contact node active.
 - :func:`independent_system`: Cartesian ``K``, ``F`` and Dirichlet data assembled from the mesh
-  with :mod:`signorini.fem.elasticity` only (no rotated frames, no
-  :mod:`signorini.contact.solution`).
+  with :mod:`signorini.fem.stiffness` and :mod:`signorini.fem.loads` only (no rotated frames,
+  no :mod:`signorini.contact`).
 """
 
 from __future__ import annotations
@@ -18,15 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from signorini.fem.elasticity import (
-    Material,
-    assemble_body_force,
-    assemble_edge_load,
-    assemble_stiffness,
-    stress,
-)
+from signorini.fem.loads import assemble_body_force, assemble_edge_load
+from signorini.fem.material import Material
+from signorini.fem.stiffness import assemble_stiffness
 from signorini.mesh.mesh import Mesh
-from signorini.problem.problem import Contact, ContactProblem, Dirichlet, Neumann
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
 
 
 def rotation(angle_deg: float) -> np.ndarray:
@@ -54,6 +51,17 @@ class Quadratic:
     def gradient(self, x: np.ndarray) -> np.ndarray:
         x = np.asarray(x, dtype=float)
         return self.G + np.einsum("ijk,...k->...ij", self.H, x)
+
+    def hessian(self) -> np.ndarray:
+        """``∂²u_i / ∂x_j ∂x_k = H_ijk`` (constant)."""
+        return self.H
+
+    def stress(self, x: np.ndarray, material: Material) -> np.ndarray:
+        """``σ(u) = λ tr ε I + 2 μ ε`` at ``x (..., 2)``, shape ``(..., 2, 2)``."""
+        g = self.gradient(x)
+        eps = 0.5 * (g + np.swapaxes(g, -1, -2))
+        tr = eps[..., 0, 0] + eps[..., 1, 1]
+        return material.lam * tr[..., None, None] * np.eye(2) + 2 * material.mu * eps
 
     def div_stress(self, material: Material) -> np.ndarray:
         """``(div σ(u))_i = (λ + μ) ∂_i div u + μ Δu_i`` (a constant vector)."""
@@ -109,7 +117,7 @@ def patch_problem(
     f = -u.div_stress(material)
 
     def traction(x, n):
-        sig = stress(material, u.gradient(x))
+        sig = u.stress(x, material)
         return np.einsum("...ij,...j->...i", sig, np.broadcast_to(n, x.shape))
 
     conditions = {}

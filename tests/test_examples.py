@@ -13,12 +13,13 @@ import pytest
 
 from signorini.contact.solution import solve
 from signorini.examples import EXAMPLES, example_6_1, example_6_2, get_example
-from signorini.fem.elasticity import assemble_stiffness, stress
+from signorini.fem.material import stress
 from signorini.fem.p2 import physical_points
 from signorini.fem.quadrature import triangle_rule
+from signorini.fem.stiffness import assemble_stiffness
 from signorini.mesh.refine import refine_uniform
 from signorini.output import fitted_slope
-from signorini.problem.problem import Contact, Dirichlet, Neumann
+from signorini.problem import Contact, Dirichlet, Neumann
 
 # 4 x 4 squares and four uniform refinements: up to 33,024 unknowns (Example 6.1: ~4 s, so
 # its tests are marked slow; Example 6.2: ~2 s)

@@ -14,9 +14,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .fem.elasticity import Material, stress
+from .fem.material import Material, stress
 from .mesh.builders import rectangle
-from .problem.problem import Contact, ContactProblem, Dirichlet, ExactSolution, Neumann
+from .problem import Contact, ContactProblem, Dirichlet, ExactSolution, Neumann
 
 __all__ = ["example_6_1", "example_6_2", "EXAMPLES", "get_example"]
 

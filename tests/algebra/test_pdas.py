@@ -27,7 +27,7 @@ from signorini.algebra import (
     make_solver,
     solve_pdas,
 )
-from signorini.contact.frames import rotate_frames, to_cartesian
+from signorini.contact.node_frames import rotate_frames, to_cartesian
 
 BACKEND_LIST = available_backends()
 

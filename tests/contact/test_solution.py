@@ -25,11 +25,19 @@ from scipy.optimize import LinearConstraint, minimize, nnls
 
 from signorini.contact.solution import solve
 from signorini.examples import example_6_1, example_6_2
-from signorini.fem.elasticity import Material
+from signorini.fem.material import Material
+from signorini.fem.norms import energy_error2, h1_seminorm_error2
 from signorini.mesh.builders import rectangle
 from signorini.mesh.mesh import Mesh
 from signorini.mesh.refine import refine_nvb, refine_uniform
-from signorini.problem.problem import Contact, ContactProblem, Dirichlet, Neumann
+from signorini.problem import (
+    Contact,
+    ContactProblem,
+    Dirichlet,
+    ExactSolution,
+    Neumann,
+    ProblemError,
+)
 
 MATERIAL = Material.from_young(7.0, 0.28)
 EXAMPLES = {"6.1": example_6_1, "6.2": example_6_2}
@@ -407,3 +415,23 @@ def test_u0_with_nan():
     u0[3, 1] = np.nan
     with pytest.raises(ValueError, match="u0 contains NaN"):
         solve(pb, u0=u0)
+
+
+def test_errors_check_the_exact_gradient():
+    pb = example_6_1(nx=2)
+    r = solve(pb)
+    # checking the user's gradient does not change the numbers
+    u_cell = r.space.cell_values(r.u)
+    e2 = energy_error2(r.space.vertices, u_cell, pb.exact.gradient, pb.material)
+    h2 = h1_seminorm_error2(r.space.vertices, u_cell, pb.exact.gradient)
+    assert r.errors() == {"error_energy": np.sqrt(e2.sum()), "error_h1": np.sqrt(h2.sum())}
+    bad = ContactProblem(
+        pb.mesh,
+        pb.material,
+        pb.conditions,
+        body_force=pb.body_force,
+        exact=ExactSolution(pb.exact.displacement, lambda x: x),
+        name=pb.name,
+    )
+    with pytest.raises(ProblemError, match=r"the exact gradient must return shape \(\d+, 2, 2\)"):
+        solve(bad).errors()

@@ -18,10 +18,10 @@ from signorini.contact.solution import solve
 from signorini.estimator.h_half_norm import hhalf_norm2_positive_part, l2_norm2_positive_part
 from signorini.estimator.residual import ETA5_VARIANTS, TERMS, estimate
 from signorini.examples import example_6_1, example_6_2
-from signorini.fem.elasticity import Material
+from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle
 from signorini.mesh.refine import refine_nvb, refine_uniform
-from signorini.problem.problem import Contact, ContactProblem, Dirichlet, Neumann
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
 
 EXAMPLES = {"6.1": example_6_1, "6.2": example_6_2}
 #: row of each term in Estimate.eta2_cell / eta2_node

@@ -1,72 +1,16 @@
 """The P2 reference element and affine geometry."""
 
 import numpy as np
-import pytest
+from contact_problems import random_quadratic
+from fem_problems import cell_values, random_reference_points, random_triangles
 
 from signorini.fem import p2
 
 RNG = np.random.default_rng(20240611)
 
 
-def random_reference_points(n, rng=RNG):
-    """Uniform random points in the reference triangle, shape (n, 2)."""
-    xy = rng.random((n, 2))
-    flip = xy.sum(axis=1) > 1
-    xy[flip] = 1 - xy[flip]
-    return xy
-
-
-def random_triangles(m, rng=RNG, min_angle_deg=15.0):
-    """Counter-clockwise random triangles of moderate shape, shape (m, 3, 2)."""
-    out = []
-    while len(out) < m:
-        v = rng.uniform(-2, 2, size=(3, 2))
-        e = np.roll(v, -1, axis=0) - v
-        area2 = e[0, 0] * e[1, 1] - e[0, 1] * e[1, 0]
-        if area2 < 0:
-            v = v[[0, 2, 1]]
-            e = np.roll(v, -1, axis=0) - v
-        lens = np.linalg.norm(e, axis=1)
-        angles = []
-        for k in range(3):
-            a, b = -e[k - 1], e[k]
-            angles.append(np.degrees(np.arccos(a @ b / (lens[k - 1] * lens[k]))))
-        if min(angles) > min_angle_deg:
-            out.append(v)
-    return np.array(out)
-
-
-class Quadratic:
-    """A random quadratic vector field u_i = c_i + b_i.x + x.A_i.x, with derivatives."""
-
-    def __init__(self, rng=RNG):
-        self.c = rng.standard_normal(2)
-        self.b = rng.standard_normal((2, 2))
-        a = rng.standard_normal((2, 2, 2))
-        self.A = 0.5 * (a + a.transpose(0, 2, 1))  # symmetric in the last two
-
-    def __call__(self, x):
-        return (
-            self.c
-            + np.einsum("ij,...j->...i", self.b, x)
-            + np.einsum("...j,ijk,...k->...i", x, self.A, x)
-        )
-
-    def grad(self, x):
-        return self.b + 2 * np.einsum("ijk,...k->...ij", self.A, x)
-
-    def hessian(self):
-        return 2 * self.A
-
-
-def interpolate(field, vertices):
-    """Interleaved nodal values (m, 12) of a vector field on P2 cells."""
-    nodes = p2.physical_points(vertices, p2.REFERENCE_NODES)  # (m, 6, 2)
-    return field(nodes).reshape(len(vertices), 12)
-
-
 def test_partition_of_unity_and_zero_gradient_sum():
-    xi = random_reference_points(50)
+    xi = random_reference_points(50, RNG)
     assert np.allclose(p2.basis(xi).sum(axis=1), 1.0, atol=1e-14)
     assert np.allclose(p2.grad_basis(xi).sum(axis=1), 0.0, atol=1e-13)
     assert np.allclose(p2.hessian_basis().sum(axis=0), 0.0, atol=1e-13)
@@ -74,6 +18,22 @@ def test_partition_of_unity_and_zero_gradient_sum():
 
 def test_nodal_kronecker_property():
     assert np.allclose(p2.basis(p2.REFERENCE_NODES), np.eye(6), atol=1e-15)
+
+
+def test_basis_from_barycentric_coordinates():
+    # the one formula of the basis: at barycentric points, and batched over any leading axes
+    bary = p2.barycentric(p2.REFERENCE_NODES)
+    assert np.array_equal(bary[:3], np.eye(3))
+    assert np.array_equal(p2.basis_barycentric(bary), np.eye(6))
+    b = RNG.dirichlet(np.ones(3), size=(7, 5))
+    phi = p2.basis_barycentric(b)
+    assert phi.shape == (7, 5, 6)
+    assert np.allclose(phi.sum(-1), 1.0, atol=1e-14)
+    xi = b[..., 1:].reshape(-1, 2)
+    assert np.allclose(p2.basis(xi), phi.reshape(-1, 6), atol=1e-15)
+    # phi_0 = l0 (2 l0 - 1) at the two quarter points of edge 0: 3/8 near vertex 0, -1/8 far
+    assert p2.basis_barycentric(np.array([0.75, 0.25, 0.0]))[0] == 0.375
+    assert p2.basis_barycentric(np.array([0.25, 0.75, 0.0]))[0] == -0.125
 
 
 def test_node_order_matches_vtk_triangle6():
@@ -86,7 +46,7 @@ def test_node_order_matches_vtk_triangle6():
 
 def test_reference_gradients_by_central_differences():
     # central differences are exact for quadratics up to rounding
-    xi = random_reference_points(20)
+    xi = random_reference_points(20, RNG)
     h = 1e-3
     fd = np.empty((20, 6, 2))
     for j in range(2):
@@ -104,9 +64,9 @@ def test_reference_gradients_by_central_differences():
 
 
 def test_physical_gradients_by_finite_differences():
-    verts = random_triangles(5)
+    verts = random_triangles(5, RNG)
     J, det = p2.jacobian(verts)
-    xi = random_reference_points(4)
+    xi = random_reference_points(4, RNG)
     G = p2.physical_gradients(verts, xi)  # (m, q, 6, 2)
     h = 1e-4
     for j in range(2):
@@ -120,7 +80,7 @@ def test_physical_gradients_by_finite_differences():
 
 
 def test_jacobian_and_area():
-    verts = random_triangles(10)
+    verts = random_triangles(10, RNG)
     J, det = p2.jacobian(verts)
     e1, e2 = verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0]
     assert np.allclose(det, e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
@@ -132,33 +92,33 @@ def test_jacobian_and_area():
 
 
 def test_quadratic_fields_are_reproduced_exactly():
-    verts = random_triangles(8)
-    u = Quadratic()
-    u_cell = interpolate(u, verts)
-    xi = random_reference_points(12)
+    verts = random_triangles(8, RNG)
+    u = random_quadratic(RNG)
+    u_cell = cell_values(u.value, verts)
+    xi = random_reference_points(12, RNG)
     x = p2.physical_points(verts, xi)
-    assert np.allclose(p2.field_values(u_cell, xi), u(x), atol=1e-12)
-    assert np.allclose(p2.field_gradients(verts, u_cell, xi), u.grad(x), atol=1e-11)
+    assert np.allclose(p2.field_values(u_cell, xi), u.value(x), atol=1e-12)
+    assert np.allclose(p2.field_gradients(verts, u_cell, xi), u.gradient(x), atol=1e-11)
     H = p2.field_hessian(verts, u_cell)
     assert H.shape == (8, 2, 2, 2)
     assert np.allclose(H, u.hessian(), atol=1e-10)
 
 
 def test_per_cell_reference_points():
-    verts = random_triangles(6)
-    u = Quadratic()
-    u_cell = interpolate(u, verts)
-    xi = np.stack([random_reference_points(3) for _ in range(6)])  # (6, 3, 2)
+    verts = random_triangles(6, RNG)
+    u = random_quadratic(RNG)
+    u_cell = cell_values(u.value, verts)
+    xi = np.stack([random_reference_points(3, RNG) for _ in range(6)])  # (6, 3, 2)
     x = np.einsum("mqk,mkd->mqd", np.dstack([1 - xi.sum(-1), xi[..., 0], xi[..., 1]]), verts)
-    assert np.allclose(p2.field_values(u_cell, xi), u(x), atol=1e-12)
-    assert np.allclose(p2.field_gradients(verts, u_cell, xi), u.grad(x), atol=1e-11)
+    assert np.allclose(p2.field_values(u_cell, xi), u.value(x), atol=1e-12)
+    assert np.allclose(p2.field_gradients(verts, u_cell, xi), u.gradient(x), atol=1e-11)
 
 
 def test_non_quadratic_field_is_not_reproduced():
     # guards the test above: a cubic is only interpolated, not reproduced
-    verts = random_triangles(3)
-    u_cell = interpolate(lambda x: np.stack([x[..., 0] ** 3, x[..., 1] ** 3], -1), verts)
-    xi = random_reference_points(5)
+    verts = random_triangles(3, RNG)
+    u_cell = cell_values(lambda x: np.stack([x[..., 0] ** 3, x[..., 1] ** 3], -1), verts)
+    xi = random_reference_points(5, RNG)
     x = p2.physical_points(verts, xi)
     assert np.abs(p2.field_values(u_cell, xi)[..., 0] - x[..., 0] ** 3).max() > 1e-4
 
@@ -182,26 +142,3 @@ def test_edge_basis_and_edge_points():
     batch = p2.edge_reference_points(np.array([2, 0]), t)
     assert batch.shape == (2, 7, 2)
     assert np.allclose(batch[1], p2.edge_reference_points(0, t))
-
-
-def test_bad_geometry_raises():
-    good = random_triangles(4)
-    bad = good.copy()
-    bad[1] = bad[1][[0, 2, 1]]  # clockwise
-    bad[3, 2] = bad[3, 1]  # degenerate
-    with pytest.raises(ValueError, match=r"2 cell\(s\).*first: cell 1"):
-        p2.jacobian(bad)
-    with pytest.raises(ValueError, match="shape"):
-        p2.jacobian(good[:, :2])
-    nan = good.copy()
-    nan[2, 0, 0] = np.nan
-    with pytest.raises(ValueError, match="not finite.*cell 2"):
-        p2.jacobian(nan)
-    with pytest.raises(ValueError, match="u_cell"):
-        p2.field_gradients(good, np.zeros((4, 10)), p2.REFERENCE_NODES)
-    with pytest.raises(ValueError, match="u_cell"):
-        p2.field_gradients(good, np.zeros((3, 12)), p2.REFERENCE_NODES)
-    with pytest.raises(ValueError, match="xi"):
-        p2.basis(np.zeros((3, 3)))
-    with pytest.raises(ValueError, match="local_edge"):
-        p2.edge_reference_points(np.array([0, 3]), np.array([0.5]))

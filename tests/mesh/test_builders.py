@@ -160,5 +160,8 @@ def test_rectangle_rejects_bad_input(kwargs, match: str) -> None:
 
 
 def test_rectangle_accepts_integral_floats() -> None:
-    m = rectangle(nx=3.0, ny=2.0)
-    assert m.n_cells == 12
+    m, ref = rectangle(nx=3.0, ny=2.0), rectangle(nx=3, ny=2)
+    assert np.array_equal(m.points, ref.points) and np.array_equal(m.cells, ref.cells)
+    assert np.array_equal(m.boundary_part, ref.boundary_part)
+    assert m.part_length("bottom") == pytest.approx(1.0, rel=1e-14)
+    assert m.part_edges("left").size == 2

@@ -1,207 +1,29 @@
-"""Tests of :mod:`signorini.mesh.mesh`: validation, topology, geometry, boundary parts."""
+"""Tests of :mod:`signorini.mesh.mesh`: construction from arrays and boundary parts, cached
+topology, geometry."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.spatial import Delaunay
+from mesh_problems import (
+    ALL,
+    HAND_MESHES,
+    SQUARE_C,
+    SQUARE_P,
+    everything,
+    hexfan,
+    jittered_delaunay,
+    square4,
+)
 
 from signorini.mesh.builders import rectangle
 from signorini.mesh.mesh import Mesh, MeshError, boundary_edges
 
 
-def everything(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    return np.ones_like(x, dtype=bool)
-
-
-ALL = {"all": everything}
-
-# unit square split along its diagonal 0-2
-SQUARE_P = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-SQUARE_C = np.array([[0, 1, 2], [0, 2, 3]])
-
-
-def square4() -> tuple[np.ndarray, np.ndarray]:
-    """Unit square cut into four triangles through its centre."""
-    p = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5]], dtype=float)
-    c = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
-    return p, c
-
-
-def hexfan() -> tuple[np.ndarray, np.ndarray]:
-    """Regular hexagon fanned around its centre, with one more triangle on a side."""
-    t = np.arange(6) * np.pi / 3
-    p = np.vstack([[0.0, 0.0], np.column_stack([np.cos(t), np.sin(t)]), [[1.5, 0.8]]])
-    c = [[0, 1 + k, 1 + (k + 1) % 6] for k in range(6)] + [[1, 7, 2]]
-    return p, np.array(c)
-
-
-def jittered_delaunay(n: int = 7, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Delaunay triangulation (scipy) of a jittered grid on the unit square, made CCW."""
-    rng = np.random.default_rng(seed)
-    s = np.linspace(0.0, 1.0, n)
-    x, y = np.meshgrid(s, s)
-    p = np.column_stack([x.ravel(), y.ravel()])
-    inner = (p > 0).all(1) & (p < 1).all(1)
-    p[inner] += rng.uniform(-0.3, 0.3, size=(inner.sum(), 2)) / (n - 1)
-    c = Delaunay(p).simplices.astype(np.int64)
-    d1, d2 = p[c[:, 1]] - p[c[:, 0]], p[c[:, 2]] - p[c[:, 0]]
-    cw = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0] < 0
-    c[cw] = c[cw][:, [0, 2, 1]]
-    return p, c
-
-
-HAND_MESHES = {
-    "square2": lambda: (SQUARE_P, SQUARE_C),
-    "square4": square4,
-    "hexfan": hexfan,
-    "delaunay": jittered_delaunay,
-}
-
-
-# ---------------------------------------------------------------------------- validation
-def test_degenerate_triangle() -> None:
-    p = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [0.0, 1.0]])
-    with pytest.raises(MeshError, match=r"degenerate triangle\(s\) 1 .*cell 1 = \[0, 1, 2\]"):
-        Mesh.from_arrays(p, [[0, 1, 3], [0, 1, 2]], ALL)
-
-
-def test_repeated_vertex_is_degenerate() -> None:
-    with pytest.raises(MeshError, match="degenerate triangle.*repeated vertex"):
-        Mesh.from_arrays(SQUARE_P, [[0, 1, 1], [0, 2, 3]], ALL)
-
-
-def test_clockwise_triangle() -> None:
-    with pytest.raises(MeshError, match=r"clockwise triangle\(s\) 1: .*counter-clockwise"):
-        Mesh.from_arrays(SQUARE_P, [[0, 1, 2], [0, 3, 2]], ALL)
-
-
-def test_duplicate_points() -> None:
-    # two triangles that touch along the diagonal, but through copies of its end points
-    p = np.vstack([SQUARE_P, SQUARE_P[[0, 2]]])
-    with pytest.raises(MeshError, match=r"duplicate points 0, 2, 4, 5"):
-        Mesh.from_arrays(p, [[0, 1, 2], [4, 5, 3]], ALL)
-
-
-def test_unreferenced_points() -> None:
-    p = np.vstack([SQUARE_P, [[5.0, 5.0], [6.0, 5.0]]])
-    with pytest.raises(MeshError, match=r"unreferenced point\(s\) 4, 5"):
-        Mesh.from_arrays(p, SQUARE_C, ALL)
-
-
-def test_hanging_node() -> None:
-    # one triangle below the segment (0,0)-(2,0), four above it that use its midpoint 3
-    p = np.array([[0, 0], [2, 0], [1, -1], [1, 0], [1, 1], [0, 1], [2, 1]], dtype=float)
-    c = [[0, 2, 1], [0, 3, 4], [3, 1, 4], [0, 4, 5], [1, 6, 4]]
-    with pytest.raises(MeshError, match=r"point 3 lies inside edge \(0, 1\) \(hanging node\)"):
-        Mesh.from_arrays(p, c, ALL)
-
-
-@pytest.mark.parametrize("turn", [0.5 * np.pi, 0.3, 2.0])
-def test_hanging_node_in_any_direction(turn: float) -> None:
-    rot = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
-    p = np.array([[0, 0], [2, 0], [1, -1], [1, 0], [1, 1], [0, 1], [2, 1]], dtype=float)
-    c = [[0, 2, 1], [0, 3, 4], [3, 1, 4], [0, 4, 5], [1, 6, 4]]
-    with pytest.raises(MeshError, match=r"point 3 lies inside edge \(0, 1\) \(hanging node\)"):
-        Mesh.from_arrays(p @ rot.T + [5.0, -2.0], c, ALL)
-
-
-@pytest.mark.parametrize("pattern", ["unionjack", "crossed"])
-def test_bisecting_one_cell_alone_leaves_a_hanging_node(pattern: str) -> None:
-    # split each interior-edge cell in turn without touching its neighbour
-    m = rectangle(0, 1, 0, 2, nx=3, ny=3, pattern=pattern)
-    p = m.points @ np.array([[1.0, 0.4], [0.0, 1.0]]).T
-    interior = np.flatnonzero(m.edge2cell[m.cell2edge[:, 0], 1] >= 0)
-    assert interior.size > 10
-    for t in interior[::3]:
-        a, b, c = m.cells[t]
-        q = np.vstack([p, 0.5 * (p[a] + p[b])])
-        n = len(p)
-        cells = np.vstack([np.delete(m.cells, t, axis=0), [[c, a, n], [b, c, n]]])
-        lo, hi = sorted((a, b))
-        with pytest.raises(MeshError, match=rf"point {n} lies inside edge \({lo}, {hi}\)"):
-            Mesh.from_arrays(q, cells, ALL)
-
-
-def test_non_manifold_edge() -> None:
-    # three cells on the edge (0, 1): one below, two above
-    p = np.array([[0, 0], [1, 0], [0.5, 1], [0.5, -1], [0.2, 2]], dtype=float)
-    with pytest.raises(MeshError, match=r"non-manifold mesh: 1 edge\(s\).*first \(0, 1\)"):
-        Mesh.from_arrays(p, [[0, 1, 2], [1, 0, 3], [0, 1, 4]], ALL)
-
-
-def test_overlapping_cells() -> None:
-    # both cells lie above (0, 1): the edge is traversed twice in the same direction
-    p = np.array([[0, 0], [1, 0], [0, 1], [1, 1]], dtype=float)
-    m = Mesh.from_arrays(p, [[0, 1, 2], [1, 3, 2]], ALL)
-    with pytest.raises(MeshError, match=r"inconsistently oriented across edge \(0, 1\)"):
-        Mesh(p, [[0, 1, 2], [0, 1, 3]], m.boundary, m.boundary_part, m.part_names)
-
-
-def test_boundary_edges_without_part_from_arrays() -> None:
-    with pytest.raises(MeshError, match=r"3 boundary edge\(s\) have no part.*label every"):
-        Mesh.from_arrays(SQUARE_P, SQUARE_C, {"bottom": lambda x, y: y < 1e-12})
-
-
-def test_boundary_edges_without_part_constructor() -> None:
-    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
-    keep = np.any(np.sort(m.boundary, axis=1) != [2, 3], axis=1)
-    assert keep.sum() == 3
-    with pytest.raises(MeshError, match=r"1 boundary edge\(s\) without a part, first \(2, 3\)"):
-        Mesh(SQUARE_P, SQUARE_C, m.boundary[keep], m.boundary_part[keep], ["all"])
-
-
-def test_part_index_out_of_range() -> None:
-    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
-    with pytest.raises(MeshError, match=r"4 boundary edge\(s\) have no part"):
-        Mesh(SQUARE_P, SQUARE_C, m.boundary, m.boundary_part + 1, ["all"])
-
-
-@pytest.mark.parametrize("empty", [lambda x, y: x > 5, [], np.zeros((0, 2), dtype=int)])
-def test_part_without_edges(empty) -> None:
-    with pytest.raises(MeshError, match=r"boundary part 'ghost' has no edges"):
-        Mesh.from_arrays(SQUARE_P, SQUARE_C, {"all": everything, "ghost": empty})
-
-
-def test_part_without_edges_constructor() -> None:
-    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
-    with pytest.raises(MeshError, match=r"boundary part 'x' has no edges"):
-        Mesh(SQUARE_P, SQUARE_C, m.boundary, m.boundary_part, ["all", "x"])
-
-
+# ---------------------------------------------------------------------------- boundary parts
 def test_part_lists_interior_edge() -> None:
     with pytest.raises(MeshError, match=r"part 'diag': \(2, 0\) is not a boundary edge"):
         Mesh.from_arrays(SQUARE_P, SQUARE_C, {"diag": [[2, 0]], "rest": everything})
-
-
-def test_constructor_labels_interior_edge() -> None:
-    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
-    b = np.vstack([m.boundary, [[0, 2]]])
-    with pytest.raises(MeshError, match=r"edge \(0, 2\) is labelled as boundary but is shared"):
-        Mesh(SQUARE_P, SQUARE_C, b, np.append(m.boundary_part, 0), ["all"])
-
-
-def test_constructor_edge_not_in_mesh() -> None:
-    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
-    b = np.vstack([m.boundary, [[1, 3]]])
-    with pytest.raises(MeshError, match=r"boundary edge\(s\) 4 are not edges of the mesh"):
-        Mesh(SQUARE_P, SQUARE_C, b, np.append(m.boundary_part, 0), ["all"])
-
-
-def test_constructor_boundary_edge_twice() -> None:
-    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
-    b = np.vstack([m.boundary, m.boundary[:1, ::-1]])
-    with pytest.raises(MeshError, match="a boundary edge is listed twice"):
-        Mesh(SQUARE_P, SQUARE_C, b, np.append(m.boundary_part, 0), ["all"])
-
-
-def test_constructor_boundary_index_out_of_range() -> None:
-    # (0, 6) has the same key as the edge (1, 2) when n_points = 4: it must not pass
-    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
-    b = m.boundary.copy()
-    b[np.flatnonzero(np.sort(b, axis=1)[:, 0] == 1)[0]] = [0, 6]
-    with pytest.raises(MeshError, match=r"boundary edges refer to points outside 0\.\.3"):
-        Mesh(SQUARE_P, SQUARE_C, b, m.boundary_part, ["all"])
 
 
 @pytest.mark.parametrize(
@@ -229,34 +51,6 @@ def test_predicate_claims_only_unlisted_edges() -> None:
 
 
 @pytest.mark.parametrize(
-    ("points", "cells", "match"),
-    [
-        (SQUARE_P[:, :1], SQUARE_C, r"points must have shape \(n_points, 2\), got \(4, 1\)"),
-        (SQUARE_P.ravel(), SQUARE_C, r"points must have shape \(n_points, 2\), got \(8,\)"),
-        (SQUARE_P, SQUARE_C[:, :2], r"cells must have shape \(n, 3\), got \(2, 2\)"),
-        (SQUARE_P, SQUARE_C.ravel(), r"cells must have shape \(n, 3\), got \(6,\)"),
-        (SQUARE_P, SQUARE_C + 1, r"cells refer to points outside 0\.\.3"),
-        (SQUARE_P, SQUARE_C - 1, r"cells refer to points outside 0\.\.3"),
-        (SQUARE_P, SQUARE_C + 0.5, "cells must hold integer point indices"),
-        (SQUARE_P, SQUARE_C[:0], "the mesh has no cells"),
-        (
-            np.where([[0, 0], [0, 0], [0, 1], [0, 0]], np.nan, SQUARE_P),
-            SQUARE_C,
-            r"point\(s\) 2 have non-finite coordinates",
-        ),
-        (
-            np.where([[0, 0], [1, 0], [0, 0], [0, 0]], np.inf, SQUARE_P),
-            SQUARE_C,
-            r"point\(s\) 1 have non-finite coordinates",
-        ),
-    ],
-)
-def test_bad_arrays(points, cells, match) -> None:
-    with pytest.raises(MeshError, match=match):
-        Mesh.from_arrays(points, cells, ALL)
-
-
-@pytest.mark.parametrize(
     ("spec", "match"),
     [
         ([[0, 1, 2]], r"boundary edges must have shape \(n, 2\), got \(1, 3\)"),
@@ -267,20 +61,6 @@ def test_bad_arrays(points, cells, match) -> None:
 def test_bad_part_specs(spec, match) -> None:
     with pytest.raises(MeshError, match=match):
         Mesh.from_arrays(SQUARE_P, SQUARE_C, {"a": spec})
-
-
-def test_constructor_bad_boundary_shape() -> None:
-    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
-    with pytest.raises(MeshError, match=r"boundary edges must have shape \(n, 2\)"):
-        Mesh(SQUARE_P, SQUARE_C, m.boundary.ravel()[:7], m.boundary_part, ["all"])
-    with pytest.raises(MeshError, match="boundary_part must have one entry per boundary edge"):
-        Mesh(SQUARE_P, SQUARE_C, m.boundary, m.boundary_part[:3], ["all"])
-
-
-def test_mesh_error_is_value_error() -> None:
-    assert issubclass(MeshError, ValueError)
-    with pytest.raises(ValueError, match="clockwise"):
-        Mesh.from_arrays(SQUARE_P, [[0, 2, 1], [0, 2, 3]], ALL)
 
 
 def test_unknown_part_name() -> None:
@@ -389,6 +169,27 @@ def test_boundary_edges_have_one_cell(name: str) -> None:
     assert all(tuple(e) in directed for e in be.tolist())
 
 
+@pytest.mark.parametrize("name", sorted(HAND_MESHES))
+def test_edge_local_is_the_index_of_the_edge_in_its_cells(name: str) -> None:
+    p, c = HAND_MESHES[name]()
+    m = Mesh.from_arrays(p, c, ALL)
+    e = np.arange(m.n_edges)
+    for side in range(2):
+        has = m.edge2cell[:, side] >= 0
+        cell, k = m.edge2cell[has, side], m.edge_local[has, side]
+        assert np.array_equal(m.cell2edge[cell, k], e[has])
+        # local edge k joins local vertices k and k + 1
+        pair = np.sort(np.column_stack([m.cells[cell, k], m.cells[cell, (k + 1) % 3]]), axis=1)
+        assert np.array_equal(pair, m.edges[has])
+    assert np.array_equal(m.edge_local[:, 1] < 0, m.edge2cell[:, 1] < 0)
+
+
+def test_topology_is_computed_once() -> None:
+    m = rectangle(nx=3, ny=2)
+    for name in ("edges", "cell2edge", "edge2cell", "edge_local", "boundary_edge", "edge_part"):
+        assert getattr(m, name) is getattr(m, name), name
+
+
 def test_from_arrays_puts_longest_edge_first() -> None:
     rng = np.random.default_rng(7)
     p, c = jittered_delaunay(8, seed=1)
@@ -490,6 +291,7 @@ def test_cached_arrays_are_read_only():
         "edges",
         "cell2edge",
         "edge2cell",
+        "edge_local",
         "area",
         "edge_length",
         "h",

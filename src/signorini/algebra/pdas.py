@@ -76,7 +76,7 @@ def solve_pdas(
     K : scipy sparse matrix, shape (n, n)
         Symmetric; positive definite on the non-Dirichlet DOFs. Its pattern must contain the
         diagonal. Rotate contact DOFs into normal frames first
-        (:func:`signorini.contact.frames.rotate_frames`) so each constraint bounds one DOF.
+        (:func:`signorini.contact.node_frames.rotate_frames`) so each constraint bounds one DOF.
     F : (n,) float array
         Load vector.
     constrained : (m,) int array or (n,) bool mask

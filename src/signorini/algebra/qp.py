@@ -6,7 +6,7 @@
     \\quad\\text{subject to}\\quad x_c \\le g,\\quad x_d = x_D,
 
 the discrete Signorini problem of docs/method.md, *Discrete problem*, once the contact DOFs are
-rotated into their normal frames (:mod:`signorini.contact.frames`). :func:`check_qp` turns the
+rotated into their normal frames (:mod:`signorini.contact.node_frames`). :func:`check_qp` turns the
 arguments of :func:`~.pdas.solve_pdas` and :func:`~.kkt.kkt_residuals` into a :class:`BoundQP`
 or raises a :class:`ValueError` naming the argument; everything after it trusts the data.
 """

@@ -2,7 +2,7 @@
 
 Every function here takes a square matrix and knows nothing of where it came from; the
 solvers (:mod:`.solvers`, :mod:`.pardiso`), the symmetric elimination (:mod:`.elimination`)
-and the node rotations of :mod:`signorini.contact.frames` build on them.
+and the node rotations of :mod:`signorini.contact.node_frames` build on them.
 """
 
 from __future__ import annotations

@@ -5,11 +5,12 @@ not Dirichlet nodes; the discrete constraint is ``u_h(z)·n ≤ ψ(z)`` (paper, 
 Section 3). From the nodal contact force ``Λ_z = L(ψ_z n) − a(u_h, ψ_z n)`` (3.5), (3.9),
 (3.17) we derive (docs/method.md, *Discrete problem*)
 
-- the paper's contact force density ``s_z = Λ_z / m_z`` (4.1), with the lumped weights
-  ``m_z = ∫ φ_z`` of the half-edge hats of Q^h (3.6): ``|e|/4`` per edge at a vertex,
-  ``|e|/2`` at a midpoint;
-- the consistent pressure ``p_z = Λ_z / w_z`` with ``w_z = ∫ ψ_z`` (Simpson weights
-  ``|e|/6`` per edge at a vertex, ``2|e|/3`` at a midpoint), exact for linear pressures.
+- the paper's contact force density ``s_z = Λ_z / m_z`` (4.1), with ``m_z = ∫ φ_z ds`` the
+  integral of the half-edge hat φ_z of Q^h (3.6) (:attr:`ContactSet.hat_integral`):
+  ``|e|/4`` per edge at a vertex, ``|e|/2`` at a midpoint;
+- the consistent pressure ``p_z = Λ_z / w_z`` with ``w_z = ∫_{Γ_C} ψ_z ds`` the integral of the
+  P2 basis function (:attr:`ContactSet.basis_integral`): ``|e|/6`` per edge at a vertex,
+  ``2|e|/3`` at a midpoint; exact for linear pressures.
 """
 
 from __future__ import annotations
@@ -20,7 +21,9 @@ from functools import cached_property
 import numpy as np
 
 from ..fem.space import P2Space
-from ..problem.problem import Contact, ContactProblem, ProblemError
+from ..problem.conditions import Contact
+from ..problem.fields import ProblemError, evaluate_field
+from ..problem.problem import ContactProblem
 
 __all__ = [
     "ContactSet",
@@ -46,10 +49,12 @@ class ContactSet:
         Outward unit normal of the node's contact part.
     gap : (k,) float array
         ψ(z).
-    lumped : (k,) float array
-        ``m_z``, the integral of the half-edge hat φ_z of Q^h (3.6).
-    simpson : (k,) float array
-        ``w_z = ∫_{Γ_C} ψ_z ds``, the integral of the P2 basis function.
+    hat_integral : (k,) float array
+        ``m_z = ∫_{Γ_C} φ_z ds``, the integral of the half-edge hat φ_z of Q^h (3.6); the
+        contact force density is ``s_z = Λ_z / m_z`` (4.1).
+    basis_integral : (k,) float array
+        ``w_z = ∫_{Γ_C} ψ_z ds``, the integral of the P2 basis function; the consistent
+        pressure is ``p_z = Λ_z / w_z``.
     is_vertex : (k,) bool array
     edges : (n_ce,) int array
         Mesh edges of Γ_C.
@@ -66,8 +71,8 @@ class ContactSet:
     nodes: np.ndarray
     normal: np.ndarray
     gap: np.ndarray
-    lumped: np.ndarray
-    simpson: np.ndarray
+    hat_integral: np.ndarray
+    basis_integral: np.ndarray
     is_vertex: np.ndarray
     edges: np.ndarray
     edge_nodes: np.ndarray
@@ -113,6 +118,50 @@ def _locate(sorted_nodes: np.ndarray, query: np.ndarray) -> np.ndarray:
     return np.where(sorted_nodes[pos] == query, pos, -1)
 
 
+def _empty(parts: tuple[str, ...]) -> ContactSet:
+    """The contact set of a problem without contact parts."""
+    no_int, no_edges = np.zeros(0, dtype=np.int64), np.zeros((0, 3), dtype=np.int64)
+    return ContactSet(
+        nodes=no_int,
+        normal=np.zeros((0, 2)),
+        gap=np.zeros(0),
+        hat_integral=np.zeros(0),
+        basis_integral=np.zeros(0),
+        is_vertex=np.zeros(0, dtype=bool),
+        edges=no_int,
+        edge_nodes=no_edges,
+        edge_part=no_int,
+        parts=parts,
+        edge_gap=np.zeros((0, 3)),
+        edge_normal=np.zeros((0, 2)),
+    )
+
+
+def _edge_gaps(
+    problem: ContactProblem, parts: tuple[str, ...], edge_part: np.ndarray, x: np.ndarray
+) -> np.ndarray:
+    """ψ at the nodes ``x (n_ce, 3, 2)`` of the contact edges, part by part (each part has its
+    own gap function), shape ``(n_ce, 3)``."""
+    edge_gap = np.empty(x.shape[:-1])
+    for i, p in enumerate(parts):
+        sel = edge_part == i
+        cond: Contact = problem.conditions[p]
+        edge_gap[sel] = evaluate_field(
+            cond.gap_field(), x[sel], f"the gap function of contact part {p!r}", shape=()
+        )
+    return edge_gap
+
+
+def _to_nodes(pos: np.ndarray, values: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Values per constrained node from values per edge node (``pos`` its position in the set,
+    ``-1`` for Dirichlet nodes), and how far each edge node's value is from its node's."""
+    inside = pos >= 0
+    out = np.zeros((n,) + values.shape[1:])
+    out[pos[inside]] = values[inside]
+    diff = np.abs(out[pos[inside]] - values[inside])
+    return out, diff.reshape(diff.shape[0], -1).max(axis=1, initial=0.0)
+
+
 def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     """Collect the constrained nodes of ``space`` for ``problem`` (docs/method.md, *Discrete
     problem*).
@@ -120,84 +169,52 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     Raises
     ------
     ProblemError
-        If a node is shared by contact parts with different normals.
+        If every contact node is a Dirichlet node, a node is shared by contact parts with
+        different normals or gaps, or a gap function does not return finite numbers.
     """
     mesh = space.mesh
     parts = tuple(problem.contact_parts)
-    empty_i = np.zeros(0, dtype=np.int64)
     if not parts:
-        z2 = np.zeros((0, 2))
-        return ContactSet(
-            empty_i,
-            z2,
-            np.zeros(0),
-            np.zeros(0),
-            np.zeros(0),
-            np.zeros(0, bool),
-            empty_i,
-            np.zeros((0, 3), np.int64),
-            empty_i,
-            parts,
-            np.zeros((0, 3)),
-            z2,
-        )
+        return _empty(parts)
     edge_lists = [mesh.part_edges(p) for p in parts]
     edges = np.concatenate(edge_lists)
     edge_part = np.repeat(np.arange(len(parts)), [e.size for e in edge_lists])
     edge_nodes = space.edge_nodes(edges)
     edge_normal = np.stack([problem.contact_normals[p] for p in parts])[edge_part]
-    length = mesh.edge_length[edges]
+    edge_gap = _edge_gaps(problem, parts, edge_part, space.node_points[edge_nodes])
 
-    # ψ at the edge nodes, part by part (each part has its own gap function)
-    x = space.node_points[edge_nodes]  # (n_ce, 3, 2)
-    edge_gap = np.empty(edge_nodes.shape)
-    for i, p in enumerate(parts):
-        sel = edge_part == i
-        cond: Contact = problem.conditions[p]
-        edge_gap[sel] = cond.gap_values(x[sel], p)
-
-    dirichlet = problem.dirichlet_nodes(space)
-    nodes = np.setdiff1d(np.unique(edge_nodes), dirichlet)
+    nodes = np.setdiff1d(np.unique(edge_nodes), problem.dirichlet_nodes(space))
     if nodes.size == 0:
         raise ProblemError("every node of the contact boundary is a Dirichlet node")
-
-    # per-node normal; a node on two contact parts needs equal normals
-    flat_nodes = edge_nodes.ravel()
-    flat_normal = np.repeat(edge_normal, 3, axis=0)
-    pos = _locate(nodes, flat_nodes)
+    # a node on two contact parts needs equal normals and equal gaps
+    pos = _locate(nodes, edge_nodes.ravel())
     inside = pos >= 0
-    normal = np.zeros((nodes.size, 2))
-    normal[pos[inside]] = flat_normal[inside]
-    if np.abs(normal[pos[inside]] - flat_normal[inside]).max(initial=0) > 1e-12:
-        bad = nodes[
-            pos[inside][np.abs(normal[pos[inside]] - flat_normal[inside]).max(1) > 1e-12][0]
-        ]
+    normal, off = _to_nodes(pos, np.repeat(edge_normal, 3, axis=0), nodes.size)
+    if off.max(initial=0.0) > 1e-12:
+        bad = nodes[pos[inside][np.flatnonzero(off > 1e-12)[0]]]
         raise ProblemError(
             f"node {bad} at {space.node_points[bad].tolist()} lies on contact "
             "parts with different normals; this corner is not supported"
         )
-    gap = np.zeros(nodes.size)
-    gap[pos[inside]] = edge_gap.ravel()[inside]
-    mismatch = np.abs(gap[pos[inside]] - edge_gap.ravel()[inside])
-    scale = max(float(np.abs(edge_gap).max()), 1e-300)
-    if mismatch.max(initial=0) > 1e-12 * scale:
-        bad = nodes[pos[inside][np.argmax(mismatch)]]
+    gap, off = _to_nodes(pos, edge_gap.ravel(), nodes.size)
+    if off.max(initial=0.0) > 1e-12 * max(float(np.abs(edge_gap).max()), 1e-300):
+        bad = nodes[pos[inside][np.argmax(off)]]
         raise ProblemError(
             f"node {bad} at {space.node_points[bad].tolist()} lies on contact "
             "parts whose gap functions disagree there; the obstacle must be "
             "continuous"
         )
 
-    weights = np.column_stack([length / 4, length / 4, length / 2]).ravel()
-    simpson = np.column_stack([length / 6, length / 6, 2 * length / 3]).ravel()
-    lumped = np.bincount(pos[inside], weights=weights[inside], minlength=nodes.size)
-    w = np.bincount(pos[inside], weights=simpson[inside], minlength=nodes.size)
+    # per edge [start, end, midpoint]: ∫ φ_z (half-edge hats) and ∫ ψ_z (P2 basis)
+    length = mesh.edge_length[edges]
+    hat = np.column_stack([length / 4, length / 4, length / 2]).ravel()
+    basis = np.column_stack([length / 6, length / 6, 2 * length / 3]).ravel()
     return ContactSet(
         nodes=nodes,
         normal=normal,
         gap=gap,
-        lumped=lumped,
-        simpson=w,
+        hat_integral=np.bincount(pos[inside], weights=hat[inside], minlength=nodes.size),
+        basis_integral=np.bincount(pos[inside], weights=basis[inside], minlength=nodes.size),
         is_vertex=nodes < mesh.n_points,
         edges=edges,
         edge_nodes=edge_nodes,

@@ -16,12 +16,13 @@ import numpy as np
 from ..algebra.backends import make_solver
 from ..algebra.pdas import solve_pdas
 from ..algebra.result import PDASResult
-from ..fem.elasticity import energy_error2, h1_seminorm_error2
+from ..fem.norms import energy_error2, h1_seminorm_error2
 from ..fem.space import P2Space
 from ..mesh.mesh import Mesh
+from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
-from .frames import to_cartesian
+from .node_frames import to_cartesian
 from .system import Assembled, assemble
 
 __all__ = ["ContactResult", "solve"]
@@ -75,13 +76,13 @@ class ContactResult:
     @property
     def density(self) -> np.ndarray:
         """The paper's discrete contact force density ``s_z = Λ_z / m_z`` (4.1)."""
-        return self.contact_force / self.contact.lumped
+        return self.contact_force / self.contact.hat_integral
 
     @property
     def pressure(self) -> np.ndarray:
-        """Consistent nodal contact pressure ``p_z = Λ_z / ∫ψ_z`` (docs/method.md, *Discrete
-        problem*)."""
-        return self.contact_force / self.contact.simpson
+        """Consistent nodal contact pressure ``p_z = Λ_z / w_z``, ``w_z = ∫ψ_z`` (docs/method.md,
+        *Discrete problem*)."""
+        return self.contact_force / self.contact.basis_integral
 
     @property
     def total_contact_force(self) -> float:
@@ -107,10 +108,13 @@ class ContactResult:
         if exact is None:
             raise ValueError(f"{self.problem.name} has no exact solution")
         u_cell = self.space.cell_values(self.u)
-        energy = energy_error2(
-            self.space.vertices, u_cell, exact.gradient, self.problem.material, degree=degree
-        )
-        h1 = h1_seminorm_error2(self.space.vertices, u_cell, exact.gradient, degree=degree)
+
+        def gradient(x: np.ndarray) -> np.ndarray:
+            return evaluate_field(exact.gradient, x, "the exact gradient", shape=(2, 2))
+
+        vertices, material = self.space.vertices, self.problem.material
+        energy = energy_error2(vertices, u_cell, gradient, material, degree=degree)
+        h1 = h1_seminorm_error2(vertices, u_cell, gradient, degree=degree)
         return {"error_energy": float(np.sqrt(energy.sum())), "error_h1": float(np.sqrt(h1.sum()))}
 
 

@@ -11,12 +11,15 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..fem.elasticity import assemble_body_force, assemble_edge_load, assemble_stiffness
+from ..fem.loads import assemble_body_force, assemble_edge_load
 from ..fem.space import P2Space
+from ..fem.stiffness import assemble_stiffness
 from ..mesh.mesh import Mesh
-from ..problem.problem import ContactProblem, Dirichlet, Neumann, evaluate_field
+from ..problem.conditions import Dirichlet, Neumann
+from ..problem.fields import evaluate_field
+from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, contact_set
-from .frames import rotate_frames
+from .node_frames import rotate_frames
 
 __all__ = ["Assembled", "assemble", "LOAD_DEGREE"]
 
@@ -46,7 +49,10 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     t0 = time.perf_counter()
     space = P2Space(mesh)
     n_dofs = space.n_dofs
-    K = assemble_stiffness(space.vertices, space.cell_dofs, n_dofs, problem.material)
+    # the space of a validated mesh and problem: no need to re-check the arrays
+    K = assemble_stiffness(
+        space.vertices, space.cell_dofs, n_dofs, problem.material, validate=False
+    )
     F = np.zeros(n_dofs)
     if problem.body_force is not None:
         F += assemble_body_force(
@@ -83,5 +89,5 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     dirichlet = np.column_stack([2 * d_nodes, 2 * d_nodes + 1]).ravel()
 
     cs = contact_set(problem, space)
-    K, F = rotate_frames(K, F, cs.nodes, cs.normal)
+    K, F = rotate_frames(K, F, cs.nodes, cs.normal, copy=False, validate=False)
     return Assembled(space, cs, K, F, dirichlet, d_values.ravel(), time.perf_counter() - t0)

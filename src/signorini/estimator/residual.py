@@ -38,11 +38,13 @@ import numpy as np
 
 from ..contact.contact_set import SEMI_CONTACT
 from ..contact.solution import ContactResult
-from ..fem.elasticity import div_stress, stress
+from ..fem.material import stress
 from ..fem.p2 import REFERENCE_NODES, field_gradients, physical_points
+from ..fem.postprocess import div_stress
 from ..fem.quadrature import line_rule, triangle_rule
 from ..mesh.geometry import segment_normals
-from ..problem.problem import ContactProblem, evaluate_field
+from ..problem.fields import evaluate_field
+from ..problem.problem import ContactProblem
 from .terms import (
     EdgeSet,
     TermShares,

@@ -1,7 +1,7 @@
 """Finite element facts: quadrature, the P2 Lagrange element, the P2 space on a mesh, and
-plane-strain elasticity (material, stiffness, loads, error norms)."""
+plane-strain elasticity (material, stiffness, loads, stresses of ``u_h``, error norms)."""
 
-from .elasticity import Material
+from .material import Material
 from .space import P2Space
 
 __all__ = ["Material", "P2Space"]

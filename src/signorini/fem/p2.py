@@ -19,6 +19,10 @@ Arrays of cells are batched: ``vertices`` has shape ``(m, 3, 2)`` (``points[cell
 per-cell coefficients ``u_cell`` shape ``(m, 12)``; reference points ``xi`` shape
 ``(q, 2)``.  Gradients are stored last-axis-is-derivative:
 ``grad[..., i, j] = d u_i / d x_j``.
+
+These are kernels on trusted arrays: cells come from a validated
+:class:`~signorini.mesh.Mesh` (counter-clockwise, ``det J > 0``), so nothing here re-checks
+shapes or orientation.
 """
 
 from __future__ import annotations
@@ -27,7 +31,9 @@ import numpy as np
 
 __all__ = [
     "REFERENCE_NODES",
+    "barycentric",
     "basis",
+    "basis_barycentric",
     "edge_basis",
     "edge_reference_points",
     "field_gradients",
@@ -52,18 +58,50 @@ _GRAD_L = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
 _EDGE_VERTS = ((0, 1), (1, 2), (2, 0))
 
 
-def _as_points(xi: np.ndarray, name: str = "xi") -> np.ndarray:
+def _as_points(xi: np.ndarray) -> np.ndarray:
+    """Reference points as a float array: ``(q, 2)`` shared by all cells (one point ``(2,)``
+    becomes ``(1, 2)``), or ``(m, q, 2)`` given per cell."""
     xi = np.asarray(xi, dtype=np.float64)
-    if xi.ndim == 1 and xi.shape == (2,):
-        xi = xi[None, :]
-    if xi.ndim != 2 or xi.shape[1] != 2:
-        raise ValueError(f"{name} must have shape (q, 2), got {xi.shape}")
-    return xi
+    return xi[None, :] if xi.ndim == 1 else xi
 
 
-def _barycentric(xi: np.ndarray) -> np.ndarray:
-    """Barycentric coordinates, shape (q, 3)."""
+def barycentric(xi: np.ndarray) -> np.ndarray:
+    """Barycentric coordinates ``(1 - x - y, x, y)`` of reference points.
+
+    Parameters
+    ----------
+    xi : array_like of float, shape (q, 2)
+
+    Returns
+    -------
+    ndarray of float64, shape (q, 3)
+    """
+    xi = _as_points(xi)
     return np.column_stack([1.0 - xi[:, 0] - xi[:, 1], xi[:, 0], xi[:, 1]])
+
+
+def basis_barycentric(bary: np.ndarray) -> np.ndarray:
+    """Values of the 6 P2 basis functions at points given by barycentric coordinates.
+
+    Vertex functions ``l_i (2 l_i - 1)``, midpoint functions ``4 l_a l_b`` of local edge
+    ``(a, b)`` -- the one place where the P2 basis is written down.
+
+    Parameters
+    ----------
+    bary : array_like of float, shape (..., 3)
+        Barycentric coordinates ``(l0, l1, l2)``.
+
+    Returns
+    -------
+    ndarray of float64, shape (..., 6)
+        In the local node order (3 vertices, then the midpoints of local edges 0, 1, 2).
+    """
+    bary = np.asarray(bary, dtype=np.float64)
+    out = np.empty(bary.shape[:-1] + (6,))
+    out[..., :3] = bary * (2.0 * bary - 1.0)
+    for k, (a, b) in enumerate(_EDGE_VERTS):
+        out[..., 3 + k] = 4.0 * bary[..., a] * bary[..., b]
+    return out
 
 
 def basis(xi: np.ndarray) -> np.ndarray:
@@ -79,12 +117,7 @@ def basis(xi: np.ndarray) -> np.ndarray:
     ndarray of float64, shape (q, 6)
         ``phi[p, a]`` = basis function ``a`` at point ``p`` (project node order).
     """
-    lam = _barycentric(_as_points(xi))
-    out = np.empty((lam.shape[0], 6))
-    out[:, :3] = lam * (2.0 * lam - 1.0)
-    for k, (a, b) in enumerate(_EDGE_VERTS):
-        out[:, 3 + k] = 4.0 * lam[:, a] * lam[:, b]
-    return out
+    return basis_barycentric(barycentric(xi))
 
 
 def grad_basis(xi: np.ndarray) -> np.ndarray:
@@ -100,12 +133,12 @@ def grad_basis(xi: np.ndarray) -> np.ndarray:
     ndarray of float64, shape (q, 6, 2)
         ``g[p, a, j] = d phi_a / d xi_j`` at point ``p``.
     """
-    lam = _barycentric(_as_points(xi))
-    out = np.empty((lam.shape[0], 6, 2))
+    bary = barycentric(xi)
+    out = np.empty((bary.shape[0], 6, 2))
     for i in range(3):
-        out[:, i, :] = (4.0 * lam[:, i] - 1.0)[:, None] * _GRAD_L[i]
+        out[:, i, :] = (4.0 * bary[:, i] - 1.0)[:, None] * _GRAD_L[i]
     for k, (a, b) in enumerate(_EDGE_VERTS):
-        out[:, 3 + k, :] = 4.0 * (lam[:, a, None] * _GRAD_L[b] + lam[:, b, None] * _GRAD_L[a])
+        out[:, 3 + k, :] = 4.0 * (bary[:, a, None] * _GRAD_L[b] + bary[:, b, None] * _GRAD_L[a])
     return out
 
 
@@ -140,8 +173,6 @@ def edge_basis(t: np.ndarray) -> np.ndarray:
         ``(1 - t)(1 - 2 t)``, ``t (2 t - 1)``, ``4 t (1 - t)``.
     """
     t = np.asarray(t, dtype=np.float64)
-    if t.ndim != 1:
-        raise ValueError(f"t must have shape (q,), got {t.shape}")
     return np.column_stack([(1.0 - t) * (1.0 - 2.0 * t), t * (2.0 * t - 1.0), 4.0 * t * (1.0 - t)])
 
 
@@ -164,24 +195,10 @@ def edge_reference_points(local_edge: np.ndarray, t: np.ndarray) -> np.ndarray:
         Reference points.
     """
     le = np.asarray(local_edge)
-    if le.size and (not np.issubdtype(le.dtype, np.integer) or le.min() < 0 or le.max() > 2):
-        raise ValueError("local_edge must contain integers in {0, 1, 2}")
     t = np.asarray(t, dtype=np.float64)
-    if t.ndim != 1:
-        raise ValueError(f"t must have shape (q,), got {t.shape}")
     start = REFERENCE_NODES[:3][le]  # (..., 2)
     end = REFERENCE_NODES[:3][(le + 1) % 3]
     return start[..., None, :] + t[:, None] * (end - start)[..., None, :]
-
-
-def _check_vertices(vertices: np.ndarray) -> np.ndarray:
-    v = np.asarray(vertices, dtype=np.float64)
-    if v.ndim != 3 or v.shape[1:] != (3, 2):
-        raise ValueError(f"vertices must have shape (n_cells, 3, 2), got {v.shape}")
-    if not np.all(np.isfinite(v)):
-        bad = np.flatnonzero(~np.isfinite(v).all(axis=(1, 2)))
-        raise ValueError(f"vertices of {bad.size} cell(s) are not finite (first: cell {bad[0]})")
-    return v
 
 
 def jacobian(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -197,23 +214,11 @@ def jacobian(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     J : ndarray of float64, shape (m, 2, 2)
         ``J[:, :, 0] = v1 - v0``, ``J[:, :, 1] = v2 - v0``.
     det : ndarray of float64, shape (m,)
-        ``det J`` = twice the cell area, positive.
-
-    Raises
-    ------
-    ValueError
-        On a wrong shape, non-finite coordinates, or cells with ``det J <= 0``
-        (clockwise or degenerate); the message gives how many and the first.
+        ``det J`` = twice the cell area (positive for counter-clockwise cells).
     """
-    v = _check_vertices(vertices)
+    v = np.asarray(vertices, dtype=np.float64)
     J = np.stack([v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]], axis=2)
     det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
-    if not np.all(det > 0.0):
-        bad = np.flatnonzero(~(det > 0.0))
-        raise ValueError(
-            f"{bad.size} cell(s) have a non-positive Jacobian determinant "
-            f"(clockwise or degenerate; first: cell {bad[0]}, det = {det[bad[0]]:.3e})"
-        )
     return J, det
 
 
@@ -233,8 +238,6 @@ def inverse_transpose(J: np.ndarray, det: np.ndarray | None = None) -> np.ndarra
         ``J^{-T}``; physical gradients are ``J^{-T} grad_xi``.
     """
     J = np.asarray(J, dtype=np.float64)
-    if J.ndim != 3 or J.shape[1:] != (2, 2):
-        raise ValueError(f"J must have shape (m, 2, 2), got {J.shape}")
     if det is None:
         det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
     inv_det = 1.0 / det
@@ -262,7 +265,7 @@ def physical_points(vertices: np.ndarray, xi: np.ndarray) -> np.ndarray:
     ndarray of float64, shape (m, q, 2)
         ``x = v0 + J xi``.
     """
-    v = _check_vertices(vertices)
+    v = np.asarray(vertices, dtype=np.float64)
     xi = _as_points(xi)
     v0 = v[:, None, 0, :]
     return (
@@ -292,27 +295,6 @@ def physical_gradients(vertices: np.ndarray, xi: np.ndarray) -> np.ndarray:
     return np.einsum("mij,qaj->mqai", jit, grad_basis(xi))
 
 
-def _check_u_cell(u_cell: np.ndarray, m: int | None = None) -> np.ndarray:
-    u = np.asarray(u_cell, dtype=np.float64)
-    if u.ndim != 2 or u.shape[1] != 12:
-        raise ValueError(f"u_cell must have shape (n_cells, 12), got {u.shape}")
-    if m is not None and u.shape[0] != m:
-        raise ValueError(f"u_cell has {u.shape[0]} rows but vertices has {m} cells")
-    return u
-
-
-def _cell_points(xi: np.ndarray, m: int | None = None) -> np.ndarray:
-    """Reference points shared by all cells (q, 2) or given per cell (m, q, 2)."""
-    xi = np.asarray(xi, dtype=np.float64)
-    if xi.ndim == 3:
-        if xi.shape[2] != 2 or (m is not None and xi.shape[0] != m):
-            raise ValueError(
-                f"per-cell reference points must have shape ({m}, q, 2), got {xi.shape}"
-            )
-        return xi
-    return _as_points(xi)
-
-
 def field_values(u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
     """Values of a P2 vector field at reference points of each cell.
 
@@ -328,8 +310,8 @@ def field_values(u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
     ndarray of float64, shape (m, q, 2)
         ``u_h`` at the image of each reference point.
     """
-    u = _check_u_cell(u_cell).reshape(-1, 6, 2)
-    xi = _cell_points(xi, u.shape[0])
+    u = np.asarray(u_cell, dtype=np.float64).reshape(-1, 6, 2)
+    xi = _as_points(xi)
     if xi.ndim == 3:
         phi = basis(xi.reshape(-1, 2)).reshape(xi.shape[0], xi.shape[1], 6)
         return np.einsum("mqa,mac->mqc", phi, u)
@@ -354,8 +336,8 @@ def field_gradients(vertices: np.ndarray, u_cell: np.ndarray, xi: np.ndarray) ->
         ``grad[c, p, i, j] = d u_i / d x_j``.
     """
     J, det = jacobian(vertices)
-    u = _check_u_cell(u_cell, J.shape[0])
-    xi = _cell_points(xi, J.shape[0])
+    u = np.asarray(u_cell, dtype=np.float64)
+    xi = _as_points(xi)
     coef = gradient_coefficients(u, inverse_transpose(J, det))  # (m, 3, 2, 2)
     if xi.ndim == 3:
         return (
@@ -419,7 +401,7 @@ def field_hessian(vertices: np.ndarray, u_cell: np.ndarray) -> np.ndarray:
         ``H[c, i, j, k] = d^2 u_i / d x_j d x_k``.
     """
     J, det = jacobian(vertices)
-    u = _check_u_cell(u_cell, J.shape[0]).reshape(-1, 6, 2)
+    u = np.asarray(u_cell, dtype=np.float64).reshape(-1, 6, 2)
     jit = inverse_transpose(J, det)
     href = np.tensordot(u, hessian_basis(), axes=([1], [0]))  # (m, i, r, s)
     # H_i = J^{-T} href_i J^{-1}

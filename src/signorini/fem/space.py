@@ -15,24 +15,9 @@ import numpy as np
 
 from ..mesh.mesh import Mesh
 from ..mesh.refine import Refinement
+from .p2 import basis_barycentric
 
-__all__ = ["P2Space", "p2_from_barycentric"]
-
-
-def p2_from_barycentric(bary: np.ndarray) -> np.ndarray:
-    """P2 basis values ``(..., 6)`` at points given by barycentric coordinates ``(..., 3)``."""
-    l0, l1, l2 = bary[..., 0], bary[..., 1], bary[..., 2]
-    return np.stack(
-        [
-            l0 * (2 * l0 - 1),
-            l1 * (2 * l1 - 1),
-            l2 * (2 * l2 - 1),
-            4 * l0 * l1,
-            4 * l1 * l2,
-            4 * l2 * l0,
-        ],
-        axis=-1,
-    )
+__all__ = ["P2Space"]
 
 
 class P2Space:
@@ -41,6 +26,7 @@ class P2Space:
     Parameters
     ----------
     mesh : Mesh
+        A validated mesh; the space trusts it (built inside the package, not a user entry).
     """
 
     def __init__(self, mesh: Mesh) -> None:
@@ -148,7 +134,7 @@ class P2Space:
                 "the refinement is not a refinement of this space's mesh (a new "
                 "cell is not inside its parent cell)"
             )
-        phi = p2_from_barycentric(bary)  # (m, 6, 6): new local node, parent local node
+        phi = basis_barycentric(bary)  # (m, 6, 6): new local node, parent local node
         coarse = u[self.cell_nodes[parent]]  # (m, 6) or (m, 6, 2)
         if u.ndim == 1:
             vals = np.einsum("mij,mj->mi", phi, coarse)

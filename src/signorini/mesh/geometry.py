@@ -1,4 +1,4 @@
-"""Geometry of straight segments: lengths and unit normals.
+"""Geometry of straight segments and triangles: lengths, unit normals, signed areas.
 
 The one place where an edge's normal is computed. For a segment traversed from ``a`` to
 ``b`` the normal is the right-hand one, ``(d_y, −d_x) / |d|`` with ``d = b − a``: it points
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["segment_normals"]
+__all__ = ["segment_normals", "signed_area"]
 
 
 def segment_normals(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -31,3 +31,20 @@ def segment_normals(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarra
     length = np.hypot(d[..., 0], d[..., 1])
     normal = np.stack([d[..., 1], -d[..., 0]], axis=-1) / length[..., None]
     return length, normal
+
+
+def signed_area(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """Signed areas of triangles, positive for counter-clockwise ones.
+
+    Parameters
+    ----------
+    points : (n_points, 2) float array
+    cells : (n_cells, 3) int array
+
+    Returns
+    -------
+    (n_cells,) float array
+    """
+    p0, p1, p2 = (points[cells[:, k]] for k in range(3))
+    d1, d2 = p1 - p0, p2 - p0
+    return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])

@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .mesh import Mesh, MeshError, signed_area
+from .geometry import signed_area
+from .mesh import Mesh, MeshError
 
 __all__ = ["read_mesh"]
 

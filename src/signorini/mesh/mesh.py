@@ -14,7 +14,8 @@ Conventions (fixed for the whole package)
   index of its part in ``boundary_part``. What a part means (Dirichlet, Neumann, contact) is the
   business of :mod:`signorini.problem`, not of the mesh. Parts survive refinement.
 
-A :class:`Mesh` is immutable; derived topology is computed once and cached.
+A :class:`Mesh` is immutable; derived topology is computed once and cached. Building one from
+user arrays runs the checks of :mod:`signorini.mesh.validation`.
 """
 
 from __future__ import annotations
@@ -24,18 +25,17 @@ from functools import cached_property
 
 import numpy as np
 
-__all__ = ["Mesh", "MeshError", "boundary_edges", "signed_area"]
+from .geometry import signed_area
+from .validation import (
+    MeshError,
+    as_cells,
+    as_points,
+    check_orientation,
+    format_indices,
+    validate_mesh,
+)
 
-
-class MeshError(ValueError):
-    """Raised for a mesh that is not a valid conforming triangulation."""
-
-
-def _first(indices: np.ndarray, limit: int = 5) -> str:
-    """Format the first few entries of an index array for an error message."""
-    shown = ", ".join(str(int(i)) for i in indices[:limit])
-    more = f" (and {indices.size - limit} more)" if indices.size > limit else ""
-    return shown + more
+__all__ = ["Mesh", "MeshError", "boundary_edges"]
 
 
 def _edge_keys(pairs: np.ndarray, n_points: int) -> np.ndarray:
@@ -77,8 +77,9 @@ class Mesh:
     part_names : sequence of str
         Names of the boundary parts; every part must own at least one edge.
     validate : bool
-        Check the mesh (orientation, degeneracy, conformity, labels). Refinement, which
-        preserves validity by construction, skips it.
+        Check the mesh (:func:`~signorini.mesh.validation.validate_mesh`: orientation,
+        degeneracy, conformity, labels). Refinement, which preserves validity by
+        construction, skips it.
 
     Raises
     ------
@@ -107,7 +108,7 @@ class Mesh:
         for a in (self.points, self.cells, self.boundary, self.boundary_part):
             a.flags.writeable = False
         if validate:
-            self._validate()
+            validate_mesh(self)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -128,9 +129,9 @@ class Mesh:
             Edges claimed by a predicate are those not listed explicitly; a boundary edge
             claimed by two parts is an error.
         """
-        points = _as_points(points)
-        cells = _as_cells(cells, len(points))
-        _check_orientation(points, cells)
+        points = as_points(points)
+        cells = as_cells(cells, len(points))
+        check_orientation(points, cells)
         cells = _longest_edge_first(points, cells)
         bnd = boundary_edges(cells)
         part_of = np.full(len(bnd), -1, dtype=np.int64)
@@ -159,7 +160,7 @@ class Mesh:
                 else:
                     if pairs.ndim == 1 and pairs.size % 2 == 0:
                         pairs = pairs.reshape(-1, 2)
-                    pairs = _as_cells(pairs, len(points), what="boundary edges")
+                    pairs = as_cells(pairs, len(points), what="boundary edges")
                     k = _edge_keys(pairs, len(points))
                     pos = np.searchsorted(keys, k, sorter=order)
                     pos = np.minimum(pos, len(keys) - 1)
@@ -258,7 +259,7 @@ class Mesh:
         pos = np.minimum(np.searchsorted(keys, k), keys.size - 1)
         if keys.size == 0 or not np.array_equal(keys[pos], k):
             bad = np.flatnonzero(keys[pos] != k)
-            raise MeshError(f"boundary edge(s) {_first(bad)} are not edges of the mesh")
+            raise MeshError(f"boundary edge(s) {format_indices(bad)} are not edges of the mesh")
         return _frozen(pos)
 
     @cached_property
@@ -332,174 +333,12 @@ class Mesh:
             f"Mesh(n_points={self.n_points}, n_cells={self.n_cells}, parts={list(self.part_names)})"
         )
 
-    # ------------------------------------------------------------------ validation
-    def _validate(self) -> None:
-        points = _as_points(self.points)
-        cells = _as_cells(self.cells, len(points))
-        _as_cells(self.boundary, len(points), what="boundary edges")
-        _check_orientation(points, cells)
-        used = np.zeros(len(points), dtype=bool)
-        used[cells.ravel()] = True
-        if not used.all():
-            raise MeshError(
-                f"unreferenced point(s) {_first(np.flatnonzero(~used))}: every "
-                "point must be a vertex of some cell"
-            )
-        _check_duplicate_points(points)
-        if self.boundary_part.shape != (len(self.boundary),):
-            raise MeshError("boundary_part must have one entry per boundary edge")
-        bad_part = (self.boundary_part < 0) | (self.boundary_part >= len(self.part_names))
-        if bad_part.any():
-            first = self.boundary[np.flatnonzero(bad_part)[0]]
-            raise MeshError(
-                f"{int(bad_part.sum())} boundary edge(s) have no part, first "
-                f"({first[0]}, {first[1]}); label every boundary edge"
-            )
-        for index, name in enumerate(self.part_names):
-            if not np.any(self.boundary_part == index):
-                raise MeshError(f"boundary part {name!r} has no edges")
-        e2c = self.edge2cell  # raises on non-manifold edges
-        is_bnd = e2c[:, 1] < 0
-        self._check_conforming(is_bnd)
-        labelled = np.zeros(self.n_edges, dtype=bool)
-        be = self.boundary_edge
-        if np.any(~is_bnd[be]):
-            bad = self.boundary[np.flatnonzero(~is_bnd[be])[0]]
-            raise MeshError(
-                f"edge ({bad[0]}, {bad[1]}) is labelled as boundary but is shared by two cells"
-            )
-        if np.unique(be).size != be.size:
-            raise MeshError("a boundary edge is listed twice")
-        labelled[be] = True
-        missing = np.flatnonzero(is_bnd & ~labelled)
-        if missing.size:
-            e = self.edges[missing[0]]
-            raise MeshError(
-                f"{missing.size} boundary edge(s) without a part, first "
-                f"({e[0]}, {e[1]}); label every boundary edge"
-            )
-
-    def _check_conforming(self, is_bnd: np.ndarray) -> None:
-        """Neighbouring cells must traverse a shared edge in opposite directions, and no vertex
-        may lie inside a boundary edge (a hanging node)."""
-        local = self.cells[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-        forward = local[:, 0] < local[:, 1]
-        inner = ~is_bnd[self.cell2edge.ravel()]
-        # each interior edge is traversed once forwards and once backwards
-        counts = np.bincount(self.cell2edge.ravel()[inner & forward], minlength=self.n_edges)
-        if np.any(counts[~is_bnd] != 1):
-            bad = np.flatnonzero((counts != 1) & ~is_bnd)[0]
-            e = self.edges[bad]
-            raise MeshError(
-                f"cells overlap or are inconsistently oriented across edge ({e[0]}, {e[1]})"
-            )
-        bnd = np.flatnonzero(is_bnd)
-        verts = np.unique(self.edges[bnd])
-        a = self.points[self.edges[bnd, 0]]
-        b = self.points[self.edges[bnd, 1]]
-        tol = 1e-10
-        margin = 1e-9 * np.hypot(*(b - a).T)
-        # candidates of each edge: the boundary vertices inside its bounding box, found by
-        # sorting along the axis in which the box holds fewer (near-linear, not all pairs)
-        first, count, by_axis = [], [], []
-        for axis in range(2):
-            order = verts[np.argsort(self.points[verts, axis], kind="stable")]
-            coord = self.points[order, axis]
-            lo = np.searchsorted(coord, np.minimum(a[:, axis], b[:, axis]) - margin, "left")
-            hi = np.searchsorted(coord, np.maximum(a[:, axis], b[:, axis]) + margin, "right")
-            first.append(lo)
-            count.append(hi - lo)
-            by_axis.append(order)
-        use_y = count[1] < count[0]
-        n_cand = np.where(use_y, count[1], count[0])
-        edge_of = np.repeat(np.arange(bnd.size), n_cand)
-        pos = np.where(use_y, first[1], first[0])[edge_of] + (
-            np.arange(edge_of.size) - np.repeat(np.cumsum(n_cand) - n_cand, n_cand)
-        )
-        cand = np.where(use_y[edge_of], by_axis[1][pos], by_axis[0][pos])
-        ab = (b - a)[edge_of]
-        ap = self.points[cand] - a[edge_of]
-        length2 = (ab**2).sum(-1)
-        t = (ap * ab).sum(-1) / length2
-        cross = ab[:, 0] * ap[:, 1] - ab[:, 1] * ap[:, 0]
-        on = (np.abs(cross) <= tol * length2) & (t > tol) & (t < 1 - tol)
-        if on.any():
-            i = np.flatnonzero(on)[0]
-            e = self.edges[bnd[edge_of[i]]]
-            raise MeshError(
-                f"non-conforming mesh: point {cand[i]} lies inside edge "
-                f"({e[0]}, {e[1]}) (hanging node)"
-            )
-
 
 # ---------------------------------------------------------------------- helpers
 def _frozen(a: np.ndarray) -> np.ndarray:
     """Mark a cached array read-only (a Mesh is immutable)."""
     a.flags.writeable = False
     return a
-
-
-def _as_points(points: np.ndarray) -> np.ndarray:
-    p = np.asarray(points, dtype=np.float64)
-    if p.ndim != 2 or p.shape[1] != 2:
-        raise MeshError(f"points must have shape (n_points, 2), got {p.shape}")
-    if not np.isfinite(p).all():
-        raise MeshError(
-            f"point(s) {_first(np.flatnonzero(~np.isfinite(p).all(1)))} have non-finite coordinates"
-        )
-    return p
-
-
-def _as_cells(cells: np.ndarray, n_points: int, what: str = "cells") -> np.ndarray:
-    c = np.asarray(cells)
-    width = 3 if what == "cells" else 2
-    if c.ndim != 2 or c.shape[1] != width:
-        raise MeshError(f"{what} must have shape (n, {width}), got {c.shape}")
-    if c.size and not np.issubdtype(c.dtype, np.integer):
-        if not np.all(np.equal(np.mod(c, 1), 0)):
-            raise MeshError(f"{what} must hold integer point indices")
-    c = c.astype(np.int64)
-    if c.size and (c.min() < 0 or c.max() >= n_points):
-        raise MeshError(f"{what} refer to points outside 0..{n_points - 1}")
-    return c
-
-
-def signed_area(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
-    """``(n_cells,)`` signed areas, positive for counter-clockwise cells."""
-    p0, p1, p2 = (points[cells[:, k]] for k in range(3))
-    d1, d2 = p1 - p0, p2 - p0
-    return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
-
-
-def _check_orientation(points: np.ndarray, cells: np.ndarray) -> None:
-    if cells.shape[0] == 0:
-        raise MeshError("the mesh has no cells")
-    area = signed_area(points, cells)
-    p = points[cells]
-    h2 = ((p - np.roll(p, 1, axis=1)) ** 2).sum(-1).max(axis=1)
-    degenerate = np.abs(area) <= 1e-12 * h2
-    if degenerate.any():
-        bad = np.flatnonzero(degenerate)
-        raise MeshError(
-            f"degenerate triangle(s) {_first(bad)} (zero area or repeated vertex), "
-            f"e.g. cell {bad[0]} = {cells[bad[0]].tolist()}"
-        )
-    if np.any(area < 0):
-        bad = np.flatnonzero(area < 0)
-        raise MeshError(
-            f"clockwise triangle(s) {_first(bad)}: list each cell's vertices counter-clockwise"
-        )
-
-
-def _check_duplicate_points(points: np.ndarray) -> None:
-    scale = max(float(np.ptp(points, axis=0).max()), 1.0)
-    q = np.round(points / (1e-10 * scale)).astype(np.int64)
-    _, inverse, counts = np.unique(q, axis=0, return_inverse=True, return_counts=True)
-    if counts.max() > 1:
-        dup = np.flatnonzero(counts[inverse.reshape(-1)] > 1)
-        raise MeshError(
-            f"duplicate points {_first(dup)} (same coordinates {points[dup[0]].tolist()})"
-        )
 
 
 def _longest_edge_first(points: np.ndarray, cells: np.ndarray) -> np.ndarray:

@@ -1,5 +1,9 @@
-"""The problem a user states: boundary conditions on named parts, material and data."""
+"""The problem a user states: boundary conditions on named parts (``conditions``), the
+problem itself (``problem``), and the one place where user functions are evaluated and
+checked (``fields``)."""
 
-from .problem import Contact, ContactProblem, Dirichlet, ExactSolution, Neumann, ProblemError
+from .conditions import Contact, Dirichlet, ExactSolution, Neumann
+from .fields import ProblemError
+from .problem import ContactProblem
 
 __all__ = ["Contact", "ContactProblem", "Dirichlet", "ExactSolution", "Neumann", "ProblemError"]

@@ -1,127 +1,31 @@
-"""Problem definitions: material, data and boundary conditions of a Signorini problem.
+"""The Signorini problem a user states: a mesh, a material, one condition per boundary part,
+the body force and (optionally) an exact solution.
 
 The strong form (paper, Section 2; docs/method.md, *The continuous problem*)::
 
     −div σ(u) = f in Ω,   u = u_D on Γ_D,   σ(u) n = g on Γ_N,
     u·n ≤ ψ,  σ_nn ≤ 0,  (u·n − ψ) σ_nn = 0,  σ_t = 0 on Γ_C.
 
-A :class:`ContactProblem` assigns one condition to every boundary part of its mesh.
+:class:`ContactProblem` is a public boundary: it checks that every part has exactly one
+condition, that there is a Dirichlet part, and that each contact part is straight with the
+given normal. Everything below it trusts the problem.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fem.elasticity import Material
+from ..fem.material import Material
 from ..fem.space import P2Space
 from ..mesh.geometry import segment_normals
 from ..mesh.mesh import Mesh
+from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann
+from .fields import ProblemError, VectorField
 
-__all__ = ["Dirichlet", "Neumann", "Contact", "ExactSolution", "ContactProblem", "ProblemError"]
-
-VectorField = Callable[[np.ndarray], np.ndarray]
-
-
-class ProblemError(ValueError):
-    """Raised for an ill-posed or inconsistent problem definition."""
-
-
-def _constant_field(value: np.ndarray) -> VectorField:
-    v = np.asarray(value, dtype=np.float64).reshape(2)
-    return lambda x: np.broadcast_to(v, np.shape(x)[:-1] + (2,)).copy()
-
-
-def evaluate_field(func: VectorField, x: np.ndarray, what: str) -> np.ndarray:
-    """Evaluate a vector field at points ``x (..., 2)``, checking shape and finiteness."""
-    values = np.asarray(func(x), dtype=np.float64)
-    expected = np.shape(x)[:-1] + (2,)
-    if values.shape != expected:
-        try:
-            values = np.broadcast_to(values, expected).copy()
-        except ValueError:
-            raise ProblemError(
-                f"{what} must return shape {expected} for points of shape "
-                f"{np.shape(x)}, got {values.shape}"
-            ) from None
-    if not np.isfinite(values).all():
-        raise ProblemError(f"{what} returned NaN or inf")
-    return values
-
-
-@dataclass(frozen=True)
-class Dirichlet:
-    """Prescribed displacement ``u = u_D`` (a constant vector or a function of ``x (n, 2)``)."""
-
-    value: VectorField | tuple[float, float] = (0.0, 0.0)
-
-    def field(self) -> VectorField:
-        return self.value if callable(self.value) else _constant_field(self.value)
-
-
-@dataclass(frozen=True)
-class Neumann:
-    """Prescribed traction ``σ(u) n = g``: a constant vector or ``g(x (..., 2), n (..., 2))``."""
-
-    traction: Callable[[np.ndarray, np.ndarray], np.ndarray] | tuple[float, float] = (0.0, 0.0)
-
-    def field(self) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
-        if callable(self.traction):
-            return self.traction
-        const = _constant_field(self.traction)
-        return lambda x, n: const(x)
-
-    @property
-    def is_zero(self) -> bool:
-        return not callable(self.traction) and not np.any(np.asarray(self.traction))
-
-
-@dataclass(frozen=True)
-class Contact:
-    """Frictionless unilateral contact ``u·n ≤ ψ`` on a straight boundary part.
-
-    Parameters
-    ----------
-    gap : float or callable
-        The gap (obstacle) function ``ψ(x (n, 2)) -> (n,)``, or a constant.
-    normal : (2,) array or None
-        The outward unit normal; ``None`` takes it from the geometry. A given normal must agree
-        with the geometry.
-    """
-
-    gap: Callable[[np.ndarray], np.ndarray] | float = 0.0
-    normal: tuple[float, float] | None = None
-
-    def gap_values(self, x: np.ndarray, part: str) -> np.ndarray:
-        if callable(self.gap):
-            values = np.asarray(self.gap(x), dtype=np.float64)
-            if values.shape != x.shape[:-1]:
-                try:
-                    values = np.broadcast_to(values, x.shape[:-1]).copy()
-                except ValueError:
-                    raise ProblemError(
-                        f"the gap function of contact part {part!r} must return "
-                        f"shape {x.shape[:-1]}, got {values.shape}"
-                    ) from None
-        else:
-            values = np.full(x.shape[:-1], float(self.gap))
-        if not np.isfinite(values).all():
-            raise ProblemError(f"the gap function of contact part {part!r} returned NaN or inf")
-        return values
-
-
-@dataclass(frozen=True)
-class ExactSolution:
-    """A known solution: displacement ``u(x) -> (..., 2)``, gradient ``grad(x) -> (..., 2, 2)``
-    with ``grad[..., i, j] = ∂u_i/∂x_j``."""
-
-    displacement: VectorField
-    gradient: Callable[[np.ndarray], np.ndarray]
-
-
-Condition = Dirichlet | Neumann | Contact
+__all__ = ["ContactProblem"]
 
 
 @dataclass(frozen=True)
@@ -174,6 +78,11 @@ class ContactProblem:
                     f"the condition of part {name!r} must be Dirichlet, Neumann or "
                     f"Contact, got {type(cond).__name__}"
                 )
+            _check_data(name, cond)
+        if self.body_force is not None and not callable(self.body_force):
+            raise ProblemError("body_force must be a function of x (..., 2), or None")
+        if self.exact is not None and not isinstance(self.exact, ExactSolution):
+            raise ProblemError(f"exact must be an ExactSolution, got {type(self.exact).__name__}")
         if not self.dirichlet_parts:
             raise ProblemError(
                 "the problem needs a Dirichlet part (meas Γ_D > 0) to rule out rigid body motions"
@@ -229,3 +138,25 @@ class ContactProblem:
                     f"is not its outward normal {tuple(np.round(mean, 12))}"
                 )
         return mean
+
+
+def _check_data(name: str, cond: Condition) -> None:
+    """A condition's data given as numbers must be finite, of the right size: two numbers for a
+    displacement or traction, one for a gap (functions are checked where they are called)."""
+    if isinstance(cond, Dirichlet):
+        data, size, what = cond.value, 2, "Dirichlet value"
+    elif isinstance(cond, Neumann):
+        data, size, what = cond.traction, 2, "traction"
+    else:
+        data, size, what = cond.gap, 1, "gap"
+    if callable(data):
+        return
+    try:
+        values = np.asarray(data, dtype=np.float64)
+    except (TypeError, ValueError):
+        values = np.full(0, np.nan)
+    if values.size != size or not np.isfinite(values).all():
+        raise ProblemError(
+            f"the {what} of part {name!r} must be a function of x or {size} finite "
+            f"number(s), got {data!r}"
+        )

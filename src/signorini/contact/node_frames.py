@@ -1,4 +1,4 @@
-"""Rotation of the two DOFs of a node into its (normal, tangential) frame.
+"""Node frames: rotation of the two DOFs of a contact node into its (normal, tangential) frame.
 
 A contact node ``z`` has a constant outward unit normal ``n = (n1, n2)`` and the tangent
 ``t = (-n2, n1)``. With interleaved DOFs (``dof = 2 * node + component``), the Cartesian values
@@ -12,6 +12,9 @@ becomes a bound on the single DOF ``2z`` of the rotated system ``Q^T K Q y = Q^T
 interleaved DOFs has a 2 x 2 node-block pattern (rows ``2z`` and ``2z + 1`` store the same
 columns, and columns ``2z``, ``2z + 1`` sit next to each other in every row), so the product
 only mixes pairs of stored values.
+
+:func:`rotate_frames` checks its input unless told not to (the assembly of a validated problem
+passes ``validate=False``); :func:`to_frames` and :func:`to_cartesian` trust theirs.
 """
 
 from __future__ import annotations
@@ -24,7 +27,9 @@ from ..algebra.sparse import as_csr, csr_row_indices
 __all__ = ["rotate_frames", "to_cartesian", "to_frames"]
 
 
-def _check_frames(nodes: np.ndarray, normals: np.ndarray, n_dofs: int) -> tuple[np.ndarray, ...]:
+def _checked_frames(
+    nodes: np.ndarray, normals: np.ndarray, n_dofs: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Validate ``nodes (k,)`` and unit ``normals (k, 2)``; return them as int64 / float64."""
     if n_dofs % 2:
         raise ValueError(f"interleaved 2D DOFs need an even size, got {n_dofs}")
@@ -79,7 +84,8 @@ def to_frames(x: np.ndarray, nodes: np.ndarray, normals: np.ndarray) -> np.ndarr
         ``y[2z] = u(z).n``, ``y[2z + 1] = u(z).t`` with ``t = (-n2, n1)``; other DOFs copied.
     """
     y = np.array(x, dtype=np.float64)
-    nodes, normals = _check_frames(nodes, normals, y.shape[0])
+    nodes = np.asarray(nodes, dtype=np.int64)
+    normals = np.asarray(normals, dtype=np.float64)
     shape = (-1,) + (1,) * (y.ndim - 1)
     n1, n2 = normals[:, 0].reshape(shape), normals[:, 1].reshape(shape)
     _rotate_pairs(2 * nodes, 2 * nodes + 1, n1, n2, y)
@@ -102,8 +108,47 @@ def to_cartesian(y: np.ndarray, nodes: np.ndarray, normals: np.ndarray) -> np.nd
     """
     normals = np.asarray(normals, dtype=np.float64)
     # Q_z^{-1} = Q_z^T is the frame of the reflected normal (n1, -n2).
-    mirrored = normals * np.array([1.0, -1.0]) if normals.ndim == 2 else normals
-    return to_frames(y, nodes, mirrored)
+    return to_frames(y, nodes, normals * np.array([1.0, -1.0]))
+
+
+def _row_pairs(indptr: np.ndarray, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions ``pos0``, ``pos1`` of the stored entries of rows ``2z`` and ``2z + 1`` of each
+    node, paired entry by entry, and the length of row ``2z`` per node."""
+    start0, start1 = indptr[2 * nodes], indptr[2 * nodes + 1]
+    length = start1 - start0
+    offset = np.arange(length.sum()) - np.repeat(np.cumsum(length) - length, length)
+    pos0 = np.repeat(start0, length) + offset
+    return pos0, pos0 + np.repeat(length, length), length
+
+
+def _check_node_blocks(
+    K: sp.csr_matrix, nodes: np.ndarray, first: np.ndarray, n_column_entries: int
+) -> None:
+    """Raise unless ``K`` has a 2 x 2 node-block pattern at ``nodes``: rows ``2z``, ``2z + 1``
+    store the same columns, and in every row column ``2z`` (stored at ``first``) is followed by
+    column ``2z + 1``."""
+    indptr, indices = K.indptr, K.indices
+    length = indptr[2 * nodes + 1] - indptr[2 * nodes]
+    bad = np.flatnonzero(length != indptr[2 * nodes + 2] - indptr[2 * nodes + 1])
+    if bad.size == 0:
+        pos0, pos1, length = _row_pairs(indptr, nodes)
+        mismatch = indices[pos0] != indices[pos1]
+        if mismatch.any():
+            bad = np.unique(np.repeat(np.arange(nodes.size), length)[mismatch])
+    if bad.size:
+        raise ValueError(
+            f"K has no 2x2 node-block pattern: rows 2z, 2z+1 of node {nodes[bad[0]]} store "
+            "different columns"
+        )
+    second = np.minimum(first + 1, K.nnz - 1)
+    rows = csr_row_indices(K)
+    ok = (first + 1 < K.nnz) & (indices[second] == indices[first] + 1)
+    ok &= rows[second] == rows[first]
+    if not ok.all() or 2 * first.size != n_column_entries:
+        raise ValueError(
+            "K has no 2x2 node-block pattern: columns 2z and 2z+1 of a rotated node are not "
+            "stored side by side in every row"
+        )
 
 
 def rotate_frames(
@@ -113,6 +158,7 @@ def rotate_frames(
     normals: np.ndarray,
     *,
     copy: bool = True,
+    validate: bool = True,
 ) -> tuple[sp.csr_matrix, np.ndarray]:
     """Rotate a system ``K x = F`` into node frames: ``(Q^T K Q, Q^T F)``.
 
@@ -123,7 +169,7 @@ def rotate_frames(
     Parameters
     ----------
     K : scipy sparse matrix, shape (n_dofs, n_dofs)
-        With a 2 x 2 node-block pattern at the listed nodes (checked).
+        With a 2 x 2 node-block pattern at the listed nodes.
     F : (n_dofs,) float array
     nodes : (m,) int array
         Nodes to rotate (distinct).
@@ -132,6 +178,11 @@ def rotate_frames(
     copy : bool
         If False and ``K`` is canonical float64 CSR and ``F`` a float64 array, both are
         overwritten and returned.
+    validate : bool
+        Check ``K`` (square, finite, canonical CSR), ``F``, the nodes and normals, and the
+        node-block pattern. The assembly passes False: its stiffness matrix has the pattern by
+        construction (:func:`signorini.fem.stiffness.assemble_stiffness`) and its nodes and
+        normals come from a validated problem.
 
     Returns
     -------
@@ -142,53 +193,33 @@ def rotate_frames(
     Raises
     ------
     ValueError
-        On bad shapes or normals, or if the pattern is not node-blocked at a listed node.
+        If ``validate``: on bad shapes or normals, or if the pattern is not node-blocked at a
+        listed node.
     """
-    K = as_csr(K, "K")
-    n = K.shape[0]
-    F_in = np.asarray(F)
-    if F_in.shape != (n,):
-        raise ValueError(f"F must have shape ({n},), got {F_in.shape}")
-    nodes, normals = _check_frames(nodes, normals, n)
+    if validate:
+        K = as_csr(K, "K")
+        if np.shape(F) != (K.shape[0],):
+            raise ValueError(f"F must have shape ({K.shape[0]},), got {np.shape(F)}")
+        nodes, normals = _checked_frames(nodes, normals, K.shape[0])
+    else:
+        nodes = np.asarray(nodes, dtype=np.int64)
+        normals = np.asarray(normals, dtype=np.float64)
     if copy:
         K = K.copy()
-    F_rot = np.array(F_in, dtype=np.float64) if copy else np.asarray(F_in, dtype=np.float64)
+    F_rot = np.array(F, dtype=np.float64) if copy else np.asarray(F, dtype=np.float64)
     n1, n2 = normals[:, 0], normals[:, 1]
 
-    indptr, indices = K.indptr, K.indices
-    # Row rotation: rows 2z and 2z + 1 must store the same columns.
-    start0, start1, end1 = indptr[2 * nodes], indptr[2 * nodes + 1], indptr[2 * nodes + 2]
-    length = start1 - start0
-    bad = np.flatnonzero(length != end1 - start1)
-    if bad.size == 0:
-        offset = np.arange(length.sum()) - np.repeat(np.cumsum(length) - length, length)
-        pos0 = np.repeat(start0, length) + offset
-        pos1 = pos0 + np.repeat(length, length)
-        mismatch = indices[pos0] != indices[pos1]
-        if mismatch.any():
-            which = np.repeat(np.arange(nodes.size), length)[mismatch]
-            bad = np.unique(which)
-    if bad.size:
-        raise ValueError(
-            f"K has no 2x2 node-block pattern: rows 2z, 2z+1 of node {nodes[bad[0]]} store "
-            "different columns"
-        )
     # Column rotation: in every row, column 2z is stored and followed by column 2z + 1.
-    which_node = np.full(n // 2, -1, dtype=np.int64)
+    which_node = np.full(K.shape[0] // 2, -1, dtype=np.int64)
     which_node[nodes] = np.arange(nodes.size)
-    col_node = which_node[indices >> 1]
-    first = np.flatnonzero((col_node >= 0) & (indices % 2 == 0))
-    second = first + 1
-    rows = csr_row_indices(K)
-    ok = (second < K.nnz) & (indices[np.minimum(second, K.nnz - 1)] == indices[first] + 1)
-    ok &= rows[np.minimum(second, K.nnz - 1)] == rows[first]
-    if not ok.all() or 2 * first.size != np.count_nonzero(col_node >= 0):
-        raise ValueError(
-            "K has no 2x2 node-block pattern: columns 2z and 2z+1 of a rotated node are not "
-            "stored side by side in every row"
-        )
+    col_node = which_node[K.indices >> 1]
+    first = np.flatnonzero((col_node >= 0) & (K.indices % 2 == 0))
+    if validate:
+        _check_node_blocks(K, nodes, first, np.count_nonzero(col_node >= 0))
+    # Row rotation: rows 2z and 2z + 1 store the same columns, paired entry by entry.
+    pos0, pos1, length = _row_pairs(K.indptr, nodes)
     data = K.data
-    _rotate_pairs(first, second, n1[col_node[first]], n2[col_node[first]], data)
+    _rotate_pairs(first, first + 1, n1[col_node[first]], n2[col_node[first]], data)
     _rotate_pairs(pos0, pos1, np.repeat(n1, length), np.repeat(n2, length), data)
     _rotate_pairs(2 * nodes, 2 * nodes + 1, n1, n2, F_rot)
     return K, F_rot

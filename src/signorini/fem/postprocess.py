@@ -1,0 +1,127 @@
+"""Stresses of a discrete displacement ``u_h``: ``sigma(u_h)`` in cells, tractions
+``sigma(u_h) n`` on edges, and ``div sigma(u_h)`` (the quantities of the residual estimator,
+paper Section 5).
+
+Arrays are vectorized over cells: ``vertices (m, 3, 2)`` counter-clockwise and
+``u_cell (m, 12)`` the interleaved local coefficients ``u[cell_dofs]``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..mesh.geometry import segment_normals
+from . import p2
+from .material import Material, stress
+
+__all__ = ["cell_stress", "div_stress", "edge_traction", "traction"]
+
+
+def cell_stress(
+    vertices: np.ndarray, u_cell: np.ndarray, material: Material, xi: np.ndarray
+) -> np.ndarray:
+    """Stress ``sigma(u_h)`` at reference points of each cell.
+
+    Parameters
+    ----------
+    vertices : ndarray of float, shape (m, 3, 2)
+    u_cell : ndarray of float, shape (m, 12)
+        Interleaved local coefficients.
+    material : Material
+    xi : ndarray of float, shape (q, 2) or (m, q, 2)
+        Reference points, shared or per cell.
+
+    Returns
+    -------
+    ndarray of float64, shape (m, q, 2, 2)
+    """
+    return stress(material, p2.field_gradients(vertices, u_cell, xi))
+
+
+def traction(
+    vertices: np.ndarray, u_cell: np.ndarray, material: Material, xi: np.ndarray, normal: np.ndarray
+) -> np.ndarray:
+    """Traction ``sigma(u_h) n`` at reference points of each cell.
+
+    Parameters
+    ----------
+    vertices : ndarray of float, shape (m, 3, 2)
+    u_cell : ndarray of float, shape (m, 12)
+    material : Material
+    xi : ndarray of float, shape (q, 2) or (m, q, 2)
+        Reference points, shared or per cell.
+    normal : ndarray of float, shape (m, 2), (m, q, 2) or (2,)
+        Normal vectors (not normalised here).
+
+    Returns
+    -------
+    ndarray of float64, shape (m, q, 2)
+        ``(sigma n)_i = sum_j sigma_ij n_j``.
+    """
+    sig = cell_stress(vertices, u_cell, material, xi)
+    nrm = np.asarray(normal, dtype=np.float64)
+    if nrm.ndim == 2:
+        nrm = nrm[:, None, :]
+    return np.einsum("mqij,mqj->mqi", sig, np.broadcast_to(nrm, sig.shape[:-1]))
+
+
+def edge_traction(
+    vertices: np.ndarray,
+    u_cell: np.ndarray,
+    material: Material,
+    local_edge: np.ndarray,
+    t: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Traction ``sigma(u_h) n`` along one local edge of each cell, ``n`` outward.
+
+    Local edge ``k`` runs from local vertex ``k`` to ``(k + 1) % 3``; ``t`` is the
+    parameter along it (0 at the start).  The neighbour across an interior edge
+    traverses it the other way: evaluate it at ``1 - t`` to get the same
+    physical points (its normal is the opposite one), e.g. for the jump
+    ``[[sigma n]] = sigma_1 n_1 + sigma_2 n_2``.
+
+    Parameters
+    ----------
+    vertices : ndarray of float, shape (m, 3, 2)
+    u_cell : ndarray of float, shape (m, 12)
+    material : Material
+    local_edge : ndarray of int, shape (m,)
+        Which local edge of each cell, in {0, 1, 2} (e.g. :attr:`Mesh.edge_local`).
+    t : ndarray of float, shape (q,)
+        Edge parameters in [0, 1].
+
+    Returns
+    -------
+    traction : ndarray of float64, shape (m, q, 2)
+    normal : ndarray of float64, shape (m, 2)
+        Outward unit normals of those edges.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    le = np.asarray(local_edge)
+    xi = p2.edge_reference_points(le, t)
+    rows = np.arange(v.shape[0])
+    _, normal = segment_normals(v[rows, le], v[rows, (le + 1) % 3])
+    return traction(v, u_cell, material, xi, normal), normal
+
+
+def div_stress(vertices: np.ndarray, u_cell: np.ndarray, material: Material) -> np.ndarray:
+    """``div sigma(u_h)`` on each cell (constant for P2 on straight triangles).
+
+    ``(div sigma)_i = mu Laplace u_i + (lam + mu) d_i div u``, from the constant
+    Hessian of ``u_h``; this enters the interior residual ``f + div sigma(u_h)``
+    of the estimator (term eta_1 of Section 5).
+
+    Parameters
+    ----------
+    vertices : ndarray of float, shape (m, 3, 2)
+    u_cell : ndarray of float, shape (m, 12)
+    material : Material
+
+    Returns
+    -------
+    ndarray of float64, shape (m, 2)
+    """
+    H = p2.field_hessian(vertices, u_cell)  # (m, i, j, k)
+    lap = H[:, :, 0, 0] + H[:, :, 1, 1]
+    grad_div = H[:, 0, 0, :] + H[:, 1, 1, :]
+    return material.mu * lap + (material.lam + material.mu) * grad_div
