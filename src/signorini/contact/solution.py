@@ -140,7 +140,7 @@ def solve(
         Warm start (e.g. the previous level's solution prolongated to ``mesh``): its nodes in
         contact form the initial active set.
     backend : str
-        Sparse solver backend, see :func:`signorini.linsolve.make_solver`.
+        Sparse solver backend, see :func:`signorini.algebra.make_solver`.
     max_iter : int
         Bound on PDAS iterations.
     fallback : bool
