@@ -7,8 +7,10 @@ The strong form (paper, Section 2; docs/method.md, *The continuous problem*)::
     u·n ≤ ψ,  σ_nn ≤ 0,  (u·n − ψ) σ_nn = 0,  σ_t = 0 on Γ_C.
 
 :class:`ContactProblem` is a public boundary: it checks that every part has exactly one
-condition, that there is a Dirichlet part, and that each contact part is straight with the
-given normal. Everything below it trusts the problem.
+condition, that every component of the body (cells joined through shared edges) has a
+Dirichlet part, that each user function can be called by the convention of docs/method.md,
+*User functions*, and that each contact part is straight with the given normal. Everything
+below it trusts the problem.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from ..fem.space import P2Space
 from ..mesh.geometry import segment_normals
 from ..mesh.mesh import Mesh
 from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann
-from .fields import ProblemError, VectorField
+from .fields import ProblemError, VectorField, check_function
 
 __all__ = ["ContactProblem"]
 
@@ -32,16 +34,32 @@ __all__ = ["ContactProblem"]
 class ContactProblem:
     """A Signorini problem on an initial mesh.
 
+    Units are the user's, and must be consistent: if E is in MPa (N/mm²) and lengths in mm,
+    displacements and gaps are in mm, tractions and stresses in MPa, body forces in N/mm³, and
+    forces along the boundary (per unit thickness, plane strain) in N/mm.
+
     Parameters
     ----------
     mesh : Mesh
-        The initial mesh; its boundary parts carry the conditions.
+        The initial mesh; its boundary parts carry the conditions. Every component of the body
+        (cells joined through shared edges) needs a Dirichlet part.
     material : Material
     conditions : mapping part name -> Dirichlet | Neumann | Contact
         Every boundary part of the mesh must get exactly one condition.
-    body_force : callable ``f(x (..., 2)) -> (..., 2)`` or None (zero)
+    body_force : callable or None
+        ``f(x)`` of the points ``x``, a float array of shape ``(n, 2)``, returning the force
+        per unit volume ``(n, 2)`` (or one ``(2,)`` vector); ``None`` for no body force.
+        docs/method.md, *User functions*.
     exact : ExactSolution or None
     name : str
+
+    Raises
+    ------
+    ProblemError
+        Before any work, if a part has no condition or a condition names no part, a condition
+        or the body force is of the wrong kind, a component of the body has no Dirichlet part
+        (the message names each such component), or a contact part is not straight or not
+        along its given normal.
     """
 
     mesh: Mesh
@@ -59,6 +77,11 @@ class ContactProblem:
         if not isinstance(self.material, Material):
             raise ProblemError(
                 "material must be a signorini Material (Material.from_young or Material.from_lame)"
+            )
+        if not isinstance(self.conditions, Mapping):
+            raise ProblemError(
+                "conditions must be a mapping part name -> Dirichlet | Neumann | Contact, "
+                f"got {type(self.conditions).__name__}"
             )
         unknown = sorted(set(self.conditions) - set(mesh.part_names))
         if unknown:
@@ -78,9 +101,12 @@ class ContactProblem:
                     f"the condition of part {name!r} must be Dirichlet, Neumann or "
                     f"Contact, got {type(cond).__name__}"
                 )
-            _check_data(name, cond)
-        if self.body_force is not None and not callable(self.body_force):
-            raise ProblemError("body_force must be a function of x (..., 2), or None")
+        if self.body_force is not None:
+            check_function(
+                self.body_force,
+                "ContactProblem(body_force=...)",
+                "None or a function f(x) of points x (n, 2)",
+            )
         if self.exact is not None and not isinstance(self.exact, ExactSolution):
             raise ProblemError(f"exact must be an ExactSolution, got {type(self.exact).__name__}")
         if not self.dirichlet_parts:
@@ -126,11 +152,7 @@ class ContactProblem:
             )
         given = self.conditions[name].normal
         if given is not None:
-            g = np.asarray(given, dtype=np.float64).reshape(2)
-            if not np.isfinite(g).all() or np.linalg.norm(g) == 0:
-                raise ProblemError(
-                    f"the normal of contact part {name!r} must be a non-zero finite vector"
-                )
+            g = np.asarray(given, dtype=np.float64).reshape(2)  # checked by Contact
             g = g / np.linalg.norm(g)
             if np.abs(g - mean).max() > 1e-6:
                 raise ProblemError(
@@ -138,25 +160,3 @@ class ContactProblem:
                     f"is not its outward normal {tuple(np.round(mean, 12))}"
                 )
         return mean
-
-
-def _check_data(name: str, cond: Condition) -> None:
-    """A condition's data given as numbers must be finite, of the right size: two numbers for a
-    displacement or traction, one for a gap (functions are checked where they are called)."""
-    if isinstance(cond, Dirichlet):
-        data, size, what = cond.value, 2, "Dirichlet value"
-    elif isinstance(cond, Neumann):
-        data, size, what = cond.traction, 2, "traction"
-    else:
-        data, size, what = cond.gap, 1, "gap"
-    if callable(data):
-        return
-    try:
-        values = np.asarray(data, dtype=np.float64)
-    except (TypeError, ValueError):
-        values = np.full(0, np.nan)
-    if values.size != size or not np.isfinite(values).all():
-        raise ProblemError(
-            f"the {what} of part {name!r} must be a function of x or {size} finite "
-            f"number(s), got {data!r}"
-        )
