@@ -159,6 +159,110 @@ def test_body_force_and_exact_solution_types():
         ContactProblem(_square(), MATERIAL, conditions, exact=lambda x: x)
 
 
+# ---------------------------------------------------------------- components of the body
+
+
+def _union(*meshes_and_parts) -> Mesh:
+    """One mesh from several, each given as ``(mesh, shift, {new part: old part})``; points
+    that coincide after the shift are merged (so meshes may share vertices)."""
+    points, cells, parts = [], [], {}
+    offset = 0
+    for mesh, shift, names in meshes_and_parts:
+        points.append(mesh.points + np.asarray(shift, dtype=float))
+        cells.append(mesh.cells + offset)
+        for new, old in names.items():
+            pairs = mesh.oriented_boundary(mesh.part_edges(old)) + offset
+            parts[new] = np.concatenate([parts[new], pairs]) if new in parts else pairs
+        offset += mesh.n_points
+    p = np.concatenate(points)
+    _, first, inverse = np.unique(p.round(12), axis=0, return_index=True, return_inverse=True)
+    keep = np.sort(first)
+    renumber = np.empty(len(first), dtype=np.int64)
+    renumber[np.argsort(first)] = np.arange(len(first))
+    new_index = renumber[inverse.ravel()]
+    return Mesh.from_arrays(
+        p[keep], new_index[np.concatenate(cells)], {k: new_index[v] for k, v in parts.items()}
+    )
+
+
+SIDES = {"left": "left", "top": "top", "right": "right", "bottom": "bottom"}
+
+
+def _two_squares():
+    """The unit square (parts left, top, right, bottom) and a second one at x in [2, 3] (parts
+    left2, top2, right2, bottom2), not touching."""
+    sq = rectangle(nx=2, ny=2)
+    return _union((sq, (0, 0), SIDES), (sq, (2, 0), {f"{k}2": v for k, v in SIDES.items()}))
+
+
+def test_a_floating_component_is_named():
+    mesh = _two_squares()
+    conditions = {p: Neumann() for p in mesh.part_names}
+    conditions["left"] = Dirichlet()
+    conditions["top2"] = Neumann((0.0, -1.0))
+    with pytest.raises(ProblemError) as info:
+        ContactProblem(mesh, MATERIAL, conditions)
+    assert str(info.value) == (
+        "the body falls into 2 components (cells joined through shared edges; cells that "
+        "share only a vertex are not joined), and 1 of them has no Dirichlet part, so nothing "
+        "rules out their rigid body motions: component 2 (8 cells in [2, 3] × [0, 1], "
+        "boundary parts ['left2', 'top2', 'right2', 'bottom2']). Give each component a "
+        "Dirichlet part or join it to the body along an edge; contact alone does not hold a "
+        "component (docs/method.md, *The continuous problem*)"
+    )
+    # held on both: accepted
+    ContactProblem(mesh, MATERIAL, {**conditions, "left2": Dirichlet()})
+
+
+def test_a_bow_tie_is_two_components():
+    # a triangle joined to the clamped square at its corner (1, 1) only
+    sq = rectangle(nx=2, ny=2)
+    points = np.concatenate([sq.points, [[2.0, 1.0], [2.0, 2.0]]])
+    corner = int(np.flatnonzero((sq.points == 1.0).all(axis=1))[0])
+    n = sq.n_points
+    wing = [[corner, n], [n, n + 1], [n + 1, corner]]
+    parts = {name: sq.oriented_boundary(sq.part_edges(name)) for name in sq.part_names}
+    mesh = Mesh.from_arrays(
+        points, np.vstack([sq.cells, [[corner, n, n + 1]]]), {**parts, "wing": np.array(wing)}
+    )
+    conditions = {"left": Dirichlet(), "top": Neumann(), "right": Neumann(), "bottom": Neumann()}
+    with pytest.raises(
+        ProblemError,
+        match=r"component 2 \(1 cell in \[1, 2\] × \[1, 2\], "
+        r"boundary parts \['wing'\]\)",
+    ):
+        ContactProblem(mesh, MATERIAL, {**conditions, "wing": Neumann((0.0, 1.0))})
+
+
+def test_a_component_held_only_by_contact_is_refused():
+    mesh = _two_squares()
+    conditions = {p: Neumann() for p in mesh.part_names}
+    conditions.update(left=Dirichlet(), bottom2=Contact(0.0), right2=Contact(0.0))
+    with pytest.raises(
+        ProblemError,
+        match=r"component 2 \(8 cells in \[2, 3\] × \[0, 1\], boundary parts \['left2', "
+        r"'top2', 'right2', 'bottom2'\]\) is held only by contact parts \['right2', "
+        r"'bottom2'\]\. .*contact alone does not hold a component",
+    ):
+        ContactProblem(mesh, MATERIAL, conditions)
+
+
+def test_many_floating_components_are_counted():
+    sq = rectangle(nx=1, ny=1)
+    free = {f"free_{side}": side for side in ("top", "right", "bottom")}
+    pieces = [(sq, (0, 0), {"clamp": "left", **free})]
+    pieces += [(sq, (2 * i, 0), {"free_left": "left", **free}) for i in range(1, 8)]
+    mesh = _union(*pieces)
+    conditions = {p: Neumann() for p in mesh.part_names}
+    conditions["clamp"] = Dirichlet()
+    with pytest.raises(
+        ProblemError,
+        match=r"and 7 of them have no Dirichlet part.*component 6 \(2 cells in \[10, 11\] .*"
+        r"; and 2 more\. Give",
+    ):
+        ContactProblem(mesh, MATERIAL, conditions)
+
+
 # ---------------------------------------------------------------- user functions end to end
 
 

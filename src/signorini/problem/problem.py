@@ -19,6 +19,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from ..fem.material import Material
 from ..fem.space import P2Space
@@ -113,6 +115,7 @@ class ContactProblem:
             raise ProblemError(
                 "the problem needs a Dirichlet part (meas Γ_D > 0) to rule out rigid body motions"
             )
+        _check_components(mesh, self.dirichlet_parts, self.contact_parts)
         normals = {name: self._segment_normal(name) for name in self.contact_parts}
         object.__setattr__(self, "contact_normals", normals)
 
@@ -160,3 +163,64 @@ class ContactProblem:
                     f"is not its outward normal {tuple(np.round(mean, 12))}"
                 )
         return mean
+
+
+#: How many floating components an error message describes (the rest are counted).
+_NAMED_COMPONENTS = 5
+
+
+def _check_components(mesh: Mesh, dirichlet_parts: list[str], contact_parts: list[str]) -> None:
+    """Every component of the body (cells joined through shared edges) must have a Dirichlet
+    edge: a component without one can move rigidly (docs/method.md, *The continuous problem*).
+
+    Raises
+    ------
+    ProblemError
+        Naming each component without a Dirichlet edge by its cells, bounding box and
+        boundary parts (the first few, and how many more).
+    """
+    e2c = mesh.edge2cell
+    inner = e2c[:, 1] >= 0
+    n = mesh.n_cells
+    graph = sp.coo_matrix(
+        (np.ones(int(inner.sum()), dtype=np.int8), (e2c[inner, 0], e2c[inner, 1])), shape=(n, n)
+    )
+    n_comp, label = connected_components(graph, directed=False)
+    if n_comp == 1:
+        return
+    held = np.zeros(n_comp, dtype=bool)
+    for name in dirichlet_parts:
+        held[label[e2c[mesh.part_edges(name), 0]]] = True
+    floating = np.flatnonzero(~held)
+    if floating.size == 0:
+        return
+    # cells, bounding box and boundary parts of each component
+    n_cells = np.bincount(label, minlength=n_comp)
+    xy = mesh.points[mesh.cells]  # (n_cells, 3, 2)
+    lo = np.full((n_comp, 2), np.inf)
+    hi = np.full((n_comp, 2), -np.inf)
+    np.minimum.at(lo, label, xy.min(axis=1))
+    np.maximum.at(hi, label, xy.max(axis=1))
+    be = np.flatnonzero(mesh.edge_part >= 0)
+    pairs = np.unique(np.column_stack([label[e2c[be, 0]], mesh.edge_part[be]]), axis=0)
+    lines = []
+    for c in floating[:_NAMED_COMPONENTS]:
+        parts = [mesh.part_names[p] for p in pairs[pairs[:, 0] == c, 1]]
+        on_contact = [p for p in parts if p in contact_parts]
+        cells = f"{n_cells[c]} cell{'s' if n_cells[c] > 1 else ''}"
+        box = f"[{lo[c, 0]:.6g}, {hi[c, 0]:.6g}] × [{lo[c, 1]:.6g}, {hi[c, 1]:.6g}]"
+        line = f"component {c + 1} ({cells} in {box}, boundary parts {parts})"
+        if on_contact:
+            line += f" is held only by contact parts {on_contact}"
+        lines.append(line)
+    more = floating.size - len(lines)
+    if more:
+        lines.append(f"and {more} more")
+    raise ProblemError(
+        f"the body falls into {n_comp} components (cells joined through shared edges; cells "
+        f"that share only a vertex are not joined), and {floating.size} of them ha"
+        f"{'ve' if floating.size > 1 else 's'} no Dirichlet part, so nothing rules out "
+        f"their rigid body motions: {'; '.join(lines)}. Give each component a Dirichlet part "
+        "or join it to the body along an edge; contact alone does not hold a component "
+        "(docs/method.md, *The continuous problem*)"
+    )
