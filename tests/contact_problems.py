@@ -116,9 +116,9 @@ def patch_problem(
     """
     f = -u.div_stress(material)
 
-    def traction(x, n):
+    def traction(x, normal):
         sig = u.stress(x, material)
-        return np.einsum("...ij,...j->...i", sig, np.broadcast_to(n, x.shape))
+        return np.einsum("...ij,...j->...i", sig, normal)
 
     conditions = {}
     for name, kind in kinds.items():

@@ -80,9 +80,9 @@ def example_6_1(nx: int = 4) -> ContactProblem:
     def body_force(x):
         return -div_stress(x, material.lam, material.mu)
 
-    def traction(x, n):
+    def traction(x, normal):
         sigma = stress(material, gradient(x))
-        return np.einsum("...ij,...j->...i", sigma, np.broadcast_to(n, x.shape))
+        return np.einsum("...ij,...j->...i", sigma, normal)
 
     return ContactProblem(
         mesh=rectangle(nx=nx, ny=nx, pattern="unionjack"),

@@ -52,9 +52,9 @@ def test_dirichlet_value_returning_nan():
 
 
 def test_traction_of_the_wrong_shape():
-    pb = square_problem(top=Neumann(lambda x, n: x[..., 0]))
+    pb = square_problem(top=Neumann(lambda x, normal: x[..., 0]))
     with pytest.raises(
-        ProblemError, match=r"traction of part 'top' must return shape \(\d+, \d+, 2\)"
+        ProblemError, match=r"traction of Neumann part 'top' must return shape \(\d+, 2\)"
     ):
         assemble(pb, pb.mesh)
 

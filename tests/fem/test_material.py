@@ -12,7 +12,7 @@ def test_material_from_young_plane_strain():
     assert m.lam == pytest.approx(500 * 0.3 / (1.3 * 0.4), rel=1e-15)
     assert m.young == pytest.approx(500.0, rel=1e-14)
     assert m.poisson == pytest.approx(0.3, rel=1e-14)
-    assert Material.from_lame(1, 1) == Material(1.0, 1.0)
+    assert Material.from_lame(1, 1) == Material(lam=1.0, mu=1.0)
 
 
 @pytest.mark.parametrize(
@@ -30,6 +30,23 @@ def test_material_from_young_plane_strain():
 def test_material_from_young_rejects(args, match):
     with pytest.raises(ValueError, match=match):
         Material.from_young(*args)
+
+
+def test_material_takes_its_parameters_by_name():
+    m = Material(lam=1000.0, mu=0.3)
+    assert (m.lam, m.mu) == (1000.0, 0.3)
+    # Material(1000, 0.3) could be read as (lam, mu) or as (E, nu): refused
+    with pytest.raises(TypeError) as info:
+        Material(1000, 0.3)
+    assert str(info.value) == (
+        "Material takes its parameters by name, got Material(1000, 0.3): write "
+        "Material.from_young(E, nu) for Young's modulus and Poisson's ratio, or "
+        "Material(lam=..., mu=...) / Material.from_lame(lam, mu) for the Lamé parameters"
+    )
+    with pytest.raises(TypeError, match=r"^Material takes its parameters by name"):
+        Material(1000, mu=0.3)
+    with pytest.raises(TypeError, match=r"^Material needs mu: write Material\(lam=..., mu=...\)"):
+        Material(lam=1.0)
 
 
 @pytest.mark.parametrize(
@@ -59,13 +76,13 @@ def test_material_allows_negative_lam_with_positive_bulk():
 def test_stress_closed_form():
     g = np.array([[1.0, 2.0], [4.0, -3.0]])
     assert np.array_equal(strain(g), [[1.0, 3.0], [3.0, -3.0]])
-    sig = stress(Material(2.0, 0.5), g)
+    sig = stress(Material(lam=2.0, mu=0.5), g)
     # eps = [[1, 3], [3, -3]], tr = -2: sigma = 2 * (-2) I + 1.0 * eps
     assert np.allclose(sig, [[-3.0, 3.0], [3.0, -7.0]])
-    batch = stress(Material(2.0, 0.5), np.broadcast_to(g, (4, 5, 2, 2)))
+    batch = stress(Material(lam=2.0, mu=0.5), np.broadcast_to(g, (4, 5, 2, 2)))
     assert batch.shape == (4, 5, 2, 2) and np.allclose(batch, sig)
     with pytest.raises(ValueError, match="grad_u"):
-        stress(Material(2.0, 0.5), np.zeros((3, 2)))
+        stress(Material(lam=2.0, mu=0.5), np.zeros((3, 2)))
 
 
 def test_stress_is_linear_and_gives_the_energy_density():

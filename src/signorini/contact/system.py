@@ -72,7 +72,7 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
         g = cond.field()
 
         def traction(x, n, g=g, name=name):
-            return evaluate_field(lambda y: g(y, n), x, f"the traction of part {name!r}")
+            return evaluate_field(g, x, f"the traction of Neumann part {name!r}", normal=n)
 
         F += assemble_edge_load(
             mesh.points[nodes[:, :2]], dofs, n_dofs, traction, degree=LOAD_DEGREE

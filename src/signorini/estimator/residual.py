@@ -250,7 +250,7 @@ def _traction_misfit(problem: ContactProblem, mesh, traction, t: np.ndarray) -> 
             _, n = segment_normals(a, b)
             g = cond.field()
             sn = sn - evaluate_field(
-                lambda y, n=n, g=g: g(y, n[:, None, :]), x, f"the traction of part {name!r}"
+                g, x, f"the traction of Neumann part {name!r}", normal=n[:, None, :]
             )
         out.append(sn)
     return np.concatenate(out) if out else np.zeros((0, t.size, 2))

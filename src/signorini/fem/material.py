@@ -29,19 +29,29 @@ def _finite_float(value: float, name: str) -> float:
     return x
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Material:
     """Isotropic, homogeneous linear elastic material in plane strain.
 
+    Built from its Lamé parameters by name, ``Material(lam=..., mu=...)``, or with
+    :meth:`from_young` (Young's modulus and Poisson's ratio) or :meth:`from_lame`. Positional
+    arguments are refused: ``Material(1000, 0.3)`` could mean either.
+
+    Units are the user's and must be consistent: if E is in MPa (N/mm²), and so are ``lam``
+    and ``mu``, and lengths are in mm, then stresses and tractions are in MPa, body forces in
+    N/mm³, and forces along the boundary (per unit thickness, plane strain) in N/mm.
+
     Parameters
     ----------
-    lam : float
-        First Lamé parameter (the paper's ``chi`` in (2.1)).
-    mu : float
-        Shear modulus, ``> 0``.
+    lam : float, keyword-only
+        First Lamé parameter (the paper's ``chi`` in (2.1)), in stress units.
+    mu : float, keyword-only
+        Shear modulus, ``> 0``, in stress units.
 
     Raises
     ------
+    TypeError
+        If a parameter is given by position, or ``lam`` or ``mu`` is missing.
     ValueError
         If a parameter is not finite, ``mu <= 0``, or the plane-strain bulk
         modulus ``lam + mu <= 0`` (the elasticity tensor would not be
@@ -51,9 +61,22 @@ class Material:
     lam: float
     mu: float
 
-    def __post_init__(self) -> None:
-        lam = _finite_float(self.lam, "lam")
-        mu = _finite_float(self.mu, "mu")
+    def __init__(self, *args: float, lam: float | None = None, mu: float | None = None) -> None:
+        if args:
+            given = ", ".join(repr(a) for a in args)
+            raise TypeError(
+                f"Material takes its parameters by name, got Material({given}): write "
+                "Material.from_young(E, nu) for Young's modulus and Poisson's ratio, or "
+                "Material(lam=..., mu=...) / Material.from_lame(lam, mu) for the Lamé parameters"
+            )
+        if lam is None or mu is None:
+            missing = " and ".join(n for n, v in (("lam", lam), ("mu", mu)) if v is None)
+            raise TypeError(
+                f"Material needs {missing}: write Material(lam=..., mu=...), or "
+                "Material.from_young(E, nu)"
+            )
+        lam = _finite_float(lam, "lam")
+        mu = _finite_float(mu, "mu")
         if mu <= 0.0:
             raise ValueError(f"shear modulus mu must be positive, got {mu}")
         if lam + mu <= 0.0:
@@ -65,8 +88,8 @@ class Material:
 
     @classmethod
     def from_lame(cls, lam: float, mu: float) -> Material:
-        """Material from the Lamé parameters ``lam``, ``mu``."""
-        return cls(lam, mu)
+        """Material from the Lamé parameters ``lam``, ``mu`` (stress units)."""
+        return cls(lam=lam, mu=mu)
 
     @classmethod
     def from_young(cls, E: float, nu: float) -> Material:  # noqa: N803 (the usual symbol)
@@ -77,7 +100,7 @@ class Material:
         Parameters
         ----------
         E : float
-            Young's modulus, ``> 0``.
+            Young's modulus, ``> 0`` (stress units, e.g. MPa with lengths in mm).
         nu : float
             Poisson's ratio, ``-1 < nu < 0.5``.
 
@@ -99,7 +122,7 @@ class Material:
             raise ValueError(f"Poisson's ratio nu must be > -1, got {nu}")
         mu = E / (2.0 * (1.0 + nu))
         lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-        return cls(lam, mu)
+        return cls(lam=lam, mu=mu)
 
     @property
     def young(self) -> float:

@@ -6,46 +6,119 @@ The strong form (paper, Section 2; docs/method.md, *The continuous problem*)::
     σ(u) n = g on Γ_N   (Neumann),
     u·n ≤ ψ,  σ_nn ≤ 0,  (u·n − ψ) σ_nn = 0,  σ_t = 0 on Γ_C   (Contact).
 
-Each condition holds its data as given (a constant or a function of ``x``) and hands it out as
-a function through ``field`` / ``gap_field``; the functions are called and checked by
-:func:`signorini.problem.fields.evaluate_field`.
+Each condition holds its data as given (numbers, or a function of the points ``x``) and checks
+them when it is built: numbers must be finite and as many as the condition needs, a function
+must accept the calling convention of docs/method.md, *User functions* (points ``x (n, 2)``,
+the normal by name). The data are handed out as functions through ``field`` / ``gap_field``;
+they are called and their values checked by :func:`signorini.problem.fields.evaluate_field`.
+
+Units are the user's, and must be consistent: if E is in MPa (N/mm²) and lengths in mm,
+displacements and gaps are in mm, tractions in MPa, body forces in N/mm³, and forces along the
+boundary (per unit thickness, plane strain) in N/mm.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from .fields import VectorField, constant_field
+from .fields import (
+    CALL_NAMED,
+    CALL_POSITIONAL,
+    CALL_X,
+    ProblemError,
+    VectorField,
+    check_function,
+    check_numbers,
+    constant_field,
+)
 
 __all__ = ["Condition", "Contact", "Dirichlet", "ExactSolution", "Neumann"]
+
+_DIRICHLET = "two finite numbers (u_x, u_y) or a function u_D(x) of points x (n, 2)"
+_TRACTION = (
+    "two finite numbers (g_x, g_y) or a function g(x) or g(x, normal) of points x (n, 2) "
+    "and outward unit normals normal (n, 2)"
+)
+_GAP = "a finite number or a function gap(x) of points x (n, 2)"
+_NORMAL = "None or two finite numbers, not both zero"
 
 
 @dataclass(frozen=True)
 class Dirichlet:
-    """Prescribed displacement ``u = u_D`` (a constant vector or a function of ``x (n, 2)``)."""
+    """Prescribed displacement ``u = u_D`` on a boundary part.
+
+    Parameters
+    ----------
+    value : two floats, or callable, default (0, 0)
+        The displacement ``(u_x, u_y)`` on the whole part, or a function ``u_D(x)`` of the
+        points ``x``, a float array of shape ``(n, 2)``, returning ``(n, 2)`` (or one
+        ``(2,)`` vector for all points). Length units (docs/method.md, *User functions*).
+
+    Raises
+    ------
+    ProblemError
+        If ``value`` is neither two finite numbers nor a function of one argument ``x``.
+    """
 
     value: VectorField | tuple[float, float] = (0.0, 0.0)
 
+    def __post_init__(self) -> None:
+        if callable(self.value):
+            check_function(self.value, "Dirichlet(value=...)", _DIRICHLET)
+        else:
+            check_numbers(self.value, 2, "Dirichlet(value=...)", _DIRICHLET)
+
     def field(self) -> VectorField:
-        """``u_D`` as a function of ``x (..., 2)``."""
+        """``u_D`` as a function of ``x (n, 2)``."""
         return self.value if callable(self.value) else constant_field(self.value)
 
 
 @dataclass(frozen=True)
 class Neumann:
-    """Prescribed traction ``σ(u) n = g``: a constant vector or ``g(x (..., 2), n (..., 2))``."""
+    """Prescribed traction ``σ(u) n = g`` on a boundary part.
 
-    traction: Callable[[np.ndarray, np.ndarray], np.ndarray] | tuple[float, float] = (0.0, 0.0)
+    Parameters
+    ----------
+    traction : two floats, or callable, default (0, 0)
+        The traction ``(g_x, g_y)`` (force per unit length of boundary, in stress units: MPa
+        if E is in MPa) on the whole part, or a function of the points ``x``, a float array of
+        shape ``(n, 2)``, returning ``(n, 2)`` (or one ``(2,)`` vector). A function whose
+        signature has a parameter ``normal`` is called ``g(x, normal=n)`` with the outward unit
+        normals ``n (n, 2)`` at the points; a function of one argument is called ``g(x)``. The
+        older ``g(x, n)``, with the normal as a second positional argument, still works and
+        issues a :class:`DeprecationWarning` (docs/method.md, *User functions*).
+
+    Raises
+    ------
+    ProblemError
+        If ``traction`` is neither two finite numbers nor a function callable as ``g(x)``,
+        ``g(x, normal=n)`` or ``g(x, n)``.
+    """
+
+    traction: Callable[..., np.ndarray] | tuple[float, float] = (0.0, 0.0)
+    _call: str = field(default=CALL_X, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if callable(self.traction):
+            call = check_function(self.traction, "Neumann(traction=...)", _TRACTION, normal=True)
+            object.__setattr__(self, "_call", call)
+        else:
+            check_numbers(self.traction, 2, "Neumann(traction=...)", _TRACTION)
 
     def field(self) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
-        """``g`` as a function of the points and the outward unit normals."""
-        if callable(self.traction):
-            return self.traction
-        const = constant_field(self.traction)
-        return lambda x, n: const(x)
+        """``g`` as a function ``(x (n, 2), normal (n, 2))``, whatever form the user wrote."""
+        g = self.traction
+        if not callable(g):
+            const = constant_field(g)
+            return lambda x, normal: const(x)
+        if self._call == CALL_NAMED:
+            return lambda x, normal: g(x, normal=normal)
+        if self._call == CALL_POSITIONAL:
+            return g
+        return lambda x, normal: g(x)
 
     @property
     def is_zero(self) -> bool:
@@ -59,28 +132,72 @@ class Contact:
 
     Parameters
     ----------
-    gap : float or callable
-        The gap (obstacle) function ``ψ(x (n, 2)) -> (n,)``, or a constant.
-    normal : (2,) array or None
-        The outward unit normal; ``None`` takes it from the geometry. A given normal must agree
-        with the geometry (checked by :class:`~signorini.problem.problem.ContactProblem`).
+    gap : float or callable, default 0
+        The gap ψ between the part and the obstacle, measured along the outward normal (length
+        units): a constant, or a function ``ψ(x)`` of the points ``x``, a float array of shape
+        ``(n, 2)``, returning ``(n,)`` (or one value for all points); docs/method.md, *User
+        functions*.
+    normal : two floats or None
+        The outward normal (normalised here); ``None`` takes it from the geometry. A given
+        normal must agree with the geometry (checked by
+        :class:`~signorini.problem.problem.ContactProblem`).
+
+    Raises
+    ------
+    ProblemError
+        If ``gap`` is neither a finite number nor a function of one argument ``x``, or
+        ``normal`` is not ``None`` nor two finite numbers, not both zero.
     """
 
     gap: Callable[[np.ndarray], np.ndarray] | float = 0.0
     normal: tuple[float, float] | None = None
 
+    def __post_init__(self) -> None:
+        if callable(self.gap):
+            check_function(self.gap, "Contact(gap=...)", _GAP)
+        else:
+            check_numbers(self.gap, 1, "Contact(gap=...)", _GAP)
+        if self.normal is not None:
+            check_numbers(self.normal, 2, "Contact(normal=...)", _NORMAL)
+            if not np.any(np.asarray(self.normal, dtype=np.float64)):
+                raise ProblemError(f"Contact(normal=...) must be {_NORMAL}; got {self.normal!r}")
+
     def gap_field(self) -> Callable[[np.ndarray], np.ndarray]:
-        """``ψ`` as a scalar function of ``x (..., 2)``."""
-        return self.gap if callable(self.gap) else constant_field(self.gap, shape=())
+        """``ψ`` as a scalar function of ``x (n, 2)``."""
+        if callable(self.gap):
+            return self.gap
+        return constant_field(np.asarray(self.gap, dtype=np.float64).reshape(()), shape=())
 
 
 @dataclass(frozen=True)
 class ExactSolution:
-    """A known solution: displacement ``u(x) -> (..., 2)``, gradient ``grad(x) -> (..., 2, 2)``
-    with ``grad[..., i, j] = ∂u_i/∂x_j``."""
+    """A known solution, for error norms.
+
+    Parameters
+    ----------
+    displacement : callable
+        ``u(x)`` of the points ``x (n, 2)``, returning ``(n, 2)``.
+    gradient : callable
+        ``grad(x)`` returning ``(n, 2, 2)`` with ``grad[:, i, j] = ∂u_i/∂x_j``.
+
+    Raises
+    ------
+    ProblemError
+        If either is not a function of one argument ``x``.
+    """
 
     displacement: VectorField
     gradient: Callable[[np.ndarray], np.ndarray]
+
+    def __post_init__(self) -> None:
+        check_function(
+            self.displacement,
+            "ExactSolution(displacement=...)",
+            "a function u(x) of points x (n, 2)",
+        )
+        check_function(
+            self.gradient, "ExactSolution(gradient=...)", "a function grad(x) of points x (n, 2)"
+        )
 
 
 Condition = Dirichlet | Neumann | Contact

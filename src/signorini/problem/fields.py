@@ -1,22 +1,48 @@
-"""Data given by the user as functions of ``x``: the one place where they are called and
+"""Data given by the user as functions of points: the one place where they are called and
 their output checked.
 
-Body force ``f``, Dirichlet values ``u_D``, tractions ``g``, gaps ``ψ`` and exact solutions are
-functions of points ``x (..., 2)``; a constant is turned into such a function by
-:func:`constant_field`. :func:`evaluate_field` calls one and checks the shape and finiteness of
-what it returns, so that the numerical layers below (:mod:`signorini.fem`) can trust their
-data.
+The calling convention (docs/method.md, *User functions*), the same for the body force ``f``,
+Dirichlet values ``u_D``, tractions ``g``, gaps ``ψ`` and exact solutions:
+
+- the function receives the points as one array ``x`` of shape ``(n, 2)``, always
+  two-dimensional (row ``i`` is the point ``(x_i, y_i)``), so ``x[:, 0]`` and ``x[..., 0]`` are
+  both the abscissae;
+- extra data are passed by name: a traction whose signature has a parameter ``normal`` is
+  called ``g(x, normal=n)`` with the outward unit normals ``n (n, 2)`` at the points, a
+  traction of one argument is called ``g(x)``; the older form ``g(x, n)``, with the normal as a
+  second positional argument, still works and warns (:class:`DeprecationWarning`);
+- it returns one value per point, ``(n,)`` for a scalar (gap), ``(n, 2)`` for a vector
+  (displacement, traction, body force), ``(n, 2, 2)`` for a gradient, or a single value of the
+  per-point shape (``()``, ``(2,)``, ``(2, 2)``), which is the same at every point.
+
+:func:`check_function` checks a function's signature when a condition or problem is built;
+:func:`evaluate_field` calls it and checks what it returns, so that the numerical layers below
+(:mod:`signorini.fem`) can trust their data. A function that raises, or returns the wrong shape,
+NaN or inf, is reported as a :class:`ProblemError` that names the condition and its part.
 """
 
 from __future__ import annotations
 
+import inspect
+import warnings
 from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["ProblemError", "VectorField", "constant_field", "evaluate_field"]
+__all__ = [
+    "ProblemError",
+    "VectorField",
+    "check_function",
+    "check_numbers",
+    "constant_field",
+    "evaluate_field",
+]
 
 VectorField = Callable[[np.ndarray], np.ndarray]
+
+#: How :func:`check_function` says a function is called: ``f(x)``, ``f(x, normal=n)``, or the
+#: deprecated ``f(x, n)``.
+CALL_X, CALL_NAMED, CALL_POSITIONAL = "x", "named", "positional"
 
 
 class ProblemError(ValueError):
@@ -37,15 +63,123 @@ def constant_field(value: float | tuple[float, ...], shape: tuple[int, ...] = (2
     return lambda x: np.broadcast_to(v, np.shape(x)[:-1] + shape).copy()
 
 
-def evaluate_field(
-    func: VectorField, x: np.ndarray, what: str, shape: tuple[int, ...] = (2,)
-) -> np.ndarray:
-    """Evaluate a user function at points ``x (..., 2)``, checking its output.
+def check_numbers(value, size: int, argument: str, expected: str) -> None:
+    """Check data given as numbers: ``size`` finite real numbers.
+
+    Parameters
+    ----------
+    value : object
+        The data as given.
+    size : int
+        How many numbers: 2 for a vector, 1 for a scalar.
+    argument : str
+        The argument, as the user wrote it, e.g. ``"Dirichlet(value=...)"``.
+    expected : str
+        What the argument may be, e.g. ``"two finite numbers (u_x, u_y) or a function u_D(x)"``.
+
+    Raises
+    ------
+    ProblemError
+        Naming the argument, what was expected and what was given.
+    """
+    bad = isinstance(value, str | bytes)
+    if not bad:
+        try:
+            values = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            bad = True
+        else:
+            bad = values.size != size or values.ndim > 1 or not np.isfinite(values).all()
+    if bad:
+        raise ProblemError(f"{argument} must be {expected}; got {value!r}")
+
+
+def check_function(
+    func: Callable, argument: str, expected: str, *, normal: bool = False, stacklevel: int = 4
+) -> str:
+    """Check that a user function can be called by the convention, and say how to call it.
 
     Parameters
     ----------
     func : callable
-        ``func(x)``; its value must broadcast to ``x.shape[:-1] + shape``.
+    argument : str
+        The argument, as the user wrote it, e.g. ``"Neumann(traction=...)"``.
+    expected : str
+        What the argument may be (for the error message).
+    normal : bool
+        Whether the function may receive the outward unit normal (a traction).
+    stacklevel : int
+        Passed to :func:`warnings.warn` for the deprecated form, so that the warning points at
+        the user's line.
+
+    Returns
+    -------
+    str
+        ``CALL_X`` (``func(x)``), ``CALL_NAMED`` (``func(x, normal=n)``) or ``CALL_POSITIONAL``
+        (``func(x, n)``, deprecated: a :class:`DeprecationWarning` is issued).
+
+    Raises
+    ------
+    ProblemError
+        If ``func`` is not callable, or its signature admits none of these calls.
+    """
+    if not callable(func):
+        raise ProblemError(f"{argument} must be {expected}; got {func!r}")
+    try:
+        sig = inspect.signature(func)
+    except (TypeError, ValueError):  # no signature to read (some builtins): call it f(x)
+        return CALL_X
+    params = sig.parameters.values()
+    if normal and (
+        any(p.kind == p.VAR_KEYWORD for p in params)
+        or any(
+            p.name == "normal" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+            for p in params
+        )
+    ):
+        if _binds(sig, None, normal=None):
+            return CALL_NAMED
+    if _binds(sig, None):
+        return CALL_X
+    if normal and _binds(sig, None, None):
+        warnings.warn(
+            f"{argument}: a traction g(x, n) that takes the normal as a second positional "
+            "argument is deprecated; name the parameter `normal` (def g(x, normal): ...), it "
+            "is passed by name, or write g(x) if the traction does not depend on the normal",
+            DeprecationWarning,
+            stacklevel=stacklevel,
+        )
+        return CALL_POSITIONAL
+    raise ProblemError(f"{argument} must be {expected}; got a function with signature {sig}")
+
+
+def _binds(sig: inspect.Signature, *args, **kwargs) -> bool:
+    try:
+        sig.bind(*args, **kwargs)
+    except TypeError:
+        return False
+    return True
+
+
+def evaluate_field(
+    func: Callable,
+    x: np.ndarray,
+    what: str,
+    shape: tuple[int, ...] = (2,),
+    *,
+    normal: np.ndarray | None = None,
+) -> np.ndarray:
+    """Evaluate a user function at points ``x (..., 2)``, checking its output.
+
+    The function receives the points flattened to ``(n, 2)`` (and the normals, if given,
+    broadcast to the points and flattened the same way); its values are returned in the shape
+    of ``x``.
+
+    Parameters
+    ----------
+    func : callable
+        ``func(x)``, or ``func(x, normal)`` when ``normal`` is given (the form of
+        :meth:`~signorini.problem.conditions.Neumann.field`).
     x : (..., 2) float array
     what : str
         How to name the function in an error message, e.g. ``"the gap function of contact
@@ -53,6 +187,8 @@ def evaluate_field(
     shape : tuple of int
         Shape of the value at one point: ``(2,)`` for a vector field, ``()`` for a scalar
         field, ``(2, 2)`` for a gradient.
+    normal : (..., 2) float array, optional
+        Outward unit normals, broadcastable to ``x``.
 
     Returns
     -------
@@ -61,18 +197,37 @@ def evaluate_field(
     Raises
     ------
     ProblemError
-        If the value does not broadcast to the expected shape, or is NaN or infinite.
+        If the function raises, returns something other than ``(n,) + shape`` numbers (or one
+        value of shape ``shape``), or NaN or infinite values.
     """
-    values = np.asarray(func(x), dtype=np.float64)
-    expected = np.shape(x)[:-1] + shape
-    if values.shape != expected:
-        try:
-            values = np.broadcast_to(values, expected).copy()
-        except ValueError:
-            raise ProblemError(
-                f"{what} must return shape {expected} for points of shape "
-                f"{np.shape(x)}, got {values.shape}"
-            ) from None
+    x = np.asarray(x, dtype=np.float64)
+    lead = x.shape[:-1]
+    points = np.array(x.reshape(-1, 2))
+    args = (points,)
+    if normal is not None:
+        args += (np.array(np.broadcast_to(normal, x.shape).reshape(-1, 2)),)
+    try:
+        raw = func(*args)
+    except ProblemError:
+        raise
+    except Exception as err:
+        raise ProblemError(f"{what} raised {type(err).__name__}: {err}") from err
+    if raw is None:
+        raise ProblemError(f"{what} returned None (is a return statement missing?)")
+    try:
+        values = np.asarray(raw, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ProblemError(
+            f"{what} must return an array of numbers, got {type(raw).__name__}"
+        ) from None
+    expected = points.shape[:1] + shape
+    if values.shape == shape:  # one value for every point
+        values = np.broadcast_to(values, expected).copy()
+    elif values.shape != expected:
+        raise ProblemError(
+            f"{what} must return shape {expected} for points of shape {points.shape}, "
+            f"got {values.shape}"
+        )
     if not np.isfinite(values).all():
         raise ProblemError(f"{what} returned NaN or inf")
-    return values
+    return values.reshape(lead + shape)

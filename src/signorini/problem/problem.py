@@ -7,8 +7,10 @@ The strong form (paper, Section 2; docs/method.md, *The continuous problem*)::
     u·n ≤ ψ,  σ_nn ≤ 0,  (u·n − ψ) σ_nn = 0,  σ_t = 0 on Γ_C.
 
 :class:`ContactProblem` is a public boundary: it checks that every part has exactly one
-condition, that there is a Dirichlet part, and that each contact part is straight with the
-given normal. Everything below it trusts the problem.
+condition, that every component of the body (cells joined through shared edges) has a
+Dirichlet part, that each user function can be called by the convention of docs/method.md,
+*User functions*, and that each contact part is straight with the given normal. Everything
+below it trusts the problem.
 """
 
 from __future__ import annotations
@@ -17,13 +19,15 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from ..fem.material import Material
 from ..fem.space import P2Space
 from ..mesh.geometry import segment_normals
 from ..mesh.mesh import Mesh
 from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann
-from .fields import ProblemError, VectorField
+from .fields import ProblemError, VectorField, check_function
 
 __all__ = ["ContactProblem"]
 
@@ -32,16 +36,32 @@ __all__ = ["ContactProblem"]
 class ContactProblem:
     """A Signorini problem on an initial mesh.
 
+    Units are the user's, and must be consistent: if E is in MPa (N/mm²) and lengths in mm,
+    displacements and gaps are in mm, tractions and stresses in MPa, body forces in N/mm³, and
+    forces along the boundary (per unit thickness, plane strain) in N/mm.
+
     Parameters
     ----------
     mesh : Mesh
-        The initial mesh; its boundary parts carry the conditions.
+        The initial mesh; its boundary parts carry the conditions. Every component of the body
+        (cells joined through shared edges) needs a Dirichlet part.
     material : Material
     conditions : mapping part name -> Dirichlet | Neumann | Contact
         Every boundary part of the mesh must get exactly one condition.
-    body_force : callable ``f(x (..., 2)) -> (..., 2)`` or None (zero)
+    body_force : callable or None
+        ``f(x)`` of the points ``x``, a float array of shape ``(n, 2)``, returning the force
+        per unit volume ``(n, 2)`` (or one ``(2,)`` vector); ``None`` for no body force.
+        docs/method.md, *User functions*.
     exact : ExactSolution or None
     name : str
+
+    Raises
+    ------
+    ProblemError
+        Before any work, if a part has no condition or a condition names no part, a condition
+        or the body force is of the wrong kind, a component of the body has no Dirichlet part
+        (the message names each such component), or a contact part is not straight or not
+        along its given normal.
     """
 
     mesh: Mesh
@@ -59,6 +79,11 @@ class ContactProblem:
         if not isinstance(self.material, Material):
             raise ProblemError(
                 "material must be a signorini Material (Material.from_young or Material.from_lame)"
+            )
+        if not isinstance(self.conditions, Mapping):
+            raise ProblemError(
+                "conditions must be a mapping part name -> Dirichlet | Neumann | Contact, "
+                f"got {type(self.conditions).__name__}"
             )
         unknown = sorted(set(self.conditions) - set(mesh.part_names))
         if unknown:
@@ -78,15 +103,19 @@ class ContactProblem:
                     f"the condition of part {name!r} must be Dirichlet, Neumann or "
                     f"Contact, got {type(cond).__name__}"
                 )
-            _check_data(name, cond)
-        if self.body_force is not None and not callable(self.body_force):
-            raise ProblemError("body_force must be a function of x (..., 2), or None")
+        if self.body_force is not None:
+            check_function(
+                self.body_force,
+                "ContactProblem(body_force=...)",
+                "None or a function f(x) of points x (n, 2)",
+            )
         if self.exact is not None and not isinstance(self.exact, ExactSolution):
             raise ProblemError(f"exact must be an ExactSolution, got {type(self.exact).__name__}")
         if not self.dirichlet_parts:
             raise ProblemError(
                 "the problem needs a Dirichlet part (meas Γ_D > 0) to rule out rigid body motions"
             )
+        _check_components(mesh, self.dirichlet_parts, self.contact_parts)
         normals = {name: self._segment_normal(name) for name in self.contact_parts}
         object.__setattr__(self, "contact_normals", normals)
 
@@ -126,11 +155,7 @@ class ContactProblem:
             )
         given = self.conditions[name].normal
         if given is not None:
-            g = np.asarray(given, dtype=np.float64).reshape(2)
-            if not np.isfinite(g).all() or np.linalg.norm(g) == 0:
-                raise ProblemError(
-                    f"the normal of contact part {name!r} must be a non-zero finite vector"
-                )
+            g = np.asarray(given, dtype=np.float64).reshape(2)  # checked by Contact
             g = g / np.linalg.norm(g)
             if np.abs(g - mean).max() > 1e-6:
                 raise ProblemError(
@@ -140,23 +165,62 @@ class ContactProblem:
         return mean
 
 
-def _check_data(name: str, cond: Condition) -> None:
-    """A condition's data given as numbers must be finite, of the right size: two numbers for a
-    displacement or traction, one for a gap (functions are checked where they are called)."""
-    if isinstance(cond, Dirichlet):
-        data, size, what = cond.value, 2, "Dirichlet value"
-    elif isinstance(cond, Neumann):
-        data, size, what = cond.traction, 2, "traction"
-    else:
-        data, size, what = cond.gap, 1, "gap"
-    if callable(data):
+#: How many floating components an error message describes (the rest are counted).
+_NAMED_COMPONENTS = 5
+
+
+def _check_components(mesh: Mesh, dirichlet_parts: list[str], contact_parts: list[str]) -> None:
+    """Every component of the body (cells joined through shared edges) must have a Dirichlet
+    edge: a component without one can move rigidly (docs/method.md, *The continuous problem*).
+
+    Raises
+    ------
+    ProblemError
+        Naming each component without a Dirichlet edge by its cells, bounding box and
+        boundary parts (the first few, and how many more).
+    """
+    e2c = mesh.edge2cell
+    inner = e2c[:, 1] >= 0
+    n = mesh.n_cells
+    graph = sp.coo_matrix(
+        (np.ones(int(inner.sum()), dtype=np.int8), (e2c[inner, 0], e2c[inner, 1])), shape=(n, n)
+    )
+    n_comp, label = connected_components(graph, directed=False)
+    if n_comp == 1:
         return
-    try:
-        values = np.asarray(data, dtype=np.float64)
-    except (TypeError, ValueError):
-        values = np.full(0, np.nan)
-    if values.size != size or not np.isfinite(values).all():
-        raise ProblemError(
-            f"the {what} of part {name!r} must be a function of x or {size} finite "
-            f"number(s), got {data!r}"
-        )
+    held = np.zeros(n_comp, dtype=bool)
+    for name in dirichlet_parts:
+        held[label[e2c[mesh.part_edges(name), 0]]] = True
+    floating = np.flatnonzero(~held)
+    if floating.size == 0:
+        return
+    # cells, bounding box and boundary parts of each component
+    n_cells = np.bincount(label, minlength=n_comp)
+    xy = mesh.points[mesh.cells]  # (n_cells, 3, 2)
+    lo = np.full((n_comp, 2), np.inf)
+    hi = np.full((n_comp, 2), -np.inf)
+    np.minimum.at(lo, label, xy.min(axis=1))
+    np.maximum.at(hi, label, xy.max(axis=1))
+    be = np.flatnonzero(mesh.edge_part >= 0)
+    pairs = np.unique(np.column_stack([label[e2c[be, 0]], mesh.edge_part[be]]), axis=0)
+    lines = []
+    for c in floating[:_NAMED_COMPONENTS]:
+        parts = [mesh.part_names[p] for p in pairs[pairs[:, 0] == c, 1]]
+        on_contact = [p for p in parts if p in contact_parts]
+        cells = f"{n_cells[c]} cell{'s' if n_cells[c] > 1 else ''}"
+        box = f"[{lo[c, 0]:.6g}, {hi[c, 0]:.6g}] × [{lo[c, 1]:.6g}, {hi[c, 1]:.6g}]"
+        line = f"component {c + 1} ({cells} in {box}, boundary parts {parts})"
+        if on_contact:
+            line += f" is held only by contact parts {on_contact}"
+        lines.append(line)
+    more = floating.size - len(lines)
+    if more:
+        lines.append(f"and {more} more")
+    raise ProblemError(
+        f"the body falls into {n_comp} components (cells joined through shared edges; cells "
+        f"that share only a vertex are not joined), and {floating.size} of them ha"
+        f"{'ve' if floating.size > 1 else 's'} no Dirichlet part, so nothing rules out "
+        f"their rigid body motions: {'; '.join(lines)}. Give each component a Dirichlet part "
+        "or join it to the body along an edge; contact alone does not hold a component "
+        "(docs/method.md, *The continuous problem*)"
+    )
