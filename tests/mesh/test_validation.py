@@ -205,6 +205,14 @@ def test_bad_arrays(points, cells, match) -> None:
         Mesh.from_arrays(points, cells, ALL)
 
 
+def test_constructor_names_string_arguments() -> None:
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
+    with pytest.raises(MeshError, match=r"points must be an \(n_points, 2\) array of numbers"):
+        Mesh(SQUARE_P.astype(str), SQUARE_C, m.boundary, m.boundary_part, m.part_names)
+    with pytest.raises(MeshError, match=r"cells must be an \(n, 3\) array of point indices"):
+        Mesh(SQUARE_P, "0 1 2", m.boundary, m.boundary_part, m.part_names)
+
+
 def test_constructor_bad_boundary_shape() -> None:
     m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
     with pytest.raises(MeshError, match=r"boundary edges must have shape \(n, 2\)"):

@@ -90,8 +90,9 @@ class Mesh:
         Names of the boundary parts; every part must own at least one edge.
     validate : bool
         Check the mesh (:func:`~signorini.mesh.validation.validate_mesh`: orientation,
-        degeneracy, conformity, labels). Refinement, which preserves validity by
-        construction, skips it.
+        degeneracy, duplicate points, conformity, overlap, labels). Unlike
+        :meth:`from_arrays`, the constructor refuses clockwise cells. Refinement, which
+        preserves validity by construction, skips it.
 
     Attributes
     ----------
@@ -117,6 +118,9 @@ class Mesh:
         *,
         validate: bool = True,
     ) -> None:
+        if validate:  # argument kinds first: a clear error instead of NumPy's
+            points = as_points(points)
+            cells = as_cells(cells, len(points))
         self.points = np.ascontiguousarray(points, dtype=np.float64)
         self.cells = np.ascontiguousarray(cells, dtype=np.int64)
         boundary = np.asarray(boundary, dtype=np.int64)
