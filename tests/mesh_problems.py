@@ -15,8 +15,8 @@ from scipy.spatial import Delaunay
 from signorini.mesh.mesh import Mesh
 
 
-def everything(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    return np.ones_like(x, dtype=bool)
+def everything(x: np.ndarray) -> np.ndarray:
+    return np.ones(x.shape[:-1], dtype=bool)
 
 
 ALL = {"all": everything}

@@ -302,11 +302,11 @@ def _split_right_side():
         base.points,
         base.cells,
         {
-            "left": lambda x, y: np.abs(x) < tol,
-            "top": lambda x, y: np.abs(y - 1) < tol,
-            "bottom": lambda x, y: np.abs(y) < tol,
-            "right_low": lambda x, y: (np.abs(x - 1) < tol) & (y < 0.5),
-            "right_high": lambda x, y: (np.abs(x - 1) < tol) & (y > 0.5),
+            "left": lambda x: np.abs(x[:, 0]) < tol,
+            "top": lambda x: np.abs(x[:, 1] - 1) < tol,
+            "bottom": lambda x: np.abs(x[:, 1]) < tol,
+            "right_low": lambda x: (np.abs(x[:, 0] - 1) < tol) & (x[:, 1] < 0.5),
+            "right_high": lambda x: (np.abs(x[:, 0] - 1) < tol) & (x[:, 1] > 0.5),
         },
     )
 

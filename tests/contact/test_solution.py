@@ -78,7 +78,7 @@ def rotated_mesh(mesh: Mesh, R: np.ndarray, sides: dict[str, object]) -> Mesh:
     """The mesh with points ``R x``; parts chosen by predicates on the unrotated coordinates."""
 
     def part(pred):
-        return lambda x, y: pred(*(np.column_stack([x, y]) @ R).T)
+        return lambda x: pred(x @ R)
 
     return Mesh.from_arrays(
         mesh.points @ R.T, mesh.cells, {name: part(p) for name, p in sides.items()}
@@ -87,10 +87,10 @@ def rotated_mesh(mesh: Mesh, R: np.ndarray, sides: dict[str, object]) -> Mesh:
 
 def square_sides(x1: float = 1.0, y1: float = 1.0, tol: float = 1e-9) -> dict[str, object]:
     return {
-        "bottom": lambda x, y: np.abs(y) < tol,
-        "right": lambda x, y: np.abs(x - x1) < tol,
-        "top": lambda x, y: np.abs(y - y1) < tol,
-        "left": lambda x, y: np.abs(x) < tol,
+        "bottom": lambda x: np.abs(x[:, 1]) < tol,
+        "right": lambda x: np.abs(x[:, 0] - x1) < tol,
+        "top": lambda x: np.abs(x[:, 1] - y1) < tol,
+        "left": lambda x: np.abs(x[:, 0]) < tol,
     }
 
 

@@ -96,3 +96,70 @@ def test_read_mesh_rejects_a_text_file(tmp_path, name):
 def test_read_mesh_missing_file(tmp_path):
     with pytest.raises(MeshError, match="no mesh file"):
         read_mesh(tmp_path / "absent.msh")
+
+
+def write(tmp_path, mesh: meshio.Mesh, name: str = "m.msh"):
+    path = tmp_path / name
+    meshio.write(path, mesh, file_format="gmsh22", binary=False)
+    return path
+
+
+@pytest.mark.parametrize("z", [lambda p: p[:, 1], lambda p: 1e-3 * p[:, 0] * p[:, 1]])
+def test_read_mesh_refuses_a_mesh_that_is_not_flat(tmp_path, z):
+    m = gmsh_square(example_6_2().mesh)
+    m.points[:, 2] = z(m.points)
+    with pytest.raises(MeshError, match=r"m\.msh is not flat in the xy-plane: z ranges over "):
+        read_mesh(write(tmp_path, m))
+
+
+def test_read_mesh_accepts_a_constant_z(tmp_path):
+    m = gmsh_square(example_6_2().mesh)
+    m.points[:, 2] = 7.5
+    mesh = read_mesh(write(tmp_path, m))
+    assert mesh.n_cells == 32 and mesh.area.sum() == pytest.approx(1.0, rel=1e-14)
+
+
+def test_read_mesh_without_any_physical_group(tmp_path):
+    # triangles and lines, no physical group at all (Gmsh writes physical tag 0)
+    m = gmsh_square(example_6_2().mesh)
+    for blocks in m.cell_data.values():
+        for tags in blocks:
+            tags[:] = 0
+    m.field_data = {}
+    with pytest.raises(MeshError, match=r"m\.msh has no tagged boundary lines .*Physical Curve"):
+        read_mesh(write(tmp_path, m))
+
+
+def test_physical_tag_0_names_no_part(tmp_path):
+    # the left side in no physical group: its lines name no part, so its edges are unlabelled
+    base = example_6_2().mesh
+    m = gmsh_square(base)
+    tags = m.cell_data["gmsh:physical"][1]
+    tags[tags == 1 + base.part_names.index("left")] = 0
+    with pytest.raises(MeshError, match=r"m\.msh: 4 boundary edge\(s\) have no part"):
+        read_mesh(write(tmp_path, m))
+    # keeping the named parts only still leaves the left side unlabelled
+    with pytest.raises(MeshError, match="have no part"):
+        read_mesh(write(tmp_path, m), parts=["bottom", "right", "top"])
+
+
+def test_read_mesh_with_line_groups_only(tmp_path):
+    m = gmsh_square(example_6_2().mesh)
+    m = meshio.Mesh(
+        m.points,
+        [m.cells[1]],
+        cell_data={k: [v[1]] for k, v in m.cell_data.items()},
+        field_data=m.field_data,
+    )
+    with pytest.raises(
+        MeshError,
+        match=r"contains no triangles \(it has \['line'\]\): only line elements were saved; add "
+        r"a physical surface group .* or save all elements",
+    ):
+        read_mesh(write(tmp_path, m))
+
+
+def test_read_mesh_mixed_orientation_is_reported(tmp_path):
+    # gmsh_square lists every other triangle clockwise
+    mesh = read_mesh(write(tmp_path, gmsh_square(example_6_2().mesh)))
+    np.testing.assert_array_equal(mesh.reoriented, np.arange(0, 32, 2))

@@ -55,7 +55,7 @@ def test_predicate_claims_only_unlisted_edges() -> None:
     [
         ([[0, 1, 2]], r"boundary edges must have shape \(n, 2\), got \(1, 3\)"),
         ([[0, 9]], r"boundary edges refer to points outside 0\.\.3"),
-        (lambda x, y: True, r"predicate of boundary part 'a' must return one bool per edge "),
+        (lambda x: True, r"selector of boundary part 'a' must return one bool per edge "),
     ],
 )
 def test_bad_part_specs(spec, match) -> None:
@@ -73,10 +73,10 @@ def test_unknown_part_name() -> None:
 def test_from_arrays_with_predicates() -> None:
     p, c = jittered_delaunay(6, seed=3)
     parts = {
-        "bottom": lambda x, y: y < 1e-12,
-        "right": lambda x, y: x > 1 - 1e-12,
-        "top": lambda x, y: y > 1 - 1e-12,
-        "left": lambda x, y: x < 1e-12,
+        "bottom": lambda x: x[:, 1] < 1e-12,
+        "right": lambda x: x[:, 0] > 1 - 1e-12,
+        "top": lambda x: x[:, 1] > 1 - 1e-12,
+        "left": lambda x: x[:, 0] < 1e-12,
     }
     m = Mesh.from_arrays(p, c, parts)
     assert m.part_names == ("bottom", "right", "top", "left")
@@ -303,3 +303,112 @@ def test_cached_arrays_are_read_only():
     ):
         with pytest.raises(ValueError, match="read-only"):
             getattr(mesh, name)[0] = 0
+
+
+# ---------------------------------------------------------------------------- selectors f(x)
+def test_selectors_are_called_with_points_of_shape_n_2() -> None:
+    seen = []
+
+    def right(x):
+        seen.append(x.shape)
+        return x[:, 0] > 1 - 1e-12
+
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, {"right": right, "rest": lambda x: x[:, 0] < 1})
+    assert seen == [(4, 2)]
+    assert m.edges[m.part_edges("right")].tolist() == [[1, 2]]
+
+
+def test_old_two_argument_selectors_warn_and_still_work() -> None:
+    rest = {"rest": lambda x: x[:, 0] <= 0.5}
+    new = Mesh.from_arrays(SQUARE_P, SQUARE_C, {"right": lambda x: x[:, 0] > 0.5, **rest})
+    with pytest.warns(
+        DeprecationWarning,
+        match=r"selector of boundary part 'right' takes \(x, y\); selectors take the points x "
+        r"of shape \(n, 2\): write `lambda x: \.\.\.` with x\[:, 0\] and x\[:, 1\]",
+    ) as record:
+        old = Mesh.from_arrays(SQUARE_P, SQUARE_C, {"right": lambda x, y: x > 0.5, **rest})
+    assert len(record) == 1 and record[0].filename == __file__
+    np.testing.assert_array_equal(old.boundary_part, new.boundary_part)
+    np.testing.assert_array_equal(old.part_edges("right"), new.part_edges("right"))
+
+
+def test_selector_that_raises_is_named() -> None:
+    with pytest.raises(MeshError, match=r"selector of boundary part 'top' raised IndexError: "):
+        Mesh.from_arrays(SQUARE_P, SQUARE_C, {"top": lambda x: x[:, 2] > 0})
+
+
+# ---------------------------------------------------------------------------- argument kinds
+@pytest.mark.parametrize(
+    ("points", "cells", "parts", "match"),
+    [
+        (
+            "0 0 1 0 1 1",
+            SQUARE_C,
+            ALL,
+            r"points must be an \(n_points, 2\) array of numbers, got a string '0 0 1 0 1 1'",
+        ),
+        (
+            SQUARE_P.astype(str),
+            SQUARE_C,
+            ALL,
+            r"points must be an \(n_points, 2\) array of numbers, got an array of strings",
+        ),
+        (
+            [[0, 0], [1, 0, 0]],
+            SQUARE_C,
+            ALL,
+            r"points must be an \(n_points, 2\) array of numbers; NumPy says",
+        ),
+        (
+            SQUARE_P,
+            "0 1 2",
+            ALL,
+            r"cells must be an \(n, 3\) array of point indices, got a string '0 1 2'",
+        ),
+        (
+            SQUARE_P,
+            [["0", "1", "2"]],
+            ALL,
+            r"cells must be an \(n, 3\) array of point indices, got an array of strings",
+        ),
+        (
+            SQUARE_P,
+            SQUARE_C,
+            [everything],
+            r"parts must be a mapping \{name: \(k, 2\) boundary vertex pairs or selector "
+            r"f\(x\)\}, got list",
+        ),
+        (SQUARE_P, SQUARE_C, ["all"], r"parts must be a mapping .*, got list"),
+        (
+            SQUARE_P,
+            SQUARE_C,
+            {"all": "everything"},
+            r"boundary part 'all' must be a \(k, 2\) array of boundary vertex pairs or a "
+            r"selector f\(x\), got the string 'everything'",
+        ),
+        (
+            SQUARE_P,
+            SQUARE_C,
+            {"all": [[0, 1], [2]]},
+            r"boundary part 'all' must be a \(k, 2\) array .*, got list",
+        ),
+        (SQUARE_P, SQUARE_C, {1: everything}, r"part names must be strings, got 1"),
+    ],
+)
+def test_arguments_of_the_wrong_kind(points, cells, parts, match) -> None:
+    with pytest.raises(MeshError, match=match):
+        Mesh.from_arrays(points, cells, parts)
+
+
+def test_parts_are_checked_before_any_work() -> None:
+    # a list of parts is named even when the arrays are huge (nothing else is looked at)
+    calls = []
+
+    class Points:
+        def __array__(self, *args, **kwargs):
+            calls.append(1)
+            return SQUARE_P
+
+    with pytest.raises(MeshError, match="parts must be a mapping"):
+        Mesh.from_arrays(Points(), SQUARE_C, [everything])
+    assert calls == []

@@ -145,7 +145,7 @@ def check_shapes(mesh: Mesh, classes: np.ndarray) -> None:
 # ---------------------------------------------------------------------------- closed form
 def one_triangle() -> Mesh:
     p = np.array([[0.0, 0.0], [2.0, 0.0], [0.5, 1.0]])
-    return Mesh.from_arrays(p, [[0, 1, 2]], {"all": lambda x, y: np.ones_like(x, dtype=bool)})
+    return Mesh.from_arrays(p, [[0, 1, 2]], {"all": lambda x: np.ones(len(x), dtype=bool)})
 
 
 def test_bisect_one_triangle() -> None:

@@ -3,9 +3,11 @@ violation raises a :class:`MeshError` naming the offending cells, edges or point
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 import pytest
-from mesh_problems import ALL, SQUARE_C, SQUARE_P, everything
+from mesh_problems import ALL, HAND_MESHES, SQUARE_C, SQUARE_P, everything, jittered_delaunay
 
 from signorini.mesh import mesh as mesh_module
 from signorini.mesh.builders import rectangle
@@ -24,9 +26,32 @@ def test_repeated_vertex_is_degenerate() -> None:
         Mesh.from_arrays(SQUARE_P, [[0, 1, 1], [0, 2, 3]], ALL)
 
 
-def test_clockwise_triangle() -> None:
+def test_clockwise_triangle_in_the_constructor() -> None:
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
+    cells = m.cells.copy()
+    cells[1] = cells[1, [0, 2, 1]]
     with pytest.raises(MeshError, match=r"clockwise triangle\(s\) 1: .*counter-clockwise"):
-        Mesh.from_arrays(SQUARE_P, [[0, 1, 2], [0, 3, 2]], ALL)
+        Mesh(SQUARE_P, cells, m.boundary, m.boundary_part, m.part_names)
+
+
+@pytest.mark.parametrize("name", sorted(HAND_MESHES))
+def test_from_arrays_reorients_clockwise_cells(name: str, caplog) -> None:
+    # other tools mix orientations: every other cell given clockwise gives the same mesh
+    p, c = HAND_MESHES[name]()
+    c = np.array(c)
+    flip = np.arange(len(c))[1::2]
+    mixed = c.copy()
+    mixed[flip] = mixed[flip][:, [0, 2, 1]]
+    reference = Mesh.from_arrays(p, c, ALL)
+    with caplog.at_level(logging.INFO, logger="signorini.mesh.mesh"):
+        m = Mesh.from_arrays(p, mixed, ALL)
+    assert f"{flip.size} of {len(c)} cells were clockwise and were reoriented" in caplog.text
+    np.testing.assert_array_equal(m.reoriented, flip)
+    assert reference.reoriented.size == 0
+    assert np.all(m.area > 0)
+    np.testing.assert_array_equal(np.sort(m.cells, axis=1), np.sort(reference.cells, axis=1))
+    np.testing.assert_array_equal(m.area, reference.area)
+    assert not m.reoriented.flags.writeable
 
 
 def test_duplicate_points() -> None:
@@ -93,7 +118,7 @@ def test_overlapping_cells() -> None:
 
 def test_boundary_edges_without_part_from_arrays() -> None:
     with pytest.raises(MeshError, match=r"3 boundary edge\(s\) have no part.*label every"):
-        Mesh.from_arrays(SQUARE_P, SQUARE_C, {"bottom": lambda x, y: y < 1e-12})
+        Mesh.from_arrays(SQUARE_P, SQUARE_C, {"bottom": lambda x: x[:, 1] < 1e-12})
 
 
 def test_boundary_edges_without_part_constructor() -> None:
@@ -110,7 +135,7 @@ def test_part_index_out_of_range() -> None:
         Mesh(SQUARE_P, SQUARE_C, m.boundary, m.boundary_part + 1, ["all"])
 
 
-@pytest.mark.parametrize("empty", [lambda x, y: x > 5, [], np.zeros((0, 2), dtype=int)])
+@pytest.mark.parametrize("empty", [lambda x: x[:, 0] > 5, [], np.zeros((0, 2), dtype=int)])
 def test_part_without_edges(empty) -> None:
     with pytest.raises(MeshError, match=r"boundary part 'ghost' has no edges"):
         Mesh.from_arrays(SQUARE_P, SQUARE_C, {"all": everything, "ghost": empty})
@@ -180,6 +205,14 @@ def test_bad_arrays(points, cells, match) -> None:
         Mesh.from_arrays(points, cells, ALL)
 
 
+def test_constructor_names_string_arguments() -> None:
+    m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
+    with pytest.raises(MeshError, match=r"points must be an \(n_points, 2\) array of numbers"):
+        Mesh(SQUARE_P.astype(str), SQUARE_C, m.boundary, m.boundary_part, m.part_names)
+    with pytest.raises(MeshError, match=r"cells must be an \(n, 3\) array of point indices"):
+        Mesh(SQUARE_P, "0 1 2", m.boundary, m.boundary_part, m.part_names)
+
+
 def test_constructor_bad_boundary_shape() -> None:
     m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
     with pytest.raises(MeshError, match=r"boundary edges must have shape \(n, 2\)"):
@@ -190,8 +223,8 @@ def test_constructor_bad_boundary_shape() -> None:
 
 def test_mesh_error_is_value_error() -> None:
     assert issubclass(MeshError, ValueError)
-    with pytest.raises(ValueError, match="clockwise"):
-        Mesh.from_arrays(SQUARE_P, [[0, 2, 1], [0, 2, 3]], ALL)
+    with pytest.raises(ValueError, match="degenerate"):
+        Mesh.from_arrays(SQUARE_P, [[0, 2, 2], [0, 2, 3]], ALL)
 
 
 def test_validate_mesh_is_what_the_constructor_runs() -> None:
@@ -210,3 +243,104 @@ def test_validate_mesh_is_what_the_constructor_runs() -> None:
     with pytest.raises(MeshError, match=r"inconsistently oriented across edge \(0, 1\)"):
         validate_mesh(bad)
     assert MeshError is mesh_module.MeshError
+
+
+# ---------------------------------------------------------------------------- overlapping cells
+UNIT = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+TWO = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def two_squares(scale: float, shift: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """The unit square and a copy scaled and shifted, meshed separately (no shared point)."""
+    return np.vstack([UNIT, scale * UNIT + shift]), np.vstack([TWO, TWO + 4])
+
+
+@pytest.mark.parametrize(
+    ("scale", "shift", "match"),
+    [
+        # overlapping by half in each direction: boundary edges cross
+        (1.0, (0.5, 0.5), r"cells overlap: boundary edges \(2, 3\) and \(7, 4\) cross"),
+        (1.0, (0.5, -0.25), r"cells overlap: boundary edges \(0, 1\) and \(7, 4\) cross"),
+        # a small square inside the big one: no edge crosses, the inside is covered twice
+        (0.25, (0.3, 0.2), r"cells overlap: the centroid .* of cell \d is covered by 2 cells"),
+    ],
+)
+def test_overlapping_squares(scale, shift, match) -> None:
+    p, c = two_squares(scale, shift)
+    with pytest.raises(MeshError, match=match):
+        Mesh.from_arrays(p, c, ALL)
+
+
+def test_crossing_strips() -> None:
+    # a plus sign: two thin rectangles, no vertex of one inside the other
+    a = np.array([[-1, -0.1], [1, -0.1], [1, 0.1], [-1, 0.1]])
+    with pytest.raises(MeshError, match=r"cells overlap: boundary edges \(\d, \d\) and"):
+        Mesh.from_arrays(np.vstack([a, a[:, ::-1] * [1, -1]]), np.vstack([TWO, TWO + 4]), ALL)
+
+
+def test_overlap_at_a_pinch_vertex() -> None:
+    # a small quadrilateral inside the unit square that touches it only at the corner (0, 0)
+    q = 0.1 * np.array([[1.0, 0.5], [1.2, 1.5], [0.3, 1.0]])
+    cells = [[0, 1, 2], [0, 2, 3], [0, 4, 5], [0, 5, 6]]
+    with pytest.raises(MeshError, match=r"cells overlap: the centroid .* covered by 2 cells"):
+        Mesh.from_arrays(np.vstack([UNIT, q]), cells, ALL)
+
+
+def test_touching_squares_and_holes_are_not_overlaps() -> None:
+    # two squares meeting at a corner; the square next to the first one; a square with a hole
+    touching = Mesh.from_arrays(np.vstack([UNIT, UNIT[1:] + 1]), [*TWO, [2, 4, 5], [2, 5, 6]], ALL)
+    assert touching.area.sum() == pytest.approx(2.0, rel=1e-15)
+    side = Mesh.from_arrays(
+        np.vstack([UNIT, UNIT[[1, 2]] + [1, 0]]), [*TWO, [1, 4, 5], [1, 5, 2]], ALL
+    )
+    assert side.area.sum() == pytest.approx(2.0, rel=1e-15)
+    m = rectangle(nx=3, ny=3)
+    centre = m.points[m.cells].mean(axis=1)
+    keep = np.abs(centre - 0.5).max(axis=1) > 1 / 6
+    holed = Mesh.from_arrays(m.points, m.cells[keep], ALL)
+    assert holed.area.sum() == pytest.approx(8 / 9, rel=1e-14)
+
+
+def test_mesh_winding_twice_around_a_hole() -> None:
+    # an annulus of 8 quadrilaterals around a square hole, closed after two turns: each
+    # interior edge has a cell on either side, but every point is covered twice
+    t = np.arange(16) * 2 * np.pi / 8
+    inner = np.column_stack([np.cos(t), np.sin(t)]) * (1 + 0.01 * np.arange(16))[:, None]
+    outer = 2 * inner
+    p = np.vstack([inner, outer])
+    k = np.arange(16)
+    nxt = (k + 1) % 16
+    c = np.vstack([np.column_stack([k, nxt, 16 + nxt]), np.column_stack([k, 16 + nxt, 16 + k])])
+    with pytest.raises(MeshError, match="cells overlap"):
+        Mesh.from_arrays(p, c, ALL)
+
+
+# ---------------------------------------------------------------------------- relative tolerances
+@pytest.mark.parametrize(
+    ("scale", "shift"),
+    [(1e-12, 0.0), (1e-150, 0.0), (1e12, 0.0), (1e150, 0.0), (1.0, 1e9), (1.0, -1e12), (1e6, 1e15)],
+)
+def test_tolerances_are_relative_to_the_mesh(scale: float, shift: float) -> None:
+    # Example 6.2's mesh scaled by 1e-12 and the unit square at x = 1e9 were "duplicate points"
+    base = rectangle(nx=4, ny=4)
+    p = base.points * scale + [shift, 0.5 * shift]
+    m = Mesh.from_arrays(p, base.cells, ALL)
+    assert m.n_points == base.n_points
+    np.testing.assert_allclose(m.area.sum(), scale**2, rtol=1e-6)
+    # still caught at that scale: a duplicate point, a hanging node, an overlap
+    q = np.vstack([p, p[[5]] + scale * 1e-13])
+    with pytest.raises(MeshError, match=r"duplicate points 5, 25"):
+        Mesh.from_arrays(q, np.vstack([base.cells, [[25, 1, 0]]]), ALL)
+    u, c = two_squares(0.25, (0.3, 0.2))
+    with pytest.raises(MeshError, match="cells overlap"):
+        Mesh.from_arrays(u * scale + [shift, 0.5 * shift], c, ALL)
+
+
+def test_duplicate_points_after_a_large_shift() -> None:
+    # at x = 1e9 two points one rounding unit apart are the same point
+    p, c = jittered_delaunay(5)
+    p = p + [1e9, 0.0]
+    q = np.vstack([p, p[[3]] + [np.spacing(1e9), 0.0]])
+    extra = np.vstack([c, [[len(p), 4, 9]]])
+    with pytest.raises(MeshError, match=rf"duplicate points 3, {len(p)}"):
+        Mesh.from_arrays(q, extra, ALL)

@@ -109,8 +109,8 @@ def test_curved_contact_part():
         m.points,
         m.cells,
         {
-            "corner": lambda x, y: (np.abs(y) < 1e-12) | (np.abs(x - 1) < 1e-12),
-            "rest": lambda x, y: (np.abs(y - 1) < 1e-12) | (np.abs(x) < 1e-12),
+            "corner": lambda x: (np.abs(x[:, 1]) < 1e-12) | (np.abs(x[:, 0] - 1) < 1e-12),
+            "rest": lambda x: (np.abs(x[:, 1] - 1) < 1e-12) | (np.abs(x[:, 0]) < 1e-12),
         },
     )
     with pytest.raises(ProblemError, match="'corner' is not straight"):

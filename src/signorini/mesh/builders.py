@@ -72,9 +72,9 @@ def rectangle(
         cells = np.concatenate([t1, t2])
     tol = 1e-12 * max(x1 - x0, y1 - y0)
     parts = {
-        "bottom": lambda x, y: np.abs(y - y0) < tol,
-        "right": lambda x, y: np.abs(x - x1) < tol,
-        "top": lambda x, y: np.abs(y - y1) < tol,
-        "left": lambda x, y: np.abs(x - x0) < tol,
+        "bottom": lambda x: np.abs(x[:, 1] - y0) < tol,
+        "right": lambda x: np.abs(x[:, 0] - x1) < tol,
+        "top": lambda x: np.abs(x[:, 1] - y1) < tol,
+        "left": lambda x: np.abs(x[:, 0] - x0) < tol,
     }
     return Mesh.from_arrays(points, cells, parts)

@@ -10,10 +10,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .geometry import signed_area
 from .mesh import Mesh, MeshError
 
 __all__ = ["read_mesh"]
+
+
+#: Relative spread of z (against the mesh's extent in x and y) below which z is constant.
+FLAT_TOL = 1e-10
 
 
 def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Mesh:
@@ -21,18 +24,28 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
 
     Triangles (``triangle`` or ``triangle6``, whose vertices are used) make the cells; line
     elements tagged with physical groups make the boundary parts, named after the groups
-    (``gmsh:physical`` / field data). Cells are oriented counter-clockwise and each cell's
-    longest edge becomes its refinement edge.
+    (``gmsh:physical`` / field data; a physical group without a name is called
+    ``"part<tag>"``). Physical tag 0 is Gmsh's mark for an element in *no* physical group
+    (written when all elements are saved): such lines name no part. The mesh must lie in a
+    plane ``z = const``. Cells are oriented counter-clockwise (see
+    :meth:`Mesh.from_arrays`) and each cell's longest edge becomes its refinement edge.
 
     Parameters
     ----------
     path : file readable by meshio
     parts : names of the parts to keep (default: all named line groups)
 
+    Returns
+    -------
+    Mesh
+
     Raises
     ------
     MeshError
-        If the file cannot be read as a mesh, has no triangles, or has no tagged boundary.
+        If the file cannot be read as a mesh, has no triangles (e.g. only line groups were
+        saved: add a physical surface group or save all elements), is not flat in the
+        xy-plane, has no boundary lines in a physical group (every boundary edge must be in
+        one), or lacks a requested part.
     """
     import meshio
 
@@ -49,17 +62,31 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
         raise MeshError(f"{path} is not a mesh file meshio can read: {detail}") from None
     tri = [(i, b) for i, b in enumerate(m.cells) if b.type in ("triangle", "triangle6")]
     if not tri:
-        raise MeshError(f"{path} contains no triangles")
+        found = sorted({b.type for b in m.cells})
+        hint = (
+            ": only line elements were saved; add a physical surface group holding the "
+            "triangles (Gmsh: Physical Surface) or save all elements (Gmsh: Mesh.SaveAll = 1)"
+            if found and set(found) <= {"line", "line3", "vertex"}
+            else ""
+        )
+        raise MeshError(f"{path} contains no triangles (it has {found or 'no cells'}){hint}")
     cells = np.concatenate([b.data[:, :3] for _, b in tri]).astype(np.int64)
-    points = np.asarray(m.points, dtype=np.float64)[:, :2]
+    xyz = np.asarray(m.points, dtype=np.float64)
     # drop points that no triangle uses (e.g. geometry points), renumber
     used = np.unique(cells)
-    renumber = np.full(len(points), -1, dtype=np.int64)
+    renumber = np.full(len(xyz), -1, dtype=np.int64)
     renumber[used] = np.arange(used.size)
-    points, cells = points[used], renumber[cells]
-    area = signed_area(points, cells)
-    flip = area < 0
-    cells[flip] = cells[flip][:, [0, 2, 1]]
+    xyz, cells = xyz[used], renumber[cells]
+    points = xyz[:, :2]
+    if xyz.shape[1] > 2 and xyz.size:
+        z = xyz[:, 2]
+        extent = float(np.hypot(*np.ptp(points, axis=0)))
+        if np.ptp(z) > FLAT_TOL * extent:
+            raise MeshError(
+                f"{path} is not flat in the xy-plane: z ranges over [{z.min():.6g}, "
+                f"{z.max():.6g}]; a mesh must lie in a plane z = const (dropping z would "
+                "distort it)"
+            )
     tags = m.cell_data.get("gmsh:physical")
     names = {int(v[0]): k for k, v in (m.field_data or {}).items() if len(v) > 1 and v[1] == 1}
     groups: dict[str, list[np.ndarray]] = {}
@@ -67,6 +94,8 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
         if block.type not in ("line", "line3") or tags is None:
             continue
         for tag in np.unique(tags[i]):
+            if tag == 0:  # in no physical group
+                continue
             name = names.get(int(tag), f"part{int(tag)}")
             pairs = renumber[block.data[tags[i] == tag][:, :2]]
             if np.any(pairs < 0):
@@ -77,11 +106,15 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
     if not groups:
         raise MeshError(
             f"{path} has no tagged boundary lines (physical groups); the boundary "
-            "parts cannot be named"
+            "parts cannot be named: put the boundary lines in physical line groups "
+            "(Gmsh: Physical Curve)"
         )
     if parts is not None:
         missing = [p for p in parts if p not in groups]
         if missing:
             raise MeshError(f"{path} has no boundary group(s) {missing}; it has {sorted(groups)}")
         groups = {p: groups[p] for p in parts}
-    return Mesh.from_arrays(points, cells, {k: np.concatenate(v) for k, v in groups.items()})
+    try:
+        return Mesh.from_arrays(points, cells, {k: np.concatenate(v) for k, v in groups.items()})
+    except MeshError as exc:
+        raise MeshError(f"{path}: {exc}") from None

@@ -16,10 +16,17 @@ Conventions (fixed for the whole package)
 
 A :class:`Mesh` is immutable; derived topology is computed once and cached. Building one from
 user arrays runs the checks of :mod:`signorini.mesh.validation`.
+
+Part selectors follow the package's one convention for user functions: they are called with
+points ``x`` of shape ``(..., 2)`` (here the boundary edge midpoints, ``(n, 2)``) and return
+one value per point.
 """
 
 from __future__ import annotations
 
+import inspect
+import logging
+import warnings
 from collections.abc import Callable, Mapping
 from functools import cached_property
 
@@ -30,12 +37,17 @@ from .validation import (
     MeshError,
     as_cells,
     as_points,
-    check_orientation,
+    degenerate_cells,
     format_indices,
     validate_mesh,
 )
 
 __all__ = ["Mesh", "MeshError", "boundary_edges"]
+
+logger = logging.getLogger(__name__)
+
+_NO_CELLS = np.zeros(0, dtype=np.int64)
+_NO_CELLS.flags.writeable = False
 
 
 def _edge_keys(pairs: np.ndarray, n_points: int) -> np.ndarray:
@@ -78,14 +90,23 @@ class Mesh:
         Names of the boundary parts; every part must own at least one edge.
     validate : bool
         Check the mesh (:func:`~signorini.mesh.validation.validate_mesh`: orientation,
-        degeneracy, conformity, labels). Refinement, which preserves validity by
-        construction, skips it.
+        degeneracy, duplicate points, conformity, overlap, labels). Unlike
+        :meth:`from_arrays`, the constructor refuses clockwise cells. Refinement, which
+        preserves validity by construction, skips it.
+
+    Attributes
+    ----------
+    reoriented : (k,) int array
+        Indices of the cells that :meth:`from_arrays` received clockwise and listed
+        counter-clockwise (empty for every other mesh, e.g. a refined one).
 
     Raises
     ------
     MeshError
         With a message naming the offending cells, edges or points.
     """
+
+    reoriented: np.ndarray = _NO_CELLS
 
     def __init__(
         self,
@@ -97,6 +118,9 @@ class Mesh:
         *,
         validate: bool = True,
     ) -> None:
+        if validate:  # argument kinds first: a clear error instead of NumPy's
+            points = as_points(points)
+            cells = as_cells(cells, len(points))
         self.points = np.ascontiguousarray(points, dtype=np.float64)
         self.cells = np.ascontiguousarray(cells, dtype=np.int64)
         boundary = np.asarray(boundary, dtype=np.int64)
@@ -116,28 +140,63 @@ class Mesh:
         cls,
         points: np.ndarray,
         cells: np.ndarray,
-        parts: Mapping[str, np.ndarray | Callable[[np.ndarray, np.ndarray], np.ndarray]],
+        parts: Mapping[str, np.ndarray | Callable[[np.ndarray], np.ndarray]],
     ) -> Mesh:
         """Build a mesh from user arrays, putting each cell's longest edge first.
+
+        Cells may come in either orientation (other tools mix them): clockwise cells are
+        listed counter-clockwise; their indices are kept in :attr:`reoriented` and their
+        number is logged (``logging.INFO``). Only degenerate cells are refused.
 
         Parameters
         ----------
         points : (n_points, 2) float array
-        cells : (n_cells, 3) int array, counter-clockwise
-        parts : mapping from part name to either an ``(k, 2)`` array of boundary vertex pairs
-            or a predicate ``f(x, y) -> bool array`` evaluated at boundary edge midpoints.
-            Edges claimed by a predicate are those not listed explicitly; a boundary edge
-            claimed by two parts is an error.
+        cells : (n_cells, 3) int array
+            Triangles, in either orientation.
+        parts : mapping from part name (str) to either
+            - a ``(k, 2)`` int array of boundary vertex pairs, or
+            - a selector ``f(x) -> (n,) bool array``, called with the boundary edge
+              midpoints ``x`` of shape ``(n, 2)`` (``x[:, 0]`` and ``x[:, 1]`` are the
+              coordinates). A selector written ``f(x, y)`` still works, with a
+              ``DeprecationWarning``.
+
+            Selectors claim only the edges no list names; a boundary edge claimed by two
+            parts is an error.
+
+        Raises
+        ------
+        MeshError
+            Before any work for arguments of the wrong kind (``points`` or ``cells`` that
+            are not arrays of numbers, ``parts`` that is not a mapping); then at the first
+            fault of the mesh, naming it.
         """
+        names = _check_parts(parts)
         points = as_points(points)
         cells = as_cells(cells, len(points))
-        check_orientation(points, cells)
+        if cells.shape[0] == 0:
+            raise MeshError("the mesh has no cells")
+        area = signed_area(points, cells)
+        degenerate = degenerate_cells(points, cells, area)
+        if degenerate.any():
+            bad = np.flatnonzero(degenerate)
+            raise MeshError(
+                f"degenerate triangle(s) {format_indices(bad)} (zero area or repeated "
+                f"vertex), e.g. cell {bad[0]} = {cells[bad[0]].tolist()}"
+            )
+        flipped = np.flatnonzero(area < 0)
+        if flipped.size:
+            cells = cells.copy()
+            cells[flipped] = cells[flipped][:, [0, 2, 1]]
+            logger.info(
+                "Mesh.from_arrays: %d of %d cells were clockwise and were reoriented",
+                flipped.size,
+                cells.shape[0],
+            )
         cells = _longest_edge_first(points, cells)
         bnd = boundary_edges(cells)
         part_of = np.full(len(bnd), -1, dtype=np.int64)
         keys = _edge_keys(bnd, len(points))
         order = np.argsort(keys)
-        names = list(parts)
         listed = None  # edges named by an explicit list; predicates only claim the others
         for index in sorted(range(len(names)), key=lambda i: callable(parts[names[i]])):
             name = names[index]
@@ -146,12 +205,7 @@ class Mesh:
                 if listed is None:
                     listed = part_of >= 0
                 mid = 0.5 * (points[bnd[:, 0]] + points[bnd[:, 1]])
-                hit = np.asarray(spec(mid[:, 0], mid[:, 1]), dtype=bool).reshape(-1)
-                if hit.shape != (len(bnd),):
-                    raise MeshError(
-                        f"the predicate of boundary part {name!r} must return one "
-                        f"bool per edge midpoint, got shape {hit.shape}"
-                    )
+                hit = _select(name, spec, mid)
                 where = np.flatnonzero(hit & ~listed)
             else:
                 pairs = np.asarray(spec)
@@ -181,7 +235,10 @@ class Mesh:
                     f"{other!r} and {name!r}"
                 )
             part_of[where] = index
-        return cls(points, cells, bnd, part_of, names)
+        mesh = cls(points, cells, bnd, part_of, names)
+        if flipped.size:
+            mesh.reoriented = _frozen(flipped)
+        return mesh
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -335,6 +392,77 @@ class Mesh:
 
 
 # ---------------------------------------------------------------------- helpers
+def _check_parts(parts: object) -> list[str]:
+    """The part names of ``parts``, after checking that it is a mapping from str to an edge
+    list or a selector (before any work on the mesh)."""
+    if not isinstance(parts, Mapping):
+        raise MeshError(
+            "parts must be a mapping {name: (k, 2) boundary vertex pairs or selector f(x)}, "
+            f"got {type(parts).__name__}"
+        )
+    for name, spec in parts.items():
+        if not isinstance(name, str):
+            raise MeshError(f"part names must be strings, got {name!r}")
+        if callable(spec):
+            continue
+        if isinstance(spec, (str, bytes)):
+            raise MeshError(
+                f"boundary part {name!r} must be a (k, 2) array of boundary vertex pairs or a "
+                f"selector f(x), got the string {spec[:40]!r}"
+            )
+        try:
+            a = np.asarray(spec)
+        except (TypeError, ValueError):  # ragged nested sequences
+            a = np.array([None])
+        if a.size and a.dtype.kind not in "iuf":
+            raise MeshError(
+                f"boundary part {name!r} must be a (k, 2) array of boundary vertex pairs or a "
+                f"selector f(x), got {type(spec).__name__}"
+            )
+    return list(parts)
+
+
+def _takes_x_and_y(f: Callable) -> bool:
+    """Whether ``f`` is an old-style selector ``f(x, y)``: exactly two required positional
+    parameters and no ``*args``."""
+    try:
+        params = inspect.signature(f).parameters.values()
+    except (TypeError, ValueError):  # no signature (some builtins): the documented form
+        return False
+    positional = (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
+    required = [p for p in params if p.kind in positional and p.default is inspect.Parameter.empty]
+    star = any(p.kind is inspect.Parameter.VAR_POSITIONAL for p in params)
+    return len(required) == 2 and not star
+
+
+def _select(name: str, f: Callable, mid: np.ndarray) -> np.ndarray:
+    """The selector of part ``name`` at the edge midpoints ``mid (n, 2)``: a ``(n,)`` bool
+    array, or a :class:`MeshError` naming the part."""
+    try:
+        if _takes_x_and_y(f):
+            warnings.warn(
+                f"the selector of boundary part {name!r} takes (x, y); selectors take the "
+                "points x of shape (n, 2): write `lambda x: ...` with x[:, 0] and x[:, 1] "
+                "for the coordinates (the form f(x, y) will stop working)",
+                DeprecationWarning,
+                stacklevel=3,
+            )
+            hit = f(mid[:, 0], mid[:, 1])
+        else:
+            hit = f(mid)
+    except Exception as exc:
+        raise MeshError(
+            f"the selector of boundary part {name!r} raised {type(exc).__name__}: {exc}"
+        ) from exc
+    hit = np.asarray(hit)
+    if hit.dtype.kind not in "biuf" or hit.size != len(mid):
+        raise MeshError(
+            f"the selector of boundary part {name!r} must return one bool per edge "
+            f"midpoint, shape ({len(mid)},), got shape {hit.shape} of {hit.dtype}"
+        )
+    return hit.astype(bool).reshape(-1)
+
+
 def _frozen(a: np.ndarray) -> np.ndarray:
     """Mark a cached array read-only (a Mesh is immutable)."""
     a.flags.writeable = False
