@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import numpy as np
@@ -25,12 +25,27 @@ from .contact_set import ContactSet, node_classes
 from .node_frames import to_cartesian
 from .system import Assembled, assemble
 
-__all__ = ["ContactResult", "solve"]
+__all__ = ["ContactResult", "solve", "stiffness_unit"]
 
 log = logging.getLogger(__name__)
 
 #: quadrature degree for errors against a smooth exact solution
 ERROR_DEGREE = 10
+#: a stiffness matrix whose largest diagonal entry lies in this range is solved as it is;
+#: outside it (E beyond about 1e±77) K and F are divided by a power of 2 first
+STIFFNESS_RANGE = (2.0**-256, 2.0**256)
+
+
+def stiffness_unit(K) -> float:
+    """1 if ``max |diag K|`` lies in ``STIFFNESS_RANGE`` (or is 0), else the power of 2
+    not above it. Dividing K and F by it is exact, so u_h is the same; it keeps sums over
+    K (the active set rule's constant c = mean diag K, the force scales of the KKT check)
+    and the factorization's products away from overflow and underflow when E is extreme."""
+    d = float(np.abs(K.diagonal()).max(initial=0.0))
+    lo, hi = STIFFNESS_RANGE
+    if d == 0.0 or not np.isfinite(d) or lo <= d <= hi:
+        return 1.0
+    return float(np.ldexp(1.0, int(np.floor(np.log2(d)))))
 
 
 @dataclass
@@ -162,12 +177,16 @@ def solve(
         un = cs.normal_displacement(u0)
         scale = max(float(np.abs(cs.gap).max(initial=0)), float(np.abs(u0).max()), 1e-300)
         active0 = un - cs.gap >= -1e-10 * scale
+    # K and F divided by a power of 2 when E is extreme (exact; 1 otherwise), so that no
+    # product in the factorization overflows or underflows
+    unit = stiffness_unit(assembled.K)
+    K, F = (assembled.K, assembled.F) if unit == 1.0 else (assembled.K / unit, assembled.F / unit)
     t0 = time.perf_counter()
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
     with make_solver(backend, check_symmetry=False) as solver:
         res = solve_pdas(
-            assembled.K,
-            assembled.F,
+            K,
+            F,
             2 * cs.nodes,
             cs.gap,
             assembled.dirichlet,
@@ -178,6 +197,8 @@ def solve(
             fallback=fallback,
         )
     seconds = time.perf_counter() - t0
+    if unit != 1.0:
+        res = replace(res, multiplier=res.multiplier * unit, c_scale=res.c_scale * unit)
     u = to_cartesian(res.x, cs.nodes, cs.normal).reshape(-1, 2)
     log.info(
         "solved %s: %d unknowns, %d PDAS iterations, %d active of %d",
