@@ -102,21 +102,38 @@ class ContactProfile:
 class ContactResult:
     """The discrete solution of one mesh and everything derived from it.
 
+    Consistent units: if E is in MPa and lengths in mm, ``u`` is in mm, ``contact_force``
+    Λ_z in N per mm of thickness (plane strain: forces per unit thickness), ``density``
+    s_z and ``pressure`` p_z in MPa.
+
     Attributes
     ----------
     problem : ContactProblem
+        The problem that was solved.
     space : P2Space
+        The P2 space of the mesh (``space.mesh``; node numbering: vertices, then midpoints).
     u : (n_nodes, 2) float array
-        Nodal displacements (Cartesian).
+        Nodal displacements u_h(z) (Cartesian) at every P2 node.
     contact : ContactSet
+        The constrained nodes (k of them) with normals, gaps ψ(z) and weights.
     contact_force : (k,) float array
-        Nodal contact forces Λ_z ≥ 0 (3.17).
+        Nodal contact forces Λ_z ≥ 0 (3.17), ``L(ψ_z n) − a(u_h, ψ_z n)``; their sum is the
+        resultant normal force on Γ_C.
     active : (k,) bool array
         Final active set of the PDAS iteration (``u(z)·n = ψ(z)`` imposed): the actual
         contact nodes.
     pdas : PDASResult
+        How the active set solver got there: iterations, KKT residuals (relative), timings.
+        ``pdas.multiplier`` equals ``contact_force``; when E is extreme the system was
+        solved divided by ``stiffness_unit(K)``, so ``pdas.kkt.force_scale`` is in that unit.
+    dirichlet_nodes : (n_D,) int array
+        The P2 nodes on the closure of Γ_D (both components prescribed).
     timings : dict
         Seconds spent in ``assemble`` and ``solve``.
+
+    Derived: ``ndof``, ``density`` s_z, ``pressure`` p_z, ``total_contact_force``,
+    ``classes``, :meth:`contact_profile` (the contact quantities of a part in boundary
+    order), :meth:`errors`.
     """
 
     problem: ContactProblem
@@ -135,7 +152,8 @@ class ContactResult:
 
     @property
     def ndof(self) -> int:
-        """Free scalar unknowns (the paper's Ndof): all DOFs minus the Dirichlet ones."""
+        """Free scalar unknowns (the paper's Ndof): ``2 n_nodes − 2 n_D``, all P2 DOFs minus
+        both DOFs of every Dirichlet node; constrained contact DOFs are counted."""
         return self.space.n_dofs - 2 * self.dirichlet_nodes.size
 
     @property

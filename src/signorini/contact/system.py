@@ -29,13 +29,38 @@ LOAD_DEGREE = 8
 
 @dataclass
 class Assembled:
-    """The algebraic problem of one mesh, in rotated (normal, tangential) contact frames."""
+    """The algebraic problem of one mesh, in rotated (normal, tangential) contact frames.
+
+    DOFs are interleaved, ``2 node + component`` (docs/method.md, *Data conventions*); at a
+    constrained node z the two DOFs are ``(u·n, u·t)`` with ``t = (−n_y, n_x)``, elsewhere
+    ``(u_x, u_y)``. Consistent units: if E is in MPa and lengths in mm, entries of K are in
+    N/mm per mm of thickness (MPa), F and Λ_z in N per mm of thickness, displacements in mm.
+
+    Attributes
+    ----------
+    space : P2Space
+        The P2 space of the mesh (node numbering: vertices, then edge midpoints).
+    contact : ContactSet
+        The constrained nodes, their normals, gaps and weights.
+    K : (n_dofs, n_dofs) scipy.sparse CSR matrix
+        The stiffness matrix ``a(ψ_j, ψ_i)`` (symmetric positive semi-definite before the
+        Dirichlet DOFs are fixed), rotated in place at the constrained nodes.
+    F : (n_dofs,) float array
+        The load ``L(ψ_i)``: body force and Neumann tractions, rotated like K.
+    dirichlet : (2 n_D,) int array
+        Both DOFs of every Dirichlet node, node after node (sorted by node).
+    dirichlet_values : (2 n_D,) float array
+        The prescribed displacements of those DOFs (Cartesian: Dirichlet nodes are never
+        rotated).
+    seconds : float
+        Wall-clock time of the assembly.
+    """
 
     space: P2Space
     contact: ContactSet
     K: sp.csr_matrix
     F: np.ndarray
-    dirichlet: np.ndarray  # DOFs
+    dirichlet: np.ndarray
     dirichlet_values: np.ndarray
     seconds: float
 
