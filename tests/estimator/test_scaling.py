@@ -26,12 +26,14 @@ import pytest
 
 from signorini.contact.solution import solve, stiffness_unit
 from signorini.contact.system import assemble
+from signorini.estimator.h_half_norm import hhalf_seminorm2_positive_part, l2_norm2_positive_part
 from signorini.estimator.residual import STRESS_RANGE, estimate, stress_unit
 from signorini.examples import example_6_1, example_6_2
 from signorini.fem.material import Material
 from signorini.loop import adaptive
+from signorini.mesh.mesh import Mesh
 from signorini.mesh.refine import refine_nvb
-from signorini.problem import Neumann
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
 
 RTOL = 1e-11
 EXAMPLES = {"6.1": example_6_1, "6.2": example_6_2}
@@ -149,3 +151,49 @@ def test_adaptive_run_with_young_modulus_1e300_completes():
         np.testing.assert_allclose(
             lv.estimate.eta_terms[:5] / c, lr.estimate.eta_terms[:5], rtol=1e-9
         )
+
+
+def moved_6_2(a: float, shift: float) -> ContactProblem:
+    """Example 6.2 with its mesh, Dirichlet data and gap scaled by ``a`` and shifted by
+    ``(shift, shift)``."""
+    base = example_6_2()
+    m = base.mesh
+    # validate=False: the mesh layer's own tolerances are not under test here
+    mesh = Mesh(
+        m.points * a + shift, m.cells, m.boundary, m.boundary_part, m.part_names, validate=False
+    )
+
+    def gap(x):
+        return a * (-0.2 + 0.5 * np.abs((x[..., 1] - shift) / a - 0.5))
+
+    conditions = dict(base.conditions)
+    conditions["left"] = Dirichlet((0.1 * a, 0.0))
+    conditions["right"] = Contact(gap=gap, normal=(1.0, 0.0))
+    return ContactProblem(mesh=mesh, material=base.material, conditions=conditions, name="moved")
+
+
+@pytest.mark.parametrize(("a", "shift"), [(1.0, 1e9), (1e-12, 0.0), (1e12, 0.0), (1e12, 1e9)])
+def test_solution_and_estimator_under_scaling_and_translation(a, shift):
+    """Lengths times a: u_h and Λ_z (a force per unit thickness, σ × length) scale with a,
+    σ(u_h) does not, so η1 … η6 scale with a; η7² = ‖v‖²_{L²} + |v|²_{H^{1/2}} scales as
+    a³ ‖v‖²_{L²} + a² |v|²_{H^{1/2}}. A shift changes nothing (before: the H^{1/2} norm
+    computed distances of quadrature points at 1e9 and η7 was off by 9e-8)."""
+    r0 = solve(moved_6_2(1.0, 0.0), refined_mesh(moved_6_2(1.0, 0.0)))
+    e0 = estimate(r0)
+    problem = moved_6_2(a, shift)
+    r = solve(problem, refined_mesh(problem))
+    e = estimate(r)
+    np.testing.assert_allclose(r.u / a, r0.u, rtol=0, atol=RTOL * np.abs(r0.u).max())
+    np.testing.assert_allclose(
+        r.contact_force / a, r0.contact_force, rtol=0, atol=RTOL * r0.contact_force.max()
+    )
+    assert np.array_equal(r.active, r0.active) and np.array_equal(r.classes, r0.classes)
+    cs = r0.contact
+    x0, x1 = r0.mesh.points[cs.edge_nodes[:, 0]], r0.mesh.points[cs.edge_nodes[:, 1]]
+    v = cs.edge_normal_gap(r0.u)
+    l2 = l2_norm2_positive_part(x0, x1, v)
+    semi = hhalf_seminorm2_positive_part(x0, x1, v)
+    l2, semi = (q[0] if isinstance(q, tuple) else q for q in (l2, semi))
+    want = e0.eta_terms * a
+    want[6] = a * np.sqrt(a * l2 + semi)
+    np.testing.assert_allclose(e.eta_terms, want, rtol=RTOL)

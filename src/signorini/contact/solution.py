@@ -36,6 +36,23 @@ ERROR_DEGREE = 10
 STIFFNESS_RANGE = (2.0**-256, 2.0**256)
 
 
+#: a Dirichlet end point of Γ_C touches the obstacle (for the node classes) where
+#: ``u_D·n − ψ ≥ −TOUCH_RTOL · max(max|u_h|, |ψ|)``
+TOUCH_RTOL = 1e-12
+#: a warm start's node starts in the active set where
+#: ``u0·n − ψ ≥ −WARM_START_RTOL · max(max|u0|, |ψ|)``: the prolongated contact nodes
+#: of the previous level, whose u0·n − ψ is round-off of the displacements
+WARM_START_RTOL = 1e-10
+
+
+def _round_off_scale(u: np.ndarray, gap: np.ndarray) -> np.ndarray:
+    """``max(max|u|, |ψ(z)|)`` per node (the shape of ``gap``): the size of the two numbers
+    ``u(z)·n − ψ(z)`` is the difference of, hence of its round-off. Relative to the
+    displacements and to the gap at the node itself, not to the gap far away (a distant
+    obstacle must not make the test lenient), and invariant under scaling of the problem."""
+    return np.maximum(np.abs(u).max(initial=0.0), np.abs(gap))
+
+
 def stiffness_unit(K) -> float:
     """1 if ``max |diag K|`` lies in ``STIFFNESS_RANGE`` (or is 0), else the power of 2
     not above it. Dividing K and F by it is exact, so u_h is the same; it keeps sums over
@@ -178,10 +195,7 @@ class ContactResult:
         cs = self.contact
         loc = cs.edge_local
         gap = cs.edge_normal_gap(self.u)
-        scale = max(
-            float(np.abs(cs.edge_gap).max(initial=0)), float(np.abs(self.u).max(initial=0)), 1e-300
-        )
-        dirichlet_touch = gap >= -1e-12 * scale
+        dirichlet_touch = gap >= -TOUCH_RTOL * _round_off_scale(self.u, cs.edge_gap)
         edge_in = np.where(loc >= 0, self.active[np.maximum(loc, 0)], dirichlet_touch)
         return node_classes(cs, self.active, edge_in)
 
@@ -342,8 +356,7 @@ def solve(
         if not np.isfinite(u0).all():
             raise ValueError("u0 contains NaN or inf")
         un = cs.normal_displacement(u0)
-        scale = max(float(np.abs(cs.gap).max(initial=0)), float(np.abs(u0).max()), 1e-300)
-        active0 = un - cs.gap >= -1e-10 * scale
+        active0 = un - cs.gap >= -WARM_START_RTOL * _round_off_scale(u0, cs.gap)
     # K and F divided by a power of 2 when E is extreme (exact; 1 otherwise), so that no
     # product in the factorization overflows or underflows
     unit = stiffness_unit(assembled.K)
