@@ -168,3 +168,23 @@ def test_profile_names_a_wrong_part():
     result = solve(example_6_2())
     with pytest.raises(ValueError, match=r"part: 'left' is not a contact part .*\['right'\]"):
         result.contact_profile("left")
+
+
+def test_profile_without_a_part_needs_a_single_contact_part():
+    problem = ContactProblem(
+        mesh=rectangle(nx=4, ny=4),
+        material=Material.from_young(100.0, 0.3),
+        conditions={
+            "left": Dirichlet((0.0, 0.0)),
+            "right": Neumann((0.0, 0.0)),
+            "bottom": Contact(gap=0.1),
+            "top": Contact(gap=0.1),
+        },
+        name="two-parts",
+    )
+    result = solve(problem)
+    with pytest.raises(ValueError, match=r"part: the problem has contact parts .*; name one"):
+        result.contact_profile()
+    top = result.contact_profile("top")
+    assert np.all(np.diff(top.points[:, 0]) < 0)  # counter-clockwise: right to left on top
+    np.testing.assert_allclose(top.s, 1.0 - top.points[:, 0], atol=1e-15)

@@ -33,7 +33,7 @@ from signorini.fem.material import Material
 from signorini.loop import adaptive
 from signorini.mesh.mesh import Mesh
 from signorini.mesh.refine import refine_nvb
-from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
 
 RTOL = 1e-11
 EXAMPLES = {"6.1": example_6_1, "6.2": example_6_2}
@@ -136,6 +136,15 @@ def test_solve_with_young_modulus_near_the_float_limit():
     np.testing.assert_array_equal(r.pdas.multiplier, r.contact_force)
     eta = estimate(r).eta_terms
     np.testing.assert_allclose(eta[:5] / c, estimate(r0).eta_terms[:5], rtol=RTOL)
+
+
+def test_a_stiffness_matrix_beyond_float64_is_named():
+    """E = 5e307 makes entries of K overflow: a ProblemError naming the material, not a
+    solver error about a matrix the user never saw."""
+    problem = example_6_2()
+    huge = dataclasses.replace(problem, material=Material.from_young(5e307, 0.3))
+    with pytest.raises(ProblemError, match=r"material: the stiffness matrix overflows float64"):
+        solve(huge)
 
 
 def test_adaptive_run_with_young_modulus_1e300_completes():

@@ -16,7 +16,7 @@ from ..fem.space import P2Space
 from ..fem.stiffness import assemble_stiffness
 from ..mesh.mesh import Mesh
 from ..problem.conditions import Dirichlet, Neumann
-from ..problem.fields import evaluate_field
+from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, contact_set
 from .node_frames import rotate_frames
@@ -75,9 +75,16 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     space = P2Space(mesh)
     n_dofs = space.n_dofs
     # the space of a validated mesh and problem: no need to re-check the arrays
-    K = assemble_stiffness(
-        space.vertices, space.cell_dofs, n_dofs, problem.material, validate=False
-    )
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported just below
+        K = assemble_stiffness(
+            space.vertices, space.cell_dofs, n_dofs, problem.material, validate=False
+        )
+    if not np.isfinite(K.data).all():
+        m = problem.material
+        raise ProblemError(
+            f"material: the stiffness matrix overflows float64 (lam = {m.lam:.3g}, "
+            f"mu = {m.mu:.3g}); state E in larger units (e.g. GPa instead of Pa)"
+        )
     F = np.zeros(n_dofs)
     if problem.body_force is not None:
         F += assemble_body_force(
