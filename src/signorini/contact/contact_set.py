@@ -39,7 +39,12 @@ NO_CONTACT, SEMI_CONTACT, FULL_CONTACT = 0, 1, 2
 
 @dataclass(frozen=True)
 class ContactSet:
-    """Discrete contact data of a P2 space (all arrays indexed by constrained node).
+    """Discrete contact data of a P2 space.
+
+    Arrays of length k are indexed by constrained node (all P2 nodes on the closure of Γ_C
+    that are not Dirichlet nodes), arrays of length n_ce by contact edge. Consistent units:
+    if lengths are in mm, gaps and weights are in mm (the weights are lengths: integrals of
+    dimensionless basis functions along Γ_C).
 
     Attributes
     ----------
@@ -48,24 +53,30 @@ class ContactSet:
     normal : (k, 2) float array
         Outward unit normal of the node's contact part.
     gap : (k,) float array
-        ψ(z).
+        ψ(z), the admissible normal displacement (``u(z)·n ≤ ψ(z)``), in length units.
     hat_integral : (k,) float array
-        ``m_z = ∫_{Γ_C} φ_z ds``, the integral of the half-edge hat φ_z of Q^h (3.6); the
-        contact force density is ``s_z = Λ_z / m_z`` (4.1).
+        ``m_z = ∫_{Γ_C} φ_z ds`` (length), the integral of the half-edge hat φ_z of Q^h
+        (3.6): ``|e|/4`` per edge at a vertex, ``|e|/2`` at a midpoint; the contact force
+        density is ``s_z = Λ_z / m_z`` (4.1).
     basis_integral : (k,) float array
-        ``w_z = ∫_{Γ_C} ψ_z ds``, the integral of the P2 basis function; the consistent
-        pressure is ``p_z = Λ_z / w_z``.
+        ``w_z = ∫_{Γ_C} ψ_z ds`` (length), the integral of the P2 basis function: ``|e|/6``
+        per edge at a vertex, ``2|e|/3`` at a midpoint; the consistent pressure is
+        ``p_z = Λ_z / w_z``.
     is_vertex : (k,) bool array
+        Whether the node is a mesh vertex (else an edge midpoint).
     edges : (n_ce,) int array
-        Mesh edges of Γ_C.
+        Mesh edges of Γ_C, part after part.
     edge_nodes : (n_ce, 3) int array
-        Global nodes ``[start, end, midpoint]`` of each contact edge (counter-clockwise).
+        Global nodes ``[start, end, midpoint]`` of each contact edge, start to end in the
+        counter-clockwise direction of the boundary (Dirichlet nodes included).
     edge_part : (n_ce,) int array
         Index into ``parts`` of each contact edge.
     parts : tuple of str
+        The contact parts, in the problem's order.
     edge_gap : (n_ce, 3) float array
         ψ at ``[start, end, midpoint]`` (also at Dirichlet end points).
     edge_normal : (n_ce, 2) float array
+        Outward unit normal of each contact edge (its part's).
     """
 
     nodes: np.ndarray

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import numpy as np
@@ -25,33 +25,132 @@ from .contact_set import ContactSet, node_classes
 from .node_frames import to_cartesian
 from .system import Assembled, assemble
 
-__all__ = ["ContactResult", "solve"]
+__all__ = ["ContactProfile", "ContactResult", "solve", "stiffness_unit"]
 
 log = logging.getLogger(__name__)
 
 #: quadrature degree for errors against a smooth exact solution
 ERROR_DEGREE = 10
+#: a stiffness matrix whose largest diagonal entry lies in this range is solved as it is;
+#: outside it (E beyond about 1e±77) K and F are divided by a power of 2 first
+STIFFNESS_RANGE = (2.0**-256, 2.0**256)
+
+
+#: a Dirichlet end point of Γ_C touches the obstacle (for the node classes) where
+#: ``u_D·n − ψ ≥ −TOUCH_RTOL · max(max|u_h|, |ψ|)``
+TOUCH_RTOL = 1e-12
+#: a warm start's node starts in the active set where
+#: ``u0·n − ψ ≥ −WARM_START_RTOL · max(max|u0|, |ψ|)``: the prolongated contact nodes
+#: of the previous level, whose u0·n − ψ is round-off of the displacements
+WARM_START_RTOL = 1e-10
+
+
+def _round_off_scale(u: np.ndarray, gap: np.ndarray) -> np.ndarray:
+    """``max(max|u|, |ψ(z)|)`` per node (the shape of ``gap``): the size of the two numbers
+    ``u(z)·n − ψ(z)`` is the difference of, hence of its round-off. Relative to the
+    displacements and to the gap at the node itself, not to the gap far away (a distant
+    obstacle must not make the test lenient), and invariant under scaling of the problem."""
+    return np.maximum(np.abs(u).max(initial=0.0), np.abs(gap))
+
+
+def stiffness_unit(K) -> float:
+    """1 if ``max |diag K|`` lies in ``STIFFNESS_RANGE`` (or is 0), else the power of 2
+    not above it. Dividing K and F by it is exact, so u_h is the same; it keeps sums over
+    K (the active set rule's constant c = mean diag K, the force scales of the KKT check)
+    and the factorization's products away from overflow and underflow when E is extreme."""
+    d = float(np.abs(K.diagonal()).max(initial=0.0))
+    lo, hi = STIFFNESS_RANGE
+    if d == 0.0 or not np.isfinite(d) or lo <= d <= hi:
+        return 1.0
+    return float(np.ldexp(1.0, int(np.floor(np.log2(d)))))
+
+
+@dataclass(frozen=True)
+class ContactProfile:
+    """The nodes of one contact part in order along the boundary, with the contact quantities.
+
+    Consistent units: if E is in MPa and lengths in mm, ``s``, ``points``, ``gap``,
+    ``normal_displacement`` and ``normal_gap`` are in mm, ``pressure`` in MPa and
+    ``contact_force`` in N per mm of thickness.
+
+    Attributes
+    ----------
+    part : str
+        The contact part.
+    nodes : (m,) int array
+        Global P2 nodes (vertices and edge midpoints) of the part, in the order of the
+        counter-clockwise boundary.
+    chain : (m,) int array
+        Which connected piece of the part each node is on: 0, 1, … in the order of the pieces
+        along the part's direction (a part made of disjoint segments has several chains).
+    s : (m,) float array
+        Distance from the part's first node: ``s_0 = 0``, ``s_{i+1} = s_i + |x_{i+1} − x_i|``.
+        Within a chain this is the arc length; from one chain to the next it jumps by the
+        straight distance between them (contact parts are straight).
+    points : (m, 2) float array
+        The nodes' coordinates.
+    pressure : (m,) float array
+        Consistent pressure ``p_z = Λ_z / w_z`` (docs/method.md, *Discrete problem*); NaN at
+        Dirichlet nodes (no contact unknown there).
+    contact_force : (m,) float array
+        Nodal contact force ``Λ_z`` (3.17); NaN at Dirichlet nodes. A node shared with another
+        contact part carries its whole ``Λ_z`` (and ``w_z`` counts both parts' edges).
+    gap : (m,) float array
+        The obstacle ψ(z).
+    normal_displacement : (m,) float array
+        ``u_h(z)·n``, n the part's outward unit normal.
+    normal_gap : (m,) float array
+        ``u_h(z)·n − ψ(z)``: 0 in contact, < 0 where the body is off the obstacle.
+    """
+
+    part: str
+    nodes: np.ndarray
+    chain: np.ndarray
+    s: np.ndarray
+    points: np.ndarray
+    pressure: np.ndarray
+    contact_force: np.ndarray
+    gap: np.ndarray
+    normal_displacement: np.ndarray
+    normal_gap: np.ndarray
 
 
 @dataclass
 class ContactResult:
     """The discrete solution of one mesh and everything derived from it.
 
+    Consistent units: if E is in MPa and lengths in mm, ``u`` is in mm, ``contact_force``
+    Λ_z in N per mm of thickness (plane strain: forces per unit thickness), ``density``
+    s_z and ``pressure`` p_z in MPa.
+
     Attributes
     ----------
     problem : ContactProblem
+        The problem that was solved.
     space : P2Space
+        The P2 space of the mesh (``space.mesh``; node numbering: vertices, then midpoints).
     u : (n_nodes, 2) float array
-        Nodal displacements (Cartesian).
+        Nodal displacements u_h(z) (Cartesian) at every P2 node.
     contact : ContactSet
+        The constrained nodes (k of them) with normals, gaps ψ(z) and weights.
     contact_force : (k,) float array
-        Nodal contact forces Λ_z ≥ 0 (3.17).
+        Nodal contact forces Λ_z ≥ 0 (3.17), ``L(ψ_z n) − a(u_h, ψ_z n)``; their sum is the
+        resultant normal force on Γ_C.
     active : (k,) bool array
         Final active set of the PDAS iteration (``u(z)·n = ψ(z)`` imposed): the actual
         contact nodes.
     pdas : PDASResult
+        How the active set solver got there: iterations, KKT residuals (relative), timings.
+        ``pdas.multiplier`` equals ``contact_force``; when E is extreme the system was
+        solved divided by ``stiffness_unit(K)``, so ``pdas.kkt.force_scale`` is in that unit.
+    dirichlet_nodes : (n_D,) int array
+        The P2 nodes on the closure of Γ_D (both components prescribed).
     timings : dict
         Seconds spent in ``assemble`` and ``solve``.
+
+    Derived: ``ndof``, ``density`` s_z, ``pressure`` p_z, ``total_contact_force``,
+    ``classes``, :meth:`contact_profile` (the contact quantities of a part in boundary
+    order), :meth:`errors`.
     """
 
     problem: ContactProblem
@@ -70,7 +169,8 @@ class ContactResult:
 
     @property
     def ndof(self) -> int:
-        """Free scalar unknowns (the paper's Ndof): all DOFs minus the Dirichlet ones."""
+        """Free scalar unknowns (the paper's Ndof): ``2 n_nodes − 2 n_D``, all P2 DOFs minus
+        both DOFs of every Dirichlet node; constrained contact DOFs are counted."""
         return self.space.n_dofs - 2 * self.dirichlet_nodes.size
 
     @property
@@ -95,12 +195,70 @@ class ContactResult:
         cs = self.contact
         loc = cs.edge_local
         gap = cs.edge_normal_gap(self.u)
-        scale = max(
-            float(np.abs(cs.edge_gap).max(initial=0)), float(np.abs(self.u).max(initial=0)), 1e-300
-        )
-        dirichlet_touch = gap >= -1e-12 * scale
+        dirichlet_touch = gap >= -TOUCH_RTOL * _round_off_scale(self.u, cs.edge_gap)
         edge_in = np.where(loc >= 0, self.active[np.maximum(loc, 0)], dirichlet_touch)
         return node_classes(cs, self.active, edge_in)
+
+    def contact_profile(self, part: str | None = None) -> ContactProfile:
+        """The contact quantities of one contact part, ordered along the boundary.
+
+        Parameters
+        ----------
+        part : str, optional
+            A contact part of the problem; may be omitted when there is only one.
+
+        Returns
+        -------
+        ContactProfile
+            Every P2 node of the part (Dirichlet end points included) in the order of the
+            counter-clockwise boundary, with arc length, p_z, Λ_z, ψ, u·n and u·n − ψ. A part
+            made of disjoint segments gives one ``chain`` per segment, in the order of the
+            segments along the part's direction.
+
+        Examples
+        --------
+        >>> prof = result.contact_profile("right")                    # doctest: +SKIP
+        >>> plt.plot(prof.s, prof.pressure)                           # doctest: +SKIP
+        """
+        cs = self.contact
+        if part is None:
+            if len(cs.parts) != 1:
+                raise ValueError(
+                    f"part: the problem has contact parts {list(cs.parts)}; name one of them"
+                )
+            part = cs.parts[0]
+        if part not in cs.parts:
+            raise ValueError(
+                f"part: {part!r} is not a contact part of {self.problem.name!r}; its contact "
+                f"parts are {list(cs.parts)}"
+            )
+        mine = np.flatnonzero(cs.edge_part == cs.parts.index(part))
+        order, chain_end, chain = _walk(cs.edge_nodes[mine], self.space.node_points)
+        edges = mine[order]
+        # per ordered edge: start, midpoint, and the end vertex where a chain ends
+        take = np.column_stack([np.ones(edges.size, bool), np.ones(edges.size, bool), chain_end])
+        column = np.broadcast_to(np.array([0, 2, 1]), take.shape)[take]
+        row = np.broadcast_to(edges[:, None], take.shape)[take]
+        nodes = cs.edge_nodes[row, column]
+        points = self.space.node_points[nodes]
+        step = np.sqrt((np.diff(points, axis=0) ** 2).sum(axis=1))
+        loc = cs.local(nodes)
+        inside = loc >= 0
+        force = np.where(inside, self.contact_force[np.maximum(loc, 0)], np.nan)
+        gap = cs.edge_gap[row, column]
+        un = self.u[nodes] @ cs.edge_normal[edges[0]]
+        return ContactProfile(
+            part=part,
+            nodes=nodes,
+            chain=np.broadcast_to(chain[:, None], take.shape)[take],
+            s=np.concatenate([[0.0], np.cumsum(step)]),
+            points=points,
+            pressure=np.where(inside, force / cs.basis_integral[np.maximum(loc, 0)], np.nan),
+            contact_force=force,
+            gap=gap,
+            normal_displacement=un,
+            normal_gap=un - gap,
+        )
 
     def errors(self, degree: int = ERROR_DEGREE) -> dict[str, float]:
         """Energy-norm ``a(e,e)^{1/2}`` and H¹-seminorm errors against the exact solution."""
@@ -116,6 +274,44 @@ class ContactResult:
         energy = energy_error2(vertices, u_cell, gradient, material, degree=degree)
         h1 = h1_seminorm_error2(vertices, u_cell, gradient, degree=degree)
         return {"error_energy": float(np.sqrt(energy.sum())), "error_h1": float(np.sqrt(h1.sum()))}
+
+
+def _walk(edge_nodes: np.ndarray, node_points: np.ndarray):
+    """Order the oriented edges ``[start, end, midpoint]`` of one straight contact part into
+    chains (each edge's end is the next edge's start), vectorized by pointer doubling.
+
+    Returns
+    -------
+    order : (k,) int array
+        The edges, chain after chain, each chain from its first edge.
+    chain_end : (k,) bool array
+        For the ordered edges: the last edge of its chain.
+    chain : (k,) int array
+        For the ordered edges: the chain number, chains ordered along the part's direction.
+    """
+    k = edge_nodes.shape[0]
+    start, end = edge_nodes[:, 0], edge_nodes[:, 1]
+    by_start = np.argsort(start, kind="stable")
+    pos = np.minimum(np.searchsorted(start[by_start], end), k - 1)
+    succ = np.where(start[by_start][pos] == end, by_start[pos], -1)
+    pred = np.full(k, -1)
+    pred[succ[succ >= 0]] = np.flatnonzero(succ >= 0)
+    # pointer doubling: every edge finds its chain's first edge and its distance to it
+    root = np.where(pred >= 0, pred, np.arange(k))
+    rank = (pred >= 0).astype(np.int64)  # distance to ``root``
+    for _ in range(int(np.ceil(np.log2(max(k, 2)))) + 1):
+        rank, root = rank + rank[root], root[root]
+    if np.any(pred[root] >= 0):  # a closed chain: impossible for a straight part
+        raise ValueError("the contact part is a closed curve; it has no first node")
+    # chains in the order of their first point along the (straight) part
+    first = np.flatnonzero(pred < 0)
+    direction = node_points[end[first[0]]] - node_points[start[first[0]]]
+    along = node_points[start[first]] @ direction
+    chain_of_root = np.empty(k, dtype=np.int64)
+    chain_of_root[first[np.argsort(along, kind="stable")]] = np.arange(first.size)
+    chain = chain_of_root[root]
+    order = np.lexsort((rank, chain))
+    return order, succ[order] < 0, chain[order]
 
 
 def solve(
@@ -160,14 +356,17 @@ def solve(
         if not np.isfinite(u0).all():
             raise ValueError("u0 contains NaN or inf")
         un = cs.normal_displacement(u0)
-        scale = max(float(np.abs(cs.gap).max(initial=0)), float(np.abs(u0).max()), 1e-300)
-        active0 = un - cs.gap >= -1e-10 * scale
+        active0 = un - cs.gap >= -WARM_START_RTOL * _round_off_scale(u0, cs.gap)
+    # K and F divided by a power of 2 when E is extreme (exact; 1 otherwise), so that no
+    # product in the factorization overflows or underflows
+    unit = stiffness_unit(assembled.K)
+    K, F = (assembled.K, assembled.F) if unit == 1.0 else (assembled.K / unit, assembled.F / unit)
     t0 = time.perf_counter()
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
     with make_solver(backend, check_symmetry=False) as solver:
         res = solve_pdas(
-            assembled.K,
-            assembled.F,
+            K,
+            F,
             2 * cs.nodes,
             cs.gap,
             assembled.dirichlet,
@@ -178,6 +377,8 @@ def solve(
             fallback=fallback,
         )
     seconds = time.perf_counter() - t0
+    if unit != 1.0:
+        res = replace(res, multiplier=res.multiplier * unit, c_scale=res.c_scale * unit)
     u = to_cartesian(res.x, cs.nodes, cs.normal).reshape(-1, 2)
     log.info(
         "solved %s: %d unknowns, %d PDAS iterations, %d active of %d",

@@ -16,7 +16,7 @@ from ..fem.space import P2Space
 from ..fem.stiffness import assemble_stiffness
 from ..mesh.mesh import Mesh
 from ..problem.conditions import Dirichlet, Neumann
-from ..problem.fields import evaluate_field
+from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, contact_set
 from .node_frames import rotate_frames
@@ -29,13 +29,38 @@ LOAD_DEGREE = 8
 
 @dataclass
 class Assembled:
-    """The algebraic problem of one mesh, in rotated (normal, tangential) contact frames."""
+    """The algebraic problem of one mesh, in rotated (normal, tangential) contact frames.
+
+    DOFs are interleaved, ``2 node + component`` (docs/method.md, *Data conventions*); at a
+    constrained node z the two DOFs are ``(u·n, u·t)`` with ``t = (−n_y, n_x)``, elsewhere
+    ``(u_x, u_y)``. Consistent units: if E is in MPa and lengths in mm, entries of K are in
+    N/mm per mm of thickness (MPa), F and Λ_z in N per mm of thickness, displacements in mm.
+
+    Attributes
+    ----------
+    space : P2Space
+        The P2 space of the mesh (node numbering: vertices, then edge midpoints).
+    contact : ContactSet
+        The constrained nodes, their normals, gaps and weights.
+    K : (n_dofs, n_dofs) scipy.sparse CSR matrix
+        The stiffness matrix ``a(ψ_j, ψ_i)`` (symmetric positive semi-definite before the
+        Dirichlet DOFs are fixed), rotated in place at the constrained nodes.
+    F : (n_dofs,) float array
+        The load ``L(ψ_i)``: body force and Neumann tractions, rotated like K.
+    dirichlet : (2 n_D,) int array
+        Both DOFs of every Dirichlet node, node after node (sorted by node).
+    dirichlet_values : (2 n_D,) float array
+        The prescribed displacements of those DOFs (Cartesian: Dirichlet nodes are never
+        rotated).
+    seconds : float
+        Wall-clock time of the assembly.
+    """
 
     space: P2Space
     contact: ContactSet
     K: sp.csr_matrix
     F: np.ndarray
-    dirichlet: np.ndarray  # DOFs
+    dirichlet: np.ndarray
     dirichlet_values: np.ndarray
     seconds: float
 
@@ -50,9 +75,16 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     space = P2Space(mesh)
     n_dofs = space.n_dofs
     # the space of a validated mesh and problem: no need to re-check the arrays
-    K = assemble_stiffness(
-        space.vertices, space.cell_dofs, n_dofs, problem.material, validate=False
-    )
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported just below
+        K = assemble_stiffness(
+            space.vertices, space.cell_dofs, n_dofs, problem.material, validate=False
+        )
+    if not np.isfinite(K.data).all():
+        m = problem.material
+        raise ProblemError(
+            f"material: the stiffness matrix overflows float64 (lam = {m.lam:.3g}, "
+            f"mu = {m.mu:.3g}); state E in larger units (e.g. GPa instead of Pa)"
+        )
     F = np.zeros(n_dofs)
     if problem.body_force is not None:
         F += assemble_body_force(

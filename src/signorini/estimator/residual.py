@@ -62,7 +62,7 @@ from .terms import (
     tangential_stress,
 )
 
-__all__ = ["ETA5_VARIANTS", "TERMS", "Estimate", "estimate"]
+__all__ = ["ETA5_VARIANTS", "TERMS", "Estimate", "estimate", "stress_unit"]
 
 ETA5_VARIANTS = ("consistent", "paper")
 #: the terms of (5.1), in the row order of ``Estimate.eta2_cell`` and ``Estimate.eta2_node``
@@ -74,46 +74,85 @@ EDGE_DEGREE = 7
 NEUMANN_DEGREE = 15
 #: triangle quadrature degree for η1 with a body force
 CELL_DEGREE = 8
+#: stresses of magnitude inside this range are squared as they are (``Estimate.unit`` = 1);
+#: outside it the estimator divides them by a power of 4 first, so that no square overflows
+#: or underflows (docs/method.md, *Estimator*, "Units")
+STRESS_RANGE = (2.0**-256, 2.0**256)
+#: power of the stress unit in each term's square, in the order of ``TERMS``: η1² … η5² are
+#: squares of stresses (times lengths), η6² = s_p d_p is a stress times a length² times a
+#: displacement, η7² a squared displacement
+UNIT_POWER = (2, 2, 2, 2, 2, 1, 0)
 
 
 @dataclass(frozen=True)
 class Estimate:
     """Estimator contributions of one discrete solution.
 
+    Consistent units: if E is in MPa and lengths in mm (so displacements are in mm), η1 …
+    η5 are in MPa·mm (stress × length), η6 in MPa^{1/2}·mm (η6² = s_p d_p: stress × length²),
+    and η7 in mm (a displacement; its square is ‖v‖²_{L²} (mm³) plus the H^{1/2} seminorm
+    (mm²), so η7 is not homogeneous in length alone). η_h adds the squares as the paper does.
+
     Attributes
     ----------
     eta2_cell : (7, n_cells) float array
-        Share of each cell in η_k², k = 1..7 (rows in the order of ``TERMS``). Sums to η_k².
+        Share of each cell in η_k² / unit^{a_k}, k = 1..7 (rows in the order of ``TERMS``,
+        ``a = UNIT_POWER = (2, 2, 2, 2, 2, 1, 0)``). Each row sums to η_k² / unit^{a_k};
+        with ``unit = 1`` (every ordinary problem) these are the squares themselves.
     eta2_node : (6, n_nodes) float array
-        Node contributions η_{k,p}², k = 1..6, as the paper writes them (zero at Dirichlet
-        nodes and where a term does not apply). η7 is global.
+        Node contributions η_{k,p}² / unit^{a_k}, k = 1..6, as the paper writes them (zero at
+        Dirichlet nodes and where a term does not apply). η7 is global.
     eta5_variant : str
         The η5 variant used (one of ``ETA5_VARIANTS``).
+    unit : float
+        The stress unit σ₀ the squares were taken in: 1 when max|σ(u_h)| lies in
+        ``STRESS_RANGE``, else the largest power of 4 not above it (so that scaling by it and by
+        its square root is exact in floating point).
     """
 
     eta2_cell: np.ndarray
     eta2_node: np.ndarray
     eta5_variant: str
+    unit: float = 1.0
+
+    @property
+    def _exponents(self) -> tuple[np.ndarray, int]:
+        """``a_k e`` with ``unit = 2^e`` (row k times ``2^{a_k e}`` is η_k²), and ``r`` with
+        ``max_k η_k ≤ 2^r`` (0 when ``unit = 1``): the power of two η_T² and η_h² are
+        taken relative to, so that neither overflows nor underflows."""
+        e = int(np.frexp(self.unit)[1]) - 1
+        power = np.array(UNIT_POWER) * e
+        if e == 0:
+            return power, 0
+        top = float(self.eta_terms.max())
+        return power, int(np.frexp(top)[1]) if top > 0 else 0
 
     @property
     def eta2_terms(self) -> np.ndarray:
-        """``(7,)`` the squared contributions η_k²."""
-        return self.eta2_cell.sum(axis=1)
+        """``(7,)`` the squared contributions η_k² (they overflow to inf when ``unit`` is
+        beyond about 1e154; :attr:`eta_terms` does not)."""
+        return np.ldexp(self.eta2_cell.sum(axis=1), self._exponents[0])
 
     @property
     def eta_terms(self) -> np.ndarray:
         """``(7,)`` the contributions η_k."""
-        return np.sqrt(self.eta2_terms)
+        power = (np.frexp(self.unit)[1] - 1) * np.array(UNIT_POWER) // 2
+        return np.ldexp(np.sqrt(self.eta2_cell.sum(axis=1)), power)
 
     @property
     def eta2(self) -> np.ndarray:
-        """``(n_cells,)`` element indicators η_T² for marking."""
-        return self.eta2_cell.sum(axis=0)
+        """``(n_cells,)`` element indicators η_T² for marking: the squares themselves when
+        ``unit = 1``, else η_T² / 4^r with ``max_k η_k ≤ 2^r`` (marking needs only their
+        ratios)."""
+        power, r = self._exponents
+        return np.ldexp(self.eta2_cell, (power - 2 * r)[:, None]).sum(axis=0)
 
     @property
     def eta(self) -> float:
         """The total estimator η_h = (Σ_k η_k²)^{1/2} (5.1)."""
-        return float(np.sqrt(self.eta2_cell.sum()))
+        power, r = self._exponents
+        total = np.ldexp(self.eta2_cell, (power - 2 * r)[:, None]).sum()
+        return float(np.ldexp(np.sqrt(total), r))
 
     def as_dict(self) -> dict[str, float]:
         """``{"eta": η_h, "eta_1": η1, …, "eta_7": η7}``, the names of the history columns."""
@@ -144,21 +183,28 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     h_p = _node_mesh_size(mesh.h, space.cell_nodes, result.dirichlet_nodes, n_nodes)
 
     # what the terms integrate: the residual in the cells, σ(u_h) n on the edges, the gap
+    # every stress-like input (σ(u_h), div σ(u_h), f, g, p_z, s_z) is divided by the stress
+    # unit σ₀ (a power of 4, 1 for ordinary stresses): exact, and no square overflows;
+    # Estimate puts σ₀ back (docs/method.md, *Estimator*, "Units")
     u_cell = space.cell_values(result.u)
-    div_sigma = div_stress(space.vertices, u_cell, problem.material)
-    f, w_cell = _body_force(problem, space.vertices)
     sigma = stress(problem.material, field_gradients(space.vertices, u_cell, REFERENCE_NODES[:3]))
+    unit = stress_unit(float(np.abs(sigma).max(initial=0.0)))
+    sigma = sigma / unit
+    div_sigma = div_stress(space.vertices, u_cell, problem.material) / unit
+    f, w_cell = _body_force(problem, space.vertices)
+    if f is not None:
+        f = f / unit
     traction = partial(edge_traction, sigma, mesh.points, mesh.cells)
     t, w = line_rule(EDGE_DEGREE)
     inner = _edge_set(mesh, np.flatnonzero(mesh.edge2cell[:, 1] >= 0))
     jump = _from_both_sides(mesh, traction, inner.index, t)
     neumann = _edge_set(mesh, _part_edges(mesh, problem.neumann_parts))
     t_n, w_n = line_rule(NEUMANN_DEGREE)
-    misfit = _traction_misfit(problem, mesh, traction, t_n)
+    misfit = _traction_misfit(problem, mesh, traction, t_n, unit)
     contact = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
     contact_traction = _on_boundary(mesh, traction, contact.index, t)
     normal = cs.edge_normal
-    pressure = _edge_pressure(result) if eta5 == "consistent" else None
+    pressure = _edge_pressure(result) / unit if eta5 == "consistent" else None
     gap = cs.edge_normal_gap(result.u)  # u_h·n − ψ_h at [start, end, midpoint]
     x0, x1 = mesh.points[cs.edge_nodes[:, 0]], mesh.points[cs.edge_nodes[:, 1]]
 
@@ -177,7 +223,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
         ),
         "eta_6": spread_node_parts(
             contact,
-            complementarity(gap, _semi_contact_density(result), contact.length),
+            complementarity(gap, _semi_contact_density(result) / unit, contact.length),
             n_nodes,
             n_cells,
         ),
@@ -187,10 +233,24 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
         eta2_cell=np.stack([shares[name].cell for name in TERMS]),
         eta2_node=np.stack([shares[name].node for name in TERMS[:6]]),
         eta5_variant=eta5,
+        unit=unit,
     )
 
 
 # --------------------------------------------------------------------------- inputs of the terms
+
+
+def stress_unit(sigma_max: float) -> float:
+    """The stress unit σ₀ the estimator squares stresses in: 1 if ``sigma_max`` lies in
+    ``STRESS_RANGE`` (or is 0 or not finite), else the largest power of 4 not above ``sigma_max``.
+
+    Dividing by a power of 4 is exact, and so is multiplying η_k by its square root, so
+    η_k are the same numbers as without scaling wherever those do not overflow or underflow.
+    """
+    lo, hi = STRESS_RANGE
+    if not np.isfinite(sigma_max) or sigma_max == 0.0 or lo <= sigma_max <= hi:
+        return 1.0
+    return float(np.ldexp(1.0, 2 * int(np.floor(np.log2(sigma_max) / 2))))
 
 
 def _node_mesh_size(
@@ -236,8 +296,11 @@ def _from_both_sides(mesh, traction, e: np.ndarray, t: np.ndarray):
     return traction(c[:, 0], k[:, 0], t), traction(c[:, 1], k[:, 1], 1 - t)
 
 
-def _traction_misfit(problem: ContactProblem, mesh, traction, t: np.ndarray) -> np.ndarray:
-    """``σ(u_h) n − g`` ``(k, q, 2)`` on the Neumann edges (part after part) at points ``t``."""
+def _traction_misfit(
+    problem: ContactProblem, mesh, traction, t: np.ndarray, unit: float = 1.0
+) -> np.ndarray:
+    """``σ(u_h) n − g`` ``(k, q, 2)`` on the Neumann edges (part after part) at points ``t``,
+    with ``traction`` already in the stress unit ``unit`` and g divided by it."""
     out = []
     for name in problem.neumann_parts:
         cond = problem.conditions[name]
@@ -249,8 +312,12 @@ def _traction_misfit(problem: ContactProblem, mesh, traction, t: np.ndarray) -> 
             x = a[:, None] + t[None, :, None] * (b - a)[:, None]
             _, n = segment_normals(a, b)
             g = cond.field()
-            sn = sn - evaluate_field(
-                g, x, f"the traction of Neumann part {name!r}", normal=n[:, None, :]
+            sn = (
+                sn
+                - evaluate_field(
+                    g, x, f"the traction of Neumann part {name!r}", normal=n[:, None, :]
+                )
+                / unit
             )
         out.append(sn)
     return np.concatenate(out) if out else np.zeros((0, t.size, 2))

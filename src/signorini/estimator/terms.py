@@ -331,8 +331,15 @@ def penetration(x0: np.ndarray, x1: np.ndarray, gap: np.ndarray) -> np.ndarray:
     Returns
     -------
     (k,) float array
+
+    Notes
+    -----
+    The norm only depends on differences of points, so Γ_C is first moved next to the
+    origin (by its lower-left bounding-box corner): far from the origin (a mesh shifted by
+    1e9) the distances ``|x − y|`` of the quadrature points would otherwise lose 9 digits.
     """
-    _, share = hhalf_norm2_positive_part(x0, x1, gap, validate=False)
+    origin = x0.min(axis=0) if len(x0) else np.zeros(2)
+    _, share = hhalf_norm2_positive_part(x0 - origin, x1 - origin, gap, validate=False)
     return share
 
 
