@@ -194,3 +194,25 @@ def random_problem(rng, n, m, n_dirichlet=0, dense=True):
     g = 0.3 * rng.standard_normal(m)
     xd = 0.2 * rng.standard_normal(n_dirichlet)
     return K, F, c, g, d, xd
+
+
+def just_touching_square(
+    n: int, lam: float = 288.46153846153845, mu: float = 192.30769230769232
+) -> tuple[sp.csr_matrix, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The unit square pushed by exactly its gap: every constraint is degenerate.
+
+    ``u = (0.1, 0)`` on the left side, free top and bottom, ``u_x <= 0.1`` on the right side
+    (E = 500, ν = 0.3 by default). The solution is the rigid shift ``(0.1, 0)``: every right
+    node touches the bound with zero multiplier.
+
+    Returns
+    -------
+    K, F, constrained, dirichlet, dirichlet_values
+        ``F = 0``; the gap is 0.1 on every constrained DOF.
+    """
+    K, xy = p2_elasticity(n, n, lam, mu)
+    left = np.flatnonzero(xy[:, 0] < 1e-12)
+    right = np.flatnonzero(xy[:, 0] > 1 - 1e-12)
+    dirichlet = np.column_stack([2 * left, 2 * left + 1]).ravel()
+    values = np.tile([0.1, 0.0], left.size)
+    return K, np.zeros(K.shape[0]), 2 * right, dirichlet, values
