@@ -17,7 +17,7 @@ import scipy.sparse as sp
 
 from .sparse import as_csr, csr_row_indices, diagonal_positions, list_indices, symmetry_defect
 
-__all__ = ["BackendUnavailableError", "FactorizationError", "SPDSolver"]
+__all__ = ["BackendUnavailableError", "FactorizationError", "SPDSolver", "SingularSystemError"]
 
 
 class FactorizationError(np.linalg.LinAlgError):
@@ -47,6 +47,24 @@ class FactorizationError(np.linalg.LinAlgError):
         self.backend = backend
         self.code = code
         self.equation = equation
+
+
+class SingularSystemError(FactorizationError):
+    """A solve whose residual shows the matrix is singular or too ill-conditioned.
+
+    Raised whatever the backend, when the relative residual ``max |b - A x| / max |b|`` of a
+    solve exceeds its bound: a factorization that went through with a near-zero pivot gives
+    a garbage solution that only its residual reveals.
+
+    Attributes
+    ----------
+    residual : float
+        The relative residual of the failed solve.
+    """
+
+    def __init__(self, message: str, *, backend: str = "", residual: float = np.nan) -> None:
+        super().__init__(message, backend=backend)
+        self.residual = residual
 
 
 class BackendUnavailableError(RuntimeError):
