@@ -66,9 +66,10 @@ def random_spd_dense(n: int, rng: np.random.Generator, shift: float = 0.1) -> np
 
 
 def p2_elasticity(
-    nx: int, ny: int, lam: float = 1.0, mu: float = 1.0
+    nx: int, ny: int, lam: float = 1.0, mu: float = 1.0, height: float = 1.0
 ) -> tuple[sp.csr_matrix, np.ndarray]:
-    """P2 plane-strain stiffness on the unit square cut into ``2 nx ny`` right triangles.
+    """P2 plane-strain stiffness on ``(0, 1) × (0, height)`` cut into ``2 nx ny`` right
+    triangles.
 
     Returns
     -------
@@ -77,7 +78,7 @@ def p2_elasticity(
     node_xy : (n_nodes, 2) float array
         Vertices first, then edge midpoints.
     """
-    X, Y = np.meshgrid(np.linspace(0, 1, nx + 1), np.linspace(0, 1, ny + 1), indexing="ij")
+    X, Y = np.meshgrid(np.linspace(0, 1, nx + 1), np.linspace(0, height, ny + 1), indexing="ij")
     points = np.column_stack([X.ravel(), Y.ravel()])
     idx = np.arange((nx + 1) * (ny + 1)).reshape(nx + 1, ny + 1)
     a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()

@@ -97,3 +97,31 @@ def test_near_singular_solve_is_reported(backend):
     # the held block alone is solved, its residual checked and far below the bound
     result = solve_pdas(K1, np.ones(n1), np.zeros(0, dtype=int), np.zeros(0), d, backend=backend)
     assert result.kkt.stationarity < 1e-14
+
+
+@pytest.mark.parametrize("backend", BACKEND_LIST)
+@pytest.mark.parametrize("case", ["floating block", "thin strip"])
+def test_failed_factorization_names_the_usual_causes(backend, case):
+    if case == "floating block":  # exactly singular: a second block without Dirichlet DOFs
+        K1, xy = p2_elasticity(4, 4)
+        K = sp.block_diag([K1, K1], format="csr")
+    else:  # a 1 x 1e-4 strip clamped at one end: singular in double precision
+        K, xy = p2_elasticity(16, 1, 288.46, 192.31, height=1e-4)
+    left = np.flatnonzero(xy[:, 0] < 1e-12)
+    d = np.r_[2 * left, 2 * left + 1]
+    F = np.zeros(K.shape[0])
+    F[1::2] = -1e-3
+    with pytest.raises(FactorizationError) as info:
+        solve_pdas(K, F, np.zeros(0, dtype=int), np.zeros(0), d, 0.0, backend=backend)
+    message = str(info.value)
+    # a failed factorization, or (PARDISO on the strip) a factorization whose solve fails
+    # the residual check
+    assert message.startswith(
+        (
+            "the stiffness matrix with the Dirichlet and active DOFs eliminated is not positive "
+            "definite in floating point: ",
+            "the linear system is singular or too ill-conditioned: ",
+        )
+    )
+    assert "no Dirichlet condition" in message and "aspect ratio 1e3" in message
+    assert info.value.backend == backend

@@ -16,7 +16,7 @@ import scipy.sparse as sp
 
 from .elimination import SymmetricEliminator
 from .qp import BoundQP
-from .solvers import SingularSystemError, SPDSolver
+from .solvers import SINGULAR_CAUSES, FactorizationError, SingularSystemError, SPDSolver
 
 __all__ = ["ActiveSetSystem", "SOLVE_RTOL", "UPDATE_RTOL"]
 
@@ -100,10 +100,21 @@ class ActiveSetSystem:
         if x is None:
             keep = self.eliminator.keep_mask(self.fixed)
             # the solver factorizes K with the eliminated entries dropped: no copy of K
-            if self.factored is None:
-                self.solver.factorize(self.K, keep=keep)
-            else:
-                self.solver.refactorize(keep)
+            try:
+                if self.factored is None:
+                    self.solver.factorize(self.K, keep=keep)
+                else:
+                    self.solver.refactorize(keep)
+            except SingularSystemError:
+                raise
+            except FactorizationError as err:
+                raise FactorizationError(
+                    "the stiffness matrix with the Dirichlet and active DOFs eliminated is not "
+                    f"positive definite in floating point: {err}. {SINGULAR_CAUSES}",
+                    backend=err.backend,
+                    code=err.code,
+                    equation=err.equation,
+                ) from err
             self.factored = self.fixed.copy()
             x = self.solver.solve(b)
             residual = self.residual(b, x) / max(np.abs(b).max(initial=0.0), 1e-300)
@@ -111,9 +122,7 @@ class ActiveSetSystem:
                 raise SingularSystemError(
                     f"the linear system is singular or too ill-conditioned: its solution has "
                     f"the relative residual max|b - A x| / max|b| = {residual:.1e} "
-                    f"(backend {self.solver.backend}, bound {SOLVE_RTOL:.0e}). Usually a part "
-                    "of the body is not held: it has no Dirichlet condition and can move "
-                    "rigidly.",
+                    f"(backend {self.solver.backend}, bound {SOLVE_RTOL:.0e}). {SINGULAR_CAUSES}",
                     backend=self.solver.backend,
                     residual=residual,
                 )
