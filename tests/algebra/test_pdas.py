@@ -268,7 +268,7 @@ def test_cycling_is_detected_and_fallback_solves():
     )
     assert np.abs(result.x - x_ref).max() < 1e-12
     assert np.array_equal(result.active, active_ref)
-    assert_kkt(result, 1e-14)
+    assert_kkt(result, 1e-13)  # relative to the contact force 0.66, not max |K||x| = 4.8
 
 
 def test_max_iter_reached():
