@@ -40,7 +40,6 @@ def test_kkt_residuals_closed_form():
         "kkt_complementarity": kkt.complementarity,
         "kkt_stationarity": 0.0,
         "kkt_dirichlet": 0.0,
-        "contact_force": 0.4,
     }
 
 

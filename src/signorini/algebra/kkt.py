@@ -76,16 +76,14 @@ class KKTResiduals:
         return max(self.primal, self.dual, self.complementarity, self.stationarity, self.dirichlet)
 
     def columns(self) -> dict[str, float]:
-        """The residuals as history columns: ``kkt_primal``, ``kkt_dual``,
-        ``kkt_complementarity``, ``kkt_stationarity``, ``kkt_dirichlet`` (relative, as above)
-        and ``contact_force`` (the total, in force units)."""
+        """The five relative residuals as history columns: ``kkt_primal``, ``kkt_dual``,
+        ``kkt_complementarity``, ``kkt_stationarity``, ``kkt_dirichlet``."""
         return {
             "kkt_primal": self.primal,
             "kkt_dual": self.dual,
             "kkt_complementarity": self.complementarity,
             "kkt_stationarity": self.stationarity,
             "kkt_dirichlet": self.dirichlet,
-            "contact_force": self.contact_force,
         }
 
 
