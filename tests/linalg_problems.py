@@ -66,9 +66,10 @@ def random_spd_dense(n: int, rng: np.random.Generator, shift: float = 0.1) -> np
 
 
 def p2_elasticity(
-    nx: int, ny: int, lam: float = 1.0, mu: float = 1.0
+    nx: int, ny: int, lam: float = 1.0, mu: float = 1.0, height: float = 1.0
 ) -> tuple[sp.csr_matrix, np.ndarray]:
-    """P2 plane-strain stiffness on the unit square cut into ``2 nx ny`` right triangles.
+    """P2 plane-strain stiffness on ``(0, 1) × (0, height)`` cut into ``2 nx ny`` right
+    triangles.
 
     Returns
     -------
@@ -77,7 +78,7 @@ def p2_elasticity(
     node_xy : (n_nodes, 2) float array
         Vertices first, then edge midpoints.
     """
-    X, Y = np.meshgrid(np.linspace(0, 1, nx + 1), np.linspace(0, 1, ny + 1), indexing="ij")
+    X, Y = np.meshgrid(np.linspace(0, 1, nx + 1), np.linspace(0, height, ny + 1), indexing="ij")
     points = np.column_stack([X.ravel(), Y.ravel()])
     idx = np.arange((nx + 1) * (ny + 1)).reshape(nx + 1, ny + 1)
     a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
@@ -194,3 +195,25 @@ def random_problem(rng, n, m, n_dirichlet=0, dense=True):
     g = 0.3 * rng.standard_normal(m)
     xd = 0.2 * rng.standard_normal(n_dirichlet)
     return K, F, c, g, d, xd
+
+
+def just_touching_square(
+    n: int, lam: float = 288.46153846153845, mu: float = 192.30769230769232
+) -> tuple[sp.csr_matrix, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The unit square pushed by exactly its gap: every constraint is degenerate.
+
+    ``u = (0.1, 0)`` on the left side, free top and bottom, ``u_x <= 0.1`` on the right side
+    (E = 500, ν = 0.3 by default). The solution is the rigid shift ``(0.1, 0)``: every right
+    node touches the bound with zero multiplier.
+
+    Returns
+    -------
+    K, F, constrained, dirichlet, dirichlet_values
+        ``F = 0``; the gap is 0.1 on every constrained DOF.
+    """
+    K, xy = p2_elasticity(n, n, lam, mu)
+    left = np.flatnonzero(xy[:, 0] < 1e-12)
+    right = np.flatnonzero(xy[:, 0] > 1 - 1e-12)
+    dirichlet = np.column_stack([2 * left, 2 * left + 1]).ravel()
+    values = np.tile([0.1, 0.0], left.size)
+    return K, np.zeros(K.shape[0]), 2 * right, dirichlet, values

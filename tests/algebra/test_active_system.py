@@ -5,9 +5,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from linalg_problems import random_problem
+import scipy.sparse as sp
+from linalg_problems import p2_elasticity, random_problem
 
-from signorini.algebra import available_backends, make_solver, solve_pdas
+from signorini.algebra import (
+    FactorizationError,
+    SingularSystemError,
+    available_backends,
+    make_solver,
+    solve_pdas,
+)
 from signorini.algebra.active_system import ActiveSetSystem
 from signorini.algebra.qp import check_qp
 
@@ -68,3 +75,53 @@ def test_low_rank_updates_agree_with_refactorization(backend):
         assert updated.kkt.max < 1e-10
         used += updated.n_updates
     assert used > 0, f"{backend}: no iteration was solved by a low-rank update"
+
+
+@pytest.mark.parametrize("backend", BACKEND_LIST)
+def test_near_singular_solve_is_reported(backend):
+    # a second block held only by a spring 1e-12 times its stiffness, loaded: both backends
+    # factorize it and returned |x| ~ 1e9 with KKT residuals at round-off
+    K1, xy = p2_elasticity(2, 2)
+    n1 = K1.shape[0]
+    K = sp.block_diag([K1, K1 + 1e-12 * sp.eye(n1)], format="csr")
+    left = np.flatnonzero(xy[:, 0] < 1e-12)
+    d = np.r_[2 * left, 2 * left + 1]
+    F = np.zeros(2 * n1)
+    F[n1 + 1 :: 2] = -1e-3
+    with pytest.raises(SingularSystemError, match="singular or too ill-conditioned") as info:
+        solve_pdas(K, F, np.zeros(0, dtype=int), np.zeros(0), d, 0.0, backend=backend)
+    err = info.value
+    assert isinstance(err, FactorizationError)
+    assert err.backend == backend and err.residual > 1e-4
+    assert "no Dirichlet condition" in str(err)
+    # the held block alone is solved, its residual checked and far below the bound
+    result = solve_pdas(K1, np.ones(n1), np.zeros(0, dtype=int), np.zeros(0), d, backend=backend)
+    assert result.kkt.stationarity < 1e-14
+
+
+@pytest.mark.parametrize("backend", BACKEND_LIST)
+@pytest.mark.parametrize("case", ["floating block", "thin strip"])
+def test_failed_factorization_names_the_usual_causes(backend, case):
+    if case == "floating block":  # exactly singular: a second block without Dirichlet DOFs
+        K1, xy = p2_elasticity(4, 4)
+        K = sp.block_diag([K1, K1], format="csr")
+    else:  # a 1 x 1e-4 strip clamped at one end: singular in double precision
+        K, xy = p2_elasticity(16, 1, 288.46, 192.31, height=1e-4)
+    left = np.flatnonzero(xy[:, 0] < 1e-12)
+    d = np.r_[2 * left, 2 * left + 1]
+    F = np.zeros(K.shape[0])
+    F[1::2] = -1e-3
+    with pytest.raises(FactorizationError) as info:
+        solve_pdas(K, F, np.zeros(0, dtype=int), np.zeros(0), d, 0.0, backend=backend)
+    message = str(info.value)
+    # a failed factorization, or (PARDISO on the strip) a factorization whose solve fails
+    # the residual check
+    assert message.startswith(
+        (
+            "the stiffness matrix with the Dirichlet and active DOFs eliminated is not positive "
+            "definite in floating point: ",
+            "the linear system is singular or too ill-conditioned: ",
+        )
+    )
+    assert "no Dirichlet condition" in message and "aspect ratio 1e3" in message
+    assert info.value.backend == backend

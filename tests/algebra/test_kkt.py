@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from linalg_problems import p2_elasticity
 
 from signorini.algebra import kkt_residuals
 
@@ -15,19 +16,58 @@ def test_kkt_residuals_closed_form():
     c, g = np.array([0, 1]), np.array([0.5, 5.0])
     x = np.array([0.6, 2.0, 0.0])  # violates x_0 <= 0.5 by 0.1, multiplier 0.4
     kkt = kkt_residuals(K, F, x, c, g)
-    assert kkt.disp_scale == 5.0  # max(|x|, |g|)
+    assert kkt.disp_scale == 2.0  # max |x|; g = 5 is away from the contact (x_1 < g_1)
     assert kkt.force_scale == 2.0  # max(|F|, |K||x|)
-    assert np.isclose(kkt.primal, 0.1 / 5.0)
+    assert kkt.contact_force == 0.4 and kkt.contact_force_scale == 0.4
+    assert np.isclose(kkt.primal, 0.1 / 2.0)
     assert kkt.dual == 0.0
-    assert np.isclose(kkt.complementarity, 0.4 * 0.1 / (2.0 * 5.0))
+    assert np.isclose(kkt.complementarity, min(0.4 / 0.4, 0.1 / 2.0))
     assert kkt.stationarity == 0.0
     x2 = np.array([0.5, 2.0, 0.3])  # free row residual -0.3; x_0 at the bound
     kkt2 = kkt_residuals(K, F, x2, c, g, dirichlet=[2], dirichlet_values=0.1)
-    assert np.isclose(kkt2.dirichlet, 0.2 / 5.0)
+    assert np.isclose(kkt2.dirichlet, 0.2 / 2.0)
     assert kkt2.stationarity == 0.0  # row 2 is a Dirichlet row, not a free one
     kkt3 = kkt_residuals(K, np.array([0.0, 2.0, 0.0]), np.array([0.5, 2.0, 0.0]), c, g)
-    assert np.isclose(kkt3.dual, 0.5 / 2.0)  # multiplier -0.5 at the active bound
+    # multiplier -0.5 at the active bound and no positive contact force: the force scale
+    assert kkt3.contact_force == 0.0 and kkt3.contact_force_scale == 2.0
+    assert np.isclose(kkt3.dual, 0.5 / 2.0)
     assert np.isclose(kkt3.max, 0.25)
+    g4 = np.array([-3.0, 5.0])  # the obstacle penetrates: x_0 = 0.6 >= g_0, |g_0| counts
+    assert kkt_residuals(K, F, x, c, g4).disp_scale == 3.0
+    assert kkt.columns() == {
+        "kkt_primal": kkt.primal,
+        "kkt_dual": 0.0,
+        "kkt_complementarity": kkt.complementarity,
+        "kkt_stationarity": 0.0,
+        "kkt_dirichlet": 0.0,
+    }
+
+
+def test_a_far_gap_does_not_hide_a_penetration():
+    # Hertz-like: a clamped P2 block whose bottom nodes carry the gap 49.9 far from the contact
+    # and 0 at one node that touches; the displacement is of size 0.1. A penetration of 1e-6
+    # (1e-5 of the displacement) read 2e-8 against the old scale max|g| = 49.9.
+    K, xy = p2_elasticity(4, 4, lam=1.0, mu=1.0)
+    top = np.flatnonzero(xy[:, 1] > 1 - 1e-12)
+    bottom = np.flatnonzero(xy[:, 1] < 1e-12)
+    c = 2 * bottom + 1  # the y DOFs of the bottom nodes
+    g = np.full(bottom.size, 49.9)
+    touching = np.argmin(np.abs(xy[bottom, 0] - 0.5))
+    g[touching] = 0.0
+    rng = np.random.default_rng(3)
+    x = 0.1 * rng.uniform(-1, 1, K.shape[0])
+    x[c] = np.minimum(x[c], 0.09)
+    x[c[touching]] = 1e-6  # penetrates by 1e-6
+    d = np.r_[2 * top, 2 * top + 1]
+    F = K @ x
+    F[c[touching]] += 0.05  # a contact force at the touching node
+    kkt = kkt_residuals(K, F, x, c, g, d, x[d])
+    assert kkt.disp_scale == np.abs(x).max() <= 0.1
+    assert np.isclose(kkt.primal, 1e-6 / np.abs(x).max())
+    assert kkt.primal > 1e-5  # the old scale max(|x|, |g|) = 49.9 read it as 2e-8
+    assert np.isclose(kkt.contact_force, 0.05)
+    assert np.isclose(kkt.complementarity, min(1.0, 1e-6 / np.abs(x).max()))
+    assert kkt.stationarity < 1e-15 and kkt.dual < 1e-13
 
 
 def test_stationarity_on_a_free_row_and_zero_scales():

@@ -22,12 +22,13 @@ from .elimination import SymmetricEliminator, eliminate_symmetric
 from .kkt import KKTResiduals, kkt_residuals
 from .pdas import solve_pdas
 from .result import PDASConvergenceError, PDASResult, PDASStep
-from .solvers import BackendUnavailableError, FactorizationError, SPDSolver
+from .solvers import BackendUnavailableError, FactorizationError, SingularSystemError, SPDSolver
 
 __all__ = [
     "BACKENDS",
     "BackendUnavailableError",
     "FactorizationError",
+    "SingularSystemError",
     "KKTResiduals",
     "PDASConvergenceError",
     "PDASResult",

@@ -21,19 +21,27 @@ from .qp import BoundQP, check_qp, check_vector
 
 __all__ = ["KKTResiduals", "kkt_residuals"]
 
+_SQRT_EPS = float(np.sqrt(np.finfo(np.float64).eps))
+
 
 @dataclass(frozen=True)
 class KKTResiduals:
     """Relative KKT residuals of a point ``x`` (see :func:`kkt_residuals`).
 
+    Each residual is relative to the quantity it is about (docs/method.md, *Solver*): the
+    contact conditions to the displacements and forces *at the contact*, not to a far-away gap
+    nor to the largest row of ``|K| |x|``.
+
     Attributes
     ----------
     primal : float
-        ``max (x_c - g)^+ / disp_scale``.
+        ``max (x_c - g)^+ / disp_scale``: the largest penetration.
     dual : float
-        ``max (-Λ)^+ / force_scale``.
+        ``max (-Λ)^+ / contact_force_scale``: the largest contact force of the wrong sign.
     complementarity : float
-        ``max |Λ (x_c - g)| / (force_scale * disp_scale)``.
+        ``max min(|Λ| / contact_force_scale, |x_c - g| / disp_scale)``: at every constrained DOF
+        the force or the gap must vanish (the round-off multiplier of a DOF far from the
+        obstacle is not multiplied by its large gap).
     stationarity : float
         ``max |F - K x|`` over the free unconstrained rows, over ``force_scale``.
     dirichlet : float
@@ -42,7 +50,14 @@ class KKTResiduals:
         ``max(max |F|, max (|K| |x|))`` (1 if both vanish): the size of the forces, which also
         bounds the round-off in ``F - K x``.
     disp_scale : float
-        ``max(max |x|, max |g|, max |x_D|)`` (1 if all vanish).
+        ``max(max |x|, max |x_D|, max |g|`` over the constrained DOFs that touch or penetrate,
+        ``x_c >= g)`` (1 if all vanish): the displacement of the body and the gap only where
+        the contact is (a gap far from it does not count).
+    contact_force : float
+        The total contact force ``Σ max(Λ, 0)``.
+    contact_force_scale : float
+        ``contact_force``, or ``force_scale`` when the contact force is below ``√eps`` of it
+        (no contact: the multipliers are round-off).
     """
 
     primal: float
@@ -52,11 +67,24 @@ class KKTResiduals:
     dirichlet: float
     force_scale: float
     disp_scale: float
+    contact_force: float = 0.0
+    contact_force_scale: float = 1.0
 
     @property
     def max(self) -> float:
         """The largest of the five relative residuals."""
         return max(self.primal, self.dual, self.complementarity, self.stationarity, self.dirichlet)
+
+    def columns(self) -> dict[str, float]:
+        """The five relative residuals as history columns: ``kkt_primal``, ``kkt_dual``,
+        ``kkt_complementarity``, ``kkt_stationarity``, ``kkt_dirichlet``."""
+        return {
+            "kkt_primal": self.primal,
+            "kkt_dual": self.dual,
+            "kkt_complementarity": self.complementarity,
+            "kkt_stationarity": self.stationarity,
+            "kkt_dirichlet": self.dirichlet,
+        }
 
 
 def kkt_residuals(
@@ -110,20 +138,31 @@ def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
     r = F - K @ x
     absK = sp.csr_matrix((np.abs(K.data), K.indices, K.indptr), shape=K.shape)
     force = max(np.abs(F).max(initial=0.0), (absK @ np.abs(x)).max(initial=0.0))
-    disp = max(np.abs(x).max(initial=0.0), np.abs(g).max(initial=0.0), np.abs(xd).max(initial=0.0))
     force = force if force > 0 else 1.0
-    disp = disp if disp > 0 else 1.0
     multiplier = r[c]
     slack = x[c] - g
+    touching = slack >= 0
+    disp = max(
+        np.abs(x).max(initial=0.0),
+        np.abs(xd).max(initial=0.0),
+        np.abs(g[touching]).max(initial=0.0),
+    )
+    disp = disp if disp > 0 else 1.0
+    contact_force = float(np.maximum(multiplier, 0.0).sum())
+    contact_scale = contact_force if contact_force > _SQRT_EPS * force else force
     other = np.ones(x.size, dtype=bool)
     other[c] = False
     other[d] = False
     return KKTResiduals(
         primal=float(np.maximum(slack, 0.0).max(initial=0.0) / disp),
-        dual=float(np.maximum(-multiplier, 0.0).max(initial=0.0) / force),
-        complementarity=float(np.abs(multiplier * slack).max(initial=0.0) / (force * disp)),
+        dual=float(np.maximum(-multiplier, 0.0).max(initial=0.0) / contact_scale),
+        complementarity=float(
+            np.minimum(np.abs(multiplier) / contact_scale, np.abs(slack) / disp).max(initial=0.0)
+        ),
         stationarity=float(np.abs(r[other]).max(initial=0.0) / force),
         dirichlet=float(np.abs(x[d] - xd).max(initial=0.0) / disp),
         force_scale=float(force),
         disp_scale=float(disp),
+        contact_force=contact_force,
+        contact_force_scale=float(contact_scale),
     )

@@ -47,9 +47,12 @@ __all__ = ["solve_pdas"]
 
 logger = logging.getLogger(__name__)
 
-# Relative size below which ``Λ + c (x - g)`` counts as zero when the active set is updated
-# (keeps a degenerate constraint, Λ = 0 and x = g, from flipping on round-off).
-_ACTIVE_RTOL = 1e-13
+# Relative size of the band ``|Λ + c (x - g)| <= _ACTIVE_RTOL * scale`` in which a constraint
+# keeps its state when the active set is updated: a degenerate constraint (Λ = 0 and x = g,
+# "just touching") has both Λ and x - g at round-off, whose sign must not decide. The round-off
+# of x grows with the condition number of K (measured: |x_c - g| / |g| = 2e-12 at 33k unknowns),
+# so the band is far above eps and far below any decision that matters.
+_ACTIVE_RTOL = 1e-9
 
 
 def solve_pdas(
@@ -265,12 +268,7 @@ def _iterate(
     """
     qp = system.qp
     c, g = qp.constrained, qp.gap
-    scale = max(
-        np.abs(qp.F).max(initial=0.0),
-        c_scale * np.abs(g).max(initial=0.0),
-        c_scale * np.abs(qp.dirichlet_values).max(initial=0.0),
-    )
-    threshold = _ACTIVE_RTOL * scale
+    force = np.abs(qp.F).max(initial=0.0)
     seen = {active.tobytes(): 1}  # active set -> iteration that used it
     previous = active.copy()
     for it in range(1, max_iter + 1):
@@ -278,7 +276,8 @@ def _iterate(
         multiplier = np.where(active, multiplier, 0.0)
         history.append(PDASStep.between(it, "pdas", previous, active))
         logger.debug("PDAS %s", history[-1])
-        new_active = multiplier + c_scale * (x[c] - g) > threshold
+        value = multiplier + c_scale * (x[c] - g)
+        new_active = _update_active_set(active, value, force, c_scale, x)
         if np.array_equal(new_active, active):
             return x, multiplier, active, None
         key = new_active.tobytes()
@@ -292,6 +291,37 @@ def _iterate(
         previous, active = active, new_active
     message = f"PDAS did not converge in max_iter = {max_iter} iterations"
     return x, multiplier, active, ("max_iter", message)
+
+
+def _update_active_set(
+    active: np.ndarray, value: np.ndarray, force: float, c_scale: float, x: np.ndarray
+) -> np.ndarray:
+    """The active set rule ``Λ + c (x - g) > 0`` with a round-off band (docs/method.md,
+    *Solver*).
+
+    A constraint whose ``|Λ + c (x - g)|`` is at most ``_ACTIVE_RTOL`` times the force scale
+    ``max(max |F|, c max |x|)`` keeps its state in ``active``: there both Λ and ``x - g`` are
+    round-off, either state satisfies the KKT conditions to round-off, and deciding by their
+    sign makes PDAS cycle on degenerate complementarity.
+
+    Parameters
+    ----------
+    active : (m,) bool array
+        The active set of the last solve.
+    value : (m,) float array
+        ``Λ + c (x_c - g)`` of the last solve.
+    force : float
+        ``max |F|``.
+    c_scale : float
+    x : (n,) float array
+        The last iterate.
+
+    Returns
+    -------
+    (m,) bool array
+    """
+    threshold = _ACTIVE_RTOL * max(force, c_scale * np.abs(x).max(initial=0.0))
+    return np.where(np.abs(value) <= threshold, active, value > 0)
 
 
 def _after_failure(
