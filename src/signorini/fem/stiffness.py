@@ -164,10 +164,13 @@ def _assemble_node_blocks(
     indices = np.empty((half.nnz, 2), dtype=half.indices.dtype)
     np.multiply(half.indices, 2, out=indices[:, 0])
     np.add(indices[:, 0], 1, out=indices[:, 1])
-    data = np.ascontiguousarray(half.data[: half.nnz]).view(np.float64)
-    out = sp.csr_matrix(
-        (data, indices.reshape(-1), 2 * half.indptr), shape=(n_dofs, n_dofs), copy=False
-    )
+    indptr = 2 * half.indptr
+    # SciPy's COO -> CSR sizes the data buffer for every COO entry, duplicates included, and
+    # sums them in place without shrinking it: copy the summed part so that K does not keep
+    # the larger buffer alive (about 1.5 x the data of K)
+    data = half.data[: half.nnz].view(np.float64).copy()
+    del half
+    out = sp.csr_matrix((data, indices.reshape(-1), indptr), shape=(n_dofs, n_dofs), copy=False)
     out.has_sorted_indices = True
     return out
 
