@@ -4,6 +4,8 @@ the paper's Ndof."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -12,7 +14,14 @@ from signorini.fem.space import P2Space
 from signorini.mesh.builders import rectangle
 from signorini.mesh.mesh import Mesh
 from signorini.mesh.refine import refine_uniform
-from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
+from signorini.problem import (
+    Contact,
+    ContactProblem,
+    Dirichlet,
+    Neumann,
+    ProblemError,
+    SlenderBodyWarning,
+)
 
 MATERIAL = Material.from_young(10.0, 0.3)
 
@@ -334,3 +343,21 @@ def test_docstrings_state_units_and_shapes():
         assert "(n, 2)" in obj.__doc__, obj
     for obj in (ContactProblem, Material):
         assert "consistent: if E is in MPa" in " ".join(obj.__doc__.split()), obj
+
+
+@pytest.mark.parametrize(("height", "warns"), [(1.0, False), (0.05, False), (2e-3, True)])
+def test_a_slender_body_is_warned_about(height, warns):
+    """A cantilever strip of aspect 1/height: its stiffness condition number grows like the
+    aspect to the fourth, so above 100 the user is told, with the measured ratio."""
+    mesh = rectangle(0.0, 1.0, 0.0, height, nx=8, ny=1)
+    conditions = {"left": Dirichlet(), "right": Neumann((0.0, -1.0)), "top": Neumann()}
+    conditions["bottom"] = Neumann()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ContactProblem(mesh, Material.from_young(1.0, 0.3), conditions)
+    slender = [w for w in caught if issubclass(w.category, SlenderBodyWarning)]
+    assert len(slender) == int(warns), [str(w.message) for w in caught]
+    if warns:
+        ratio = (1.0 + height**2) / height
+        assert f"{ratio:.3g}" in str(slender[0].message)
+        assert slender[0].filename == __file__  # points at the user's line

@@ -4,6 +4,14 @@ checked (``fields``)."""
 
 from .conditions import Contact, Dirichlet, ExactSolution, Neumann
 from .fields import ProblemError
-from .problem import ContactProblem
+from .problem import ContactProblem, SlenderBodyWarning
 
-__all__ = ["Contact", "ContactProblem", "Dirichlet", "ExactSolution", "Neumann", "ProblemError"]
+__all__ = [
+    "Contact",
+    "ContactProblem",
+    "Dirichlet",
+    "ExactSolution",
+    "Neumann",
+    "ProblemError",
+    "SlenderBodyWarning",
+]
