@@ -428,6 +428,9 @@ def test_resume_after_an_interrupt_gives_the_uninterrupted_run(tmp_path, capsys,
 def test_resume_refuses_a_folder_that_is_not_a_run(tmp_path, capsys):
     assert main(["run", "--resume", str(tmp_path)]) == 2
     assert "holds no signorini-run.json" in capsys.readouterr().err
+    assert main(["run", "--out", str(tmp_path / "x")]) == 2  # no PROBLEM, no --resume
+    err = capsys.readouterr().err
+    assert err == "signorini: error: give a PROBLEM (an example's name or a problem file)\n"
 
 
 def run_in_subprocess(out: Path, *extra: str):
@@ -665,3 +668,36 @@ def test_resume_refuses_a_changed_problem_file(tmp_path, capsys):
         f"signorini: error: --resume {out}: {source.resolve()} is not the problem file the run "
         f"solved ({source}): another file, or its contents changed\n"
     )
+
+
+def test_resume_after_an_interrupt_while_drawing_redraws_from_the_last_level(
+    tmp_path, capsys, monkeypatch
+):
+    """Every level finished, the figures did not: --resume solves the last level again
+    (warm started from its saved solution) only to draw them, and writes no new level."""
+    import signorini.cli as cli
+
+    drawn = []
+
+    def figures(example, out, last=None):
+        if not drawn:
+            drawn.append(None)
+            raise KeyboardInterrupt
+        drawn.append(last)
+        return []
+
+    monkeypatch.setattr(cli, "_figures", figures)
+    out = tmp_path / "d"
+    argv = ["run", "example-6.2", "--max-ndof", "700", "--out", str(out), "--no-vtu"]
+    assert main(argv) == 130
+    err = capsys.readouterr().err
+    assert err.startswith("signorini: interrupted while drawing the figures; levels 0-")
+    before = history_without_timings(out / "history.csv")
+    assert main(["run", "--resume", str(out)]) == 0
+    assert "were finished; drawing what is missing" in capsys.readouterr().out
+    last = drawn[-1]
+    assert last.record.level == len(before) - 1 and last.record.ndof == int(before[-1]["ndof"])
+    assert last.record.eta == pytest.approx(float(before[-1]["eta"]), rel=1e-9)
+    assert history_without_timings(out / "history.csv") == before
+    assert json.loads((out / "signorini-run.json").read_text())["status"] == "finished"
+    assert not (out / "resume.npz").exists()

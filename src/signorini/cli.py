@@ -78,7 +78,9 @@ def _parser() -> argparse.ArgumentParser:
         help="solve a problem on a sequence of meshes",
         description="Solve a problem on a sequence of adaptively (or uniformly) refined "
         "meshes, writing history.csv, one VTU file per level and figures into the output "
-        f"folder. {TRUST}",
+        "folder. A run owns its output folder: it refuses a non-empty one unless "
+        "--overwrite is given, and --resume continues an interrupted run. "
+        f"{TRUST}",
     )
     run.add_argument(
         "example",
