@@ -609,6 +609,15 @@ def test_a_problem_file_that_raises_shows_its_own_file_and_line(tmp_path, capsys
     err = capsys.readouterr().err
     assert re.findall(r'File "(.*)", line (\d+)', err) == [(str(source), "5"), (str(source), "2")]
     assert err.endswith("KeyError: 'gap'\n") and "cli.py" not in err
+    # frames of installed packages (a virtual environment beside the file) are left out
+    lib = tmp_path / "venv" / "lib" / "site-packages"
+    lib.mkdir(parents=True)
+    (lib / "somelib.py").write_text("def load(name):\n    raise OSError(f'no {name}')\n")
+    text = f"import sys\nsys.path.append({str(lib)!r})\nimport somelib\nsomelib.load('x')\n"
+    assert run_file(tmp_path, text) == 2
+    err = capsys.readouterr().err
+    assert re.findall(r'File "(.*)", line (\d+)', err) == [(str(source), "4")]
+    assert err.endswith("OSError: no x\n")
     # a syntax error points at its line too
     assert run_file(tmp_path, "def problem(:\n    pass\n") == 2
     err = capsys.readouterr().err

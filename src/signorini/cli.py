@@ -155,14 +155,15 @@ def _label(name: str) -> str:
 # ---------------------------------------------------------------------- problem files
 def _user_traceback(exc: BaseException, folder: Path) -> str:
     """The traceback of ``exc`` restricted to frames in files under ``folder`` (the problem
-    file and its helper modules), outside this package."""
+    file and its helper modules), outside this package and installed packages."""
     package = Path(__file__).resolve().parent
 
     def users(filename: str) -> bool:
         if not os.path.isfile(filename):
             return False
         path = Path(filename).resolve()
-        return path.is_relative_to(folder) and not path.is_relative_to(package)
+        installed = {"site-packages", "dist-packages"} & set(path.parts)
+        return path.is_relative_to(folder) and not path.is_relative_to(package) and not installed
 
     frames = [f for f in traceback.extract_tb(exc.__traceback__) if users(f.filename)]
     lines = traceback.format_list(frames) + traceback.format_exception_only(type(exc), exc)
