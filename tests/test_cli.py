@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import csv
+import json
 import math
 import os
 import re
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import meshio
@@ -168,7 +171,9 @@ def test_run_options_eta5_no_vtu_quiet(tmp_path, capsys):
     )
     printed = capsys.readouterr()
     assert code == 0 and printed.out == ""
-    assert os.listdir(out) == ["history.csv"]
+    # the run's files: its history, the columns' description, its manifest (the resume
+    # state is removed once the run finished)
+    assert sorted(os.listdir(out)) == ["history.csv", "history.md", "signorini-run.json"]
     _, rows = read_history(out / "history.csv")
     assert len(rows) == 2
     paper = estimate(solve(example_6_1()), eta5="paper").eta_terms[4]
@@ -281,3 +286,427 @@ def test_bad_problem_file(tmp_path, capsys, text, message):
     code = main(["run", str(source), "--out", str(tmp_path / "o"), "--no-figures"])
     err = capsys.readouterr().err
     assert code == 2 and message in err
+
+
+# ---------------------------------------------------------------------- run folders
+def history_without_timings(path: Path) -> list[dict[str, str]]:
+    _, rows = read_history(path)
+    return [{k: v for k, v in r.items() if not k.startswith("t_")} for r in rows]
+
+
+def assert_same_history(a: list[dict[str, str]], b: list[dict[str, str]]) -> None:
+    """Equal histories: counts and names exactly, numbers to round-off (two uninterrupted
+    runs differ at round-off too: the threaded sparse solver sums in varying order)."""
+    assert len(a) == len(b) and [list(r) for r in a] == [list(r) for r in b]
+    for ra, rb in zip(a, b, strict=True):
+        for key, va in ra.items():
+            vb = rb[key]
+            try:
+                int(va)
+            except ValueError:
+                try:
+                    number = float(va)
+                except ValueError:  # text, e.g. the backend
+                    assert va == vb, (ra["level"], key)
+                else:
+                    assert float(vb) == pytest.approx(number, rel=1e-9, nan_ok=True), key
+            else:
+                assert va == vb, (ra["level"], key)
+
+
+def assert_same_vtu(a: Path, b: Path) -> None:
+    ma, mb = meshio.read(a), meshio.read(b)
+    np.testing.assert_array_equal(ma.points, mb.points)
+    np.testing.assert_array_equal(ma.cells[0].data, mb.cells[0].data)
+    for key in ma.point_data:
+        x, y = ma.point_data[key], mb.point_data[key]
+        np.testing.assert_allclose(x, y, rtol=0, atol=1e-9 * np.abs(x).max(), err_msg=key)
+    for key in ma.cell_data:
+        x, y = ma.cell_data[key][0], mb.cell_data[key][0]
+        np.testing.assert_allclose(x, y, rtol=0, atol=1e-9 * np.abs(x).max(), err_msg=key)
+
+
+RUN_62 = ["run", "example-6.2", "--max-ndof", "1200", "--no-figures", "--quiet"]
+
+
+def test_a_folder_holding_a_run_is_refused_and_overwrite_clears_only_that_run(tmp_path, capsys):
+    """A shorter rerun never leaves the longer run's levels beside its own history."""
+    out = tmp_path / "r"
+    assert main([*RUN_62, "--out", str(out)]) == 0
+    n_long = len(list(out.glob("level_*.vtu")))
+    (out / "notes.txt").write_text("my notes")
+    (out / ".level_029.vtu.a1b2c3d4.vtu").write_bytes(b"")  # left by a killed write
+    before = sorted(os.listdir(out))
+    capsys.readouterr()
+    short = ["run", "example-6.2", "--uniform", "--max-ndof", "600", "--out", str(out)]
+    assert main([*short, "--no-figures"]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"signorini: error: output folder {out} is not empty: it holds a run of example-6.2 "
+        "(finished). Give --overwrite to remove that run's files first (only the files a run "
+        f"writes), --resume {out} to continue an interrupted run, or another --out folder\n"
+    )
+    # the refused run removed its temporaries only
+    assert sorted(os.listdir(out)) == [n for n in before if not n.startswith(".level")]
+    assert main([*short, "--no-figures", "--overwrite"]) == 0
+    assert "removed" in capsys.readouterr().out
+    rows = check_history_and_vtu(out)
+    assert len(rows) == 2 < n_long
+    assert (out / "notes.txt").read_text() == "my notes"
+    assert sorted(os.listdir(out)) == sorted(
+        ["history.csv", "history.md", "level_000.vtu", "level_001.vtu", "notes.txt"]
+        + ["signorini-run.json"]
+    )
+
+
+def test_out_naming_a_file_or_a_foreign_folder(tmp_path, capsys):
+    path = tmp_path / "results.txt"
+    path.write_text("x")
+    assert main([*RUN_62, "--out", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert (
+        err == f"signorini: error: --out {path} is an existing file, not a folder: give a "
+        "folder name\n"
+    )
+    assert "Errno" not in err
+    (tmp_path / "photos").mkdir()
+    (tmp_path / "photos" / "a.jpg").write_bytes(b"")
+    assert main([*RUN_62, "--out", str(tmp_path / "photos")]) == 2
+    assert "it holds 1 file(s): a.jpg" in capsys.readouterr().err
+
+
+def interrupt_after_level(monkeypatch, k: int) -> None:
+    """Make the command line receive Ctrl-C right after level ``k`` is written."""
+    import signorini.cli as cli
+
+    progress = cli._progress
+
+    def stop(level):
+        if level.record.level == k:
+            raise KeyboardInterrupt
+        return progress(level)
+
+    monkeypatch.setattr(cli, "_progress", stop)
+
+
+def test_resume_after_an_interrupt_gives_the_uninterrupted_run(tmp_path, capsys, monkeypatch):
+    full, part = tmp_path / "full", tmp_path / "part"
+    args = ["run", "example-6.2", "--max-ndof", "2500", "--theta", "0.5", "--no-figures"]
+    assert main([*args, "--out", str(full), "--quiet"]) == 0
+    interrupt_after_level(monkeypatch, 5)
+    assert main([*args, "--out", str(part)]) == 130
+    err = capsys.readouterr().err
+    assert err == (
+        f"signorini: interrupted at level 6; levels 0-5 finished in {part}; continue with: "
+        f"signorini run example-6.2 --resume {part}\n"
+    )
+    assert json.loads((part / "signorini-run.json").read_text())["status"] == "interrupted"
+    monkeypatch.undo()
+    # options given again must agree with the run's
+    assert main(["run", "--resume", str(part), "--max-ndof", "3000"]) == 2
+    assert "--max-ndof 3000 (the run has 2500)" in capsys.readouterr().err
+    assert main(["run", "example-6.1", "--resume", str(part)]) == 2
+    assert "the run solved 'example-6.2'" in capsys.readouterr().err
+    assert len(list(part.glob("level_*.vtu"))) == 6
+    assert main(["run", "--resume", str(part), "--theta", "0.5", "--quiet", "--no-figures"]) == 0
+    a, b = (
+        history_without_timings(full / "history.csv"),
+        history_without_timings(part / "history.csv"),
+    )
+    print(f"{len(a)} levels; resumed after level 5")
+    assert len(a) > 9
+    assert_same_history(a, b)  # every column but the timings
+    names = sorted(p.name for p in full.glob("level_*.vtu"))
+    assert names == sorted(p.name for p in part.glob("level_*.vtu"))
+    for name in names[5:]:
+        assert_same_vtu(full / name, part / name)
+    assert sorted(os.listdir(full)) == sorted(os.listdir(part))
+    assert main(["run", "--resume", str(part)]) == 0
+    assert "is finished: nothing to resume" in capsys.readouterr().out
+
+
+def test_resume_refuses_a_folder_that_is_not_a_run(tmp_path, capsys):
+    assert main(["run", "--resume", str(tmp_path)]) == 2
+    assert "holds no signorini-run.json" in capsys.readouterr().err
+    assert main(["run", "--out", str(tmp_path / "x")]) == 2  # no PROBLEM, no --resume
+    err = capsys.readouterr().err
+    assert err == "signorini: error: give a PROBLEM (an example's name or a problem file)\n"
+
+
+def run_in_subprocess(out: Path, *extra: str):
+    return subprocess.Popen(
+        [sys.executable, "-m", "signorini.cli", "run", "example-6.2", "--out", str(out)]
+        + ["--no-figures", *extra],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "MPLBACKEND": "Agg"},
+    )
+
+
+def wait_for_level(proc, k: int, timeout: float = 120) -> None:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        line = proc.stdout.readline()
+        if line.startswith(f"level {k:3d}"):
+            return
+        assert line, f"the run ended before level {k}: {proc.stderr.read()}"
+    proc.kill()
+    raise AssertionError(f"no level {k} within {timeout} s")
+
+
+def test_ctrl_c_prints_one_line_and_exits_130(tmp_path):
+    out = tmp_path / "big"
+    proc = run_in_subprocess(out, "--max-ndof", "1000000")
+    try:
+        wait_for_level(proc, 3)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    print(f"exit {proc.returncode}; stderr: {err!r}")
+    assert proc.returncode == 130
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err
+    lines = err.splitlines()
+    assert len(lines) == 1 and re.fullmatch(
+        rf"signorini: interrupted at level (\d+); levels 0-(\d+) finished in {re.escape(str(out))}"
+        rf"; continue with: signorini run example-6\.2 --resume {re.escape(str(out))}",
+        lines[0],
+    )
+    done = int(re.search(r"levels 0-(\d+)", lines[0]).group(1))
+    assert done >= 3 and len(list(out.glob("level_*.vtu"))) == done + 1
+    assert not [n for n in os.listdir(out) if n.startswith(".")]
+
+
+def test_sigkill_then_resume_gives_the_uninterrupted_run(tmp_path, capsys):
+    """Killed at any moment (possibly inside a VTU write), the run is continued by
+    --resume: temporaries removed, the same history and files as an uninterrupted run."""
+    args = ["--max-ndof", "6000"]
+    full, part = tmp_path / "full", tmp_path / "part"
+    proc = run_in_subprocess(part, *args)
+    try:
+        wait_for_level(proc, 8)
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(timeout=60)
+    finally:
+        proc.kill()
+    assert main(["run", "example-6.2", *args, "--out", str(full), "--no-figures", "--quiet"]) == 0
+    before = len(list(part.glob("level_*.vtu")))
+    (part / ".level_029.vtu.zz_9q7w3.vtu").write_bytes(b"")  # as SIGKILL in a write leaves
+    assert main(["run", "--resume", str(part), "--quiet", "--no-figures"]) == 0
+    a = history_without_timings(full / "history.csv")
+    b = history_without_timings(part / "history.csv")
+    print(f"killed with {before} VTU files; {len(a)} levels")
+    assert len(a) > before
+    assert_same_history(a, b)
+    assert sorted(os.listdir(full)) == sorted(os.listdir(part))
+    assert_same_vtu(full / f"level_{len(a) - 1:03d}.vtu", part / f"level_{len(a) - 1:03d}.vtu")
+
+
+# ---------------------------------------------------------------------- options
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--max-levels", "0"], "--max-levels must be an integer >= 1, got 0"),
+        (["--max-levels", "-2"], "--max-levels must be an integer >= 1, got -2"),
+        (["--tol", "nan"], "--tol must be a number >= 0, got nan"),
+        (["--resume", "x", "--overwrite"], "--resume and --overwrite exclude each other"),
+    ],
+)
+def test_bad_run_options_fail_before_the_run(tmp_path, capsys, argv, message):
+    out = tmp_path / "x"
+    code = main(["run", "example-6.2", "--out", str(out), "--no-figures", *argv])
+    err = capsys.readouterr().err
+    assert code == 2 and err == f"signorini: error: {message}\n"
+    assert not out.exists()
+
+
+def test_unknown_backend_is_rejected_by_the_parser(tmp_path, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["run", "example-6.2", "--backend", "foo", "--out", str(tmp_path / "x")])
+    err = capsys.readouterr().err
+    assert info.value.code == 2
+    assert "argument --backend: invalid choice: 'foo' (choose from" in err
+    assert "pardiso" in err and "scipy" in err and not (tmp_path / "x").exists()
+
+
+def test_version_and_help(capsys):
+    from signorini import __version__
+
+    with pytest.raises(SystemExit) as info:
+        main(["--version"])
+    assert info.value.code == 0 and capsys.readouterr().out == f"signorini {__version__}\n"
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "A problem file is Python code: signorini executes it with your rights" in text
+    assert re.search(r"--max-levels MAX_LEVELS\s+stop after this many levels", text)
+    assert "--resume DIR" in text and "--overwrite" in text
+
+
+def test_history_md_describes_every_column(tmp_path):
+    out = tmp_path / "h"
+    assert main([*RUN_62, "--out", str(out), "--max-levels", "2"]) == 0
+    columns, _ = read_history(out / "history.csv")
+    text = (out / "history.md").read_text()
+    described = re.findall(r"^\| `(\w+)` \|", text, flags=re.M)
+    assert described == columns
+    ndof = next(line for line in text.splitlines() if line.startswith("| `ndof` |"))
+    assert "free scalar unknowns" in ndof and "Dirichlet" in ndof and "excluded" in ndof
+
+
+def test_figures_are_announced_before_they_are_drawn(tmp_path, capsys, monkeypatch):
+    import signorini.cli as cli
+
+    def figures(example, out, last=None):
+        print("DRAWING")
+        return []
+
+    monkeypatch.setattr(cli, "_figures", figures)
+    argv = ["run", "example-6.1", "--uniform", "--max-ndof", "600", "--no-vtu"]
+    assert main([*argv, "--out", str(tmp_path / "a")]) == 0
+    out = capsys.readouterr().out.splitlines()
+    i = out.index("DRAWING")
+    assert out[i - 1].startswith("drawing the figures of example-6.1")
+    assert main([*argv, "--out", str(tmp_path / "b"), "--quiet"]) == 0
+    assert capsys.readouterr().out == "DRAWING\n"
+
+
+# ---------------------------------------------------------------------- problem files
+GOOD = (
+    "from signorini import Contact, ContactProblem, Dirichlet, Material, Neumann, rectangle\n"
+    "def make(gap=0.01):\n"
+    "    return ContactProblem(rectangle(nx=2, ny=2), Material.from_young(100.0, 0.25), {\n"
+    "        'top': Dirichlet((0.0, -0.02)), 'left': Neumann(), 'right': Neumann(),\n"
+    "        'bottom': Contact(gap=lambda x: gap * x[..., 0])}, name='user')\n"
+)
+
+
+def run_file(tmp_path, text: str, *extra: str, name: str = "user.py") -> int:
+    source = tmp_path / name
+    source.write_text(text)
+    out = tmp_path / "out"
+    argv = ["run", str(source), "--max-ndof", "300", "--out", str(out), "--no-figures"]
+    return main([*argv, "--quiet", *extra])
+
+
+def test_a_problem_file_that_raises_shows_its_own_file_and_line(tmp_path, capsys):
+    text = "import math\n\nscale = 1 / 0\n\ndef problem():\n    pass\n"
+    assert run_file(tmp_path, text) == 2
+    err = capsys.readouterr().err
+    print(err)
+    source = tmp_path / "user.py"
+    lines = [x for x in err.splitlines() if not re.fullmatch(r"\s*[~^]+\s*", x)]  # 3.11 carets
+    assert lines == [
+        f"signorini: error: the problem file {source} raised ZeroDivisionError:",
+        f'  File "{source}", line 3, in <module>',
+        "    scale = 1 / 0",
+        "ZeroDivisionError: division by zero",
+    ]
+    # raised inside problem(), through a helper of the file: the user's two frames only
+    text = "def helper():\n    return {}['gap']\n\ndef problem():\n    return helper()\n"
+    assert run_file(tmp_path, text) == 2
+    err = capsys.readouterr().err
+    assert re.findall(r'File "(.*)", line (\d+)', err) == [(str(source), "5"), (str(source), "2")]
+    assert err.endswith("KeyError: 'gap'\n") and "cli.py" not in err
+    # frames of installed packages (a virtual environment beside the file) are left out
+    lib = tmp_path / "venv" / "lib" / "site-packages"
+    lib.mkdir(parents=True)
+    (lib / "somelib.py").write_text("def load(name):\n    raise OSError(f'no {name}')\n")
+    text = f"import sys\nsys.path.append({str(lib)!r})\nimport somelib\nsomelib.load('x')\n"
+    assert run_file(tmp_path, text) == 2
+    err = capsys.readouterr().err
+    assert re.findall(r'File "(.*)", line (\d+)', err) == [(str(source), "4")]
+    assert err.endswith("OSError: no x\n")
+    # a syntax error points at its line too
+    assert run_file(tmp_path, "def problem(:\n    pass\n") == 2
+    err = capsys.readouterr().err
+    assert f'File "{source}", line 1' in err and "SyntaxError" in err
+
+
+def test_a_problem_file_with_future_annotations_dataclass_and_a_helper(tmp_path, capsys):
+    (tmp_path / "helpers_for_user.py").write_text(GOOD)
+    text = (
+        "from __future__ import annotations\n"
+        "from dataclasses import dataclass\n"
+        "from helpers_for_user import make\n"
+        "@dataclass\n"
+        "class Data:\n"
+        "    gap: float = 0.01\n"
+        "def problem():\n"
+        "    return make(Data().gap)\n"
+    )
+    assert run_file(tmp_path, text) == 0, capsys.readouterr().err
+    assert str(tmp_path) not in sys.path  # the folder is on the path only while loading
+    _, rows = read_history(tmp_path / "out" / "history.csv")
+    assert len(rows) >= 2
+
+
+def test_compare_uniform_executes_the_problem_file_once(tmp_path, capsys):
+    counter = tmp_path / "count.txt"
+    text = f"from pathlib import Path\nPath({str(counter)!r}).open('a').write('x')\n" + GOOD
+    text += "def problem():\n    return make()\n"
+    assert run_file(tmp_path, text, "--compare-uniform") == 0, capsys.readouterr().err
+    assert counter.read_text() == "x"
+    assert (tmp_path / "out" / "uniform" / "history.csv").is_file()
+
+
+def test_a_file_that_is_not_a_problem_file(tmp_path, capsys):
+    mesh = tmp_path / "part.msh"
+    mesh.write_text("$MeshFormat\n")
+    assert main(["run", str(mesh), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"signorini: error: {mesh} is not a problem file: a problem file is a Python file "
+        "(.py) that defines a function problem() taking no arguments and returning a "
+        "ContactProblem (see examples/inclined_block.py)\n"
+    )
+    assert run_file(tmp_path, "def make():\n    pass\n") == 2
+    assert "is not a problem file: it must define a function problem()" in (capsys.readouterr().err)
+
+
+def test_resume_refuses_a_changed_problem_file(tmp_path, capsys):
+    text = GOOD + "def problem():\n    return make()\n"
+    assert run_file(tmp_path, text, "--max-levels", "2") == 0
+    out, source = tmp_path / "out", tmp_path / "user.py"
+    assert main(["run", "--resume", str(out)]) == 0  # the same file: nothing to do
+    assert "is finished: nothing to resume" in capsys.readouterr().out
+    source.write_text(text.replace("0.01", "0.02"))
+    assert main(["run", "--resume", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"signorini: error: --resume {out}: {source.resolve()} is not the problem file the run "
+        f"solved ({source}): another file, or its contents changed\n"
+    )
+
+
+def test_resume_after_an_interrupt_while_drawing_redraws_from_the_last_level(
+    tmp_path, capsys, monkeypatch
+):
+    """Every level finished, the figures did not: --resume solves the last level again
+    (warm started from its saved solution) only to draw them, and writes no new level."""
+    import signorini.cli as cli
+
+    drawn = []
+
+    def figures(example, out, last=None):
+        if not drawn:
+            drawn.append(None)
+            raise KeyboardInterrupt
+        drawn.append(last)
+        return []
+
+    monkeypatch.setattr(cli, "_figures", figures)
+    out = tmp_path / "d"
+    argv = ["run", "example-6.2", "--max-ndof", "700", "--out", str(out), "--no-vtu"]
+    assert main(argv) == 130
+    err = capsys.readouterr().err
+    assert err.startswith("signorini: interrupted while drawing the figures; levels 0-")
+    before = history_without_timings(out / "history.csv")
+    assert main(["run", "--resume", str(out)]) == 0
+    assert "were finished; drawing what is missing" in capsys.readouterr().out
+    last = drawn[-1]
+    assert last.record.level == len(before) - 1 and last.record.ndof == int(before[-1]["ndof"])
+    assert last.record.eta == pytest.approx(float(before[-1]["eta"]), rel=1e-9)
+    assert history_without_timings(out / "history.csv") == before
+    assert json.loads((out / "signorini-run.json").read_text())["status"] == "finished"
+    assert not (out / "resume.npz").exists()

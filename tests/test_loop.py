@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import fields
 
 import numpy as np
@@ -11,7 +12,7 @@ import pytest
 from signorini.contact.contact_set import FULL_CONTACT
 from signorini.estimator.marking import mark_doerfler
 from signorini.examples import example_6_1, example_6_2
-from signorini.loop import Level, LevelRecord, adaptive
+from signorini.loop import COLUMNS, Level, LevelRecord, adaptive
 from signorini.mesh.refine import refine_nvb
 from signorini.output import fitted_slope
 
@@ -123,6 +124,79 @@ def test_stops_at_tolerance_and_after_max_levels():
 def test_bad_arguments_raise(kwargs, message):
     with pytest.raises(ValueError, match=message):
         next(adaptive(example_6_2(), **kwargs))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"theta": "0.4"}, r"theta must be a number in \(0, 1\], got '0.4'"),
+        ({"theta": "0.4", "uniform": True}, "theta must be a number"),
+        ({"max_levels": 0}, "max_levels must be an integer >= 1, got 0"),
+        ({"max_levels": -3}, "max_levels must be an integer >= 1, got -3"),
+        ({"max_levels": 2.5}, "max_levels must be an integer >= 1, got 2.5"),
+        ({"max_ndof": float("nan")}, "max_ndof must be a positive number, got nan"),
+        ({"max_ndof": "1000"}, "max_ndof must be a positive number, got '1000'"),
+        ({"tol": float("nan")}, "tol must be a number >= 0, got nan"),
+        ({"tol": "small"}, "tol must be a number >= 0, got 'small'"),
+        ({"tol": -1.0}, "tol must be a number >= 0, got -1"),
+        ({"eta5": "other"}, "eta5 must be one of"),
+        ({"backend": "foo"}, "backend must be one of"),
+        ({"first_level": 5, "max_levels": 5}, "first_level must be below max_levels=5"),
+        ({"uniform": "yes"}, "uniform must be True or False"),
+    ],
+)
+def test_bad_arguments_raise_at_the_call_before_any_work(kwargs, message, monkeypatch):
+    """The call itself raises (not the first ``next``), and nothing is solved."""
+    import signorini.loop as loop
+
+    def no_solve(*args, **kw):
+        raise AssertionError("solve called")
+
+    monkeypatch.setattr(loop, "solve", no_solve)
+    with pytest.raises(ValueError, match=message):
+        adaptive(example_6_2(), **kwargs)
+
+
+def test_a_run_continued_from_a_level_gives_the_same_levels():
+    """``mesh=level.next_mesh, u0=level.next_u0, first_level=k + 1`` continues the loop
+    exactly: the records of the continued run are those of the uninterrupted one."""
+    problem = example_6_2()
+    full = list(adaptive(problem, max_ndof=2500))
+    k = 6
+    assert len(full) > k + 3 and full[-1].next_mesh is None and full[-1].next_u0 is None
+    start = full[k]
+    assert start.next_mesh is full[k + 1].result.mesh
+    rest = list(
+        adaptive(problem, max_ndof=2500, mesh=start.next_mesh, u0=start.next_u0, first_level=k + 1)
+    )
+    assert len(rest) == len(full) - k - 1
+    for a, b in zip(full[k + 1 :], rest, strict=True):
+        ra = {c: v for c, v in a.record.row().items() if not c.startswith("t_")}
+        rb = {c: v for c, v in b.record.row().items() if not c.startswith("t_")}
+        assert ra == rb
+        np.testing.assert_array_equal(a.result.u, b.result.u)
+    # without the warm start the continued level needs more PDAS iterations (cold start)
+    cold = next(adaptive(problem, max_ndof=2500, mesh=start.next_mesh, first_level=k + 1))
+    print("warm/cold PDAS iterations:", rest[0].record.pdas_iterations, cold.record.n_solves)
+    assert cold.record.n_solves > rest[0].record.n_solves
+
+
+def test_level_record_docs_name_every_field_and_what_ndof_counts():
+    names = [f.name for f in fields(LevelRecord)]
+    doc = LevelRecord.__doc__
+    missing = [n for n in names if not re.search(rf"\b{n}\b", doc)]
+    assert not missing, f"LevelRecord's docstring lacks {missing}"
+    assert set(COLUMNS) == set(names) - {"extra"}
+    assert "Dirichlet" in COLUMNS["ndof"] and "excluded" in COLUMNS["ndof"]
+    assert "free" in doc and "``ndof_total`` minus 2 for every node" in " ".join(doc.split())
+    level_fields = [f.name for f in fields(Level)]
+    assert not [n for n in level_fields if f"{n} :" not in Level.__doc__]
+    # the count the description states, on the initial mesh of Example 6.2 (4 x 4 squares,
+    # clamped on the left: 9 Dirichlet nodes on x = 0)
+    level = next(adaptive(example_6_2(), max_levels=1))
+    mesh = level.result.mesh
+    assert level.record.ndof_total == 2 * (mesh.n_points + mesh.n_edges) == 162
+    assert level.record.ndof == 162 - 2 * 9
 
 
 def test_warm_start_needs_few_pdas_solves():

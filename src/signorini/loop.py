@@ -3,41 +3,128 @@
 The only orchestrator of the package: it calls the solver, the estimator, the marking and
 the refinement, warm-starts each solve from the previous level, and yields one
 :class:`Level` at a time so that callers can write results as soon as a level is done.
+A level also carries the mesh and warm start of the next one (:attr:`Level.next_mesh`,
+:attr:`Level.next_u0`), so an interrupted run can be continued from its last finished level
+with ``adaptive(..., mesh=level.next_mesh, u0=level.next_u0, first_level=k + 1)`` and gives
+the same levels as an uninterrupted run.
 """
 
 from __future__ import annotations
 
 import logging
 import math
+import numbers
 import time
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from .algebra.backends import BACKENDS
 from .contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
 from .contact.solution import ContactResult, solve
 from .estimator.marking import check_theta, mark_doerfler
-from .estimator.residual import Estimate, estimate
+from .estimator.residual import ETA5_VARIANTS, Estimate, estimate
 from .mesh.mesh import Mesh
 from .mesh.refine import refine_nvb, refine_uniform
 from .problem.problem import ContactProblem
 
-__all__ = ["LevelRecord", "Level", "adaptive"]
+__all__ = ["COLUMNS", "LevelRecord", "Level", "adaptive"]
 
 log = logging.getLogger(__name__)
+
+#: What each :class:`LevelRecord` field (= each column of a run's ``history.csv``) means,
+#: with its unit. Units are those of the problem's data ("consistent units": if E is in MPa
+#: and lengths in mm, forces are in N/mm of thickness and energies in N·mm/mm).
+COLUMNS: dict[str, str] = {
+    "level": "index of the level, 0 for the initial mesh",
+    "ndof": "the paper's Ndof: free scalar unknowns, i.e. 2 × (vertices + edges) of the P2 "
+    "space minus 2 per node on a Dirichlet part (both components of a Dirichlet node are "
+    "excluded; contact unknowns are counted)",
+    "ndof_total": "all scalar P2 unknowns, 2 × (vertices + edges), Dirichlet ones included",
+    "n_cells": "triangles of the mesh",
+    "eta": "the estimator η_h of (5.1), in units of energy norm (√energy)",
+    **{
+        f"eta_{k}": f"contribution η_{k} of the estimator, unsquared (η² = Σ η_k²), "
+        "same unit as eta"
+        for k in range(1, 8)
+    },
+    "error_energy": "energy norm of u − u_h (only with an exact solution, else nan), "
+    "same unit as eta",
+    "error_h1": "H¹ seminorm of u − u_h (only with an exact solution, else nan), "
+    "unit of displacement",
+    "efficiency": "eta / error_energy (only with an exact solution, else nan), no unit",
+    "pdas_iterations": "primal-dual active set iterations",
+    "n_solves": "linear solves done by the active set method",
+    "n_factorizations": "numerical factorizations of the stiffness matrix",
+    "n_analyses": "symbolic analyses (orderings) of the stiffness matrix",
+    "n_updates": "solves done with a low-rank update of an existing factor",
+    "n_active": "contact nodes in the final active set (u·n = ψ imposed)",
+    "n_constrained": "nodes on the contact parts (vertices and edge midpoints)",
+    "n_full_contact": "contact nodes in full contact",
+    "n_semi_contact": "contact nodes in semi contact",
+    "n_no_contact": "contact nodes without contact",
+    "contact_force": "sum of the nodal contact forces Λ_z, unit of force per thickness",
+    "n_marked": "cells marked for refinement on this level (0 on the last level)",
+    "backend": "sparse solver backend used (pardiso or scipy)",
+    "t_assemble": "seconds spent assembling the linear system",
+    "t_solve": "seconds spent in the active set solver",
+    "t_estimate": "seconds spent computing the estimator",
+    "t_mark": "seconds spent in Dörfler marking",
+    "t_refine": "seconds spent refining the mesh (and prolongating the warm start)",
+}
 
 
 @dataclass
 class LevelRecord:
     """One row of the convergence history: what the numerics measured on one level.
 
-    ``eta`` is the estimator η_h of (5.1) and ``eta_1`` … ``eta_7`` its contributions,
-    unsquared, with ``eta² = eta_1² + … + eta_7²`` (docs/method.md, *Estimator*; the
-    squared per-cell indicators are :attr:`Estimate.eta2 <signorini.Estimate.eta2>`).
-    ``ndof`` is the paper's number of free unknowns, ``t_*`` are seconds spent in each
-    step of the loop. A caller writing the row adds its own columns to the dict
-    :meth:`row` returns (the command line adds its output time ``t_output``).
+    Units are those of the problem's data (consistent units: if E is in MPa and lengths in
+    mm, forces are in N/mm of thickness). :data:`COLUMNS` holds the same descriptions as
+    text; the command line writes them beside ``history.csv`` as ``history.md``.
+
+    Attributes
+    ----------
+    level : int
+        Index of the level, 0 for the initial mesh.
+    ndof : int
+        The paper's Ndof, the number of **free** scalar unknowns: ``ndof_total`` minus 2
+        for every node (vertex or edge midpoint) on a Dirichlet part. Contact unknowns are
+        counted. Other codes that count all unknowns report ``ndof_total``.
+    ndof_total : int
+        All scalar P2 unknowns, ``2 × (n_vertices + n_edges)``.
+    n_cells : int
+        Triangles of the mesh.
+    eta : float
+        The estimator η_h of (5.1) (unit of the energy norm, √energy).
+    eta_1, eta_2, eta_3, eta_4, eta_5, eta_6, eta_7 : float
+        Its contributions, unsquared, with ``eta² = eta_1² + … + eta_7²`` (docs/method.md,
+        *Estimator*; the squared per-cell indicators are
+        :attr:`Estimate.eta2 <signorini.Estimate.eta2>`).
+    error_energy, error_h1 : float
+        Energy norm and H¹ seminorm of ``u − u_h`` when the problem has an exact solution,
+        else NaN.
+    efficiency : float
+        ``eta / error_energy`` (NaN without an exact solution).
+    pdas_iterations, n_solves, n_factorizations, n_analyses, n_updates : int
+        Active set iterations; linear solves; numerical factorizations; symbolic analyses;
+        solves done by a low-rank update of an existing factor.
+    n_active, n_constrained : int
+        Contact nodes in the final active set; all nodes on the contact parts.
+    n_full_contact, n_semi_contact, n_no_contact : int
+        Contact nodes by class (paper Section 4; docs/method.md, *Estimator*).
+    contact_force : float
+        Sum of the nodal contact forces Λ_z (force per unit thickness).
+    n_marked : int
+        Cells marked for refinement (0 on the last level).
+    backend : str
+        Sparse solver backend used.
+    t_assemble, t_solve, t_estimate, t_mark, t_refine : float
+        Seconds spent in each step of the loop.
+    extra : dict
+        Further columns; :meth:`row` merges them into the row. A caller writing the row
+        adds its own columns to the dict :meth:`row` returns (the command line adds its
+        output time ``t_output``).
     """
 
     level: int
@@ -85,12 +172,103 @@ class LevelRecord:
 
 @dataclass
 class Level:
-    """Everything known about one level of the loop."""
+    """Everything known about one level of the loop.
+
+    Attributes
+    ----------
+    record : LevelRecord
+        The level's row of the convergence history.
+    result : ContactResult
+        The discrete solution on the level's mesh (``result.mesh``).
+    estimate : Estimate
+        The a posteriori estimator of that solution.
+    marked : (n_cells,) bool array or None
+        Cells marked for refinement; None on the last level.
+    next_mesh : Mesh or None
+        The refined mesh the next level solves on; None on the last level.
+    next_u0 : (n_nodes_next, 2) float array or None
+        The next level's warm start: ``result.u`` prolongated to ``next_mesh`` (None on the
+        last level or without warm start). With ``next_mesh`` it is all the loop needs to
+        continue from this level (:func:`adaptive`, ``first_level``).
+    """
 
     record: LevelRecord
     result: ContactResult
     estimate: Estimate
     marked: np.ndarray | None  # cells marked for refinement (None on the last level)
+    next_mesh: Mesh | None = None
+    next_u0: np.ndarray | None = None
+
+
+def _check_count(value: object, name: str, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    if value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value}")
+    return int(value)
+
+
+def _check_real(value: object, name: str, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name} must be {what}, got {value!r}")
+    value = float(value)
+    if math.isnan(value):
+        raise ValueError(f"{name} must be {what}, got nan")
+    return value
+
+
+def check_loop_arguments(
+    *,
+    theta: object = 0.4,
+    max_ndof: object = 100_000,
+    tol: object = 0.0,
+    max_levels: object = 100,
+    uniform: object = False,
+    eta5: object = "consistent",
+    backend: object = "auto",
+    first_level: object = 0,
+    prefix: str = "",
+) -> dict:
+    """The arguments of :func:`adaptive`, checked; a ``ValueError`` naming the first bad one.
+
+    ``prefix`` is put before each name in the messages (the command line passes ``"--"``
+    and spells the names with dashes).
+    """
+
+    def name(n: str) -> str:
+        return prefix + (n.replace("_", "-") if prefix else n)
+
+    if not isinstance(uniform, bool | np.bool_):
+        raise ValueError(f"{name('uniform')} must be True or False, got {uniform!r}")
+    theta = check_theta(theta, name("theta"))
+    max_ndof = _check_real(max_ndof, name("max_ndof"), "a positive number")
+    if max_ndof <= 0:
+        raise ValueError(f"{name('max_ndof')} must be positive, got {max_ndof:g}")
+    tol = _check_real(tol, name("tol"), "a number >= 0")
+    if tol < 0:
+        raise ValueError(f"{name('tol')} must be a number >= 0, got {tol:g}")
+    max_levels = _check_count(max_levels, name("max_levels"), 1)
+    if eta5 not in ETA5_VARIANTS:
+        raise ValueError(f"{name('eta5')} must be one of {list(ETA5_VARIANTS)}, got {eta5!r}")
+    backends = ("auto", *BACKENDS)
+    if backend not in backends:
+        raise ValueError(f"{name('backend')} must be one of {list(backends)}, got {backend!r}")
+    first_level = _check_count(first_level, name("first_level"), 0)
+    if first_level >= max_levels:
+        raise ValueError(
+            f"{name('first_level')} must be below {name('max_levels')}={max_levels}, "
+            f"got {first_level}"
+        )
+    return {
+        "theta": theta,
+        "max_ndof": max_ndof,
+        "tol": tol,
+        "max_levels": max_levels,
+        "uniform": bool(uniform),
+        "eta5": eta5,
+        "backend": backend,
+        "first_level": first_level,
+    }
 
 
 def adaptive(
@@ -105,13 +283,16 @@ def adaptive(
     backend: str = "auto",
     warm_start: bool = True,
     mesh: Mesh | None = None,
+    u0: np.ndarray | None = None,
+    first_level: int = 0,
 ) -> Iterator[Level]:
     """Run SOLVE → ESTIMATE → MARK → REFINE, yielding each finished level.
 
     Stops after the level whose refinement would exceed ``max_ndof`` free unknowns, when
-    ``η_h ≤ tol``, or after ``max_levels`` levels. The four steps stay in this one function
-    (about 50 lines of code) so that the loop reads top to bottom as in docs/method.md,
-    *Marking and refinement*.
+    ``η_h ≤ tol``, or after ``max_levels`` levels. The four steps stay in one function
+    (:func:`_levels`, about 50 lines of code) so that the loop reads top to bottom as in
+    docs/method.md, *Marking and refinement*. The arguments are checked when ``adaptive``
+    is called, before any work.
 
     Parameters
     ----------
@@ -119,21 +300,29 @@ def adaptive(
     theta : float
         Dörfler parameter in (0, 1] (ignored when ``uniform``).
     max_ndof : int
-        Budget of free unknowns: no level exceeds it.
+        Budget of free unknowns (:attr:`LevelRecord.ndof`): no level exceeds it.
     tol : float
-        Stop once the estimator reaches this value.
+        Stop once the estimator reaches this value (>= 0).
     max_levels : int
-        Stop after this many levels.
+        Stop after the level with index ``max_levels - 1`` (at least 1).
     uniform : bool
         Refine every cell (NVB with all edges bisected) instead of Dörfler marking.
     eta5 : {"consistent", "paper"}
         Variant of the estimator's η5 (docs/method.md, *Estimator*).
-    backend : str
+    backend : {"auto", "pardiso", "scipy"}
         Sparse solver backend.
     warm_start : bool
         Start each PDAS from the previous level's prolongated solution and contact set.
     mesh : Mesh, optional
-        Initial mesh (default: the problem's).
+        Mesh of the first level (default: the problem's).
+    u0 : (n_nodes, 2) float array, optional
+        Warm start of the first level's solve on ``mesh`` (P2 nodal displacements: vertices
+        first, then edge midpoints); its nodes in contact form the initial active set.
+        Default: a cold start.
+    first_level : int
+        Index of the first level (default 0). To continue a run from its level ``k``, pass
+        ``mesh=level.next_mesh, u0=level.next_u0, first_level=k + 1`` and the run's other
+        arguments: the levels are those an uninterrupted run yields.
 
     Yields
     ------
@@ -144,29 +333,60 @@ def adaptive(
     Raises
     ------
     ValueError
-        For ``theta`` outside (0, 1], a non-positive ``max_ndof`` or an initial mesh with
-        more than ``max_ndof`` unknowns.
+        At the call, for an argument of the wrong type or out of range (naming it):
+        ``theta`` outside (0, 1], ``max_ndof`` not a positive number, ``tol`` negative or
+        NaN, ``max_levels`` < 1, an unknown ``eta5`` or ``backend``, ``first_level`` not
+        in ``[0, max_levels)``, or an initial mesh with more than ``max_ndof`` unknowns.
     """
-    if not uniform:
-        theta = check_theta(theta)
-    if max_ndof <= 0:
-        raise ValueError(f"max_ndof must be positive, got {max_ndof}")
+    if not isinstance(problem, ContactProblem):
+        raise ValueError(f"problem must be a ContactProblem, got {type(problem).__name__}")
+    args = check_loop_arguments(
+        theta=theta,
+        max_ndof=max_ndof,
+        tol=tol,
+        max_levels=max_levels,
+        uniform=uniform,
+        eta5=eta5,
+        backend=backend,
+        first_level=first_level,
+    )
+    if mesh is not None and not isinstance(mesh, Mesh):
+        raise ValueError(f"mesh must be a Mesh, got {type(mesh).__name__}")
     mesh = problem.mesh if mesh is None else mesh
-    if problem.free_ndof(mesh) > max_ndof:
+    if problem.free_ndof(mesh) > args["max_ndof"]:
         raise ValueError(
             f"the initial mesh already has {problem.free_ndof(mesh)} unknowns, "
             f"more than max_ndof={max_ndof}"
         )
-    u0 = None
-    for level in range(max_levels):
+    return _levels(problem, mesh, u0, warm_start=bool(warm_start), **args)
+
+
+def _levels(
+    problem: ContactProblem,
+    mesh: Mesh,
+    u0: np.ndarray | None,
+    *,
+    theta: float,
+    max_ndof: float,
+    tol: float,
+    max_levels: int,
+    uniform: bool,
+    eta5: str,
+    backend: str,
+    warm_start: bool,
+    first_level: int,
+) -> Iterator[Level]:
+    """The loop of :func:`adaptive`, on checked arguments."""
+    for level in range(first_level, max_levels):
         result = solve(problem, mesh, u0=u0, backend=backend)
+        u0 = None
         t0 = time.perf_counter()
         est = estimate(result, eta5=eta5)
         t_est = time.perf_counter() - t0
         record = _record(level, result, est)
         record.t_estimate = t_est
         last = level == max_levels - 1 or est.eta <= tol
-        marked = None
+        marked = next_mesh = None
         if not last:
             t0 = time.perf_counter()
             marked = (
@@ -181,7 +401,7 @@ def adaptive(
                 u0 = result.space.prolongate(result.u, refinement)
             record.t_refine = time.perf_counter() - t0
             if last:
-                marked = None  # the budget ends the run: this marking is discarded
+                marked = next_mesh = None  # the budget ends the run: this marking is discarded
             else:
                 record.n_marked = int(marked.sum())
         log.info(
@@ -191,7 +411,7 @@ def adaptive(
             record.eta,
             record.pdas_iterations,
         )
-        yield Level(record, result, est, marked)
+        yield Level(record, result, est, marked, next_mesh, u0)
         if last:
             return
         mesh = next_mesh

@@ -50,3 +50,34 @@ def test_a_failed_write_keeps_the_old_file(tmp_path, monkeypatch):
         raise RuntimeError("interrupted")
     assert path.read_bytes() == b"old"
     assert os.listdir(tmp_path) == ["f.txt"]
+
+
+def test_a_killed_write_leaves_a_recognisable_temporary_that_is_removed(tmp_path):
+    """A process killed inside a write (here: ``os._exit``, as SIGKILL would) leaves its
+    temporary file; its name marks it, and :func:`remove_temporaries` removes exactly it."""
+    import subprocess
+    import sys
+
+    code = (
+        "import os, sys\n"
+        "from signorini.output.files import replacing\n"
+        "with replacing(sys.argv[1]) as tmp:\n"
+        "    tmp.write_bytes(b'half')\n"
+        "    os._exit(9)\n"
+    )
+    target = tmp_path / "level_029.vtu"
+    proc = subprocess.run([sys.executable, "-c", code, str(target)], timeout=60)
+    assert proc.returncode == 9
+    left = os.listdir(tmp_path)
+    print(left)
+    assert len(left) == 1 and left[0].startswith(".level_029.vtu.")
+    assert left[0].endswith(files.TEMP_SUFFIX) and files.is_temporary(left[0])
+    # a leftover of earlier versions, and files that only look alike, which stay
+    (tmp_path / ".level_029.vtu.k2x_9abc.vtu").write_bytes(b"")
+    keep = ["level_029.vtu", "notes.vtu", ".hidden.vtu", ".a.b.signorini-tmp.txt"]
+    for name in keep:
+        (tmp_path / name).write_bytes(b"x")
+    removed = files.remove_temporaries(tmp_path)
+    assert sorted(p.name for p in removed) == sorted([left[0], ".level_029.vtu.k2x_9abc.vtu"])
+    assert sorted(os.listdir(tmp_path)) == sorted(keep)
+    assert files.remove_temporaries(tmp_path / "missing") == []

@@ -1,26 +1,40 @@
 """Atomic file replacement: an interrupted run never leaves a half-written file behind.
 
 Each file is written to a temporary file in the same folder, then moved over the target with
-``os.replace``.
+``os.replace``. A temporary file is named ``.<target name>.<8 random characters>.signorini-tmp``;
+if the process is killed before the move, :func:`remove_temporaries` recognises and removes
+it (the command line does so at the start of every run into a folder).
 """
 
 from __future__ import annotations
 
 import os
+import re
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["atomic_write", "replacing"]
+__all__ = ["TEMP_SUFFIX", "atomic_write", "remove_temporaries", "replacing"]
+
+#: Ending of every temporary file the atomic writers create.
+TEMP_SUFFIX = ".signorini-tmp"
+
+# ".<name>.<mkstemp's 8 characters><suffix>"; ".tmp" and ".vtu" were the suffixes of
+# earlier versions, whose leftovers are removed too
+_TEMPORARY = re.compile(r"^\..+\.[a-z0-9_]{8}(\.signorini-tmp|\.tmp|\.vtu)$")
 
 
 @contextmanager
-def replacing(path: str | os.PathLike, suffix: str = ".tmp") -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; on success it replaces ``path`` atomically."""
+def replacing(path: str | os.PathLike) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; on success it replaces ``path`` atomically.
+
+    On any exception (KeyboardInterrupt included) the temporary file is removed and ``path``
+    is left as it was.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=suffix)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=TEMP_SUFFIX)
     os.close(fd)
     try:
         yield Path(tmp)
@@ -41,3 +55,27 @@ def atomic_write(path: str | os.PathLike, data: bytes) -> Path:
         fh.flush()
         os.fsync(fh.fileno())
     return Path(path)
+
+
+def is_temporary(name: str) -> bool:
+    """Whether a file name is that of a temporary file left by an atomic writer."""
+    return _TEMPORARY.match(name) is not None
+
+
+def remove_temporaries(folder: str | os.PathLike) -> list[Path]:
+    """Remove the temporary files an interrupted atomic write left in ``folder``.
+
+    Returns
+    -------
+    list of Path
+        The files removed (none if ``folder`` does not exist).
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    removed = []
+    for entry in os.scandir(folder):
+        if entry.is_file(follow_symlinks=False) and is_temporary(entry.name):
+            Path(entry.path).unlink(missing_ok=True)
+            removed.append(Path(entry.path))
+    return removed

@@ -21,7 +21,13 @@ from numpy.typing import ArrayLike
 
 from .files import atomic_write
 
-__all__ = ["HistoryWriter", "read_history", "history_columns", "fitted_slope"]
+__all__ = [
+    "HistoryWriter",
+    "read_history",
+    "history_columns",
+    "fitted_slope",
+    "write_columns",
+]
 
 #: A history: a mapping from column name to (n_levels,) array, or the path of a CSV file.
 HistoryLike = Mapping[str, ArrayLike] | str | os.PathLike
@@ -38,11 +44,14 @@ class HistoryWriter:
     ----------
     path : str or os.PathLike
         The CSV file (replaced if it exists).
+    rows : sequence of mapping, optional
+        Rows already written (e.g. read back from the file to continue a run); they are
+        written again as they are.
     """
 
-    def __init__(self, path: str | os.PathLike) -> None:
+    def __init__(self, path: str | os.PathLike, rows: Sequence[Mapping] = ()) -> None:
         self.path = Path(path)
-        self.rows: list[dict] = []
+        self.rows: list[dict] = [dict(r) for r in rows]
 
     def append(self, row: Mapping[str, object]) -> None:
         """Add one level's row and rewrite the file."""
@@ -56,6 +65,29 @@ class HistoryWriter:
         for r in self.rows:
             writer.writerow({c: _fmt(r.get(c, "")) for c in columns})
         atomic_write(self.path, out.getvalue().encode())
+
+
+def write_columns(path: str | os.PathLike, columns: Mapping[str, str]) -> Path:
+    """Write the description of a history's columns as a Markdown table (atomically).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file, e.g. ``history.md`` beside ``history.csv``.
+    columns : mapping of str to str
+        Column name to its meaning and unit.
+    """
+    lines = [
+        "# Columns of history.csv",
+        "",
+        "One row per level. Units are those of the problem's data (consistent units: if E is "
+        "in MPa and lengths in mm, forces are in N/mm of thickness).",
+        "",
+        "| column | meaning |",
+        "|---|---|",
+        *(f"| `{name}` | {text} |" for name, text in columns.items()),
+    ]
+    return atomic_write(path, ("\n".join(lines) + "\n").encode())
 
 
 def _fmt(value: object) -> object:

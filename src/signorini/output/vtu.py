@@ -58,6 +58,6 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
         },
         cell_data=cell_data,
     )
-    with replacing(path, suffix=".vtu") as tmp:
+    with replacing(path) as tmp:
         meshio.write(tmp, mesh, file_format="vtu")
     return Path(path)

@@ -1,0 +1,327 @@
+"""Run folders: a run owns its output folder, and an interrupted run can be continued.
+
+The rule (one for every run of the command line):
+
+- A run writes ``signorini-run.json`` (the *manifest*) into its folder before anything else:
+  the problem, the arguments that decide the numbers and the files, the run's status
+  (``running``, ``interrupted``, ``finished``) and the name of every file the run writes,
+  recorded before the file is written.
+- A run starts only in a folder that does not exist or is empty. A non-empty folder is
+  refused unless ``overwrite`` is given; then exactly the old run's files are removed first:
+  those its manifest lists, plus the names the command line writes (``level_NNN.vtu``,
+  ``history.csv``, ``history.md``, ``resume.npz``, ``uniform/history.csv``, the manifest,
+  and with a manifest the figures named after its problem). Any other file stays.
+- Temporary files of interrupted atomic writes (:func:`~signorini.output.files.is_temporary`)
+  are removed by the next run into the folder, whatever its options.
+- After each finished level the run saves ``resume.npz`` atomically: that level's index, the
+  next level's mesh exactly as stored (points, cells in their vertex order, which fixes the
+  refinement edges of newest vertex bisection, boundary edges and parts) and its warm start
+  (the solution prolongated to that mesh); after the run's last level, that level's own
+  mesh and solution, from which the figures can be drawn again. :meth:`RunFolder.restart`
+  reads it back, so that the loop continues where it stopped and yields the levels an
+  uninterrupted run yields. A finished run removes it.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import io
+import json
+import os
+import re
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..mesh.mesh import Mesh
+from .files import atomic_write, remove_temporaries, replacing
+
+__all__ = ["MANIFEST", "STATE", "RunFolder", "RunFolderError", "ResumeState", "file_digest"]
+
+MANIFEST = "signorini-run.json"
+STATE = "resume.npz"
+_FORMAT = 1
+# files of a run, by name, in the run's folder and in its "uniform" sub-folder
+_RUN_FILE = re.compile(
+    r"^(level_\d{3,}\.vtu|history\.csv|history\.md|resume\.npz|signorini-run\.json)$"
+)
+_FIGURE_NAMES = ("mesh", "deformed", "adaptive_vs_uniform")
+UNIFORM = "uniform"
+
+
+class RunFolderError(ValueError):
+    """An output folder that cannot be used as asked (the message says why and what to do)."""
+
+
+def file_digest(path: str | os.PathLike) -> str:
+    """SHA-256 of a file's bytes, as hex."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+@dataclass
+class ResumeState:
+    """What :meth:`RunFolder.restart` found: where to continue an interrupted run.
+
+    Attributes
+    ----------
+    level : int
+        Index of the last finished level (-1 when none finished).
+    final : bool
+        Whether that level was the run's last (only the figures may be missing).
+    mesh : Mesh or None
+        The next level's mesh; when ``final``, the last level's own mesh (None when no
+        level finished).
+    u0 : (n_nodes, 2) float array or None
+        The warm start on ``mesh``: the next level's, or when ``final`` the last level's
+        solution.
+    history_rows : list of dict
+        The history rows of levels ``0 … level``, as text.
+    """
+
+    level: int
+    final: bool
+    mesh: Mesh | None
+    u0: np.ndarray | None
+    history_rows: list[dict]
+
+
+def _listing(folder: Path) -> list[str]:
+    return sorted(os.listdir(folder)) if folder.is_dir() else []
+
+
+def _describe(names: list[str]) -> str:
+    shown = ", ".join(names[:4])
+    return shown + (f" and {len(names) - 4} more" if len(names) > 4 else "")
+
+
+class RunFolder:
+    """The output folder of one run and its manifest.
+
+    Use :meth:`create` for a new run; :meth:`open` and :meth:`restart` to continue an
+    interrupted one.
+    """
+
+    def __init__(self, path: Path, manifest: dict) -> None:
+        self.path = path
+        self.manifest = manifest
+
+    # ------------------------------------------------------------------ opening
+    @classmethod
+    def create(
+        cls, path: str | os.PathLike, problem: dict, arguments: dict, *, overwrite: bool = False
+    ) -> tuple[RunFolder, list[Path]]:
+        """Claim ``path`` for a new run and write its manifest.
+
+        Parameters
+        ----------
+        path : folder (created if missing)
+        problem : dict
+            How the run names its problem (JSON-serialisable).
+        arguments : dict
+            The run's arguments (JSON-serialisable).
+        overwrite : bool
+            Remove a previous run's files from a non-empty folder instead of refusing it.
+
+        Returns
+        -------
+        (RunFolder, list of Path)
+            The folder, and the files removed (temporary files and, with ``overwrite``, the
+            previous run's files).
+
+        Raises
+        ------
+        RunFolderError
+            If ``path`` is an existing file, or a non-empty folder without ``overwrite``.
+        """
+        path = Path(path)
+        cls._check_is_folder(path)
+        removed = remove_temporaries(path) + remove_temporaries(path / UNIFORM)
+        present = _listing(path)
+        if present and not overwrite:
+            old = cls._read_manifest(path)
+            what = (
+                f"it holds a run of {old.get('problem', {}).get('name', '?')} "
+                f"({old.get('status', '?')})"
+                if old
+                else f"it holds {len(present)} file(s): {_describe(present)}"
+            )
+            raise RunFolderError(
+                f"output folder {path} is not empty: {what}. Give --overwrite to remove "
+                f"that run's files first (only the files a run writes), --resume {path} to "
+                "continue an interrupted run, or another --out folder"
+            )
+        if present:
+            removed += cls._remove_run_files(path)
+        path.mkdir(parents=True, exist_ok=True)
+        folder = cls(
+            path,
+            {
+                "format": _FORMAT,
+                "problem": problem,
+                "arguments": arguments,
+                "status": "running",
+                "files": [MANIFEST],
+            },
+        )
+        folder._write_manifest()
+        return folder, removed
+
+    @classmethod
+    def open(cls, path: str | os.PathLike) -> RunFolder:
+        """The folder of an earlier run, read only (to check it before :meth:`restart`).
+
+        Raises
+        ------
+        RunFolderError
+            If ``path`` is not a folder with a manifest.
+        """
+        path = Path(path)
+        if not path.is_dir():
+            raise RunFolderError(f"cannot resume: {path} is not a folder")
+        manifest = cls._read_manifest(path)
+        if manifest is None:
+            raise RunFolderError(
+                f"cannot resume: {path} holds no {MANIFEST}, so no run of signorini wrote it"
+            )
+        return cls(path, manifest)
+
+    def restart(self) -> ResumeState:
+        """Prepare the folder to continue the run: remove temporary files and the files of
+        levels after the last one saved in ``resume.npz``, and return the saved state with
+        the history rows of the saved levels.
+
+        Raises
+        ------
+        RunFolderError
+            If the saved state is unreadable or inconsistent with the history.
+        """
+        path = self.path
+        remove_temporaries(path)
+        remove_temporaries(path / UNIFORM)
+        state = self._read_state()
+        rows = self._history_rows()
+        if len(rows) < state.level + 1:
+            raise RunFolderError(
+                f"cannot resume: {path / 'history.csv'} has {len(rows)} level(s) but "
+                f"{STATE} says level {state.level} finished; start again with --overwrite"
+            )
+        state.history_rows = rows[: state.level + 1]
+        for name in _listing(path):
+            m = re.fullmatch(r"level_(\d{3,})\.vtu", name)
+            if m and int(m.group(1)) > state.level:
+                (path / name).unlink()
+        self.set_status("running")
+        return state
+
+    # ------------------------------------------------------------------ writing
+    def add_files(self, *names: str) -> None:
+        """Record files (relative to the folder) as the run's, before they are written."""
+        files = self.manifest["files"]
+        new = [n for n in names if n not in files]
+        if new:
+            files.extend(new)
+            self._write_manifest()
+
+    def set_status(self, status: str) -> None:
+        """Record the run's status: ``running``, ``interrupted`` or ``finished`` (a finished
+        run needs no resume state: ``resume.npz`` is removed)."""
+        self.manifest["status"] = status
+        self._write_manifest()
+        if status == "finished":
+            (self.path / STATE).unlink(missing_ok=True)
+
+    def save_state(self, level: int, mesh: Mesh, u0: np.ndarray | None, final: bool) -> None:
+        """Save atomically that ``level`` finished, with the next level's mesh and warm start
+        (``final``: that level was the run's last; then its own mesh and solution)."""
+        self.add_files(STATE)
+        arrays: dict[str, np.ndarray] = {
+            "level": np.array(level, dtype=np.int64),
+            "final": np.array(final),
+        }
+        if mesh is not None:
+            arrays.update(
+                points=mesh.points,
+                cells=mesh.cells,
+                boundary=mesh.boundary,
+                boundary_part=mesh.boundary_part,
+                part_names=np.array(mesh.part_names, dtype=str),
+            )
+            if u0 is not None:
+                arrays["u0"] = np.asarray(u0, dtype=np.float64)
+        with replacing(self.path / STATE) as tmp, open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+
+    # ------------------------------------------------------------------ internals
+    @staticmethod
+    def _check_is_folder(path: Path) -> None:
+        if path.exists() and not path.is_dir():
+            raise RunFolderError(
+                f"--out {path} is an existing file, not a folder: give a folder name"
+            )
+
+    @staticmethod
+    def _read_manifest(path: Path) -> dict | None:
+        try:
+            manifest = json.loads((path / MANIFEST).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return None
+        return manifest if isinstance(manifest, dict) else None
+
+    def _write_manifest(self) -> None:
+        text = json.dumps(self.manifest, indent=1, sort_keys=True) + "\n"
+        atomic_write(self.path / MANIFEST, text.encode())
+
+    @classmethod
+    def _remove_run_files(cls, path: Path) -> list[Path]:
+        """Remove what a previous run wrote into ``path``, never any other file."""
+        manifest = cls._read_manifest(path) or {}
+        listed = {str(n) for n in manifest.get("files", [])}
+        label = str(manifest.get("problem", {}).get("label", ""))
+        stems = "|".join(re.escape(n) for n in (*_FIGURE_NAMES, *([label] if label else [])))
+        figure = re.compile(rf"^({stems})[\w.-]*\.(png|pdf)$")
+        removed = []
+        for sub in ("", UNIFORM):
+            folder = path / sub if sub else path
+            for name in _listing(folder):
+                rel = f"{sub}/{name}" if sub else name
+                target = folder / name
+                if not target.is_file():
+                    continue
+                if rel in listed or _RUN_FILE.match(name) or (not sub and figure.match(name)):
+                    target.unlink()
+                    removed.append(target)
+        uniform = path / UNIFORM
+        if uniform.is_dir() and not os.listdir(uniform):
+            shutil.rmtree(uniform)
+        return removed
+
+    def _read_state(self) -> ResumeState:
+        file = self.path / STATE
+        if not file.is_file():  # no level finished
+            return ResumeState(-1, False, None, None, [])
+        try:
+            with np.load(file) as data:
+                level, final = int(data["level"]), bool(data["final"])
+                mesh = Mesh(
+                    data["points"],
+                    data["cells"],
+                    data["boundary"],
+                    data["boundary_part"],
+                    [str(n) for n in data["part_names"]],
+                )
+                u0 = np.array(data["u0"]) if "u0" in data else None
+        except (OSError, ValueError, KeyError) as exc:
+            raise RunFolderError(
+                f"cannot resume: {file} is unreadable ({exc}); start again with --overwrite"
+            ) from None
+        return ResumeState(level, final, mesh, u0, [])
+
+    def _history_rows(self) -> list[dict]:
+        file = self.path / "history.csv"
+        if not file.is_file():
+            return []
+        text = file.read_text(encoding="utf-8")
+        return list(csv.DictReader(io.StringIO(text)))
