@@ -542,6 +542,7 @@ def test_version_and_help(capsys):
     assert "A problem file is Python code: signorini executes it with your rights" in text
     assert re.search(r"--max-levels MAX_LEVELS\s+stop after this many levels", text)
     assert "--resume DIR" in text and "--overwrite" in text
+    assert re.search(r"--fallback\s+where the active set iteration cycles", text)
 
 
 def test_history_md_describes_every_column(tmp_path):

@@ -343,3 +343,21 @@ def test_example_6_2_refines_at_the_singular_points(run_6_2):
         fine = finest_near(p)
         print(f"smallest cell near {np.round(p, 4)}: {fine:.2e} (away from them: {coarse:.2e})")
         assert fine <= coarse / 20
+
+
+@pytest.mark.parametrize("fallback", [False, True])
+def test_fallback_reaches_every_solve(fallback, monkeypatch):
+    """The advice of a PDAS failure (finish with the primal active set method) can be given
+    to the loop: ``adaptive(..., fallback=True)`` passes it to each level's solve."""
+    import signorini.loop as loop
+
+    seen = []
+    real = loop.solve
+
+    def spy(*args, **kw):
+        seen.append(kw["fallback"])
+        return real(*args, **kw)
+
+    monkeypatch.setattr(loop, "solve", spy)
+    levels = list(adaptive(example_6_2(), max_ndof=400, fallback=fallback))
+    assert len(seen) == len(levels) >= 3 and set(seen) == {fallback}

@@ -50,6 +50,7 @@ RUN_DEFAULTS: dict[str, object] = {
     "max_levels": 100,
     "eta5": "consistent",
     "backend": "auto",
+    "fallback": False,
     "no_vtu": False,
     "compare_uniform": False,
 }
@@ -116,6 +117,12 @@ def _parser() -> argparse.ArgumentParser:
         "--backend",
         choices=("auto", *BACKENDS),
         help="sparse solver (default auto: pardiso if available, else scipy)",
+    )
+    run.add_argument(
+        "--fallback",
+        action="store_true",
+        help="where the active set iteration cycles, finish that level with the primal "
+        "active set method instead of stopping",
     )
     run.add_argument(
         "--out", type=Path, default=None, help="output folder (default results/<problem>)"
@@ -424,6 +431,7 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
         "uniform": opts["uniform"],
         "eta5": opts["eta5"],
         "backend": opts["backend"],
+        "fallback": opts["fallback"],
     }
     status.phase = "at level 0" if state is None else f"at level {state.level + 1}"
     last = None
@@ -487,6 +495,7 @@ def _compare_uniform(
         uniform=True,
         eta5=opts["eta5"],
         backend=opts["backend"],
+        fallback=opts["fallback"],
         max_levels=opts["max_levels"],
     )
     _write_levels(levels, history, folder, vtu=False, save_state=False, say=say)

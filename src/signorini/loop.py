@@ -285,6 +285,7 @@ def adaptive(
     mesh: Mesh | None = None,
     u0: np.ndarray | None = None,
     first_level: int = 0,
+    fallback: bool = False,
 ) -> Iterator[Level]:
     """Run SOLVE → ESTIMATE → MARK → REFINE, yielding each finished level.
 
@@ -323,6 +324,10 @@ def adaptive(
         Index of the first level (default 0). To continue a run from its level ``k``, pass
         ``mesh=level.next_mesh, u0=level.next_u0, first_level=k + 1`` and the run's other
         arguments: the levels are those an uninterrupted run yields.
+    fallback : bool
+        Where PDAS cycles or reaches its iteration bound, finish that level's solve with the
+        primal active set method instead of raising (:func:`signorini.solve`); the record's
+        ``n_solves`` counts both.
 
     Yields
     ------
@@ -358,7 +363,7 @@ def adaptive(
             f"the initial mesh already has {problem.free_ndof(mesh)} unknowns, "
             f"more than max_ndof={max_ndof}"
         )
-    return _levels(problem, mesh, u0, warm_start=bool(warm_start), **args)
+    return _levels(problem, mesh, u0, warm_start=bool(warm_start), fallback=bool(fallback), **args)
 
 
 def _levels(
@@ -374,11 +379,12 @@ def _levels(
     eta5: str,
     backend: str,
     warm_start: bool,
+    fallback: bool,
     first_level: int,
 ) -> Iterator[Level]:
     """The loop of :func:`adaptive`, on checked arguments."""
     for level in range(first_level, max_levels):
-        result = solve(problem, mesh, u0=u0, backend=backend)
+        result = solve(problem, mesh, u0=u0, backend=backend, fallback=fallback)
         u0 = None
         t0 = time.perf_counter()
         est = estimate(result, eta5=eta5)

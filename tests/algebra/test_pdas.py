@@ -260,6 +260,8 @@ def test_cycling_is_detected_and_fallback_solves():
     assert err.reason == "cycling"
     assert len(err.history) >= 2
     assert "iteration history" in str(err) and "fallback=True" in str(err)
+    # the advice names every place it can be given
+    assert "adaptive()" in str(err) and "--fallback" in str(err)
     result = solve_pdas(K, CYCLING_F, np.arange(4), CYCLING_G, fallback=True)
     assert result.method == "primal-active-set"
     assert any(step.method == "primal-active-set" for step in result.history)

@@ -337,7 +337,8 @@ def _after_failure(
     reason, message = failure
     if not fallback:
         raise PDASConvergenceError(
-            message + " (pass fallback=True to finish with a primal active set method)",
+            message + " (to finish with a primal active set method instead, pass fallback=True to "
+            "solve() or adaptive(), or --fallback to signorini run)",
             history,
             reason,
             x=x,
