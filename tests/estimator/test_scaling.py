@@ -45,7 +45,7 @@ def scaled(problem, c: float):
     """``problem`` with λ, μ, the body force and the tractions multiplied by ``c``."""
 
     def times_c(g):
-        return Neumann(lambda x, n: c * g(x, n))
+        return Neumann(lambda x, normal: c * g(x, normal))
 
     conditions = {
         name: times_c(cond.field()) if isinstance(cond, Neumann) else cond
