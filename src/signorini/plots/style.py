@@ -119,6 +119,12 @@ def trim_height(fig: Figure, passes: int = 3, pad: float = 0.06) -> None:
     """
     engine = fig.get_layout_engine()
     renderer = fig.canvas.get_renderer()
+    # data clipped to its axes cannot reach out of them: leave it out of the extents (for a
+    # mesh of many cells, measuring every triangle would cost more than drawing the figure)
+    for ax in fig.axes:
+        for artist in (*ax.collections, *ax.lines, *ax.patches, *ax.images):
+            if artist.get_clip_on() and artist.get_clip_box() is not None:
+                artist.set_in_layout(False)
     for _ in range(passes):
         engine.execute(fig)
         for ax in fig.axes:
