@@ -21,7 +21,13 @@ from ..mesh.mesh import boundary_edges
 from .mesh import line_width, mesh_arrays
 from .style import RC, STYLES, fit_title, new_figure, save_figure, trim_height
 
-__all__ = ["plot_deformed", "contact_coordinate", "displacement_scale", "scale_text"]
+__all__ = [
+    "plot_deformed",
+    "contact_coordinate",
+    "displacement_scale",
+    "scale_text",
+    "free_boundary_ends",
+]
 
 #: Largest displacement drawn, as a fraction of the body's size, when it is rescaled.
 DRAWN_FRACTION = 0.1
@@ -110,6 +116,34 @@ def contact_coordinate(cp: np.ndarray) -> tuple[np.ndarray, str]:
         direction = -direction
     t = centred @ direction
     return t - t.min(), r"$s$ (along $\Gamma_C$)"
+
+
+def free_boundary_ends(contact_points: ArrayLike, active: ArrayLike) -> np.ndarray:
+    """Where the contact zone ends: midpoints between neighbouring contact nodes, one active
+    and one not, in order along the boundary (:func:`contact_coordinate`).
+
+    Parameters
+    ----------
+    contact_points : (k, 2) float array
+        The contact nodes, in any order.
+    active : (k,) bool array
+        Which of them are in contact.
+
+    Returns
+    -------
+    (m, 2) float array
+        The ends (none when the whole boundary, or none of it, is in contact).
+    """
+    cp = np.asarray(contact_points, dtype=np.float64).reshape(-1, 2)
+    on = np.asarray(active, dtype=bool).reshape(-1)
+    if on.shape != (cp.shape[0],):
+        raise ValueError(f"active must have shape ({cp.shape[0]},), got {on.shape}")
+    if cp.shape[0] < 2:
+        return np.zeros((0, 2))
+    order = np.argsort(contact_coordinate(cp)[0], kind="stable")
+    q, a = cp[order], on[order]
+    change = np.flatnonzero(a[1:] != a[:-1])
+    return 0.5 * (q[change] + q[change + 1])
 
 
 def _draw_body(

@@ -19,6 +19,7 @@ from pathlib import Path
 import matplotlib as mpl
 import numpy as np
 from matplotlib.collections import LineCollection
+from matplotlib.patches import Rectangle
 from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
@@ -163,6 +164,8 @@ def plot_mesh(
     highlight: ArrayLike | Mapping[str, ArrayLike] | None = None,
     highlight_label: str = r"contact boundary $\Gamma_C$",
     colors: Sequence[str] = _HIGHLIGHT_COLORS,
+    zoom: tuple[float, float, float] | None = None,
+    zoom_title: str = "zoom",
 ) -> list[Path]:
     """Fig. 6.3(b): a triangulation, thin lines, equal aspect, with boundary edges highlighted.
 
@@ -184,6 +187,12 @@ def plot_mesh(
         Legend label of ``highlight`` when it is a single array.
     colors : sequence of str
         Colours of the highlighted groups, in order (repeated if there are more groups).
+    zoom : (x, y, half_width), optional
+        A second panel below shows the square window of this centre and half width (e.g.
+        around a free-boundary end, :func:`~signorini.plots.deformed.free_boundary_ends`);
+        the window is outlined on the whole mesh.
+    zoom_title : str
+        Title of the zoom panel.
 
     Returns
     -------
@@ -201,27 +210,45 @@ def plot_mesh(
         span = np.ptp(p, axis=0) if p.size else np.ones(2)
         aspect = float(span[1] / max(span[0], 1e-300))
         # the equal-aspect box is ~3 in wide; the height follows, plus title, labels, legend
-        fig = new_figure(height=float(np.clip(2.9 * aspect, 0.8, 3.0)) + 1.1)
-        ax = fig.add_subplot()
-        ax.triplot(
-            Triangulation(p[:, 0], p[:, 1], c),
-            color="0.15",
-            linewidth=line_width(c.shape[0]),
-            rasterized=big,
-        )
-        for i, (label, e) in enumerate(groups.items()):
-            if e.shape[0] == 0:
+        body = float(np.clip(2.9 * aspect, 0.8, 3.0))
+        if zoom is None:
+            fig = new_figure(height=body + 1.1)
+            ax, axz = fig.add_subplot(), None
+        else:
+            fig = new_figure(height=body + 1.1 + 2.1)
+            ax, axz = fig.subplots(2, 1, gridspec_kw={"height_ratios": [body + 0.5, 1.9]})
+        tri = Triangulation(p[:, 0], p[:, 1], c)
+        for a, width, labelled in ((ax, line_width(c.shape[0]), True), (axz, 0.5, False)):
+            if a is None:
                 continue
-            color = colors[i % len(colors)]
-            ax.add_collection(
-                LineCollection(  # thin: the refinement along the boundary stays visible
-                    p[e], colors=color, linewidths=1.1, label=label, zorder=4, capstyle="butt"
+            a.triplot(tri, color="0.15", linewidth=width, rasterized=big)
+            for i, (label, e) in enumerate(groups.items()):
+                if e.shape[0] == 0:
+                    continue
+                a.add_collection(
+                    LineCollection(  # thin: the refinement along the boundary stays visible
+                        p[e],
+                        colors=colors[i % len(colors)],
+                        linewidths=1.1 if labelled else 1.6,
+                        label=label if labelled else "_" + label,
+                        zorder=4,
+                        capstyle="butt",
+                    )
                 )
-            )
-        ax.set_aspect("equal")
-        ax.set_xlabel(r"$x$")
-        ax.set_ylabel(r"$y$")
+            a.set_aspect("equal")
+            a.set_xlabel(r"$x$")
+            a.set_ylabel(r"$y$")
         ax.autoscale_view()
+        if axz is not None:
+            x, y, half = (float(v) for v in zoom)
+            if not (np.isfinite([x, y, half]).all() and half > 0):
+                raise ValueError(f"zoom must be (x, y, half_width > 0), got {zoom}")
+            axz.set_xlim(x - half, x + half)
+            axz.set_ylim(y - half, y + half)
+            axz.set_title(fit_title(zoom_title, fig))
+            ax.add_patch(
+                Rectangle((x - half, y - half), 2 * half, 2 * half, fill=False, lw=0.9, zorder=5)
+            )
         if any(e.shape[0] for e in groups.values()):
             shown = sum(1 for e in groups.values() if e.shape[0])
             fig.legend(loc="outside lower center", ncols=min(shown, 3))
