@@ -210,6 +210,7 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
     """
     from . import plots
     from .output import read_history
+    from .plots.deformed import free_boundary_ends
 
     written = list(plots.make_figures(out / "history.csv", out, example))
     if last is None:
@@ -238,6 +239,15 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
         )
         for label, parts in kinds.items()
     }
+    # a zoom on the first end of the contact zone, if it ends inside Γ_C
+    cs = res.contact
+    ends = free_boundary_ends(res.space.node_points[cs.nodes], res.active)
+    zoom = {}
+    if len(ends):
+        half = 0.06 * float(np.ptp(points, axis=0).max())
+        # the window inside the body's bounding box, so it shows mesh, not empty space
+        centre = np.clip(ends[0], points.min(axis=0) + 0.9 * half, points.max(axis=0) - 0.9 * half)
+        zoom = {"zoom": (*centre, half), "zoom_title": "end of the contact zone"}
     written += plots.plot_mesh(
         points,
         cells,
@@ -245,8 +255,8 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
         title=f"{example}: mesh, level {level}, {cells.shape[0]} cells",
         highlight=plots.boundary_groups(points, cells, segments),
         colors=("#1f77b4", "#2ca02c", "#d62728"),
+        **zoom,
     )
-    cs = res.contact
     written += plots.plot_deformed(
         mesh.points,
         mesh.cells,
