@@ -7,7 +7,7 @@ import pytest
 
 from signorini.mesh.builders import rectangle
 from signorini.plots import plot_deformed
-from signorini.plots.deformed import contact_coordinate, displacement_scale
+from signorini.plots.deformed import contact_coordinate, displacement_scale, free_boundary_ends
 
 from .figure_checks import check_written
 
@@ -123,3 +123,16 @@ def test_obstacle_from_the_gap_is_drawn_with_the_body_scale(tmp_path, captured):
         plot_deformed(p, c, u, tmp_path / "x", contact_points=bottom, gap=gap)
     with pytest.raises(ValueError, match="scale must be"):
         plot_deformed(p, c, u, tmp_path / "x", scale="big")
+
+
+def test_free_boundary_ends_lie_between_active_and_inactive_neighbours():
+    s = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+    d = np.array([0.6, 0.8])
+    pts = s[:, None] * d
+    active = np.array([False, True, True, False, False])
+    shuffled = np.array([3, 0, 4, 2, 1])
+    ends = free_boundary_ends(pts[shuffled], active[shuffled])
+    np.testing.assert_allclose(ends, [0.125 * d, 0.625 * d])
+    assert free_boundary_ends(pts, np.ones(5, bool)).shape == (0, 2)
+    with pytest.raises(ValueError, match="active must have shape"):
+        free_boundary_ends(pts, active[:3])

@@ -71,6 +71,9 @@ def test_every_figure_of_the_examples_is_readable(tmp_path, captured, monkeypatc
         n_cells = int(info["titles"][0].rsplit(", ", 1)[1].split()[0])
         assert n_cells <= READABLE_CELLS
     assert np.all([len(i["segments"]) == 3 for i in meshes])
+    # where the contact zone ends inside Γ_C (6.2, the block), a zoom panel shows it
+    assert [len(i["titles"]) for i in meshes] == [1, 2, 2]
+    assert [i["titles"][1] for i in meshes[1:]] == ["end of the contact zone"] * 2
     # Example 6.1: the mesh of level 6 (the last with <= 200 cells), from level_006.vtu
     history = np.genfromtxt(tmp_path / "e1" / "history.csv", delimiter=",", names=True)
     k = int(np.flatnonzero(history["n_cells"] <= 200)[-1])

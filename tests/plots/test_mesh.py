@@ -97,3 +97,23 @@ def test_mesh_figure_height_follows_a_wide_body(tmp_path, captured):
     height = png_size(written[0])[1] / DPI
     print(f"figure height {height:.2f} in")
     assert height < 2.2
+
+
+def test_mesh_figure_with_a_zoom(tmp_path, captured):
+    mesh = refine_uniform(rectangle(nx=4, ny=4)).mesh
+    right = mesh.edges[mesh.part_edges("right")]
+    plot_mesh(
+        mesh.points,
+        mesh.cells,
+        tmp_path / "z",
+        highlight={"C": right},
+        zoom=(0.9, 0.5, 0.1),
+        zoom_title="end of the contact zone",
+    )
+    (info,) = captured
+    assert info["titles"] == ["", "end of the contact zone"]
+    assert info["ylim"][1] == pytest.approx((0.4, 0.6)) and info["legend"] == ["C"]
+    (frame,) = [p for p in info["patches"] if p.get_width() == pytest.approx(0.2)]
+    assert frame.get_xy() == pytest.approx((0.8, 0.4))
+    with pytest.raises(ValueError, match="zoom must be"):
+        plot_mesh(mesh.points, mesh.cells, tmp_path / "x", zoom=(0.5, 0.5, 0.0))
