@@ -100,12 +100,16 @@ def fit_title(title: str, fig: Figure, share: float = 0.9) -> str:
     """``title`` with its lines wrapped at spaces to fit ``share`` of the figure's width.
 
     The width of a character is taken as 0.6 em of the title font (DejaVu Sans averages
-    about 0.55 em), so a wrapped line is not wider than the figure and is not clipped.
+    about 0.55 em), so a wrapped line is not wider than the figure and is not clipped. A line
+    with mathtext (``$``) is not wrapped.
     """
     size = FontProperties(size=mpl.rcParams["axes.titlesize"]).get_size_in_points()
     chars = max(int(share * fig.get_figwidth() * 72.0 / (0.6 * size)), 10)
     lines = []
     for line in str(title).splitlines() or [""]:
+        if "$" in line:  # mathtext: a break inside $...$ would not render; left as is
+            lines.append(line)
+            continue
         lines += textwrap.wrap(line, chars, break_long_words=False, break_on_hyphens=False) or [""]
     return "\n".join(lines)
 
