@@ -513,36 +513,73 @@ def _compare_uniform(
 
 
 def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
+    """The run's convergence figures; with its last level also the mesh and the deformed body.
+
+    The mesh figure shows the finest level of at most ``plots.READABLE_CELLS`` cells (read back
+    from its ``level_NNN.vtu``; the last level when that file is missing or holds another
+    mesh), with Γ_D, Γ_N and Γ_C marked. The deformed body is drawn with a stated displacement
+    scale, the obstacle at its gap with the same scale.
+    """
     from . import plots
+    from .output import read_history
+    from .plots.deformed import free_boundary_ends
 
     written = list(plots.make_figures(out / "history.csv", out, example))
-    if last is not None:
-        res = last.result
-        mesh = res.mesh
-        contact = mesh.edges[res.contact.edges]
-        written += plots.plot_mesh(
-            mesh.points,
-            mesh.cells,
-            out / "mesh",
-            title=f"{example}: final mesh, {mesh.n_cells} cells",
-            highlight=contact,
+    if last is None:
+        return written
+    res = last.result
+    mesh = res.mesh
+    # the level the mesh figure shows
+    history = read_history(out / "history.csv")
+    k = plots.readable_level(history["n_cells"])
+    level, points, cells = last.record.level, mesh.points, mesh.cells
+    if k != level and (out / f"level_{k:03d}.vtu").is_file():
+        p, c = plots.read_level_mesh(out / f"level_{k:03d}.vtu")
+        if c.shape[0] == int(history["n_cells"][k]):
+            level, points, cells = k, p, c
+    problem = res.problem
+    initial = problem.mesh
+    kinds = {
+        r"Dirichlet $\Gamma_D$": problem.dirichlet_parts,
+        r"Neumann $\Gamma_N$": problem.neumann_parts,
+        r"contact $\Gamma_C$": problem.contact_parts,
+    }
+    segments = {
+        label: np.concatenate(
+            [initial.points[initial.edges[initial.part_edges(n)]] for n in parts]
+            or [np.zeros((0, 2, 2))]
         )
-        cs = res.contact
-        x = res.space.node_points[cs.nodes]
-        # the obstacle surface: each contact point moved by the gap along its normal
-        order = np.lexsort(x.T[::-1])
-        obstacle = (x + cs.gap[:, None] * cs.normal)[order]
-        written += plots.plot_deformed(
-            mesh.points,
-            mesh.cells,
-            res.u[: mesh.n_points],
-            out / "deformed",
-            contact_points=x,
-            pressure=res.pressure,
-            scale=1.0,
-            obstacle=obstacle,
-            title=f"{example}: deformed body and contact pressure",
-        )
+        for label, parts in kinds.items()
+    }
+    # a zoom on the first end of the contact zone, if it ends inside Γ_C
+    cs = res.contact
+    ends = free_boundary_ends(res.space.node_points[cs.nodes], res.active)
+    zoom = {}
+    if len(ends):
+        half = 0.06 * float(np.ptp(points, axis=0).max())
+        # the window inside the body's bounding box, so it shows mesh, not empty space
+        centre = np.clip(ends[0], points.min(axis=0) + 0.9 * half, points.max(axis=0) - 0.9 * half)
+        zoom = {"zoom": (*centre, half), "zoom_title": "end of the contact zone"}
+    written += plots.plot_mesh(
+        points,
+        cells,
+        out / "mesh",
+        title=f"{example}: mesh, level {level}, {cells.shape[0]} cells",
+        highlight=plots.boundary_groups(points, cells, segments),
+        colors=("#1f77b4", "#2ca02c", "#d62728"),
+        **zoom,
+    )
+    written += plots.plot_deformed(
+        mesh.points,
+        mesh.cells,
+        res.u[: mesh.n_points],
+        out / "deformed",
+        contact_points=res.space.node_points[cs.nodes],
+        pressure=res.pressure,
+        gap=cs.gap,
+        normal=cs.normal,
+        title=f"{example}: deformed body",
+    )
     return written
 
 

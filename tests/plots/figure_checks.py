@@ -86,6 +86,8 @@ def describe(fig: Figure) -> dict:
     }
     return {
         "legend": [t.get_text() for lg in legends for t in lg.get_texts()],
+        "legend_title": "\n".join(lg.get_title().get_text() for lg in legends),
+        "caption": fig._supxlabel.get_text() if fig._supxlabel is not None else "",
         "lines": lines,
         "segments": segments,
         "xlabel": [ax.get_xlabel() for ax in fig.axes],
@@ -97,6 +99,14 @@ def describe(fig: Figure) -> dict:
         "titles": [ax.get_title() for ax in fig.axes],
         "patches": [p for ax in fig.axes for p in ax.patches],
         "xticks": [list(ax.get_xticks()) for ax in fig.axes],
+        "lines_by_axes": [
+            [
+                (np.asarray(ln.get_xdata(), float), np.asarray(ln.get_ydata(), float))
+                for ln in ax.get_lines()
+            ]
+            for ax in fig.axes
+        ],
+        "yticklabels": [[t.get_text() for t in ax.get_yticklabels()] for ax in fig.axes],
     }
 
 
@@ -104,3 +114,122 @@ def legend_slope(label: str) -> float | None:
     """The slope a legend label states (``"…, slope −1.23"``), or None."""
     m = re.search(r", slope ([\u2212-]?\d+\.\d+)$", label)
     return float(m.group(1).replace("\u2212", "-")) if m else None
+
+
+def _boxes(fig: Figure, renderer) -> list[tuple[str, object]]:
+    """``(name, window extent)`` of every text a reader reads, and of every legend."""
+    boxes = []
+    axes = [a for ax in fig.axes for a in (ax, *ax.child_axes) if a.get_visible()]
+    for i, ax in enumerate(axes):
+        for title in (ax.title, ax._left_title, ax._right_title):
+            if title.get_text():
+                boxes.append(
+                    (f"axes {i} title {title.get_text()!r}", title.get_window_extent(renderer))
+                )
+        for axis, name in ((ax.xaxis, "x"), (ax.yaxis, "y")):
+            if axis.label.get_visible() and axis.label.get_text():
+                label = axis.label
+                boxes.append(
+                    (
+                        f"axes {i} {name} label {label.get_text()!r}",
+                        label.get_window_extent(renderer),
+                    )
+                )
+            # matplotlib draws the ticks inside the view interval (on the axis' scale)
+            scale = axis.get_transform()
+            lo, hi = sorted(scale.transform(np.asarray(axis.get_view_interval())))
+            slack = 1e-9 * (hi - lo)
+            for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+                loc = float(scale.transform(np.array([tick.get_loc()]))[0])
+                if not lo - slack <= loc <= hi + slack:
+                    continue
+                for label in (tick.label1, tick.label2):
+                    if label.get_visible() and label.get_text():
+                        b = label.get_window_extent(renderer)
+                        boxes.append((f"axes {i} {name} tick {label.get_text()!r}", b))
+        for t in ax.texts:
+            if t.get_visible() and t.get_text():
+                boxes.append((f"axes {i} text {t.get_text()!r}", t.get_window_extent(renderer)))
+        if ax.get_legend() is not None:
+            boxes.append((f"axes {i} legend", ax.get_legend().get_window_extent(renderer)))
+    for k, lg in enumerate(fig.legends):
+        boxes.append((f"figure legend {k}", lg.get_window_extent(renderer)))
+    for t in fig.texts:
+        if t.get_visible() and t.get_text():
+            boxes.append((f"figure text {t.get_text()!r}", t.get_window_extent(renderer)))
+    return boxes
+
+
+def layout_faults(fig: Figure, margin_in: float = 0.3) -> list[str]:
+    """What a reader of the saved figure would stumble on, as sentences (empty: none).
+
+    - a text or legend that leaves the canvas, even in part (a clipped title);
+    - two texts or legends that overlap (an x label under a legend, a legend over the slope
+      triangle's labels); tick labels of one axis are checked against other texts only;
+    - a legend inside the axes over a marker of a curve;
+    - an empty horizontal band of the canvas taller than ``margin_in`` inches, between the
+      drawn elements or at the top or bottom (a wide body in a tall figure).
+    """
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    frame = fig.bbox
+    faults = []
+    boxes = _boxes(fig, renderer)
+    tol = 0.5  # pixels
+    for name, b in boxes:
+        if (
+            b.x0 < frame.x0 - tol
+            or b.y0 < frame.y0 - tol
+            or b.x1 > frame.x1 + tol
+            or b.y1 > frame.y1 + tol
+        ):
+            faults.append(f"{name} leaves the canvas: {b.bounds} outside {frame.bounds}")
+    for i in range(len(boxes)):
+        for j in range(i + 1, len(boxes)):
+            (n1, b1), (n2, b2) = boxes[i], boxes[j]
+            if " tick " in n1 and " tick " in n2 and n1.split(" tick ")[0] == n2.split(" tick ")[0]:
+                continue  # two ticks of one axis: matplotlib spaces them
+            w = min(b1.x1, b2.x1) - max(b1.x0, b2.x0)
+            h = min(b1.y1, b2.y1) - max(b1.y0, b2.y0)
+            if w > tol and h > tol:
+                faults.append(f"{n1} and {n2} overlap by {w:.1f} x {h:.1f} px")
+    # a legend inside the axes must not hide the data: no marker of a curve under it
+    for i, ax in enumerate(fig.axes):
+        lg = ax.get_legend()
+        if lg is None:
+            continue
+        box = lg.get_window_extent(renderer)
+        for line in ax.get_lines():
+            xy = line.get_xydata()
+            xy = xy[np.all(np.isfinite(xy), axis=1)]
+            if xy.size == 0 or line.get_marker() in ("", "None", None):
+                continue
+            px = ax.transData.transform(xy)
+            under = (
+                (px[:, 0] > box.x0)
+                & (px[:, 0] < box.x1)
+                & (px[:, 1] > box.y0)
+                & (px[:, 1] < box.y1)
+            )
+            if under.any():
+                n, what = np.count_nonzero(under), line.get_label()
+                faults.append(f"axes {i} legend hides {n} point(s) of {what!r}")
+    # empty horizontal bands: cover [0, height] with every drawn box
+    drawn = [b for _, b in boxes]
+    drawn += [
+        a.get_window_extent(renderer)
+        for ax in fig.axes
+        for a in (ax, *ax.child_axes)
+        if a.get_visible()
+    ]
+    spans = sorted((max(b.y0, frame.y0), min(b.y1, frame.y1)) for b in drawn)
+    top, largest = frame.y0, (0.0, "")
+    for lo, hi in spans:
+        if lo - top > largest[0]:
+            largest = (lo - top, f"at {top / fig.dpi:.2f}-{lo / fig.dpi:.2f} in")
+        top = max(top, hi)
+    if frame.y1 - top > largest[0]:
+        largest = (frame.y1 - top, "at the top")
+    if largest[0] > margin_in * fig.dpi:
+        faults.append(f"an empty band of {largest[0] / fig.dpi:.2f} in {largest[1]}")
+    return faults

@@ -18,20 +18,22 @@ from signorini.plots import (
     plot_error_and_estimator,
     plot_estimator,
 )
+from signorini.plots.slopes import finer_half_slope
 from signorini.plots.style import NDOF_LABEL, SINGLE_COLUMN
 
 from .figure_checks import NDOF, check_written, legend_slope, synthetic_history, write_csv
 
 
-def check_legend_slopes(info: dict, last: int) -> dict[str, float]:
-    """Every stated slope is the fitted slope of its own line, to the two decimals shown;
-    returns the stated slope of each label's prefix."""
+def check_legend_slopes(info: dict, last: int | None = None) -> dict[str, float]:
+    """Every stated slope is the fitted slope of its own line (over the finer half of the run,
+    or the last ``last`` levels), to the two decimals shown; returns the stated slope of each
+    label's prefix."""
     stated = {}
     for label, (x, y) in info["lines"].items():
         slope = legend_slope(label)
         if slope is None:
             continue
-        observed = fitted_slope(x, y, last=last)
+        observed = fitted_slope(x, y, last=last) if last else finer_half_slope(x, y)
         assert slope == pytest.approx(round(observed, 2), abs=1e-12), (
             f"{label!r} states {slope}, the line's fitted slope is {observed:.4f}"
         )
@@ -50,7 +52,7 @@ def test_error_and_estimator_figure(tmp_path, captured):
     (info,) = captured
     assert info["scales"] == [("log", "log")] and info["xlabel"] == [NDOF_LABEL]
     assert info["titles"] == ["Example 6.1"]
-    stated = check_legend_slopes(info, last=3)
+    stated = check_legend_slopes(info)
     err_label, eta_label = STYLES["error_energy"]["label"], STYLES["eta"]["label"]
     assert list(stated) == [err_label, eta_label]
     assert stated[err_label] == pytest.approx(-1.0) and stated[eta_label] == pytest.approx(-0.8)
@@ -113,11 +115,15 @@ def test_contributions_draw_each_known_term_and_list_vanishing_ones(tmp_path, ca
         r"$\eta_6 \equiv 0$",
     ]
     assert "eta_7" in caplog.text
-    stated = check_legend_slopes(info, last=3)
+    stated = check_legend_slopes(info)
     for k in (1, 3, 5):
         assert stated[rf"$\eta_{k}$"] == pytest.approx(round(-0.5 - 0.1 * k, 2))
     (x, y) = next(v for k, v in info["lines"].items() if k.startswith(r"$\eta_4$"))
     assert np.isnan(y[2]) and np.all(np.isfinite(np.delete(y, 2)))
+    # ... and the zero is drawn on the ≈0 strip, with the zeros of eta_2 and eta_6
+    strip = info["lines_by_axes"][1]
+    assert sorted(len(xs) for xs, _ in strip) == [1, 6, 6]
+    assert any(np.array_equal(xs, [NDOF[2]]) for xs, _ in strip)
 
 
 def test_estimator_figure_and_suffix_kept(tmp_path, captured):
@@ -125,7 +131,7 @@ def test_estimator_figure_and_suffix_kept(tmp_path, captured):
     h = {"ndof": ndof, "eta": 4.0 * ndof**-0.75}
     written = plot_estimator(h, tmp_path / "fig6.3")  # ".3" is not an image suffix
     check_written(written, tmp_path / "fig6.3")
-    stated = check_legend_slopes(captured[0], last=3)
+    stated = check_legend_slopes(captured[0])
     assert stated == {STYLES["eta"]["label"]: -0.75}
     # a short log axis gets 2 and 5 times powers of ten as labelled major ticks
     assert {200.0, 500.0, 1000.0, 2000.0} <= set(captured[0]["xticks"][0])
@@ -140,7 +146,7 @@ def test_adaptive_vs_uniform_figure(tmp_path, captured):
     written = plot_adaptive_vs_uniform(histories, tmp_path / "cmp", key="eta")
     check_written(written, tmp_path / "cmp")
     (info,) = captured
-    stated = check_legend_slopes(info, last=3)
+    stated = check_legend_slopes(info)
     assert stated == {"adaptive": -1.0, "uniform": -0.67}
     assert info["ylabel"] == [STYLES["eta"]["label"]]
     # a column without a style is labelled by its name; no triangle when asked for none
@@ -171,3 +177,46 @@ def test_bad_inputs_raise_value_errors(tmp_path):
     with pytest.raises(ValueError, match="non-empty mapping"):
         plot_adaptive_vs_uniform({}, tmp_path / "x")
     assert not any(tmp_path.iterdir())
+
+
+def test_slopes_are_fitted_over_the_finer_half_and_the_legend_says_so(tmp_path, captured):
+    ndof = np.geomspace(100.0, 10_000.0, 13)  # the finer half: N_dof >= 1000, 7 levels
+    eta = 3.0 / ndof
+    eta[-3:] *= np.array([0.8, 1.0, 1.3])  # the last three levels wobble
+    plot_estimator({"ndof": ndof, "eta": eta}, tmp_path / "est")
+    (info,) = captured
+    stated = check_legend_slopes(info)
+    half = fitted_slope(ndof[6:], eta[6:], last=7)
+    last3 = fitted_slope(ndof, eta, last=3)
+    print(f"finer half {half:.3f}, last three {last3:.3f}, stated {stated}")
+    assert stated == {STYLES["eta"]["label"]: round(half, 2)}
+    assert abs(half + 1.0) < 0.12 and last3 > -0.5  # the last three levels alone mislead
+    assert info["caption"] == r"slopes: least squares on $N_{\mathrm{dof}} \geq 1000$"
+
+
+def test_zero_and_round_off_terms_sit_on_the_zero_strip(tmp_path, captured):
+    h = synthetic_history(zero_terms=("eta_6",))
+    eta7 = h["eta_7"].copy()
+    h["eta_7"][[1, 4]] = [1e-17, 0.0]  # round-off on level 1, exactly zero on level 4
+    plot_contributions(h, tmp_path / "c")
+    (info,) = captured
+    # the log axis keeps the meaningful range: nothing below the smallest real value / 10
+    smallest = min(np.min(h[k][h[k] > 1e-12]) for k in ("eta_1", "eta_5", "eta_7"))
+    assert info["scales"][0] == ("log", "log") and info["ylim"][0][0] > smallest / 10
+    # eta_6 (zero everywhere) and eta_7's two levels on the strip, nothing else
+    strip = sorted(tuple(x) for x, _ in info["lines_by_axes"][1])
+    assert strip == sorted([tuple(NDOF), tuple(NDOF[[1, 4]])])
+    assert info["yticklabels"][1] == [r"$\approx$0"]
+    assert info["legend_title"].endswith(r"round-off below $10^{-10}\,\eta_h$")
+    # eta_7's slope is fitted on its real values only
+    label = next(t for t in info["legend"] if t.startswith(r"$\eta_7$"))
+    keep = np.isin(np.arange(NDOF.size), [1, 4], invert=True)
+    assert legend_slope(label) == round(finer_half_slope(NDOF[keep], eta7[keep]), 2)
+    assert r"$\eta_6 \equiv 0$" in info["legend"]
+
+
+def test_a_term_at_round_off_on_every_level_is_named_so(tmp_path, captured):
+    h = synthetic_history(zero_terms=())
+    h["eta_7"] = 1e-17 * np.ones(NDOF.size)
+    plot_contributions(h, tmp_path / "c")
+    assert captured[0]["legend"][-1] == r"$\eta_7 \approx 0$ (round-off)"

@@ -7,7 +7,7 @@ import pytest
 
 from signorini.mesh.builders import rectangle
 from signorini.plots import plot_deformed
-from signorini.plots.deformed import contact_coordinate
+from signorini.plots.deformed import contact_coordinate, displacement_scale, free_boundary_ends
 
 from .figure_checks import check_written
 
@@ -25,7 +25,7 @@ def test_deformed_figure_with_pressure_and_obstacle(tmp_path, captured):
     check_written(written, tmp_path / "deformed")
     (info,) = captured
     assert info["legend"] == ["reference"]
-    assert info["titles"][0] == "deformed body (displacement \u00d73)"
+    assert info["titles"][0] == "deformed body, displacement \u00d73"
     # the body is drawn at p + 3 u: x in [0, 1.15], y in [-0.06, 1]
     lim = info["data_lim"][0]
     assert (lim.x0, lim.y0, lim.x1, lim.y1) == pytest.approx((0.0, -0.06, 1.15, 1.0))
@@ -51,7 +51,8 @@ def test_deformed_figure_with_obstacle_only(tmp_path, captured):
     u = np.zeros(2 * mesh.n_points)  # interleaved layout
     plot_deformed(mesh.points, mesh.cells, u, tmp_path / "d", obstacle=obstacle, title="t")
     (info,) = captured
-    assert info["legend"] == ["reference", "obstacle"] and info["titles"][0] == "t"
+    assert info["legend"] == ["reference", "obstacle"]
+    assert info["titles"][0] == "t\ndisplacement at true scale"
     np.testing.assert_array_equal(np.column_stack(info["lines"]["obstacle"]), obstacle)
 
 
@@ -81,3 +82,57 @@ def test_contact_coordinate_is_arclength_on_a_slanted_boundary():
     assert label == r"$x$" and np.array_equal(t, s)
     t, label = contact_coordinate(np.column_stack([np.ones(4), s]))
     assert label == r"$y$" and np.array_equal(t, s)
+
+
+@pytest.mark.parametrize(
+    ("size", "u_max", "scale"),
+    [
+        (1.0, 0.88, 0.1),  # Example 6.1: drawn at true scale the body folds over itself
+        (1.0, 0.2, 1.0),  # Example 6.2: readable as it is
+        (2.0, 0.03, 5.0),  # the inclined block: 1.5 % of its length, magnified
+        (1.0, 0.019, 5.0),
+        (1.0, 0.26, 0.2),
+        (10.0, 40.0, 0.02),
+        (1.0, 0.0, 1.0),
+    ],
+)
+def test_displacement_scale(size, u_max, scale):
+    points = np.array([[0.0, 0.0], [size, 0.0], [0.0, 0.5 * size]])
+    u = np.array([[0.0, 0.0], [0.6 * u_max, -0.8 * u_max], [0.1 * u_max, 0.0]])
+    assert displacement_scale(points, u) == pytest.approx(scale, rel=1e-12)
+    drawn = scale * u_max / size
+    assert drawn <= 0.25 and (u_max == 0 or drawn >= 0.02)  # visible, and not folding over
+
+
+def test_obstacle_from_the_gap_is_drawn_with_the_body_scale(tmp_path, captured):
+    mesh = rectangle(nx=4, ny=4)
+    p, c = mesh.points, mesh.cells
+    u = np.column_stack([np.zeros(len(p)), -0.5 * (1.0 - p[:, 1])])  # |u| up to 0.5
+    bottom = p[np.isclose(p[:, 1], 0.0)][::-1]  # in reverse order
+    gap = 0.5 + 0.1 * bottom[:, 0]
+    normal = np.tile([0.0, -1.0], (len(bottom), 1))
+    plot_deformed(
+        p, c, u, tmp_path / "d", contact_points=bottom, pressure=np.ones(5), gap=gap, normal=normal
+    )
+    (info,) = captured
+    assert info["titles"][0] == "deformed body, displacement \u00d70.2"
+    x, y = info["lines"]["obstacle (gap \u00d70.2)"]
+    np.testing.assert_allclose(x, bottom[::-1, 0])  # ordered along the boundary
+    np.testing.assert_allclose(y, -0.2 * gap[::-1])
+    with pytest.raises(ValueError, match="gap and normal"):
+        plot_deformed(p, c, u, tmp_path / "x", contact_points=bottom, gap=gap)
+    with pytest.raises(ValueError, match="scale must be"):
+        plot_deformed(p, c, u, tmp_path / "x", scale="big")
+
+
+def test_free_boundary_ends_lie_between_active_and_inactive_neighbours():
+    s = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+    d = np.array([0.6, 0.8])
+    pts = s[:, None] * d
+    active = np.array([False, True, True, False, False])
+    shuffled = np.array([3, 0, 4, 2, 1])
+    ends = free_boundary_ends(pts[shuffled], active[shuffled])
+    np.testing.assert_allclose(ends, [0.125 * d, 0.625 * d])
+    assert free_boundary_ends(pts, np.ones(5, bool)).shape == (0, 2)
+    with pytest.raises(ValueError, match="active must have shape"):
+        free_boundary_ends(pts, active[:3])

@@ -11,6 +11,7 @@ from signorini.plots.style import (
     CONTRIBUTIONS,
     DPI,
     SINGLE_COLUMN,
+    fit_title,
     new_figure,
     positive,
     save_figure,
@@ -62,3 +63,13 @@ def test_positive_marks_gaps_for_log_axes():
     out = positive(values)
     np.testing.assert_array_equal(out, [1.0, np.nan, np.nan, np.nan, np.nan, 3.0])
     assert values[1] == 0.0  # a copy
+
+
+def test_fit_title_wraps_long_titles_at_spaces():
+    fig = new_figure()  # 3.5 in wide: about 46 characters of the 9 pt title font
+    title = "inclined_block: deformed body and contact pressure"
+    with mpl.rc_context({"axes.titlesize": 9}):
+        assert fit_title(title, fig) == "inclined_block: deformed body and contact\npressure"
+        assert fit_title("short\ntwo lines", fig) == "short\ntwo lines"
+        math = r"a long title with mathtext $\eta_h \leq \mathrm{something\ quite\ long}$ in it"
+        assert fit_title(math, fig) == math

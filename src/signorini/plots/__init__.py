@@ -5,7 +5,8 @@ so that a figure can be redrawn from the files a run leaves (``history.csv``, me
 
 - :mod:`.style`: colours, markers and labels of every quantity, figure creation and saving;
 - :mod:`.convergence`: the figures against ``N_dof`` (Figs. 6.1, 6.2, 6.3(a), 6.4);
-- :mod:`.slopes`: fitted slopes in legends and slope triangles;
+- :mod:`.slopes`: fitted slopes in legends (over the finer half of the run, stated in the
+  legend) and slope triangles;
 - :mod:`.mesh`: a triangulation (Fig. 6.3(b)); :mod:`.deformed`: the deformed body and the
   contact pressure;
 - :mod:`.report`: the figures a finished run gets, chosen by what its history contains.
@@ -22,10 +23,10 @@ from .convergence import (
     plot_error_and_estimator,
     plot_estimator,
 )
-from .deformed import plot_deformed
-from .mesh import plot_mesh
+from .deformed import displacement_scale, plot_deformed
+from .mesh import READABLE_CELLS, boundary_groups, plot_mesh, read_level_mesh, readable_level
 from .report import make_figures
-from .slopes import add_slope_triangle
+from .slopes import add_slope_triangle, finer_half_slope
 from .style import STYLES
 
 __all__ = [
@@ -39,6 +40,12 @@ __all__ = [
     "plot_estimator",
     "plot_mesh",
     "plot_deformed",
+    "displacement_scale",
     "plot_adaptive_vs_uniform",
     "make_figures",
+    "finer_half_slope",
+    "READABLE_CELLS",
+    "readable_level",
+    "read_level_mesh",
+    "boundary_groups",
 ]

@@ -9,9 +9,14 @@
 
 All five share one frame (:func:`convergence_figure`): log ``N_dof`` axis, one styled curve
 per quantity with its fitted slope in the legend, a reference slope triangle below the data.
+The slopes are least-squares fits over the finer half of the run in log ``N_dof``
+(:func:`~signorini.plots.slopes.finer_half_slope`), and the legend's title says so.
 A *history* is a mapping from column name to a 1-d array, one entry per level (e.g.
 :func:`~signorini.output.read_history` of a run's ``history.csv``), or the path of such a
-file. ``NaN`` marks an unknown value; zero and ``NaN`` entries are left out of log plots.
+file. ``NaN`` marks an unknown value and is not drawn. A value that is exactly zero, or (for
+the contributions ``η_k``) round-off below ``ROUNDOFF · η_h`` of its level, cannot be drawn
+on a log axis: it is drawn as a hollow marker on a strip labelled ``≈0`` below the axes, so
+the log axis keeps the meaningful range and no gap is left unexplained.
 Each function writes ``<path>.png`` and ``<path>.pdf`` and returns the written paths.
 """
 
@@ -28,11 +33,12 @@ import matplotlib as mpl
 import numpy as np
 
 from ..output.history import HistoryLike, check_last, history_columns
-from .slopes import draw_slope_triangle, slope_label
+from .slopes import draw_slope_triangle, fit_note, slope_label
 from .style import (
     CONTRIBUTIONS,
     RC,
     STYLES,
+    fit_title,
     format_number,
     log_log_axes,
     new_figure,
@@ -42,6 +48,7 @@ from .style import (
 )
 
 __all__ = [
+    "ROUNDOFF",
     "Curve",
     "convergence_figure",
     "plot_error_and_estimator",
@@ -57,6 +64,10 @@ log = logging.getLogger(__name__)
 _RUN_COLORS = ("#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2")
 _RUN_MARKERS = ("s", "o", "^", "v", "D", "p", "h")
 
+#: A contribution ``η_k`` below ``ROUNDOFF · η_h`` of its level is round-off (e.g. η_7 of a
+#: fully active contact boundary, ~1e-17 against η_h ~ 1e-2): drawn as ≈ 0, not fitted.
+ROUNDOFF = 1e-10
+
 
 @dataclass(frozen=True)
 class Curve:
@@ -67,13 +78,44 @@ class Curve:
     label: str
     color: str
     marker: str
+    #: (n,) bool: levels whose value is exactly zero or round-off, drawn on the ``≈0`` strip
+    #: (None: those where ``values == 0``).
+    negligible: np.ndarray | None = None
+
+    @property
+    def near_zero(self) -> np.ndarray:
+        """(n,) bool: the levels drawn on the ``≈0`` strip instead of the log axis."""
+        if self.negligible is not None:
+            return np.asarray(self.negligible, dtype=bool)
+        return np.asarray(self.values) == 0.0
 
     @classmethod
-    def of(cls, key: str, ndof: np.ndarray, values: np.ndarray, last: int) -> Curve:
-        """The history column ``key`` in its :data:`STYLES`, its fitted slope in the label."""
+    def of(
+        cls,
+        key: str,
+        ndof: np.ndarray,
+        values: np.ndarray,
+        last: int | None = None,
+        reference: np.ndarray | None = None,
+    ) -> Curve:
+        """The history column ``key`` in its :data:`STYLES`, its fitted slope in the label.
+
+        With ``reference`` (n,), values ``<= ROUNDOFF * reference`` count as round-off: on the
+        ``≈0`` strip and out of the fit, like exact zeros.
+        """
         style = STYLES[key]
-        label = slope_label(style["label"], ndof, values, last)
-        return cls(ndof, values, label, style["color"], style["marker"])
+        values = np.asarray(values, dtype=np.float64)
+        small = np.isfinite(values) & (values <= 0.0)
+        if reference is not None:
+            small |= np.isfinite(values) & (values <= ROUNDOFF * np.asarray(reference))
+        shown = np.where(small, np.nan, values)
+        if np.any(np.isfinite(shown) & (shown > 0)):
+            label = slope_label(style["label"], ndof, shown, last)
+        elif np.all(values[small] == 0.0):
+            label = style["label"][:-1] + r" \equiv 0$"
+        else:
+            label = style["label"][:-1] + r" \approx 0$ (round-off)"
+        return cls(ndof, values, label, style["color"], style["marker"], small)
 
 
 def convergence_figure(
@@ -83,10 +125,11 @@ def convergence_figure(
     *,
     title: str | None = None,
     height: float = 2.7,
-    legend: str = "upper right",
+    legend: str = "best",
     reference_slope: float | None = -1.0,
     log_y: bool = True,
     decorate: Callable[[Any], None] | None = None,
+    note: str | None = None,
 ) -> list[Path]:
     """The frame every convergence figure shares: curves against ``N_dof``, saved.
 
@@ -111,6 +154,8 @@ def convergence_figure(
         Logarithmic y axis (else linear).
     decorate : callable, optional
         Called with the axes after the curves are drawn, before the legend.
+    note : str, optional
+        Title of the legend (e.g. the range the slopes are fitted over).
 
     Returns
     -------
@@ -118,37 +163,129 @@ def convergence_figure(
         The PNG and PDF files written.
     """
     drawn = [c for c in curves if isinstance(c, Curve)]
+    strip = log_y and any(c.near_zero.any() for c in drawn)
     with mpl.rc_context(RC):
-        fig = new_figure(height=height)
-        ax = fig.add_subplot()
+        fig = new_figure(height=height + (0.3 if strip else 0.0))
+        if strip:
+            ax, zero_ax = fig.subplots(
+                2, 1, sharex=True, gridspec_kw={"height_ratios": [1.0, 0.13], "hspace": 0.0}
+            )
+        else:
+            ax, zero_ax = fig.add_subplot(), None
         log_log_axes(ax, ylabel, log_y=log_y)
+        n_rows = sum(1 for c in drawn if c.near_zero.any())
+        rows = iter(np.linspace(-0.5, 0.5, n_rows) if n_rows > 1 else [0.0])
         for c in curves:
-            if isinstance(c, Curve):
-                ax.plot(c.ndof, positive(c.values), color=c.color, marker=c.marker, label=c.label)
-            else:
+            if not isinstance(c, Curve):
                 ax.plot([], [], linestyle="none", marker="", label=c)
+                continue
+            shown = positive(np.where(c.near_zero, np.nan, c.values))
+            if np.any(np.isfinite(shown)):
+                ax.plot(c.ndof, shown, color=c.color, marker=c.marker, label=c.label)
+            else:  # only ≈0 values: the legend entry shows the strip's hollow marker
+                ax.plot([], [], color=c.color, marker=c.marker, mfc="none", ls="", label=c.label)
+            if zero_ax is not None and c.near_zero.any():
+                zero_ax.plot(  # each curve on its own row of the strip, so none hides another
+                    c.ndof[c.near_zero],
+                    np.full(np.count_nonzero(c.near_zero), next(rows)),
+                    color=c.color,
+                    marker=c.marker,
+                    mfc="none",
+                    linestyle="none",
+                    clip_on=False,
+                )
+        if zero_ax is not None:
+            _zero_strip(ax, zero_ax)
+            note = "\n".join(filter(None, [note, _ZERO_NOTE]))
         if reference_slope is not None:
-            draw_slope_triangle(ax, [(c.ndof, c.values) for c in drawn], float(reference_slope))
+            series = [(c.ndof, np.where(c.near_zero, np.nan, c.values)) for c in drawn]
+            draw_slope_triangle(ax, series, float(reference_slope))
         if decorate is not None:
             decorate(ax)
         if legend.startswith("outside"):
-            fig.legend(loc=legend, ncols=2)
-        else:
-            ax.legend(loc=legend)
+            fig.legend(loc=legend, ncols=2, title=note)
         if title:
-            ax.set_title(title)
+            ax.set_title(fit_title(title, fig))
         tidy_log_ticks(ax)
+        if zero_ax is not None:
+            _clear_bottom_tick(ax)
+        if not legend.startswith("outside"):
+            # the note as a caption under the axes: in the legend it would cover the data
+            if note:
+                fig.supxlabel(note, fontsize="x-small", color="0.3")
+            _place_legend(fig, ax, legend)
         return save_figure(fig, path)
 
 
+_ZERO_NOTE = r"$\approx$0: exactly 0, or round-off below $10^{-10}\,\eta_h$"
+
+_LEGEND_PLACES = ("upper right", "lower left", "lower right", "upper left", "center right")
+
+
+def _place_legend(fig: Any, ax: Any, loc: str) -> None:
+    """The in-axes legend at ``loc`` or else the first place where it hides no marker of a
+    curve (the fewest if it hides some everywhere): matplotlib's "best" can settle on a
+    corner over the data."""
+    renderer = fig.canvas.get_renderer()
+    points = [
+        xy[np.all(np.isfinite(xy), axis=1)]
+        for line in ax.get_lines()
+        if line.get_marker() not in ("", "None", None)
+        for xy in [line.get_xydata()]
+    ]
+    best = None
+    for place in ([loc] if loc != "best" else []) + list(_LEGEND_PLACES):
+        ax.legend(loc=place)
+        fig.get_layout_engine().execute(fig)
+        box = ax.get_legend().get_window_extent(renderer)
+        hidden = 0
+        for xy in points:
+            px = ax.transData.transform(xy)
+            inside = (px > [box.x0, box.y0]) & (px < [box.x1, box.y1])
+            hidden += int(np.count_nonzero(inside.all(axis=1)))
+        # the slope triangle and its labels count as one point each
+        hidden += sum(box.overlaps(a.get_window_extent(renderer)) for a in ax.texts + ax.patches)
+        if best is None or hidden < best[0]:
+            best = (hidden, place)
+        if hidden == 0:
+            return
+    ax.legend(loc=best[1])
+
+
+def _clear_bottom_tick(ax: Any, room: float = 0.07) -> None:
+    """Lower the log axis so that no labelled tick sits within ``room`` (a fraction of the
+    axis height) of its bottom, where its label would run into the ``≈0`` strip's label."""
+    lo, hi = np.log10(ax.get_ylim())
+    ticks = np.log10([t for t in ax.get_yticks() if t > 0])
+    near = ticks[(ticks >= lo) & (ticks < lo + room * (hi - lo))]
+    if near.size:
+        ax.set_ylim(10.0 ** (near.min() - room * (hi - lo)), 10.0**hi)
+
+
+def _zero_strip(ax: Any, zero_ax: Any) -> None:
+    """The ``≈0`` strip below the log axes: one tick ``≈0``, the x axis moved onto it."""
+    zero_ax.set_ylim(-1.0, 1.0)
+    zero_ax.set_yticks([0.0], [r"$\approx$0"])
+    zero_ax.grid(True, which="major", axis="x", linestyle="-")
+    zero_ax.grid(True, which="minor", axis="x", linestyle=":", alpha=0.3)
+    zero_ax.set_xlabel(ax.get_xlabel())
+    ax.set_xlabel("")
+    ax.tick_params(axis="x", which="both", labelbottom=False)
+    ax.spines["bottom"].set_linestyle((0, (2, 2)))
+    zero_ax.spines["top"].set_visible(False)
+
+
 def plot_error_and_estimator(
-    history: HistoryLike, path: str | os.PathLike, title: str | None = None, last: int = 3
+    history: HistoryLike,
+    path: str | os.PathLike,
+    title: str | None = None,
+    last: int | None = None,
 ) -> list[Path]:
     """Fig. 6.1(a): energy error and estimator ``η_h`` (5.1) against ``N_dof``, log-log.
 
-    The legend gives the slope of each curve fitted over the last ``last`` levels
-    (:func:`~signorini.output.fitted_slope`); a slope −1 triangle (the optimal rate of P2
-    in 2D, ``N_dof^{-1}``) is drawn below the data.
+    The legend gives the slope of each curve fitted over the finer half of the run
+    (:func:`~signorini.plots.slopes.finer_half_slope`) and states that range; a slope −1
+    triangle (the optimal rate of P2 in 2D, ``N_dof^{-1}``) is drawn below the data.
 
     Parameters
     ----------
@@ -158,8 +295,8 @@ def plot_error_and_estimator(
         Output path without extension.
     title : str, optional
         Axes title.
-    last : int, default 3
-        Number of final levels used for the fitted slopes.
+    last : int, optional
+        Fit the slopes over the last ``last`` levels instead of the finer half of the run.
 
     Returns
     -------
@@ -171,7 +308,8 @@ def plot_error_and_estimator(
     ValueError
         If a column is missing or no error value is known.
     """
-    check_last(last)
+    if last is not None:
+        check_last(last)
     h = history_columns(history, ("ndof", "eta", "error_energy"))
     ndof = h["ndof"]
     if not np.any(np.isfinite(h["error_energy"]) & (h["error_energy"] > 0)):
@@ -180,7 +318,9 @@ def plot_error_and_estimator(
             "estimator alone with plot_estimator"
         )
     curves = [Curve.of(key, ndof, h[key], last) for key in ("error_energy", "eta")]
-    return convergence_figure(path, curves, "error, estimator", title=title)
+    return convergence_figure(
+        path, curves, "error, estimator", title=title, note=fit_note([ndof], last)
+    )
 
 
 def plot_efficiency(
@@ -245,14 +385,19 @@ def plot_efficiency(
 
 
 def plot_contributions(
-    history: HistoryLike, path: str | os.PathLike, title: str | None = None, last: int = 3
+    history: HistoryLike,
+    path: str | os.PathLike,
+    title: str | None = None,
+    last: int | None = None,
 ) -> list[Path]:
     """Figs. 6.2 / 6.4: the estimator contributions ``η_1 … η_7`` of (5.1) against ``N_dof``.
 
-    Terms that vanish on every level (e.g. ``η_6``, ``η_7`` in Example 6.1, where the whole
-    contact boundary is active) cannot be drawn on a log axis; they are listed in the legend
-    as ``η_k ≡ 0``. Single zero entries leave a gap. A slope −1 triangle is drawn below the
-    curves and the legend gives each fitted slope over the last ``last`` levels.
+    A value that is exactly zero, or round-off (below ``ROUNDOFF`` times ``η_h`` of its level,
+    e.g. ``η_7 ≈ 1e-17``), is drawn as a hollow marker on the ``≈0`` strip below the log axes
+    and left out of the fitted slope; a term that is zero on every level (``η_6``, ``η_7`` in
+    Example 6.1, where the whole contact boundary is active) is listed as ``η_k ≡ 0``. A slope
+    −1 triangle is drawn below the curves and the legend gives each fitted slope over the
+    finer half of the run, and says so.
 
     Parameters
     ----------
@@ -262,35 +407,46 @@ def plot_contributions(
         Output path without extension.
     title : str, optional
         Axes title.
-    last : int, default 3
-        Number of final levels used for the fitted slopes.
+    last : int, optional
+        Fit the slopes over the last ``last`` levels instead of the finer half of the run.
 
     Returns
     -------
     list of pathlib.Path
         The PNG and PDF files written.
     """
-    check_last(last)
-    h = history_columns(history, ("ndof",), CONTRIBUTIONS)
+    if last is not None:
+        check_last(last)
+    h = history_columns(history, ("ndof",), (*CONTRIBUTIONS, "eta"))
     keys = [k for k in CONTRIBUTIONS if k in h]
     if not keys:
         raise ValueError(f"the history has none of the columns {', '.join(CONTRIBUTIONS)}")
+    # η_h of each level, the scale of round-off (from the terms if the column is absent)
+    total = np.sqrt(sum(np.nan_to_num(h[k]) ** 2 for k in keys))
+    reference = np.where(np.isfinite(h["eta"]), h["eta"], total) if "eta" in h else total
     curves: list[Curve | str] = []
     for key in keys:
         v = h[key]
-        if np.any(np.isfinite(v) & (v > 0)):
-            curves.append(Curve.of(key, h["ndof"], v, last))
-        elif np.any(v == 0):
-            curves.append(STYLES[key]["label"][:-1] + r" \equiv 0$")
+        if np.any(np.isfinite(v)):
+            curves.append(Curve.of(key, h["ndof"], v, last, reference=reference))
         else:
             log.warning("estimator contribution %s has no known value; skipped", key)
     return convergence_figure(
-        path, curves, r"$\eta_k$", title=title, height=3.3, legend="outside lower center"
+        path,
+        curves,
+        r"$\eta_k$",
+        title=title,
+        height=3.4,
+        legend="outside lower center",
+        note=fit_note([h["ndof"]], last),
     )
 
 
 def plot_estimator(
-    history: HistoryLike, path: str | os.PathLike, title: str | None = None, last: int = 3
+    history: HistoryLike,
+    path: str | os.PathLike,
+    title: str | None = None,
+    last: int | None = None,
 ) -> list[Path]:
     """Fig. 6.3(a): the estimator ``η_h`` (5.1) against ``N_dof``, log-log, slope −1 triangle.
 
@@ -302,18 +458,21 @@ def plot_estimator(
         Output path without extension.
     title : str, optional
         Axes title.
-    last : int, default 3
-        Number of final levels used for the fitted slope.
+    last : int, optional
+        Fit the slope over the last ``last`` levels instead of the finer half of the run.
 
     Returns
     -------
     list of pathlib.Path
         The PNG and PDF files written.
     """
-    check_last(last)
+    if last is not None:
+        check_last(last)
     h = history_columns(history, ("ndof", "eta"))
     curves = [Curve.of("eta", h["ndof"], h["eta"], last)]
-    return convergence_figure(path, curves, r"$\eta_h$", title=title)
+    return convergence_figure(
+        path, curves, r"$\eta_h$", title=title, note=fit_note([h["ndof"]], last)
+    )
 
 
 def plot_adaptive_vs_uniform(
@@ -321,7 +480,7 @@ def plot_adaptive_vs_uniform(
     path: str | os.PathLike,
     key: str = "eta",
     title: str | None = None,
-    last: int = 3,
+    last: int | None = None,
     reference_slope: float | None = -1.0,
 ) -> list[Path]:
     """Several runs of one quantity on one log-log plot, each with its fitted slope.
@@ -340,8 +499,8 @@ def plot_adaptive_vs_uniform(
         Column to compare (e.g. ``"eta"``, ``"error_energy"``, ``"eta_5"``).
     title : str, optional
         Axes title.
-    last : int, default 3
-        Number of final levels used for the fitted slopes.
+    last : int, optional
+        Fit the slopes over the last ``last`` levels instead of the finer half of the run.
     reference_slope : float or None, default -1.0
         Slope of the reference triangle; None draws none.
 
@@ -350,7 +509,8 @@ def plot_adaptive_vs_uniform(
     list of pathlib.Path
         The PNG and PDF files written.
     """
-    check_last(last)
+    if last is not None:
+        check_last(last)
     if not isinstance(histories, Mapping) or not histories:
         raise ValueError("histories must be a non-empty mapping from label to history")
     runs = {str(label): history_columns(h, ("ndof", key)) for label, h in histories.items()}
@@ -371,6 +531,7 @@ def plot_adaptive_vs_uniform(
         ylabel,
         title=title,
         height=3.0,
-        legend="best",
+        legend="lower left",
         reference_slope=reference_slope,
+        note=fit_note([h["ndof"] for h in runs.values()], last),
     )

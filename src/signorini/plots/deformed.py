@@ -1,4 +1,8 @@
-"""The deformed body coloured by ``|u_h|``, and the contact pressure along ``Γ_C``."""
+"""The deformed body coloured by ``|u_h|``, and the contact pressure along ``Γ_C``.
+
+The displacement is magnified or shrunk by a stated factor (:func:`displacement_scale`): at
+true scale a large displacement folds the drawn body over itself, a small one is invisible.
+"""
 
 from __future__ import annotations
 
@@ -9,14 +13,65 @@ from typing import Any
 import matplotlib as mpl
 import numpy as np
 from matplotlib.collections import LineCollection
+from matplotlib.transforms import offset_copy
 from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
 from ..mesh.mesh import boundary_edges
 from .mesh import line_width, mesh_arrays
-from .style import RC, STYLES, new_figure, save_figure
+from .style import RC, STYLES, fit_title, new_figure, save_figure, trim_height
 
-__all__ = ["plot_deformed", "contact_coordinate"]
+__all__ = [
+    "plot_deformed",
+    "contact_coordinate",
+    "displacement_scale",
+    "scale_text",
+    "free_boundary_ends",
+]
+
+#: Largest displacement drawn, as a fraction of the body's size, when it is rescaled.
+DRAWN_FRACTION = 0.1
+#: Displacements between these fractions of the body's size are drawn at true scale.
+TRUE_SCALE_RANGE = (0.02, 0.25)
+
+
+def displacement_scale(points: ArrayLike, displacement: ArrayLike) -> float:
+    """The factor the displacement is drawn with: 1 when that is readable, else a 1-2-5 value.
+
+    With ``size`` the larger side of the bounding box of ``points`` and ``u_max`` the largest
+    ``|u|``: 1 when ``u_max / size`` lies in :data:`TRUE_SCALE_RANGE` (or ``u_max = 0``),
+    else the largest value ``{1, 2, 5} · 10^k`` with ``scale · u_max <= DRAWN_FRACTION ·
+    size``.
+
+    Parameters
+    ----------
+    points : (n, 2) float array
+        Reference coordinates.
+    displacement : (n, 2) float array
+        The displacement at ``points``.
+    """
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    u = np.asarray(displacement, dtype=np.float64).reshape(-1, 2)
+    size = float(np.ptp(p, axis=0).max()) if p.size else 0.0
+    u_max = float(np.max(np.hypot(u[:, 0], u[:, 1]))) if u.size else 0.0
+    if not (np.isfinite(size) and np.isfinite(u_max)):
+        raise ValueError("points and displacement must be finite")
+    if size == 0.0 or u_max == 0.0:
+        return 1.0
+    low, high = TRUE_SCALE_RANGE
+    if low <= u_max / size <= high:
+        return 1.0
+    raw = DRAWN_FRACTION * size / u_max
+    exponent = np.floor(np.log10(raw))
+    mantissa = max(m for m in (1.0, 2.0, 5.0) if m <= raw / 10.0**exponent * (1 + 1e-12))
+    return float(mantissa * 10.0**exponent)
+
+
+def scale_text(scale: float) -> str:
+    """How a title states the drawing scale: ``"displacement ×0.1"``, or true scale."""
+    if scale == 1.0:
+        return "displacement at true scale"
+    return f"displacement \u00d7{scale:g}"
 
 
 def _vertex_displacement(displacement: ArrayLike, n_points: int) -> np.ndarray:
@@ -63,6 +118,34 @@ def contact_coordinate(cp: np.ndarray) -> tuple[np.ndarray, str]:
     return t - t.min(), r"$s$ (along $\Gamma_C$)"
 
 
+def free_boundary_ends(contact_points: ArrayLike, active: ArrayLike) -> np.ndarray:
+    """Where the contact zone ends: midpoints between neighbouring contact nodes, one active
+    and one not, in order along the boundary (:func:`contact_coordinate`).
+
+    Parameters
+    ----------
+    contact_points : (k, 2) float array
+        The contact nodes, in any order.
+    active : (k,) bool array
+        Which of them are in contact.
+
+    Returns
+    -------
+    (m, 2) float array
+        The ends (none when the whole boundary, or none of it, is in contact).
+    """
+    cp = np.asarray(contact_points, dtype=np.float64).reshape(-1, 2)
+    on = np.asarray(active, dtype=bool).reshape(-1)
+    if on.shape != (cp.shape[0],):
+        raise ValueError(f"active must have shape ({cp.shape[0]},), got {on.shape}")
+    if cp.shape[0] < 2:
+        return np.zeros((0, 2))
+    order = np.argsort(contact_coordinate(cp)[0], kind="stable")
+    q, a = cp[order], on[order]
+    change = np.flatnonzero(a[1:] != a[:-1])
+    return 0.5 * (q[change] + q[change + 1])
+
+
 def _draw_body(
     fig: Any,
     ax: Any,
@@ -71,6 +154,7 @@ def _draw_body(
     u: np.ndarray,
     scale: float,
     obstacle: np.ndarray | None,
+    obstacle_label: str,
     show_mesh: bool,
 ) -> None:
     """The body at ``p + scale u`` coloured by ``|u|``, its reference boundary dashed."""
@@ -100,8 +184,8 @@ def _draw_body(
             obstacle[:, 0],
             obstacle[:, 1],
             color=st["color"],
-            linewidth=2.0,
-            label=st["label"],
+            linewidth=1.5,
+            label=obstacle_label,
             zorder=5,
         )
     ax.set_aspect("equal")
@@ -110,7 +194,11 @@ def _draw_body(
     ax.set_ylabel(r"$y$")
     cax = ax.inset_axes((1.04, 0.0, 0.05, 1.0))  # follows the equal-aspect box
     fig.colorbar(image, cax=cax, label=r"$|u_h|$")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=2, frameon=False)
+    # below the x label at a fixed distance, whatever the height of the (equal-aspect) box
+    below = offset_copy(ax.transAxes, fig=fig, y=-27.0, units="points")
+    ax.legend(
+        loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=below, ncols=2, frameon=False
+    )
 
 
 def _draw_pressure(ax: Any, contact_points: np.ndarray, pressure: np.ndarray) -> None:
@@ -139,18 +227,21 @@ def plot_deformed(
     path: str | os.PathLike,
     contact_points: ArrayLike | None = None,
     pressure: ArrayLike | None = None,
-    scale: float = 1.0,
+    scale: float | str = "auto",
     obstacle: ArrayLike | None = None,
     title: str | None = None,
     show_mesh: bool = True,
+    gap: ArrayLike | None = None,
+    normal: ArrayLike | None = None,
 ) -> list[Path]:
     """The deformed body coloured by ``|u_h|``, and the contact pressure along ``Γ_C``.
 
     The body is drawn at ``points + scale * displacement`` (vertices only; the P2 solution is
     drawn piecewise linearly), coloured by the unscaled ``|u_h|`` with Gouraud shading; the
-    reference configuration's boundary is dashed. When ``pressure`` is given, a second axes
-    below shows it against the coordinate along the contact boundary
-    (:func:`contact_coordinate`).
+    reference configuration's boundary is dashed. The title's last line states the scale.
+    When ``pressure`` is given, a second axes below shows it against the coordinate along the
+    contact boundary (:func:`contact_coordinate`). The figure's height follows the drawn
+    body's aspect ratio.
 
     Parameters
     ----------
@@ -164,18 +255,24 @@ def plot_deformed(
     path : str or os.PathLike
         Output path without extension.
     contact_points : (k, 2) float array, optional
-        Reference coordinates of the contact nodes (needed with ``pressure``).
+        Reference coordinates of the contact nodes (needed with ``pressure``, ``gap``).
     pressure : (k,) float array, optional
         Contact pressure at ``contact_points`` (e.g. ``p_z`` of docs/method.md, *Discrete
         problem*).
-    scale : float, default 1.0
-        Magnification of the displacement in the drawing.
+    scale : float or "auto", default "auto"
+        Magnification of the displacement in the drawing; "auto":
+        :func:`displacement_scale`.
     obstacle : (j, 2) float array, optional
-        Polyline of the obstacle in physical coordinates, drawn on the body's axes.
+        Polyline of the obstacle in physical coordinates, drawn as given (true scale).
     title : str, optional
-        Title of the body's axes.
+        First line of the body's title (default "deformed body").
     show_mesh : bool, default True
         Draw the deformed triangulation with faint lines.
+    gap : (k,) float array, optional
+        The gap ``ψ`` at ``contact_points`` along ``normal`` (k, 2): the obstacle is then
+        drawn at ``contact_points + scale * gap * normal``, ordered along the boundary: with
+        the same scale as the body, so a body that does not penetrate the obstacle is not
+        drawn through it. Not together with ``obstacle``.
 
     Returns
     -------
@@ -184,27 +281,56 @@ def plot_deformed(
     """
     p, c = mesh_arrays(points, cells)
     u = _vertex_displacement(displacement, p.shape[0])
+    if isinstance(scale, str):
+        if scale != "auto":
+            raise ValueError(f"scale must be a positive number or 'auto', got {scale!r}")
+        scale = displacement_scale(p, u)
     scale = float(scale)
-    if (contact_points is None) != (pressure is None):
-        raise ValueError("contact_points and pressure must be given together")
+    if not (np.isfinite(scale) and scale > 0):
+        raise ValueError(f"scale must be a positive number or 'auto', got {scale!r}")
+    if (pressure is not None or gap is not None) and contact_points is None:
+        raise ValueError("contact_points and pressure (or gap) must be given together")
+    if (gap is None) != (normal is None):
+        raise ValueError("gap and normal must be given together")
+    if gap is not None and obstacle is not None:
+        raise ValueError("give the obstacle either as a polyline or by gap and normal, not both")
+    cp = None if contact_points is None else np.asarray(contact_points, np.float64).reshape(-1, 2)
     if pressure is not None:
-        cp = np.asarray(contact_points, dtype=np.float64).reshape(-1, 2)
         pr = np.asarray(pressure, dtype=np.float64)
         if pr.shape != (cp.shape[0],):
             raise ValueError(
                 f"pressure must have shape ({cp.shape[0]},) to match contact_points, got {pr.shape}"
             )
     obs = None if obstacle is None else np.asarray(obstacle, dtype=np.float64).reshape(-1, 2)
+    obstacle_label = STYLES["obstacle"]["label"]
+    if gap is not None:
+        g = np.asarray(gap, dtype=np.float64)
+        n = np.asarray(normal, dtype=np.float64)
+        if g.shape != (cp.shape[0],) or n.shape != cp.shape:
+            raise ValueError(
+                f"gap must have shape ({cp.shape[0]},) and normal {cp.shape} to match "
+                f"contact_points, got {g.shape} and {n.shape}"
+            )
+        order = np.argsort(contact_coordinate(cp)[0], kind="stable")
+        obs = (cp + scale * g[:, None] * n)[order]
+        if scale != 1.0:
+            obstacle_label += f" (gap \u00d7{scale:g})"
+    drawn = [p + scale * u] + ([] if obs is None else [obs])
+    lo = np.min([d.min(axis=0) for d in drawn], axis=0)
+    hi = np.max([d.max(axis=0) for d in drawn], axis=0)
+    aspect = float((hi[1] - lo[1]) / max(hi[0] - lo[0], 1e-300))
+    body = float(np.clip(2.2 * aspect, 0.8, 3.0))  # inches of the equal-aspect box
+    head = f"{title}\n{scale_text(scale)}" if title else f"deformed body, {scale_text(scale)}"
     with mpl.rc_context(RC):
         if pressure is None:
-            fig = new_figure(height=3.0)
+            fig = new_figure(height=body + 1.45)
             ax = fig.add_subplot()
         else:
-            fig = new_figure(height=4.8)
-            ax, axp = fig.subplots(2, 1, gridspec_kw={"height_ratios": [2.4, 1.0]})
-        _draw_body(fig, ax, p, c, u, scale, obs, show_mesh)
-        magnified = f" (displacement \u00d7{scale:g})" if scale != 1.0 else ""
-        ax.set_title(title if title else "deformed body" + magnified)
+            fig = new_figure(height=body + 1.45 + 1.7)
+            ax, axp = fig.subplots(2, 1, gridspec_kw={"height_ratios": [body + 1.0, 1.2]})
+        _draw_body(fig, ax, p, c, u, scale, obs, obstacle_label, show_mesh)
+        ax.set_title(fit_title(head, fig))
         if pressure is not None:
             _draw_pressure(axp, cp, pr)
+        trim_height(fig)
         return save_figure(fig, path)

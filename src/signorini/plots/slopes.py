@@ -16,16 +16,83 @@ from numpy.typing import ArrayLike
 from ..output.history import fitted_slope
 from .style import format_number
 
-__all__ = ["add_slope_triangle", "draw_slope_triangle", "slope_label", "triangle_vertices"]
+__all__ = [
+    "add_slope_triangle",
+    "draw_slope_triangle",
+    "fit_note",
+    "fit_start",
+    "finer_half_slope",
+    "slope_label",
+    "triangle_vertices",
+]
 
 
-def slope_label(label: str, ndof: np.ndarray, values: np.ndarray, last: int) -> str:
-    """``label`` followed by the fitted slope over the last ``last`` levels (two decimals),
-    or ``label`` alone when there is no slope (:func:`~signorini.output.fitted_slope`)."""
+def fit_start(ndof: ArrayLike) -> float:
+    """First ``N_dof`` of the finer half of a run: ``sqrt(min N_dof · max N_dof)``, the middle
+    of the run's ``N_dof`` range on a log scale (over all its levels, drawn or not)."""
+    x = np.asarray(ndof, dtype=np.float64)
+    x = x[np.isfinite(x) & (x > 0)]
+    if x.size == 0:
+        raise ValueError("ndof has no positive finite value")
+    return float(np.sqrt(x.min() * x.max()))
+
+
+def finer_half_slope(ndof: ArrayLike, values: ArrayLike) -> float:
+    """Least-squares slope of ``log(values)`` against ``log(ndof)`` over the finer half of a run.
+
+    The fit uses every level with ``N_dof >= fit_start(ndof)`` (:func:`fit_start`) and a
+    positive finite value, through :func:`~signorini.output.fitted_slope`. Half the run in
+    log ``N_dof`` is many levels on an adaptive run, so one level's jump (a term that is
+    zero or tiny on a few levels) moves the slope little; the pre-asymptotic start is left out.
+
+    Raises
+    ------
+    ValueError
+        As :func:`~signorini.output.fitted_slope`, when fewer than two valid points lie in
+        the finer half.
+    """
+    x = np.asarray(ndof, dtype=np.float64)
+    y = np.asarray(values, dtype=np.float64)
+    if x.ndim != 1 or x.shape != y.shape:
+        raise ValueError(
+            f"ndof and values must be 1-d arrays of equal length, got shapes {x.shape} and "
+            f"{y.shape}"
+        )
+    keep = (x >= fit_start(x) * (1.0 - 1e-12)) & np.isfinite(y) & (y > 0)
+    return fitted_slope(x[keep], y[keep], last=max(int(np.count_nonzero(keep)), 2))
+
+
+def fit_note(ndof_runs: Sequence[ArrayLike], last: int | None = None) -> str:
+    """What a legend says about its slopes: the range each one is fitted over.
+
+    Parameters
+    ----------
+    ndof_runs : sequence of (n,) array_like
+        ``N_dof`` of each run drawn (one entry for a figure of one run).
+    last : int or None
+        None: the finer half of each run (:func:`finer_half_slope`), stated as
+        ``N_dof ≥`` its start when there is one run; an int: the last ``last`` levels.
+    """
+    if last is not None:
+        return f"slopes: least squares over the last {last} levels"
+    if len(ndof_runs) == 1:
+        start = int(np.ceil(fit_start(ndof_runs[0]) * (1.0 - 1e-12)))
+        return rf"slopes: least squares on $N_{{\mathrm{{dof}}}} \geq {start}$"
+    return "slopes: least squares on the finer half of each run"
+
+
+def slope_label(label: str, ndof: np.ndarray, values: np.ndarray, last: int | None) -> str:
+    """``label`` followed by the fitted slope (two decimals), or ``label`` alone when there is
+    no slope: over the finer half of the run (:func:`finer_half_slope`) for ``last=None``,
+    else over the last ``last`` levels (:func:`~signorini.output.fitted_slope`)."""
     try:
-        return f"{label}, slope {format_number(fitted_slope(ndof, values, last))}"
+        if last is None:
+            slope = finer_half_slope(ndof, values)
+        else:
+            slope = fitted_slope(ndof, values, last)
     except ValueError:
         return label
+    return f"{label}, slope {format_number(slope)}"
 
 
 def _valid_logs(series: Sequence[tuple[np.ndarray, np.ndarray]]) -> list[tuple[np.ndarray, ...]]:
@@ -119,6 +186,12 @@ def draw_slope_triangle(
     (x0, y0), (x1, y1), corner = verts
     tri = Polygon(verts, closed=True, fill=False, edgecolor=color, linewidth=0.9, zorder=3)
     ax.add_patch(tri)
+    # room for the "1" below the horizontal leg: 7 % of the log y range of the data
+    lo, hi = sorted(ax.dataLim.intervaly)
+    if lo > 0 and hi > lo:
+        drop = 10.0 ** (-0.07 * np.log10(hi / lo))
+        ax.update_datalim([(np.sqrt(x0 * x1), min(y0, y1) * drop)], updatex=False)
+        ax.autoscale_view(scalex=False)
     ax.annotate(
         "1",
         xy=(np.sqrt(x0 * x1), min(y0, y1)),

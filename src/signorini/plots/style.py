@@ -13,12 +13,15 @@ from __future__ import annotations
 
 import logging
 import os
+import textwrap
 from pathlib import Path
 from typing import Any
 
+import matplotlib as mpl
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.font_manager import FontProperties
 from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
 
 __all__ = [
@@ -34,6 +37,8 @@ __all__ = [
     "log_log_axes",
     "tidy_log_ticks",
     "format_number",
+    "fit_title",
+    "trim_height",
 ]
 
 log = logging.getLogger(__name__)
@@ -89,6 +94,49 @@ RC: dict[str, Any] = {
 def format_number(value: float, digits: int = 2) -> str:
     """``value`` with ``digits`` decimals and a typographic minus sign."""
     return f"{value:.{digits}f}".replace("-", "\u2212")
+
+
+def fit_title(title: str, fig: Figure, share: float = 0.9) -> str:
+    """``title`` with its lines wrapped at spaces to fit ``share`` of the figure's width.
+
+    The width of a character is taken as 0.6 em of the title font (DejaVu Sans averages
+    about 0.55 em), so a wrapped line is not wider than the figure and is not clipped. A line
+    with mathtext (``$``) is not wrapped.
+    """
+    size = FontProperties(size=mpl.rcParams["axes.titlesize"]).get_size_in_points()
+    chars = max(int(share * fig.get_figwidth() * 72.0 / (0.6 * size)), 10)
+    lines = []
+    for line in str(title).splitlines() or [""]:
+        if "$" in line:  # mathtext: a break inside $...$ would not render; left as is
+            lines.append(line)
+            continue
+        lines += textwrap.wrap(line, chars, break_long_words=False, break_on_hyphens=False) or [""]
+    return "\n".join(lines)
+
+
+def trim_height(fig: Figure, passes: int = 3, pad: float = 0.06) -> None:
+    """Lower the figure to what its content needs, plus ``pad`` inches above and below.
+
+    An equal-aspect box (a body, a mesh) keeps its shape inside the cell the layout gives it;
+    when the cell is taller than the box and its labels, the difference would be left empty.
+    The layout and the extents are computed without rendering the figure.
+    """
+    engine = fig.get_layout_engine()
+    renderer = fig.canvas.get_renderer()
+    # data clipped to its axes cannot reach out of them: leave it out of the extents (for a
+    # mesh of many cells, measuring every triangle would cost more than drawing the figure)
+    for ax in fig.axes:
+        for artist in (*ax.collections, *ax.lines, *ax.patches, *ax.images):
+            if artist.get_clip_on() and artist.get_clip_box() is not None:
+                artist.set_in_layout(False)
+    for _ in range(passes):
+        engine.execute(fig)
+        for ax in fig.axes:
+            ax.apply_aspect()
+        needed = fig.get_tightbbox(renderer).height + 2.0 * pad  # inches
+        if fig.get_figheight() - needed < 0.02:
+            return
+        fig.set_figheight(needed)
 
 
 def _stem(path: str | os.PathLike) -> Path:
