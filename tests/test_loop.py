@@ -361,3 +361,15 @@ def test_fallback_reaches_every_solve(fallback, monkeypatch):
     monkeypatch.setattr(loop, "solve", spy)
     levels = list(adaptive(example_6_2(), max_ndof=400, fallback=fallback))
     assert len(seen) == len(levels) >= 3 and set(seen) == {fallback}
+
+
+def test_history_reports_the_kkt_residuals_of_each_level():
+    """Every level's record carries its five relative KKT residuals, all at round-off."""
+    names = ("primal", "dual", "complementarity", "stationarity", "dirichlet")
+    for lv in adaptive(example_6_2(), max_ndof=3000):
+        kkt = lv.result.pdas.kkt
+        for name in names:
+            value = getattr(lv.record, f"kkt_{name}")
+            assert value == getattr(kkt, name), (lv.record.level, name)
+            assert 0.0 <= value < 1e-12, (lv.record.level, name, value)
+        assert lv.record.row()["kkt_primal"] == lv.record.kkt_primal

@@ -66,6 +66,13 @@ COLUMNS: dict[str, str] = {
     "n_no_contact": "contact nodes without contact",
     "contact_force": "sum of the nodal contact forces Λ_z, unit of force per thickness",
     "n_marked": "cells marked for refinement on this level (0 on the last level)",
+    "kkt_primal": "largest penetration u·n − ψ, relative to the contact's displacement scale "
+    "(docs/method.md, *Solver*), no unit",
+    "kkt_dual": "largest negative contact force, relative to the total contact force",
+    "kkt_complementarity": "largest min(|Λ_z| / force scale, |u·n − ψ| / displacement scale)",
+    "kkt_stationarity": "largest residual of the equilibrium equations at the free, "
+    "unconstrained unknowns, relative to the largest force",
+    "kkt_dirichlet": "largest misfit of the Dirichlet values, relative to the displacement scale",
     "backend": "sparse solver backend used (pardiso or scipy)",
     "t_assemble": "seconds spent assembling the linear system",
     "t_solve": "seconds spent in the active set solver",
@@ -117,6 +124,9 @@ class LevelRecord:
         Sum of the nodal contact forces Λ_z (force per unit thickness).
     n_marked : int
         Cells marked for refinement (0 on the last level).
+    kkt_primal, kkt_dual, kkt_complementarity, kkt_stationarity, kkt_dirichlet : float
+        The KKT residuals of the discrete problem, each relative to the quantity it is about
+        (:class:`signorini.algebra.kkt.KKTResiduals`; docs/method.md, *Solver*).
     backend : str
         Sparse solver backend used.
     t_assemble, t_solve, t_estimate, t_mark, t_refine : float
@@ -154,6 +164,11 @@ class LevelRecord:
     n_no_contact: int = 0
     contact_force: float = 0.0
     n_marked: int = 0
+    kkt_primal: float = math.nan
+    kkt_dual: float = math.nan
+    kkt_complementarity: float = math.nan
+    kkt_stationarity: float = math.nan
+    kkt_dirichlet: float = math.nan
     backend: str = ""
     t_assemble: float = 0.0
     t_solve: float = 0.0
@@ -444,6 +459,7 @@ def _record(level: int, result: ContactResult, est: Estimate) -> LevelRecord:
         n_semi_contact=int((classes == SEMI_CONTACT).sum()),
         n_no_contact=int((classes == NO_CONTACT).sum()),
         contact_force=result.total_contact_force,
+        **result.pdas.kkt.columns(),
         backend=result.pdas.backend,
         t_assemble=result.timings["assemble"],
         t_solve=result.timings["solve"],
