@@ -94,7 +94,7 @@ def main() -> None:
         contact_points=x,
         pressure=result.pressure,
         scale=5.0,
-        title="deformed (×5) and contact pressure",
+        title="deformed body and contact pressure",
     )
     # the pressure balances the load: Σ Λ_z equals the normal reaction of the foundation
     print(
