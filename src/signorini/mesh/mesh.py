@@ -37,8 +37,8 @@ from .validation import (
     MeshError,
     as_cells,
     as_points,
-    degenerate_cells,
     format_indices,
+    nondegenerate_area,
     validate_mesh,
 )
 
@@ -173,16 +173,7 @@ class Mesh:
         names = _check_parts(parts)
         points = as_points(points)
         cells = as_cells(cells, len(points))
-        if cells.shape[0] == 0:
-            raise MeshError("the mesh has no cells")
-        area = signed_area(points, cells)
-        degenerate = degenerate_cells(points, cells, area)
-        if degenerate.any():
-            bad = np.flatnonzero(degenerate)
-            raise MeshError(
-                f"degenerate triangle(s) {format_indices(bad)} (zero area or repeated "
-                f"vertex), e.g. cell {bad[0]} = {cells[bad[0]].tolist()}"
-            )
+        area = nondegenerate_area(points, cells)
         flipped = np.flatnonzero(area < 0)
         if flipped.size:
             cells = cells.copy()

@@ -31,6 +31,7 @@ __all__ = [
     "as_cells",
     "as_points",
     "check_orientation",
+    "nondegenerate_area",
     "format_indices",
     "validate_mesh",
 ]
@@ -108,8 +109,8 @@ def degenerate_cells(points: np.ndarray, cells: np.ndarray, area: np.ndarray) ->
     return np.abs(area) <= 1e-12 * h2
 
 
-def check_orientation(points: np.ndarray, cells: np.ndarray) -> None:
-    """Raise unless there are cells and all are counter-clockwise and non-degenerate."""
+def nondegenerate_area(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """The signed areas ``(n_cells,)``; raise if there are no cells or one is degenerate."""
     if cells.shape[0] == 0:
         raise MeshError("the mesh has no cells")
     area = signed_area(points, cells)
@@ -120,6 +121,12 @@ def check_orientation(points: np.ndarray, cells: np.ndarray) -> None:
             f"degenerate triangle(s) {format_indices(bad)} (zero area or repeated vertex), "
             f"e.g. cell {bad[0]} = {cells[bad[0]].tolist()}"
         )
+    return area
+
+
+def check_orientation(points: np.ndarray, cells: np.ndarray) -> None:
+    """Raise unless there are cells and all are counter-clockwise and non-degenerate."""
+    area = nondegenerate_area(points, cells)
     if np.any(area < 0):
         bad = np.flatnonzero(area < 0)
         raise MeshError(
