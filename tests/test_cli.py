@@ -711,3 +711,32 @@ def test_resume_after_an_interrupt_while_drawing_redraws_from_the_last_level(
     assert history_without_timings(out / "history.csv") == before
     assert json.loads((out / "signorini-run.json").read_text())["status"] == "finished"
     assert not (out / "resume.npz").exists()
+
+
+def test_a_problem_file_in_an_old_form_is_told_so(tmp_path):
+    """Python hides DeprecationWarnings outside __main__; those raised at the problem file's
+    own lines (here a traction g(x, n)) are shown, pointing at the file."""
+    source = tmp_path / "old_form.py"
+    source.write_text(
+        "from signorini import ContactProblem, Dirichlet, Material, Neumann, rectangle\n"
+        "\n"
+        "def problem():\n"
+        "    return ContactProblem(\n"
+        "        rectangle(0, 1, 0, 1, nx=2, ny=2),\n"
+        "        Material.from_young(1.0, 0.3),\n"
+        "        {'left': Dirichlet(), 'right': Neumann(lambda x, n: 0.1 * n),\n"
+        "         'top': Neumann(), 'bottom': Neumann()},\n"
+        "    )\n"
+    )
+    argv = [str(source), "--max-levels", "1", "--no-vtu", "--no-figures", "--quiet"]
+    done = subprocess.run(
+        [sys.executable, "-c", "from signorini.cli import main; raise SystemExit(main())", "run"]
+        + argv
+        + ["--out", str(tmp_path / "out")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert f"{source}:7: DeprecationWarning" in done.stderr, done.stderr
+    assert "name the parameter `normal`" in done.stderr

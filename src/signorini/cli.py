@@ -23,6 +23,7 @@ import re
 import sys
 import time
 import traceback
+import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -219,6 +220,9 @@ def load_problem(name: str) -> ContactProblem:
     spec = importlib.util.spec_from_file_location(module_name, path)
     module = importlib.util.module_from_spec(spec)
     folder = str(path.resolve().parent)
+    # Python shows DeprecationWarnings only for __main__: show those raised at the file's
+    # own lines (a user function in an old form), which the file's author can act on
+    warnings.filterwarnings("default", category=DeprecationWarning, module=module_name)
     sys.modules[module_name] = module
     sys.path.insert(0, folder)
     try:
