@@ -53,8 +53,13 @@ class P2Space:
 
     @cached_property
     def node_points(self) -> np.ndarray:
-        """``(n_nodes, 2)`` coordinates of the P2 nodes."""
-        return np.vstack([self.mesh.points, self.mesh.edge_midpoints])
+        """``(n_nodes, 2)`` coordinates of the P2 nodes.
+
+        The midpoint node of an edge on a boundary part that carries a curve lies on the
+        curve (:attr:`~signorini.mesh.Mesh.curved_midpoints`), where an isoparametric cell
+        would put it. Assembly does not use these coordinates: it still treats every cell as
+        the straight-sided triangle of its vertices."""
+        return np.vstack([self.mesh.points, self.mesh.curved_midpoints])
 
     @cached_property
     def vertices(self) -> np.ndarray:
@@ -124,7 +129,7 @@ class P2Space:
                 f"cells do not index the {self.mesh.n_cells} cells)"
             )
         P = self.vertices[parent]  # (m, 3, 2)
-        X = fine.node_points[fine.cell_nodes]  # (m, 6, 2)
+        X = _reference_nodes(self.mesh, refinement, fine)[fine.cell_nodes]  # (m, 6, 2)
         J = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=-1)  # columns
         rhs = (X - P[:, None, 0, :]).transpose(0, 2, 1)  # (m, 2, 6)
         xi = np.linalg.solve(J, rhs).transpose(0, 2, 1)  # (m, 6, 2)
@@ -144,3 +149,17 @@ class P2Space:
             out = np.empty((fine.n_nodes,) + u.shape[1:])
         out[fine.cell_nodes.ravel()] = vals.reshape((-1,) + u.shape[1:])
         return out
+
+
+def _reference_nodes(coarse: Mesh, refinement: Refinement, fine: P2Space) -> np.ndarray:
+    """``(n_nodes_new, 2)`` where the new nodes lie in their parent cells: the fine node
+    points, except that a vertex placed on a curve counts at the chord midpoint of the edge
+    it bisected (its parent cells are straight-sided), and the edge nodes of the fine mesh at
+    the chord midpoints of these positions."""
+    if all(curve is None for curve in coarse.curves):
+        return fine.node_points
+    points = refinement.mesh.points.copy()
+    split = refinement.edge_point >= 0
+    points[refinement.edge_point[split]] = coarse.edge_midpoints[split]
+    e = refinement.mesh.edges
+    return np.vstack([points, 0.5 * (points[e[:, 0]] + points[e[:, 1]])])

@@ -2,11 +2,16 @@
 meshes read from files, and newest vertex bisection (the REFINE step)."""
 
 from .builders import rectangle
+from .curves import Circle, Curve, Line, ProjectedCurve
 from .gmsh import read_mesh
 from .mesh import Mesh, MeshError
 from .refine import Refinement, refine_nvb, refine_uniform
 
 __all__ = [
+    "Circle",
+    "Curve",
+    "Line",
+    "ProjectedCurve",
     "Mesh",
     "MeshError",
     "Refinement",

@@ -32,6 +32,7 @@ from functools import cached_property
 
 import numpy as np
 
+from .curves import Curve
 from .geometry import signed_area
 from .validation import (
     MeshError,
@@ -93,12 +94,17 @@ class Mesh:
         degeneracy, duplicate points, conformity, overlap, labels). Unlike
         :meth:`from_arrays`, the constructor refuses clockwise cells. Refinement, which
         preserves validity by construction, skips it.
+    curves : sequence of Curve or None, optional
+        The curve each part carries (``None`` for a part without one), one per part name;
+        attach curves with :meth:`with_curve`, which checks them.
 
     Attributes
     ----------
     reoriented : (k,) int array
         Indices of the cells that :meth:`from_arrays` received clockwise and listed
         counter-clockwise (empty for every other mesh, e.g. a refined one).
+    curves : tuple of Curve or None
+        The curve of each part, ``None`` for straight parts (see :meth:`with_curve`).
 
     Raises
     ------
@@ -117,6 +123,7 @@ class Mesh:
         part_names: tuple[str, ...] | list[str],
         *,
         validate: bool = True,
+        curves: tuple[Curve | None, ...] | list[Curve | None] | None = None,
     ) -> None:
         if validate:  # argument kinds first: a clear error instead of NumPy's
             points = as_points(points)
@@ -129,6 +136,16 @@ class Mesh:
         self.boundary = np.ascontiguousarray(boundary)
         self.boundary_part = np.ascontiguousarray(boundary_part, dtype=np.int64).reshape(-1)
         self.part_names = tuple(str(p) for p in part_names)
+        if curves is None:
+            curves = (None,) * len(self.part_names)
+        self.curves = tuple(curves)
+        if len(self.curves) != len(self.part_names) or not all(
+            c is None or isinstance(c, Curve) for c in self.curves
+        ):
+            raise MeshError(
+                f"curves needs one Curve or None per part ({len(self.part_names)}), got "
+                f"{self.curves!r}"
+            )
         for a in (self.points, self.cells, self.boundary, self.boundary_part):
             a.flags.writeable = False
         if validate:
@@ -229,6 +246,62 @@ class Mesh:
         mesh = cls(points, cells, bnd, part_of, names)
         if flipped.size:
             mesh.reoriented = _frozen(flipped)
+        return mesh
+
+    def with_curve(self, part: str, curve: Curve, *, rtol: float = 1e-8) -> Mesh:
+        """A new mesh whose boundary part ``part`` carries ``curve``.
+
+        Refinement then puts the new vertex of a bisected edge of the part at the curve's
+        halfway point (:meth:`Curve.halfway`) instead of the chord midpoint, and the P2
+        space puts the edge's midpoint node there (:attr:`curved_midpoints`). The cells stay
+        straight-sided in assembly (no isoparametric cells yet). The points are not moved.
+
+        Parameters
+        ----------
+        part : str
+            A boundary part of the mesh.
+        curve : Curve
+            E.g. :class:`~signorini.mesh.curves.Circle` or
+            :class:`~signorini.mesh.curves.Line`; replaces any curve the part had.
+        rtol : float
+            Every vertex of the part must lie within ``rtol`` times the mesh's diameter
+            (the diagonal of its bounding box) of the curve.
+
+        Raises
+        ------
+        MeshError
+            If ``part`` is not a part, ``curve`` is not a :class:`Curve`, or a vertex of the
+            part is off the curve (naming the vertex and its distance).
+        """
+        index = self.part_index(part)
+        if not isinstance(curve, Curve):
+            raise MeshError(
+                f"with_curve: the curve of part {part!r} must be a Curve (Line, Circle, "
+                f"ProjectedCurve), got {type(curve).__name__}"
+            )
+        vertices = np.unique(self.boundary[self.boundary_part == index])
+        x = self.points[vertices]
+        distance = np.hypot(*(curve.project(x) - x).T)
+        diameter = float(np.hypot(*np.ptp(self.points, axis=0)))
+        if np.any(distance > rtol * diameter):
+            k = int(np.argmax(distance))
+            raise MeshError(
+                f"with_curve: vertex {vertices[k]} {x[k].tolist()} of part {part!r} lies "
+                f"{distance[k]:.3g} from {curve!r}, more than rtol * diameter = "
+                f"{rtol * diameter:.3g}"
+            )
+        curves = list(self.curves)
+        curves[index] = curve
+        mesh = Mesh(
+            self.points,
+            self.cells,
+            self.boundary,
+            self.boundary_part,
+            self.part_names,
+            validate=False,
+            curves=curves,
+        )
+        mesh.reoriented = self.reoriented
         return mesh
 
     # ------------------------------------------------------------------ sizes
@@ -360,6 +433,24 @@ class Mesh:
     def edge_midpoints(self) -> np.ndarray:
         """``(n_edges, 2)`` midpoints."""
         return _frozen(0.5 * (self.points[self.edges[:, 0]] + self.points[self.edges[:, 1]]))
+
+    @cached_property
+    def curved_midpoints(self) -> np.ndarray:
+        """``(n_edges, 2)`` edge midpoints, on the curve for edges of a part that carries
+        one (:meth:`Curve.halfway` of the edge's ends): where refinement puts new vertices
+        and the P2 space its edge nodes. The same array as :attr:`edge_midpoints` when no
+        part carries a curve."""
+        if all(c is None for c in self.curves):
+            return self.edge_midpoints
+        mid = self.edge_midpoints.copy()
+        part = self.edge_part
+        for index, curve in enumerate(self.curves):  # a loop over parts, not edges
+            if curve is None:
+                continue
+            e = np.flatnonzero(part == index)
+            ends = self.edges[e]
+            mid[e] = curve.halfway(self.points[ends[:, 0]], self.points[ends[:, 1]])
+        return _frozen(mid)
 
     def min_angle(self) -> float:
         """Smallest interior angle (radians) over all cells."""

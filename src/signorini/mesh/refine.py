@@ -21,7 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import signed_area
 from .mesh import Mesh
+from .validation import MeshError, degenerate_cells
 
 __all__ = ["Refinement", "refine_nvb", "refine_uniform", "closure"]
 
@@ -129,7 +131,7 @@ def _bisect(mesh: Mesh, marked_edges: np.ndarray) -> Refinement:
     bisected = np.flatnonzero(marked_edges)
     edge_point = np.full(mesh.n_edges, -1, dtype=np.int64)
     edge_point[bisected] = n_points + np.arange(bisected.size)
-    points = np.vstack([mesh.points, mesh.edge_midpoints[bisected]])
+    points = np.vstack([mesh.points, mesh.curved_midpoints[bisected]])
 
     cells = mesh.cells
     a, b, c = cells[:, 0], cells[:, 1], cells[:, 2]
@@ -173,5 +175,38 @@ def _bisect(mesh: Mesh, marked_edges: np.ndarray) -> Refinement:
     )
     part = mesh.boundary_part
     new_part = np.concatenate([part[~split], part[split], part[split]])
-    refined = Mesh(points, new_cells, new_boundary, new_part, mesh.part_names, validate=False)
+    if any(curve is not None for curve in mesh.curves):
+        _check_curved_cells(mesh, points, new_cells, bisected)
+    refined = Mesh(
+        points,
+        new_cells,
+        new_boundary,
+        new_part,
+        mesh.part_names,
+        validate=False,
+        curves=mesh.curves,
+    )
     return Refinement(refined, parent, edge_point)
+
+
+def _check_curved_cells(
+    mesh: Mesh, points: np.ndarray, cells: np.ndarray, bisected: np.ndarray
+) -> None:
+    """Raise if a new vertex placed on a curve leaves a cell clockwise or degenerate."""
+    curved = np.isin(
+        mesh.edge_part[bisected], [i for i, c in enumerate(mesh.curves) if c is not None]
+    )
+    on_curve = np.zeros(len(points), dtype=bool)
+    on_curve[mesh.n_points + np.flatnonzero(curved)] = True
+    touched = np.flatnonzero(on_curve[cells].any(axis=1))
+    area = signed_area(points, cells[touched])
+    bad = (area <= 0) | degenerate_cells(points, cells[touched], area)
+    if bad.any():
+        cell = cells[touched[np.flatnonzero(bad)]]
+        parts = [mesh.part_names[i] for i in np.unique(mesh.edge_part[bisected[curved]])]
+        raise MeshError(
+            f"refinement: placing new vertices on the curve of part(s) {parts} turns "
+            f"{bad.sum()} new cell(s) clockwise or flat, e.g. {cell[0].tolist()} at "
+            f"{points[cell[0]].tolist()}: the initial mesh is too coarse for the curve "
+            "(refine it near the curve before attaching the curve)"
+        )

@@ -1,0 +1,210 @@
+"""Boundary curves: projection, normals, halfway points; curves on meshes and under refinement."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from signorini.fem.space import P2Space
+from signorini.mesh import Circle, Line, Mesh, MeshError, ProjectedCurve, rectangle
+from signorini.mesh.refine import refine_nvb, refine_uniform
+
+
+def disc(k: int = 8, radius: float = 1.0, center=(0.0, 0.0)) -> Mesh:
+    """The disc fanned around its centre into ``k`` triangles; the whole boundary is "arc"."""
+    t = 2 * np.pi * np.arange(k) / k
+    p = np.vstack([[0.0, 0.0], np.column_stack([np.cos(t), np.sin(t)])]) * radius + center
+    c = np.array([[0, 1 + j, 1 + (j + 1) % k] for j in range(k)])
+    return Mesh.from_arrays(p, c, {"arc": lambda x: np.ones(len(x), bool)})
+
+
+def on_circle_error(mesh: Mesh, part: str, center, radius) -> float:
+    v = np.unique(mesh.edges[mesh.part_edges(part)])
+    r = np.hypot(*(mesh.points[v] - center).T)
+    return float(np.abs(r / radius - 1).max())
+
+
+def test_uniform_refinement_of_a_disc_stays_on_the_circle_and_the_area_converges_like_h2():
+    center, radius = np.array([0.3, -0.2]), 2.0
+    mesh = disc(8, radius, center).with_curve("arc", Circle(center, radius))
+    straight = disc(8, radius, center)
+    n_cells, error, straight_error = [], [], []
+    for _ in range(6):
+        mesh = refine_uniform(mesh).mesh
+        straight = refine_uniform(straight).mesh
+        assert on_circle_error(mesh, "arc", center, radius) <= 1e-14
+        assert mesh.area.min() > 0
+        n_cells.append(mesh.n_cells)
+        error.append(np.pi * radius**2 - mesh.area.sum())
+        straight_error.append(np.pi * radius**2 - straight.area.sum())
+    slope = np.polyfit(np.log(n_cells), np.log(error), 1)[0]
+    print(f"area error vs n_cells: slope {slope:.3f} on the circle; chords: {straight_error}")
+    assert -1.05 <= slope <= -0.95
+    assert np.allclose(straight_error, straight_error[0])  # chords never approach the disc
+    assert isinstance(mesh.curves[0], Circle)
+
+
+def test_adaptive_refinement_of_a_disc_keeps_boundary_vertices_on_the_circle():
+    rng = np.random.default_rng(3)
+    mesh = disc(6).with_curve("arc", Circle((0, 0), 1))
+    for _ in range(12):
+        mesh = refine_nvb(mesh, rng.random(mesh.n_cells) < 0.3).mesh
+        assert on_circle_error(mesh, "arc", (0, 0), 1) <= 1e-14
+        assert mesh.area.min() > 0
+    assert mesh.n_cells > 500
+
+
+def test_a_quarter_disc_keeps_straight_sides_straight_and_its_arc_on_the_circle():
+    t = np.linspace(0, np.pi / 2, 5)
+    p = np.vstack([[0, 0], np.column_stack([np.cos(t), np.sin(t)])])
+    p[-1] = [0.0, 1.0]  # cos(π/2) is not 0 in floating point
+    c = np.array([[0, 1 + j, 2 + j] for j in range(4)])
+    mesh = Mesh.from_arrays(
+        p,
+        c,
+        {
+            "bottom": lambda x: np.abs(x[:, 1]) < 1e-12,
+            "left": lambda x: np.abs(x[:, 0]) < 1e-12,
+            "arc": lambda x: np.hypot(x[:, 0], x[:, 1]) > 0.5,
+        },
+    ).with_curve("arc", Circle((0, 0), 1))
+    for _ in range(4):
+        mesh = refine_uniform(mesh).mesh
+    assert on_circle_error(mesh, "arc", (0, 0), 1) <= 1e-14
+    assert np.all(mesh.points[np.unique(mesh.edges[mesh.part_edges("bottom")]), 1] == 0)
+    assert np.all(mesh.points[np.unique(mesh.edges[mesh.part_edges("left")]), 0] == 0)
+
+
+def test_a_straight_mesh_refines_exactly_as_without_curves():
+    rng = np.random.default_rng(0)
+    plain = rectangle(nx=3, ny=2)
+    lined = plain.with_curve("bottom", Line((0, 0), (1, 0))).with_curve("top", Line((1, 1), (0, 1)))
+    for _ in range(5):
+        marked = rng.random(plain.n_cells) < 0.4
+        plain, lined = refine_nvb(plain, marked).mesh, refine_nvb(lined, marked).mesh
+        assert np.array_equal(plain.points, lined.points)
+        assert np.array_equal(plain.cells, lined.cells)
+        assert np.array_equal(plain.boundary, lined.boundary)
+    assert plain.curves == (None,) * 4
+    assert plain.curved_midpoints is plain.edge_midpoints
+    assert np.array_equal(P2Space(lined).node_points, P2Space(plain).node_points)
+
+
+def test_p2_edge_nodes_of_curved_edges_lie_on_the_curve_and_prolongation_follows_the_parent():
+    mesh = disc(8).with_curve("arc", Circle((0, 0), 1))
+    space = P2Space(mesh)
+    arc = mesh.part_edges("arc")
+    mid = space.node_points[mesh.n_points + arc]
+    assert np.abs(np.hypot(*mid.T) - 1).max() <= 1e-15
+    inner = np.setdiff1d(np.arange(mesh.n_edges), arc)
+    assert np.array_equal(space.node_points[mesh.n_points + inner], mesh.edge_midpoints[inner])
+    assert np.array_equal(space.node_points[: mesh.n_points], mesh.points)
+    # a P2 function is carried over as the parent cell's quadratic in its own coordinates:
+    # the new vertex on a curved edge takes the value of the edge's midpoint node
+    u = np.random.default_rng(1).random((space.n_nodes, 2))
+    refinement = refine_uniform(mesh)
+    fine_u = space.prolongate(u, refinement)
+    new = refinement.edge_point[arc]
+    assert np.allclose(fine_u[new], u[mesh.n_points + arc], rtol=0, atol=1e-14)
+    assert np.allclose(fine_u[: mesh.n_points], u[: mesh.n_points], rtol=0, atol=1e-14)
+
+
+def test_a_projected_circle_refines_like_the_circle():
+    project = lambda x: x / np.hypot(x[:, 0], x[:, 1])[:, None]  # noqa: E731
+    a = disc(8).with_curve("arc", Circle((0, 0), 1))
+    b = disc(8).with_curve("arc", ProjectedCurve(project))
+    for _ in range(3):
+        a, b = refine_uniform(a).mesh, refine_uniform(b).mesh
+    assert np.allclose(a.points, b.points, rtol=0, atol=1e-15)
+    assert np.array_equal(a.cells, b.cells)
+
+
+angles = st.floats(-10.0, 10.0, allow_nan=False)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    cx=st.floats(-100, 100),
+    cy=st.floats(-100, 100),
+    radius=st.floats(1e-3, 1e3),
+    a=angles,
+    turn=st.floats(-3.1, 3.1),
+    scale=st.floats(0.01, 10.0),
+)
+def test_circle_projection_normal_and_halfway_points(cx, cy, radius, a, turn, scale):
+    circle = Circle((cx, cy), radius)
+    c = np.array([cx, cy])
+    unit = lambda phi: np.array([[np.cos(phi), np.sin(phi)]])  # noqa: E731
+    p, q = c + radius * unit(a), c + radius * unit(a + turn)
+    x = c + scale * radius * unit(a)  # off the circle, on the ray through p
+    tol = 1e-13 * (radius + np.hypot(cx, cy))
+    assert np.abs(circle.project(x) - p).max() <= tol
+    assert np.abs(circle.project(p) - p).max() <= tol
+    assert np.allclose(circle.normal(p), unit(a), rtol=0, atol=tol / radius)
+    assert abs(float(circle.tangent(p)[0] @ circle.normal(p)[0])) <= 1e-15
+    m = circle.halfway(p, q)
+    assert abs(np.hypot(*(m - c)[0]) - radius) <= tol
+    # halfway along the shorter arc: as far from p as from q, and at the arc's midpoint
+    assert np.abs(m - (c + radius * unit(a + turn / 2))).max() <= 10 * tol + 1e-12 * radius
+    assert abs(np.hypot(*(m - p)[0]) - np.hypot(*(m - q)[0])) <= 10 * tol
+
+
+def test_circle_halfway_takes_the_shorter_arc_across_the_branch_cut():
+    circle = Circle((0, 0), 1)
+    p = np.array([[np.cos(3.0), np.sin(3.0)]])
+    q = np.array([[np.cos(-3.0), np.sin(-3.0)]])  # the short way runs through angle π
+    assert np.allclose(circle.halfway(p, q), [[-1.0, 0.0]], atol=1e-15)
+    assert np.allclose(circle.halfway(q, p), [[-1.0, 0.0]], atol=1e-15)
+
+
+def test_line_projection_normal_and_halfway():
+    line = Line((0, 0), (2, 0))
+    assert np.array_equal(line.project([[1.0, 3.0], [-5.0, -1.0]]), [[1, 0], [-5, 0]])
+    assert np.array_equal(line.normal([[1.0, 0.0]]), [[0.0, -1.0]])  # right of a -> b
+    assert np.array_equal(line.tangent([[1.0, 0.0]]), [[1.0, 0.0]])
+    assert np.array_equal(line.halfway([[0.0, 0.0]], [[1.0, 0.0]]), [[0.5, 0.0]])
+
+
+def test_with_curve_refuses_a_part_off_the_curve_naming_the_vertex_and_distance():
+    mesh = disc(8)
+    with pytest.raises(MeshError, match=r"vertex \d+ .* of part 'arc' lies 0\.1 from Circle"):
+        mesh.with_curve("arc", Circle((0, 0), 1.1))
+    with pytest.raises(MeshError, match="the mesh has no boundary part 'outer'"):
+        mesh.with_curve("outer", Circle((0, 0), 1))
+    with pytest.raises(MeshError, match="part 'arc' must be a Curve .* got tuple"):
+        mesh.with_curve("arc", ((0, 0), 1))
+    assert mesh.with_curve("arc", Circle((0, 0), 1 + 1e-10)).curves[0].radius == 1 + 1e-10
+
+
+def test_curve_arguments_are_checked():
+    with pytest.raises(MeshError, match=r"curves needs one Curve or None per part \(1\)"):
+        Mesh(disc(4).points, disc(4).cells, disc(4).boundary, [0] * 4, ["arc"], curves=[3])
+    with pytest.raises(MeshError, match="Circle: radius must be a positive number, got -1"):
+        Circle((0, 0), -1)
+    with pytest.raises(MeshError, match=re.escape("Circle: center must be two finite numbers")):
+        Circle((0, 0, 0), 1)
+    with pytest.raises(MeshError, match="Line: a and b are the same point"):
+        Line((1, 1), (1, 1))
+    with pytest.raises(MeshError, match="ProjectedCurve: project must be a function"):
+        ProjectedCurve(3)
+    bad = ProjectedCurve(lambda x: x[:, 0])
+    with pytest.raises(MeshError, match=r"project must return finite points of shape \(8, 2\)"):
+        disc(8).with_curve("arc", bad)
+    with pytest.raises(MeshError, match="ProjectedCurve: no normal function was given"):
+        ProjectedCurve(lambda x: x).normal(np.zeros((1, 2)))
+
+
+def test_refinement_refuses_a_mesh_too_coarse_for_its_curve():
+    # one triangle whose long edge lies on an arc bulging past the opposite vertex
+    p = np.array([[-1.0, 0.0], [1.0, 0.0], [0.0, 0.1]])
+    mesh = Mesh.from_arrays(
+        p, [[0, 1, 2]], {"bottom": np.array([[0, 1]]), "rest": np.array([[1, 2], [2, 0]])}
+    ).with_curve("bottom", Circle((0, -0.5), np.sqrt(1.25)))
+    with pytest.raises(MeshError, match=r"part\(s\) \['bottom'\] .* initial mesh is too coarse"):
+        refine_uniform(mesh)
+    with pytest.raises(MeshError, match="too coarse for the curve"):
+        refine_nvb(mesh, [0])
