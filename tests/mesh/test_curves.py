@@ -208,3 +208,37 @@ def test_refinement_refuses_a_mesh_too_coarse_for_its_curve():
         refine_uniform(mesh)
     with pytest.raises(MeshError, match="too coarse for the curve"):
         refine_nvb(mesh, [0])
+
+
+def test_the_adaptive_loop_runs_on_a_quarter_disc_with_a_curved_neumann_part():
+    from signorini.fem.material import Material
+    from signorini.loop import adaptive
+    from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
+
+    t = np.linspace(0, np.pi / 2, 5)
+    p = np.vstack([[0, 0], np.column_stack([np.cos(t), np.sin(t)])])
+    p[-1] = [0.0, 1.0]
+    c = np.array([[0, 1 + j, 2 + j] for j in range(4)])
+    mesh = Mesh.from_arrays(
+        p,
+        c,
+        {
+            "bottom": lambda x: np.abs(x[:, 1]) < 1e-12,
+            "left": lambda x: np.abs(x[:, 0]) < 1e-12,
+            "arc": lambda x: np.hypot(x[:, 0], x[:, 1]) > 0.5,
+        },
+    ).with_curve("arc", Circle((0, 0), 1))
+    problem = ContactProblem(
+        mesh=mesh,
+        material=Material.from_lame(1.0, 1.0),
+        conditions={
+            "left": Dirichlet((0.0, 0.0)),
+            "arc": Neumann((0.0, -0.05)),
+            "bottom": Contact(gap=0.02, normal=(0.0, -1.0)),
+        },
+    )
+    levels = list(adaptive(problem, max_ndof=1500))
+    final = levels[-1].result.mesh
+    assert len(levels) >= 5 and final.n_cells > 4 * mesh.n_cells
+    assert on_circle_error(final, "arc", (0, 0), 1) <= 1e-14
+    assert final.area.min() > 0
