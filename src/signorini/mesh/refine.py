@@ -131,7 +131,15 @@ def _bisect(mesh: Mesh, marked_edges: np.ndarray) -> Refinement:
     bisected = np.flatnonzero(marked_edges)
     edge_point = np.full(mesh.n_edges, -1, dtype=np.int64)
     edge_point[bisected] = n_points + np.arange(bisected.size)
-    points = np.vstack([mesh.points, mesh.curved_midpoints[bisected]])
+    points = np.vstack([mesh.points, mesh.edge_midpoints[bisected]])
+    curved = _curved_bisected(mesh, edge_point)  # bisected edges of parts with a curve
+    if curved is not None:
+        ends = mesh.edges[curved[0]]
+        for index in np.unique(curved[1]):  # a loop over parts, not edges
+            mine = curved[1] == index
+            points[edge_point[curved[0][mine]]] = mesh.curves[index].halfway(
+                mesh.points[ends[mine, 0]], mesh.points[ends[mine, 1]]
+            )
 
     cells = mesh.cells
     a, b, c = cells[:, 0], cells[:, 1], cells[:, 2]
@@ -175,8 +183,8 @@ def _bisect(mesh: Mesh, marked_edges: np.ndarray) -> Refinement:
     )
     part = mesh.boundary_part
     new_part = np.concatenate([part[~split], part[split], part[split]])
-    if any(curve is not None for curve in mesh.curves):
-        _check_curved_cells(mesh, points, new_cells, bisected)
+    if curved is not None:
+        _check_curved_cells(mesh, points, new_cells, parent, curved)
     refined = Mesh(
         points,
         new_cells,
@@ -189,21 +197,35 @@ def _bisect(mesh: Mesh, marked_edges: np.ndarray) -> Refinement:
     return Refinement(refined, parent, edge_point)
 
 
+def _curved_bisected(mesh: Mesh, edge_point: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The bisected edges of parts that carry a curve and their parts, or None if no part
+    carries one (work proportional to the boundary, not to the mesh)."""
+    with_curve = [i for i, c in enumerate(mesh.curves) if c is not None]
+    if not with_curve:
+        return None
+    rows = np.flatnonzero(np.isin(mesh.boundary_part, with_curve))
+    edge = mesh.boundary_edge[rows]
+    split = edge_point[edge] >= 0
+    return edge[split], mesh.boundary_part[rows[split]]
+
+
 def _check_curved_cells(
-    mesh: Mesh, points: np.ndarray, cells: np.ndarray, bisected: np.ndarray
+    mesh: Mesh,
+    points: np.ndarray,
+    cells: np.ndarray,
+    parent: np.ndarray,
+    curved: tuple[np.ndarray, np.ndarray],
 ) -> None:
-    """Raise if a new vertex placed on a curve leaves a cell clockwise or degenerate."""
-    curved = np.isin(
-        mesh.edge_part[bisected], [i for i, c in enumerate(mesh.curves) if c is not None]
-    )
-    on_curve = np.zeros(len(points), dtype=bool)
-    on_curve[mesh.n_points + np.flatnonzero(curved)] = True
-    touched = np.flatnonzero(on_curve[cells].any(axis=1))
+    """Raise if a new vertex placed on a curve leaves a cell clockwise or degenerate (only
+    the children of cells with such a vertex are looked at)."""
+    moved = np.zeros(mesh.n_cells, dtype=bool)
+    moved[mesh.edge2cell[curved[0], 0]] = True
+    touched = np.flatnonzero(moved[parent])
     area = signed_area(points, cells[touched])
     bad = (area <= 0) | degenerate_cells(points, cells[touched], area)
     if bad.any():
         cell = cells[touched[np.flatnonzero(bad)]]
-        parts = [mesh.part_names[i] for i in np.unique(mesh.edge_part[bisected[curved]])]
+        parts = [mesh.part_names[i] for i in np.unique(curved[1])]
         raise MeshError(
             f"refinement: placing new vertices on the curve of part(s) {parts} turns "
             f"{bad.sum()} new cell(s) clockwise or flat, e.g. {cell[0].tolist()} at "
