@@ -740,3 +740,50 @@ def test_a_problem_file_in_an_old_form_is_told_so(tmp_path):
     assert done.returncode == 0, done.stderr
     assert f"{source}:7: DeprecationWarning" in done.stderr, done.stderr
     assert "name the parameter `normal`" in done.stderr
+
+
+QUARTER_DISC = """
+import numpy as np
+from signorini import Contact, ContactProblem, Dirichlet, Material, Mesh, Neumann
+from signorini.mesh import Circle
+
+def problem():
+    t = np.linspace(0, np.pi / 2, 5)
+    p = np.vstack([[0, 0], np.column_stack([np.cos(t), np.sin(t)])])
+    p[-1] = [0.0, 1.0]
+    cells = np.array([[0, 1 + j, 2 + j] for j in range(4)])
+    parts = {
+        "bottom": lambda x: np.abs(x[:, 1]) < 1e-12,
+        "left": lambda x: np.abs(x[:, 0]) < 1e-12,
+        "arc": lambda x: np.hypot(x[:, 0], x[:, 1]) > 0.5,
+    }
+    mesh = Mesh.from_arrays(p, cells, parts).with_curve("arc", Circle((0, 0), 1))
+    return ContactProblem(
+        mesh=mesh,
+        material=Material.from_lame(1.0, 1.0),
+        conditions={
+            "left": Dirichlet((0.0, 0.0)),
+            "arc": Neumann((0.0, -0.05)),
+            "bottom": Contact(gap=0.02, normal=(0.0, -1.0)),
+        },
+    )
+"""
+
+
+def test_resume_keeps_the_curves_of_the_problem(tmp_path, capsys, monkeypatch):
+    """The saved state holds arrays only; a resumed run refines on the problem's curves
+    again, so it gives the uninterrupted run's levels (not a run refined on chords)."""
+    source = tmp_path / "quarter.py"
+    source.write_text(QUARTER_DISC)
+    full, part = tmp_path / "full", tmp_path / "part"
+    args = ["run", str(source), "--max-ndof", "1500", "--no-figures", "--quiet"]
+    assert main([*args, "--out", str(full)]) == 0
+    interrupt_after_level(monkeypatch, 2)
+    assert main([*args, "--out", str(part)]) == 130
+    monkeypatch.undo()
+    capsys.readouterr()
+    assert main(["run", "--resume", str(part), "--quiet", "--no-figures"]) == 0
+    a = history_without_timings(full / "history.csv")
+    b = history_without_timings(part / "history.csv")
+    assert len(a) > 4
+    assert_same_history(a, b)

@@ -34,6 +34,7 @@ from .algebra.backends import BACKENDS
 from .estimator.residual import ETA5_VARIANTS
 from .examples import EXAMPLES, get_example
 from .loop import COLUMNS, Level, adaptive, check_loop_arguments
+from .mesh.mesh import Mesh
 from .output import HistoryWriter, write_columns, write_vtu
 from .output.run import RunFolder, file_digest
 from .problem.problem import ContactProblem
@@ -250,6 +251,14 @@ def load_problem(name: str) -> ContactProblem:
     return problem
 
 
+def _with_curves_of(mesh: Mesh, initial: Mesh) -> Mesh:
+    """``mesh`` with the curves that ``initial`` attaches to the parts of the same name."""
+    for name, curve in zip(initial.part_names, initial.curves, strict=True):
+        if curve is not None:  # a loop over parts
+            mesh = mesh.with_curve(name, curve)
+    return mesh
+
+
 def _problem_id(name: str) -> dict:
     """How a run records its problem: the example's name, or the file with its digest."""
     if name in EXAMPLES:
@@ -411,6 +420,10 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
     if args.resume is not None:
         state = folder.restart()
         status.folder, status.done = folder, state.level
+        if state.mesh is not None:
+            # the saved state holds arrays only: the curves of the problem's parts come back
+            # from the problem itself (the same problem, checked by restart)
+            state.mesh = _with_curves_of(state.mesh, problem.mesh)
     else:
         out: Path = args.out or Path("results") / label
         folder, removed = RunFolder.create(out, _problem_id(name), opts, overwrite=args.overwrite)
