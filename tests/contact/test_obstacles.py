@@ -203,6 +203,12 @@ def circle_phi(x):
         (circle_phi, lambda x: x[:, 0], "grad(x) must return shape (2, 2) for x of shape (2, 2)"),
         (circle_phi, lambda x: 0 * x, "the gradient of phi vanishes at x[0] = [2.0, 0.0]"),
         (lambda x: "a", None, "phi(x) did not return numbers"),
+        (
+            lambda x: x[:, 0] ** 2 + x[:, 1] ** 2 - 1,
+            None,
+            "phi is not a signed distance: its difference quotients have length 4 > sqrt(2) "
+            "at x[0] = [2.0, 0.0]",
+        ),
     ],
 )
 def test_bad_user_functions_are_rejected(phi, grad, message):

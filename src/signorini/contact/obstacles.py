@@ -397,6 +397,13 @@ class SignedDistance(Obstacle):
     ``O(h**2)`` where ``phi`` is smooth, and at kinks of ``phi`` (the bisector of a corner)
     the difference quotient averages the one-sided gradients.
 
+    A distance is 1-Lipschitz, so each of its two difference quotients is at most 1 and their
+    vector at most ``sqrt(2)`` long (1 where ``phi`` is smooth; more only at a kink, where the
+    two quotients may come from different branches). Longer quotients (e.g. from
+    ``|x|**2 - R**2`` instead of ``|x| - R`` away from the origin) show that ``phi`` is not a
+    distance, so ``psi`` would be a wrong gap: the points are refused. A flatter ``phi`` (a
+    distance divided by a constant) is not detected.
+
     Parameters
     ----------
     phi : callable
@@ -465,5 +472,11 @@ class SignedDistance(Obstacle):
             raise ValueError(
                 f"{self!r}: the gradient of phi vanishes at x[{k}] = {x[k].tolist()}, so no "
                 "direction to the obstacle exists there"
+            )
+        if self.grad is None and (length > np.sqrt(2) * (1 + 1e-6)).any():
+            k = int(np.argmax(length))
+            raise ValueError(
+                f"{self!r}: phi is not a signed distance: its difference quotients have "
+                f"length {length[k]:.6g} > sqrt(2) at x[{k}] = {x[k].tolist()}"
             )
         return psi, -gradient / length[:, None]
