@@ -14,7 +14,7 @@ from signorini.fem.material import Material
 from signorini.fem.norms import energy_error2
 from signorini.fem.space import P2Space
 from signorini.fem.stiffness import assemble_stiffness
-from signorini.mesh import Circle, Mesh, rectangle
+from signorini.mesh import Circle, Mesh, MeshError, rectangle
 from signorini.mesh.refine import refine_nvb, refine_uniform
 from signorini.problem import ContactProblem, Dirichlet, Neumann
 
@@ -309,3 +309,17 @@ def test_solve_errors_and_estimate_run_on_a_mesh_with_curved_cells():
     assert result.errors()["error_energy"] == pytest.approx(np.sqrt(e2.sum()), rel=1e-8)
     eta = estimate(result)  # affine formulas on the curved cells, for now
     assert np.isfinite(eta.eta) and eta.eta > 0
+
+
+def test_a_cell_folding_over_along_a_curve_is_refused_naming_it():
+    # outside the unit circle, the opposite vertex closer to the arc than the arc's bulge
+    p = np.array([[1.0, 0.0], [0.0, 1.0], [0.8, 0.8]])
+    on_chord = lambda x: np.abs(x[:, 0] + x[:, 1] - 1) < 1e-9  # noqa: E731
+    mesh = Mesh.from_arrays(
+        p, np.array([[0, 2, 1]]), {"hole": on_chord, "rest": lambda x: ~on_chord(x)}
+    ).with_curve("hole", Circle((0, 0), 1))
+    with pytest.raises(MeshError, match=r"1 cell\(s\) along a curved .* \(first: cell 0, "):
+        _ = P2Space(mesh).curved
+    pb = ContactProblem(mesh, MATERIAL, {"hole": Neumann(), "rest": Dirichlet()})
+    with pytest.raises(MeshError, match="refine the mesh near the curve before attaching it"):
+        assemble(pb, mesh)

@@ -29,6 +29,7 @@ __all__ = [
     "curved_edges",
     "curved_cells",
     "geometry",
+    "folded",
     "stiffness_blocks",
     "edge_geometry",
     "gradient_errors",
@@ -72,6 +73,14 @@ def geometry(nodes: np.ndarray, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     J = np.einsum("qaj,mai->mqij", p2.grad_basis(xi), nodes)
     det = J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
     return x, J, det
+
+
+def folded(nodes: np.ndarray) -> np.ndarray:
+    """Indices of the cells whose quadratic map has a non-positive Jacobian determinant at
+    one of its six nodes or at a point of the stiffness rule (the map folds over)."""
+    xi = np.vstack([p2.REFERENCE_NODES, triangle_rule(STIFFNESS_DEGREE)[0]])
+    _, _, det = geometry(nodes, xi)
+    return np.flatnonzero(~(det > 0.0).all(axis=1))
 
 
 def _physical_gradients(

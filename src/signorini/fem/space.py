@@ -15,6 +15,7 @@ import numpy as np
 
 from ..mesh.mesh import Mesh
 from ..mesh.refine import Refinement
+from ..mesh.validation import MeshError
 from . import iso
 from .p2 import basis_barycentric
 
@@ -65,11 +66,28 @@ class P2Space:
     def curved(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The isoparametric cells: ``(cells (k,), node points (k, 6, 2))`` of the cells with
         an edge on a part carrying a curve other than a line (:mod:`signorini.fem.iso`), or
-        ``None`` if there are none (every cell is affine)."""
+        ``None`` if there are none (every cell is affine).
+
+        Raises
+        ------
+        MeshError
+            If the quadratic map of a curved cell folds over (its Jacobian determinant is
+            not positive at a node or a quadrature point): the mesh is too coarse for the
+            curve there."""
         cells = iso.curved_cells(self.mesh)
         if cells.size == 0:
             return None
-        return cells, self.node_points[self.cell_nodes[cells]]
+        nodes = self.node_points[self.cell_nodes[cells]]
+        bad = iso.folded(nodes)
+        if bad.size:
+            c = int(cells[bad[0]])
+            raise MeshError(
+                f"{bad.size} cell(s) along a curved boundary part fold over as isoparametric "
+                f"cells (first: cell {c}, vertices {self.vertices[c].tolist()}): the curve "
+                "bends by more than the cell's height; refine the mesh near the curve before "
+                "attaching it"
+            )
+        return cells, nodes
 
     @cached_property
     def vertices(self) -> np.ndarray:
