@@ -12,7 +12,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..mesh.geometry import segment_normals
-from . import p2
+from . import iso, p2
 from .quadrature import line_rule, triangle_rule
 
 __all__ = ["assemble_body_force", "assemble_edge_load"]
@@ -24,6 +24,7 @@ def assemble_body_force(
     n_dofs: int,
     f: Callable[[np.ndarray], np.ndarray],
     degree: int = 6,
+    curved: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Load vector of a body force, ``F[2 z + c] = int_Omega f_c psi_z dx``.
 
@@ -40,6 +41,9 @@ def assemble_body_force(
     degree : int, optional
         Quadrature degree on each cell (exact for ``f`` polynomial of degree
         ``degree - 2``).
+    curved : (cells (k,), nodes (k, 6, 2)), optional
+        Isoparametric cells (:attr:`~signorini.fem.space.P2Space.curved`), integrated on
+        their quadratic maps with per-point Jacobians.
 
     Returns
     -------
@@ -48,9 +52,15 @@ def assemble_body_force(
     _, det = p2.jacobian(vertices)
     xi, w = triangle_rule(degree)
     x = p2.physical_points(vertices, xi)
+    if curved is not None:  # f is called once, at the curved cells' own points
+        cells, nodes = curved
+        x_curved, _, det_curved = iso.geometry(nodes, xi)
+        x[cells] = x_curved
     fx = np.broadcast_to(np.asarray(f(x), dtype=np.float64), x.shape)
     phi = p2.basis(xi) * w[:, None]  # (q, 6)
     local = np.einsum("qa,mqc->mac", phi, fx) * det[:, None, None]
+    if curved is not None:
+        local[cells] = np.einsum("qa,mqc,mq->mac", phi, fx[cells], det_curved)
     return np.bincount(np.ravel(cell_dofs), weights=local.ravel(), minlength=n_dofs)
 
 
@@ -60,6 +70,7 @@ def assemble_edge_load(
     n_dofs: int,
     g: Callable[[np.ndarray, np.ndarray], np.ndarray],
     degree: int = 6,
+    midpoints: np.ndarray | None = None,
 ) -> np.ndarray:
     """Load vector of boundary tractions, ``G[2 z + c] = int_{Gamma_N} g_c psi_z ds``.
 
@@ -78,14 +89,23 @@ def assemble_edge_load(
     degree : int, optional
         Gauss-Legendre degree along each edge (exact for ``g`` polynomial of
         degree ``degree - 2``).
+    midpoints : ndarray of float, shape (k, 2), optional
+        Midpoint nodes of curved edges (on the curve): each edge is then the quadratic
+        ``x(t)`` through start, midpoint and end, ``g`` gets the points ``x(t)`` and the
+        normals of that curve ``(k, q, 2)``, and the integral is ``int_0^1 g psi |x'(t)| dt``.
 
     Returns
     -------
     ndarray of float64, shape (n_dofs,)
     """
     ev = np.asarray(edge_vertices, dtype=np.float64)
-    length, normal = segment_normals(ev[:, 0], ev[:, 1])
     t, w = line_rule(degree)
+    if midpoints is not None:
+        x, speed, normal = iso.edge_geometry(ev, midpoints, t)
+        gx = np.broadcast_to(np.asarray(g(x, normal), dtype=np.float64), x.shape)
+        local = np.einsum("qa,kqc,kq->kac", p2.edge_basis(t), gx, speed * w[None, :])
+        return np.bincount(np.ravel(edge_dofs), weights=local.ravel(), minlength=n_dofs)
+    length, normal = segment_normals(ev[:, 0], ev[:, 1])
     x = ev[:, None, 0, :] + t[None, :, None] * (ev[:, 1] - ev[:, 0])[:, None, :]
     gx = np.broadcast_to(np.asarray(g(x, normal[:, None, :]), dtype=np.float64), x.shape)
     psi = p2.edge_basis(t) * w[:, None]  # (q, 3)

@@ -11,7 +11,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import p2
+from . import iso, p2
 from .material import Material
 from .quadrature import triangle_rule
 
@@ -30,8 +30,9 @@ def _error_setup(vertices, u_cell, degree):
     return u, J, det, xi, w, point
 
 
-def _grad_error_loop(vertices, u_cell, grad_exact, degree, density):
-    """Sum over quadrature points of density(grad u - grad u_h) * w * det, per cell."""
+def _grad_error_loop(vertices, u_cell, grad_exact, degree, density, curved=None):
+    """Sum over quadrature points of density(grad u - grad u_h) * w * det, per cell
+    (isoparametric cells ``curved`` with their per-point Jacobians)."""
     u, J, det, xi, w, point = _error_setup(vertices, u_cell, degree)
     coef = p2.gradient_coefficients(u, p2.inverse_transpose(J, det))  # (m, 3, 2, 2)
     out = np.zeros(det.shape[0])
@@ -41,7 +42,11 @@ def _grad_error_loop(vertices, u_cell, grad_exact, degree, density):
         diff -= xi[p, 0] * coef[:, 1]
         diff -= xi[p, 1] * coef[:, 2]
         out += w[p] * density(diff)
-    return out * det
+    out *= det
+    if curved is not None:
+        cells, nodes = curved
+        out[cells] = iso.gradient_errors(nodes, u[cells], grad_exact, degree, density)
+    return out
 
 
 def energy_error2(
@@ -50,6 +55,7 @@ def energy_error2(
     grad_exact: Callable[[np.ndarray], np.ndarray],
     material: Material,
     degree: int = 10,
+    curved: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Per-cell squared energy error ``a_T(e, e)``, ``e = u - u_h``.
 
@@ -66,6 +72,9 @@ def energy_error2(
     material : Material
     degree : int, optional
         Quadrature degree on each cell.
+    curved : (cells (k,), nodes (k, 6, 2)), optional
+        Isoparametric cells (:attr:`~signorini.fem.space.P2Space.curved`), integrated on
+        their quadratic maps (the same for the other norms).
 
     Returns
     -------
@@ -80,7 +89,7 @@ def energy_error2(
         e01 = 0.5 * (ge[:, 0, 1] + ge[:, 1, 0])
         return lam * (e00 + e11) ** 2 + 2.0 * mu * (e00**2 + e11**2 + 2.0 * e01**2)
 
-    return _grad_error_loop(vertices, u_cell, grad_exact, degree, density)
+    return _grad_error_loop(vertices, u_cell, grad_exact, degree, density, curved)
 
 
 def h1_seminorm_error2(
@@ -88,6 +97,7 @@ def h1_seminorm_error2(
     u_cell: np.ndarray,
     grad_exact: Callable[[np.ndarray], np.ndarray],
     degree: int = 10,
+    curved: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Per-cell squared H^1 seminorm error ``int_T |grad(u - u_h)|^2``.
 
@@ -104,7 +114,7 @@ def h1_seminorm_error2(
     ndarray of float64, shape (m,)
     """
     return _grad_error_loop(
-        vertices, u_cell, grad_exact, degree, lambda ge: np.einsum("mij,mij->m", ge, ge)
+        vertices, u_cell, grad_exact, degree, lambda ge: np.einsum("mij,mij->m", ge, ge), curved
     )
 
 
@@ -113,6 +123,7 @@ def l2_error2(
     u_cell: np.ndarray,
     u_exact: Callable[[np.ndarray], np.ndarray],
     degree: int = 10,
+    curved: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Per-cell squared L^2 error ``int_T |u - u_h|^2``.
 
@@ -135,4 +146,8 @@ def l2_error2(
     for p in range(w.size):
         d = np.asarray(u_exact(point(p)), dtype=np.float64) - uh[:, :, p]
         out += w[p] * np.einsum("mi,mi->m", d, d)
-    return out * det
+    out *= det
+    if curved is not None:
+        cells, nodes = curved
+        out[cells] = iso.l2_errors(nodes, u[cells], u_exact, degree)
+    return out

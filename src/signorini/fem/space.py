@@ -15,6 +15,8 @@ import numpy as np
 
 from ..mesh.mesh import Mesh
 from ..mesh.refine import Refinement
+from ..mesh.validation import MeshError
+from . import iso
 from .p2 import basis_barycentric
 
 __all__ = ["P2Space"]
@@ -56,10 +58,36 @@ class P2Space:
         """``(n_nodes, 2)`` coordinates of the P2 nodes.
 
         The midpoint node of an edge on a boundary part that carries a curve lies on the
-        curve (:attr:`~signorini.mesh.Mesh.curved_midpoints`), where an isoparametric cell
-        would put it. Assembly does not use these coordinates: it still treats every cell as
-        the straight-sided triangle of its vertices."""
+        curve (:attr:`~signorini.mesh.Mesh.curved_midpoints`): the isoparametric cells
+        (:attr:`curved`) are the quadratic maps through these points."""
         return np.vstack([self.mesh.points, self.mesh.curved_midpoints])
+
+    @cached_property
+    def curved(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The isoparametric cells: ``(cells (k,), node points (k, 6, 2))`` of the cells with
+        an edge on a part carrying a curve other than a line (:mod:`signorini.fem.iso`), or
+        ``None`` if there are none (every cell is affine).
+
+        Raises
+        ------
+        MeshError
+            If the quadratic map of a curved cell folds over (its Jacobian determinant is
+            not positive at a node or a quadrature point): the mesh is too coarse for the
+            curve there."""
+        cells = iso.curved_cells(self.mesh)
+        if cells.size == 0:
+            return None
+        nodes = self.node_points[self.cell_nodes[cells]]
+        bad = iso.folded(nodes)
+        if bad.size:
+            c = int(cells[bad[0]])
+            raise MeshError(
+                f"{bad.size} cell(s) along a curved boundary part fold over as isoparametric "
+                f"cells (first: cell {c}, vertices {self.vertices[c].tolist()}): the curve "
+                "bends by more than the cell's height; refine the mesh near the curve before "
+                "attaching it"
+            )
+        return cells, nodes
 
     @cached_property
     def vertices(self) -> np.ndarray:

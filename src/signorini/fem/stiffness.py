@@ -24,7 +24,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
-from . import p2
+from . import iso, p2
 from .material import Material
 from .quadrature import triangle_rule
 
@@ -230,6 +230,7 @@ def assemble_stiffness(
     material: Material,
     *,
     validate: bool = True,
+    curved: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> sp.csr_matrix:
     """Global stiffness matrix of ``a(u, v) = int sigma(u) : eps(v)``.
 
@@ -246,6 +247,11 @@ def assemble_stiffness(
         Check the arrays (shapes, finite counter-clockwise cells, interleaved DOFs in
         range). The assembly of a :class:`~signorini.fem.space.P2Space`, whose arrays are
         right by construction, skips it.
+    curved : (cells (k,), nodes (k, 6, 2)), optional
+        Isoparametric cells (:attr:`~signorini.fem.space.P2Space.curved`): their element
+        matrices are those of the quadratic map through the six node points, integrated with
+        per-quadrature-point Jacobians (:func:`signorini.fem.iso.stiffness_blocks`); they
+        replace the affine ones before the (unchanged) node-block assembly.
 
     Returns
     -------
@@ -269,4 +275,7 @@ def assemble_stiffness(
         nodes = np.asarray(cell_dofs, dtype=np.int64)[:, 0::2] // 2
         n = int(n_dofs)
     blocks = _element_matrices(J, det, material, dof_order=False).reshape(-1, 6, 6, 2, 2)
+    if curved is not None:
+        cells, nodes_xy = curved
+        blocks[cells] = iso.stiffness_blocks(nodes_xy, material)
     return _assemble_node_blocks(nodes, n // 2, blocks)
