@@ -444,16 +444,6 @@ class SignedDistance(Obstacle):
             raise ValueError(f"{self!r}: {name}(x) is not finite at x[{k}] = {x[k].tolist()}")
         return value
 
-    def _arc_claims(self, j: int, x: np.ndarray):
-        """Points whose closest point on the circle of arc ``j`` lies on the arc (its ends
-        included), the vectors from the centre and their lengths."""
-        centers, first, last = self._arcs
-        radial = x - centers[j]
-        r = np.hypot(radial[:, 0], radial[:, 1])
-        in_sector = (_cross(first[j], radial) >= 0) & (_cross(radial, last[j]) >= 0)
-        # the centre sees every arc point: it is left to the segments' tangent points
-        return in_sector & (r > TIE * self.radius), radial, r
-
     def _gap_and_direction(self, x):
         n_points = x.shape[0]
         psi = self._call(self.phi, "phi", x, (n_points,))
