@@ -4,7 +4,9 @@ The strong form (paper, Section 2; docs/method.md, *The continuous problem*)::
 
     u = u_D on Γ_D   (Dirichlet),
     σ(u) n = g on Γ_N   (Neumann),
-    u·n ≤ ψ,  σ_nn ≤ 0,  (u·n − ψ) σ_nn = 0,  σ_t = 0 on Γ_C   (Contact).
+    u·n ≤ ψ,  σ_nn ≤ 0,  (u·n − ψ) σ_nn = 0,  σ_t = 0 on Γ_C   (Contact),
+
+the obstacle of a contact part given by a gap function or as a shape (``obstacles``).
 
 Each condition holds its data as given (numbers, or a function of the points ``x``) and checks
 them when it is built: numbers must be finite and as many as the condition needs, a function
@@ -24,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .obstacles import Obstacle
 from .fields import (
     CALL_NAMED,
     CALL_POSITIONAL,
@@ -128,7 +131,18 @@ class Neumann:
 
 @dataclass(frozen=True)
 class Contact:
-    """Frictionless unilateral contact ``u·n ≤ ψ`` on a straight boundary part.
+    """Frictionless unilateral contact ``u(z)·n_z ≤ ψ(z)`` on a boundary part.
+
+    The obstacle is given either as a gap function along the body's outward normal (the
+    paper's form) or as a rigid shape (docs/method.md, *Contact directions*):
+
+    - ``gap``: ψ is measured along the body's outward normal n_z at each constrained node:
+      the exact normal of the part's curve where the mesh carries one
+      (:meth:`~signorini.mesh.mesh.Mesh.with_curve`), the part's normal on a straight part,
+      otherwise the normalised mean of the outward normals of the part's edges at the node;
+    - ``obstacle``: n_z is the obstacle's normal at its point closest to z, pointing into the
+      obstacle, and ψ(z) the signed distance from z to the obstacle
+      (:mod:`signorini.problem.obstacles`).
 
     Parameters
     ----------
@@ -136,21 +150,28 @@ class Contact:
         The gap ψ between the part and the obstacle, measured along the outward normal (length
         units): a constant, or a function ``ψ(x)`` of the points ``x``, a float array of shape
         ``(n, 2)``, returning ``(n,)`` (or one value for all points); docs/method.md, *User
-        functions*.
+        functions*. Not with ``obstacle``.
     normal : two floats or None
-        The outward normal (normalised here); ``None`` takes it from the geometry. A given
-        normal must agree with the geometry (checked by
-        :class:`~signorini.problem.problem.ContactProblem`).
+        The outward normal of a straight part (normalised here); ``None`` takes it from the
+        geometry. A given normal must agree with the geometry (checked by
+        :class:`~signorini.problem.problem.ContactProblem`). Not with ``obstacle``.
+    obstacle : Obstacle or None
+        A rigid obstacle given as a shape: :class:`~signorini.problem.obstacles.HalfPlane`,
+        :class:`~signorini.problem.obstacles.Disc`,
+        :class:`~signorini.problem.obstacles.Polyline` or
+        :class:`~signorini.problem.obstacles.SignedDistance`.
 
     Raises
     ------
     ProblemError
-        If ``gap`` is neither a finite number nor a function of one argument ``x``, or
-        ``normal`` is not ``None`` nor two finite numbers, not both zero.
+        If ``gap`` is neither a finite number nor a function of one argument ``x``,
+        ``normal`` is not ``None`` nor two finite numbers, not both zero, ``obstacle`` is not
+        an obstacle, or ``obstacle`` comes with a ``gap`` or a ``normal``.
     """
 
     gap: Callable[[np.ndarray], np.ndarray] | float = 0.0
     normal: tuple[float, float] | None = None
+    obstacle: Obstacle | None = None
 
     def __post_init__(self) -> None:
         if callable(self.gap):
@@ -161,9 +182,25 @@ class Contact:
             check_numbers(self.normal, 2, "Contact(normal=...)", _NORMAL)
             if not np.any(np.asarray(self.normal, dtype=np.float64)):
                 raise ProblemError(f"Contact(normal=...) must be {_NORMAL}; got {self.normal!r}")
+        if self.obstacle is not None:
+            if not isinstance(self.obstacle, Obstacle):
+                raise ProblemError(
+                    "Contact(obstacle=...) must be a HalfPlane, Disc, Polyline or "
+                    f"SignedDistance from signorini.problem.obstacles, got {self.obstacle!r}"
+                )
+            if callable(self.gap) or np.any(np.asarray(self.gap, dtype=np.float64)):
+                raise ProblemError(
+                    "Contact: give either gap=... (along the body's normal) or obstacle=... "
+                    "(a shape, which gives the gap itself), not both"
+                )
+            if self.normal is not None:
+                raise ProblemError(
+                    "Contact: normal=... cannot be given with obstacle=...; against a shape "
+                    "the constraint direction is the obstacle's normal at the closest point"
+                )
 
     def gap_field(self) -> Callable[[np.ndarray], np.ndarray]:
-        """``ψ`` as a scalar function of ``x (n, 2)``."""
+        """``ψ`` as a scalar function of ``x (n, 2)`` (for a gap given along the normal)."""
         if callable(self.gap):
             return self.gap
         return constant_field(np.asarray(self.gap, dtype=np.float64).reshape(()), shape=())

@@ -1,4 +1,4 @@
-"""Rigid obstacles as shapes (signorini.contact.obstacles): gap and direction at points."""
+"""Rigid obstacles as shapes (signorini.problem.obstacles): gap and direction at points."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from signorini.contact.obstacles import Disc, HalfPlane, Polyline, SignedDistance
+from signorini.problem.obstacles import Disc, HalfPlane, Polyline, SignedDistance
 
 S2 = np.sqrt(0.5)
 
