@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.linalg as la
+from contact_problems import corner_problem
 from scipy.optimize import nnls
 
 from signorini.contact.contact_set import contact_set
@@ -66,36 +67,6 @@ def reference_solution(pb: ContactProblem, mesh: Mesh | None = None):
     u = u_d.ravel().copy()
     u[free] = la.cho_solve(chol, rhs - Bf.T @ lam)
     return u.reshape(-1, 2), lam
-
-
-def corner_problem(angle: float = 0.0, shapes: bool = False) -> ContactProblem:
-    """The unit square (rotated by ``angle``) pushed by its top into a rigid corner: a floor
-    under the bottom and a wall right of the right side, both at gap 0, with a body force."""
-    c, s = np.cos(angle), np.sin(angle)
-    R = np.array([[c, -s], [s, c]])
-    base = rectangle(nx=4, ny=4)
-
-    def on(coord, value):
-        return lambda x: np.abs((x @ R)[:, coord] - value) < TOL
-
-    mesh = Mesh.from_arrays(
-        base.points @ R.T,
-        base.cells,
-        {"left": on(0, 0.0), "top": on(1, 1.0), "bottom": on(1, 0.0), "right": on(0, 1.0)},
-    )
-    if shapes:
-        floor = Contact(obstacle=HalfPlane(R @ [0.0, 0.0], R @ [0.0, 1.0]))
-        wall = Contact(obstacle=HalfPlane(R @ [1.0, 0.0], R @ [-1.0, 0.0]))
-    else:
-        floor, wall = Contact(), Contact()
-    push = R @ [0.02, -0.03]
-    force = R @ [0.5, -1.0]
-    return ContactProblem(
-        mesh,
-        MATERIAL,
-        {"left": Neumann(), "top": Dirichlet(push), "bottom": floor, "right": wall},
-        body_force=lambda x: np.broadcast_to(force, x.shape),
-    )
 
 
 @pytest.mark.parametrize("shapes", [False, True])
