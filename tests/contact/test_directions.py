@@ -23,7 +23,7 @@ from signorini.fem.material import Material
 from signorini.fem.space import P2Space
 from signorini.fem.stiffness import assemble_stiffness
 from signorini.mesh.builders import rectangle
-from signorini.mesh.curves import Circle
+from signorini.mesh.curves import Circle, ProjectedCurve
 from signorini.mesh.mesh import Mesh
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
 from signorini.problem.obstacles import HalfPlane
@@ -234,3 +234,29 @@ def test_nearly_parallel_corner_is_refused():
     )
     with pytest.raises(ProblemError, match=r"at \[0\.5, 0\.0\] lies on two contact parts"):
         solve(pb)
+
+
+def test_curve_without_normal_takes_the_mean_rule():
+    """A ProjectedCurve given without its normal: the directions are the polygon's (mean of
+    the edges' normals at a vertex), not an error from deep inside."""
+    mesh = quarter_annulus()
+    project = lambda x: 2.0 * x / np.hypot(x[:, 0], x[:, 1])[:, None]  # noqa: E731
+    mesh = mesh.with_curve("outer", ProjectedCurve(project))
+    pb = ContactProblem(
+        mesh,
+        MATERIAL,
+        {
+            "inner": Dirichlet(lambda x: 0.02 * x / np.hypot(x[:, 0], x[:, 1])[:, None]),
+            "outer": Contact(gap=0.005),
+            "sides": Neumann(),
+        },
+    )
+    res = solve(pb)
+    cs = res.contact
+    x = res.space.node_points[cs.nodes]
+    # at a vertex between two equal chords the mean normal is the radial direction
+    inner_vertex = cs.is_vertex & (x[:, 0] > 1e-9) & (x[:, 1] > 1e-9)
+    assert np.abs(cs.normal[inner_vertex] - x[inner_vertex] / 2).max() < 1e-14
+    # at a midpoint the chord's normal: radial at the chord's middle, i.e. through the node
+    assert np.abs(cs.normal[~cs.is_vertex] - x[~cs.is_vertex] / 2).max() < 1e-14
+    assert res.pdas.kkt.max < 1e-10

@@ -207,14 +207,15 @@ def _body_normals(
 ) -> np.ndarray:
     """The body's outward unit normal at the nodes ``[start, end, midpoint]`` of one part's
     edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``: the part's normal
-    on a straight part, the curve's normal on a part with a curve, else the edge's normal at a
-    midpoint and the normalised mean of the part's two edges' normals at a vertex
+    on a straight part, the curve's normal on a part with a curve that has one, else the
+    edge's normal at a midpoint and the normalised mean of the part's two edges' normals at a
+    vertex
     (docs/method.md, *Contact directions*)."""
     mesh = space.mesh
     if name in problem.contact_normals:
         return np.broadcast_to(problem.contact_normals[name], nodes.shape + (2,)).copy()
     curve = mesh.curves[mesh.part_index(name)]
-    if curve is not None:
+    if curve is not None and curve.has_normal:
         n = curve.normal(space.node_points[nodes.ravel()]).reshape(nodes.shape + (2,))
         sign = np.sign(np.einsum("ejc,ec->ej", n, chord))
         return n * np.where(sign < 0, -1.0, 1.0)[..., None]

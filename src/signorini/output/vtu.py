@@ -20,8 +20,8 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     ``contact_traction`` (``−p_z n_z``, 3 components: the obstacle's pressure on the body as
     a vector), ``active`` (1 where u·n_z = ψ is imposed) and ``contact_class`` (0 none,
     1 semi, 2 full, −1 off Γ_C). At a corner node with two constraints the scalars are the
-    larger of the two and the traction their sum. Cell data: ``eta2`` (element indicators) and ``eta2_k`` per contribution
-    when an estimate is given.
+    larger of the two and the traction their sum. Cell data: ``eta2`` (element indicators)
+    and ``eta2_k`` per contribution when an estimate is given.
 
     Parameters
     ----------
