@@ -26,7 +26,7 @@ from signorini.mesh.builders import rectangle
 from signorini.mesh.curves import Circle, ProjectedCurve
 from signorini.mesh.mesh import Mesh
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
-from signorini.problem.obstacles import HalfPlane
+from signorini.problem.obstacles import Disc, HalfPlane
 
 MATERIAL = Material.from_young(10.0, 0.3)
 TOL = 1e-12
@@ -260,3 +260,19 @@ def test_curve_without_normal_takes_the_mean_rule():
     # at a midpoint the chord's normal: radial at the chord's middle, i.e. through the node
     assert np.abs(cs.normal[~cs.is_vertex] - x[~cs.is_vertex] / 2).max() < 1e-14
     assert res.pdas.kkt.max < 1e-10
+
+
+def test_obstacle_without_a_distance_at_a_node_names_the_part():
+    """A disc whose centre is a contact node gives no direction there."""
+    pb = ContactProblem(
+        rectangle(nx=2, ny=2),
+        MATERIAL,
+        {
+            "left": Dirichlet(),
+            "top": Neumann(),
+            "bottom": Neumann(),
+            "right": Contact(obstacle=Disc((1.0, 0.5), 0.25)),
+        },
+    )
+    with pytest.raises(ProblemError, match="the obstacle of contact part 'right': Disc"):
+        solve(pb)

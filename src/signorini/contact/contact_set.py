@@ -241,7 +241,10 @@ def _directions_and_gaps(
         nodes, inverse = np.unique(edge_nodes[sel], return_inverse=True)
         x = space.node_points[nodes]
         if cond.obstacle is not None:
-            psi, n = cond.obstacle.gap_and_direction(x)
+            try:
+                psi, n = cond.obstacle.gap_and_direction(x)
+            except ValueError as err:
+                raise ProblemError(f"the obstacle of contact part {name!r}: {err}") from err
             direction[sel] = n[inverse].reshape(-1, 3, 2)
         else:
             what = f"the gap function of contact part {name!r}"
