@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from signorini.fem.space import P2Space
 from signorini.mesh import Circle, Line, Mesh, MeshError, ProjectedCurve, rectangle
+from signorini.mesh import curves as curves_module
 from signorini.mesh.curves import QuadraticBoundary
 from signorini.mesh.refine import refine_nvb, refine_uniform
 
@@ -260,7 +261,11 @@ def piece_at(edges: np.ndarray, t: np.ndarray) -> np.ndarray:
     return a + t * (4 * m - 3 * a - b) + t**2 * (2 * (a + b - 2 * m))
 
 
-def test_quadratic_boundary_projection_is_the_nearest_point_of_the_pieces():
+@pytest.mark.parametrize("nearest_samples", [24, 2])  # 2: most points compare all pieces
+def test_quadratic_boundary_projection_is_the_nearest_point_of_the_pieces(
+    monkeypatch, nearest_samples
+):
+    monkeypatch.setattr(curves_module, "NEAREST_SAMPLES", nearest_samples)
     edges = wavy_pieces()
     curve = QuadraticBoundary(edges)
     rng = np.random.default_rng(7)

@@ -19,6 +19,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from .validation import MeshError
 
@@ -210,8 +211,14 @@ class ProjectedCurve(Curve):
         return f"ProjectedCurve({getattr(self._project, '__name__', 'project')})"
 
 
-#: Candidate (point, piece) pairs examined at once by :meth:`QuadraticBoundary.project`.
+#: Candidate (point, piece) pairs examined at once by :meth:`QuadraticBoundary.project`
+#: when it compares a point with every piece.
 CHUNK = 1 << 21
+
+#: Parameters of each piece's sample points, and how many of the nearest samples a point
+#: looks at before it falls back to comparing with every piece.
+SAMPLES = np.linspace(0.0, 1.0, 5)
+NEAREST_SAMPLES = 24
 
 #: Newton steps on a piece's parameter (quadratic convergence from the chord projection).
 NEWTON_STEPS = 8
@@ -224,11 +231,15 @@ class QuadraticBoundary(Curve):
     ``X(t) = a (1 - t)(1 - 2t) + b t (2t - 1) + 4 m t (1 - t)``, ``0 <= t <= 1``, the quadratic
     through ``a``, ``m``, ``b`` at ``t = 0, 1/2, 1`` (what Gmsh's ``line3`` elements mean).
 
-    - :meth:`project`: the nearest point on the pieces. Candidate pieces are those whose
-      bounding box (of ``a``, ``b`` and the Bézier control point ``2m - (a + b)/2``, which
-      hold the piece) is no farther than the nearest ``a``, ``b`` or ``m``; on each, Newton's
-      method on ``|X(t) - x|²`` from the chord projection and from both ends, ``t`` clamped to
-      ``[0, 1]``; the nearest result wins. Cost O(points × pieces) comparisons.
+    - :meth:`project`: the nearest point on the pieces. Each piece has five sample points
+      (``t = 0, 1/4, …, 1``), any point of the piece lying within ``s = max |X'| / 8`` of
+      one of them; with ``u`` the distance to the nearest sample (a k-d tree), every piece
+      holding a point within ``u`` has a sample within ``u + s``: these are the candidates.
+      A point with more than :data:`NEAREST_SAMPLES` samples in that radius (far from the
+      curve) takes as candidates the pieces whose bounding box (of ``a``, ``b`` and the
+      Bézier control point ``2m - (a + b)/2``, which hold the piece) is within ``u``. On
+      each candidate, Newton's method on ``|X(t) - x|²`` from the chord projection and from
+      both ends, ``t`` clamped to ``[0, 1]``; the nearest result wins.
     - :meth:`halfway` of ``p`` and ``q`` on one piece at parameters ``s`` and ``t``: the point
       ``X((s + t)/2)``. For the piece's own ends this is exactly its midpoint ``m``, so the P2
       midpoint nodes of the initial edges are the given ones; and the sub-arc between
@@ -286,6 +297,12 @@ class QuadraticBoundary(Curve):
         control = 2.0 * m - 0.5 * (a + b)
         self._lo = np.minimum(np.minimum(a, b), control)
         self._hi = np.maximum(np.maximum(a, b), control)
+        speed = np.maximum(np.hypot(*self._B.T), np.hypot(*(self._B + 2 * self._C).T))
+        self._reach = speed * (0.5 * (SAMPLES[1] - SAMPLES[0]))  # |X'| is largest at an end
+        k = np.arange(len(e))
+        samples = self._at(np.repeat(k, SAMPLES.size), np.tile(SAMPLES, len(e)))
+        self._sample_piece = np.repeat(k, SAMPLES.size)
+        self._tree = cKDTree(samples)
 
     def _at(self, piece: np.ndarray, t: np.ndarray) -> np.ndarray:
         """``X(t)`` in the Lagrange form, so that ``t = 1/2`` gives ``m`` exactly."""
@@ -321,24 +338,30 @@ class QuadraticBoundary(Curve):
     def _locate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The piece ``(n,)`` and parameter ``(n,)`` of the nearest point to each point."""
         x = _points(x)
-        piece = np.zeros(len(x), dtype=np.int64)
-        param = np.empty(len(x))
-        k = len(self.edges)
-        step = max(1, CHUNK // k)
-        for s in range(0, len(x), step):  # chunks bound the (points, pieces) arrays' memory
-            y = x[s : s + step]
-            if not len(y):
-                break
+        if not len(x):
+            return np.zeros(0, dtype=np.int64), np.zeros(0)
+        k = min(NEAREST_SAMPLES, len(self._sample_piece))
+        dist, sample = self._tree.query(x, k=k)
+        dist, sample = dist.reshape(len(x), k), sample.reshape(len(x), k)
+        u = dist[:, :1]
+        crowded = (dist[:, -1:] <= u + self._reach.max()).ravel() & (k < len(self._sample_piece))
+        piece = self._sample_piece[sample]
+        i, c = np.nonzero((dist <= u + self._reach[piece]) & ~crowded[:, None])
+        pairs = [np.unique(i * len(self.edges) + piece[i, c])]
+        far = np.flatnonzero(crowded)
+        step = max(1, CHUNK // len(self.edges))
+        for s in range(0, far.size, step):  # chunks bound the (points, pieces) arrays' memory
+            y = x[far[s : s + step]]
             gap = np.maximum(np.maximum(self._lo[None] - y[:, None], y[:, None] - self._hi), 0.0)
             lower = np.hypot(gap[..., 0], gap[..., 1])  # (n, k) distance to each box
-            sample = np.hypot(*(self.edges[None] - y[:, None, None]).transpose(3, 0, 1, 2))
-            upper = sample.min(axis=(1, 2))
-            i, j = np.nonzero(lower <= upper[:, None] * (1 + 1e-12))
-            t, d2 = self._nearest_on(y[i], j)
-            order = np.lexsort((d2, i))  # per point, the nearest candidate first
-            first = order[np.r_[True, i[order][1:] != i[order][:-1]]]
-            piece[s : s + step], param[s : s + step] = j[first], t[first]
-        return piece, param
+            fi, fj = np.nonzero(lower <= dist[far[s : s + step], :1] * (1 + 1e-12))
+            pairs.append(far[s : s + step][fi] * len(self.edges) + fj)
+        key = np.sort(np.concatenate(pairs))  # sorted by point, every point present
+        i, j = np.divmod(key, len(self.edges))
+        t, d2 = self._nearest_on(x[i], j)
+        order = np.lexsort((d2, i))  # per point, the nearest candidate first
+        first = order[np.r_[True, i[order][1:] != i[order][:-1]]]
+        return j[first], t[first]
 
     def project(self, x: np.ndarray) -> np.ndarray:
         piece, t = self._locate(x)

@@ -199,7 +199,6 @@ def _with_quadratic_boundaries(mesh: Mesh, given: tuple[np.ndarray, np.ndarray])
         )
     if not curved.any():
         return mesh
-    _check_vertex_jacobians(mesh, mid, curved)
     curves = {}
     for index, name in enumerate(mesh.part_names):  # a loop over parts, not edges
         e = mesh.boundary_edge[mesh.boundary_part == index]
@@ -210,6 +209,7 @@ def _with_quadratic_boundaries(mesh: Mesh, given: tuple[np.ndarray, np.ndarray])
             curves[name] = QuadraticBoundary(np.concatenate([ends, mid[e][:, None]], axis=1))
         except MeshError as exc:
             raise MeshError(f"boundary part {name!r}: {exc}") from None
+    _check_vertex_jacobians(mesh, mid, curved)
     for name, curve in curves.items():
         mesh = mesh.with_curve(name, curve)
     return mesh
