@@ -182,8 +182,9 @@ def _with_quadratic_boundaries(mesh: Mesh, given: tuple[np.ndarray, np.ndarray])
     if np.any(spread > tol):
         e = int(edge[np.argmax(spread)])
         raise MeshError(
-            f"edge {mesh.edges[e].tolist()} has two midpoints {np.max(spread):.3g} apart in "
-            "different elements"
+            f"edge {mesh.edges[e].tolist()} from {mesh.points[mesh.edges[e, 0]].tolist()} to "
+            f"{mesh.points[mesh.edges[e, 1]].tolist()} has two midpoints {np.max(spread):.3g} "
+            "apart in different elements"
         )
     offset = np.hypot(*(mid - mesh.edge_midpoints).T)
     curved = offset > tol
