@@ -323,6 +323,20 @@ def test_quadratic_boundary_normal_is_the_outward_unit_normal_of_the_pieces():
     np.testing.assert_allclose(curve.tangent(x), tangent / np.hypot(*tangent.T)[:, None], atol=1e-8)
 
 
+def test_quadratic_boundary_normal_where_pieces_meet_is_the_mean_of_theirs():
+    # pieces through points of a circle at equal spacing: at a joint the two pieces' normals
+    # lean by ±θ³/32 (θ the angle per piece); their mean is the circle's normal
+    theta = np.pi / 16
+    phi = theta * np.arange(9)
+    v = 2.0 * np.column_stack([np.cos(phi), np.sin(phi)])
+    mid = 2.0 * np.column_stack([np.cos(phi[:-1] + theta / 2), np.sin(phi[:-1] + theta / 2)])
+    curve = QuadraticBoundary(np.stack([v[:-1], v[1:], mid], axis=1))
+    error = np.hypot(*(curve.normal(v) - v / 2.0).T)
+    print(f"normal error at the vertices {error}, theta^3 / 32 = {theta**3 / 32:.3e}")
+    assert error[1:-1].max() <= 1e-14  # joints
+    assert error[[0, -1]] == pytest.approx(theta**3 / 32, rel=0.02)  # the part's two ends
+
+
 @pytest.mark.parametrize(
     ("edges", "message"),
     [

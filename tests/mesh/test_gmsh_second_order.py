@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
 
+from signorini.contact.solution import solve
 from signorini.contact.system import assemble
 from signorini.fem import iso
 from signorini.fem.material import Material
@@ -19,7 +20,7 @@ from signorini.fem.space import P2Space
 from signorini.mesh import Circle, Mesh, MeshError, read_mesh
 from signorini.mesh.curves import QuadraticBoundary
 from signorini.mesh.refine import refine_uniform
-from signorini.problem import ContactProblem, Dirichlet, Neumann
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
 
 MATERIAL = Material.from_young(1.0, 0.3)
 A = 1.0  # u = grad(-cos(A x) cos(A y) / A), as in tests/fem/test_iso.py
@@ -297,6 +298,34 @@ def test_with_curve_replaces_the_files_curve(tmp_path):
     off = np.abs(np.hypot(*exact.points[v].T) - 2).max()
     print(f"outer arc with the exact circle after 3 refinements: radial error {off:.1e}")
     assert off <= 1e-14
+
+
+def test_contact_on_a_files_arc_is_the_contact_on_the_exact_circle(tmp_path):
+    # the same P2 nodes and isoparametric cells; the contact directions are the quadratics'
+    # normals, which equal the circle's at the midpoints and (as the mean of two pieces') at
+    # the joints; only the arc's two end vertices differ, by θ³/32 (both are off contact)
+    exact = sector(8)
+    read = read_mesh(write(tmp_path, gmsh_file(exact, order=2)))
+
+    def solved(mesh):
+        conditions = {
+            "inner": Dirichlet(lambda x: 0.02 * x / np.hypot(x[:, 0], x[:, 1])[:, None]),
+            "outer": Contact(gap=lambda x: 0.002 + 0.01 * (x[:, 0] - x[:, 1]) ** 2),
+            "bottom": Neumann(),
+            "left": Neumann(),
+        }
+        return solve(ContactProblem(mesh, MATERIAL, conditions))
+
+    a, b = solved(read), solved(exact)
+    np.testing.assert_array_equal(a.contact.nodes, b.contact.nodes)
+    turn = np.hypot(*(a.contact.normal - b.contact.normal).T)
+    print(f"contact directions: max difference {turn.max():.2e}, at nodes {np.argsort(turn)[-2:]}")
+    assert np.sort(turn)[-3] <= 1e-14 and turn.max() <= 1.02 * (np.pi / 16) ** 3 / 32
+    assert not a.active[np.argsort(turn)[-2:]].any()
+    diff = np.abs(a.u - b.u).max() / np.abs(b.u).max()
+    print(f"|u_file - u_circle| / |u| = {diff:.2e}, active {a.active.sum()} of {a.active.size}")
+    assert np.array_equal(a.active, b.active) and 0 < a.active.sum() < a.active.size
+    assert diff <= 1e-10 and a.pdas.kkt.max <= 1e-10
 
 
 def moved_midpoint(edge_of: str, shift) -> meshio.Mesh:

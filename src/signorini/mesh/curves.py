@@ -249,7 +249,11 @@ class QuadraticBoundary(Curve):
       the chord midpoint.
     - :meth:`normal`: ``X'(t)`` turned clockwise, at the projected point. Each piece's tangent
       runs from ``a`` to ``b``; ``read_mesh`` lists the pieces counter-clockwise around the
-      domain, so the normal points out of it.
+      domain, so the normal points out of it. Where one piece ends and the next begins
+      (``b`` of one is ``a`` of the other) the pieces meet at a small angle, O(H³) for a
+      smooth curve sampled at spacing H; there the normal is the normalised mean of the
+      two pieces' normals (for pieces through points of a circle at equal spacing, the
+      circle's normal).
 
     Parameters
     ----------
@@ -303,6 +307,15 @@ class QuadraticBoundary(Curve):
         samples = self._at(np.repeat(k, SAMPLES.size), np.tile(SAMPLES, len(e)))
         self._sample_piece = np.repeat(k, SAMPLES.size)
         self._tree = cKDTree(samples)
+        # the piece that ends where each piece starts, and the one that starts where it ends
+        _, ends = np.unique(np.vstack([a, b]), axis=0, return_inverse=True)
+        ends = ends.reshape(2, -1)
+        owner = np.full(ends.max() + 1, -1)
+        owner[ends[1]] = k
+        self._previous = owner[ends[0]]
+        owner[:] = -1
+        owner[ends[0]] = k
+        self._next = owner[ends[1]]
 
     def _at(self, piece: np.ndarray, t: np.ndarray) -> np.ndarray:
         """``X(t)`` in the Lagrange form, so that ``t = 1/2`` gives ``m`` exactly."""
@@ -367,11 +380,23 @@ class QuadraticBoundary(Curve):
         piece, t = self._locate(x)
         return self._at(piece, t)
 
-    def normal(self, x: np.ndarray) -> np.ndarray:
-        piece, t = self._locate(x)
+    def _piece_normal(self, piece: np.ndarray, t: np.ndarray) -> np.ndarray:
         dX = self._B[piece] + 2.0 * t[:, None] * self._C[piece]
         dX /= np.hypot(dX[:, 0], dX[:, 1])[:, None]
         return np.column_stack([dX[:, 1], -dX[:, 0]])
+
+    def normal(self, x: np.ndarray) -> np.ndarray:
+        piece, t = self._locate(x)
+        n = self._piece_normal(piece, t)
+        for end, neighbour, other_end in ((0.0, self._previous, 1.0), (1.0, self._next, 0.0)):
+            joint = np.flatnonzero((t == end) & (neighbour[piece] >= 0))
+            mean = n[joint] + self._piece_normal(
+                neighbour[piece[joint]], np.full(joint.size, other_end)
+            )
+            length = np.hypot(mean[:, 0], mean[:, 1])
+            keep = length > 1e-8  # a cusp: the piece's own normal
+            n[joint[keep]] = mean[keep] / length[keep, None]
+        return n
 
     def _move_onto(
         self, x: np.ndarray, piece: np.ndarray, t: np.ndarray, target: np.ndarray
