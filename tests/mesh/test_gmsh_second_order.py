@@ -19,7 +19,7 @@ from signorini.fem.quadrature import triangle_rule
 from signorini.fem.space import P2Space
 from signorini.mesh import Circle, Mesh, MeshError, read_mesh
 from signorini.mesh.curves import QuadraticBoundary
-from signorini.mesh.refine import refine_uniform
+from signorini.mesh.refine import refine_nvb, refine_uniform
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
 
 MATERIAL = Material.from_young(1.0, 0.3)
@@ -177,6 +177,27 @@ def test_refinement_stays_on_the_files_quadratics_and_keeps_every_cell_valid(tmp
     sagitta = 2 * (1 - np.cos(np.pi / 32))  # the outer chords' sagitta
     assert chords[0] == 0 and all(e == pytest.approx(sagitta, rel=1e-12) for e in chords[1:])
     assert errors[0] == 0 and errors[1] <= 1e-15 and max(errors) < 1e-3 * sagitta
+
+
+def test_adaptive_refinement_stays_on_the_files_quadratics(tmp_path):
+    mesh = read_mesh(write(tmp_path, gmsh_file(sector(4), order=2)))
+    area0 = isoparametric_area(mesh)
+    rng = np.random.default_rng(11)
+    for _ in range(6):
+        centroid = mesh.points[mesh.cells].mean(1)
+        near = np.hypot(*(centroid - [2.0, 0.0]).T) < 0.6  # grade towards the corner (2, 0)
+        mesh = refine_nvb(mesh, near | (rng.random(mesh.n_cells) < 0.1)).mesh
+        assert mesh.area.min() > 0 and iso.folded(P2Space(mesh).curved[1]).size == 0
+    for name in ARCS:
+        curve = mesh.curves[mesh.part_index(name)]
+        v = np.unique(mesh.edges[mesh.part_edges(name)])
+        assert np.abs(curve.project(mesh.points[v]) - mesh.points[v]).max() <= 1e-15
+    change = abs(isoparametric_area(mesh) - area0) / area0
+    lengths = mesh.edge_length[mesh.part_edges("outer")]
+    print(
+        f"outer arc edges from {lengths.min():.2e} to {lengths.max():.2e}; area change {change:.1e}"
+    )
+    assert change <= 1e-14 and lengths.max() > 4 * lengths.min()
 
 
 def test_the_files_geometry_converges_like_h4_and_the_chords_like_h2(tmp_path):
