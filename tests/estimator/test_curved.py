@@ -16,6 +16,7 @@ from signorini.estimator.curved import contact_integrals, curved_cells, div_stre
 from signorini.estimator.residual import estimate
 from signorini.estimator.terms import (
     EdgeSet,
+    direction_field,
     edge_traction,
     tangential_stress,
     third_integrals,
@@ -29,8 +30,8 @@ from signorini.fem.space import P2Space
 from signorini.loop import adaptive
 from signorini.mesh import Circle, Line, Mesh, rectangle
 from signorini.mesh.refine import refine_uniform
-from signorini.problem import Contact, ContactProblem, Dirichlet
-from signorini.problem.obstacles import HalfPlane
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
+from signorini.problem.obstacles import Disc, HalfPlane
 
 from ..fem.test_iso import MATERIAL, curved_sector, exact_grad, exact_u, problem
 
@@ -379,3 +380,49 @@ def test_adaptive_loop_on_a_half_disc_pressed_onto_a_rigid_plane():
     }
     print(f"‖σ_t(u_h)‖ on Γ_C at Ndof {ndof[-1]}: {eta4}")
     assert eta4["n_z"] < 0.5 * eta4["body normal"], eta4
+
+
+def test_straight_contact_part_against_a_disc_splits_along_the_obstacle_direction():
+    """A block [−1, 1] × [0, 1] pushed 0.01 down onto the cylinder of radius 1 below it: the
+    contact part is straight but n_z is radial (the obstacle's). η4 splits the traction along
+    the direction field of n_z; the edge normal would leave a tangential stress of order
+    p a/R that no refinement removes."""
+    pb = ContactProblem(
+        rectangle(-1.0, 1.0, 0.0, 1.0, nx=4, ny=2),
+        Material.from_young(1.0, 0.3),
+        {
+            "top": Dirichlet((0.0, -0.01)),
+            "left": Neumann(),
+            "right": Neumann(),
+            "bottom": Contact(obstacle=Disc((0.0, -1.0), 1.0)),
+        },
+    )
+    ndof, eta = [], []
+    for level in adaptive(pb, theta=0.4, max_ndof=16_000):
+        est, res = level.estimate, level.result
+        assert abs(est.eta2.sum() - est.eta**2) <= 1e-13 * est.eta**2
+        ndof.append(level.record.ndof)
+        eta.append(est.eta)
+    s = slope(ndof[-6:], eta[-6:])
+    mesh, cs = res.mesh, res.contact
+    t, w = line_rule(7)
+    sigma = stress(
+        res.problem.material,
+        p2.field_gradients(
+            res.space.vertices, res.space.cell_values(res.u), p2.REFERENCE_NODES[:3]
+        ),
+    )
+    sn = edge_traction(
+        sigma, mesh.points, mesh.cells, mesh.edge2cell[cs.edges, 0], mesh.edge_local[cs.edges, 0], t
+    )
+    length = mesh.edge_length[cs.edges]
+    eta4 = {
+        "n_z": np.sqrt(
+            tangential_stress(sn, direction_field(cs.edge_direction, t), w, length).sum()
+        ),
+        "edge normal": np.sqrt(tangential_stress(sn, cs.edge_normal, w, length).sum()),
+    }
+    print(f"η_h slope over the last 6 levels {s:.3f} (Ndof {ndof[-6:]})")
+    print(f"‖σ_t(u_h)‖ on Γ_C at Ndof {ndof[-1]}: {eta4}")
+    assert s <= -0.9, s
+    assert eta4["n_z"] < 0.5 * eta4["edge normal"], eta4

@@ -12,15 +12,19 @@ and edges where those are not the estimator of the discrete solution:
   (those edges are straight, so the points and the normal are the affine ones);
 - η3, η4, η5 on the boundary edges of isoparametric cells: the edge is the quadratic
   ``x(t)`` through its three nodes, with its own unit normal ``n(t)`` and ``|x'(t)|`` at
-  each quadrature point (on a straight edge of such a cell these are the chord's);
+  each quadrature point (on a straight edge of such a cell these are the chord's); η4 and
+  η5 split the traction along the constraint direction field, the normalised quadratic
+  interpolant of the nodal n_z;
 - η6 on contact edges of curved parts: ``d_p`` integrated with ``|x'(t)|``.
 
 η7 stays on the chords (docs/method.md). The cost is proportional to the number of
-isoparametric cells and their edges; a mesh without them never reaches this module.
+isoparametric cells and their edges; on a mesh without them :func:`curved_cells` returns
+``None`` and nothing else here runs.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,6 +34,8 @@ from ..fem import iso
 from ..fem.material import Material, stress
 from ..fem.p2 import edge_reference_points
 from ..fem.quadrature import triangle_rule
+from ..fem.space import P2Space
+from ..mesh.mesh import Mesh
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .terms import (
@@ -97,7 +103,9 @@ class CurvedCells:
             r = r + f
         return np.einsum("q,mq,mqc,mqc->m", self.w, det, r, r)
 
-    def traction(self, cell: np.ndarray, k: np.ndarray, t: np.ndarray):
+    def traction(
+        self, cell: np.ndarray, k: np.ndarray, t: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``σ(u_h) n`` along local edge ``k`` of isoparametric ``cell`` at parameters ``t``
         (counter-clockwise around the cell), in the stress unit, with the quadratic edge.
 
@@ -116,7 +124,13 @@ class CurvedCells:
         sig = stress(self.material, grad) / self.unit
         return np.einsum("eqij,eqj->eqi", sig, normal), x, speed, normal
 
-    def mixed_traction(self, affine, cell: np.ndarray, k: np.ndarray, t: np.ndarray):
+    def mixed_traction(
+        self,
+        affine: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray],
+        cell: np.ndarray,
+        k: np.ndarray,
+        t: np.ndarray,
+    ) -> np.ndarray:
         """``σ(u_h) n`` ``(e, q, 2)`` of any cells: ``affine(cell, k, t)``, replaced on the
         isoparametric ones (the interior edges of the jump term are straight, so the points
         and normals agree)."""
@@ -136,7 +150,7 @@ def curved_cells(result: ContactResult, unit: float, degree: int) -> CurvedCells
     cells, nodes = space.curved
     slot = np.full(space.mesh.n_cells, -1)
     slot[cells] = np.arange(cells.size)
-    u = space.cell_values(result.u)[cells]
+    u = np.asarray(result.u)[space.cell_nodes[cells]].reshape(cells.size, 12)
     xi, w = triangle_rule(degree)
     return CurvedCells(cells, nodes, u, slot, result.problem.material, unit, xi, w)
 
@@ -157,7 +171,7 @@ def boundary_rows(curved: CurvedCells, edges: EdgeSet) -> np.ndarray:
 def neumann_integrals(
     curved: CurvedCells,
     problem: ContactProblem,
-    mesh,
+    mesh: Mesh,
     edges: EdgeSet,
     t: np.ndarray,
     w: np.ndarray,
@@ -184,7 +198,7 @@ def neumann_integrals(
 
 def contact_integrals(
     curved: CurvedCells,
-    mesh,
+    mesh: Mesh,
     edges: EdgeSet,
     t: np.ndarray,
     w: np.ndarray,
@@ -204,7 +218,7 @@ def contact_integrals(
     return rows, tangential_stress(sn, d, w, speed), normal_stress(sn, d, t, w, speed, p)
 
 
-def edge_node_points(space, edges: EdgeSet) -> tuple[np.ndarray, np.ndarray]:
+def edge_node_points(space: P2Space, edges: EdgeSet) -> tuple[np.ndarray, np.ndarray]:
     """Rows of contact ``edges`` on curved parts and their node points ``(r, 3, 2)``
     ``[start, end, midpoint]`` (for η6 along the quadratic edge)."""
     rows = np.flatnonzero(np.isin(edges.index, iso.curved_edges(space.mesh)))

@@ -27,6 +27,11 @@ Each term is one function of :mod:`signorini.estimator.terms` (arrays in, integr
 term is a sum of cell or edge integrals; each cell receives its share (edge terms split
 equally between the edge's cells, ``terms.spread_edge_integrals``), so the element
 indicators sum exactly to η_h².
+
+On a mesh with curved parts the integrals of the isoparametric cells and their edges are
+replaced by those along the quadratic maps (:mod:`signorini.estimator.curved`), and η4, η5
+split the traction along the constraint direction field where n_z is not the edge's normal
+(docs/method.md, *Estimator*, "On curved boundaries").
 """
 
 from __future__ import annotations

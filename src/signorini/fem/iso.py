@@ -181,15 +181,25 @@ def field_derivatives(
         dphi = np.broadcast_to(p2.grad_basis(xi), (len(nodes),) + (len(xi), 6, 2))
     else:
         dphi = p2.grad_basis(xi.reshape(-1, 2)).reshape(xi.shape[:2] + (6, 2))
-    J = np.einsum("mqaj,mai->mqij", dphi, nodes)
-    Du = np.einsum("mqaj,mai->mqij", dphi, u)
-    Jinv = np.linalg.inv(J)
+    m, q = dphi.shape[:2]
+    # d/dxi of the map and of the field: (m, q, 2, 6) @ (m, 1, 6, 2) -> (m, q, 2, 2)
+    dphi_t = np.swapaxes(dphi, -1, -2)
+    J = np.swapaxes(np.matmul(dphi_t, nodes[:, None]), -1, -2)
+    Du = np.swapaxes(np.matmul(dphi_t, u[:, None]), -1, -2)
+    det = J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
+    Jinv = np.empty_like(J)
+    Jinv[..., 0, 0] = J[..., 1, 1]
+    Jinv[..., 0, 1] = -J[..., 0, 1]
+    Jinv[..., 1, 0] = -J[..., 1, 0]
+    Jinv[..., 1, 1] = J[..., 0, 0]
+    Jinv /= det[..., None, None]
     grad = np.matmul(Du, Jinv)
-    d2phi = p2.hessian_basis()  # (6, 2, 2), constant
-    D2u = np.einsum("akl,mai->mikl", d2phi, u)  # (m, 2, 2, 2)
-    D2x = np.einsum("akl,mai->mikl", d2phi, nodes)
-    inner = D2u[:, None] - np.einsum("mqci,mikl->mqckl", grad, D2x)
-    hess = np.einsum("mqkj,mqckl,mqlr->mqcjr", Jinv, inner, Jinv)
+    d2phi = p2.hessian_basis().reshape(6, 4)  # constant: (a, kl)
+    D2u = np.swapaxes(u, 1, 2) @ d2phi  # (m, 2, 4): [c, kl]
+    D2x = (np.swapaxes(nodes, 1, 2) @ d2phi)[:, None]  # (m, 1, 2, 4): [i, kl]
+    inner = (D2u[:, None] - np.matmul(grad, D2x)).reshape(m, q, 2, 2, 2)
+    Jinv = Jinv[:, :, None]
+    hess = np.matmul(np.matmul(np.swapaxes(Jinv, -1, -2), inner), Jinv)
     return grad, hess
 
 
