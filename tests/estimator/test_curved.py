@@ -356,7 +356,12 @@ def test_adaptive_loop_on_a_half_disc_pressed_onto_a_rigid_plane():
     h = res.mesh.h
     mid = res.mesh.points[res.mesh.cells].mean(axis=1)
     near_end = np.abs(np.abs(mid[:, 0]) - a) + np.abs(mid[:, 1]) < 0.05
-    print(f"smallest h near the contact ends {h[near_end].min():.2e}, overall {h.min():.2e}")
+    near_corner = np.hypot(np.abs(mid[:, 0]) - 1.0, mid[:, 1] - 1.0) < 0.05
+    print(
+        f"smallest h near the contact ends {h[near_end].min():.2e} ({near_end.sum()} cells), "
+        f"near the clamped corners {h[near_corner].min():.2e} ({near_corner.sum()} cells), "
+        f"largest {h.max():.2e}"
+    )
     assert 0.05 < a < 0.1
     assert s <= -0.9, s
     assert h[near_end].min() < 0.1 * h.max()
