@@ -33,7 +33,15 @@ from signorini.mesh.refine import refine_uniform
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
 from signorini.problem.obstacles import Disc, HalfPlane
 
-from ..fem.test_iso import MATERIAL, body_force, curved_sector, exact_grad, exact_u, problem
+from ..fem.test_iso import (
+    MATERIAL,
+    annulus_sector,
+    body_force,
+    curved_sector,
+    exact_grad,
+    exact_u,
+    problem,
+)
 
 
 def straight_estimator(monkeypatch) -> None:
@@ -461,3 +469,81 @@ def test_a_gap_along_the_curve_normal_splits_along_the_body_normal():
         print(f"n = {n}: η4 along d {np.sqrt(J4.sum()):.4e}, along n(t) {np.sqrt(J4n.sum()):.4e}")
     print(f"relative differences {np.round(diffs, 6)}")
     assert diffs[-1] < 1e-4 and diffs[-1] < 0.1 * diffs[0], diffs
+
+
+# ---------------------------------------------------------------------------- exact contact
+LAME_B = 0.01  # u = LAME_B x / |x|²: the Lamé field (LAME_B / r) e_r, div σ(u) = 0
+
+
+def lame_u(x):
+    return LAME_B * x / (x**2).sum(axis=1, keepdims=True)
+
+
+def lame_grad(x):
+    r2 = (x**2).sum(axis=1)[:, None, None]
+    return LAME_B * (np.eye(2) / r2 - 2 * np.einsum("ni,nj->nij", x, x) / r2**2)
+
+
+def lame_traction(x, normal):
+    g = lame_grad(x.reshape(-1, 2))
+    eps = 0.5 * (g + np.swapaxes(g, -1, -2))
+    tr = eps[:, 0, 0] + eps[:, 1, 1]
+    sig = MATERIAL.lam * tr[:, None, None] * np.eye(2) + 2 * MATERIAL.mu * eps
+    n = np.broadcast_to(normal, x.shape).reshape(-1, 2)
+    return np.einsum("nij,nj->ni", sig, n).reshape(x.shape)
+
+
+def press_fit_levels(levels: int = 5):
+    """A press fit with an exact solution: the annulus sector around a rigid shaft whose
+    surface lies at ψ = u·n = −LAME_B along the inner arc's normal (a gap function on a
+    curved contact part). u = (LAME_B / r) e_r has σ_rθ = 0 and σ_rr = −2μ LAME_B / r² < 0:
+    full contact, no tangential stress, so it solves the Signorini problem with u on the
+    outer arc and its tractions on the straight sides."""
+    mesh = (
+        annulus_sector()
+        .with_curve("inner", Circle((0, 0), 1))
+        .with_curve("outer", Circle((0, 0), 2))
+    )
+    out = []
+    for level in range(levels):
+        if level:
+            mesh = refine_uniform(mesh).mesh
+        conditions = {
+            "outer": Dirichlet(lame_u),
+            "inner": Contact(gap=lambda x: -np.einsum("nc,nc->n", lame_u(x), x) / np.hypot(*x.T)),
+            "bottom": Neumann(lame_traction),
+            "left": Neumann(lame_traction),
+        }
+        res = solve(ContactProblem(mesh, MATERIAL, conditions))
+        assert res.active.all() and res.pdas.kkt.max < 1e-10
+        est = estimate(res)
+        sp = res.space
+        e2 = energy_error2(
+            sp.vertices, sp.cell_values(res.u), lame_grad, MATERIAL, curved=sp.curved
+        )
+        out.append((res.ndof, est.eta, float(np.sqrt(e2.sum())), est))
+    return out
+
+
+def test_estimator_is_efficient_on_an_exact_contact_solution_on_a_curved_part(monkeypatch):
+    levels = press_fit_levels()
+    ndof = [lv[0] for lv in levels]
+    eta, err = np.array([lv[1] for lv in levels]), np.array([lv[2] for lv in levels])
+    eff = eta / err
+    for n, e, r, est in levels:
+        terms = " ".join(f"{v:.2e}" for v in est.eta_terms)
+        print(f"Ndof {n:6d}  η {e:.4e}  error {r:.4e}  η/error {e / r:.2f}  η1…η7 {terms}")
+        assert abs(est.eta2.sum() - e**2) <= 1e-13 * e**2
+    s_eta, s_err = slope(ndof[1:], eta[1:]), slope(ndof[1:], err[1:])
+    print(f"slopes in Ndof: η {s_eta:.3f}, error {s_err:.3f}; efficiency {eff.round(2)}")
+    assert -1.1 <= s_eta <= -0.9, s_eta
+    assert -1.1 <= s_err <= -0.9, s_err
+    assert eff[1:].max() / eff[1:].min() < 1.05, eff
+
+    straight_estimator(monkeypatch)
+    eta_old = np.array([lv[1] for lv in press_fit_levels()])
+    eff_old = eta_old / err
+    s_old = slope(ndof[1:], eta_old[1:])
+    print(f"straight cells: slope {s_old:.3f}; efficiency {eff_old.round(2)}")
+    assert s_old > -0.85, s_old
+    assert eff_old[-1] > 2 * eff_old[1], eff_old
