@@ -547,3 +547,16 @@ def test_estimator_is_efficient_on_an_exact_contact_solution_on_a_curved_part(mo
     print(f"straight cells: slope {s_old:.3f}; efficiency {eff_old.round(2)}")
     assert s_old > -0.85, s_old
     assert eff_old[-1] > 2 * eff_old[1], eff_old
+
+
+def test_direction_field_interpolates_unit_directions():
+    t = np.array([0.0, 0.3, 0.5, 1.0, (1 + np.sqrt(5)) / 4])
+    a, b = np.array([1.0, 0.0]), np.array([0.0, 1.0])
+    m = (a + b) / np.sqrt(2)
+    d = direction_field(np.array([[a, b, m], [a, -a, b]]), t)
+    assert np.allclose(np.hypot(d[..., 0], d[..., 1]), 1.0, rtol=0, atol=1e-15)
+    assert np.allclose(d[0, [0, 2, 3]], [a, m, b], rtol=0, atol=1e-15)
+    # nodal directions [a, −a, a]: the interpolant (1 + 2t − 4t²) a vanishes at the last t,
+    # where the midpoint's direction is used
+    d = direction_field(np.array([[a, -a, a]]), t)
+    assert np.allclose(d[0], [a, a, a, -a, a], rtol=0, atol=1e-12), d

@@ -201,9 +201,15 @@ def direction_field(direction: np.ndarray, t: np.ndarray) -> np.ndarray:
     """The constraint direction along contact edges: the normalised quadratic interpolant of
     the nodal directions n_z ``(k, 3, 2)`` at ``[start, end, midpoint]``, at parameters
     ``t (q,)``: ``(k, q, 2)`` unit vectors (docs/method.md, *Estimator*, "On curved
-    boundaries")."""
+    boundaries"). Where the interpolant vanishes (nodal directions opposed across one edge,
+    e.g. an edge spanning a slot of an obstacle) the midpoint node's direction is used."""
     d = np.einsum("qa,kac->kqc", edge_basis(t), direction)
-    return d / np.hypot(d[..., 0], d[..., 1])[..., None]
+    size = np.hypot(d[..., 0], d[..., 1])[..., None]
+    small = size <= 1e-8
+    if small.any():
+        d = np.where(small, direction[:, None, 2], d)
+        size = np.where(small, 1.0, size)
+    return d / size
 
 
 def _point_weights(w: np.ndarray, length: np.ndarray) -> np.ndarray:
