@@ -111,7 +111,11 @@ def check_friction(
         _disjoint(tangent, d, "tangent", "dirichlet")
     m = normal.size
     g = check_vector(gap, m, "gap", allow_scalar=True)
-    ref = np.zeros(m) if reference is None else check_vector(reference, m, "reference", True)
+    ref = (
+        np.zeros(m)
+        if reference is None
+        else check_vector(reference, m, "reference", allow_scalar=True)
+    )
     if (bound is None) == (coefficient is None):
         raise ValueError("give exactly one of bound (Tresca) and coefficient (Coulomb)")
     law, name = ("tresca", "bound") if coefficient is None else ("coulomb", "coefficient")
