@@ -17,7 +17,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from contact_problems import pressed_block
 
-from signorini.algebra import available_backends, solve_pdas
+from signorini.algebra import available_backends, make_lu_solver, make_solver, solve_pdas
 from signorini.algebra.friction import INACTIVE, SLIP, STICK, solve_friction
 from signorini.algebra.friction_result import FrictionConvergenceError
 
@@ -193,6 +193,20 @@ def test_coulomb_superlu_and_pardiso_agree():
     assert (a.backend, b.backend) == ("scipy", "pardiso")
     assert rel(a.x, b.x) < 1e-11, rel(a.x, b.x)
     assert b.n_analyses == 1 and b.n_factorizations == b.iterations
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_a_kept_solver_analyses_the_pattern_once_across_calls(backend):
+    S = block()
+    with make_lu_solver(backend) as solver:
+        first = solve_friction(*args(S), coefficient=0.5, solver=solver)
+        second = solve_friction(*args(S), coefficient=0.2, solver=solver)
+    assert (first.n_analyses, second.n_analyses) == (1, 0)
+    assert second.n_factorizations == second.iterations
+    with make_solver(backend) as solver:
+        first = solve_friction(*args(S), bound=1e-3, solver=solver)
+        second = solve_friction(*args(S), bound=2e-3, solver=solver)
+    assert (first.n_analyses, second.n_analyses) == (1, 0)
 
 
 def test_a_load_step_from_its_own_solution_does_not_slip():

@@ -19,11 +19,17 @@ linear system of these states (:mod:`.friction_system`) and updates them with th
 the semismooth Newton step for the equations ``Λ_n = max(0, Λ_n + c (x_n − g))`` and
 ``Λ_t = P_[−s, s](Λ_t + c (x_t − x_ref))``, of which in 2D the slip branch ``Λ_t = σ s`` is
 linear. It stops when the states repeat, and then checks the KKT residuals of both laws.
+The constant ``c`` is :data:`C_FACTOR` times the mean diagonal of ``K`` over the normal DOFs,
+not the diagonal itself as in :func:`~.pdas.solve_pdas`: it only decides whether a node
+slipping against its force sticks (small ``c``) or flips its direction (large ``c``), and
+flipping made the iteration cycle (docs/method.md, *Friction*).
 
 Tresca's bound acts by default only on nodes in contact (``Λ_n > 0``, where a Tresca bound
 models a known contact pressure); with ``tresca_everywhere=True`` it acts on every node, which
 is the classical Tresca problem: the minimisation of
-``1/2 x^T K x − F^T x + Σ s |x_t − x_ref|`` subject to ``x_n ≤ g``, whose systems are SPD.
+``1/2 x^T K x − F^T x + Σ s |x_t − x_ref|`` subject to ``x_n ≤ g``. Both have SPD systems;
+the contact-only law is discontinuous where ``Λ_n`` vanishes and can make the iteration
+cycle at the edge of the contact zone (docs/method.md, *Friction*).
 
 References
 ----------

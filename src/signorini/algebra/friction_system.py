@@ -105,9 +105,13 @@ class CoulombSystem:
         pattern.sum_duplicates()
         pattern.sort_indices()
         self.rows = csr_row_indices(pattern)
-        keys = self.rows * n + pattern.indices
-        self.pos_K = np.searchsorted(keys, rows_K * n + K.indices)
-        self.pos_copy = np.searchsorted(keys, copy_rows * n + copy_cols)
+
+        def key(r: np.ndarray, c: np.ndarray) -> np.ndarray:  # 64-bit: n² overflows int32
+            return r.astype(np.int64) * n + c
+
+        keys = key(self.rows, pattern.indices)
+        self.pos_K = np.searchsorted(keys, key(rows_K, K.indices))
+        self.pos_copy = np.searchsorted(keys, key(copy_rows, copy_cols))
         self.indptr, self.indices = pattern.indptr, pattern.indices
         self.diagonal = diagonal_positions(pattern, self.rows)
         self.is_diagonal = self.indices == self.rows
