@@ -8,6 +8,7 @@ and slip zones.
 from __future__ import annotations
 
 from functools import cache
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -16,6 +17,7 @@ import scipy.optimize as so
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from contact_problems import pressed_block
+from linalg_problems import block_spd
 
 from signorini.algebra import available_backends, make_lu_solver, make_solver, solve_pdas
 from signorini.algebra.friction import INACTIVE, SLIP, STICK, solve_friction
@@ -110,6 +112,30 @@ def test_classical_tresca_is_the_minimiser_computed_by_duality():
         y[S.normal] = np.minimum(y[S.normal], S.gap)
         assert energy(S, y, bound) > e
     assert r.symmetric and r.kkt.max < 1e-10, r.kkt
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_classical_tresca_on_random_node_blocked_systems(seed):
+    """Random SPD matrices with 2 x 2 node blocks (not elasticity), random loads, gaps and
+    bounds on 8 of 30 nodes: the minimiser by duality."""
+    rng = np.random.default_rng(seed)
+    K = block_spd(6, 5, rng, shift=0.05)
+    n = K.shape[0]
+    nodes = rng.choice(n // 2, 8, replace=False)
+    S = SimpleNamespace(
+        K=K,
+        F=rng.standard_normal(n),
+        normal=2 * nodes,
+        tangent=2 * nodes + 1,
+        gap=0.3 * rng.standard_normal(8),
+        dirichlet=np.zeros(0, dtype=int),
+        dirichlet_values=np.zeros(0),
+    )
+    bound = rng.uniform(0.0, 1.0, 8)
+    r = solve_friction(*args(S), bound=bound, tresca_everywhere=True)
+    x, _, lam_t = tresca_by_duality(S, bound)
+    assert rel(r.x, x) < 1e-10, rel(r.x, x)
+    assert np.abs(r.multiplier_t - lam_t).max() < 1e-10 * np.abs(S.F).max()
 
 
 def test_tresca_in_contact_only_is_classical_tresca_with_the_bound_cut_to_the_contact_set():

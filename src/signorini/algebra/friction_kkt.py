@@ -138,7 +138,9 @@ def _disjoint(a: np.ndarray, b: np.ndarray, name_a: str, name_b: str) -> None:
         )
 
 
-def slip_bound(problem: FrictionProblem, multiplier_n: np.ndarray, in_contact: np.ndarray):
+def slip_bound(
+    problem: FrictionProblem, multiplier_n: np.ndarray, in_contact: np.ndarray
+) -> np.ndarray:
     """The slip bound ``s (m,)`` of each node: Tresca's ``s`` (times ``in_contact`` unless
     ``everywhere``), or Coulomb's ``F max(Λ_n, 0)``."""
     if problem.law == "coulomb":
