@@ -188,6 +188,7 @@ def solve_friction(
     kkt = friction_kkt(problem, x, active)
     if not kkt.max <= kkt_tol:
         message = f"the states repeat, but the KKT residual {kkt.max:.2e} exceeds {kkt_tol:.0e}"
+        direction = direction.astype(np.int8)
         raise FrictionConvergenceError(message, history, "kkt", x, _state(*states), direction)
     multiplier_n, multiplier_t = _multipliers(problem, x, states)
     times = {key: used[key] for key in ("analysis", "factorization", "solve")}
@@ -327,11 +328,15 @@ def _iterate(
                 f"the frictional active set iteration cycles: the states computed in iteration "
                 f"{it} are the ones iteration {seen[key]} used"
             )
-            raise FrictionConvergenceError(message, history, "cycling", x, _state(*states))
+            raise FrictionConvergenceError(
+                message, history, "cycling", x, _state(*states), states[2].astype(np.int8)
+            )
         seen[key] = it + 1
         previous, states = states, new
     message = f"the frictional active set iteration did not converge in max_iter = {max_iter}"
-    raise FrictionConvergenceError(message, history, "max_iter", x, _state(*states))
+    raise FrictionConvergenceError(
+        message, history, "max_iter", x, _state(*states), states[2].astype(np.int8)
+    )
 
 
 def _update(
