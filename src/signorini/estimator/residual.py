@@ -188,9 +188,19 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     Returns
     -------
     Estimate
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``eta5``, or a result with friction.
     """
     if eta5 not in ETA5_VARIANTS:
         raise ValueError(f"eta5 must be one of {ETA5_VARIANTS}, got {eta5!r}")
+    if result.contact.friction_law.any():
+        raise ValueError(
+            "result: the residual estimator (5.1) assumes frictionless contact (σ_t = 0 on "
+            "Γ_C); its frictional extension is not available yet"
+        )
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells
     h_p = _node_mesh_size(mesh.h, space.cell_nodes, result.dirichlet_nodes, n_nodes)
