@@ -11,6 +11,8 @@
 - :func:`independent_system`: Cartesian ``K``, ``F`` and Dirichlet data assembled from the mesh
   with :mod:`signorini.fem.stiffness` and :mod:`signorini.fem.loads` only (no rotated frames,
   no :mod:`signorini.contact`).
+- :func:`graded_half_disc`: a half-disc on its arc, its mesh graded towards the bottom point
+  (the partial-slip problem).
 """
 
 from __future__ import annotations
@@ -23,7 +25,9 @@ from signorini.fem.loads import assemble_body_force, assemble_edge_load
 from signorini.fem.material import Material
 from signorini.fem.stiffness import assemble_stiffness
 from signorini.mesh.builders import rectangle
+from signorini.mesh.curves import Circle
 from signorini.mesh.mesh import Mesh
+from signorini.mesh.refine import refine_nvb
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
 from signorini.problem.obstacles import HalfPlane
 
@@ -288,3 +292,31 @@ def pressed_block(
         a.contact.gap,
         a.space.node_points[nodes, 0],
     )
+
+
+def graded_half_disc(radius: float, h_contact: float, zone: float, grading: float = 0.25) -> Mesh:
+    """The lower half of the disc of ``radius`` centred at ``(0, radius)``: flat side ``top``
+    (y = radius), arc ``arc`` carrying its :class:`Circle` (isoparametric cells), touching
+    y = 0 at the origin. The union-jack rectangle [−1, 1] × [−1, 0] mapped by
+    p ↦ p |p|_∞ / |p|_2 (squares to circles), then bisected (new arc vertices on the circle)
+    until every cell within ``zone`` of the origin has ``h_T ≤ h_contact`` and every other
+    ``h_T ≤ max(h_contact, grading · (distance − zone))``."""
+    base = rectangle(-1.0, 1.0, -1.0, 0.0, nx=8, ny=4)
+    p = base.points
+    norm2 = np.hypot(p[:, 0], p[:, 1])
+    scale = np.abs(p).max(axis=1) / np.where(norm2 > 0, norm2, 1.0)
+    mesh = Mesh.from_arrays(
+        radius * p * scale[:, None] + [0.0, radius],
+        base.cells,
+        {
+            "top": lambda x: x[:, 1] > radius * (1 - 1e-12),
+            "arc": lambda x: x[:, 1] < radius * (1 - 1e-12),
+        },
+    ).with_curve("arc", Circle((0.0, radius), radius))
+    while True:
+        corners = mesh.points[mesh.cells]
+        distance = np.hypot(corners[..., 0], corners[..., 1]).min(axis=1)
+        marked = mesh.h > np.maximum(h_contact, grading * (distance - zone))
+        if not marked.any():
+            return mesh
+        mesh = refine_nvb(mesh, marked).mesh

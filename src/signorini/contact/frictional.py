@@ -7,6 +7,10 @@ in the node frame ``[n t]``; frictionless parts of the same problem take the bou
 or the coefficient 0 (Coulomb). Tresca is the classical problem, the bound acting on every
 node of Γ_C (the minimiser of ``½ a(u, u) − L(u) + Σ_z s_z |u_t(z)|`` subject to
 ``u(z)·n_z ≤ ψ(z)``).
+
+A load step of a quasi-static path (docs/method.md, *Load paths*) gets the previous step's
+result: its tangential displacements ``u(z)·t_z`` are the reference ``x_t,ref`` of the law (it
+acts on the slip increment), and its node states warm-start the iteration.
 """
 
 from __future__ import annotations
@@ -17,12 +21,19 @@ import numpy as np
 
 from ..algebra.friction import INACTIVE, SLIP, solve_friction
 from ..algebra.friction_result import FrictionResult
+from ..mesh.mesh import Mesh
 from ..problem.fields import ProblemError
 from .contact_set import COULOMB, TRESCA, ContactSet
 from .node_frames import to_frames
 from .system import Assembled
 
-__all__ = ["FrictionSolve", "check_friction_set", "solve_frictional"]
+__all__ = [
+    "FrictionSolve",
+    "check_friction_set",
+    "check_previous",
+    "slip_reference",
+    "solve_frictional",
+]
 
 
 @dataclass(frozen=True)
@@ -34,6 +45,7 @@ class FrictionSolve:
     tangential_force: np.ndarray
     state: np.ndarray
     report: FrictionResult
+    reference: np.ndarray
 
 
 def check_friction_set(cs: ContactSet) -> str:
@@ -65,6 +77,50 @@ def check_friction_set(cs: ContactSet) -> str:
     return "tresca" if TRESCA in laws else "coulomb"
 
 
+def check_previous(previous: object, mesh: Mesh, cs: ContactSet) -> None:
+    """Check that ``previous`` is the result of a load step on ``mesh`` with the contact
+    nodes of ``cs`` (docs/method.md, *Load paths*).
+
+    Raises
+    ------
+    ValueError
+        If ``previous`` is not a result, was solved on another mesh (other points or cells),
+        or has other contact parts or nodes.
+    """
+    if not all(hasattr(previous, name) for name in ("u", "contact", "space", "pdas")):
+        raise ValueError(
+            f"previous must be the ContactResult of the previous load step, got "
+            f"{type(previous).__name__}"
+        )
+    old = previous.space.mesh
+    same_mesh = old is mesh or (
+        old.points.shape == mesh.points.shape
+        and old.cells.shape == mesh.cells.shape
+        and np.array_equal(old.points, mesh.points)
+        and np.array_equal(old.cells, mesh.cells)
+    )
+    if not same_mesh:
+        raise ValueError(
+            f"previous was solved on another mesh ({old.n_points} points, {old.n_cells} "
+            f"cells; this one has {mesh.n_points} and {mesh.n_cells}): the steps of a load "
+            "path share one mesh"
+        )
+    pc = previous.contact
+    if pc.parts != cs.parts or not np.array_equal(pc.nodes, cs.nodes):
+        raise ValueError(
+            f"previous has the contact parts {list(pc.parts)} with {pc.size} constraints, this "
+            f"problem {list(cs.parts)} with {cs.size}: the steps of a load path share their "
+            "contact parts"
+        )
+
+
+def slip_reference(previous: object, cs: ContactSet) -> np.ndarray:
+    """``(k,)`` the tangential displacement of no slip per constraint: the previous step's
+    ``u(z)·t_z`` in this step's frames (the DOF ``2z + 1`` of :func:`to_frames`)."""
+    x = to_frames(previous.u.ravel(), cs.frame_nodes, cs.frames)
+    return x[2 * cs.nodes + 1]
+
+
 def solve_frictional(
     assembled: Assembled,
     K,
@@ -73,6 +129,7 @@ def solve_frictional(
     u0: np.ndarray | None,
     backend: str,
     max_iter: int,
+    previous: object = None,
 ) -> FrictionSolve:
     """Solve the frictional contact problem of an assembled system (``K``, ``F`` possibly
     divided by the stiffness unit: the forces returned are in that unit).
@@ -85,18 +142,31 @@ def solve_frictional(
         Warm start: the update rule evaluated at it.
     backend : str
     max_iter : int
+    previous : ContactResult, optional
+        The previous load step (checked by :func:`check_previous`): the law acts on the slip
+        from its tangential displacements (:func:`slip_reference`); without ``u0`` its states
+        (same law) or its displacement (else) are the warm start.
     """
     cs = assembled.contact
     law = check_friction_set(cs)
-    x0 = None
+    warm = {}
+    reference = np.zeros(cs.size)
+    if previous is not None:
+        reference = slip_reference(previous, cs)
+        report = previous.pdas
+        if u0 is None and isinstance(report, FrictionResult) and report.law == law:
+            warm = {"state0": report.state, "direction0": report.direction}
+        elif u0 is None:
+            u0 = previous.u
     if u0 is not None:
-        x0 = to_frames(u0.ravel(), cs.frame_nodes, cs.frames)
+        warm = {"x0": to_frames(u0.ravel(), cs.frame_nodes, cs.frames)}
     common = {
         "dirichlet": assembled.dirichlet,
         "dirichlet_values": assembled.dirichlet_values,
-        "x0": x0,
+        "reference": reference,
         "max_iter": max_iter,
         "backend": backend,
+        **warm,
     }
     nodes = cs.nodes
     if law == "tresca":
@@ -112,4 +182,4 @@ def solve_frictional(
     state = res.state.astype(np.int64)
     # a frictionless node in contact slides freely: its friction force (0) is at its bound
     state[(state != INACTIVE) & (cs.friction_law == 0)] = SLIP
-    return FrictionSolve(res.x, res.multiplier_n, res.multiplier_t, state, res)
+    return FrictionSolve(res.x, res.multiplier_n, res.multiplier_t, state, res, reference)

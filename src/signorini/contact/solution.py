@@ -23,7 +23,7 @@ from ..mesh.mesh import Mesh
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
-from .frictional import solve_frictional
+from .frictional import check_previous, solve_frictional
 from .node_frames import to_cartesian
 from .profile import ContactProfile, contact_profile
 from .system import Assembled, assemble
@@ -116,6 +116,11 @@ class ContactResult:
     state : (k,) int array
         ``INACTIVE`` (no contact), ``STICK`` or ``SLIP`` per constraint; a frictionless
         node in contact slips (its friction force, 0, is at its bound).
+    tangential_reference : (k,) float array
+        The tangential displacement of no slip per constraint, which the friction law's slip
+        ``u(z)·t_z − tangential_reference`` is measured from: the previous load step's
+        ``u(z)·t_z`` (docs/method.md, *Load paths*), 0 for a single step and without
+        friction.
 
     Derived: ``ndof``, ``density`` s_z, ``pressure`` p_z, ``total_contact_force``,
     ``classes``, :meth:`contact_profile` (the contact quantities of a part in boundary
@@ -133,10 +138,13 @@ class ContactResult:
     timings: dict = field(default_factory=dict)
     tangential_force: np.ndarray | None = None
     state: np.ndarray | None = None
+    tangential_reference: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.tangential_force is None:
             self.tangential_force = np.zeros(self.contact.size)
+        if self.tangential_reference is None:
+            self.tangential_reference = np.zeros(self.contact.size)
         if self.state is None:
             self.state = np.where(self.active, SLIP, INACTIVE)
 
@@ -220,6 +228,7 @@ def solve(
     max_iter: int = 50,
     fallback: bool = False,
     assembled: Assembled | None = None,
+    previous: ContactResult | None = None,
 ) -> ContactResult:
     """Solve the discrete Signorini problem (3.2) on ``mesh`` by the primal-dual active set
     method (docs/method.md, *Solver*); with Tresca or Coulomb friction on a contact part, by
@@ -241,11 +250,25 @@ def solve(
         On PDAS failure, fall back to a convergent method instead of raising.
     assembled : Assembled, optional
         Reuse an assembly of the same mesh.
+    previous : ContactResult, optional
+        The previous step of a quasi-static load path on the same mesh with the same contact
+        parts (docs/method.md, *Load paths*): the friction law acts on the slip from its
+        tangential displacements, and it is the warm start (its node states, or its
+        displacement; ``u0`` replaces it). Without friction only the warm start.
+
+    Raises
+    ------
+    ValueError
+        For a malformed ``u0``, or a ``previous`` of another mesh or other contact parts.
     """
     mesh = problem.mesh if mesh is None else mesh
     if assembled is None:
         assembled = assemble(problem, mesh)
     space, cs = assembled.space, assembled.contact
+    if previous is not None:
+        check_previous(previous, mesh, cs)
+        if u0 is None and not cs.friction_law.any():
+            u0 = previous.u
     active0 = None
     if u0 is not None:
         u0 = np.asarray(u0, dtype=np.float64)
@@ -261,7 +284,9 @@ def solve(
     K, F = (assembled.K, assembled.F) if unit == 1.0 else (assembled.K / unit, assembled.F / unit)
     t0 = time.perf_counter()
     if cs.friction_law.any():
-        fr = solve_frictional(assembled, K, F, u0=u0, backend=backend, max_iter=max_iter)
+        fr = solve_frictional(
+            assembled, K, F, u0=u0, backend=backend, max_iter=max_iter, previous=previous
+        )
         seconds = time.perf_counter() - t0
         u = to_cartesian(fr.x, cs.frame_nodes, cs.frames).reshape(-1, 2)
         return ContactResult(
@@ -276,6 +301,7 @@ def solve(
             timings={"assemble": assembled.seconds, "solve": seconds},
             tangential_force=fr.tangential_force * unit,
             state=fr.state,
+            tangential_reference=fr.reference,
         )
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
     with make_solver(backend, check_symmetry=False) as solver:

@@ -1,0 +1,103 @@
+"""Quasi-static load paths: a sequence of problems on one mesh, solved step by step.
+
+Coulomb friction is path-dependent: the state after a load path is not the static solution
+of its last load. Each step is solved with the previous step's result (``solve(...,
+previous=...)``), so that the friction law acts on the slip increment of the step and the
+iteration starts from the previous states (docs/method.md, *Load paths*).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+
+from ..mesh.mesh import Mesh
+from ..problem.problem import ContactProblem
+from .solution import ContactResult, solve
+
+__all__ = ["solve_path"]
+
+log = logging.getLogger(__name__)
+
+
+def solve_path(
+    problems: Sequence[ContactProblem],
+    mesh: Mesh | None = None,
+    *,
+    backend: str = "auto",
+    max_iter: int = 50,
+) -> list[ContactResult]:
+    """Solve a prescribed load path: one problem per load step, each from the previous step.
+
+    Parameters
+    ----------
+    problems : sequence of ContactProblem
+        The load steps in order, e.g. ``[problem(t) for t in (0.5, 1.0)]`` with a function
+        ``problem`` of the load parameter. They have the same contact parts and the same
+        initial mesh (points and cells); only their data (Dirichlet values, loads, gaps,
+        friction) differ.
+    mesh : Mesh, optional
+        The mesh of every step; defaults to the problems' initial mesh.
+    backend : str
+        Sparse solver backend, see :func:`signorini.algebra.make_solver`.
+    max_iter : int
+        Bound on the active set iterations of each step.
+
+    Returns
+    -------
+    list of ContactResult
+        One per step; step 0 from the undeformed state (slip measured from 0), step ``i``
+        with the law on the slip from step ``i − 1``.
+
+    Raises
+    ------
+    ValueError
+        If ``problems`` is empty or holds something else than problems, or two steps have
+        different contact parts or initial meshes (naming the step).
+    """
+    problems = _checked(problems)
+    mesh = problems[0].mesh if mesh is None else mesh
+    results: list[ContactResult] = []
+    for i, problem in enumerate(problems):
+        previous = results[-1] if results else None
+        results.append(solve(problem, mesh, previous=previous, backend=backend, max_iter=max_iter))
+        log.info("load step %d of %d solved", i + 1, len(problems))
+    return results
+
+
+def _checked(problems: object) -> list[ContactProblem]:
+    """The steps as a list, checked: problems on one initial mesh with one set of contact
+    parts."""
+    if isinstance(problems, ContactProblem) or not isinstance(problems, Sequence):
+        raise ValueError(
+            f"problems must be a sequence of ContactProblem (one per load step), got "
+            f"{type(problems).__name__}"
+        )
+    steps = list(problems)
+    if not steps:
+        raise ValueError("problems is empty: a load path has at least one step")
+    for i, problem in enumerate(steps):
+        if not isinstance(problem, ContactProblem):
+            raise ValueError(
+                f"problems[{i}] must be a ContactProblem, got {type(problem).__name__}"
+            )
+    first = steps[0]
+    for i, problem in enumerate(steps[1:], start=1):
+        if problem.contact_parts != first.contact_parts:
+            raise ValueError(
+                f"problems[{i}] has the contact parts {list(problem.contact_parts)}, "
+                f"problems[0] {list(first.contact_parts)}: the steps of a load path share "
+                "their contact parts"
+            )
+        a, b = problem.mesh, first.mesh
+        if a is not b and (
+            a.points.shape != b.points.shape
+            or a.cells.shape != b.cells.shape
+            or (a.points != b.points).any()
+            or (a.cells != b.cells).any()
+        ):
+            raise ValueError(
+                f"problems[{i}] is posed on another mesh than problems[0] ({a.n_cells} and "
+                f"{b.n_cells} cells): the steps of a load path share one mesh"
+            )
+    return steps
