@@ -787,3 +787,52 @@ def test_resume_keeps_the_curves_of_the_problem(tmp_path, capsys, monkeypatch):
     b = history_without_timings(part / "history.csv")
     assert len(a) > 4
     assert_same_history(a, b)
+
+
+def test_the_deformed_figure_of_a_frictional_result_marks_stick_and_slip(tmp_path, monkeypatch):
+    """The figures of a last level with friction pass the node states, the contact nodes'
+    displacement and p_t to the deformed-body figure; without friction none of them."""
+    from types import SimpleNamespace
+
+    from plots.figure_checks import synthetic_history, write_csv
+
+    import signorini.cli as cli
+    import signorini.plots
+    from signorini.fem.material import Material
+    from signorini.mesh.builders import rectangle
+    from signorini.problem import Contact, ContactProblem, Coulomb, Dirichlet, Neumann
+    from signorini.problem.obstacles import Disc
+
+    seen = []
+    original = signorini.plots.plot_deformed
+
+    def spy(*args, **kwargs):
+        seen.append(kwargs)
+        return original(*args, **kwargs)
+
+    # only the deformed body is drawn
+    monkeypatch.setattr(signorini.plots, "plot_deformed", spy)
+    monkeypatch.setattr(signorini.plots, "make_figures", lambda *args, **kwargs: [])
+    monkeypatch.setattr(signorini.plots, "plot_mesh", lambda *args, **kwargs: [])
+    write_csv(tmp_path / "history.csv", synthetic_history())
+    for friction in (Coulomb(0.3), None):
+        problem = ContactProblem(
+            rectangle(0.0, 2.0, 0.0, 1.0, nx=8, ny=4),
+            Material.from_young(1.0, 0.3),
+            {
+                "left": Neumann(),
+                "right": Neumann(),
+                "top": Dirichlet((0.012, -0.02)),
+                "bottom": Contact(obstacle=Disc((1.0, -12.5), 12.5), friction=friction),
+            },
+        )
+        res = solve(problem)
+        cli._figures(
+            "block", tmp_path, SimpleNamespace(result=res, record=SimpleNamespace(level=0))
+        )
+    with_friction, without = seen
+    res_nodes = res.contact.nodes
+    assert set(with_friction["state"].tolist()) == {0, 1, 2}
+    assert with_friction["contact_displacement"].shape == (res_nodes.size, 2)
+    assert np.abs(with_friction["tangential_pressure"]).max() > 0
+    assert not {"state", "contact_displacement", "tangential_pressure"} & set(without)

@@ -535,7 +535,8 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
     The mesh figure shows the finest level of at most ``plots.READABLE_CELLS`` cells (read back
     from its ``level_NNN.vtu``; the last level when that file is missing or holds another
     mesh), with Γ_D, Γ_N and Γ_C marked. The deformed body is drawn with a stated displacement
-    scale, the obstacle at its gap with the same scale.
+    scale, the obstacle at its gap with the same scale; with friction its stick and slip nodes
+    marked and the friction stress drawn with the pressure.
     """
     from . import plots
     from .output import read_history
@@ -586,6 +587,13 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
         colors=("#1f77b4", "#2ca02c", "#d62728"),
         **zoom,
     )
+    friction = {}
+    if cs.friction_law.any():  # stick and slip nodes marked, the friction stress drawn
+        friction = {
+            "state": res.state,
+            "contact_displacement": res.u[cs.nodes],
+            "tangential_pressure": res.tangential_pressure,
+        }
     written += plots.plot_deformed(
         mesh.points,
         mesh.cells,
@@ -596,6 +604,7 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
         gap=cs.gap,
         normal=cs.normal,
         title=f"{example}: deformed body",
+        **friction,
     )
     return written
 

@@ -11,11 +11,15 @@ import pytest
 from contact_problems import corner_problem
 
 from signorini.contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
-from signorini.contact.solution import solve
+from signorini.contact.solution import INACTIVE, SLIP, STICK, solve
 from signorini.estimator.residual import estimate
 from signorini.examples import example_6_2
+from signorini.fem.material import Material
+from signorini.mesh.builders import rectangle
 from signorini.mesh.refine import refine_uniform
 from signorini.output import write_vtu
+from signorini.problem import Contact, ContactProblem, Coulomb, Dirichlet, Neumann
+from signorini.problem.obstacles import Disc
 
 
 @pytest.fixture(scope="module")
@@ -117,3 +121,46 @@ def test_corner_node_gets_the_larger_scalars_and_the_sum_of_tractions(tmp_path):
     expected = -(result.pressure[rows, None] * cs.normal[rows]).sum(axis=0)
     np.testing.assert_allclose(pd["contact_traction"][corner[0], :2], expected, rtol=1e-15)
     assert pd["active"][corner[0]] == 1
+
+
+def test_friction_fields(tmp_path):
+    """A block pressed and pulled onto a rigid cylinder with Coulomb friction: the VTU file
+    holds p_t and the node states (stick and slip both occur), and the traction
+    ``−p n − p_t t`` sums, times the weights w_z, to the resultant of the obstacle's forces;
+    without friction p_t is 0 and a node in contact is stated as slipping."""
+    mesh = rectangle(0.0, 2.0, 0.0, 1.0, nx=16, ny=8)
+
+    def block(friction):
+        return ContactProblem(
+            mesh,
+            Material.from_young(1.0, 0.3),
+            {
+                "left": Neumann(),
+                "right": Neumann(),
+                "top": Dirichlet((0.012, -0.02)),
+                "bottom": Contact(obstacle=Disc((1.0, -12.5), 12.5), friction=friction),
+            },
+        )
+
+    result = solve(block(Coulomb(0.3)))
+    cs = result.contact
+    off = np.setdiff1d(np.arange(result.space.n_nodes), cs.nodes)
+    pd = meshio.read(write_vtu(tmp_path / "friction.vtu", result)).point_data
+    np.testing.assert_array_equal(pd["tangential_pressure"][cs.nodes], result.tangential_pressure)
+    np.testing.assert_array_equal(pd["tangential_pressure"][off], 0.0)
+    np.testing.assert_array_equal(pd["contact_state"][cs.nodes], result.state)
+    np.testing.assert_array_equal(pd["contact_state"][off], -1)
+    assert set(pd["contact_state"][cs.nodes]) == {INACTIVE, STICK, SLIP}
+    assert np.abs(pd["tangential_pressure"]).max() > 0.1 * pd["pressure"].max()
+    resultant = (pd["contact_traction"][cs.nodes, :2] * cs.basis_integral[:, None]).sum(axis=0)
+    print(
+        f"\nresultant from the traction {resultant}, from the forces {result.contact_force_vector}"
+    )
+    np.testing.assert_allclose(resultant, result.contact_force_vector, rtol=1e-13)
+    assert abs(resultant[0]) > 0.1 * abs(resultant[1])
+    frictionless = solve(block(None))
+    pd = meshio.read(write_vtu(tmp_path / "frictionless.vtu", frictionless)).point_data
+    np.testing.assert_array_equal(pd["tangential_pressure"], 0.0)
+    np.testing.assert_array_equal(
+        pd["contact_state"][cs.nodes], np.where(frictionless.active, SLIP, INACTIVE)
+    )

@@ -136,3 +136,47 @@ def test_free_boundary_ends_lie_between_active_and_inactive_neighbours():
     assert free_boundary_ends(pts, np.ones(5, bool)).shape == (0, 2)
     with pytest.raises(ValueError, match="active must have shape"):
         free_boundary_ends(pts, active[:3])
+
+
+def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
+    """With node states the stick and slip nodes are marked on the drawn body (at
+    ``contact_points + scale * contact_displacement``; inactive ones not) and on the friction
+    stress, which is drawn with the pressure; without them the figure has neither."""
+    mesh = rectangle(nx=4, ny=2)
+    p, c = mesh.points, mesh.cells
+    u = np.column_stack([0.01 * p[:, 1], -0.02 * (1.0 - p[:, 1])])
+    bottom = np.column_stack([np.linspace(0.0, 1.0, 9), np.zeros(9)])  # vertices and midpoints
+    u_bottom = np.column_stack([np.zeros(9), np.full(9, -0.02)])
+    state = np.array([0, 0, 2, 1, 1, 1, 2, 2, 0])
+    pressure = np.array([0, 0, 1, 2, 3, 2, 1, 0.5, 0.0])
+    p_t = np.array([0, 0, 0.5, 0.4, 0.1, -0.2, 0.5, 0.25, 0.0])
+    kwargs = {"contact_points": bottom, "pressure": pressure, "scale": 5.0}
+    plot_deformed(
+        p, c, u, tmp_path / "f", **kwargs, state=state, contact_displacement=u_bottom,
+        tangential_pressure=p_t,
+    )  # fmt: skip
+    plot_deformed(p, c, u, tmp_path / "n", **kwargs)
+    friction, frictionless = captured
+    assert friction["legend"] == ["reference", "stick", "slip", "$p_h$", "$p_{t,h}$"]
+    drawn = bottom + 5.0 * u_bottom
+    for label, value in (("stick", 1), ("slip", 2)):
+        np.testing.assert_array_equal(
+            np.column_stack(friction["lines"][label]), drawn[state == value]
+        )
+    np.testing.assert_array_equal(friction["lines"]["$p_{t,h}$"][1], p_t)
+    # the friction stress panel: its curve, then the stick and the slip nodes on it
+    (x_pt, y_pt), (x_stick, y_stick), (x_slip, y_slip) = friction["lines_by_axes"][-1][1:4]
+    np.testing.assert_array_equal(y_stick, p_t[state == 1])
+    np.testing.assert_array_equal(x_slip, bottom[state == 2, 0])
+    assert friction["ylabel"][-1] == "contact stresses"
+    assert frictionless["legend"] == ["reference"]
+    assert list(frictionless["lines"]) == ["$p_h$"]
+    assert frictionless["ylabel"][-1] == "contact pressure $p_h$"
+    with pytest.raises(ValueError, match="state needs contact_points and contact_displacement"):
+        plot_deformed(p, c, u, tmp_path / "x", **kwargs, state=state)
+    with pytest.raises(ValueError, match="state must hold"):
+        plot_deformed(
+            p, c, u, tmp_path / "x", **kwargs, state=state + 1, contact_displacement=u_bottom
+        )
+    with pytest.raises(ValueError, match="tangential_pressure must have shape"):
+        plot_deformed(p, c, u, tmp_path / "x", **kwargs, tangential_pressure=p_t[:3])

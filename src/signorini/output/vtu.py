@@ -17,10 +17,13 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
 
     Point data: ``displacement`` (3 components, z = 0, for ParaView's "Warp By Vector"),
     and on Γ_C ``pressure`` (consistent nodal pressure p_z), ``contact_force`` (Λ_z),
-    ``contact_traction`` (``−p_z n_z``, 3 components: the obstacle's pressure on the body as
-    a vector), ``active`` (1 where u·n_z = ψ is imposed) and ``contact_class`` (0 none,
-    1 semi, 2 full, −1 off Γ_C). At a corner node with two constraints the scalars are the
-    larger of the two and the traction their sum. Cell data: ``eta2`` (element indicators)
+    ``tangential_pressure`` (the consistent friction stress ``p_t,z = Λ_t,z / w_z`` along
+    ``t_z = (−n_y, n_x)``; 0 without friction), ``contact_traction`` (``−p_z n_z − p_t,z t_z``,
+    3 components: the obstacle's traction on the body as a vector), ``active`` (1 where
+    u·n_z = ψ is imposed), ``contact_class`` (0 none, 1 semi, 2 full, −1 off Γ_C) and
+    ``contact_state`` (0 inactive, 1 stick, 2 slip, −1 off Γ_C; a frictionless node in contact
+    slips). At a corner node with two constraints the scalars are the larger of the two, the
+    tangential pressure and the traction their sums. Cell data: ``eta2`` (element indicators)
     and ``eta2_k`` per contribution when an estimate is given.
 
     Parameters
@@ -39,6 +42,8 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     force = np.zeros(n)
     active = np.zeros(n, dtype=np.int32)
     klass = np.full(n, -1, dtype=np.int32)
+    state = np.full(n, -1, dtype=np.int32)
+    tangential = np.zeros(n)
     traction = np.zeros((n, 3))
     pressure[cs.nodes] = -np.inf  # a corner node's two constraints: the larger value
     force[cs.nodes] = -np.inf
@@ -46,7 +51,11 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     np.maximum.at(force, cs.nodes, result.contact_force)
     np.maximum.at(active, cs.nodes, result.active.astype(np.int32))
     np.maximum.at(klass, cs.nodes, result.classes.astype(np.int32))
-    np.add.at(traction[:, :2], cs.nodes, -result.pressure[:, None] * cs.normal)
+    np.maximum.at(state, cs.nodes, result.state.astype(np.int32))
+    p_t = result.tangential_pressure
+    np.add.at(tangential, cs.nodes, p_t)
+    t = np.column_stack([-cs.normal[:, 1], cs.normal[:, 0]])
+    np.add.at(traction[:, :2], cs.nodes, -result.pressure[:, None] * cs.normal - p_t[:, None] * t)
     cell_data = {}
     if estimate is not None:
         cell_data["eta2"] = [estimate.eta2]
@@ -59,9 +68,11 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
             "displacement": disp,
             "pressure": pressure,
             "contact_force": force,
+            "tangential_pressure": tangential,
             "contact_traction": traction,
             "active": active,
             "contact_class": klass,
+            "contact_state": state,
         },
         cell_data=cell_data,
     )

@@ -2,6 +2,8 @@
 
 The displacement is magnified or shrunk by a stated factor (:func:`displacement_scale`): at
 true scale a large displacement folds the drawn body over itself, a small one is invisible.
+With friction the contact nodes that stick and slip are marked on the body, and the friction
+stress p_t is drawn with the pressure.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from matplotlib.transforms import offset_copy
 from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
+from ..algebra.friction_result import INACTIVE, SLIP, STICK
 from ..mesh.mesh import boundary_edges
 from .mesh import line_width, mesh_arrays
 from .style import RC, STYLES, fit_title, new_figure, save_figure, trim_height
@@ -33,6 +36,13 @@ __all__ = [
 DRAWN_FRACTION = 0.1
 #: Displacements between these fractions of the body's size are drawn at true scale.
 TRUE_SCALE_RANGE = (0.02, 0.25)
+
+#: How the stick and slip nodes of a frictional contact and its friction stress are drawn.
+FRICTION_STYLES: dict[str, dict[str, str]] = {
+    "stick": {"color": "#1b9e77", "marker": "o", "label": "stick"},
+    "slip": {"color": "#e7298a", "marker": "D", "label": "slip"},
+    "tangential_pressure": {"color": "#d95f02", "marker": "s", "label": r"$p_{t,h}$"},
+}
 
 
 def displacement_scale(points: ArrayLike, displacement: ArrayLike) -> float:
@@ -156,8 +166,11 @@ def _draw_body(
     obstacle: np.ndarray | None,
     obstacle_label: str,
     show_mesh: bool,
+    states: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> None:
-    """The body at ``p + scale u`` coloured by ``|u|``, its reference boundary dashed."""
+    """The body at ``p + scale u`` coloured by ``|u|``, its reference boundary dashed; with
+    ``states`` (drawn positions ``(k, 2)`` and states ``(k,)`` of the contact nodes) the
+    stick and slip nodes marked."""
     big = c.shape[0] > 20000
     q = p + scale * u
     tri = Triangulation(q[:, 0], q[:, 1], c)
@@ -188,6 +201,8 @@ def _draw_body(
             label=obstacle_label,
             zorder=5,
         )
+    if states is not None:
+        _draw_states(ax, *states)
     ax.set_aspect("equal")
     ax.autoscale_view()
     ax.set_xlabel(r"$x$")
@@ -201,23 +216,62 @@ def _draw_body(
     )
 
 
-def _draw_pressure(ax: Any, contact_points: np.ndarray, pressure: np.ndarray) -> None:
-    """The pressure against the coordinate along the contact boundary."""
+def _draw_pressure(
+    ax: Any,
+    contact_points: np.ndarray,
+    pressure: np.ndarray,
+    tangential: np.ndarray | None,
+    state: np.ndarray | None,
+) -> None:
+    """The pressure (and the friction stress, its stick and slip nodes marked) against the
+    coordinate along the contact boundary."""
     t, tlabel = contact_coordinate(contact_points)
     order = np.argsort(t, kind="stable")
-    st = STYLES["pressure"]
-    ax.plot(
-        t[order],
-        pressure[order],
-        color=st["color"],
-        marker=st["marker"] if t.size <= 80 else "",
-        markersize=2.5,
-        label=st["label"],
-    )
+    curves = [("pressure", pressure)]
+    if tangential is not None:
+        curves.append(("tangential_pressure", tangential))
+    for key, values in curves:
+        st = STYLES.get(key) or FRICTION_STYLES[key]
+        ax.plot(
+            t[order],
+            values[order],
+            color=st["color"],
+            marker=st["marker"] if t.size <= 80 and state is None else "",
+            markersize=2.5,
+            label=st["label"],
+        )
+    if state is not None:
+        marked = np.column_stack([t, curves[-1][1]])
+        _draw_states(ax, marked, state, legend=False)
     ax.axhline(0.0, color="0.5", linewidth=0.6)
     ax.grid(True, linestyle="-")
     ax.set_xlabel(tlabel)
-    ax.set_ylabel(r"contact pressure $p_h$")
+    if tangential is None:
+        ax.set_ylabel(r"contact pressure $p_h$")
+    else:
+        ax.set_ylabel("contact stresses")
+        ax.legend(loc="best", ncols=2)
+
+
+def _draw_states(ax: Any, at: np.ndarray, state: np.ndarray, legend: bool = True) -> None:
+    """Markers on the contact nodes that stick and that slip, at the points ``at (k, 2)``
+    (labelled for the legend, or not)."""
+    size = 3.0 if state.size <= 200 else 1.5
+    for key, value in (("stick", STICK), ("slip", SLIP)):
+        on = state == value
+        if not on.any():
+            continue
+        st = FRICTION_STYLES[key]
+        ax.plot(
+            at[on, 0],
+            at[on, 1],
+            linestyle="",
+            marker=st["marker"],
+            markersize=size,
+            color=st["color"],
+            label=st["label"] if legend else f"_{st['label']}",
+            zorder=6,
+        )
 
 
 def plot_deformed(
@@ -233,6 +287,9 @@ def plot_deformed(
     show_mesh: bool = True,
     gap: ArrayLike | None = None,
     normal: ArrayLike | None = None,
+    state: ArrayLike | None = None,
+    contact_displacement: ArrayLike | None = None,
+    tangential_pressure: ArrayLike | None = None,
 ) -> list[Path]:
     """The deformed body coloured by ``|u_h|``, and the contact pressure along ``Γ_C``.
 
@@ -240,8 +297,10 @@ def plot_deformed(
     drawn piecewise linearly), coloured by the unscaled ``|u_h|`` with Gouraud shading; the
     reference configuration's boundary is dashed. The title's last line states the scale.
     When ``pressure`` is given, a second axes below shows it against the coordinate along the
-    contact boundary (:func:`contact_coordinate`). The figure's height follows the drawn
-    body's aspect ratio.
+    contact boundary (:func:`contact_coordinate`), with the friction stress
+    ``tangential_pressure`` when that is given. With ``state`` the contact nodes that stick
+    and that slip are marked on the drawn body (at ``contact_points + scale *
+    contact_displacement``). The figure's height follows the drawn body's aspect ratio.
 
     Parameters
     ----------
@@ -301,6 +360,10 @@ def plot_deformed(
             raise ValueError(
                 f"pressure must have shape ({cp.shape[0]},) to match contact_points, got {pr.shape}"
             )
+    pt = _friction_stress(tangential_pressure, pressure, cp)
+    states = None
+    if state is not None:
+        states = _checked_states(state, contact_displacement, cp)
     obs = None if obstacle is None else np.asarray(obstacle, dtype=np.float64).reshape(-1, 2)
     obstacle_label = STYLES["obstacle"]["label"]
     if gap is not None:
@@ -328,9 +391,46 @@ def plot_deformed(
         else:
             fig = new_figure(height=body + 1.45 + 1.7)
             ax, axp = fig.subplots(2, 1, gridspec_kw={"height_ratios": [body + 1.0, 1.2]})
-        _draw_body(fig, ax, p, c, u, scale, obs, obstacle_label, show_mesh)
+        if states is not None:
+            states = (cp + scale * states[0], states[1])
+        _draw_body(fig, ax, p, c, u, scale, obs, obstacle_label, show_mesh, states)
         ax.set_title(fit_title(head, fig))
         if pressure is not None:
-            _draw_pressure(axp, cp, pr)
+            _draw_pressure(axp, cp, pr, pt, None if states is None else states[1])
         trim_height(fig)
         return save_figure(fig, path)
+
+
+def _friction_stress(
+    tangential: ArrayLike | None, pressure: ArrayLike | None, cp: np.ndarray | None
+) -> np.ndarray | None:
+    """``tangential_pressure`` checked: given with ``pressure``, one value per contact point."""
+    if tangential is None:
+        return None
+    if pressure is None:
+        raise ValueError("tangential_pressure is drawn with the pressure: give pressure too")
+    pt = np.asarray(tangential, dtype=np.float64)
+    if pt.shape != (cp.shape[0],):
+        raise ValueError(
+            f"tangential_pressure must have shape ({cp.shape[0]},) to match contact_points, "
+            f"got {pt.shape}"
+        )
+    return pt
+
+
+def _checked_states(
+    state: ArrayLike, contact_displacement: ArrayLike | None, cp: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(contact_displacement (k, 2), state (k,))`` checked against ``contact_points``."""
+    if cp is None or contact_displacement is None:
+        raise ValueError("state needs contact_points and contact_displacement")
+    st = np.asarray(state)
+    uc = np.asarray(contact_displacement, dtype=np.float64)
+    if st.shape != (cp.shape[0],) or uc.shape != cp.shape:
+        raise ValueError(
+            f"state must have shape ({cp.shape[0]},) and contact_displacement {cp.shape} to "
+            f"match contact_points, got {st.shape} and {uc.shape}"
+        )
+    if not np.isin(st, (INACTIVE, STICK, SLIP)).all():
+        raise ValueError("state must hold 0 (inactive), 1 (stick) or 2 (slip)")
+    return uc, st
