@@ -18,9 +18,11 @@ uncouple; a/R ≈ 0.08):
 - unloading from Q* to Q (Mindlin): stick where ``|x| < c'``, slip against the loading
   direction outside, ``c'/a = √(1 − (Q* − Q)/(2 F P))``.
 
-Tolerance: the stick ends are located to a node spacing (h/2, the P2 nodes) at each end and
-the normal step alone leaves a slip zone of about one cell at the edges (β ≠ 0 and the
-clamped top), so c/a is asserted within h/a (0.048); observed 0.005 and less.
+Tolerance: the stick ends are located to a node spacing (h/2, the P2 nodes) at each end, so
+c/a is asserted within h/a (0.048); observed 0.005 and less. The press alone leaves slip at
+the edges, c/a = 0.954, 0.943, 0.937 for h = 2⁻⁷, 2⁻⁸, 2⁻⁹: not from β (it is 0.916 at
+ν = 0.499, β = 0.002) but from the body, which is not the half-space of the theory (a/R =
+0.08, clamped top); it is smaller with F = 1 (0.966) and is overtaken by the pull's slip.
 """
 
 from __future__ import annotations
@@ -54,11 +56,11 @@ def path(mesh):
     return steps, solve_path([half_disc_problem(mesh, xi) for xi in steps])
 
 
-def half_disc_problem(mesh, shift: float, push: float = DELTA) -> ContactProblem:
+def half_disc_problem(mesh, shift: float, push: float = DELTA, nu: float = NU) -> ContactProblem:
     """The half-disc with its top displaced by (shift, −push) on the rigid plane y ≤ 0."""
     return ContactProblem(
         mesh,
-        Material.from_young(1.0, NU),
+        Material.from_young(1.0, nu),
         {
             "top": Dirichlet((shift, -push)),
             "arc": Contact(
@@ -99,7 +101,7 @@ def test_the_stick_zone_follows_cattaneo_mindlin_on_loading_and_unloading(path):
         f"\nβ = {BETA:.4f}, F = {COEFFICIENT}, a = {a:.4f} (a/R = {a / RADIUS:.3f}), "
         f"h/a = {h / a:.3f}"
     )
-    print(f"press: P = {m[0]['P']:.5e}, c/a = {m[0]['c'] / a:.4f} (edge slip from β and the top)")
+    print(f"press: P = {m[0]['P']:.5e}, c/a = {m[0]['c'] / a:.4f} (edge slip: the finite body)")
     assert 0.05 < a / RADIUS < 0.1
     for k, xi in enumerate(PULL, start=1):
         ratio = m[k]["Q"] / (COEFFICIENT * m[k]["P"])
@@ -126,9 +128,9 @@ def test_coulomb_friction_is_path_dependent(mesh, path):
     """The static (one-step) solve of a load against the end of a load path.
 
     - Press then pull (twice): the static solution of the pulled state is the path's end
-      state (the press step leaves its stick nodes at u_t = 0, and the pulls only shrink the
-      stick zone and keep the slip directions, so the path's end state satisfies the static
-      law).
+      state (the press step leaves its stick nodes at u_t = 0, the pulls only shrink the
+      stick zone, and at the end every slipping node has moved along its friction force from
+      where it started, so the path's end state satisfies the static law).
     - Press, pull, move back halfway: the path ends with reversed slip at the edges and a
       larger stick zone than the static solve of the same final load, and a smaller Q.
     - Proportional loading (push and pull grow together in 6 steps): the contact grows and
@@ -163,3 +165,20 @@ def test_coulomb_friction_is_path_dependent(mesh, path):
     )
     assert mp["c"] / mp["a"] > 0.9 and ms["c"] / ms["a"] < 0.6
     assert (ms["Q"] - mp["Q"]) / mp["Q"] > 0.02
+
+
+def test_with_coupling_the_stick_zone_departs_from_cattaneo_mindlin(mesh):
+    """The same press and pull with ν = 0.3 (β = 0.286): the normal and tangential problems
+    couple, and c/a departs from √(1 − Q/(F P)) by far more than h/a, so the agreement at
+    ν = 0.49 is not built into the measurement."""
+    nu = 0.3
+    beta = (1 - 2 * nu) / (2 * (1 - nu))
+    steps = solve_path([half_disc_problem(mesh, xi, nu=nu) for xi in (0.0, PULL[-1])])
+    m, pressed = measure(steps[-1]), measure(steps[0])
+    theory = np.sqrt(1 - m["Q"] / (COEFFICIENT * m["P"]))
+    measured = m["c"] / m["a"]
+    print(
+        f"\nν = {nu}, β = {beta:.3f}: press c/a {pressed['c'] / pressed['a']:.3f}; pull "
+        f"c/a measured {measured:.4f}, Cattaneo–Mindlin {theory:.4f}"
+    )
+    assert theory - measured > 2 * H_CONTACT / m["a"], (measured, theory)
