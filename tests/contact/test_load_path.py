@@ -5,13 +5,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from contact_problems import graded_half_disc
 
 from signorini.contact.load_path import solve_path
 from signorini.contact.solution import INACTIVE, SLIP, STICK, solve
 from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle
+from signorini.mesh.curves import Circle
+from signorini.mesh.mesh import Mesh
 from signorini.problem import Contact, ContactProblem, Coulomb, Dirichlet, Neumann, Tresca
-from signorini.problem.obstacles import Disc
+from signorini.problem.obstacles import Disc, HalfPlane
 
 MESH = rectangle(0.0, 2.0, 0.0, 1.0, nx=16, ny=8)
 COULOMB = Coulomb(0.5)
@@ -114,3 +117,29 @@ def test_load_paths_are_checked():
     with pytest.raises(ValueError, match="previous must be the ContactResult"):
         solve(block(0.01), previous=first.u)
     assert (first.state != INACTIVE).any()
+
+
+def test_a_step_on_the_chords_of_a_curved_mesh_is_refused():
+    """Same points and cells, but the arc's midpoints on its circle in one mesh and on the
+    chords in the other: another discrete problem, refused as a previous step."""
+    graded = graded_half_disc(1.0, 0.25, zone=0.1)
+    chords = Mesh.from_arrays(
+        graded.points,
+        graded.cells,
+        {"top": lambda x: x[:, 1] > 1 - 1e-12, "arc": lambda x: x[:, 1] < 1 - 1e-12},
+    )
+    curved = chords.with_curve("arc", Circle((0.0, 1.0), 1.0))
+
+    def pressed(mesh):
+        obstacle = HalfPlane((0.0, 0.0), (0.0, 1.0))
+        return ContactProblem(
+            mesh,
+            Material.from_young(1.0, 0.3),
+            {"top": Dirichlet((0.0, -0.01)), "arc": Contact(obstacle=obstacle, friction=COULOMB)},
+        )
+
+    first = solve(pressed(chords))
+    assert np.array_equal(chords.cells, curved.cells)
+    assert np.array_equal(chords.points, curved.points)
+    with pytest.raises(ValueError, match="previous was solved on another mesh"):
+        solve(pressed(curved), previous=first)

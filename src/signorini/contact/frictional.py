@@ -21,7 +21,7 @@ import numpy as np
 
 from ..algebra.friction import INACTIVE, SLIP, solve_friction
 from ..algebra.friction_result import FrictionResult
-from ..mesh.mesh import Mesh
+from ..fem.space import P2Space
 from ..problem.fields import ProblemError
 from .contact_set import COULOMB, TRESCA, ContactSet
 from .node_frames import to_frames
@@ -77,33 +77,33 @@ def check_friction_set(cs: ContactSet) -> str:
     return "tresca" if TRESCA in laws else "coulomb"
 
 
-def check_previous(previous: object, mesh: Mesh, cs: ContactSet) -> None:
-    """Check that ``previous`` is the result of a load step on ``mesh`` with the contact
+def check_previous(previous: object, space: P2Space, cs: ContactSet) -> None:
+    """Check that ``previous`` is the result of a load step in ``space`` with the contact
     nodes of ``cs`` (docs/method.md, *Load paths*).
 
     Raises
     ------
     ValueError
-        If ``previous`` is not a result, was solved on another mesh (other points or cells),
-        or has other contact parts or nodes.
+        If ``previous`` is not a result, was solved on another mesh (other P2 nodes, curved
+        midpoints included, or cells), or has other contact parts or nodes.
     """
     if not all(hasattr(previous, name) for name in ("u", "contact", "space", "pdas")):
         raise ValueError(
             f"previous must be the ContactResult of the previous load step, got "
             f"{type(previous).__name__}"
         )
-    old = previous.space.mesh
-    same_mesh = old is mesh or (
-        old.points.shape == mesh.points.shape
-        and old.cells.shape == mesh.cells.shape
-        and np.array_equal(old.points, mesh.points)
-        and np.array_equal(old.cells, mesh.cells)
+    old = previous.space
+    same_mesh = old is space or (
+        old.node_points.shape == space.node_points.shape
+        and old.cell_nodes.shape == space.cell_nodes.shape
+        and np.array_equal(old.node_points, space.node_points)
+        and np.array_equal(old.cell_nodes, space.cell_nodes)
     )
     if not same_mesh:
         raise ValueError(
-            f"previous was solved on another mesh ({old.n_points} points, {old.n_cells} "
-            f"cells; this one has {mesh.n_points} and {mesh.n_cells}): the steps of a load "
-            "path share one mesh"
+            f"previous was solved on another mesh ({old.n_nodes} P2 nodes, "
+            f"{old.cell_nodes.shape[0]} cells; this one has {space.n_nodes} and "
+            f"{space.cell_nodes.shape[0]}): the steps of a load path share one mesh"
         )
     pc = previous.contact
     if pc.parts != cs.parts or not np.array_equal(pc.nodes, cs.nodes):

@@ -266,7 +266,7 @@ def solve(
         assembled = assemble(problem, mesh)
     space, cs = assembled.space, assembled.contact
     if previous is not None:
-        check_previous(previous, mesh, cs)
+        check_previous(previous, space, cs)
         if u0 is None and not cs.friction_law.any():
             u0 = previous.u
     active0 = None
