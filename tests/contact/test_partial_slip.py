@@ -134,8 +134,8 @@ def test_coulomb_friction_is_path_dependent(mesh, path):
     - Press, pull, move back halfway: the path ends with reversed slip at the edges and a
       larger stick zone than the static solve of the same final load, and a smaller Q.
     - Proportional loading (push and pull grow together in 6 steps): the contact grows and
-      its new nodes stick where they touch, so almost all of it sticks (Mindlin–Deresiewicz)
-      where the static solve of the same load slips at c/a ≈ 0.55.
+      its new nodes stick about where they touch, so almost all of it sticks
+      (Mindlin–Deresiewicz) where the static solve of the same load slips at c/a ≈ 0.55.
     """
     xi = PULL[-1]
     pulled, back = path[1][-2:]
