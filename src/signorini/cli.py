@@ -32,7 +32,7 @@ import numpy as np
 
 from .algebra.backends import BACKENDS
 from .estimator.residual import ETA5_VARIANTS
-from .examples import EXAMPLES, get_example
+from .examples import EXAMPLES, METRICS, Metrics, get_example
 from .loop import COLUMNS, Level, adaptive, check_loop_arguments
 from .mesh.mesh import Mesh
 from .output import HistoryWriter, write_columns, write_vtu
@@ -417,6 +417,7 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
     status.problem = name
     problem = load_problem(name)
     label = _label(name)
+    metrics = METRICS.get(name) if name in EXAMPLES else None
     if args.resume is not None:
         state = folder.restart()
         status.folder, status.done = folder, state.level
@@ -435,7 +436,11 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
     folder.add_files("history.csv", "history.md")
     write_columns(
         out / "history.md",
-        {**COLUMNS, "t_output": "seconds spent writing the level's VTU file and recording it"},
+        {
+            **COLUMNS,
+            **(metrics.columns if metrics else {}),
+            "t_output": "seconds spent writing the level's VTU file and recording it",
+        },
     )
     history = HistoryWriter(out / "history.csv", rows=state.history_rows if state else ())
     mode = "uniform" if opts["uniform"] else f"adaptive, theta={opts['theta']}"
@@ -449,6 +454,7 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
         "eta5": opts["eta5"],
         "backend": opts["backend"],
         "fallback": opts["fallback"],
+        "metrics": metrics,
     }
     status.phase = "at level 0" if state is None else f"at level {state.level + 1}"
     last = None
@@ -485,18 +491,25 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
         status.phase = "while drawing the figures"
         say(f"drawing the figures of {label} (convergence history, mesh, deformed body) ...")
         written = _figures(label, out, last)
+        if metrics is not None and metrics.pressure is not None:
+            written += _pressure_figure(label, out, last, metrics)
         folder.add_files(*(str(p.relative_to(out)) for p in written))
         say(f"figures: {', '.join(str(p.name) for p in written)}")
     if opts["compare_uniform"] and not opts["uniform"] and last is not None:
         status.phase = "during the uniform comparison"
-        _compare_uniform(problem, opts, args.no_figures, folder, say)
+        _compare_uniform(problem, opts, args.no_figures, folder, say, metrics)
     folder.set_status("finished")
     say(f"solver backend: {last.record.backend}" if last else "no level finished")
     return 0
 
 
 def _compare_uniform(
-    problem: ContactProblem, opts: dict, no_figures: bool, folder: RunFolder, say
+    problem: ContactProblem,
+    opts: dict,
+    no_figures: bool,
+    folder: RunFolder,
+    say,
+    metrics: Metrics | None = None,
 ) -> None:
     """Uniform refinement to the same budget, and one plot of both convergence histories."""
     from . import plots
@@ -514,6 +527,7 @@ def _compare_uniform(
         backend=opts["backend"],
         fallback=opts["fallback"],
         max_levels=opts["max_levels"],
+        metrics=metrics,
     )
     _write_levels(levels, history, folder, vtu=False, save_state=False, say=say)
     if no_figures:
@@ -598,6 +612,23 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
         title=f"{example}: deformed body",
     )
     return written
+
+
+def _pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> list[Path]:
+    """The last level's pressure beside the known one the example's ``metrics`` give
+    (``<example>_pressure``; e.g. Hertz's for ``hertz``)."""
+    from . import plots
+
+    known = metrics.pressure(last.result)
+    return plots.plot_pressure_comparison(
+        known.x,
+        known.pressure,
+        known.x_reference,
+        known.reference,
+        out / f"{example}_pressure",
+        label=known.label,
+        title=known.title,
+    )
 
 
 def main(argv: list[str] | None = None) -> int:
