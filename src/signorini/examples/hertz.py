@@ -42,8 +42,8 @@ __all__ = [
     "hertz_solution",
 ]
 
-#: the prescribed displacement of the top, δ / R: gives a / R ≈ 0.1 with ν = 0.3
-DEPTH = 0.02
+#: the prescribed displacement of the top, δ / R: gives a / R ≈ 0.099 with ν = 0.3
+DEPTH = 0.015
 
 
 def hertz(
@@ -54,12 +54,13 @@ def hertz(
     *,
     rings: int = 4,
     h_bottom: float | None = None,
+    grading: float = 0.5,
     curved: bool = True,
     angle: float = 0.0,
 ) -> ContactProblem:
     """The Hertz problem: an elastic half-disc pressed by its flat top onto a rigid plane.
 
-    Defaults: R = 1, δ = 0.02 R (:data:`DEPTH`), E = 1, ν = 0.3 (consistent units; the
+    Defaults: R = 1, δ = 0.015 R (:data:`DEPTH`), E = 1, ν = 0.3 (consistent units; the
     problem is linear in E, and a / R depends on δ / R and ν only): a / R ≈ 0.1.
 
     Parameters
@@ -70,9 +71,10 @@ def hertz(
         δ, the downward displacement prescribed on the flat top (length units).
     young, poisson : float
         E (stress units) and ν of the body.
-    rings, h_bottom : optional
+    rings, h_bottom, grading : optional
         The initial mesh, :func:`~signorini.mesh.builders.half_disc` ``(radius, rings,
-        h_bottom=h_bottom)``: ``h_bottom`` grades it towards the first point of contact.
+        h_bottom=h_bottom, grading=grading)``: ``h_bottom`` grades it towards the first point
+        of contact.
     curved : bool
         Whether the arc carries its circle (isoparametric cells, new points on the circle);
         ``False`` keeps the same vertices with straight chords between them.
@@ -88,7 +90,7 @@ def hertz(
     """
     c, s = np.cos(angle), np.sin(angle)
     rotation = np.array([[c, -s], [s, c]])
-    mesh = half_disc(radius, rings, h_bottom=h_bottom)
+    mesh = half_disc(radius, rings, h_bottom=h_bottom, grading=grading)
     mesh = Mesh(
         mesh.points @ rotation.T,
         mesh.cells,
@@ -158,7 +160,10 @@ def hertz_contact(result: ContactResult) -> dict[str, object]:
 
 def hertz_metrics(result: ContactResult) -> dict[str, float]:
     """Half-width and peak pressure of a level, and their errors against Hertz with the
-    level's own total force P (:func:`hertz_contact`, :func:`hertz_solution`)."""
+    level's own total force P (:func:`hertz_contact`, :func:`hertz_solution`); NaN without
+    contact."""
+    if not result.total_contact_force > 0:
+        return dict.fromkeys(("a", "p0", "a_rel_error", "p0_rel_error"), float("nan"))
     zone = hertz_contact(result)
     a, p0 = hertz_solution(zone["force"], zone["radius"], result.problem.material)
     return {

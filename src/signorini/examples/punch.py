@@ -63,7 +63,7 @@ def punch(
         (contact with the punch) and ``"right"`` (contact with the wall).
     """
     bottom = height - depth
-    reach = width + 2.0 * radius + (width - edge)  # the punch ends beyond the wall
+    reach = 2.0 * width - edge  # the punch ends beyond the wall, centred on it
     tool = Polyline(
         [(edge, height + 1.0), (edge, bottom), (reach, bottom), (reach, height + 1.0)],
         radius=radius,
