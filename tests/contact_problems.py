@@ -22,8 +22,10 @@ import numpy as np
 from signorini.fem.loads import assemble_body_force, assemble_edge_load
 from signorini.fem.material import Material
 from signorini.fem.stiffness import assemble_stiffness
+from signorini.mesh.builders import rectangle
 from signorini.mesh.mesh import Mesh
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
+from signorini.problem.obstacles import HalfPlane
 
 
 def rotation(angle_deg: float) -> np.ndarray:
@@ -206,3 +208,33 @@ def independent_system(problem: ContactProblem, mesh: Mesh) -> System:
         nodes, normal, gap = np.zeros(0, int), np.zeros((0, 2)), np.zeros(0)
     dirichlet = np.column_stack([2 * d_nodes, 2 * d_nodes + 1]).ravel()
     return System(K.tocsr(), F, dirichlet, d_vals.ravel(), nodes, normal, gap, node_points)
+
+
+def corner_problem(angle: float = 0.0, shapes: bool = False) -> ContactProblem:
+    """The unit square (rotated by ``angle``) pushed by its top into a rigid corner: a floor
+    under the bottom and a wall right of the right side, both at gap 0, with a body force."""
+    c, s = np.cos(angle), np.sin(angle)
+    R = np.array([[c, -s], [s, c]])
+    base = rectangle(nx=4, ny=4)
+
+    def on(coord, value):
+        return lambda x: np.abs((x @ R)[:, coord] - value) < 1e-12
+
+    mesh = Mesh.from_arrays(
+        base.points @ R.T,
+        base.cells,
+        {"left": on(0, 0.0), "top": on(1, 1.0), "bottom": on(1, 0.0), "right": on(0, 1.0)},
+    )
+    if shapes:
+        floor = Contact(obstacle=HalfPlane(R @ [0.0, 0.0], R @ [0.0, 1.0]))
+        wall = Contact(obstacle=HalfPlane(R @ [1.0, 0.0], R @ [-1.0, 0.0]))
+    else:
+        floor, wall = Contact(), Contact()
+    push = R @ [0.02, -0.03]
+    force = R @ [0.5, -1.0]
+    return ContactProblem(
+        mesh,
+        Material.from_young(10.0, 0.3),
+        {"left": Neumann(), "top": Dirichlet(push), "bottom": floor, "right": wall},
+        body_force=lambda x: np.broadcast_to(force, x.shape),
+    )

@@ -281,18 +281,19 @@ def test_gap_of_wrong_shape():
         solve(pb)
 
 
-def test_contact_parts_meeting_at_a_corner():
+def test_contact_parts_meeting_at_a_corner_give_two_constraints():
     pb = ContactProblem(
         _square(),
         MATERIAL,
         {"left": Dirichlet(), "top": Neumann(), "bottom": Contact(), "right": Contact()},
     )
-    with pytest.raises(
-        ProblemError,
-        match=r"node 2 at \[1\.0, 0\.0\] lies on contact parts "
-        "with different normals",
-    ):
-        solve(pb)
+    cs = contact_set(pb, P2Space(pb.mesh))
+    corner = np.flatnonzero(cs.nodes == 2)  # the vertex (1, 0)
+    assert corner.size == 2 and cs.second[corner].tolist() == [False, True]
+    assert {tuple(n) for n in cs.normal[corner]} == {(0.0, -1.0), (1.0, 0.0)}
+    assert cs.constrained_dofs[corner].tolist() == [4, 5]
+    # each constraint's weights count its own part's edge only: |e| / 6 with |e| = 1/2
+    assert np.allclose(cs.basis_integral[corner], 1 / 12, rtol=0, atol=1e-15)
 
 
 def _split_right_side():

@@ -133,3 +133,41 @@ def test_bad_system_raises():
         rotate_frames(sp.identity(4, format="csr"), np.zeros(3), [0], [[1.0, 0.0]])
     with pytest.raises(ValueError, match="even size"):
         rotate_frames(sp.identity(3, format="csr"), np.zeros(3), [0], [[1.0, 0.0]])
+
+
+@settings(max_examples=20, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), nx=st.integers(1, 5), ny=st.integers(1, 5))
+def test_general_frames_equal_dense_product(seed, nx, ny):
+    """Corner frames Q_z = A_z⁻¹ (rows of A_z: two constraint directions) mixed with
+    rotations: K_rot = Qᵀ K Q, y = Q⁻¹ x, and the frame unknowns are (u·n, u·m)."""
+    rng = np.random.default_rng(seed)
+    K = block_spd(nx, ny, rng)
+    n_nodes = nx * ny
+    nodes = rng.permutation(n_nodes)[: max(1, n_nodes // 2)]
+    n, m = random_normals(rng, nodes.size), random_normals(rng, nodes.size)
+    # directions at least 0.2 rad apart, so that A_z is well conditioned
+    cross = np.abs(n[:, 0] * m[:, 1] - n[:, 1] * m[:, 0])
+    m[cross < np.sin(0.2)] = n[cross < np.sin(0.2)] @ [[0.0, 1.0], [-1.0, 0.0]]
+    frames = np.linalg.inv(np.stack([n, m], axis=1))
+    F = rng.standard_normal(2 * n_nodes)
+    K_rot, F_rot = rotate_frames(K, F, nodes, frames)
+    Q = np.eye(2 * n_nodes)
+    for z, Qz in zip(nodes, frames, strict=True):
+        Q[2 * z : 2 * z + 2, 2 * z : 2 * z + 2] = Qz
+    scale = np.abs(K.data).max() * np.abs(frames).max() ** 2
+    assert np.abs(K_rot.toarray() - Q.T @ K.toarray() @ Q).max() < 1e-13 * scale
+    assert np.abs(F_rot - Q.T @ F).max() < 1e-13 * np.abs(F).max() * np.abs(frames).max()
+    u = rng.standard_normal(2 * n_nodes)
+    y = to_frames(u, nodes, frames)
+    un = np.einsum("kc,kc->k", u.reshape(-1, 2)[nodes], n)
+    um = np.einsum("kc,kc->k", u.reshape(-1, 2)[nodes], m)
+    assert np.allclose(y[2 * nodes], un, atol=1e-13) and np.allclose(
+        y[2 * nodes + 1], um, atol=1e-13
+    )
+    assert np.allclose(to_cartesian(y, nodes, frames), u, atol=1e-13)
+
+
+def test_singular_frame_is_refused():
+    K = sp.identity(4, format="csr")
+    with pytest.raises(ValueError, match=r"the frame normals\[0\] is singular"):
+        rotate_frames(K, np.zeros(4), [0], [[[1.0, 1.0], [1.0, 1.0]]])

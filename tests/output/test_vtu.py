@@ -8,6 +8,7 @@ import stat
 import meshio
 import numpy as np
 import pytest
+from contact_problems import corner_problem
 
 from signorini.contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
 from signorini.contact.solution import solve
@@ -56,6 +57,10 @@ def test_write_vtu_reads_back(tmp_path, solved):
     np.testing.assert_array_equal(pd["pressure"][cs.nodes], result.pressure)
     np.testing.assert_array_equal(pd["pressure"][off], 0.0)
     np.testing.assert_array_equal(pd["contact_force"][cs.nodes], result.contact_force)
+    np.testing.assert_array_equal(
+        pd["contact_traction"][cs.nodes, :2], -result.pressure[:, None] * cs.normal
+    )
+    np.testing.assert_array_equal(pd["contact_traction"][off], 0.0)
     np.testing.assert_array_equal(pd["active"][cs.nodes], result.active.astype(int))
     np.testing.assert_array_equal(pd["active"][off], 0)
     np.testing.assert_array_equal(pd["contact_class"][cs.nodes], result.classes)
@@ -97,3 +102,18 @@ def test_vtu_file_follows_the_umask(tmp_path, solved):
         os.umask(old)
     mode = stat.S_IMODE(os.stat(tmp_path / "s.vtu").st_mode)
     assert mode == 0o640, oct(mode)
+
+
+def test_corner_node_gets_the_larger_scalars_and_the_sum_of_tractions(tmp_path):
+    """A node with two constraints (a block in a rigid corner) in the VTU file."""
+    result = solve(corner_problem())
+    cs = result.contact
+    corner = cs.nodes[cs.second]
+    assert corner.size == 1
+    rows = np.flatnonzero(cs.nodes == corner[0])
+    pd = meshio.read(write_vtu(tmp_path / "corner.vtu", result)).point_data
+    assert pd["pressure"][corner[0]] == result.pressure[rows].max()
+    assert pd["contact_force"][corner[0]] == result.contact_force[rows].max()
+    expected = -(result.pressure[rows, None] * cs.normal[rows]).sum(axis=0)
+    np.testing.assert_allclose(pd["contact_traction"][corner[0], :2], expected, rtol=1e-15)
+    assert pd["active"][corner[0]] == 1

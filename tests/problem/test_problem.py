@@ -112,7 +112,9 @@ def test_condition_of_wrong_type():
         )
 
 
-def test_curved_contact_part():
+def test_polygonal_contact_part():
+    """A contact part that is not straight has no single normal (its directions are per
+    node); a normal given for it is refused."""
     m = _square()
     mesh = Mesh.from_arrays(
         m.points,
@@ -122,8 +124,10 @@ def test_curved_contact_part():
             "rest": lambda x: (np.abs(x[:, 1] - 1) < 1e-12) | (np.abs(x[:, 0]) < 1e-12),
         },
     )
-    with pytest.raises(ProblemError, match="'corner' is not straight"):
-        ContactProblem(mesh, MATERIAL, {"rest": Dirichlet(), "corner": Contact()})
+    pb = ContactProblem(mesh, MATERIAL, {"rest": Dirichlet(), "corner": Contact()})
+    assert "corner" not in pb.contact_normals
+    with pytest.raises(ProblemError, match="normal is given for contact part 'corner'"):
+        ContactProblem(mesh, MATERIAL, {"rest": Dirichlet(), "corner": Contact(normal=(1, 0))})
 
 
 @pytest.mark.parametrize("normal", [(-1.0, 0.0), (0.0, -1.0), (1.0, 0.1)])

@@ -1,9 +1,12 @@
-"""The discrete contact boundary: constrained nodes, weights, contact forces, node classes.
+"""The discrete contact boundary: constraints, weights, contact forces, node classes.
 
 Constrained nodes are all P2 nodes (vertices and midpoints) on the closure of Γ_C that are
-not Dirichlet nodes; the discrete constraint is ``u_h(z)·n ≤ ψ(z)`` (paper, the set K^h of
-Section 3). From the nodal contact force ``Λ_z = L(ψ_z n) − a(u_h, ψ_z n)`` (3.5), (3.9),
-(3.17) we derive (docs/method.md, *Discrete problem*)
+not Dirichlet nodes. Each carries a constraint ``u_h(z)·n_z ≤ ψ(z)`` (paper, the set K^h of
+Section 3) with its own direction n_z and gap ψ(z) (docs/method.md, *Contact directions*): the
+body's outward normal for a gap given along it, the obstacle's inward normal at the closest
+point for a shape. A node where two contact parts meet at an angle (a corner) carries one
+constraint per part. From the nodal contact force ``Λ_z = L(ψ_z n_z) − a(u_h, ψ_z n_z)``
+(3.5), (3.9), (3.17) we derive (docs/method.md, *Discrete problem*)
 
 - the paper's contact force density ``s_z = Λ_z / m_z`` (4.1), with ``m_z = ∫ φ_z ds`` the
   integral of the half-edge hat φ_z of Q^h (3.6) (:attr:`ContactSet.hat_integral`):
@@ -11,16 +14,21 @@ Section 3). From the nodal contact force ``Λ_z = L(ψ_z n) − a(u_h, ψ_z n)``
 - the consistent pressure ``p_z = Λ_z / w_z`` with ``w_z = ∫_{Γ_C} ψ_z ds`` the integral of the
   P2 basis function (:attr:`ContactSet.basis_integral`): ``|e|/6`` per edge at a vertex,
   ``2|e|/3`` at a midpoint; exact for linear pressures.
+
+On a curved edge both integrals are taken along the quadratic edge (docs/method.md, *Curved
+boundaries*).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 
+from ..fem import iso, p2
+from ..fem.quadrature import gauss_legendre
 from ..fem.space import P2Space
+from ..mesh.geometry import segment_normals
 from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
@@ -32,36 +40,49 @@ __all__ = [
     "SEMI_CONTACT",
     "FULL_CONTACT",
     "node_classes",
+    "SAME_DIRECTION",
+    "MIN_CORNER_ANGLE",
 ]
 
 NO_CONTACT, SEMI_CONTACT, FULL_CONTACT = 0, 1, 2
+#: two parts' constraint directions at a shared node closer than this (|n − m|) are one
+#: constraint; their gaps must then agree
+SAME_DIRECTION = 1e-8
+#: a corner's two constraint directions must be at least this angle apart (radians): the
+#: corner frame's condition number grows like 1 / sin² of the angle
+MIN_CORNER_ANGLE = 1e-2
 
 
 @dataclass(frozen=True)
 class ContactSet:
-    """Discrete contact data of a P2 space.
+    """Discrete contact data of a P2 space: one row per constraint.
 
-    Arrays of length k are indexed by constrained node (all P2 nodes on the closure of Γ_C
-    that are not Dirichlet nodes), arrays of length n_ce by contact edge. Consistent units:
-    if lengths are in mm, gaps and weights are in mm (the weights are lengths: integrals of
-    dimensionless basis functions along Γ_C).
+    Arrays of length k are indexed by constraint, sorted by node; a corner node (two contact
+    parts meeting at an angle) has two rows, the first bounding the DOF ``2z`` and the second
+    ``2z + 1`` of the node's frame. Arrays of length n_ce are indexed by contact edge.
+    Consistent units: if lengths are in mm, gaps and weights are in mm (the weights are
+    lengths: integrals of dimensionless basis functions along Γ_C).
 
     Attributes
     ----------
     nodes : (k,) int array
-        Global P2 node of each constrained node (sorted).
+        Global P2 node of each constraint (sorted; a corner node twice).
     normal : (k, 2) float array
-        Outward unit normal of the node's contact part.
+        The constraint direction n_z (unit): the body's outward normal for a gap function,
+        the obstacle's normal pointing into it for a shape.
     gap : (k,) float array
-        ψ(z), the admissible normal displacement (``u(z)·n ≤ ψ(z)``), in length units.
+        ψ(z), the admissible displacement along n_z (``u(z)·n_z ≤ ψ(z)``), in length units.
+    part : (k,) int array
+        Index into ``parts`` of the constraint's contact part (its zone).
+    second : (k,) bool array
+        Whether the row is the second constraint of a corner node.
     hat_integral : (k,) float array
-        ``m_z = ∫_{Γ_C} φ_z ds`` (length), the integral of the half-edge hat φ_z of Q^h
-        (3.6): ``|e|/4`` per edge at a vertex, ``|e|/2`` at a midpoint; the contact force
-        density is ``s_z = Λ_z / m_z`` (4.1).
+        ``m_z = ∫ φ_z ds`` (length) over the constraint's part(s), the integral of the
+        half-edge hat φ_z of Q^h (3.6); the contact force density is ``s_z = Λ_z / m_z``
+        (4.1).
     basis_integral : (k,) float array
-        ``w_z = ∫_{Γ_C} ψ_z ds`` (length), the integral of the P2 basis function: ``|e|/6``
-        per edge at a vertex, ``2|e|/3`` at a midpoint; the consistent pressure is
-        ``p_z = Λ_z / w_z``.
+        ``w_z = ∫ ψ_z ds`` (length) over the constraint's part(s), the integral of the P2
+        basis function; the consistent pressure is ``p_z = Λ_z / w_z``.
     is_vertex : (k,) bool array
         Whether the node is a mesh vertex (else an edge midpoint).
     edges : (n_ce,) int array
@@ -74,14 +95,21 @@ class ContactSet:
     parts : tuple of str
         The contact parts, in the problem's order.
     edge_gap : (n_ce, 3) float array
-        ψ at ``[start, end, midpoint]`` (also at Dirichlet end points).
+        ψ at ``[start, end, midpoint]`` for the edge's part (also at Dirichlet end points).
+    edge_direction : (n_ce, 3, 2) float array
+        The constraint direction at ``[start, end, midpoint]`` for the edge's part.
     edge_normal : (n_ce, 2) float array
-        Outward unit normal of each contact edge (its part's).
+        Outward unit normal of each contact edge's chord.
+    edge_local : (n_ce, 3) int array
+        Row of the constraint of each contact edge's nodes (for the edge's part), ``-1`` at
+        Dirichlet nodes.
     """
 
     nodes: np.ndarray
     normal: np.ndarray
     gap: np.ndarray
+    part: np.ndarray
+    second: np.ndarray
     hat_integral: np.ndarray
     basis_integral: np.ndarray
     is_vertex: np.ndarray
@@ -90,43 +118,65 @@ class ContactSet:
     edge_part: np.ndarray
     parts: tuple[str, ...]
     edge_gap: np.ndarray
+    edge_direction: np.ndarray
     edge_normal: np.ndarray
+    edge_local: np.ndarray
 
     @property
     def size(self) -> int:
         return self.nodes.size
 
     @property
-    def dofs(self) -> np.ndarray:
-        """Interleaved DOFs ``(k, 2)`` of the constrained nodes."""
-        return np.column_stack([2 * self.nodes, 2 * self.nodes + 1])
+    def constrained_dofs(self) -> np.ndarray:
+        """``(k,)`` the DOF each constraint bounds in the node frames: ``2z`` (``2z + 1`` for
+        a corner's second constraint)."""
+        return 2 * self.nodes + self.second
 
-    @cached_property
-    def edge_local(self) -> np.ndarray:
-        """``(n_ce, 3)`` position in this set of each contact edge's nodes, ``-1`` for
-        Dirichlet nodes."""
-        return self.local(self.edge_nodes.ravel()).reshape(-1, 3)
+    @property
+    def frame_nodes(self) -> np.ndarray:
+        """``(m,)`` the distinct constrained nodes (sorted)."""
+        return self.nodes[~self.second]
+
+    @property
+    def frames(self) -> np.ndarray:
+        """``(m, 2, 2)`` the frame ``Q_z`` of each of :attr:`frame_nodes` (``u = Q_z y``):
+        the rotation ``[n t]`` for one constraint, ``A_z^{-1}`` with rows ``n, m`` of ``A_z``
+        for a corner's two (docs/method.md, *Contact directions*)."""
+        first = np.flatnonzero(~self.second)
+        n = self.normal[first]
+        Q = np.stack(
+            [np.stack([n[:, 0], -n[:, 1]], axis=-1), np.stack([n[:, 1], n[:, 0]], axis=-1)],
+            axis=1,
+        )
+        corner = np.flatnonzero(self.second)
+        if corner.size:
+            A = np.stack([self.normal[corner - 1], self.normal[corner]], axis=1)
+            Q[np.searchsorted(self.frame_nodes, self.nodes[corner])] = np.linalg.inv(A)
+        return Q
 
     def local(self, nodes: np.ndarray) -> np.ndarray:
-        """Position in this set of global nodes, ``-1`` for nodes that are not constrained."""
-        return _locate(self.nodes, np.asarray(nodes))
+        """Row of the (first) constraint of global nodes, ``-1`` for nodes that are not
+        constrained."""
+        return _locate(self.frame_nodes, np.asarray(nodes), np.flatnonzero(~self.second))
 
     def normal_displacement(self, u: np.ndarray) -> np.ndarray:
-        """``u(z)·n`` at the constrained nodes, for nodal values ``u (n_nodes, 2)``."""
+        """``u(z)·n_z`` per constraint, for nodal values ``u (n_nodes, 2)``."""
         return np.einsum("kc,kc->k", u[self.nodes], self.normal)
 
     def edge_normal_gap(self, u: np.ndarray) -> np.ndarray:
-        """``u·n − ψ`` at ``[start, end, midpoint]`` of each contact edge, ``(n_ce, 3)``."""
-        un = np.einsum("ejc,ec->ej", u[self.edge_nodes], self.edge_normal)
+        """``u·n_z − ψ`` at ``[start, end, midpoint]`` of each contact edge, ``(n_ce, 3)``."""
+        un = np.einsum("ejc,ejc->ej", u[self.edge_nodes], self.edge_direction)
         return un - self.edge_gap
 
 
-def _locate(sorted_nodes: np.ndarray, query: np.ndarray) -> np.ndarray:
-    """Position of ``query`` entries in the sorted array ``sorted_nodes``, ``-1`` if absent."""
-    if sorted_nodes.size == 0:
+def _locate(sorted_keys: np.ndarray, query: np.ndarray, rows: np.ndarray | None = None):
+    """Position of ``query`` entries in the sorted array ``sorted_keys`` (mapped through
+    ``rows`` if given), ``-1`` if absent."""
+    if sorted_keys.size == 0:
         return np.full(query.shape, -1, dtype=np.int64)
-    pos = np.minimum(np.searchsorted(sorted_nodes, query), sorted_nodes.size - 1)
-    return np.where(sorted_nodes[pos] == query, pos, -1)
+    pos = np.minimum(np.searchsorted(sorted_keys, query), sorted_keys.size - 1)
+    found = sorted_keys[pos] == query
+    return np.where(found, pos if rows is None else rows[pos], -1)
 
 
 def _empty(parts: tuple[str, ...]) -> ContactSet:
@@ -136,6 +186,8 @@ def _empty(parts: tuple[str, ...]) -> ContactSet:
         nodes=no_int,
         normal=np.zeros((0, 2)),
         gap=np.zeros(0),
+        part=no_int,
+        second=np.zeros(0, dtype=bool),
         hat_integral=np.zeros(0),
         basis_integral=np.zeros(0),
         is_vertex=np.zeros(0, dtype=bool),
@@ -144,44 +196,135 @@ def _empty(parts: tuple[str, ...]) -> ContactSet:
         edge_part=no_int,
         parts=parts,
         edge_gap=np.zeros((0, 3)),
+        edge_direction=np.zeros((0, 3, 2)),
         edge_normal=np.zeros((0, 2)),
+        edge_local=no_edges,
     )
 
 
-def _edge_gaps(
-    problem: ContactProblem, parts: tuple[str, ...], edge_part: np.ndarray, x: np.ndarray
+def _body_normals(
+    problem: ContactProblem, space: P2Space, name: str, nodes: np.ndarray, chord: np.ndarray
 ) -> np.ndarray:
-    """ψ at the nodes ``x (n_ce, 3, 2)`` of the contact edges, part by part (each part has its
-    own gap function), shape ``(n_ce, 3)``."""
-    edge_gap = np.empty(x.shape[:-1])
-    for i, p in enumerate(parts):
+    """The body's outward unit normal at the nodes ``[start, end, midpoint]`` of one part's
+    edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``: the part's normal
+    on a straight part, the curve's normal on a part with a curve that has one, else the
+    edge's normal at a midpoint and the normalised mean of the part's two edges' normals at a
+    vertex
+    (docs/method.md, *Contact directions*)."""
+    mesh = space.mesh
+    if name in problem.contact_normals:
+        return np.broadcast_to(problem.contact_normals[name], nodes.shape + (2,)).copy()
+    curve = mesh.curves[mesh.part_index(name)]
+    if curve is not None and curve.has_normal:
+        n = curve.normal(space.node_points[nodes.ravel()]).reshape(nodes.shape + (2,))
+        sign = np.sign(np.einsum("ejc,ec->ej", n, chord))
+        return n * np.where(sign < 0, -1.0, 1.0)[..., None]
+    total = np.zeros((space.n_nodes, 2))
+    np.add.at(total, nodes[:, :2].ravel(), np.repeat(chord, 2, axis=0))
+    out = np.repeat(chord[:, None, :], 3, axis=1)
+    mean = total[nodes[:, :2]]
+    out[:, :2] = mean / np.hypot(mean[..., 0], mean[..., 1])[..., None]
+    return out
+
+
+def _directions_and_gaps(
+    problem: ContactProblem, space: P2Space, cs_edges: tuple, chord: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """n_z and ψ(z) at the nodes ``[start, end, midpoint]`` of the contact edges, part by part
+    (each part has its own obstacle), shapes ``(n_ce, 3, 2)`` and ``(n_ce, 3)``."""
+    parts, edge_part, edge_nodes = cs_edges
+    direction = np.empty(edge_nodes.shape + (2,))
+    gap = np.empty(edge_nodes.shape)
+    for i, name in enumerate(parts):
         sel = edge_part == i
-        cond: Contact = problem.conditions[p]
-        edge_gap[sel] = evaluate_field(
-            cond.gap_field(), x[sel], f"the gap function of contact part {p!r}", shape=()
+        cond: Contact = problem.conditions[name]
+        nodes, inverse = np.unique(edge_nodes[sel], return_inverse=True)
+        x = space.node_points[nodes]
+        if cond.obstacle is not None:
+            try:
+                psi, n = cond.obstacle.gap_and_direction(x)
+            except ValueError as err:
+                raise ProblemError(f"the obstacle of contact part {name!r}: {err}") from err
+            direction[sel] = n[inverse].reshape(-1, 3, 2)
+        else:
+            what = f"the gap function of contact part {name!r}"
+            psi = evaluate_field(cond.gap_field(), x, what, shape=())
+            direction[sel] = _body_normals(problem, space, name, edge_nodes[sel], chord[sel])
+        gap[sel] = psi[inverse].reshape(-1, 3)
+    return direction, gap
+
+
+def _edge_weights(space: P2Space, edges: np.ndarray, edge_nodes: np.ndarray):
+    """``∫ φ_z ds`` and ``∫ ψ_z ds`` of ``[start, end, midpoint]`` on each contact edge,
+    ``(n_ce, 3)`` each: closed forms on straight edges, a Gauss rule along the quadratic edge
+    on curved ones."""
+    length = space.mesh.edge_length[edges]
+    hat = np.column_stack([length / 4, length / 4, length / 2])
+    basis = np.column_stack([length / 6, length / 6, 2 * length / 3])
+    curved = np.flatnonzero(np.isin(edges, iso.curved_edges(space.mesh)))
+    if curved.size:
+        t, w = gauss_legendre(6)
+        halves = np.concatenate([t / 2, 0.5 + t / 2])  # φ_z is linear on each half-edge
+        wh = np.concatenate([w, w]) / 2
+        points = space.node_points[edge_nodes[curved]]
+        _, speed, _ = iso.edge_geometry(points[:, :2], points[:, 2], halves)
+        phi = np.column_stack(
+            [
+                np.maximum(1 - 2 * halves, 0),
+                np.maximum(2 * halves - 1, 0),
+                1 - np.abs(2 * halves - 1),
+            ]
         )
-    return edge_gap
+        hat[curved] = (speed * wh) @ phi
+        basis[curved] = (speed * wh) @ p2.edge_basis(halves)
+    return hat, basis
 
 
-def _to_nodes(pos: np.ndarray, values: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Values per constrained node from values per edge node (``pos`` its position in the set,
-    ``-1`` for Dirichlet nodes), and how far each edge node's value is from its node's."""
-    inside = pos >= 0
-    out = np.zeros((n,) + values.shape[1:])
-    out[pos[inside]] = values[inside]
-    diff = np.abs(out[pos[inside]] - values[inside])
-    return out, diff.reshape(diff.shape[0], -1).max(axis=1, initial=0.0)
+def _rows(
+    nodes: np.ndarray, direction: np.ndarray, gap: np.ndarray, points: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Which constraint row each (node, part) candidate becomes, and whether it starts one.
+
+    Candidates (sorted by node, then part) of the same node with directions closer than
+    :data:`SAME_DIRECTION` are one constraint (their gaps must agree); a node with two
+    distinct directions is a corner.
+    """
+    same_node = nodes[1:] == nodes[:-1]
+    diff = np.abs(direction[1:] - direction[:-1]).max(axis=1, initial=0.0)
+    merge = np.concatenate([[False], same_node & (diff <= SAME_DIRECTION)])
+    scale = max(float(np.abs(gap).max(initial=0.0)), 1e-300)
+    bad = np.flatnonzero(merge[1:] & (np.abs(gap[1:] - gap[:-1]) > 1e-12 * scale))
+    if bad.size:
+        raise ProblemError(
+            f"node {nodes[bad[0]]} at {points[nodes[bad[0]]].tolist()} lies on contact parts "
+            "whose gap functions disagree there; the obstacle must be continuous"
+        )
+    corner = np.concatenate([[False], same_node]) & ~merge
+    cos = np.einsum("kc,kc->k", direction[1:], direction[:-1])
+    narrow = np.flatnonzero(corner[1:] & (np.arccos(np.clip(cos, -1, 1)) < MIN_CORNER_ANGLE))
+    if narrow.size:
+        raise ProblemError(
+            f"node {nodes[narrow[0]]} at {points[nodes[narrow[0]]].tolist()} lies on two "
+            "contact parts whose constraint directions "
+            f"differ by less than {MIN_CORNER_ANGLE} rad but are not equal: two constraints "
+            "there would be ill-conditioned; join the parts into one part (its normal at the "
+            "node is then the mean of its edges') or give them the same obstacle"
+        )
+    starts = ~merge
+    return np.cumsum(starts) - 1, starts
 
 
 def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
-    """Collect the constrained nodes of ``space`` for ``problem`` (docs/method.md, *Discrete
-    problem*).
+    """Collect the constraints of ``space`` for ``problem`` (docs/method.md, *Discrete
+    problem* and *Contact directions*).
 
     Raises
     ------
     ProblemError
-        If every contact node is a Dirichlet node, a node is shared by contact parts with
-        different normals or gaps, or a gap function does not return finite numbers.
+        If every contact node is a Dirichlet node, contact parts with the same direction at a
+        shared node have different gaps, two directions at a corner are nearly parallel, a
+        node lies on more than two contact parts, or a gap function or obstacle does not give
+        finite numbers.
     """
     mesh = space.mesh
     parts = tuple(problem.contact_parts)
@@ -191,48 +334,59 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     edges = np.concatenate(edge_lists)
     edge_part = np.repeat(np.arange(len(parts)), [e.size for e in edge_lists])
     edge_nodes = space.edge_nodes(edges)
-    edge_normal = np.stack([problem.contact_normals[p] for p in parts])[edge_part]
-    edge_gap = _edge_gaps(problem, parts, edge_part, space.node_points[edge_nodes])
+    _, chord = segment_normals(mesh.points[edge_nodes[:, 0]], mesh.points[edge_nodes[:, 1]])
+    for i, name in enumerate(parts):  # straight parts: exactly their normal
+        if name in problem.contact_normals:
+            chord[edge_part == i] = problem.contact_normals[name]
+    direction, edge_gap = _directions_and_gaps(
+        problem, space, (parts, edge_part, edge_nodes), chord
+    )
 
-    nodes = np.setdiff1d(np.unique(edge_nodes), problem.dirichlet_nodes(space))
-    if nodes.size == 0:
+    # candidates: one per (node, part), Dirichlet nodes left out
+    n_parts = len(parts)
+    key = (edge_nodes * n_parts + edge_part[:, None]).ravel()
+    ukey, first, cand_of = np.unique(key, return_index=True, return_inverse=True)
+    cand_node = ukey // n_parts
+    free = ~np.isin(cand_node, problem.dirichlet_nodes(space))
+    if not free.any():
         raise ProblemError("every node of the contact boundary is a Dirichlet node")
-    # a node on two contact parts needs equal normals and equal gaps
-    pos = _locate(nodes, edge_nodes.ravel())
-    inside = pos >= 0
-    normal, off = _to_nodes(pos, np.repeat(edge_normal, 3, axis=0), nodes.size)
-    if off.max(initial=0.0) > 1e-12:
-        bad = nodes[pos[inside][np.flatnonzero(off > 1e-12)[0]]]
-        raise ProblemError(
-            f"node {bad} at {space.node_points[bad].tolist()} lies on contact "
-            "parts with different normals; this corner is not supported"
-        )
-    gap, off = _to_nodes(pos, edge_gap.ravel(), nodes.size)
-    if off.max(initial=0.0) > 1e-12 * max(float(np.abs(edge_gap).max()), 1e-300):
-        bad = nodes[pos[inside][np.argmax(off)]]
-        raise ProblemError(
-            f"node {bad} at {space.node_points[bad].tolist()} lies on contact "
-            "parts whose gap functions disagree there; the obstacle must be "
-            "continuous"
-        )
+    kept = np.flatnonzero(free)
+    row_of, starts = _rows(
+        cand_node[kept],
+        direction.reshape(-1, 2)[first[kept]],
+        edge_gap.ravel()[first[kept]],
+        space.node_points,
+    )
+    cand_row = np.full(ukey.size, -1)
+    cand_row[kept] = row_of
+    edge_local = cand_row[cand_of].reshape(-1, 3)
+    lead = kept[starts]
+    nodes = cand_node[lead]
+    if np.unique(nodes, return_counts=True)[1].max() > 2:
+        raise ProblemError("a node lies on more than two contact parts with different directions")
+    second = np.concatenate([[False], nodes[1:] == nodes[:-1]])
 
-    # per edge [start, end, midpoint]: ∫ φ_z (half-edge hats) and ∫ ψ_z (P2 basis)
-    length = mesh.edge_length[edges]
-    hat = np.column_stack([length / 4, length / 4, length / 2]).ravel()
-    basis = np.column_stack([length / 6, length / 6, 2 * length / 3]).ravel()
+    hat, basis = _edge_weights(space, edges, edge_nodes)
+    loc = edge_local.ravel()
+    inside = loc >= 0
+    k = nodes.size
     return ContactSet(
         nodes=nodes,
-        normal=normal,
-        gap=gap,
-        hat_integral=np.bincount(pos[inside], weights=hat[inside], minlength=nodes.size),
-        basis_integral=np.bincount(pos[inside], weights=basis[inside], minlength=nodes.size),
+        normal=direction.reshape(-1, 2)[first[lead]],
+        gap=edge_gap.ravel()[first[lead]],
+        part=ukey[lead] % n_parts,
+        second=second,
+        hat_integral=np.bincount(loc[inside], weights=hat.ravel()[inside], minlength=k),
+        basis_integral=np.bincount(loc[inside], weights=basis.ravel()[inside], minlength=k),
         is_vertex=nodes < mesh.n_points,
         edges=edges,
         edge_nodes=edge_nodes,
         edge_part=edge_part,
         parts=parts,
         edge_gap=edge_gap,
-        edge_normal=edge_normal,
+        edge_direction=direction,
+        edge_normal=chord,
+        edge_local=edge_local,
     )
 
 

@@ -1,12 +1,19 @@
-"""Node frames: rotation of the two DOFs of a contact node into its (normal, tangential) frame.
+"""Node frames: the two DOFs of a contact node in its constraint frame.
 
-A contact node ``z`` has a constant outward unit normal ``n = (n1, n2)`` and the tangent
+A node ``z`` with one constraint has a unit direction ``n = (n1, n2)`` and the tangent
 ``t = (-n2, n1)``. With interleaved DOFs (``dof = 2 * node + component``), the Cartesian values
 ``u = (x[2z], x[2z + 1])`` and the frame values ``(u.n, u.t)`` are related by the 2 x 2 block
 ``Q_z = [n t]``: ``u = Q_z (u.n, u.t)``. ``Q`` is block diagonal with ``Q_z`` at the listed
 nodes and the identity elsewhere, so the constraint ``u(z).n <= gap`` of docs/method.md, *The
-continuous problem*
-becomes a bound on the single DOF ``2z`` of the rotated system ``Q^T K Q y = Q^T F``.
+continuous problem* becomes a bound on the single DOF ``2z`` of the rotated system
+``Q^T K Q y = Q^T F``.
+
+A corner node with two constraints along independent directions ``n, m`` takes the frame
+``Q_z = A_z^{-1}``, ``A_z`` the matrix with rows ``n`` and ``m``: then ``y = (u.n, u.m)`` and
+both constraints bound one DOF each; ``Q^T K Q`` is still symmetric, and the multipliers
+``Q^T (F - K u)`` are the two constraints' nodal forces (docs/method.md, *Contact
+directions*). Every function here takes either unit directions ``(m, 2)`` (rotations) or
+general frames ``(m, 2, 2)``.
 
 :func:`rotate_frames` forms ``Q^T K Q`` directly on the CSR values: a stiffness matrix with
 interleaved DOFs has a 2 x 2 node-block pattern (rows ``2z`` and ``2z + 1`` store the same
@@ -24,13 +31,24 @@ import scipy.sparse as sp
 
 from ..algebra.sparse import as_csr, csr_row_indices
 
-__all__ = ["rotate_frames", "to_cartesian", "to_frames"]
+__all__ = ["frame_matrices", "rotate_frames", "to_cartesian", "to_frames"]
+
+
+def frame_matrices(frames: np.ndarray) -> np.ndarray:
+    """The blocks ``Q_z (m, 2, 2)`` of unit directions ``(m, 2)`` (``[n t]``) or of frames
+    ``(m, 2, 2)`` (returned as they are)."""
+    frames = np.asarray(frames, dtype=np.float64)
+    if frames.ndim == 3:
+        return frames
+    n1, n2 = frames[:, 0], frames[:, 1]
+    return np.stack([np.stack([n1, -n2], axis=-1), np.stack([n2, n1], axis=-1)], axis=1)
 
 
 def _checked_frames(
-    nodes: np.ndarray, normals: np.ndarray, n_dofs: int
+    nodes: np.ndarray, frames: np.ndarray, n_dofs: int
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Validate ``nodes (k,)`` and unit ``normals (k, 2)``; return them as int64 / float64."""
+    """Validate ``nodes (k,)`` and unit directions ``(k, 2)`` or invertible frames
+    ``(k, 2, 2)``; return them as int64 / float64."""
     if n_dofs % 2:
         raise ValueError(f"interleaved 2D DOFs need an even size, got {n_dofs}")
     nodes = np.asarray(nodes)
@@ -44,71 +62,95 @@ def _checked_frames(
         )
     if np.unique(nodes).size != nodes.size:
         raise ValueError("nodes has repeated entries")
-    normals = np.asarray(normals, dtype=np.float64)
-    if normals.shape != (nodes.size, 2):
-        raise ValueError(f"normals must have shape ({nodes.size}, 2), got {normals.shape}")
-    if not np.isfinite(normals).all():
+    frames = np.asarray(frames, dtype=np.float64)
+    if frames.shape not in ((nodes.size, 2), (nodes.size, 2, 2)):
+        raise ValueError(
+            f"normals must have shape ({nodes.size}, 2) (unit directions) or ({nodes.size}, 2, "
+            f"2) (frames), got {frames.shape}"
+        )
+    if not np.isfinite(frames).all():
         raise ValueError("normals has non-finite entries")
-    length = np.hypot(normals[:, 0], normals[:, 1])
-    if nodes.size and np.abs(length - 1.0).max() > 1e-10:
-        k = int(np.argmax(np.abs(length - 1.0)))
-        raise ValueError(f"normals must be unit vectors; normals[{k}] has length {length[k]:.6g}")
-    return nodes, normals
+    if frames.ndim == 2:
+        length = np.hypot(frames[:, 0], frames[:, 1])
+        if nodes.size and np.abs(length - 1.0).max() > 1e-10:
+            k = int(np.argmax(np.abs(length - 1.0)))
+            raise ValueError(
+                f"normals must be unit vectors; normals[{k}] has length {length[k]:.6g}"
+            )
+    elif nodes.size:
+        det = np.abs(np.linalg.det(frames))
+        scale = np.abs(frames).max(axis=(1, 2)) ** 2
+        if (det <= 1e-12 * scale).any():
+            k = int(np.argmin(det / np.maximum(scale, 1e-300)))
+            raise ValueError(
+                f"normals: the frame normals[{k}] is singular (determinant {det[k]:.3g})"
+            )
+    return nodes, frames
 
 
-def _rotate_pairs(
-    first: np.ndarray, second: np.ndarray, n1: np.ndarray, n2: np.ndarray, values: np.ndarray
+def _transform_pairs(
+    first: np.ndarray, second: np.ndarray, Q: np.ndarray, values: np.ndarray
 ) -> None:
-    """In place: ``(v[first], v[second]) <- (n1 v1 + n2 v2, -n2 v1 + n1 v2)`` (i.e. ``Q^T v``)."""
+    """In place: ``(v[first], v[second]) <- Q^T (v[first], v[second])`` for blocks
+    ``Q (k, 2, 2)`` broadcast against the values."""
     v1 = values[first]
     v2 = values[second]
-    values[first] = n1 * v1 + n2 * v2
-    values[second] = n1 * v2 - n2 * v1
+    shape = (-1,) + (1,) * (values.ndim - 1)
+    q00, q01 = Q[:, 0, 0].reshape(shape), Q[:, 0, 1].reshape(shape)
+    q10, q11 = Q[:, 1, 0].reshape(shape), Q[:, 1, 1].reshape(shape)
+    values[first] = q00 * v1 + q10 * v2
+    values[second] = q01 * v1 + q11 * v2
 
 
 def to_frames(x: np.ndarray, nodes: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """Cartesian DOF values to (normal, tangential) values at the listed nodes: ``Q^T x``.
+    """Cartesian DOF values to frame values at the listed nodes: ``Q^{-1} x``.
 
     Parameters
     ----------
     x : (n_dofs,) or (n_dofs, k) float array
         Interleaved Cartesian values.
     nodes : (m,) int array
-        Nodes to rotate (distinct).
-    normals : (m, 2) float array
-        Unit outward normal at each node.
+        Nodes to transform (distinct).
+    normals : (m, 2) or (m, 2, 2) float array
+        Unit direction at each node (a rotation ``Q_z = [n t]``), or the frames ``Q_z``.
 
     Returns
     -------
     (n_dofs,) or (n_dofs, k) float array
-        ``y[2z] = u(z).n``, ``y[2z + 1] = u(z).t`` with ``t = (-n2, n1)``; other DOFs copied.
+        For directions ``y[2z] = u(z).n``, ``y[2z + 1] = u(z).t`` with ``t = (-n2, n1)``; for
+        frames ``(y[2z], y[2z + 1]) = Q_z^{-1} u(z)``; other DOFs copied.
     """
     y = np.array(x, dtype=np.float64)
     nodes = np.asarray(nodes, dtype=np.int64)
     normals = np.asarray(normals, dtype=np.float64)
-    shape = (-1,) + (1,) * (y.ndim - 1)
-    n1, n2 = normals[:, 0].reshape(shape), normals[:, 1].reshape(shape)
-    _rotate_pairs(2 * nodes, 2 * nodes + 1, n1, n2, y)
+    # a rotation's inverse is its transpose; a general frame's is computed
+    Q = frame_matrices(normals)
+    M = Q if normals.ndim == 2 else np.linalg.inv(Q).transpose(0, 2, 1)
+    _transform_pairs(2 * nodes, 2 * nodes + 1, M, y)
     return y
 
 
 def to_cartesian(y: np.ndarray, nodes: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """(normal, tangential) values at the listed nodes back to Cartesian values: ``Q y``.
+    """Frame values at the listed nodes back to Cartesian values: ``Q y``.
 
     Parameters
     ----------
     y : (n_dofs,) or (n_dofs, k) float array
     nodes : (m,) int array
-    normals : (m, 2) float array
+    normals : (m, 2) or (m, 2, 2) float array
+        As for :func:`to_frames`.
 
     Returns
     -------
     (n_dofs,) or (n_dofs, k) float array
-        ``x[2z : 2z + 2] = y[2z] n + y[2z + 1] t``; other DOFs copied.
+        ``x[2z : 2z + 2] = Q_z (y[2z], y[2z + 1])`` (``y[2z] n + y[2z + 1] t`` for a
+        direction); other DOFs copied.
     """
-    normals = np.asarray(normals, dtype=np.float64)
-    # Q_z^{-1} = Q_z^T is the frame of the reflected normal (n1, -n2).
-    return to_frames(y, nodes, normals * np.array([1.0, -1.0]))
+    x = np.array(y, dtype=np.float64)
+    nodes = np.asarray(nodes, dtype=np.int64)
+    Q = frame_matrices(normals)
+    _transform_pairs(2 * nodes, 2 * nodes + 1, Q.transpose(0, 2, 1), x)
+    return x
 
 
 def _row_pairs(indptr: np.ndarray, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -160,7 +202,7 @@ def rotate_frames(
     copy: bool = True,
     validate: bool = True,
 ) -> tuple[sp.csr_matrix, np.ndarray]:
-    """Rotate a system ``K x = F`` into node frames: ``(Q^T K Q, Q^T F)``.
+    """Transform a system ``K x = F`` into node frames: ``(Q^T K Q, Q^T F)``.
 
     Works on the CSR values only (no sparse product): the column rotation mixes the two
     adjacent stored values of columns ``2z``, ``2z + 1`` in every row, and the row rotation
@@ -173,8 +215,9 @@ def rotate_frames(
     F : (n_dofs,) float array
     nodes : (m,) int array
         Nodes to rotate (distinct).
-    normals : (m, 2) float array
-        Unit outward normal ``n`` at each node; the tangent is ``t = (-n2, n1)``.
+    normals : (m, 2) or (m, 2, 2) float array
+        Unit direction ``n`` at each node (the tangent is ``t = (-n2, n1)``), or general
+        invertible frames ``Q_z`` (a corner node's two constraint directions).
     copy : bool
         If False and ``K`` is canonical float64 CSR and ``F`` a float64 array, both are
         overwritten and returned.
@@ -203,11 +246,10 @@ def rotate_frames(
         nodes, normals = _checked_frames(nodes, normals, K.shape[0])
     else:
         nodes = np.asarray(nodes, dtype=np.int64)
-        normals = np.asarray(normals, dtype=np.float64)
+    Q = frame_matrices(normals)
     if copy:
         K = K.copy()
     F_rot = np.array(F, dtype=np.float64) if copy else np.asarray(F, dtype=np.float64)
-    n1, n2 = normals[:, 0], normals[:, 1]
 
     # Column rotation: in every row, column 2z is stored and followed by column 2z + 1.
     which_node = np.full(K.shape[0] // 2, -1, dtype=np.int64)
@@ -219,7 +261,7 @@ def rotate_frames(
     # Row rotation: rows 2z and 2z + 1 store the same columns, paired entry by entry.
     pos0, pos1, length = _row_pairs(K.indptr, nodes)
     data = K.data
-    _rotate_pairs(first, first + 1, n1[col_node[first]], n2[col_node[first]], data)
-    _rotate_pairs(pos0, pos1, np.repeat(n1, length), np.repeat(n2, length), data)
-    _rotate_pairs(2 * nodes, 2 * nodes + 1, n1, n2, F_rot)
+    _transform_pairs(first, first + 1, Q[col_node[first]], data)
+    _transform_pairs(pos0, pos1, np.repeat(Q, length, axis=0), data)
+    _transform_pairs(2 * nodes, 2 * nodes + 1, Q, F_rot)
     return K, F_rot

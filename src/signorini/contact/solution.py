@@ -85,8 +85,9 @@ class ContactProfile:
         along the part's direction (a part made of disjoint segments has several chains).
     s : (m,) float array
         Distance from the part's first node: ``s_0 = 0``, ``s_{i+1} = s_i + |x_{i+1} − x_i|``.
-        Within a chain this is the arc length; from one chain to the next it jumps by the
-        straight distance between them (contact parts are straight).
+        Within a chain this is the length of the polygon through the nodes (the arc length
+        on a straight part); from one chain to the next it jumps by the straight distance
+        between them.
     points : (m, 2) float array
         The nodes' coordinates.
     pressure : (m,) float array
@@ -98,7 +99,7 @@ class ContactProfile:
     gap : (m,) float array
         The obstacle ψ(z).
     normal_displacement : (m,) float array
-        ``u_h(z)·n``, n the part's outward unit normal.
+        ``u_h(z)·n_z``, n_z the part's constraint direction at the node.
     normal_gap : (m,) float array
         ``u_h(z)·n − ψ(z)``: 0 in contact, < 0 where the body is off the obstacle.
     """
@@ -186,8 +187,14 @@ class ContactResult:
 
     @property
     def total_contact_force(self) -> float:
-        """``Σ_z Λ_z`` (the resultant normal force on Γ_C)."""
+        """``Σ_z Λ_z`` (the resultant normal force on Γ_C where all n_z agree)."""
         return float(self.contact_force.sum())
+
+    @property
+    def contact_force_vector(self) -> np.ndarray:
+        """``(2,)`` the resultant force of the obstacles on the body, ``−Σ_z Λ_z n_z``
+        (docs/method.md, *Contact directions*)."""
+        return -(self.contact_force @ self.contact.normal)
 
     @cached_property
     def classes(self) -> np.ndarray:
@@ -242,11 +249,11 @@ class ContactResult:
         nodes = cs.edge_nodes[row, column]
         points = self.space.node_points[nodes]
         step = np.sqrt((np.diff(points, axis=0) ** 2).sum(axis=1))
-        loc = cs.local(nodes)
+        loc = cs.edge_local[row, column]
         inside = loc >= 0
         force = np.where(inside, self.contact_force[np.maximum(loc, 0)], np.nan)
         gap = cs.edge_gap[row, column]
-        un = self.u[nodes] @ cs.edge_normal[edges[0]]
+        un = np.einsum("kc,kc->k", self.u[nodes], cs.edge_direction[row, column])
         return ContactProfile(
             part=part,
             nodes=nodes,
@@ -368,7 +375,7 @@ def solve(
         res = solve_pdas(
             K,
             F,
-            2 * cs.nodes,
+            cs.constrained_dofs,
             cs.gap,
             assembled.dirichlet,
             assembled.dirichlet_values,
@@ -380,7 +387,7 @@ def solve(
     seconds = time.perf_counter() - t0
     if unit != 1.0:
         res = replace(res, multiplier=res.multiplier * unit, c_scale=res.c_scale * unit)
-    u = to_cartesian(res.x, cs.nodes, cs.normal).reshape(-1, 2)
+    u = to_cartesian(res.x, cs.frame_nodes, cs.frames).reshape(-1, 2)
     log.info(
         "solved %s: %d unknowns, %d PDAS iterations, %d active of %d",
         problem.name,

@@ -69,8 +69,9 @@ class Assembled:
 def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     """Stiffness, load and constraints of ``problem`` on ``mesh`` (paper, Section 3).
 
-    The two DOFs of every constrained node are rotated into (normal, tangential) components
-    so that ``u(z)·n ≤ ψ(z)`` becomes a bound on one unknown.
+    The two DOFs of every constrained node are transformed into its frame (normal and
+    tangential components; a corner's two constraint directions) so that each constraint
+    ``u(z)·n_z ≤ ψ(z)`` becomes a bound on one unknown.
     """
     t0 = time.perf_counter()
     space = P2Space(mesh)
@@ -135,5 +136,5 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     dirichlet = np.column_stack([2 * d_nodes, 2 * d_nodes + 1]).ravel()
 
     cs = contact_set(problem, space)
-    K, F = rotate_frames(K, F, cs.nodes, cs.normal, copy=False, validate=False)
+    K, F = rotate_frames(K, F, cs.frame_nodes, cs.frames, copy=False, validate=False)
     return Assembled(space, cs, K, F, dirichlet, d_values.ravel(), time.perf_counter() - t0)

@@ -46,6 +46,9 @@ class Curve:
     lies to the left of the tangent (a counter-clockwise boundary).
     """
 
+    #: whether :meth:`normal` is available
+    has_normal = True
+
     def project(self, x: np.ndarray) -> np.ndarray:
         """``(n, 2)`` nearest points of the curve to the points ``x (n, 2)``."""
         raise NotImplementedError
@@ -175,6 +178,7 @@ class ProjectedCurve(Curve):
             )
         self._project = project
         self._normal = normal
+        self.has_normal = normal is not None
 
     def _call(self, what: str, f: Callable, x: np.ndarray) -> np.ndarray:
         x = _points(x)

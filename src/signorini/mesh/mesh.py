@@ -253,8 +253,9 @@ class Mesh:
 
         Refinement then puts the new vertex of a bisected edge of the part at the curve's
         halfway point (:meth:`Curve.halfway`) instead of the chord midpoint, and the P2
-        space puts the edge's midpoint node there (:attr:`curved_midpoints`). The cells stay
-        straight-sided in assembly (no isoparametric cells yet). The points are not moved.
+        space puts the edge's midpoint node there (:attr:`curved_midpoints`). Cells with an
+        edge on a part carrying a curve other than a :class:`~signorini.mesh.curves.Line` are
+        isoparametric in assembly (:mod:`signorini.fem.iso`). The points are not moved.
 
         Parameters
         ----------

@@ -17,9 +17,11 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
 
     Point data: ``displacement`` (3 components, z = 0, for ParaView's "Warp By Vector"),
     and on Γ_C ``pressure`` (consistent nodal pressure p_z), ``contact_force`` (Λ_z),
-    ``active`` (1 where u·n = ψ is imposed) and ``contact_class`` (0 none, 1 semi, 2 full,
-    −1 off Γ_C). Cell data: ``eta2`` (element indicators) and ``eta2_k`` per contribution
-    when an estimate is given.
+    ``contact_traction`` (``−p_z n_z``, 3 components: the obstacle's pressure on the body as
+    a vector), ``active`` (1 where u·n_z = ψ is imposed) and ``contact_class`` (0 none,
+    1 semi, 2 full, −1 off Γ_C). At a corner node with two constraints the scalars are the
+    larger of the two and the traction their sum. Cell data: ``eta2`` (element indicators)
+    and ``eta2_k`` per contribution when an estimate is given.
 
     Parameters
     ----------
@@ -37,10 +39,14 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     force = np.zeros(n)
     active = np.zeros(n, dtype=np.int32)
     klass = np.full(n, -1, dtype=np.int32)
-    pressure[cs.nodes] = result.pressure
-    force[cs.nodes] = result.contact_force
-    active[cs.nodes] = result.active
-    klass[cs.nodes] = result.classes
+    traction = np.zeros((n, 3))
+    pressure[cs.nodes] = -np.inf  # a corner node's two constraints: the larger value
+    force[cs.nodes] = -np.inf
+    np.maximum.at(pressure, cs.nodes, result.pressure)
+    np.maximum.at(force, cs.nodes, result.contact_force)
+    np.maximum.at(active, cs.nodes, result.active.astype(np.int32))
+    np.maximum.at(klass, cs.nodes, result.classes.astype(np.int32))
+    np.add.at(traction[:, :2], cs.nodes, -result.pressure[:, None] * cs.normal)
     cell_data = {}
     if estimate is not None:
         cell_data["eta2"] = [estimate.eta2]
@@ -53,6 +59,7 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
             "displacement": disp,
             "pressure": pressure,
             "contact_force": force,
+            "contact_traction": traction,
             "active": active,
             "contact_class": klass,
         },

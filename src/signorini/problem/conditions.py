@@ -26,7 +26,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .obstacles import Obstacle
 from .fields import (
     CALL_NAMED,
     CALL_POSITIONAL,
@@ -37,6 +36,7 @@ from .fields import (
     check_numbers,
     constant_field,
 )
+from .obstacles import Obstacle
 
 __all__ = ["Condition", "Contact", "Dirichlet", "ExactSolution", "Neumann"]
 

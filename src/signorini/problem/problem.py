@@ -9,7 +9,7 @@ The strong form (paper, Section 2; docs/method.md, *The continuous problem*)::
 :class:`ContactProblem` is a public boundary: it checks that every part has exactly one
 condition, that every component of the body (cells joined through shared edges) has a
 Dirichlet part, that each user function can be called by the convention of docs/method.md,
-*User functions*, and that each contact part is straight with the given normal. Everything
+*User functions*, and that a contact part with a given normal is straight along it. Everything
 below it trusts the problem.
 """
 
@@ -25,6 +25,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..fem.material import Material
 from ..fem.space import P2Space
+from ..mesh.curves import Line
 from ..mesh.geometry import segment_normals
 from ..mesh.mesh import Mesh
 from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann
@@ -61,8 +62,8 @@ class ContactProblem:
     ProblemError
         Before any work, if a part has no condition or a condition names no part, a condition
         or the body force is of the wrong kind, a component of the body has no Dirichlet part
-        (the message names each such component), or a contact part is not straight or not
-        along its given normal.
+        (the message names each such component), or a contact part with a given normal is not
+        straight along it.
     """
 
     mesh: Mesh
@@ -119,6 +120,7 @@ class ContactProblem:
         _check_components(mesh, self.dirichlet_parts, self.contact_parts)
         _warn_if_slender(mesh)
         normals = {name: self._segment_normal(name) for name in self.contact_parts}
+        normals = {name: n for name, n in normals.items() if n is not None}
         object.__setattr__(self, "contact_normals", normals)
 
     @property
@@ -143,19 +145,28 @@ class ContactProblem:
         space = P2Space(mesh)
         return space.n_dofs - 2 * self.dirichlet_nodes(space).size
 
-    def _segment_normal(self, name: str) -> np.ndarray:
-        """Outward unit normal of a straight contact part, checked against a given one."""
+    def _segment_normal(self, name: str) -> np.ndarray | None:
+        """Outward unit normal of a straight contact part with a gap function, checked against
+        a given one; ``None`` for a curved or polygonal part or an obstacle given as a shape
+        (their directions are per node: docs/method.md, *Contact directions*)."""
         mesh = self.mesh
+        given = self.conditions[name].normal
+        if self.conditions[name].obstacle is not None:
+            return None
         ab = mesh.oriented_boundary(mesh.part_edges(name))
         _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
         mean = n.mean(axis=0)
         mean /= np.linalg.norm(mean)
-        if np.abs(n - mean).max() > 1e-8:
+        curve = mesh.curves[mesh.part_index(name)]
+        straight = np.abs(n - mean).max() <= 1e-8 and (curve is None or isinstance(curve, Line))
+        if given is not None and not straight:
             raise ProblemError(
-                f"contact part {name!r} is not straight: its edges' outward "
-                "normals differ; split it into straight parts"
+                f"a normal is given for contact part {name!r}, which is not straight (its "
+                "edges' outward normals differ); leave normal=None and the direction at each "
+                "node is taken from the geometry"
             )
-        given = self.conditions[name].normal
+        if not straight:
+            return None
         if given is not None:
             g = np.asarray(given, dtype=np.float64).reshape(2)  # checked by Contact
             g = g / np.linalg.norm(g)
