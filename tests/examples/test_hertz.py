@@ -150,3 +150,13 @@ def test_command_line_writes_the_hertz_columns_and_the_pressure_figure(tmp_path)
         assert np.array_equal(history[column], expected, equal_nan=True), column
         assert f"| `{column}` |" in (out / "history.md").read_text()
     assert (out / "hertz_pressure.png").stat().st_size > 5000
+
+
+def test_without_contact_the_measurements_are_nan():
+    result = solve(hertz(depth=-0.01, h_bottom=0.05))  # lifted off the plane
+    assert result.total_contact_force == 0.0
+    values = hertz_metrics(result)
+    assert set(values) == {"a", "p0", "a_rel_error", "p0_rel_error"}
+    assert all(np.isnan(v) for v in values.values())
+    with pytest.raises(ValueError, match="does not touch the plane"):
+        hertz_contact(result)

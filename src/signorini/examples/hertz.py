@@ -15,8 +15,8 @@ x measured along the plane from the centre of the contact zone. Each level is co
 the Hertz solution of its own total force P (:func:`hertz_metrics`): the half-width from the
 consistent nodal forces, a_h = 2 √(Σ Λ_z x_z² / Σ Λ_z) (exact for the Hertz profile, since
 ∫ x² p dx / ∫ p dx = a² / 4 and x² is a P2 function), and the peak pressure max_z p_z. The
-finite body makes both differ from Hertz by about 0.37 (a/R)² (the issue's measurement at
-a/R = 0.1: −0.38 % in a, +0.32 % in p0).
+finite body makes both differ from Hertz by about 0.37 (a/R)² (measured at a/R = 0.099:
+−0.377 % in a, +0.301 % in p0; docs/method.md, *The Hertz and punch examples*).
 """
 
 from __future__ import annotations
@@ -138,7 +138,14 @@ def hertz_contact(result: ContactResult) -> dict[str, object]:
         ``tangent`` (2,) the plane's direction; ``x`` (k,) each constrained node's coordinate
         along the plane from ``centre``; ``a`` the half-width 2 √(Σ Λ_z x_z² / Σ Λ_z);
         ``p0`` the peak consistent pressure max p_z; ``radius`` R (half the flat top).
+
+    Raises
+    ------
+    ValueError
+        If the body does not touch the plane (no contact force).
     """
+    if not result.total_contact_force > 0:
+        raise ValueError("hertz: the half-disc does not touch the plane (no contact force)")
     problem = result.problem
     normal = problem.conditions["arc"].obstacle.normal
     tangent = np.array([normal[1], -normal[0]])
