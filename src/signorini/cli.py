@@ -34,6 +34,7 @@ from .algebra.backends import BACKENDS
 from .estimator.residual import ETA5_VARIANTS
 from .examples import EXAMPLES, METRICS, Metrics, get_example
 from .loop import COLUMNS, Level, adaptive, check_loop_arguments
+from .mesh.curves import Line
 from .mesh.mesh import Mesh
 from .output import HistoryWriter, write_columns, write_vtu
 from .output.run import RunFolder, file_digest
@@ -577,8 +578,7 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
     }
     segments = {
         label: np.concatenate(
-            [initial.points[initial.edges[initial.part_edges(n)]] for n in parts]
-            or [np.zeros((0, 2, 2))]
+            [_part_segments(initial, n, points, cells) for n in parts] or [np.zeros((0, 2, 2))]
         )
         for label, parts in kinds.items()
     }
@@ -612,6 +612,29 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
         title=f"{example}: deformed body",
     )
     return written
+
+
+def _part_segments(initial: Mesh, part: str, points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """``(k, 2, 2)`` segments that hold the boundary edges of ``part`` in the drawn mesh
+    ``(points, cells)``: the part's edges in the initial mesh, which refinement splits; for a
+    part carrying a curve (whose new points lie on the curve, off the initial chords) the
+    drawn mesh's own boundary edges with both ends on the curve, near the part's initial
+    chords (within their largest distance from the curve)."""
+    from .plots import boundary_groups
+
+    chords = initial.points[initial.edges[initial.part_edges(part)]]
+    curve = initial.curves[initial.part_index(part)]
+    if curve is None or isinstance(curve, Line):
+        return chords
+    size = float(np.ptp(points, axis=0).max())
+
+    def off(x: np.ndarray) -> np.ndarray:
+        return np.hypot(*(curve.project(x) - x).T)
+
+    bulge = float(off(chords.mean(axis=1)).max()) + 1e-9 * size
+    near = boundary_groups(points, cells, {part: chords}, tol=bulge / size)[part]
+    on = (off(points[near[:, 0]]) <= 1e-9 * size) & (off(points[near[:, 1]]) <= 1e-9 * size)
+    return points[near[on]]
 
 
 def _pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> list[Path]:
