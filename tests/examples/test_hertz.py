@@ -135,6 +135,19 @@ def test_default_depth_gives_a_over_r_about_one_tenth(levels):
     assert levels[-1].record.extra["a"] == pytest.approx(0.099, abs=0.002)
 
 
+def test_scaled_problem_gives_the_same_relative_errors():
+    """R = 2 with the default δ = DEPTH·R and the mesh scaled alike: u and a double, the
+    pressures stay, so the relative errors are the same to round-off."""
+    small = solve(hertz(h_bottom=0.02))
+    large = solve(hertz(radius=2.0, h_bottom=0.04))
+    assert np.abs(large.u - 2 * small.u).max() < 1e-12 * np.abs(large.u).max()
+    m1, m2 = hertz_metrics(small), hertz_metrics(large)
+    assert m2["a"] == pytest.approx(2 * m1["a"], rel=1e-10)
+    assert m2["p0"] == pytest.approx(m1["p0"], rel=1e-10)
+    for key in ("a_rel_error", "p0_rel_error"):
+        assert m2[key] == pytest.approx(m1[key], rel=1e-8, abs=1e-12)
+
+
 def test_command_line_writes_the_hertz_columns_and_the_pressure_figure(tmp_path):
     from signorini.cli import main
     from signorini.output import read_history

@@ -48,7 +48,7 @@ DEPTH = 0.015
 
 def hertz(
     radius: float = 1.0,
-    depth: float = DEPTH,
+    depth: float | None = None,
     young: float = 1.0,
     poisson: float = 0.3,
     *,
@@ -67,8 +67,9 @@ def hertz(
     ----------
     radius : float
         R, the radius of the half-disc (length units).
-    depth : float
-        δ, the downward displacement prescribed on the flat top (length units).
+    depth : float, optional
+        δ, the downward displacement prescribed on the flat top (length units); default
+        ``DEPTH * radius``.
     young, poisson : float
         E (stress units) and ν of the body.
     rings, h_bottom, grading : optional
@@ -88,6 +89,7 @@ def hertz(
         Named ``"hertz"``; parts ``"top"`` (Dirichlet (0, −δ)) and ``"arc"`` (contact with
         ``HalfPlane((0, 0), (0, 1))``, rotated with the problem).
     """
+    depth = DEPTH * radius if depth is None else depth
     c, s = np.cos(angle), np.sin(angle)
     rotation = np.array([[c, -s], [s, c]])
     mesh = half_disc(radius, rings, h_bottom=h_bottom, grading=grading)
