@@ -194,3 +194,20 @@ def test_mesh_figure_finds_the_arc_of_a_refined_mesh():
     assert key(found) == key(arc)
     top = _part_segments(initial, "top", mesh.points, mesh.cells)
     assert np.array_equal(top, initial.points[initial.edges[initial.part_edges("top")]])
+
+
+def test_resumed_run_gives_the_hertz_columns_of_the_uninterrupted_run(tmp_path, monkeypatch):
+    from signorini.cli import main
+    from tests.test_cli import assert_same_history, history_without_timings, interrupt_after_level
+
+    full, part = tmp_path / "full", tmp_path / "part"
+    args = ["run", "hertz", "--max-ndof", "1500", "--no-figures", "--no-vtu", "--quiet"]
+    assert main([*args, "--out", str(full)]) == 0
+    interrupt_after_level(monkeypatch, 4)
+    assert main([*args, "--out", str(part)]) == 130
+    monkeypatch.undo()
+    assert main(["run", "--resume", str(part), "--quiet", "--no-figures"]) == 0
+    a = history_without_timings(full / "history.csv")
+    b = history_without_timings(part / "history.csv")
+    assert len(a) > 6 and "p0_rel_error" in a[-1]
+    assert_same_history(a, b)
