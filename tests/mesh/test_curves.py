@@ -11,6 +11,8 @@ from hypothesis import strategies as st
 
 from signorini.fem.space import P2Space
 from signorini.mesh import Circle, Line, Mesh, MeshError, ProjectedCurve, rectangle
+from signorini.mesh import curves as curves_module
+from signorini.mesh.curves import QuadraticBoundary
 from signorini.mesh.refine import refine_nvb, refine_uniform
 
 
@@ -242,3 +244,110 @@ def test_the_adaptive_loop_runs_on_a_quarter_disc_with_a_curved_neumann_part():
     assert len(levels) >= 5 and final.n_cells > 4 * mesh.n_cells
     assert on_circle_error(final, "arc", (0, 0), 1) <= 1e-14
     assert final.area.min() > 0
+
+
+def wavy_pieces(k: int = 12) -> np.ndarray:
+    """``(k, 3, 2)`` quadratic pieces [start, end, midpoint] through points of the closed
+    curve r(φ) = 1 + 0.2 cos 3φ, counter-clockwise: a curve whose curvature changes sign."""
+    phi = 2 * np.pi * np.arange(2 * k + 1) / (2 * k)
+    x = (1 + 0.2 * np.cos(3 * phi))[:, None] * np.column_stack([np.cos(phi), np.sin(phi)])
+    return np.stack([x[0:-1:2], x[2::2], x[1::2]], axis=1)
+
+
+def piece_at(edges: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """``(k, n, 2)``: every piece at the parameters ``t (n,)`` (power form, independently)."""
+    a, b, m = edges[:, 0, None], edges[:, 1, None], edges[:, 2, None]
+    t = t[None, :, None]
+    return a + t * (4 * m - 3 * a - b) + t**2 * (2 * (a + b - 2 * m))
+
+
+@pytest.mark.parametrize("nearest_samples", [24, 2])  # 2: most points compare all pieces
+def test_quadratic_boundary_projection_is_the_nearest_point_of_the_pieces(
+    monkeypatch, nearest_samples
+):
+    monkeypatch.setattr(curves_module, "NEAREST_SAMPLES", nearest_samples)
+    edges = wavy_pieces()
+    curve = QuadraticBoundary(edges)
+    rng = np.random.default_rng(7)
+    x = np.vstack([rng.uniform(-1.5, 1.5, (400, 2)), [[0.0, 0.0]], edges[:, 0], edges[:, 2]])
+    y = curve.project(x)
+    t = np.linspace(0, 1, 4001)
+    dense = piece_at(edges, t).reshape(-1, 2)  # spacing <= 2e-4
+    brute = np.hypot(*(x[:, None] - dense[None]).transpose(2, 0, 1)).min(1)
+    d = np.hypot(*(y - x).T)
+    on_curve = np.hypot(*(y[:, None] - dense[None]).transpose(2, 0, 1)).min(1)
+    print(
+        f"projection: max (|y - x| - brute force) {np.max(d - brute):.2e}, "
+        f"max (brute force - |y - x|) {np.max(brute - d):.2e}, off the dense curve "
+        f"{on_curve.max():.2e}"
+    )
+    assert np.all(d <= brute + 1e-13)  # no sampled point of the pieces is nearer
+    assert np.all(brute - d <= 1e-6)  # and beats the samples by no more than their spacing allows
+    assert on_curve.max() <= 2e-4  # y lies on the pieces
+    np.testing.assert_array_equal(y[-2 * len(edges) : -len(edges)], edges[:, 0])  # vertices
+    np.testing.assert_allclose(y[-len(edges) :], edges[:, 2], rtol=0, atol=1e-15)  # midpoints
+
+
+def test_quadratic_boundary_halfway_is_the_parameter_midpoint_of_the_piece():
+    edges = wavy_pieces()
+    curve = QuadraticBoundary(edges)
+    # an initial edge's own ends, in either order: exactly the given midpoint
+    np.testing.assert_array_equal(curve.halfway(edges[:, 0], edges[:, 1]), edges[:, 2])
+    np.testing.assert_array_equal(curve.halfway(edges[:, 1], edges[:, 0]), edges[:, 2])
+    # two points of one piece at parameters s, t: the piece at (s + t) / 2
+    rng = np.random.default_rng(3)
+    s, t = rng.random(len(edges)), rng.random(len(edges))
+    k = np.arange(len(edges))
+    p = piece_at(edges, s)[k, k]
+    q = piece_at(edges, t)[k, k]
+    mid = piece_at(edges, 0.5 * (s + t))[k, k]
+    err = np.abs(curve.halfway(p, q) - mid).max()
+    # a piece's start (also the previous piece's end) with a point inside the piece
+    start = curve.halfway(edges[:, 0], q)
+    err_start = np.abs(start - piece_at(edges, 0.5 * t)[k, k]).max()
+    print(f"halfway vs the parameter midpoint: {err:.1e}; from a shared vertex {err_start:.1e}")
+    assert err <= 1e-14 and err_start <= 1e-14
+
+
+def test_quadratic_boundary_normal_is_the_outward_unit_normal_of_the_pieces():
+    edges = wavy_pieces()
+    curve = QuadraticBoundary(edges)
+    t = np.linspace(0.05, 0.95, 7)
+    x = piece_at(edges, t).reshape(-1, 2)
+    n = curve.normal(x)
+    h = 1e-6
+    tangent = (piece_at(edges, t + h) - piece_at(edges, t - h)).reshape(-1, 2)
+    assert np.abs(np.hypot(*n.T) - 1).max() <= 1e-14
+    assert np.abs((n * tangent).sum(1)).max() <= 1e-9 * np.abs(tangent).max()
+    assert np.all((n * x).sum(1) > 0)  # out of the star-shaped domain the pieces bound
+    np.testing.assert_allclose(curve.tangent(x), tangent / np.hypot(*tangent.T)[:, None], atol=1e-8)
+
+
+def test_quadratic_boundary_normal_where_pieces_meet_is_the_mean_of_theirs():
+    # pieces through points of a circle at equal spacing: at a joint the two pieces' normals
+    # lean by ±θ³/32 (θ the angle per piece); their mean is the circle's normal
+    theta = np.pi / 16
+    phi = theta * np.arange(9)
+    v = 2.0 * np.column_stack([np.cos(phi), np.sin(phi)])
+    mid = 2.0 * np.column_stack([np.cos(phi[:-1] + theta / 2), np.sin(phi[:-1] + theta / 2)])
+    curve = QuadraticBoundary(np.stack([v[:-1], v[1:], mid], axis=1))
+    error = np.hypot(*(curve.normal(v) - v / 2.0).T)
+    print(f"normal error at the vertices {error}, theta^3 / 32 = {theta**3 / 32:.3e}")
+    assert error[1:-1].max() <= 1e-14  # joints
+    assert error[[0, -1]] == pytest.approx(theta**3 / 32, rel=0.02)  # the part's two ends
+
+
+@pytest.mark.parametrize(
+    ("edges", "message"),
+    [
+        (np.zeros((2, 2, 2)), r"finite \(k, 3, 2\) array .* got shape \(2, 2, 2\)"),
+        (np.zeros((0, 3, 2)), "k >= 1"),
+        ([[[0, 0], [1, 0], [np.nan, 0]]], "finite"),
+        ([[[1, 2], [1, 2], [1, 2]]], r"piece 0 starts and ends at \[1.0, 2.0\]"),
+        ([[[0, 0], [1, 0], [0.8, 0.1]]], r"piece 0 .* folds back on itself: .* at 0.8 of"),
+        ([[[0, 0], [1, 0], [0.5, 0]], [[1, 0], [2, 0], [1.2, 0]]], r"piece 1 .*\(1 such"),
+    ],
+)
+def test_quadratic_boundary_arguments_are_checked(edges, message):
+    with pytest.raises(MeshError, match=message):
+        QuadraticBoundary(edges)

@@ -2,7 +2,7 @@
 meshes read from files, and newest vertex bisection (the REFINE step)."""
 
 from .builders import half_disc, rectangle
-from .curves import Circle, Curve, Line, ProjectedCurve
+from .curves import Circle, Curve, Line, ProjectedCurve, QuadraticBoundary
 from .gmsh import read_mesh
 from .mesh import Mesh, MeshError
 from .refine import Refinement, refine_nvb, refine_uniform
@@ -12,6 +12,7 @@ __all__ = [
     "Curve",
     "Line",
     "ProjectedCurve",
+    "QuadraticBoundary",
     "Mesh",
     "MeshError",
     "Refinement",

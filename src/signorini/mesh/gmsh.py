@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .mesh import Mesh, MeshError
+from .curves import QuadraticBoundary
+from .mesh import Mesh, MeshError, _edge_keys
 
 __all__ = ["read_mesh"]
 
@@ -18,17 +19,36 @@ __all__ = ["read_mesh"]
 #: Relative spread of z (against the mesh's extent in x and y) below which z is constant.
 FLAT_TOL = 1e-10
 
+#: Distance of a second-order midpoint from its chord's midpoint, relative to the mesh's
+#: size (the larger of its diameter and its largest coordinate), below which it is straight.
+STRAIGHT_TOL = 1e-12
+
+#: Local node pairs of the edges of a ``triangle6`` (nodes 3, 4, 5 are their midpoints).
+_TRIANGLE6_EDGES = ((0, 1, 3), (1, 2, 4), (2, 0, 5))
+
 
 def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Mesh:
     """Read a triangular mesh with named boundary parts from a file (e.g. Gmsh ``.msh``).
 
-    Triangles (``triangle`` or ``triangle6``, whose vertices are used) make the cells; line
-    elements tagged with physical groups make the boundary parts, named after the groups
+    Triangles (``triangle`` or ``triangle6``) make the cells; line elements (``line`` or
+    ``line3``) tagged with physical groups make the boundary parts, named after the groups
     (``gmsh:physical`` / field data; a physical group without a name is called
     ``"part<tag>"``). Physical tag 0 is Gmsh's mark for an element in *no* physical group
     (written when all elements are saved): such lines name no part. The mesh must lie in a
     plane ``z = const``. Cells are oriented counter-clockwise (see
     :meth:`Mesh.from_arrays`) and each cell's longest edge becomes its refinement edge.
+
+    A second-order mesh (``triangle6`` / ``line3``) gives each edge a midpoint node. A boundary
+    part with a midpoint off its edge's chord (by more than :data:`STRAIGHT_TOL` times the
+    mesh's size) carries the file's piecewise-quadratic boundary,
+    :class:`~signorini.mesh.curves.QuadraticBoundary`: the P2 midpoint nodes of its edges
+    are the file's midpoints, refinement places new vertices on the quadratics, and the cells
+    along it are isoparametric (docs/method.md, *Curved boundaries*). A part whose midpoints
+    all lie on the chords carries no curve, so a straight second-order file reads as the
+    first-order one. :meth:`Mesh.with_curve` replaces the curve (e.g. by the exact circle).
+    Only boundary edges may be curved: interior edges with midpoints off their chords (e.g.
+    after Gmsh's high-order optimisation) are refused, since the P2 space puts interior
+    midpoint nodes on the chords.
 
     Parameters
     ----------
@@ -45,7 +65,10 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
         If the file cannot be read as a mesh, has no triangles (e.g. only line groups were
         saved: add a physical surface group or save all elements), is not flat in the
         xy-plane, has no boundary lines in a physical group (every boundary edge must be in
-        one), or lacks a requested part.
+        one), or lacks a requested part; or if a second-order midpoint is off the chord of
+        an interior edge, differs between two elements, folds its quadratic edge back on
+        itself, or turns a cell's quadratic map over at a vertex (its Jacobian determinant
+        there is not positive; the midpoint is too far off the edge for the cell).
     """
     import meshio
 
@@ -115,6 +138,102 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
             raise MeshError(f"{path} has no boundary group(s) {missing}; it has {sorted(groups)}")
         groups = {p: groups[p] for p in parts}
     try:
-        return Mesh.from_arrays(points, cells, {k: np.concatenate(v) for k, v in groups.items()})
+        mesh = Mesh.from_arrays(points, cells, {k: np.concatenate(v) for k, v in groups.items()})
+        return _with_quadratic_boundaries(mesh, _given_midpoints(m, renumber))
     except MeshError as exc:
         raise MeshError(f"{path}: {exc}") from None
+
+
+def _given_midpoints(m: object, renumber: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The vertex pairs ``(k, 2)`` (new numbering) and midpoints ``(k, 2)`` of every edge of
+    the ``triangle6`` and ``line3`` elements of the meshio mesh ``m`` (repeats included)."""
+    pairs, mids = [np.zeros((0, 2), dtype=np.int64)], [np.zeros((0, 2))]
+    for block in m.cells:
+        if block.type == "triangle6":
+            local = np.array(_TRIANGLE6_EDGES)
+        elif block.type == "line3":
+            local = np.array([[0, 1, 2]])
+        else:
+            continue
+        nodes = block.data[:, local].reshape(-1, 3)
+        pairs.append(renumber[nodes[:, :2]])
+        mids.append(np.asarray(m.points, dtype=np.float64)[nodes[:, 2], :2])
+    pairs, mids = np.concatenate(pairs), np.concatenate(mids)
+    keep = (pairs >= 0).all(1)  # lines whose ends no triangle uses name no part
+    return pairs[keep], mids[keep]
+
+
+def _with_quadratic_boundaries(mesh: Mesh, given: tuple[np.ndarray, np.ndarray]) -> Mesh:
+    """``mesh`` with a :class:`QuadraticBoundary` on each part whose given midpoints are off
+    the chords; the checks of :func:`read_mesh` on the midpoints."""
+    pairs, mids = given
+    if not len(pairs):
+        return mesh
+    edge_keys = _edge_keys(mesh.edges, mesh.n_points)  # sorted by construction
+    keys = _edge_keys(pairs, mesh.n_points)
+    pos = np.minimum(np.searchsorted(edge_keys, keys), mesh.n_edges - 1)
+    found = edge_keys[pos] == keys
+    edge, mids = pos[found], mids[found]
+    scale = max(float(np.hypot(*np.ptp(mesh.points, axis=0))), float(np.abs(mesh.points).max()))
+    tol = STRAIGHT_TOL * scale
+    mid = mesh.edge_midpoints.copy()
+    mid[edge] = mids
+    spread = np.hypot(*(mids - mid[edge]).T)  # two elements giving one edge two midpoints
+    if np.any(spread > tol):
+        e = int(edge[np.argmax(spread)])
+        raise MeshError(
+            f"edge {mesh.edges[e].tolist()} from {mesh.points[mesh.edges[e, 0]].tolist()} to "
+            f"{mesh.points[mesh.edges[e, 1]].tolist()} has two midpoints {np.max(spread):.3g} "
+            "apart in different elements"
+        )
+    offset = np.hypot(*(mid - mesh.edge_midpoints).T)
+    curved = offset > tol
+    inside = np.flatnonzero(curved & (mesh.edge2cell[:, 1] >= 0))
+    if inside.size:
+        e = int(inside[0])
+        raise MeshError(
+            f"{inside.size} interior edge(s) have their midpoint off the chord (first: edge "
+            f"{mesh.edges[e].tolist()} from {mesh.points[mesh.edges[e, 0]].tolist()} to "
+            f"{mesh.points[mesh.edges[e, 1]].tolist()}, midpoint {mid[e].tolist()}, "
+            f"{offset[e]:.3g} off): only boundary edges may be curved (save the mesh without "
+            "high-order optimisation)"
+        )
+    if not curved.any():
+        return mesh
+    curves = {}
+    for index, name in enumerate(mesh.part_names):  # a loop over parts, not edges
+        e = mesh.boundary_edge[mesh.boundary_part == index]
+        if not curved[e].any():
+            continue
+        ends = mesh.points[mesh.oriented_boundary(e)]  # counter-clockwise: normals outward
+        try:
+            curves[name] = QuadraticBoundary(np.concatenate([ends, mid[e][:, None]], axis=1))
+        except MeshError as exc:
+            raise MeshError(f"boundary part {name!r}: {exc}") from None
+    _check_vertex_jacobians(mesh, mid, curved)
+    for name, curve in curves.items():
+        mesh = mesh.with_curve(name, curve)
+    return mesh
+
+
+def _check_vertex_jacobians(mesh: Mesh, mid: np.ndarray, curved: np.ndarray) -> None:
+    """Raise if a cell with a curved edge has a non-positive Jacobian determinant of its
+    quadratic map at a vertex, where it is (up to a positive factor) the cross product of
+    the tangents of the cell's two edges leaving the vertex, ``X'(0) = 4 m - 3 a - b`` for
+    the edge from ``a`` to ``b`` with midpoint ``m`` (``mid (n_edges, 2)``, ``curved
+    (n_edges,)`` bool)."""
+    cells = np.flatnonzero(curved[mesh.cell2edge].any(1))
+    x = mesh.points[mesh.cells[cells]]  # (c, 3, 2)
+    m = mid[mesh.cell2edge[cells]]  # (c, 3, 2): local edge k joins vertices k and k + 1
+    forward = 4 * m - 3 * x - np.roll(x, -1, axis=1)  # along edge k, leaving vertex k
+    back = 4 * np.roll(m, 1, axis=1) - 3 * x - np.roll(x, 1, axis=1)  # along edge k - 1
+    det = forward[..., 0] * back[..., 1] - forward[..., 1] * back[..., 0]
+    bad = np.flatnonzero(~(det > 0).all(1))
+    if bad.size:
+        c = int(cells[bad[0]])
+        raise MeshError(
+            f"{bad.size} cell(s) turn over at a vertex of their quadratic map (first: cell "
+            f"{c}, vertices {mesh.points[mesh.cells[c]].tolist()}, edge midpoints "
+            f"{mid[mesh.cell2edge[c]].tolist()}): a midpoint is too far off its edge for the "
+            "cell"
+        )
