@@ -238,3 +238,53 @@ def corner_problem(angle: float = 0.0, shapes: bool = False) -> ContactProblem:
         {"left": Neumann(), "top": Dirichlet(push), "bottom": floor, "right": wall},
         body_force=lambda x: np.broadcast_to(force, x.shape),
     )
+
+
+@dataclass
+class FrictionSystem:
+    """A rotated contact system for the friction solver: ``K``, ``F``, Dirichlet data, and per
+    contact node its normal DOF ``2 z``, tangential DOF ``2 z + 1`` and gap."""
+
+    K: object
+    F: np.ndarray
+    dirichlet: np.ndarray
+    dirichlet_values: np.ndarray
+    normal: np.ndarray
+    tangent: np.ndarray
+    gap: np.ndarray
+    x: np.ndarray  # (m,) abscissae of the contact nodes
+
+
+def pressed_block(
+    nx: int, ny: int, push: float = 0.02, shift: float = 0.01, curvature: float = 0.04
+) -> FrictionSystem:
+    """The block ``(0, 2) × (0, 1)`` (E = 1, ν = 0.3) pushed down by ``push`` and sideways by
+    ``shift`` at its top onto the curved obstacle ``ψ(x) = curvature (x − 1)²`` below its
+    bottom: contact in the middle, open ends, and a tangential load that makes stick and slip
+    zones. Assembled by :func:`signorini.contact.system.assemble` (frames rotated)."""
+    from signorini.contact.system import assemble
+    from signorini.mesh.builders import rectangle
+
+    mesh = rectangle(0.0, 2.0, 0.0, 1.0, nx=nx, ny=ny)
+    problem = ContactProblem(
+        mesh=mesh,
+        material=Material.from_young(1.0, 0.3),
+        conditions={
+            "top": Dirichlet((shift, -push)),
+            "left": Neumann(),
+            "right": Neumann(),
+            "bottom": Contact(gap=lambda x: curvature * (x[:, 0] - 1.0) ** 2),
+        },
+    )
+    a = assemble(problem, mesh)
+    nodes = a.contact.nodes
+    return FrictionSystem(
+        a.K,
+        a.F,
+        a.dirichlet,
+        a.dirichlet_values,
+        2 * nodes,
+        2 * nodes + 1,
+        a.contact.gap,
+        a.space.node_points[nodes, 0],
+    )

@@ -362,10 +362,18 @@ def adaptive(
         At the call, for an argument of the wrong type or out of range (naming it):
         ``theta`` outside (0, 1], ``max_ndof`` not a positive number, ``tol`` negative or
         NaN, ``max_levels`` < 1, an unknown ``eta5`` or ``backend``, ``first_level`` not
-        in ``[0, max_levels)``, or an initial mesh with more than ``max_ndof`` unknowns.
+        in ``[0, max_levels)``, an initial mesh with more than ``max_ndof`` unknowns, or a
+        problem with friction (no estimator for it yet).
     """
     if not isinstance(problem, ContactProblem):
         raise ValueError(f"problem must be a ContactProblem, got {type(problem).__name__}")
+    frictional = [p for p in problem.contact_parts if problem.conditions[p].friction is not None]
+    if frictional:
+        raise ValueError(
+            f"problem: contact parts {frictional} have friction; solve() computes frictional "
+            "contact, but the adaptive loop needs its residual estimator, which is not "
+            "available yet for friction"
+        )
     args = check_loop_arguments(
         theta=theta,
         max_ndof=max_ndof,

@@ -1,24 +1,38 @@
 """Sparse linear algebra with no knowledge of meshes: symmetric elimination, SPD solvers and
-their backends, and the primal-dual active set method (PDAS) for bound constraints.
+their backends, the primal-dual active set method (PDAS) for bound constraints, and its
+semismooth Newton extension to Tresca and Coulomb friction.
 
-=================  ============================================================================
-``sparse``         CSR helpers: checks, row indices, upper triangle, diagonal positions
-``elimination``    symmetric elimination of fixed DOFs in place (pattern kept)
-``solvers``        the SPD solver interface (analysis once per pattern), its errors
-``superlu``        SuperLU backend (always available)
-``pardiso``        MKL PARDISO backend through ctypes, and how MKL is found
-``backends``       ``make_solver`` / ``available_backends``: the choice of backend
-``qp``             the bound-constrained QP's data, checked at the public entry
-``kkt``            KKT residuals of a point
-``active_system``  one active set's linear system: refactorization or Woodbury update
-``primal``         the primal active set fallback
-``result``         steps, result and failure of an active set solve
-``pdas``           ``solve_pdas``: the PDAS iteration
-=================  ============================================================================
+=====================  ==========================================================================
+``sparse``             CSR helpers: checks, row indices, upper triangle, diagonal positions
+``elimination``        symmetric elimination of fixed DOFs in place (pattern kept)
+``solvers``            the SPD solver interface (analysis once per pattern), its errors
+``superlu``            SuperLU backends (always available): SPD, and LU for non-symmetric
+``pardiso``            MKL PARDISO through ctypes (SPD, non-symmetric LU), how MKL is found
+``backends``           ``make_solver``, ``make_lu_solver``, ``available_backends``
+``qp``                 the bound-constrained QP's data, checked at the public entry
+``kkt``                KKT residuals of a point
+``active_system``      one active set's linear system: refactorization or Woodbury update
+``primal``             the primal active set fallback
+``result``             steps, result and failure of an active set solve
+``pdas``               ``solve_pdas``: the PDAS iteration
+``friction_kkt``       the frictional contact problem's data, checks and KKT residuals
+``friction_system``    one iteration's system: symmetric (Tresca) or non-symmetric (Coulomb)
+``friction_result``    node states, steps, result and failure of a frictional solve
+``friction``           ``solve_friction``: semismooth Newton for Tresca and Coulomb friction
+=====================  ==========================================================================
 """
 
-from .backends import BACKENDS, SolverFallbackWarning, available_backends, make_solver
+from .backends import (
+    BACKENDS,
+    SolverFallbackWarning,
+    available_backends,
+    make_lu_solver,
+    make_solver,
+)
 from .elimination import SymmetricEliminator, eliminate_symmetric
+from .friction import INACTIVE, SLIP, STICK, solve_friction
+from .friction_kkt import FrictionKKT
+from .friction_result import FrictionConvergenceError, FrictionResult, FrictionStep
 from .kkt import KKTResiduals, kkt_residuals
 from .pdas import solve_pdas
 from .result import PDASConvergenceError, PDASResult, PDASStep
@@ -28,6 +42,13 @@ __all__ = [
     "BACKENDS",
     "BackendUnavailableError",
     "FactorizationError",
+    "FrictionConvergenceError",
+    "FrictionKKT",
+    "FrictionResult",
+    "FrictionStep",
+    "INACTIVE",
+    "SLIP",
+    "STICK",
     "SingularSystemError",
     "KKTResiduals",
     "PDASConvergenceError",
@@ -39,6 +60,8 @@ __all__ = [
     "available_backends",
     "eliminate_symmetric",
     "kkt_residuals",
+    "make_lu_solver",
     "make_solver",
+    "solve_friction",
     "solve_pdas",
 ]

@@ -72,13 +72,17 @@ class ActiveSetSystem:
         self.factored: np.ndarray | None = None  # fixed mask of the current factorization
         self.n_updates = 0
 
-    def solve(self, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def solve(
+        self, active: np.ndarray, load: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Minimizer with ``x_c = g`` on ``active`` and the residual of the constrained rows.
 
         Parameters
         ----------
         active : (m,) bool array
             Constrained DOFs held at their bound.
+        load : (n,) float array, optional
+            A load to use instead of ``qp.F`` for this solve (same matrix).
 
         Returns
         -------
@@ -87,10 +91,11 @@ class ActiveSetSystem:
             ``F_c - (K x)_c`` on every constrained DOF (not masked by ``active``).
         """
         c = self.c
+        F = self.F if load is None else load
         self.fixed[c] = active
         self.values[c] = np.where(active, self.g, 0.0)
         t0 = time.perf_counter()
-        b = self.eliminator.rhs(self.K, self.F, self.fixed, self.values)
+        b = self.eliminator.rhs(self.K, F, self.fixed, self.values)
         self.time_elimination += time.perf_counter() - t0
         x = None
         if self.factored is not None and self.max_update > 0:
@@ -127,7 +132,7 @@ class ActiveSetSystem:
                     residual=residual,
                 )
         x[self.fixed] = self.values[self.fixed]
-        return x, self.F[c] - self.K_c @ x
+        return x, F[c] - self.K_c @ x
 
     def _columns(self, fixed: np.ndarray, cols: np.ndarray) -> sp.csc_matrix:
         """Columns ``cols`` of the matrix eliminated for ``fixed`` (symmetric: rows of K)."""

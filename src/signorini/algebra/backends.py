@@ -20,11 +20,17 @@ from functools import cache
 
 import scipy.sparse as sp
 
-from .pardiso import PardisoSolver, pardiso_problem
+from .pardiso import PardisoLUSolver, PardisoSolver, pardiso_problem
 from .solvers import BackendUnavailableError, SPDSolver
-from .superlu import SuperLUSolver
+from .superlu import SuperLULUSolver, SuperLUSolver
 
-__all__ = ["BACKENDS", "SolverFallbackWarning", "available_backends", "make_solver"]
+__all__ = [
+    "BACKENDS",
+    "SolverFallbackWarning",
+    "available_backends",
+    "make_lu_solver",
+    "make_solver",
+]
 
 #: Names accepted by :func:`make_solver` besides ``"auto"``.
 BACKENDS: tuple[str, ...] = ("pardiso", "scipy")
@@ -88,3 +94,40 @@ def make_solver(
             raise BackendUnavailableError(f"the pardiso backend is not usable here: {problem}")
         _warn_fallback(problem)
     return SuperLUSolver(A, **options)
+
+
+def make_lu_solver(backend: str = "auto", A: sp.spmatrix | None = None) -> SPDSolver:
+    """Create a sparse LU solver for general (non-symmetric) matrices, with the interface of
+    :class:`~.solvers.SPDSolver` (no symmetry check).
+
+    Parameters
+    ----------
+    backend : {"auto", "pardiso", "scipy"}
+        ``"pardiso"``: :class:`~.pardiso.PardisoLUSolver` (analysis reused per pattern);
+        ``"scipy"``: :class:`~.superlu.SuperLULUSolver`; ``"auto"`` as in
+        :func:`make_solver`.
+    A : scipy sparse matrix, shape (n, n), optional
+        Factorized right away if given.
+
+    Returns
+    -------
+    SPDSolver
+
+    Raises
+    ------
+    ValueError
+        For an unknown backend name.
+    BackendUnavailableError
+        If ``"pardiso"`` is asked for and cannot be used.
+    """
+    valid = ("auto", *BACKENDS)
+    if backend not in valid:
+        raise ValueError(f"unknown backend {backend!r}; valid backends are {', '.join(valid)}")
+    if backend != "scipy":
+        problem = pardiso_problem()
+        if problem is None:
+            return PardisoLUSolver(A)
+        if backend == "pardiso":
+            raise BackendUnavailableError(f"the pardiso backend is not usable here: {problem}")
+        _warn_fallback(problem)
+    return SuperLULUSolver(A)

@@ -35,7 +35,13 @@ import scipy.sparse as sp
 from .solvers import BackendUnavailableError, FactorizationError, SPDSolver
 from .sparse import upper_positions
 
-__all__ = ["PardisoSolver", "mkl_runtime_candidates", "pardiso_function", "pardiso_problem"]
+__all__ = [
+    "PardisoLUSolver",
+    "PardisoSolver",
+    "mkl_runtime_candidates",
+    "pardiso_function",
+    "pardiso_problem",
+]
 
 #: File names of MKL's single dynamic library on Linux, macOS and Windows.
 _MKL_RT = re.compile(r"(lib)?mkl_rt(\.\d+)*\.(so(\.\d+)*|dylib|dll)")
@@ -158,6 +164,7 @@ class PardisoSolver(SPDSolver):
 
     backend = "pardiso"
     reuses_analysis = True
+    _mtype = 2  # real symmetric positive definite
 
     def __init__(self, A: sp.spmatrix | None = None, *, check_symmetry: bool = True) -> None:
         self._func = pardiso_function()
@@ -196,7 +203,7 @@ class PardisoSolver(SPDSolver):
             self._pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)),
             ctypes.byref(i32(1)),
             ctypes.byref(i32(1)),
-            ctypes.byref(i32(2)),  # real symmetric positive definite
+            ctypes.byref(i32(self._mtype)),
             ctypes.byref(i32(phase)),
             ctypes.byref(i32(self._n_eq)),
             self._a.ctypes.data,
@@ -272,6 +279,49 @@ class PardisoSolver(SPDSolver):
             self._release()
         except Exception:  # never raise from a finalizer
             pass
+
+
+class PardisoLUSolver(PardisoSolver):
+    """LU factorization of a general (non-symmetric) real matrix on MKL PARDISO (``mtype = 11``).
+
+    The whole matrix is handed over in 0-based CSR form and PARDISO solves ``A x = b``; the
+    analysis (ordering on ``A + A^T``, symbolic factorization) is done once per pattern, as in
+    :class:`PardisoSolver`. Settings as there, plus PARDISO's defaults for non-symmetric
+    matrices: pivot perturbation 1e-13 (``iparm[9]``), scaling and weighted matching
+    (``iparm[10]``, ``iparm[12]``, computed from the values of the analysed matrix), and two
+    steps of iterative refinement (``iparm[7]``), which a perturbed pivot needs. The caller
+    checks the residual of every solve.
+
+    Parameters
+    ----------
+    A : scipy sparse matrix, optional
+        Factorized right away if given. Its symmetry is not checked.
+    matching : bool
+        Scaling and weighted matching (``iparm[10] = iparm[12] = 1``).
+    """
+
+    _mtype = 11  # real non-symmetric
+
+    def __init__(self, A: sp.spmatrix | None = None, *, matching: bool = True) -> None:
+        super().__init__(None, check_symmetry=False)
+        self._iparm[7] = 2
+        self._iparm[9] = 13
+        self._iparm[10] = int(matching)
+        self._iparm[12] = int(matching)
+        if A is not None:
+            self.factorize(A)
+
+    def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
+        self._release()
+        if A.nnz >= 2**31 - 1:
+            raise ValueError("the matrix has too many entries for 32-bit PARDISO")
+        self._upos = np.arange(A.nnz)
+        self._ia = A.indptr.astype(np.int32)
+        self._ja = A.indices.astype(np.int32)
+        self._a = A.data.copy()
+        self._n_eq = A.shape[0]
+        self._handle_used = True
+        self._call(11)
 
 
 @lru_cache(maxsize=1)

@@ -9,7 +9,7 @@ import scipy.sparse.linalg as spla
 from .solvers import FactorizationError, SPDSolver
 from .sparse import diagonal_positions
 
-__all__ = ["SuperLUSolver"]
+__all__ = ["SuperLULUSolver", "SuperLUSolver"]
 
 
 class SuperLUSolver(SPDSolver):
@@ -91,6 +91,49 @@ class SuperLUSolver(SPDSolver):
 
     def _solve(self, b: np.ndarray) -> np.ndarray:
         return self._lu.solve(b)
+
+    def close(self) -> None:
+        self._lu = None
+        super().close()
+
+
+class SuperLULUSolver(SPDSolver):
+    """LU factorization of a general (non-symmetric) sparse matrix on SuperLU.
+
+    SuperLU's defaults: COLAMD column ordering and threshold partial pivoting. The CSR arrays
+    of ``A`` read as CSC describe ``A^T``, which is factorized without a copy; a solve then
+    uses the transposed factors. No reuse of the symbolic analysis (as :class:`SuperLUSolver`);
+    the symmetry of ``A`` is not checked.
+
+    Parameters
+    ----------
+    A : scipy sparse matrix, optional
+    """
+
+    backend = "scipy"
+    reuses_analysis = False
+
+    def __init__(self, A: sp.spmatrix | None = None) -> None:
+        self._lu: spla.SuperLU | None = None
+        super().__init__(A, check_symmetry=False)
+
+    def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
+        pass
+
+    def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
+        self._lu = None
+        data = A.data if keep is None else A.data * keep
+        transposed = sp.csc_matrix((data, A.indices, A.indptr), shape=A.shape)
+        try:
+            self._lu = spla.splu(transposed)
+        except RuntimeError as err:
+            raise FactorizationError(
+                f"SuperLU could not factorize the matrix ({err}): it is singular",
+                backend=self.backend,
+            ) from err
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        return self._lu.solve(b, trans="T")
 
     def close(self) -> None:
         self._lu = None

@@ -31,6 +31,7 @@ from ..fem.space import P2Space
 from ..mesh.geometry import segment_normals
 from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
+from ..problem.friction import Coulomb, Tresca
 from ..problem.problem import ContactProblem
 
 __all__ = [
@@ -40,11 +41,15 @@ __all__ = [
     "SEMI_CONTACT",
     "FULL_CONTACT",
     "node_classes",
+    "FRICTIONLESS",
+    "TRESCA",
+    "COULOMB",
     "SAME_DIRECTION",
     "MIN_CORNER_ANGLE",
 ]
 
 NO_CONTACT, SEMI_CONTACT, FULL_CONTACT = 0, 1, 2
+FRICTIONLESS, TRESCA, COULOMB = 0, 1, 2
 #: two parts' constraint directions at a shared node closer than this (|n − m|) are one
 #: constraint; their gaps must then agree
 SAME_DIRECTION = 1e-8
@@ -103,6 +108,14 @@ class ContactSet:
     edge_local : (n_ce, 3) int array
         Row of the constraint of each contact edge's nodes (for the edge's part), ``-1`` at
         Dirichlet nodes.
+    friction_law : (k,) int array
+        ``FRICTIONLESS``, ``TRESCA`` or ``COULOMB`` per constraint; a corner's constraints
+        are frictionless (docs/method.md, *Friction*).
+    friction_bound : (k,) float array
+        Tresca: ``s_z = ∫ s ψ_z ds`` over the constraint's part(s) (force per unit
+        thickness); 0 elsewhere.
+    friction_coefficient : (k,) float array
+        Coulomb: the coefficient F of the constraint's part; 0 elsewhere.
     """
 
     nodes: np.ndarray
@@ -121,6 +134,9 @@ class ContactSet:
     edge_direction: np.ndarray
     edge_normal: np.ndarray
     edge_local: np.ndarray
+    friction_law: np.ndarray
+    friction_bound: np.ndarray
+    friction_coefficient: np.ndarray
 
     @property
     def size(self) -> int:
@@ -199,6 +215,9 @@ def _empty(parts: tuple[str, ...]) -> ContactSet:
         edge_direction=np.zeros((0, 3, 2)),
         edge_normal=np.zeros((0, 2)),
         edge_local=no_edges,
+        friction_law=no_int,
+        friction_bound=np.zeros(0),
+        friction_coefficient=np.zeros(0),
     )
 
 
@@ -278,6 +297,46 @@ def _edge_weights(space: P2Space, edges: np.ndarray, edge_nodes: np.ndarray):
         hat[curved] = (speed * wh) @ phi
         basis[curved] = (speed * wh) @ p2.edge_basis(halves)
     return hat, basis
+
+
+def _friction(
+    problem: ContactProblem,
+    space: P2Space,
+    edge_part: np.ndarray,
+    edge_nodes: np.ndarray,
+    edge_local: np.ndarray,
+    part: np.ndarray,
+    second: np.ndarray,
+) -> dict[str, np.ndarray]:
+    """Friction law, Tresca bound ``s_z = ∫ s ψ_z ds`` and Coulomb coefficient per
+    constraint; a corner node's constraints are frictionless."""
+    k = part.size
+    law = np.zeros(k, dtype=np.int64)
+    bound, coefficient = np.zeros(k), np.zeros(k)
+    corner = second | np.concatenate([second[1:], [False]])
+    parts = tuple(problem.contact_parts)
+    t, w = gauss_legendre(4)
+    for i, name in enumerate(parts):
+        friction = problem.conditions[name].friction
+        mine = (part == i) & ~corner
+        if isinstance(friction, Coulomb):
+            law[mine], coefficient[mine] = COULOMB, float(friction.coefficient)
+        elif isinstance(friction, Tresca):
+            law[mine] = TRESCA
+            sel = np.flatnonzero(edge_part == i)
+            points = space.node_points[edge_nodes[sel]]
+            x, speed, _ = iso.edge_geometry(points[:, :2], points[:, 2], t)
+            what = f"the Tresca bound of contact part {name!r}"
+            s = evaluate_field(friction.bound_field(), x.reshape(-1, 2), what, shape=())
+            if (s < 0).any():
+                raise ProblemError(f"{what} must be >= 0; it is {s.min():.6g} somewhere")
+            # ∫ s ψ_j |x'(t)| dt on each edge, j = start, end, midpoint
+            share = (s.reshape(-1, t.size) * speed * w) @ p2.edge_basis(t)
+            loc = edge_local[sel].ravel()
+            inside = loc >= 0
+            mine_bound = np.bincount(loc[inside], weights=share.ravel()[inside], minlength=k)
+            bound[mine] += mine_bound[mine]
+    return {"friction_law": law, "friction_bound": bound, "friction_coefficient": coefficient}
 
 
 def _rows(
@@ -387,6 +446,9 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
         edge_direction=direction,
         edge_normal=chord,
         edge_local=edge_local,
+        **_friction(
+            problem, space, edge_part, edge_nodes, edge_local, ukey[lead] % n_parts, second
+        ),
     )
 
 

@@ -14,6 +14,7 @@ from functools import cached_property
 import numpy as np
 
 from ..algebra.backends import make_solver
+from ..algebra.friction import INACTIVE, SLIP, STICK
 from ..algebra.pdas import solve_pdas
 from ..algebra.result import PDASResult
 from ..fem.norms import energy_error2, h1_seminorm_error2
@@ -22,10 +23,20 @@ from ..mesh.mesh import Mesh
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
+from .frictional import solve_frictional
 from .node_frames import to_cartesian
+from .profile import ContactProfile, contact_profile
 from .system import Assembled, assemble
 
-__all__ = ["ContactProfile", "ContactResult", "solve", "stiffness_unit"]
+__all__ = [
+    "ContactProfile",
+    "ContactResult",
+    "INACTIVE",
+    "SLIP",
+    "STICK",
+    "solve",
+    "stiffness_unit",
+]
 
 log = logging.getLogger(__name__)
 
@@ -65,57 +76,6 @@ def stiffness_unit(K) -> float:
     return float(np.ldexp(1.0, int(np.floor(np.log2(d)))))
 
 
-@dataclass(frozen=True)
-class ContactProfile:
-    """The nodes of one contact part in order along the boundary, with the contact quantities.
-
-    Consistent units: if E is in MPa and lengths in mm, ``s``, ``points``, ``gap``,
-    ``normal_displacement`` and ``normal_gap`` are in mm, ``pressure`` in MPa and
-    ``contact_force`` in N per mm of thickness.
-
-    Attributes
-    ----------
-    part : str
-        The contact part.
-    nodes : (m,) int array
-        Global P2 nodes (vertices and edge midpoints) of the part, in the order of the
-        counter-clockwise boundary.
-    chain : (m,) int array
-        Which connected piece of the part each node is on: 0, 1, … in the order of the pieces
-        along the part's direction (a part made of disjoint segments has several chains).
-    s : (m,) float array
-        Distance from the part's first node: ``s_0 = 0``, ``s_{i+1} = s_i + |x_{i+1} − x_i|``.
-        Within a chain this is the length of the polygon through the nodes (the arc length
-        on a straight part); from one chain to the next it jumps by the straight distance
-        between them.
-    points : (m, 2) float array
-        The nodes' coordinates.
-    pressure : (m,) float array
-        Consistent pressure ``p_z = Λ_z / w_z`` (docs/method.md, *Discrete problem*); NaN at
-        Dirichlet nodes (no contact unknown there).
-    contact_force : (m,) float array
-        Nodal contact force ``Λ_z`` (3.17); NaN at Dirichlet nodes. A node shared with another
-        contact part carries its whole ``Λ_z`` (and ``w_z`` counts both parts' edges).
-    gap : (m,) float array
-        The obstacle ψ(z).
-    normal_displacement : (m,) float array
-        ``u_h(z)·n_z``, n_z the part's constraint direction at the node.
-    normal_gap : (m,) float array
-        ``u_h(z)·n − ψ(z)``: 0 in contact, < 0 where the body is off the obstacle.
-    """
-
-    part: str
-    nodes: np.ndarray
-    chain: np.ndarray
-    s: np.ndarray
-    points: np.ndarray
-    pressure: np.ndarray
-    contact_force: np.ndarray
-    gap: np.ndarray
-    normal_displacement: np.ndarray
-    normal_gap: np.ndarray
-
-
 @dataclass
 class ContactResult:
     """The discrete solution of one mesh and everything derived from it.
@@ -140,14 +100,22 @@ class ContactResult:
     active : (k,) bool array
         Final active set of the PDAS iteration (``u(z)·n = ψ(z)`` imposed): the actual
         contact nodes.
-    pdas : PDASResult
+    pdas : PDASResult or FrictionResult
         How the active set solver got there: iterations, KKT residuals (relative), timings.
-        ``pdas.multiplier`` equals ``contact_force``; when E is extreme the system was
-        solved divided by ``stiffness_unit(K)``, so ``pdas.kkt.force_scale`` is in that unit.
+        A :class:`~signorini.algebra.PDASResult` without friction (``pdas.multiplier``
+        equals ``contact_force``), a :class:`~signorini.algebra.FrictionResult` with it
+        (KKT residuals of both laws). When E is extreme the system was solved divided by
+        ``stiffness_unit(K)``, so ``pdas.kkt.force_scale`` is in that unit.
     dirichlet_nodes : (n_D,) int array
         The P2 nodes on the closure of Γ_D (both components prescribed).
     timings : dict
         Seconds spent in ``assemble`` and ``solve``.
+    tangential_force : (k,) float array
+        Nodal friction forces Λ_t,z (along ``t = (−n_y, n_x)``; the obstacle acts on the body
+        with ``−Λ_t t``); 0 without friction.
+    state : (k,) int array
+        ``INACTIVE`` (no contact), ``STICK`` or ``SLIP`` per constraint; a frictionless
+        node in contact slips (its friction force, 0, is at its bound).
 
     Derived: ``ndof``, ``density`` s_z, ``pressure`` p_z, ``total_contact_force``,
     ``classes``, :meth:`contact_profile` (the contact quantities of a part in boundary
@@ -163,6 +131,14 @@ class ContactResult:
     pdas: PDASResult
     dirichlet_nodes: np.ndarray
     timings: dict = field(default_factory=dict)
+    tangential_force: np.ndarray | None = None
+    state: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.tangential_force is None:
+            self.tangential_force = np.zeros(self.contact.size)
+        if self.state is None:
+            self.state = np.where(self.active, SLIP, INACTIVE)
 
     @property
     def mesh(self) -> Mesh:
@@ -186,15 +162,22 @@ class ContactResult:
         return self.contact_force / self.contact.basis_integral
 
     @property
+    def tangential_pressure(self) -> np.ndarray:
+        """Consistent nodal friction stress ``p_t,z = Λ_t,z / w_z``."""
+        return self.tangential_force / self.contact.basis_integral
+
+    @property
     def total_contact_force(self) -> float:
         """``Σ_z Λ_z`` (the resultant normal force on Γ_C where all n_z agree)."""
         return float(self.contact_force.sum())
 
     @property
     def contact_force_vector(self) -> np.ndarray:
-        """``(2,)`` the resultant force of the obstacles on the body, ``−Σ_z Λ_z n_z``
-        (docs/method.md, *Contact directions*)."""
-        return -(self.contact_force @ self.contact.normal)
+        """``(2,)`` the resultant force of the obstacles on the body,
+        ``−Σ_z (Λ_z n_z + Λ_t,z t_z)`` (docs/method.md, *Contact directions*)."""
+        n = self.contact.normal
+        t = np.column_stack([-n[:, 1], n[:, 0]])
+        return -(self.contact_force @ n) - self.tangential_force @ t
 
     @cached_property
     def classes(self) -> np.ndarray:
@@ -207,65 +190,9 @@ class ContactResult:
         return node_classes(cs, self.active, edge_in)
 
     def contact_profile(self, part: str | None = None) -> ContactProfile:
-        """The contact quantities of one contact part, ordered along the boundary.
-
-        Parameters
-        ----------
-        part : str, optional
-            A contact part of the problem; may be omitted when there is only one.
-
-        Returns
-        -------
-        ContactProfile
-            Every P2 node of the part (Dirichlet end points included) in the order of the
-            counter-clockwise boundary, with arc length, p_z, Λ_z, ψ, u·n and u·n − ψ. A part
-            made of disjoint segments gives one ``chain`` per segment, in the order of the
-            segments along the part's direction.
-
-        Examples
-        --------
-        >>> prof = result.contact_profile("right")                    # doctest: +SKIP
-        >>> plt.plot(prof.s, prof.pressure)                           # doctest: +SKIP
-        """
-        cs = self.contact
-        if part is None:
-            if len(cs.parts) != 1:
-                raise ValueError(
-                    f"part: the problem has contact parts {list(cs.parts)}; name one of them"
-                )
-            part = cs.parts[0]
-        if part not in cs.parts:
-            raise ValueError(
-                f"part: {part!r} is not a contact part of {self.problem.name!r}; its contact "
-                f"parts are {list(cs.parts)}"
-            )
-        mine = np.flatnonzero(cs.edge_part == cs.parts.index(part))
-        order, chain_end, chain = _walk(cs.edge_nodes[mine], self.space.node_points)
-        edges = mine[order]
-        # per ordered edge: start, midpoint, and the end vertex where a chain ends
-        take = np.column_stack([np.ones(edges.size, bool), np.ones(edges.size, bool), chain_end])
-        column = np.broadcast_to(np.array([0, 2, 1]), take.shape)[take]
-        row = np.broadcast_to(edges[:, None], take.shape)[take]
-        nodes = cs.edge_nodes[row, column]
-        points = self.space.node_points[nodes]
-        step = np.sqrt((np.diff(points, axis=0) ** 2).sum(axis=1))
-        loc = cs.edge_local[row, column]
-        inside = loc >= 0
-        force = np.where(inside, self.contact_force[np.maximum(loc, 0)], np.nan)
-        gap = cs.edge_gap[row, column]
-        un = np.einsum("kc,kc->k", self.u[nodes], cs.edge_direction[row, column])
-        return ContactProfile(
-            part=part,
-            nodes=nodes,
-            chain=np.broadcast_to(chain[:, None], take.shape)[take],
-            s=np.concatenate([[0.0], np.cumsum(step)]),
-            points=points,
-            pressure=np.where(inside, force / cs.basis_integral[np.maximum(loc, 0)], np.nan),
-            contact_force=force,
-            gap=gap,
-            normal_displacement=un,
-            normal_gap=un - gap,
-        )
+        """The contact quantities of one contact part, ordered along the boundary
+        (:func:`signorini.contact.profile.contact_profile`)."""
+        return contact_profile(self, part)
 
     def errors(self, degree: int = ERROR_DEGREE) -> dict[str, float]:
         """Energy-norm ``a(e,e)^{1/2}`` and H¹-seminorm errors against the exact solution."""
@@ -284,44 +211,6 @@ class ContactResult:
         return {"error_energy": float(np.sqrt(energy.sum())), "error_h1": float(np.sqrt(h1.sum()))}
 
 
-def _walk(edge_nodes: np.ndarray, node_points: np.ndarray):
-    """Order the oriented edges ``[start, end, midpoint]`` of one straight contact part into
-    chains (each edge's end is the next edge's start), vectorized by pointer doubling.
-
-    Returns
-    -------
-    order : (k,) int array
-        The edges, chain after chain, each chain from its first edge.
-    chain_end : (k,) bool array
-        For the ordered edges: the last edge of its chain.
-    chain : (k,) int array
-        For the ordered edges: the chain number, chains ordered along the part's direction.
-    """
-    k = edge_nodes.shape[0]
-    start, end = edge_nodes[:, 0], edge_nodes[:, 1]
-    by_start = np.argsort(start, kind="stable")
-    pos = np.minimum(np.searchsorted(start[by_start], end), k - 1)
-    succ = np.where(start[by_start][pos] == end, by_start[pos], -1)
-    pred = np.full(k, -1)
-    pred[succ[succ >= 0]] = np.flatnonzero(succ >= 0)
-    # pointer doubling: every edge finds its chain's first edge and its distance to it
-    root = np.where(pred >= 0, pred, np.arange(k))
-    rank = (pred >= 0).astype(np.int64)  # distance to ``root``
-    for _ in range(int(np.ceil(np.log2(max(k, 2)))) + 1):
-        rank, root = rank + rank[root], root[root]
-    if np.any(pred[root] >= 0):  # a closed chain: impossible for a straight part
-        raise ValueError("the contact part is a closed curve; it has no first node")
-    # chains in the order of their first point along the (straight) part
-    first = np.flatnonzero(pred < 0)
-    direction = node_points[end[first[0]]] - node_points[start[first[0]]]
-    along = node_points[start[first]] @ direction
-    chain_of_root = np.empty(k, dtype=np.int64)
-    chain_of_root[first[np.argsort(along, kind="stable")]] = np.arange(first.size)
-    chain = chain_of_root[root]
-    order = np.lexsort((rank, chain))
-    return order, succ[order] < 0, chain[order]
-
-
 def solve(
     problem: ContactProblem,
     mesh: Mesh | None = None,
@@ -333,7 +222,8 @@ def solve(
     assembled: Assembled | None = None,
 ) -> ContactResult:
     """Solve the discrete Signorini problem (3.2) on ``mesh`` by the primal-dual active set
-    method (docs/method.md, *Solver*).
+    method (docs/method.md, *Solver*); with Tresca or Coulomb friction on a contact part, by
+    the semismooth Newton method of docs/method.md, *Friction*.
 
     Parameters
     ----------
@@ -370,6 +260,23 @@ def solve(
     unit = stiffness_unit(assembled.K)
     K, F = (assembled.K, assembled.F) if unit == 1.0 else (assembled.K / unit, assembled.F / unit)
     t0 = time.perf_counter()
+    if cs.friction_law.any():
+        fr = solve_frictional(assembled, K, F, u0=u0, backend=backend, max_iter=max_iter)
+        seconds = time.perf_counter() - t0
+        u = to_cartesian(fr.x, cs.frame_nodes, cs.frames).reshape(-1, 2)
+        return ContactResult(
+            problem=problem,
+            space=space,
+            u=u,
+            contact=cs,
+            contact_force=fr.normal_force * unit,
+            active=fr.state != INACTIVE,
+            pdas=fr.report,
+            dirichlet_nodes=assembled.dirichlet[::2] // 2,
+            timings={"assemble": assembled.seconds, "solve": seconds},
+            tangential_force=fr.tangential_force * unit,
+            state=fr.state,
+        )
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
     with make_solver(backend, check_symmetry=False) as solver:
         res = solve_pdas(

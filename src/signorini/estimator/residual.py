@@ -27,6 +27,11 @@ Each term is one function of :mod:`signorini.estimator.terms` (arrays in, integr
 term is a sum of cell or edge integrals; each cell receives its share (edge terms split
 equally between the edge's cells, ``terms.spread_edge_integrals``), so the element
 indicators sum exactly to η_h².
+
+On a mesh with curved parts the integrals of the isoparametric cells and their edges are
+replaced by those along the quadratic maps (:mod:`signorini.estimator.curved`), and η4, η5
+split the traction along the constraint direction field where n_z is not the edge's normal
+(docs/method.md, *Estimator*, "On curved boundaries").
 """
 
 from __future__ import annotations
@@ -36,7 +41,7 @@ from functools import partial
 
 import numpy as np
 
-from ..contact.contact_set import SEMI_CONTACT
+from ..contact.contact_set import SEMI_CONTACT, ContactSet
 from ..contact.solution import ContactResult
 from ..fem.material import stress
 from ..fem.p2 import REFERENCE_NODES, field_gradients, physical_points
@@ -45,11 +50,19 @@ from ..fem.quadrature import line_rule, triangle_rule
 from ..mesh.geometry import segment_normals
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
+from .curved import (
+    CurvedCells,
+    contact_integrals,
+    curved_cells,
+    edge_node_points,
+    neumann_integrals,
+)
 from .terms import (
     EdgeSet,
     TermShares,
     boundary_cell_shares,
     complementarity,
+    direction_field,
     edge_traction,
     interior_residual,
     neumann_residual,
@@ -175,9 +188,19 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     Returns
     -------
     Estimate
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``eta5``, or a result with friction.
     """
     if eta5 not in ETA5_VARIANTS:
         raise ValueError(f"eta5 must be one of {ETA5_VARIANTS}, got {eta5!r}")
+    if result.contact.friction_law.any():
+        raise ValueError(
+            "result: the residual estimator (5.1) assumes frictionless contact (σ_t = 0 on "
+            "Γ_C); its frictional extension is not available yet"
+        )
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells
     h_p = _node_mesh_size(mesh.h, space.cell_nodes, result.dirichlet_nodes, n_nodes)
@@ -190,43 +213,53 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     sigma = stress(problem.material, field_gradients(space.vertices, u_cell, REFERENCE_NODES[:3]))
     unit = stress_unit(float(np.abs(sigma).max(initial=0.0)))
     sigma = sigma / unit
+    # isoparametric cells: their integrals replace the affine ones below (None if there are
+    # none, and then nothing below differs from the straight estimator)
+    curved = curved_cells(result, unit, CELL_DEGREE)
     div_sigma = div_stress(space.vertices, u_cell, problem.material) / unit
-    f, w_cell = _body_force(problem, space.vertices)
+    f, w_cell = _body_force(problem, space.vertices, curved)
     if f is not None:
         f = f / unit
     traction = partial(edge_traction, sigma, mesh.points, mesh.cells)
     t, w = line_rule(EDGE_DEGREE)
     inner = _edge_set(mesh, np.flatnonzero(mesh.edge2cell[:, 1] >= 0))
-    jump = _from_both_sides(mesh, traction, inner.index, t)
+    both = traction if curved is None else partial(curved.mixed_traction, traction)
+    jump = _from_both_sides(mesh, both, inner.index, t)
     neumann = _edge_set(mesh, _part_edges(mesh, problem.neumann_parts))
     t_n, w_n = line_rule(NEUMANN_DEGREE)
     misfit = _traction_misfit(problem, mesh, traction, t_n, unit)
     contact = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
-    contact_traction = _on_boundary(mesh, traction, contact.index, t)
-    normal = cs.edge_normal
     pressure = _edge_pressure(result) / unit if eta5 == "consistent" else None
     gap = cs.edge_normal_gap(result.u)  # u_h·n − ψ_h at [start, end, midpoint]
+    density = _semi_contact_density(result) / unit
     x0, x1 = mesh.points[cs.edge_nodes[:, 0]], mesh.points[cs.edge_nodes[:, 1]]
+
+    R = interior_residual(mesh.area, div_sigma, f, w_cell)
+    J3 = neumann_residual(misfit, w_n, neumann.length)
+    contact_traction = _on_boundary(mesh, traction, contact.index, t)
+    J4, J5 = _contact_stress(cs, contact.length, contact_traction, t, w, pressure)
+    parts6 = complementarity(gap, density, contact.length)
+    if curved is not None:  # docs/method.md, *Estimator*, "On curved boundaries"
+        R[curved.cells] = curved.interior_residual(None if f is None else f[curved.cells])
+        rows, values = neumann_integrals(curved, problem, mesh, neumann, t_n, w_n)
+        J3[rows] = values
+        rows, values, values5 = contact_integrals(
+            curved, mesh, contact, t, w, pressure, cs.edge_direction
+        )
+        J4[rows], J5[rows] = values, values5
+        rows, points = edge_node_points(space, contact)
+        parts6[rows] = complementarity(gap[rows], density[rows], contact.length[rows], points)
 
     def on_edges(edges: EdgeSet, J: np.ndarray) -> TermShares:
         return spread_edge_integrals(edges, J, h_p, n_cells)
 
     shares = {
-        "eta_1": spread_cell_integrals(
-            interior_residual(mesh.area, div_sigma, f, w_cell), space.cell_nodes, h_p
-        ),
+        "eta_1": spread_cell_integrals(R, space.cell_nodes, h_p),
         "eta_2": on_edges(inner, stress_jump(*jump, w, inner.length)),
-        "eta_3": on_edges(neumann, neumann_residual(misfit, w_n, neumann.length)),
-        "eta_4": on_edges(contact, tangential_stress(contact_traction, normal, w, contact.length)),
-        "eta_5": on_edges(
-            contact, normal_stress(contact_traction, normal, t, w, contact.length, pressure)
-        ),
-        "eta_6": spread_node_parts(
-            contact,
-            complementarity(gap, _semi_contact_density(result) / unit, contact.length),
-            n_nodes,
-            n_cells,
-        ),
+        "eta_3": on_edges(neumann, J3),
+        "eta_4": on_edges(contact, J4),
+        "eta_5": on_edges(contact, J5),
+        "eta_6": spread_node_parts(contact, parts6, n_nodes, n_cells),
         "eta_7": TermShares(None, boundary_cell_shares(contact, penetration(x0, x1, gap), n_cells)),
     }
     return Estimate(
@@ -263,13 +296,16 @@ def _node_mesh_size(
     return h_p
 
 
-def _body_force(problem: ContactProblem, vertices: np.ndarray):
+def _body_force(problem: ContactProblem, vertices: np.ndarray, curved: CurvedCells | None):
     """``f (n_cells, q, 2)`` at the points of a degree-``CELL_DEGREE`` rule and its weights
-    ``(q,)``; ``(None, None)`` without a body force."""
+    ``(q,)``, at the points of the quadratic map on isoparametric cells (f is called once);
+    ``(None, None)`` without a body force."""
     if problem.body_force is None:
         return None, None
     xi, w = triangle_rule(CELL_DEGREE)
     x = physical_points(vertices, xi)
+    if curved is not None:
+        x[curved.cells] = curved.points()
     return evaluate_field(problem.body_force, x, "body_force"), w
 
 
@@ -321,6 +357,31 @@ def _traction_misfit(
             )
         out.append(sn)
     return np.concatenate(out) if out else np.zeros((0, t.size, 2))
+
+
+def _contact_stress(
+    cs: ContactSet,
+    length: np.ndarray,
+    traction: np.ndarray,
+    t: np.ndarray,
+    w: np.ndarray,
+    pressure: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """η4's and η5's integrals ``(n_ce,)`` on the contact edges of lengths ``length``, from
+    ``σ(u_h) n (n_ce, q, 2)`` at the points ``t``: split along the edge's normal where every
+    nodal constraint direction is that normal (the paper's case), else along the direction
+    field (:func:`~signorini.estimator.terms.direction_field`; docs/method.md, *Estimator*,
+    "On curved boundaries")."""
+    J4 = tangential_stress(traction, cs.edge_normal, w, length)
+    J5 = normal_stress(traction, cs.edge_normal, t, w, length, pressure)
+    varying = np.flatnonzero((cs.edge_direction != cs.edge_normal[:, None, :]).any(axis=(1, 2)))
+    if varying.size:
+        d = direction_field(cs.edge_direction[varying], t)
+        tr, ell = traction[varying], length[varying]
+        J4[varying] = tangential_stress(tr, d, w, ell)
+        p = None if pressure is None else pressure[varying]
+        J5[varying] = normal_stress(tr, d, t, w, ell, p)
+    return J4, J5
 
 
 def _edge_pressure(result: ContactResult) -> np.ndarray:

@@ -27,11 +27,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..fem.edge_trace import evaluate, monomial_coefficients, roots_in_unit_interval
 from ..fem.p2 import edge_basis
-from ..fem.quadrature import gauss_legendre
 from ..mesh.geometry import segment_normals
 from .h_half_norm import hhalf_norm2_positive_part
+from .thirds import third_integrals
 
 __all__ = [
     "EdgeSet",
@@ -44,6 +43,7 @@ __all__ = [
     "normal_stress",
     "complementarity",
     "penetration",
+    "direction_field",
     "boundary_cell_shares",
     "spread_cell_integrals",
     "spread_edge_integrals",
@@ -197,6 +197,27 @@ def edge_traction(
     return np.einsum("eqij,ej->eqi", sig, n)
 
 
+def direction_field(direction: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The constraint direction along contact edges: the normalised quadratic interpolant of
+    the nodal directions n_z ``(k, 3, 2)`` at ``[start, end, midpoint]``, at parameters
+    ``t (q,)``: ``(k, q, 2)`` unit vectors (docs/method.md, *Estimator*, "On curved
+    boundaries"). Where the interpolant vanishes (nodal directions opposed across one edge,
+    e.g. an edge spanning a slot of an obstacle) the midpoint node's direction is used."""
+    d = np.einsum("qa,kac->kqc", edge_basis(t), direction)
+    size = np.hypot(d[..., 0], d[..., 1])[..., None]
+    small = size <= 1e-8
+    if small.any():
+        d = np.where(small, direction[:, None, 2], d)
+        size = np.where(small, 1.0, size)
+    return d / size
+
+
+def _point_weights(w: np.ndarray, length: np.ndarray) -> np.ndarray:
+    """``(k, q)`` quadrature weights along edges: ``w`` times the edge length ``(k,)`` or
+    times ``|x'(t)|`` at each point ``(k, q)``."""
+    return w * (length[:, None] if np.ndim(length) == 1 else length)
+
+
 # --------------------------------------------------------------------------- the terms
 
 
@@ -248,7 +269,10 @@ def stress_jump(
 
 def neumann_residual(residual: np.ndarray, w: np.ndarray, length: np.ndarray) -> np.ndarray:
     """``‖σ(u_h) n − g‖²_e`` per Neumann edge (η3), from ``residual (k, q, 2)`` at the
-    points of the weights ``w (q,)``."""
+    points of the weights ``w (q,)``; ``length (k,)``, or ``|x'(t)|`` at each point ``(k, q)``
+    on a quadratic edge."""
+    if np.ndim(length) == 2:
+        return np.einsum("eq,eqi,eqi->e", _point_weights(w, length), residual, residual)
     return length * np.einsum("q,eqi,eqi->e", w, residual, residual)
 
 
@@ -262,10 +286,16 @@ def tangential_stress(
     traction : (k, q, 2) float array
         ``σ(u_h) n`` at the points of ``w``.
     normal : (k, 2) float array
-        The contact part's outward unit normal.
+        The contact part's outward unit normal, or ``(k, q, 2)`` the direction the traction
+        is split along at each point (:func:`direction_field`).
     w : (q,) float array
     length : (k,) float array
+        Edge lengths; ``|x'(t)|`` at each point ``(k, q)`` on a quadratic edge.
     """
+    if normal.ndim == 3:
+        snn = np.einsum("eqi,eqi->eq", traction, normal)
+        st = traction - snn[..., None] * normal
+        return np.einsum("eq,eqi,eqi->e", _point_weights(w, length), st, st)
     snn = np.einsum("eqi,ei->eq", traction, normal)
     st = traction - snn[..., None] * normal[:, None, :]
     return length * np.einsum("q,eqi,eqi->e", w, st, st)
@@ -286,20 +316,29 @@ def normal_stress(
     traction : (k, q, 2) float array
         ``σ(u_h) n`` at the points ``t``.
     normal : (k, 2) float array
+        Or ``(k, q, 2)``, the direction at each point (:func:`direction_field`).
     t, w : (q,) float arrays
         Quadrature points and weights on [0, 1], in the edge's counter-clockwise direction.
     length : (k,) float array
+        ``(k, q)``: ``|x'(t)|`` at each point of a quadratic edge.
     pressure : (k, 3) float array, optional
         The nodal pressures ``p_z`` at ``[start, end, midpoint]`` (0 at Dirichlet nodes);
         ``p_h`` is their quadratic interpolant. ``None`` for the ``paper`` variant.
     """
-    snn = np.einsum("eqi,ei->eq", traction, normal)
+    if normal.ndim == 3:
+        snn = np.einsum("eqi,eqi->eq", traction, normal)
+    else:
+        snn = np.einsum("eqi,ei->eq", traction, normal)
     if pressure is not None:
         snn = snn + pressure @ edge_basis(t).T
+    if normal.ndim == 3 or np.ndim(length) == 2:
+        return (_point_weights(w, length) * snn**2).sum(axis=1)
     return length * (w * snn**2).sum(axis=1)
 
 
-def complementarity(gap: np.ndarray, density: np.ndarray, length: np.ndarray) -> np.ndarray:
+def complementarity(
+    gap: np.ndarray, density: np.ndarray, length: np.ndarray, points: np.ndarray | None = None
+) -> np.ndarray:
     """``s_p d_p`` with ``d_p = ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p``, per contact edge node (η6).
 
     Parameters
@@ -309,13 +348,16 @@ def complementarity(gap: np.ndarray, density: np.ndarray, length: np.ndarray) ->
     density : (k, 3) float array
         ``s_p`` at the same nodes where p is a semi-contact node, else 0.
     length : (k,) float array
+    points : (k, 3, 2) float array, optional
+        Node points ``[start, end, midpoint]`` of quadratic edges: integrate along them
+        (:func:`third_integrals`).
 
     Returns
     -------
     (k, 3) float array
         Each node's part from this edge.
     """
-    return density * third_integrals(-gap, length)
+    return density * third_integrals(-gap, length, points)
 
 
 def penetration(x0: np.ndarray, x1: np.ndarray, gap: np.ndarray) -> np.ndarray:
@@ -341,50 +383,3 @@ def penetration(x0: np.ndarray, x1: np.ndarray, gap: np.ndarray) -> np.ndarray:
     origin = x0.min(axis=0) if len(x0) else np.zeros(2)
     _, share = hhalf_norm2_positive_part(x0 - origin, x1 - origin, gap, validate=False)
     return share
-
-
-# --------------------------------------------------------------------------- η6's integrals
-
-#: sub-intervals of [0, 1] where a half-edge hat φ of Q^h (3.6) is linear:
-#: ``(lo, hi, column, (φ(0), φ'))`` with column 0, 1, 2 = start, end, midpoint
-_HAT_PIECES = (
-    (0.0, 1 / 3, 0, (1.0, -2.0)),
-    (2 / 3, 1.0, 1, (-1.0, 2.0)),
-    (1 / 3, 0.5, 2, (0.0, 2.0)),
-    (0.5, 2 / 3, 2, (2.0, -2.0)),
-)
-
-
-def third_integrals(v: np.ndarray, length: np.ndarray) -> np.ndarray:
-    """∫ v⁺ φ_p over the thirds γ̃_p of each edge (docs/method.md, *Estimator*, paper (4.12)).
-
-    Exact: each linear piece of φ is cut at the roots of v, and on each sub-interval the
-    product of the quadratic and the linear hat is integrated by a 3-point Gauss rule
-    (degree 5 ≥ 3).
-
-    Parameters
-    ----------
-    v : (k, 3) float array
-        A quadratic on each edge, by its values at ``[start, end, midpoint]``.
-    length : (k,) float array
-
-    Returns
-    -------
-    (k, 3) float array
-        ``[∫_{start third} v⁺ φ_start, ∫_{end third} v⁺ φ_end, ∫_{middle third} v⁺ φ_mid]``
-        where φ are the half-edge hats of Q^h (3.6).
-    """
-    v = np.asarray(v, dtype=np.float64)
-    coef = monomial_coefficients(v)
-    roots = roots_in_unit_interval(coef)  # (k, 2), NaN where none
-    gt, gw = gauss_legendre(3)
-    out = np.zeros(v.shape)
-    for lo, hi, col, (p0, p1) in _HAT_PIECES:
-        r = np.where(np.isnan(roots), lo, np.clip(roots, lo, hi))
-        bounds = np.sort(np.column_stack([np.full(len(v), lo), r, np.full(len(v), hi)]), axis=1)
-        for j in range(3):
-            x0, x1 = bounds[:, j : j + 1], bounds[:, j + 1 : j + 2]
-            tq = x0 + (x1 - x0) * gt
-            vq = evaluate(coef, tq)
-            out[:, col] += (x1 - x0)[:, 0] * (gw * np.maximum(vq, 0.0) * (p0 + p1 * tq)).sum(axis=1)
-    return out * np.asarray(length)[:, None]

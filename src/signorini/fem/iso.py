@@ -32,6 +32,7 @@ __all__ = [
     "folded",
     "stiffness_blocks",
     "edge_geometry",
+    "field_derivatives",
     "gradient_errors",
     "l2_errors",
 ]
@@ -144,6 +145,62 @@ def edge_geometry(
     speed = np.hypot(dx[..., 0], dx[..., 1])
     normal = np.stack([dx[..., 1], -dx[..., 0]], axis=-1) / speed[..., None]
     return x, speed, normal
+
+
+def field_derivatives(
+    nodes: np.ndarray, u_cell: np.ndarray, xi: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Physical gradient and Hessian of a P2 field on the isoparametric cells at reference
+    points ``xi``, shared ``(q, 2)`` or per cell ``(m, q, 2)``.
+
+    With ``u_h(x(xi)) = u(xi) = sum_a u_a phi_a(xi)`` and the quadratic map ``x(xi)``, the chain
+    rule gives ``D u = grad u_h J`` and ``D^2 u = J^T (Hess u_h) J + sum_i (grad u_h)_i D^2 x_i``,
+    where ``D^2 x_i`` is constant (the map is quadratic), so
+    ``Hess u_h = J^{-T} (D^2 u - sum_i (grad u_h)_i D^2 x_i) J^{-1}``: exact, not an
+    approximation (docs/method.md, *Estimator*, "On curved boundaries").
+
+    Parameters
+    ----------
+    nodes : (m, 6, 2) float array
+        Node points of the cells.
+    u_cell : (m, 12) float array
+        Interleaved local coefficients.
+    xi : (q, 2) or (m, q, 2) float array
+
+    Returns
+    -------
+    grad : (m, q, 2, 2)
+        ``grad[c, p, i, j] = d u_i / d x_j``.
+    hess : (m, q, 2, 2, 2)
+        ``hess[c, p, i, j, k] = d^2 u_i / d x_j d x_k``.
+    """
+    nodes = np.asarray(nodes, dtype=np.float64)
+    u = np.asarray(u_cell, dtype=np.float64).reshape(-1, 6, 2)
+    xi = np.asarray(xi, dtype=np.float64)
+    if xi.ndim == 2:
+        dphi = np.broadcast_to(p2.grad_basis(xi), (len(nodes),) + (len(xi), 6, 2))
+    else:
+        dphi = p2.grad_basis(xi.reshape(-1, 2)).reshape(xi.shape[:2] + (6, 2))
+    m, q = dphi.shape[:2]
+    # d/dxi of the map and of the field: (m, q, 2, 6) @ (m, 1, 6, 2) -> (m, q, 2, 2)
+    dphi_t = np.swapaxes(dphi, -1, -2)
+    J = np.swapaxes(np.matmul(dphi_t, nodes[:, None]), -1, -2)
+    Du = np.swapaxes(np.matmul(dphi_t, u[:, None]), -1, -2)
+    det = J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
+    Jinv = np.empty_like(J)
+    Jinv[..., 0, 0] = J[..., 1, 1]
+    Jinv[..., 0, 1] = -J[..., 0, 1]
+    Jinv[..., 1, 0] = -J[..., 1, 0]
+    Jinv[..., 1, 1] = J[..., 0, 0]
+    Jinv /= det[..., None, None]
+    grad = np.matmul(Du, Jinv)
+    d2phi = p2.hessian_basis().reshape(6, 4)  # constant: (a, kl)
+    D2u = np.swapaxes(u, 1, 2) @ d2phi  # (m, 2, 4): [c, kl]
+    D2x = (np.swapaxes(nodes, 1, 2) @ d2phi)[:, None]  # (m, 1, 2, 4): [i, kl]
+    inner = (D2u[:, None] - np.matmul(grad, D2x)).reshape(m, q, 2, 2, 2)
+    Jinv = Jinv[:, :, None]
+    hess = np.matmul(np.matmul(np.swapaxes(Jinv, -1, -2), inner), Jinv)
+    return grad, hess
 
 
 def gradient_errors(

@@ -4,14 +4,17 @@ checked (``fields``)."""
 
 from .conditions import Contact, Dirichlet, ExactSolution, Neumann
 from .fields import ProblemError
+from .friction import Coulomb, Tresca
 from .problem import ContactProblem, SlenderBodyWarning
 
 __all__ = [
     "Contact",
     "ContactProblem",
+    "Coulomb",
     "Dirichlet",
     "ExactSolution",
     "Neumann",
     "ProblemError",
     "SlenderBodyWarning",
+    "Tresca",
 ]

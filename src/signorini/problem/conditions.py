@@ -36,6 +36,7 @@ from .fields import (
     check_numbers,
     constant_field,
 )
+from .friction import Coulomb, Friction, Tresca
 from .obstacles import Obstacle
 
 __all__ = ["Condition", "Contact", "Dirichlet", "ExactSolution", "Neumann"]
@@ -160,20 +161,30 @@ class Contact:
         :class:`~signorini.problem.obstacles.Disc`,
         :class:`~signorini.problem.obstacles.Polyline` or
         :class:`~signorini.problem.obstacles.SignedDistance`.
+    friction : Tresca, Coulomb or None
+        The friction law on the part (:mod:`signorini.problem.friction`); ``None`` for
+        frictionless contact.
 
     Raises
     ------
     ProblemError
         If ``gap`` is neither a finite number nor a function of one argument ``x``,
         ``normal`` is not ``None`` nor two finite numbers, not both zero, ``obstacle`` is not
-        an obstacle, or ``obstacle`` comes with a ``gap`` or a ``normal``.
+        an obstacle, ``obstacle`` comes with a ``gap`` or a ``normal``, or ``friction`` is not
+        a friction law.
     """
 
     gap: Callable[[np.ndarray], np.ndarray] | float = 0.0
     normal: tuple[float, float] | None = None
     obstacle: Obstacle | None = None
+    friction: Friction | None = None
 
     def __post_init__(self) -> None:
+        if self.friction is not None and not isinstance(self.friction, Tresca | Coulomb):
+            raise ProblemError(
+                "Contact(friction=...) must be None, Tresca(bound) or Coulomb(coefficient) "
+                f"from signorini.problem.friction, got {self.friction!r}"
+            )
         if callable(self.gap):
             check_function(self.gap, "Contact(gap=...)", _GAP)
         else:

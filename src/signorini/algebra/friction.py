@@ -1,0 +1,424 @@
+"""Frictional contact by a primal-dual active set (semismooth Newton) method, in node frames.
+
+The problem (:mod:`.friction_kkt`; docs/method.md, *Friction: the algebraic problem and its
+solver*): at each frictional contact node a normal DOF ``x_n ≤ g`` with the Signorini
+conditions, and a tangential DOF with Tresca's law (slip bound ``s``) or Coulomb's
+(``s = F Λ_n``, static one-step form), on the slip ``x_t − x_ref`` relative to a reference
+tangential displacement (the previous load step's in a quasi-static path). ``Λ = F − K x``
+on these rows are the nodal contact forces.
+
+The method of Hüeber, Stadler and Wohlmuth [1]_ in its 2D form: every node is
+:data:`~.friction_result.INACTIVE`, :data:`~.friction_result.STICK` or
+:data:`~.friction_result.SLIP` (with a slip direction σ = ±1); one iteration solves the
+linear system of these states (:mod:`.friction_system`) and updates them with the rule
+
+- in contact where ``Λ_n + c (x_n − g) > 0``;
+- among those, stick where ``|Λ_t + c (x_t − x_ref)| < s``, with ``s`` Tresca's bound or
+  ``F (Λ_n + c (x_n − g))`` (Coulomb), else slip with ``σ = sign(Λ_t + c (x_t − x_ref))``,
+
+the semismooth Newton step for the equations ``Λ_n = max(0, Λ_n + c (x_n − g))`` and
+``Λ_t = P_[−s, s](Λ_t + c (x_t − x_ref))``, of which in 2D the slip branch ``Λ_t = σ s`` is
+linear. It stops when the states repeat, and then checks the KKT residuals of both laws.
+The constant ``c`` is :data:`C_FACTOR` times the mean diagonal of ``K`` over the normal DOFs,
+not the diagonal itself as in :func:`~.pdas.solve_pdas`: it only decides whether a node
+slipping against its force sticks (small ``c``) or flips its direction (large ``c``), and
+flipping made the iteration cycle (docs/method.md, *Friction*).
+
+Tresca's bound acts by default only on nodes in contact (``Λ_n > 0``, where a Tresca bound
+models a known contact pressure); with ``tresca_everywhere=True`` it acts on every node, which
+is the classical Tresca problem: the minimisation of
+``1/2 x^T K x − F^T x + Σ s |x_t − x_ref|`` subject to ``x_n ≤ g``. Both have SPD systems;
+the contact-only law is discontinuous where ``Λ_n`` vanishes and can make the iteration
+cycle at the edge of the contact zone (docs/method.md, *Friction*).
+
+References
+----------
+.. [1] S. Hüeber, G. Stadler, B. I. Wohlmuth, A primal-dual active set algorithm for
+   three-dimensional contact problems with Coulomb friction, SIAM J. Sci. Comput. 30 (2008)
+   572-596.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from .backends import make_lu_solver, make_solver
+from .friction_kkt import FrictionProblem, check_friction, friction_kkt, slip_bound
+from .friction_result import (
+    INACTIVE,
+    SLIP,
+    STICK,
+    FrictionConvergenceError,
+    FrictionResult,
+    FrictionStep,
+)
+from .friction_system import CoulombSystem, TrescaSystem
+from .qp import check_vector
+from .solvers import SPDSolver
+
+__all__ = ["INACTIVE", "SLIP", "STICK", "solve_friction"]
+
+logger = logging.getLogger(__name__)
+
+#: The default constant ``c`` of the update rule, relative to the mean diagonal of ``K`` over
+#: the normal DOFs (docs/method.md, *Friction*). Measured on the pressed block of the tests
+#: (65-129 nodes, Tresca and Coulomb): 10⁻² to 10⁻⁸ give the same iterations; 1 cycles.
+C_FACTOR = 1e-6
+
+#: Relative band in which a node keeps its state (as ``_ACTIVE_RTOL`` in :mod:`.pdas`): where
+#: ``|Λ_n + c (x_n − g)|`` or ``| |Λ_t + c (x_t − x_ref)| − s |`` is at most this times
+#: ``max(max |F|, c max |x|)``, both states satisfy the laws to round-off.
+_STATE_RTOL = 1e-9
+
+States = tuple[np.ndarray, np.ndarray, np.ndarray]  # active, stick (m,) bool; direction (m,)
+
+
+def solve_friction(
+    K: sp.spmatrix,
+    F: np.ndarray,
+    normal: np.ndarray,
+    tangent: np.ndarray,
+    gap: np.ndarray | float,
+    dirichlet: np.ndarray | None = None,
+    dirichlet_values: np.ndarray | float | None = None,
+    *,
+    bound: np.ndarray | float | None = None,
+    coefficient: np.ndarray | float | None = None,
+    reference: np.ndarray | float | None = None,
+    tresca_everywhere: bool = False,
+    state0: np.ndarray | None = None,
+    direction0: np.ndarray | None = None,
+    x0: np.ndarray | None = None,
+    c: float | None = None,
+    max_iter: int = 50,
+    kkt_tol: float = 1e-8,
+    solver: SPDSolver | None = None,
+    backend: str = "auto",
+) -> FrictionResult:
+    """Solve the frictional contact problem (Tresca or Coulomb) by semismooth Newton.
+
+    Parameters
+    ----------
+    K : scipy sparse matrix, shape (n, n)
+        Symmetric, positive definite on the non-Dirichlet DOFs, with the contact nodes'
+        DOFs rotated into their (normal, tangential) frames.
+    F : (n,) float array
+        Load vector (force units).
+    normal, tangent : (m,) int arrays or (n,) bool masks
+        The normal and the tangential DOF of each frictional contact node (as masks, nodes in
+        increasing DOF order).
+    gap : float or (m,) float array
+        ``g``: the bound ``x_n ≤ g`` (length units).
+    dirichlet : (n_d,) int array or (n,) bool mask, optional
+    dirichlet_values : float, (n_d,) or (n,) float array, optional
+        Default 0.
+    bound : float or (m,) float array, optional
+        Tresca: the slip bound ``s ≥ 0`` of each node (force units, e.g. ``∫ s ψ_z ds``).
+    coefficient : float or (m,) float array, optional
+        Coulomb: the friction coefficient ``F ≥ 0``. Exactly one of ``bound`` and
+        ``coefficient`` is given.
+    reference : float or (m,) float array, optional
+        ``x_ref``: the tangential displacement of no slip (default 0; the previous load step's
+        in a quasi-static path, so that the law acts on the slip increment).
+    tresca_everywhere : bool
+        Tresca only: the bound acts on every node (the classical problem, a convex
+        minimisation), not only on the nodes in contact (the default).
+    state0, direction0 : (m,) int arrays, optional
+        Warm start: the states (:data:`INACTIVE`, :data:`STICK`, :data:`SLIP`) and slip
+        directions (±1 where slipping, else 0) of a previous result. ``direction0`` is
+        required where ``state0`` is SLIP with a positive bound or coefficient.
+    x0 : (n,) float array, optional
+        Warm start by the update rule at ``x0`` (ignored when ``state0`` is given). Default
+        (neither): every node INACTIVE.
+    c : float, optional
+        The positive constant of the update rule; default :data:`C_FACTOR` times the mean
+        diagonal of ``K`` over the normal DOFs (docs/method.md, *Friction*: with the mean
+        diagonal itself, as in :func:`~.pdas.solve_pdas`, the slip directions flip and the
+        iteration cycles).
+    max_iter : int
+        Bound on iterations (linear solves).
+    kkt_tol : float
+        Largest relative KKT residual (:class:`~.friction_kkt.FrictionKKT`) accepted when the
+        states repeat.
+    solver : SPDSolver, optional
+        A solver to use and keep: SPD for Tresca (:func:`~.backends.make_solver`), LU for
+        Coulomb (:func:`~.backends.make_lu_solver`). By default one is made with ``backend``.
+    backend : {"auto", "pardiso", "scipy"}
+
+    Returns
+    -------
+    FrictionResult
+
+    Raises
+    ------
+    ValueError
+        For malformed input, naming the argument.
+    FrictionConvergenceError
+        If the states cycle, ``max_iter`` is reached, or the KKT residuals exceed ``kkt_tol``
+        when the states repeat; it carries the history.
+    signorini.algebra.solvers.FactorizationError
+        If a system is singular.
+    """
+    t_start = time.perf_counter()
+    problem = check_friction(
+        K, F, normal, tangent, gap, dirichlet, dirichlet_values, bound, coefficient, reference,
+        tresca_everywhere,
+    )  # fmt: skip
+    _check_options(max_iter, kkt_tol, solver)
+    rule = _rule_constants(problem, c)
+    states = _initial_states(problem, rule, state0, direction0, x0)
+    tresca = problem.law == "tresca"
+    own_solver = solver is None
+    if own_solver:
+        solver = make_solver(backend) if tresca else make_lu_solver(backend)
+    before = _usage(solver)
+    try:
+        system = TrescaSystem(problem, solver) if tresca else CoulombSystem(problem, solver)
+        x, states, history = _iterate(system, states, rule, max_iter)
+    finally:
+        used = {key: value - before[key] for key, value in _usage(solver).items()}
+        backend_name = solver.backend
+        if own_solver:
+            solver.close()
+    active, stick, direction = states
+    kkt = friction_kkt(problem, x, active)
+    if not kkt.max <= kkt_tol:
+        message = f"the states repeat, but the KKT residual {kkt.max:.2e} exceeds {kkt_tol:.0e}"
+        direction = direction.astype(np.int8)
+        raise FrictionConvergenceError(message, history, "kkt", x, _state(*states), direction)
+    multiplier_n, multiplier_t = _multipliers(problem, x, states)
+    times = {key: used[key] for key in ("analysis", "factorization", "solve")}
+    times["assembly"] = system.time_assembly
+    times["total"] = time.perf_counter() - t_start
+    state = _state(active, stick, direction)
+    logger.info(
+        "%s friction: %d solves, stick %d, slip %d of %d nodes, KKT residual %.2e",
+        problem.law,
+        len(history),
+        int((state == STICK).sum()),
+        int((state == SLIP).sum()),
+        problem.m,
+        kkt.max,
+    )
+    return FrictionResult(
+        x=x,
+        multiplier_n=multiplier_n,
+        multiplier_t=multiplier_t,
+        state=state,
+        direction=direction.astype(np.int8),
+        iterations=len(history),
+        history=history,
+        kkt=kkt,
+        law=problem.law,
+        backend=backend_name,
+        symmetric=system.symmetric,
+        c_scale=rule[0],
+        n_factorizations=int(used["n_factorizations"]),
+        n_analyses=int(used["n_analyses"]),
+        times=times,
+    )
+
+
+# ----------------------------------------------------------------------------------------------
+# The steps of solve_friction
+# ----------------------------------------------------------------------------------------------
+
+
+def _check_options(max_iter: object, kkt_tol: object, solver: object) -> None:
+    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
+        raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
+    if not isinstance(kkt_tol, (int, float)) or not kkt_tol > 0:
+        raise ValueError(f"kkt_tol must be a positive number, got {kkt_tol!r}")
+    if solver is not None and not isinstance(solver, SPDSolver):
+        raise ValueError(f"solver must be an SPDSolver, got {type(solver).__name__}")
+
+
+def _rule_constants(problem: FrictionProblem, c: object) -> tuple[float, float]:
+    """``(c, d)``: the constant of the update rule (given and checked, or :data:`C_FACTOR`
+    ``d``) and the mean diagonal ``d`` of ``K`` over the normal DOFs (1 without nodes)."""
+    diagonal = problem.qp.K.diagonal()[problem.normal]
+    d = float(diagonal.mean()) if diagonal.size else 1.0
+    if c is None:
+        return C_FACTOR * d, d
+    try:
+        value = float(c)
+    except (TypeError, ValueError):
+        raise ValueError(f"c must be a positive number, got {c!r}") from None
+    if not np.isfinite(value) or value <= 0:
+        raise ValueError(f"c must be positive and finite, got {value}")
+    return value, d
+
+
+def _initial_states(
+    problem: FrictionProblem,
+    rule: tuple[float, float],
+    state0: object,
+    direction0: object,
+    x0: object,
+) -> States:
+    """The states of the first solve: decoded from ``state0``/``direction0`` (checked), the
+    update rule at ``x0``, or every node inactive."""
+    m = problem.m
+    none = np.zeros(m, dtype=bool), np.zeros(m, dtype=bool), np.zeros(m)
+    if state0 is None:
+        if x0 is None:  # no contact; with tresca_everywhere, stick where there is a bound
+            return none[0], (problem.weight > 0) & problem.everywhere, none[2]
+        x = check_vector(x0, problem.qp.n, "x0")
+        r = problem.qp.F - problem.qp.K @ x
+        return _update(problem, rule, x, r[problem.normal], r[problem.tangent], none)
+    state = np.asarray(state0)
+    if state.shape != (m,) or not np.isin(state, (INACTIVE, STICK, SLIP)).all():
+        raise ValueError(f"state0 must have shape ({m},) and hold INACTIVE, STICK or SLIP")
+    forced = problem.weight > 0
+    if direction0 is None:
+        if (forced & (state == SLIP)).any():
+            raise ValueError("direction0 is needed where state0 is SLIP")
+        direction = np.zeros(m)
+    else:
+        direction = np.asarray(direction0)
+        if direction.shape != (m,) or not np.isin(direction, (-1, 0, 1)).all():
+            raise ValueError(f"direction0 must have shape ({m},) and hold -1, 0 or 1")
+        direction = direction.astype(np.float64)
+    active = state != INACTIVE
+    stick = state == STICK
+    if problem.everywhere:  # out of contact: direction 0 means stuck (FrictionResult)
+        stick |= ~active & (direction == 0) & forced
+    return active, stick, np.where(stick, 0.0, direction)
+
+
+def _usage(solver: SPDSolver) -> dict[str, float]:
+    return {
+        "n_factorizations": solver.n_factorizations,
+        "n_analyses": solver.n_analyses,
+        "analysis": solver.time_analysis,
+        "factorization": solver.time_factorization,
+        "solve": solver.time_solve,
+    }
+
+
+def _iterate(
+    system: TrescaSystem | CoulombSystem, states: States, rule: tuple[float, float], max_iter: int
+) -> tuple[np.ndarray, States, list[FrictionStep]]:
+    """The active set loop from ``states``: the last iterate, its states and the history.
+
+    Raises
+    ------
+    FrictionConvergenceError
+        On cycling or at ``max_iter``.
+    """
+    p = system.problem
+    history: list[FrictionStep] = []
+    seen = {_key(states): 1}
+    previous = states
+    for it in range(1, max_iter + 1):
+        x = system.solve(*states)
+        history.append(_step(it, previous, states))
+        logger.debug("friction %s", history[-1])
+        lam_n, lam_t = _multipliers(p, x, states)
+        new = _update(p, rule, x, lam_n, lam_t, states)
+        key = _key(new)
+        if key == _key(states):
+            return x, states, history
+        if key in seen:
+            message = (
+                f"the frictional active set iteration cycles: the states computed in iteration "
+                f"{it} are the ones iteration {seen[key]} used"
+            )
+            raise FrictionConvergenceError(
+                message, history, "cycling", x, _state(*states), states[2].astype(np.int8)
+            )
+        seen[key] = it + 1
+        previous, states = states, new
+    message = f"the frictional active set iteration did not converge in max_iter = {max_iter}"
+    raise FrictionConvergenceError(
+        message, history, "max_iter", x, _state(*states), states[2].astype(np.int8)
+    )
+
+
+def _update(
+    p: FrictionProblem,
+    rule: tuple[float, float],
+    x: np.ndarray,
+    lam_n: np.ndarray,
+    lam_t: np.ndarray,
+    states: States,
+) -> States:
+    """The update rule (module docstring) with a round-off band.
+
+    A node keeps its state where the decision is round-off. Of the two terms of
+    ``Λ_n + c (x_n − g)`` and of ``Λ_t + c (x_t − x_ref)``, one is imposed exactly by the last
+    solve and the other is computed, so the band is that of the computed one:
+    :data:`_STATE_RTOL` ``max(max |F|, d max |x|)`` for a residual ``Λ`` (as in :mod:`.pdas`),
+    ``c`` :data:`_STATE_RTOL` ``max |x|`` for a displacement.
+
+    Parameters
+    ----------
+    p : FrictionProblem
+    rule : (c, d)
+        The constant of the rule and the mean diagonal of ``K`` over the normal DOFs.
+    x : (n,) float array
+        The last iterate.
+    lam_n, lam_t : (m,) float arrays
+        Its multipliers (``lam_n`` zero off contact, ``lam_t`` its imposed value off stick).
+    states : the states of the last solve
+
+    Returns
+    -------
+    active, stick : (m,) bool arrays
+    direction : (m,) float array
+        ±1 where slipping with a positive bound, 0 elsewhere.
+    """
+    active, stick, direction = states
+    c, d = rule
+    scale_x = np.abs(x).max(initial=0.0)
+    band_force = _STATE_RTOL * max(np.abs(p.qp.F).max(initial=0.0), d * scale_x)
+    band_disp = c * _STATE_RTOL * scale_x
+    value_n = lam_n + c * (x[p.normal] - p.gap)
+    band_n = np.where(active, band_force, band_disp)
+    new_active = np.where(np.abs(value_n) <= band_n, active, value_n > 0)
+    s = p.weight * np.maximum(value_n, 0.0) if p.law == "coulomb" else p.weight
+    acts = np.ones(p.m, dtype=bool) if p.everywhere else new_active
+    y = lam_t + c * (x[p.tangent] - p.reference)
+    margin = np.abs(y) - s
+    band_t = np.where(stick, band_force, band_disp)
+    new_stick = np.where(np.abs(margin) <= band_t, stick, margin < 0) & acts
+    slip = acts & ~new_stick & (p.weight > 0)
+    new_direction = np.where(slip, np.where(np.abs(y) > band_t, np.sign(y), direction), 0.0)
+    return new_active, new_stick, new_direction
+
+
+def _key(states: States) -> bytes:
+    active, stick, direction = states
+    return active.tobytes() + stick.tobytes() + direction.astype(np.int8).tobytes()
+
+
+def _state(active: np.ndarray, stick: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """INACTIVE / STICK / SLIP per node, (m,) int8."""
+    state = np.where(stick, STICK, SLIP).astype(np.int8)
+    state[~active] = INACTIVE
+    return state
+
+
+def _step(iteration: int, previous: States, states: States) -> FrictionStep:
+    state = _state(*states)
+    changed = (state != _state(*previous)) | (states[2] != previous[2])
+    return FrictionStep(
+        iteration=iteration,
+        n_inactive=int((state == INACTIVE).sum()),
+        n_stick=int((state == STICK).sum()),
+        n_slip=int((state == SLIP).sum()),
+        n_changed=int(changed.sum()),
+    )
+
+
+def _multipliers(p: FrictionProblem, x: np.ndarray, states: States) -> tuple[np.ndarray, ...]:
+    """``Λ_n`` (0 off contact) and ``Λ_t`` (its imposed value off stick), (m,) each."""
+    active, stick, direction = states
+    r = p.qp.F - p.qp.K @ x
+    multiplier_n = np.where(active, r[p.normal], 0.0)
+    imposed = direction * slip_bound(p, multiplier_n, active)
+    return multiplier_n, np.where(stick, r[p.tangent], imposed)

@@ -1,0 +1,139 @@
+"""What a frictional contact solve reports: node states, steps, result and failure."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .friction_kkt import FrictionKKT
+
+__all__ = [
+    "INACTIVE",
+    "SLIP",
+    "STICK",
+    "FrictionConvergenceError",
+    "FrictionResult",
+    "FrictionStep",
+]
+
+#: Node state: not in contact (``Λ_n = 0``).
+INACTIVE = 0
+#: Node state: in contact and sticking (``x_n = g``, ``x_t = x_ref``).
+STICK = 1
+#: Node state: in contact and slipping (``x_n = g``, ``|Λ_t| = s``).
+SLIP = 2
+
+
+@dataclass(frozen=True)
+class FrictionStep:
+    """One linear solve of the frictional active set iteration.
+
+    Attributes
+    ----------
+    iteration : int
+        1-based solve counter within the call.
+    n_inactive, n_stick, n_slip : int
+        Node counts of the states used for this solve.
+    n_changed : int
+        Nodes whose state or slip direction differs from the previous solve's.
+    """
+
+    iteration: int
+    n_inactive: int
+    n_stick: int
+    n_slip: int
+    n_changed: int
+
+    def __str__(self) -> str:
+        return (
+            f"{self.iteration:3d}: inactive {self.n_inactive}, stick {self.n_stick}, "
+            f"slip {self.n_slip}, changed {self.n_changed}"
+        )
+
+
+@dataclass
+class FrictionResult:
+    """Solution of :func:`~.friction.solve_friction` and how it was obtained.
+
+    Attributes
+    ----------
+    x : (n,) float array
+        The solution, in the frame of ``K`` (normal and tangential components at contact
+        nodes).
+    multiplier_n, multiplier_t : (m,) float arrays
+        The nodal contact forces ``Λ_n = F_n − (K x)_n`` (0 off contact) and
+        ``Λ_t = F_t − (K x)_t`` (its imposed value ``±s`` on slipping nodes, 0 where no
+        friction acts); force units. The obstacle acts on the body with ``−Λ``.
+    state : (m,) int8 array
+        :data:`INACTIVE`, :data:`STICK` or :data:`SLIP` per node.
+    direction : (m,) int8 array
+        ``sign Λ_t`` on nodes whose friction force is at a positive bound (slipping), 0
+        elsewhere. With ``tresca_everywhere`` a node out of contact also obeys the tangential
+        law: its state is INACTIVE, its direction 0 where it sticks and ±1 where it slips.
+    iterations : int
+        Linear solves.
+    history : list of FrictionStep
+    kkt : FrictionKKT
+        Relative residuals of both laws at ``x``.
+    law : {"tresca", "coulomb"}
+    backend : str
+        Linear solver backend.
+    symmetric : bool
+        Whether the systems were symmetric (Tresca: Cholesky) or not (Coulomb: LU).
+    c_scale : float
+        The constant ``c`` of the update rule.
+    n_factorizations, n_analyses : int
+        Work done by the linear solver during this call.
+    times : dict of str to float
+        Seconds: ``analysis``, ``factorization``, ``solve``, ``assembly`` (forming the
+        systems), ``total``.
+    """
+
+    x: np.ndarray
+    multiplier_n: np.ndarray
+    multiplier_t: np.ndarray
+    state: np.ndarray
+    direction: np.ndarray
+    iterations: int
+    history: list[FrictionStep]
+    kkt: FrictionKKT
+    law: str
+    backend: str
+    symmetric: bool
+    c_scale: float
+    n_factorizations: int = 0
+    n_analyses: int = 0
+    times: dict[str, float] = field(default_factory=dict)
+
+
+class FrictionConvergenceError(RuntimeError):
+    """The frictional active set iteration cycled, hit its bound, or stopped at a point whose
+    KKT residuals are too large.
+
+    Attributes
+    ----------
+    history : list of FrictionStep
+    reason : str
+        ``"cycling"``, ``"max_iter"`` or ``"kkt"``.
+    x, state, direction : numpy arrays
+        The last iterate and the states used for it.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        history: list[FrictionStep],
+        reason: str,
+        x: np.ndarray | None = None,
+        state: np.ndarray | None = None,
+        direction: np.ndarray | None = None,
+    ) -> None:
+        lines = "\n".join(str(step) for step in history[-20:])
+        skipped = f"\n  ({len(history) - 20} earlier steps not shown)" if len(history) > 20 else ""
+        super().__init__(f"{message}\niteration history:{skipped}\n{lines}")
+        self.history = history
+        self.reason = reason
+        self.x = x
+        self.state = state
+        self.direction = direction

@@ -1,0 +1,81 @@
+"""η6's integrals: ``∫_{γ̃_p} v⁺ φ_p ds`` over the thirds of contact edges (paper (4.12);
+docs/method.md, *Estimator*), on straight edges exactly and along quadratic edges with
+``|x'(t)|`` (docs/method.md, *Estimator*, "On curved boundaries")."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..fem.edge_trace import evaluate, monomial_coefficients, roots_in_unit_interval
+from ..fem.quadrature import gauss_legendre
+
+__all__ = ["CURVED_THIRD_POINTS", "third_integrals"]
+
+#: Gauss points per sub-interval of η6's integrals along a quadratic edge, where ``|x'(t)|``
+#: makes the integrand non-polynomial (it is nearly constant: 5 points, degree 9)
+CURVED_THIRD_POINTS = 5
+
+#: sub-intervals of [0, 1] where a half-edge hat φ of Q^h (3.6) is linear:
+#: ``(lo, hi, column, (φ(0), φ'))`` with column 0, 1, 2 = start, end, midpoint
+_HAT_PIECES = (
+    (0.0, 1 / 3, 0, (1.0, -2.0)),
+    (2 / 3, 1.0, 1, (-1.0, 2.0)),
+    (1 / 3, 0.5, 2, (0.0, 2.0)),
+    (0.5, 2 / 3, 2, (2.0, -2.0)),
+)
+
+
+def third_integrals(
+    v: np.ndarray, length: np.ndarray, points: np.ndarray | None = None
+) -> np.ndarray:
+    """∫ v⁺ φ_p over the thirds γ̃_p of each edge (docs/method.md, *Estimator*, paper (4.12)).
+
+    Exact on straight edges: each linear piece of φ is cut at the roots of v, and on each
+    sub-interval the product of the quadratic and the linear hat is integrated by a 3-point
+    Gauss rule (degree 5 ≥ 3). Along quadratic edges (``points`` given) the integrand also
+    carries ``|x'(t)|`` (the square root of a quadratic, not a polynomial) and
+    ``CURVED_THIRD_POINTS`` Gauss points are used on each sub-interval.
+
+    Parameters
+    ----------
+    v : (k, 3) float array
+        A quadratic on each edge, by its values at ``[start, end, midpoint]``.
+    length : (k,) float array
+        Edge lengths (not used with ``points``).
+    points : (k, 3, 2) float array, optional
+        Node points ``[start, end, midpoint]`` of quadratic edges ``x(t)``.
+
+    Returns
+    -------
+    (k, 3) float array
+        ``[∫_{start third} v⁺ φ_start, ∫_{end third} v⁺ φ_end, ∫_{middle third} v⁺ φ_mid]``
+        where φ are the half-edge hats of Q^h (3.6).
+    """
+    v = np.asarray(v, dtype=np.float64)
+    coef = monomial_coefficients(v)
+    roots = roots_in_unit_interval(coef)  # (k, 2), NaN where none
+    gt, gw = gauss_legendre(3 if points is None else CURVED_THIRD_POINTS)
+    out = np.zeros(v.shape)
+    for lo, hi, col, (p0, p1) in _HAT_PIECES:
+        r = np.where(np.isnan(roots), lo, np.clip(roots, lo, hi))
+        bounds = np.sort(np.column_stack([np.full(len(v), lo), r, np.full(len(v), hi)]), axis=1)
+        for j in range(3):
+            x0, x1 = bounds[:, j : j + 1], bounds[:, j + 1 : j + 2]
+            tq = x0 + (x1 - x0) * gt
+            vq = evaluate(coef, tq)
+            hat = p0 + p1 * tq
+            if points is not None:
+                hat = hat * _speed(points, tq)
+            out[:, col] += (x1 - x0)[:, 0] * (gw * np.maximum(vq, 0.0) * hat).sum(axis=1)
+    if points is not None:
+        return out
+    return out * np.asarray(length)[:, None]
+
+
+def _speed(points: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """``|x'(t)|`` ``(k, q)`` of the quadratic edges through ``points (k, 3, 2)`` ``[start,
+    end, midpoint]`` at per-edge parameters ``t (k, q)``."""
+    t = t[..., None]
+    dx = (4 * t - 3) * points[:, None, 0] + (4 * t - 1) * points[:, None, 1]
+    dx = dx + (4 - 8 * t) * points[:, None, 2]
+    return np.hypot(dx[..., 0], dx[..., 1])

@@ -1,0 +1,345 @@
+"""Frictional contact solver (signorini.algebra.friction) against independent computations.
+
+The systems are the rotated P2 systems of a block pressed onto a curved obstacle and pulled
+sideways (:func:`contact_problems.pressed_block`): contact in the middle, open ends, stick
+and slip zones.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+import scipy.linalg as sl
+import scipy.optimize as so
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from contact_problems import pressed_block
+from linalg_problems import block_spd
+
+from signorini.algebra import available_backends, make_lu_solver, make_solver, solve_pdas
+from signorini.algebra.friction import INACTIVE, SLIP, STICK, solve_friction
+from signorini.algebra.friction_result import FrictionConvergenceError
+
+
+@cache
+def block():
+    """16 x 8 squares, 1122 DOFs, 33 contact nodes."""
+    return pressed_block(16, 8, shift=0.01)
+
+
+def args(S):
+    return S.K, S.F, S.normal, S.tangent, S.gap, S.dirichlet, S.dirichlet_values
+
+
+@cache
+def frictionless():
+    S = block()
+    return solve_pdas(S.K, S.F, S.normal, S.gap, S.dirichlet, S.dirichlet_values)
+
+
+def rel(a, b):
+    return np.abs(a - b).max() / np.abs(b).max()
+
+
+# ----------------------------------------------------------------------------------------------
+# Tresca
+# ----------------------------------------------------------------------------------------------
+
+
+def tresca_by_duality(S, bound):
+    """The minimiser of ``1/2 x^T K x − F^T x + Σ s |x_t|`` subject to ``x_n ≤ g``, ``x_D``
+    fixed, through its dual: ``Λ`` minimises ``1/2 Λ^T S Λ − Λ^T h`` over ``Λ_n ≥ 0``,
+    ``|Λ_t| ≤ s`` with ``S = B K_ff⁻¹ B^T`` and ``h = B K_ff⁻¹ F_f − (g, 0)``, solved exactly
+    by bounded-variable least squares on the Cholesky factor of ``S``; then
+    ``x_f = K_ff⁻¹ (F_f − B^T Λ)``. A node with ``s = 0`` has no tangential multiplier.
+    Dense, and no part of the package is used. Returns ``x``, ``Λ_n``, ``Λ_t``."""
+    K = S.K.toarray()
+    n, m = K.shape[0], S.normal.size
+    bound = np.broadcast_to(bound, (m,))
+    rubs = bound > 0
+    d = S.dirichlet
+    free = np.setdiff1d(np.arange(n), d)
+    Kff = K[np.ix_(free, free)]
+    Ff = S.F[free] - K[np.ix_(free, d)] @ S.dirichlet_values
+    where = np.full(n, -1)
+    where[free] = np.arange(free.size)
+    rows = np.concatenate([S.normal, S.tangent[rubs]])
+    B = np.zeros((rows.size, free.size))
+    B[np.arange(rows.size), where[rows]] = 1.0
+    chol = sl.cho_factor(Kff)
+    L = np.linalg.cholesky(B @ sl.cho_solve(chol, B.T))
+    h = B @ sl.cho_solve(chol, Ff) - np.concatenate([S.gap, np.zeros(rubs.sum())])
+    lower = np.concatenate([np.zeros(m), -bound[rubs]])
+    upper = np.concatenate([np.full(m, np.inf), bound[rubs]])
+    fit = so.lsq_linear(
+        L.T, sl.solve_triangular(L, h, lower=True), bounds=(lower, upper), method="bvls", tol=1e-14
+    )
+    x = np.zeros(n)
+    x[d] = S.dirichlet_values
+    x[free] = sl.cho_solve(chol, Ff - B.T @ fit.x)
+    lam_t = np.zeros(m)
+    lam_t[rubs] = fit.x[m:]
+    return x, fit.x[:m], lam_t
+
+
+def energy(S, x, bound):
+    return 0.5 * x @ (S.K @ x) - S.F @ x + bound * np.abs(x[S.tangent]).sum()
+
+
+def test_classical_tresca_is_the_minimiser_computed_by_duality():
+    S = block()
+    bound = 0.1 * frictionless().multiplier.max()
+    r = solve_friction(*args(S), bound=bound, tresca_everywhere=True)
+    x_ref, lam_n, lam_t = tresca_by_duality(S, bound)
+    counts = np.bincount(r.state, minlength=3)
+    assert counts.min() >= 3, f"states INACTIVE, STICK, SLIP occur {counts} times"
+    assert ((r.state == INACTIVE) & (r.direction == 0)).sum() >= 3  # stuck out of contact too
+    err = rel(r.x, x_ref)
+    assert err < 1e-7, f"x differs from the minimiser by {err:.2e} (relative)"
+    assert rel(r.multiplier_n, lam_n) < 1e-7, rel(r.multiplier_n, lam_n)
+    assert rel(r.multiplier_t, lam_t) < 1e-7, rel(r.multiplier_t, lam_t)
+    # no feasible point does better: x is not beaten by the reference nor by perturbations
+    e = energy(S, r.x, bound)
+    assert e <= energy(S, x_ref, bound) + 1e-12 * abs(e), (e, energy(S, x_ref, bound))
+    rng = np.random.default_rng(0)
+    free = np.setdiff1d(np.arange(S.K.shape[0]), S.dirichlet)
+    for _ in range(5):
+        y = r.x.copy()
+        y[free] += 1e-4 * np.abs(r.x).max() * rng.standard_normal(free.size)
+        y[S.normal] = np.minimum(y[S.normal], S.gap)
+        assert energy(S, y, bound) > e
+    assert r.symmetric and r.kkt.max < 1e-10, r.kkt
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_classical_tresca_on_random_node_blocked_systems(seed):
+    """Random SPD matrices with 2 x 2 node blocks (not elasticity), random loads, gaps and
+    bounds on 8 of 30 nodes: the minimiser by duality."""
+    rng = np.random.default_rng(seed)
+    K = block_spd(6, 5, rng, shift=0.05)
+    n = K.shape[0]
+    nodes = rng.choice(n // 2, 8, replace=False)
+    S = SimpleNamespace(
+        K=K,
+        F=rng.standard_normal(n),
+        normal=2 * nodes,
+        tangent=2 * nodes + 1,
+        gap=0.3 * rng.standard_normal(8),
+        dirichlet=np.zeros(0, dtype=int),
+        dirichlet_values=np.zeros(0),
+    )
+    bound = rng.uniform(0.0, 1.0, 8)
+    r = solve_friction(*args(S), bound=bound, tresca_everywhere=True)
+    x, _, lam_t = tresca_by_duality(S, bound)
+    assert rel(r.x, x) < 1e-10, rel(r.x, x)
+    assert np.abs(r.multiplier_t - lam_t).max() < 1e-10 * np.abs(S.F).max()
+
+
+def test_tresca_in_contact_only_is_classical_tresca_with_the_bound_cut_to_the_contact_set():
+    S = block()
+    bound = 0.2 * frictionless().multiplier.max()
+    r = solve_friction(*args(S), bound=bound)
+    in_contact = r.state != INACTIVE
+    assert not np.any(r.multiplier_t[~in_contact]), "friction force out of contact"
+    counts = np.bincount(r.state, minlength=3)
+    assert counts.min() >= 3, counts
+    x_ref, _, _ = tresca_by_duality(S, bound * in_contact)
+    assert rel(r.x, x_ref) < 1e-7, rel(r.x, x_ref)
+
+
+@pytest.mark.parametrize("law", ["bound", "coefficient"])
+def test_zero_friction_reproduces_the_frictionless_solver(law):
+    S = block()
+    ref = frictionless()
+    r = solve_friction(*args(S), **{law: 0.0})
+    assert np.array_equal(r.state != INACTIVE, ref.active)
+    assert rel(r.x, ref.x) < 1e-13, rel(r.x, ref.x)
+    assert rel(r.multiplier_n, ref.multiplier) < 1e-12, rel(r.multiplier_n, ref.multiplier)
+    assert not np.any(r.multiplier_t) and not np.any(r.state == STICK)
+    assert r.iterations == ref.iterations, (r.iterations, ref.iterations)
+
+
+def test_a_very_large_bound_sticks_every_contact_node():
+    S = block()
+    r = solve_friction(*args(S), bound=1e6)
+    active = r.state != INACTIVE
+    assert np.array_equal(r.state[active], np.full(active.sum(), STICK))
+    assert active.sum() > 10
+    # the linear solve with both DOFs of the contact nodes held, independently
+    n = S.K.shape[0]
+    held = np.concatenate([S.dirichlet, S.normal[active], S.tangent[active]])
+    values = np.concatenate([S.dirichlet_values, S.gap[active], np.zeros(active.sum())])
+    free = np.setdiff1d(np.arange(n), held)
+    x = np.zeros(n)
+    x[held] = values
+    K = S.K.tocsc()
+    x[free] = spla.spsolve(K[free][:, free], S.F[free] - K[free][:, held] @ values)
+    assert rel(r.x, x) < 1e-10, rel(r.x, x)
+    lam_n = (S.F - S.K @ x)[S.normal]
+    assert lam_n[active].min() > 0 and (x[S.normal] - S.gap)[~active].max() < 0
+    assert np.abs(r.multiplier_t).max() < 1e6
+
+
+# ----------------------------------------------------------------------------------------------
+# Coulomb
+# ----------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("coefficient", [0.2, 0.5])
+def test_coulomb_meets_both_laws_and_is_a_fixed_point_of_tresca(coefficient):
+    S = block()
+    r = solve_friction(*args(S), coefficient=coefficient)
+    assert not r.symmetric
+    assert r.kkt.max <= 1e-10, r.kkt
+    counts = np.bincount(r.state, minlength=3)
+    assert counts.min() >= 3, f"states INACTIVE, STICK, SLIP occur {counts} times"
+    # the laws, node by node, from x alone
+    lam = S.F - S.K @ r.x
+    lam_n, lam_t, slide = lam[S.normal], lam[S.tangent], r.x[S.tangent]
+    scale, disp = lam_n.max(), np.abs(r.x).max()
+    stick, slip = r.state == STICK, r.state == SLIP
+    assert np.abs(slide[stick]).max() < 1e-12 * disp
+    assert np.all(np.abs(lam_t[stick]) <= coefficient * lam_n[stick] + 1e-12 * scale)
+    assert np.abs(np.abs(lam_t[slip]) - coefficient * lam_n[slip]).max() < 1e-12 * scale
+    assert np.all(lam_t[slip] * slide[slip] > 0), "slip along the friction force"
+    # Tresca with the bound F Λ_n has the same solution
+    t = solve_friction(*args(S), bound=coefficient * r.multiplier_n)
+    assert rel(t.x, r.x) < 1e-9, rel(t.x, r.x)
+    assert np.array_equal(t.state, r.state)
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO is not installed")
+def test_coulomb_superlu_and_pardiso_agree():
+    S = block()
+    a = solve_friction(*args(S), coefficient=0.5, backend="scipy")
+    b = solve_friction(*args(S), coefficient=0.5, backend="pardiso")
+    assert (a.backend, b.backend) == ("scipy", "pardiso")
+    assert rel(a.x, b.x) < 1e-11, rel(a.x, b.x)
+    assert b.n_analyses == 1 and b.n_factorizations == b.iterations
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_a_kept_solver_analyses_the_pattern_once_across_calls(backend):
+    S = block()
+    with make_lu_solver(backend) as solver:
+        first = solve_friction(*args(S), coefficient=0.5, solver=solver)
+        second = solve_friction(*args(S), coefficient=0.2, solver=solver)
+    assert (first.n_analyses, second.n_analyses) == (1, 0)
+    assert second.n_factorizations == second.iterations
+    with make_solver(backend) as solver:
+        first = solve_friction(*args(S), bound=1e-3, solver=solver)
+        second = solve_friction(*args(S), bound=2e-3, solver=solver)
+    assert (first.n_analyses, second.n_analyses) == (1, 0)
+
+
+def test_a_load_step_from_its_own_solution_does_not_slip():
+    """With ``x_ref`` the converged tangential displacement and the same load, the law acts on
+    a zero slip increment: the same solution, and every contact node sticks or is at its
+    bound without moving."""
+    S = block()
+    r = solve_friction(*args(S), coefficient=0.5)
+    again = solve_friction(*args(S), coefficient=0.5, reference=r.x[S.tangent])
+    assert rel(again.x, r.x) < 1e-10, rel(again.x, r.x)
+    assert again.kkt.max < 1e-10
+    shifted = solve_friction(*args(S), coefficient=0.5, reference=r.x[S.tangent] + 1e-3)
+    assert rel(shifted.x, r.x) > 1e-3  # the reference is used
+
+
+# ----------------------------------------------------------------------------------------------
+# warm start, failure, input
+# ----------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "law",
+    [
+        {"bound": 0.05, "tresca_everywhere": True},
+        {"bound": 0.05},
+        {"coefficient": 0.5},
+    ],
+)
+def test_warm_start_from_the_converged_states_takes_one_solve(law):
+    S = block()
+    law = dict(law)
+    if "bound" in law:
+        law["bound"] *= frictionless().multiplier.max() * 2
+    r = solve_friction(*args(S), **law)
+    assert r.iterations > 2
+    again = solve_friction(*args(S), **law, state0=r.state, direction0=r.direction)
+    assert again.iterations == 1, again.history
+    assert rel(again.x, r.x) < 1e-13
+    from_x = solve_friction(*args(S), **law, x0=r.x)
+    assert from_x.iterations <= 2, from_x.history
+
+
+def test_non_convergence_raises_with_the_history():
+    S = block()
+    with pytest.raises(FrictionConvergenceError, match="max_iter = 2") as err:
+        solve_friction(*args(S), coefficient=0.5, max_iter=2)
+    assert err.value.reason == "max_iter" and len(err.value.history) == 2
+    assert "iteration history" in str(err.value)
+    with pytest.raises(FrictionConvergenceError, match="KKT residual") as err:
+        solve_friction(*args(S), coefficient=0.5, kkt_tol=1e-30)
+    assert err.value.reason == "kkt" and err.value.x.shape == S.F.shape
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        ({"coefficient": -0.1}, "coefficient must be non-negative"),
+        ({"bound": np.nan}, "bound has non-finite"),
+        ({"bound": -1.0}, "bound must be non-negative"),
+        ({"bound": np.ones(3)}, r"bound must have shape \(33,\)"),
+        ({"gap": np.zeros(5), "bound": 1.0}, r"gap must have shape \(33,\)"),
+        ({"tangent": "normal", "bound": 1.0}, "normal and tangent share 33 DOFs"),
+        ({"tangent": "dirichlet", "bound": 1.0}, "tangent must name one DOF per"),
+        ({"tangent": "first dirichlet", "bound": 1.0}, "tangent and dirichlet share 1 DOFs"),
+        ({}, "exactly one of bound"),
+        ({"bound": 1.0, "coefficient": 0.1}, "exactly one of bound"),
+        ({"coefficient": 0.1, "tresca_everywhere": True}, "Tresca law only"),
+        ({"bound": 1.0, "state0": np.full(33, 3)}, "state0 must have shape"),
+        ({"bound": 1.0, "state0": np.full(33, SLIP)}, "direction0 is needed"),
+        ({"bound": 1.0, "max_iter": 0}, "max_iter must be a positive integer"),
+        ({"bound": 1.0, "c": -1.0}, "c must be positive"),
+        ({"bound": 1.0, "reference": np.inf}, "reference has non-finite"),
+    ],
+)
+def test_bad_input_is_named(change, message):
+    S = block()
+    kwargs = dict(
+        zip(
+            ["K", "F", "normal", "tangent", "gap", "dirichlet", "dirichlet_values"],
+            args(S),
+            strict=True,
+        )
+    )
+    change = dict(change)
+    if change.get("tangent") == "normal":
+        change["tangent"] = S.normal
+    elif change.get("tangent") == "dirichlet":
+        change["tangent"] = S.dirichlet
+    elif change.get("tangent") == "first dirichlet":
+        change["tangent"] = np.concatenate([S.tangent[:-1], S.dirichlet[:1]])
+    kwargs.update(change)
+    with pytest.raises(ValueError, match=message):
+        solve_friction(**kwargs)
+
+
+def test_the_coulomb_matrix_keeps_the_pattern_of_a_non_blocked_k():
+    """A K whose normal and tangential rows have different columns: the tangential rows are
+    widened, and the result still meets both laws."""
+    S = block()
+    coo = S.K.tocoo()
+    row, col = S.normal[5], S.normal[5] + 40  # an explicit zero in the normal row only
+    assert S.K[row, col] == 0 and S.K[row + 1, col] == 0
+    K = sp.csr_matrix(
+        (np.append(coo.data, 0.0), (np.append(coo.row, row), np.append(coo.col, col))),
+        shape=S.K.shape,
+    )
+    assert K.nnz == S.K.nnz + 1
+    r = solve_friction(K, *args(S)[1:], coefficient=0.5)
+    ref = solve_friction(*args(S), coefficient=0.5)
+    assert rel(r.x, ref.x) < 1e-12

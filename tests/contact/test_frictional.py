@@ -1,0 +1,179 @@
+"""Frictional contact through ``solve`` (signorini.contact.frictional): Tresca against an
+independent solve of its convex minimisation, Coulomb's laws node by node, zero friction
+against the frictionless solve, rotation invariance, and what is refused.
+
+The reference for Tresca works in Cartesian DOFs: with the constraint rows ``B_n u ≤ ψ`` and
+the friction rows ``B_t u`` (n_z and t_z at the node's two DOFs), the minimiser of
+``½ uᵀKu − fᵀu + Σ s_z |t_z·u_z|`` subject to ``B_n u ≤ ψ`` is ``u = K⁻¹(f − B_nᵀλ_n −
+B_tᵀλ_t)`` with the dual ``min ½ λᵀ B K⁻¹ Bᵀ λ − λᵀ(B K⁻¹ f − [ψ; 0])`` over the box
+``λ_n ≥ 0, |λ_t| ≤ s``, solved by bounded-variable least squares: no node frames, no
+semismooth Newton.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg as la
+from contact_problems import corner_problem
+from scipy.optimize import lsq_linear
+
+from signorini.contact.contact_set import contact_set
+from signorini.contact.solution import INACTIVE, SLIP, STICK, solve
+from signorini.estimator.residual import estimate
+from signorini.fem.material import Material
+from signorini.fem.space import P2Space
+from signorini.fem.stiffness import assemble_stiffness
+from signorini.loop import adaptive
+from signorini.mesh.builders import rectangle
+from signorini.mesh.mesh import Mesh
+from signorini.problem import Contact, ContactProblem, Coulomb, Dirichlet, Neumann, Tresca
+from signorini.problem.fields import ProblemError
+from signorini.problem.obstacles import Disc
+
+MATERIAL = Material.from_young(1.0, 0.3)
+
+
+def pressed_block(friction, angle: float = 0.0, nx: int = 8) -> ContactProblem:
+    """The block (0, 2) × (0, 1) (rotated by ``angle``) pushed down and sideways by its top
+    onto a rigid cylinder below its bottom: contact in the middle, stick and slip zones."""
+    c, s = np.cos(angle), np.sin(angle)
+    R = np.array([[c, -s], [s, c]])
+    base = rectangle(0.0, 2.0, 0.0, 1.0, nx=nx, ny=nx // 2)
+
+    def on(coord, value):
+        return lambda x: np.abs((x @ R)[:, coord] - value) < 1e-12
+
+    mesh = Mesh.from_arrays(
+        base.points @ R.T,
+        base.cells,
+        {"left": on(0, 0.0), "right": on(0, 2.0), "top": on(1, 1.0), "bottom": on(1, 0.0)},
+    )
+    cylinder = Disc(R @ [1.0, -12.5], 12.5)  # touches the bottom at x = 1
+    return ContactProblem(
+        mesh,
+        MATERIAL,
+        {
+            "left": Neumann(),
+            "right": Neumann(),
+            "top": Dirichlet(R @ [0.012, -0.02]),
+            "bottom": Contact(obstacle=cylinder, friction=friction),
+        },
+    )
+
+
+def tresca_reference(pb: ContactProblem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """u (n_nodes, 2), λ_n and λ_t of the Tresca problem by its dual over a box."""
+    space = P2Space(pb.mesh)
+    cs = contact_set(pb, space)
+    n = space.n_dofs
+    K = assemble_stiffness(space.vertices, space.cell_dofs, n, pb.material).toarray()
+    u_d = np.zeros((space.n_nodes, 2))
+    for name in pb.dirichlet_parts:
+        nodes = space.part_nodes([name])
+        u_d[nodes] = pb.conditions[name].field()(space.node_points[nodes])
+    fixed = np.zeros(n, dtype=bool)
+    d = pb.dirichlet_nodes(space)
+    fixed[2 * d] = fixed[2 * d + 1] = True
+    free = ~fixed
+    k = cs.size
+    t = np.column_stack([-cs.normal[:, 1], cs.normal[:, 0]])
+    B = np.zeros((2 * k, n))
+    B[np.arange(k), 2 * cs.nodes], B[np.arange(k), 2 * cs.nodes + 1] = cs.normal.T
+    B[k + np.arange(k), 2 * cs.nodes], B[k + np.arange(k), 2 * cs.nodes + 1] = t.T
+    chol = la.cho_factor(K[np.ix_(free, free)])
+    rhs = -K[np.ix_(free, fixed)] @ u_d.ravel()[fixed]
+    Bf = B[:, free]
+    H = Bf @ la.cho_solve(chol, Bf.T)
+    c = Bf @ la.cho_solve(chol, rhs) - np.concatenate([cs.gap, np.zeros(k)])
+    L = np.linalg.cholesky(H)
+    s = cs.friction_bound
+    lower = np.concatenate([np.zeros(k), -s])
+    upper = np.concatenate([np.full(k, np.inf), s])
+    sol = lsq_linear(L.T, la.solve_triangular(L, c, lower=True), bounds=(lower, upper),
+                     method="bvls", tol=1e-15)  # fmt: skip
+    lam = sol.x
+    u = u_d.ravel().copy()
+    u[free] = la.cho_solve(chol, rhs - Bf.T @ lam)
+    return u.reshape(-1, 2), lam[:k], lam[k:]
+
+
+def test_tresca_equals_the_minimiser_of_its_convex_energy():
+    frictionless = solve(pressed_block(None))
+    bound = 0.2 * frictionless.pressure.max()
+    pb = pressed_block(Tresca(bound))
+    res = solve(pb)
+    u_ref, lam_n, lam_t = tresca_reference(pb)
+    err_u = np.abs(res.u - u_ref).max() / np.abs(u_ref).max()
+    err_n = np.abs(res.contact_force - lam_n).max() / lam_n.max()
+    err_t = np.abs(res.tangential_force - lam_t).max() / lam_n.max()
+    counts = {name: int((res.state == v).sum()) for name, v in (("inactive", INACTIVE),
+              ("stick", STICK), ("slip", SLIP))}  # fmt: skip
+    print(f"Tresca s = {bound:.3g}: |u − u_ref|/|u| = {err_u:.1e}, Λ_n {err_n:.1e}, "
+          f"Λ_t {err_t:.1e}; states {counts}")  # fmt: skip
+    assert err_u < 1e-7 and err_n < 1e-7 and err_t < 1e-7
+    assert min(counts.values()) > 0  # no contact, stick and slip all occur
+    assert res.pdas.kkt.max < 1e-10
+    # friction pulls against the sideways push: the obstacle's force on the body points left
+    assert res.contact_force_vector[0] < 0 < res.contact_force_vector[1]
+
+
+@pytest.mark.parametrize("friction", [Tresca(0.0), Coulomb(0.0)])
+def test_zero_friction_is_the_frictionless_solution(friction):
+    ref = solve(pressed_block(None))
+    res = solve(pressed_block(friction))
+    assert np.abs(res.u - ref.u).max() < 1e-12 * np.abs(ref.u).max()
+    assert np.abs(res.contact_force - ref.contact_force).max() < 1e-12 * ref.contact_force.max()
+    assert np.array_equal(res.active, ref.active)
+    assert np.abs(res.tangential_force).max() < 1e-14 * ref.contact_force.max()
+
+
+def test_coulomb_laws_hold_node_by_node():
+    F = 0.3
+    res = solve(pressed_block(Coulomb(F)))
+    lam_n, lam_t = res.contact_force, res.tangential_force
+    scale = lam_n.max()
+    stick, slip = res.state == STICK, res.state == SLIP
+    print(f"Coulomb F = {F}: stick {stick.sum()}, slip {slip.sum()}, KKT {res.pdas.kkt.max:.1e}")
+    assert stick.any() and slip.any()
+    assert res.pdas.kkt.max < 1e-10
+    assert (np.abs(lam_t) <= F * lam_n + 1e-10 * scale).all()
+    assert np.abs(np.abs(lam_t[slip]) - F * lam_n[slip]).max() < 1e-10 * scale
+    # the nodes that stick did not move tangentially; the ones that slip moved against Λ_t
+    n = res.contact.normal
+    t = np.column_stack([-n[:, 1], n[:, 0]])
+    u_t = np.einsum("kc,kc->k", res.u[res.contact.nodes], t)
+    assert np.abs(u_t[stick]).max() < 1e-12 * np.abs(res.u).max()
+    assert (u_t[slip] * lam_t[slip] >= 0).all()
+
+
+def test_frictional_solution_is_rotation_invariant():
+    angle = 0.9
+    c, s = np.cos(angle), np.sin(angle)
+    R = np.array([[c, -s], [s, c]])
+    ref = solve(pressed_block(Coulomb(0.3)))
+    rot = solve(pressed_block(Coulomb(0.3), angle))
+    assert np.abs(rot.u - ref.u @ R.T).max() < 1e-10 * np.abs(ref.u).max()
+    assert (
+        np.abs(rot.tangential_force - ref.tangential_force).max() < 1e-10 * ref.contact_force.max()
+    )
+    assert np.array_equal(rot.state, ref.state)
+
+
+def test_what_is_refused():
+    with pytest.raises(ProblemError, match="Tresca and with Coulomb friction in one problem"):
+        base = corner_problem()
+        conditions = dict(base.conditions)
+        conditions["bottom"] = Contact(friction=Tresca(0.1))
+        conditions["right"] = Contact(friction=Coulomb(0.1))
+        solve(ContactProblem(base.mesh, base.material, conditions))
+    with pytest.raises(ProblemError, match="is a corner of contact parts 'bottom'"):
+        base = corner_problem()
+        conditions = dict(base.conditions)
+        conditions["bottom"] = Contact(friction=Coulomb(0.2))
+        solve(ContactProblem(base.mesh, base.material, conditions))
+    pb = pressed_block(Coulomb(0.2), nx=4)
+    with pytest.raises(ValueError, match=r"contact parts \['bottom'\] have friction"):
+        adaptive(pb)
+    with pytest.raises(ValueError, match="its frictional extension is not available yet"):
+        estimate(solve(pb))

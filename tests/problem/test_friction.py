@@ -1,0 +1,107 @@
+"""Friction laws (signorini.problem.friction): their data checks, and the per-constraint
+friction data of the contact set (law, Tresca bound s_z = ∫ s ψ_z ds, Coulomb coefficient)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from contact_problems import corner_problem
+
+from signorini.contact.contact_set import COULOMB, FRICTIONLESS, TRESCA, contact_set
+from signorini.fem.material import Material
+from signorini.fem.space import P2Space
+from signorini.mesh.builders import rectangle
+from signorini.problem import Contact, ContactProblem, Coulomb, Dirichlet, Neumann, Tresca
+from signorini.problem.fields import ProblemError
+
+MATERIAL = Material.from_young(10.0, 0.3)
+
+
+@pytest.mark.parametrize(
+    ("build", "message"),
+    [
+        (lambda: Tresca(-1.0), r"Tresca\(bound=...\) must be a finite number >= 0.*got -1\.0"),
+        (lambda: Tresca(float("nan")), r"Tresca\(bound=...\) must be .*got nan"),
+        (lambda: Tresca("0.3"), r"Tresca\(bound=...\) must be .*got '0\.3'"),
+        (lambda: Tresca(lambda: 1.0), r"Tresca\(bound=...\)"),
+        (lambda: Coulomb(-0.2), r"Coulomb\(coefficient=...\) must be a finite number >= 0"),
+        (lambda: Coulomb(float("inf")), r"Coulomb\(coefficient=...\) must be"),
+        (lambda: Contact(friction=0.3), r"Contact\(friction=...\) must be None, Tresca"),
+    ],
+)
+def test_bad_friction_data_is_refused(build, message):
+    with pytest.raises(ProblemError, match=message):
+        build()
+
+
+def bottom_contact(friction) -> ContactProblem:
+    return ContactProblem(
+        rectangle(0.0, 2.0, 0.0, 1.0, nx=4, ny=2),
+        MATERIAL,
+        {
+            "left": Neumann(),
+            "right": Neumann(),
+            "top": Dirichlet((0.01, -0.02)),
+            "bottom": Contact(friction=friction),
+        },
+    )
+
+
+def test_tresca_bound_is_the_integral_of_s_times_the_basis_function():
+    # s linear in x: the Gauss rule integrates s ψ_z exactly; s_z = ∫ s ψ_z ds
+    pb = bottom_contact(Tresca(lambda x: 1.0 + 0.5 * x[:, 0]))
+    cs = contact_set(pb, P2Space(pb.mesh))
+    assert (cs.friction_law == TRESCA).all()
+    x = P2Space(pb.mesh).node_points[cs.nodes][:, 0]
+    # reference: on each edge [a, b] of length h, ∫ (1 + x/2) ψ_j dx in closed form
+    h = 0.5
+    expected = np.zeros(cs.size)
+    s = lambda y: 1.0 + 0.5 * y  # noqa: E731
+    for a in np.arange(0.0, 2.0, h):  # the 4 edges, in closed form (not the code's rule)
+        b, m = a + h, a + h / 2
+        # on τ ∈ [0, 1]: ψ_start = (1 − τ)(1 − 2τ), ψ_end = τ(2τ − 1), ψ_mid = 4τ(1 − τ),
+        # s = s(a) + (s(b) − s(a)) τ
+        ds = s(b) - s(a)
+        integrals = {
+            a: h * s(a) / 6,
+            b: h * (s(a) / 6 + ds / 6),
+            m: h * (2 * s(a) / 3 + ds / 3),
+        }
+        for node_x, value in integrals.items():
+            expected[np.abs(x - node_x) < 1e-12] += value
+    assert np.abs(cs.friction_bound - expected).max() < 1e-14
+    assert (cs.friction_coefficient == 0).all()
+
+
+def test_constant_tresca_bound_is_s_times_w_z_and_coulomb_coefficient_per_constraint():
+    pb = bottom_contact(Tresca(0.3))
+    cs = contact_set(pb, P2Space(pb.mesh))
+    assert np.allclose(cs.friction_bound, 0.3 * cs.basis_integral, rtol=1e-14, atol=0)
+    pb = bottom_contact(Coulomb(0.4))
+    cs = contact_set(pb, P2Space(pb.mesh))
+    assert (cs.friction_law == COULOMB).all() and (cs.friction_coefficient == 0.4).all()
+    assert (cs.friction_bound == 0).all()
+    pb = bottom_contact(None)
+    assert (contact_set(pb, P2Space(pb.mesh)).friction_law == FRICTIONLESS).all()
+
+
+def test_negative_bound_function_names_the_part():
+    pb = bottom_contact(Tresca(lambda x: 0.5 - x[:, 0]))
+    with pytest.raises(
+        ProblemError, match="the Tresca bound of contact part 'bottom' must be >= 0"
+    ):
+        contact_set(pb, P2Space(pb.mesh))
+
+
+def test_corner_constraints_are_frictionless():
+    base = corner_problem()
+    conditions = dict(base.conditions)
+    conditions["bottom"] = Contact(friction=Coulomb(0.5))
+    conditions["right"] = Contact(friction=Tresca(1.0))
+    pb = ContactProblem(base.mesh, base.material, conditions, body_force=base.body_force)
+    cs = contact_set(pb, P2Space(pb.mesh))
+    corner = cs.nodes == cs.nodes[cs.second][0]
+    assert (cs.friction_law[corner] == FRICTIONLESS).all()
+    assert (cs.friction_law[~corner & (cs.part == 0)] == COULOMB).all()
+    assert (cs.friction_law[~corner & (cs.part == 1)] == TRESCA).all()
+    assert (cs.friction_bound[corner] == 0).all()
