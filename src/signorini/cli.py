@@ -32,8 +32,9 @@ import numpy as np
 
 from .algebra.backends import BACKENDS
 from .estimator.residual import ETA5_VARIANTS
-from .examples import EXAMPLES, get_example
+from .examples import EXAMPLES, METRICS, Metrics, get_example
 from .loop import COLUMNS, Level, adaptive, check_loop_arguments
+from .mesh.curves import Line
 from .mesh.mesh import Mesh
 from .output import HistoryWriter, write_columns, write_vtu
 from .output.run import RunFolder, file_digest
@@ -417,6 +418,7 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
     status.problem = name
     problem = load_problem(name)
     label = _label(name)
+    metrics = METRICS.get(name) if name in EXAMPLES else None
     if args.resume is not None:
         state = folder.restart()
         status.folder, status.done = folder, state.level
@@ -435,7 +437,11 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
     folder.add_files("history.csv", "history.md")
     write_columns(
         out / "history.md",
-        {**COLUMNS, "t_output": "seconds spent writing the level's VTU file and recording it"},
+        {
+            **COLUMNS,
+            **(metrics.columns if metrics else {}),
+            "t_output": "seconds spent writing the level's VTU file and recording it",
+        },
     )
     history = HistoryWriter(out / "history.csv", rows=state.history_rows if state else ())
     mode = "uniform" if opts["uniform"] else f"adaptive, theta={opts['theta']}"
@@ -449,6 +455,7 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
         "eta5": opts["eta5"],
         "backend": opts["backend"],
         "fallback": opts["fallback"],
+        "metrics": metrics,
     }
     status.phase = "at level 0" if state is None else f"at level {state.level + 1}"
     last = None
@@ -485,18 +492,25 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
         status.phase = "while drawing the figures"
         say(f"drawing the figures of {label} (convergence history, mesh, deformed body) ...")
         written = _figures(label, out, last)
+        if metrics is not None and metrics.pressure is not None:
+            written += _pressure_figure(label, out, last, metrics)
         folder.add_files(*(str(p.relative_to(out)) for p in written))
         say(f"figures: {', '.join(str(p.name) for p in written)}")
     if opts["compare_uniform"] and not opts["uniform"] and last is not None:
         status.phase = "during the uniform comparison"
-        _compare_uniform(problem, opts, args.no_figures, folder, say)
+        _compare_uniform(problem, opts, args.no_figures, folder, say, metrics)
     folder.set_status("finished")
     say(f"solver backend: {last.record.backend}" if last else "no level finished")
     return 0
 
 
 def _compare_uniform(
-    problem: ContactProblem, opts: dict, no_figures: bool, folder: RunFolder, say
+    problem: ContactProblem,
+    opts: dict,
+    no_figures: bool,
+    folder: RunFolder,
+    say,
+    metrics: Metrics | None = None,
 ) -> None:
     """Uniform refinement to the same budget, and one plot of both convergence histories."""
     from . import plots
@@ -514,6 +528,7 @@ def _compare_uniform(
         backend=opts["backend"],
         fallback=opts["fallback"],
         max_levels=opts["max_levels"],
+        metrics=metrics,
     )
     _write_levels(levels, history, folder, vtu=False, save_state=False, say=say)
     if no_figures:
@@ -564,8 +579,7 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
     }
     segments = {
         label: np.concatenate(
-            [initial.points[initial.edges[initial.part_edges(n)]] for n in parts]
-            or [np.zeros((0, 2, 2))]
+            [_part_segments(initial, n, points, cells) for n in parts] or [np.zeros((0, 2, 2))]
         )
         for label, parts in kinds.items()
     }
@@ -607,6 +621,46 @@ def _figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
         **friction,
     )
     return written
+
+
+def _part_segments(initial: Mesh, part: str, points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """``(k, 2, 2)`` segments that hold the boundary edges of ``part`` in the drawn mesh
+    ``(points, cells)``: the part's edges in the initial mesh, which refinement splits; for a
+    part carrying a curve (whose new points lie on the curve, off the initial chords) the
+    drawn mesh's own boundary edges with both ends on the curve, near the part's initial
+    chords (within their largest distance from the curve)."""
+    from .plots import boundary_groups
+
+    chords = initial.points[initial.edges[initial.part_edges(part)]]
+    curve = initial.curves[initial.part_index(part)]
+    if curve is None or isinstance(curve, Line):
+        return chords
+    size = float(np.ptp(points, axis=0).max())
+
+    def off(x: np.ndarray) -> np.ndarray:
+        return np.hypot(*(curve.project(x) - x).T)
+
+    bulge = float(off(chords.mean(axis=1)).max()) + 1e-9 * size
+    near = boundary_groups(points, cells, {part: chords}, tol=bulge / size)[part]
+    on = (off(points[near[:, 0]]) <= 1e-9 * size) & (off(points[near[:, 1]]) <= 1e-9 * size)
+    return points[near[on]]
+
+
+def _pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> list[Path]:
+    """The last level's pressure beside the known one the example's ``metrics`` give
+    (``<example>_pressure``; e.g. Hertz's for ``hertz``)."""
+    from . import plots
+
+    known = metrics.pressure(last.result)
+    return plots.plot_pressure_comparison(
+        known.x,
+        known.pressure,
+        known.x_reference,
+        known.reference,
+        out / f"{example}_pressure",
+        label=known.label,
+        title=known.title,
+    )
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -15,7 +15,7 @@ import logging
 import math
 import numbers
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -301,6 +301,7 @@ def adaptive(
     u0: np.ndarray | None = None,
     first_level: int = 0,
     fallback: bool = False,
+    metrics: Callable[[ContactResult], Mapping[str, float]] | None = None,
 ) -> Iterator[Level]:
     """Run SOLVE → ESTIMATE → MARK → REFINE, yielding each finished level.
 
@@ -343,6 +344,11 @@ def adaptive(
         Where PDAS cycles or reaches its iteration bound, finish that level's solve with the
         primal active set method instead of raising (:func:`signorini.solve`); the record's
         ``n_solves`` counts both.
+    metrics : callable, optional
+        ``metrics(result) -> {column: value}``: measurements of each level's solution beyond
+        the record's own (e.g. the Hertz example's errors against the Hertz solution,
+        :data:`signorini.examples.METRICS`); they go into :attr:`LevelRecord.extra`, hence into
+        the row of ``history.csv``. Names must be new columns, values real numbers.
 
     Yields
     ------
@@ -378,6 +384,8 @@ def adaptive(
         backend=backend,
         first_level=first_level,
     )
+    if metrics is not None and not callable(metrics):
+        raise ValueError(f"metrics must be a function of a ContactResult, got {metrics!r}")
     if mesh is not None and not isinstance(mesh, Mesh):
         raise ValueError(f"mesh must be a Mesh, got {type(mesh).__name__}")
     mesh = problem.mesh if mesh is None else mesh
@@ -386,7 +394,15 @@ def adaptive(
             f"the initial mesh already has {problem.free_ndof(mesh)} unknowns, "
             f"more than max_ndof={max_ndof}"
         )
-    return _levels(problem, mesh, u0, warm_start=bool(warm_start), fallback=bool(fallback), **args)
+    return _levels(
+        problem,
+        mesh,
+        u0,
+        warm_start=bool(warm_start),
+        fallback=bool(fallback),
+        metrics=metrics,
+        **args,
+    )
 
 
 def _levels(
@@ -404,6 +420,7 @@ def _levels(
     warm_start: bool,
     fallback: bool,
     first_level: int,
+    metrics: Callable[[ContactResult], Mapping[str, float]] | None = None,
 ) -> Iterator[Level]:
     """The loop of :func:`adaptive`, on checked arguments."""
     for level in range(first_level, max_levels):
@@ -414,6 +431,8 @@ def _levels(
         t_est = time.perf_counter() - t0
         record = _record(level, result, est)
         record.t_estimate = t_est
+        if metrics is not None:
+            record.extra.update(_measured(metrics, result))
         last = level == max_levels - 1 or est.eta <= tol
         marked = next_mesh = None
         if not last:
@@ -444,6 +463,23 @@ def _levels(
         if last:
             return
         mesh = next_mesh
+
+
+def _measured(
+    metrics: Callable[[ContactResult], Mapping[str, float]], result: ContactResult
+) -> dict[str, float]:
+    """``metrics(result)`` checked: new column names, real values (NaN where undefined)."""
+    values = metrics(result)
+    if not isinstance(values, Mapping):
+        raise ValueError(f"metrics must return a mapping column -> value, got {values!r}")
+    out = {}
+    for name, value in values.items():
+        if not isinstance(name, str) or name in COLUMNS or name == "extra":
+            raise ValueError(f"metrics: {name!r} is not a new column name")
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise ValueError(f"metrics: the value of {name!r} must be a real number, got {value!r}")
+        out[name] = float(value)
+    return out
 
 
 def _record(level: int, result: ContactResult, est: Estimate) -> LevelRecord:

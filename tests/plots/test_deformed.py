@@ -180,3 +180,24 @@ def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
         )
     with pytest.raises(ValueError, match="tangential_pressure must have shape"):
         plot_deformed(p, c, u, tmp_path / "x", **kwargs, tangential_pressure=p_t[:3])
+
+
+def test_obstacle_from_gaps_is_left_out_where_the_drawn_gap_is_far(tmp_path, captured):
+    """A half-disc over a plane: the plane is drawn only near the contact zone, and the axes
+    are not stretched to where scale · ψ puts it far from the body."""
+    theta = np.linspace(np.pi, 2 * np.pi, 41)
+    arc = np.column_stack([np.cos(theta), 1 + np.sin(theta)])
+    points = np.vstack([[0.0, 1.0], arc])
+    cells = np.column_stack([np.zeros(40, int), np.arange(2, 42), np.arange(1, 41)])
+    u = np.zeros_like(points)
+    gap = arc[:, 1]  # the distance to the plane y = 0
+    normal = np.tile([0.0, -1.0], (41, 1))
+    plot_deformed(
+        points, cells, u, tmp_path / "d", contact_points=arc, gap=gap, normal=normal, scale=10.0
+    )
+    (info,) = captured
+    (label,) = [k for k in info["lines"] if k.startswith("obstacle")]
+    x, y = info["lines"][label]
+    shown = np.isfinite(y)
+    assert np.all(10 * gap[shown] <= 0.25 * 2.0) and not shown.all() and shown.any()
+    assert info["data_lim"][0].y0 > -0.6  # not down to 1 − 10 · 1 = −9

@@ -1,7 +1,7 @@
 """The mesh layer: the immutable triangulation with named boundary parts, built-in meshes,
 meshes read from files, and newest vertex bisection (the REFINE step)."""
 
-from .builders import rectangle
+from .builders import half_disc, rectangle
 from .curves import Circle, Curve, Line, ProjectedCurve, QuadraticBoundary
 from .gmsh import read_mesh
 from .mesh import Mesh, MeshError
@@ -16,6 +16,7 @@ __all__ = [
     "Mesh",
     "MeshError",
     "Refinement",
+    "half_disc",
     "read_mesh",
     "rectangle",
     "refine_nvb",

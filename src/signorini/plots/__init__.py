@@ -8,7 +8,7 @@ so that a figure can be redrawn from the files a run leaves (``history.csv``, me
 - :mod:`.slopes`: fitted slopes in legends (over the finer half of the run, stated in the
   legend) and slope triangles;
 - :mod:`.mesh`: a triangulation (Fig. 6.3(b)); :mod:`.deformed`: the deformed body and the
-  contact pressure;
+  contact pressure; :mod:`.pressure`: a computed pressure beside a known one;
 - :mod:`.report`: the figures a finished run gets, chosen by what its history contains.
 
 :func:`read_history` and :func:`fitted_slope` belong to :mod:`signorini.output.history` and
@@ -25,6 +25,7 @@ from .convergence import (
 )
 from .deformed import displacement_scale, plot_deformed
 from .mesh import READABLE_CELLS, boundary_groups, plot_mesh, read_level_mesh, readable_level
+from .pressure import plot_pressure_comparison
 from .report import make_figures
 from .slopes import add_slope_triangle, finer_half_slope
 from .style import STYLES
@@ -40,6 +41,7 @@ __all__ = [
     "plot_estimator",
     "plot_mesh",
     "plot_deformed",
+    "plot_pressure_comparison",
     "displacement_scale",
     "plot_adaptive_vs_uniform",
     "make_figures",

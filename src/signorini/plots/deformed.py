@@ -36,6 +36,9 @@ __all__ = [
 DRAWN_FRACTION = 0.1
 #: Displacements between these fractions of the body's size are drawn at true scale.
 TRUE_SCALE_RANGE = (0.02, 0.25)
+#: The obstacle drawn from gaps is left out where the drawn gap exceeds this fraction of the
+#: body's size (a shape far from most of a curved contact part, e.g. the plane under a disc).
+OBSTACLE_REACH = 0.25
 
 #: How the stick and slip nodes of a frictional contact and its friction stress are drawn.
 FRICTION_STYLES: dict[str, dict[str, str]] = {
@@ -331,7 +334,8 @@ def plot_deformed(
         The gap ``ψ`` at ``contact_points`` along ``normal`` (k, 2): the obstacle is then
         drawn at ``contact_points + scale * gap * normal``, ordered along the boundary: with
         the same scale as the body, so a body that does not penetrate the obstacle is not
-        drawn through it. Not together with ``obstacle``.
+        drawn through it; left out where ``scale * |gap|`` exceeds :data:`OBSTACLE_REACH`
+        times the body's size. Not together with ``obstacle``.
 
     Returns
     -------
@@ -376,11 +380,15 @@ def plot_deformed(
             )
         order = np.argsort(contact_coordinate(cp)[0], kind="stable")
         obs = (cp + scale * g[:, None] * n)[order]
+        far = scale * np.abs(g[order]) > OBSTACLE_REACH * float(np.ptp(p, axis=0).max())
+        obs[far] = np.nan  # a gap in the drawn line
+        if far.all():
+            obs = None
         if scale != 1.0:
             obstacle_label += f" (gap \u00d7{scale:g})"
     drawn = [p + scale * u] + ([] if obs is None else [obs])
-    lo = np.min([d.min(axis=0) for d in drawn], axis=0)
-    hi = np.max([d.max(axis=0) for d in drawn], axis=0)
+    lo = np.min([np.nanmin(d, axis=0) for d in drawn], axis=0)
+    hi = np.max([np.nanmax(d, axis=0) for d in drawn], axis=0)
     aspect = float((hi[1] - lo[1]) / max(hi[0] - lo[0], 1e-300))
     body = float(np.clip(2.2 * aspect, 0.8, 3.0))  # inches of the equal-aspect box
     head = f"{title}\n{scale_text(scale)}" if title else f"deformed body, {scale_text(scale)}"

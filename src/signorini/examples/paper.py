@@ -14,11 +14,11 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .fem.material import Material, stress
-from .mesh.builders import rectangle
-from .problem import Contact, ContactProblem, Dirichlet, ExactSolution, Neumann
+from ..fem.material import Material, stress
+from ..mesh.builders import rectangle
+from ..problem import Contact, ContactProblem, Dirichlet, ExactSolution, Neumann
 
-__all__ = ["example_6_1", "example_6_2", "EXAMPLES", "get_example"]
+__all__ = ["example_6_1", "example_6_2"]
 
 
 def _exact_6_1() -> tuple[Callable, Callable, Callable]:
@@ -129,24 +129,3 @@ def example_6_2(nx: int = 4) -> ContactProblem:
         },
         name="example-6.2",
     )
-
-
-#: The paper's examples by the name the command line takes (``signorini run example-6.2``).
-EXAMPLES: dict[str, Callable[..., ContactProblem]] = {
-    "example-6.1": example_6_1,
-    "example-6.2": example_6_2,
-}
-
-
-def get_example(name: str) -> ContactProblem:
-    """The example named ``name`` (a key of :data:`EXAMPLES`) on its default initial mesh.
-
-    Raises
-    ------
-    ValueError
-        For an unknown name; the message lists the known ones.
-    """
-    try:
-        return EXAMPLES[name]()
-    except KeyError:
-        raise ValueError(f"unknown example {name!r}; choose one of {sorted(EXAMPLES)}") from None

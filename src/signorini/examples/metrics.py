@@ -1,0 +1,71 @@
+"""What an example measures on each level beyond the loop's own columns.
+
+A :class:`Metrics` is called with a level's :class:`~signorini.contact.solution.ContactResult`
+and returns a few named floats; :func:`signorini.adaptive` (``metrics=...``) adds them to the
+level's record (:attr:`LevelRecord.extra <signorini.LevelRecord.extra>`), so the command line
+writes them as further columns of ``history.csv`` and describes them in ``history.md``. It may
+also give a reference pressure to draw beside the computed one.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..contact.solution import ContactResult
+
+__all__ = ["Metrics", "PressureComparison"]
+
+
+@dataclass(frozen=True)
+class PressureComparison:
+    """A computed contact pressure along a coordinate, beside a known one.
+
+    Attributes
+    ----------
+    x : (m,) float array
+        The coordinate of each node along the contact zone (length units).
+    pressure : (m,) float array
+        The computed consistent pressure p_z (stress units; NaN where there is none).
+    x_reference : (r,) float array
+        Where the known pressure is given (length units).
+    reference : (r,) float array
+        The known pressure there (stress units).
+    label : str
+        What the known pressure is (for a legend), e.g. ``"Hertz"``.
+    title : str
+        Title of the figure.
+    """
+
+    x: np.ndarray
+    pressure: np.ndarray
+    x_reference: np.ndarray
+    reference: np.ndarray
+    label: str
+    title: str = ""
+
+
+@dataclass(frozen=True)
+class Metrics:
+    """Per-level measurements of an example.
+
+    Parameters
+    ----------
+    measure : callable ``measure(result) -> dict[str, float]``
+        The measurements of one level's solution, by column name.
+    columns : mapping of str to str
+        Each column ``measure`` returns, with its meaning and unit (for ``history.md``).
+    pressure : callable ``pressure(result) -> PressureComparison``, optional
+        A known pressure to draw beside the computed one (the command line's figure
+        ``<example>_pressure``).
+    """
+
+    measure: Callable[[ContactResult], dict[str, float]]
+    columns: Mapping[str, str] = field(default_factory=dict)
+    pressure: Callable[[ContactResult], PressureComparison] | None = None
+
+    def __call__(self, result: ContactResult) -> dict[str, float]:
+        """``measure(result)``."""
+        return self.measure(result)
