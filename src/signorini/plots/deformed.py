@@ -253,7 +253,9 @@ def _draw_pressure(
         ax.set_ylabel(r"contact pressure $p_h$")
     else:
         ax.set_ylabel("contact stresses")
-        ax.legend(loc="best", ncols=2)
+        lo, hi = ax.get_ylim()
+        ax.set_ylim(lo, hi + 0.45 * (hi - lo))  # an empty band on top for the legend
+        ax.legend(loc="upper center", ncols=2)
 
 
 def _draw_states(ax: Any, at: np.ndarray, state: np.ndarray, legend: bool = True) -> None:
