@@ -77,6 +77,19 @@ def test_a_repeated_step_is_one_solve_of_the_same_solution():
         assert np.array_equal(again.state, first.state)
 
 
+def test_friction_switched_on_after_a_frictionless_step():
+    """Press without friction, then pull with Coulomb friction: the frictionless step's
+    displacement is the warm start and its u·t the reference (its tangential slip under the
+    press is not undone)."""
+    first, second = solve_path([block(0.0, friction=None), block(0.01)])
+    assert np.abs(tangential(first)).max() > 0
+    np.testing.assert_allclose(second.tangential_reference, tangential(first), rtol=0, atol=1e-15)
+    stick = second.state == STICK
+    assert stick.any()
+    np.testing.assert_allclose(tangential(second)[stick], tangential(first)[stick], atol=1e-15)
+    assert second.pdas.kkt.max < 1e-10
+
+
 def test_unloading_reverses_the_slip():
     """Pull, then move the top back: the nodes that slip in the last step slip against the
     pull (force Λ_t < 0), and the end state differs from the static solve of its load."""
