@@ -1,0 +1,145 @@
+"""The data of each constraint before the rows are formed: directions n_z and gaps ψ(z) at
+the contact edges' nodes, the weights m_z, w_z per edge, and the friction data
+(docs/method.md, *Contact directions*, *Discrete problem*, *Friction in a ContactProblem*).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..fem import iso, p2
+from ..fem.quadrature import gauss_legendre
+from ..fem.space import P2Space
+from ..problem.conditions import Contact
+from ..problem.fields import ProblemError, evaluate_field
+from ..problem.friction import Coulomb, Tresca
+from ..problem.problem import ContactProblem
+
+__all__ = [
+    "COULOMB",
+    "FRICTIONLESS",
+    "TRESCA",
+    "directions_and_gaps",
+    "edge_weights",
+    "friction_data",
+]
+
+FRICTIONLESS, TRESCA, COULOMB = 0, 1, 2
+
+
+def _body_normals(
+    problem: ContactProblem, space: P2Space, name: str, nodes: np.ndarray, chord: np.ndarray
+) -> np.ndarray:
+    """The body's outward unit normal at the nodes ``[start, end, midpoint]`` of one part's
+    edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``: the part's normal
+    on a straight part, the curve's normal on a part with a curve that has one, else the
+    edge's normal at a midpoint and the normalised mean of the part's two edges' normals at a
+    vertex
+    (docs/method.md, *Contact directions*)."""
+    mesh = space.mesh
+    if name in problem.contact_normals:
+        return np.broadcast_to(problem.contact_normals[name], nodes.shape + (2,)).copy()
+    curve = mesh.curves[mesh.part_index(name)]
+    if curve is not None and curve.has_normal:
+        n = curve.normal(space.node_points[nodes.ravel()]).reshape(nodes.shape + (2,))
+        sign = np.sign(np.einsum("ejc,ec->ej", n, chord))
+        return n * np.where(sign < 0, -1.0, 1.0)[..., None]
+    total = np.zeros((space.n_nodes, 2))
+    np.add.at(total, nodes[:, :2].ravel(), np.repeat(chord, 2, axis=0))
+    out = np.repeat(chord[:, None, :], 3, axis=1)
+    mean = total[nodes[:, :2]]
+    out[:, :2] = mean / np.hypot(mean[..., 0], mean[..., 1])[..., None]
+    return out
+
+
+def directions_and_gaps(
+    problem: ContactProblem, space: P2Space, cs_edges: tuple, chord: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """n_z and ψ(z) at the nodes ``[start, end, midpoint]`` of the contact edges, part by part
+    (each part has its own obstacle), shapes ``(n_ce, 3, 2)`` and ``(n_ce, 3)``."""
+    parts, edge_part, edge_nodes = cs_edges
+    direction = np.empty(edge_nodes.shape + (2,))
+    gap = np.empty(edge_nodes.shape)
+    for i, name in enumerate(parts):
+        sel = edge_part == i
+        cond: Contact = problem.conditions[name]
+        nodes, inverse = np.unique(edge_nodes[sel], return_inverse=True)
+        x = space.node_points[nodes]
+        if cond.obstacle is not None:
+            try:
+                psi, n = cond.obstacle.gap_and_direction(x)
+            except ValueError as err:
+                raise ProblemError(f"the obstacle of contact part {name!r}: {err}") from err
+            direction[sel] = n[inverse].reshape(-1, 3, 2)
+        else:
+            what = f"the gap function of contact part {name!r}"
+            psi = evaluate_field(cond.gap_field(), x, what, shape=())
+            direction[sel] = _body_normals(problem, space, name, edge_nodes[sel], chord[sel])
+        gap[sel] = psi[inverse].reshape(-1, 3)
+    return direction, gap
+
+
+def edge_weights(space: P2Space, edges: np.ndarray, edge_nodes: np.ndarray):
+    """``∫ φ_z ds`` and ``∫ ψ_z ds`` of ``[start, end, midpoint]`` on each contact edge,
+    ``(n_ce, 3)`` each: closed forms on straight edges, a Gauss rule along the quadratic edge
+    on curved ones."""
+    length = space.mesh.edge_length[edges]
+    hat = np.column_stack([length / 4, length / 4, length / 2])
+    basis = np.column_stack([length / 6, length / 6, 2 * length / 3])
+    curved = np.flatnonzero(np.isin(edges, iso.curved_edges(space.mesh)))
+    if curved.size:
+        t, w = gauss_legendre(6)
+        halves = np.concatenate([t / 2, 0.5 + t / 2])  # φ_z is linear on each half-edge
+        wh = np.concatenate([w, w]) / 2
+        points = space.node_points[edge_nodes[curved]]
+        _, speed, _ = iso.edge_geometry(points[:, :2], points[:, 2], halves)
+        phi = np.column_stack(
+            [
+                np.maximum(1 - 2 * halves, 0),
+                np.maximum(2 * halves - 1, 0),
+                1 - np.abs(2 * halves - 1),
+            ]
+        )
+        hat[curved] = (speed * wh) @ phi
+        basis[curved] = (speed * wh) @ p2.edge_basis(halves)
+    return hat, basis
+
+
+def friction_data(
+    problem: ContactProblem,
+    space: P2Space,
+    edge_part: np.ndarray,
+    edge_nodes: np.ndarray,
+    edge_local: np.ndarray,
+    part: np.ndarray,
+    second: np.ndarray,
+) -> dict[str, np.ndarray]:
+    """Friction law, Tresca bound ``s_z = ∫ s ψ_z ds`` and Coulomb coefficient per
+    constraint; a corner node's constraints are frictionless."""
+    k = part.size
+    law = np.zeros(k, dtype=np.int64)
+    bound, coefficient = np.zeros(k), np.zeros(k)
+    corner = second | np.concatenate([second[1:], [False]])
+    parts = tuple(problem.contact_parts)
+    t, w = gauss_legendre(4)
+    for i, name in enumerate(parts):
+        friction = problem.conditions[name].friction
+        mine = (part == i) & ~corner
+        if isinstance(friction, Coulomb):
+            law[mine], coefficient[mine] = COULOMB, float(friction.coefficient)
+        elif isinstance(friction, Tresca):
+            law[mine] = TRESCA
+            sel = np.flatnonzero(edge_part == i)
+            points = space.node_points[edge_nodes[sel]]
+            x, speed, _ = iso.edge_geometry(points[:, :2], points[:, 2], t)
+            what = f"the Tresca bound of contact part {name!r}"
+            s = evaluate_field(friction.bound_field(), x.reshape(-1, 2), what, shape=())
+            if (s < 0).any():
+                raise ProblemError(f"{what} must be >= 0; it is {s.min():.6g} somewhere")
+            # ∫ s ψ_j |x'(t)| dt on each edge, j = start, end, midpoint
+            share = (s.reshape(-1, t.size) * speed * w) @ p2.edge_basis(t)
+            loc = edge_local[sel].ravel()
+            inside = loc >= 0
+            mine_bound = np.bincount(loc[inside], weights=share.ravel()[inside], minlength=k)
+            bound[mine] += mine_bound[mine]
+    return {"friction_law": law, "friction_bound": bound, "friction_coefficient": coefficient}
