@@ -352,7 +352,8 @@ def adaptive(
     backend : {"auto", "pardiso", "scipy"}
         Sparse solver backend.
     warm_start : bool
-        Start each PDAS from the previous level's prolongated solution and contact set.
+        Start each PDAS from the previous level's prolongated solution and contact set (with
+        friction, the semismooth Newton method from its update rule at that solution).
     mesh : Mesh, optional
         Mesh of the first level (default: the problem's).
     u0 : (n_nodes, 2) float array, optional

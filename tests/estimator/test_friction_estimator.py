@@ -15,6 +15,7 @@ import pytest
 
 from signorini.contact.solution import SLIP, STICK, solve
 from signorini.estimator.residual import NODE_TERMS, TERMS, estimate
+from signorini.estimator.terms import friction_work
 from signorini.fem.material import Material, stress
 from signorini.loop import adaptive
 from signorini.mesh.builders import rectangle
@@ -30,7 +31,7 @@ from signorini.problem import (
     Neumann,
     Tresca,
 )
-from signorini.problem.obstacles import Disc
+from signorini.problem.obstacles import Disc, HalfPlane
 
 MATERIAL = Material.from_young(1.0, 0.3)
 #: the stick–slip transition point of the manufactured solution (not a dyadic point: it
@@ -309,3 +310,55 @@ def _transitions(r):
     x, state = x[order], r.state[order]
     change = np.flatnonzero(state[1:] != state[:-1])
     return x, 0.5 * (x[change] + x[change + 1])
+
+
+def test_friction_work_along_straight_edges_given_as_quadratic_edges():
+    """η8's integrals with the node points of straight edges (the quadratic-edge path, 5 Gauss
+    points with |x'(t)|) equal the straight ones; a stick edge (u_t = 0) and a slip edge with
+    the stress at its bound along the slip give 0; a slip against the stress gives 2 s ∫|u_t|."""
+    rng = np.random.default_rng(3)
+    a, b = rng.uniform(-1, 1, (20, 2)), rng.uniform(-1, 1, (20, 2))
+    points = np.stack([a, b, 0.5 * (a + b)], axis=1)
+    length = np.hypot(*(b - a).T)
+    slip, force, bound = rng.normal(size=(3, 20, 3))
+    bound = np.abs(bound)
+    straight = friction_work(slip, force, bound, length)
+    curved = friction_work(slip, force, bound, length, points)
+    np.testing.assert_allclose(curved, straight, rtol=1e-10, atol=1e-14)
+    assert straight.min() >= 0
+    # against a dense midpoint rule over each third (independent of the cuts at the kinks)
+    from signorini.fem.p2 import edge_basis
+
+    n = 30_000
+    for k, (lo, hi) in enumerate(((0, 1 / 3), (2 / 3, 1), (1 / 3, 2 / 3))):
+        t = lo + (hi - lo) * (np.arange(n) + 0.5) / n
+        u, p, s = (v @ edge_basis(t).T for v in (slip, force, bound))
+        dense = length * (hi - lo) * (np.maximum(s, np.abs(p)) * np.abs(u) - p * u).mean(axis=1)
+        np.testing.assert_allclose(straight[:, k], dense, rtol=1e-6, atol=1e-9)
+    one = np.ones((1, 3))
+    assert np.all(friction_work(0 * one, 0.5 * one, one, np.ones(1)) == 0)
+    np.testing.assert_allclose(friction_work(2 * one, one, one, np.ones(1)), 0, atol=1e-15)
+    # slip against the friction stress: max(1, 1)·2 − (−1)·2 = 4 per unit length
+    np.testing.assert_allclose(friction_work(2 * one, -one, one, np.ones(1)).sum(), 4.0)
+
+
+def test_coulomb_on_a_curved_contact_part():
+    """A half-disc (R = 1) pressed down and sideways onto the rigid half-plane y ≤ 0 with
+    Coulomb friction on its arc: η8 along the quadratic edges, indicators summing to η_h²."""
+    from tests.estimator.test_curved import half_disc
+
+    pb = ContactProblem(
+        half_disc(n=8),
+        MATERIAL,
+        {
+            "top": Dirichlet((0.002, -0.01)),
+            "arc": Contact(obstacle=HalfPlane((0.0, 0.0), (0.0, 1.0)), friction=Coulomb(0.3)),
+        },
+    )
+    r = solve(pb)
+    est = estimate(r)
+    states = np.bincount(r.state, minlength=3)
+    print("states", states, "terms", np.array2string(est.eta_terms, precision=2))
+    assert states[STICK] > 0 and states[SLIP] > 0
+    assert est.eta_terms[TERMS.index("eta_8")] > 0
+    np.testing.assert_allclose(est.eta2.sum(), est.eta**2, rtol=1e-13)

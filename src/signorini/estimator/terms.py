@@ -31,9 +31,9 @@ from typing import NamedTuple
 import numpy as np
 
 from ..fem.p2 import edge_basis
-from ..mesh.geometry import segment_normals
 from .h_half_norm import hhalf_norm2_positive_part
 from .thirds import friction_work_thirds, third_integrals
+from .traction import direction_field, edge_traction
 
 __all__ = [
     "EdgeSet",
@@ -162,58 +162,6 @@ def boundary_cell_shares(edges: EdgeSet, values: np.ndarray, n_cells: int) -> np
     out = np.zeros(n_cells)
     np.add.at(out, edges.cells[:, 0], values)
     return out
-
-
-# --------------------------------------------------------------------------- σ(u_h) n on edges
-
-
-def edge_traction(
-    sigma_vertex: np.ndarray,
-    points: np.ndarray,
-    cells: np.ndarray,
-    cell: np.ndarray,
-    k: np.ndarray,
-    t: np.ndarray,
-) -> np.ndarray:
-    """``σ(u_h) n`` along local edge ``k`` of ``cell``, n the cell's outward normal.
-
-    σ(u_h) is linear on each cell (P2 displacements), so it is interpolated from its
-    values at the vertices.
-
-    Parameters
-    ----------
-    sigma_vertex : (n_cells, 3, 2, 2) float array
-        σ(u_h) of each cell at its vertices.
-    points, cells : mesh arrays
-    cell, k : (m,) int arrays
-        Cell and local edge of each edge.
-    t : (q,) float array
-        Parameters along the edge, in the cell's counter-clockwise direction.
-
-    Returns
-    -------
-    (m, q, 2) float array
-    """
-    s0 = sigma_vertex[cell, k]
-    s1 = sigma_vertex[cell, (k + 1) % 3]
-    sig = (1 - t)[None, :, None, None] * s0[:, None] + t[None, :, None, None] * s1[:, None]
-    _, n = segment_normals(points[cells[cell, k]], points[cells[cell, (k + 1) % 3]])
-    return np.einsum("eqij,ej->eqi", sig, n)
-
-
-def direction_field(direction: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """The constraint direction along contact edges: the normalised quadratic interpolant of
-    the nodal directions n_z ``(k, 3, 2)`` at ``[start, end, midpoint]``, at parameters
-    ``t (q,)``: ``(k, q, 2)`` unit vectors (docs/method.md, *Estimator*, "On curved
-    boundaries"). Where the interpolant vanishes (nodal directions opposed across one edge,
-    e.g. an edge spanning a slot of an obstacle) the midpoint node's direction is used."""
-    d = np.einsum("qa,kac->kqc", edge_basis(t), direction)
-    size = np.hypot(d[..., 0], d[..., 1])[..., None]
-    small = size <= 1e-8
-    if small.any():
-        d = np.where(small, direction[:, None, 2], d)
-        size = np.where(small, 1.0, size)
-    return d / size
 
 
 def _point_weights(w: np.ndarray, length: np.ndarray) -> np.ndarray:

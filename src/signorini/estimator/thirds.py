@@ -1,7 +1,7 @@
 """Integrals over the thirds of contact edges: η6's ``∫_{γ̃_p} v⁺ φ_p ds`` (paper (4.12);
 docs/method.md, *Estimator*) and η8's friction work defect ``∫_{γ̃_p} (max(b, |p_t|) |u_t| −
-p_t u_t) ds`` (docs/method.md, *Estimator*, "With friction"), on straight edges exactly (up to
-η8's kinks where ``|p_t|`` crosses ``b``) and along quadratic edges with ``|x'(t)|``
+p_t u_t) ds`` (docs/method.md, *Estimator*, "With friction"), on straight edges exactly and
+along quadratic edges with ``|x'(t)|``
 (docs/method.md, *Estimator*, "On curved boundaries")."""
 
 from __future__ import annotations
@@ -88,12 +88,10 @@ def friction_work_thirds(
     """``∫ (max(b, |p_t|) |u_t| − p_t u_t) ds`` over each third of each edge (η8).
 
     The three quadratics are given by their values at ``[start, end, midpoint]``. Each third
-    is cut at the roots of ``u_t``; where ``|p_t| ≤ b`` the integrand is then a polynomial of
-    degree 4 on each piece and the 3-point Gauss rule (degree 5) is exact. Where the
-    interpolated ``|p_t|`` exceeds ``b`` (between nodes, at a stick–slip transition) the
-    kink of the maximum is not cut: the rule is accurate there, not exact. Along quadratic
-    edges (``points`` given) the integrand carries ``|x'(t)|`` and ``CURVED_THIRD_POINTS``
-    Gauss points are used on each piece.
+    is cut at the roots of ``u_t``, ``p_t − b`` and ``p_t + b``, so that on each piece the
+    integrand is one polynomial of degree 4 and the 3-point Gauss rule (degree 5) is exact.
+    Along quadratic edges (``points`` given) the integrand carries ``|x'(t)|`` and
+    ``CURVED_THIRD_POINTS`` Gauss points are used on each piece.
 
     Parameters
     ----------
@@ -117,13 +115,13 @@ def friction_work_thirds(
     cu, cp, cb = (
         monomial_coefficients(np.asarray(v, dtype=np.float64)) for v in (slip, force, bound)
     )
-    roots = roots_in_unit_interval(cu)
+    roots = np.column_stack([roots_in_unit_interval(c) for c in (cu, cp - cb, cp + cb)])
     gt, gw = gauss_legendre(3 if points is None else CURVED_THIRD_POINTS)
     out = np.zeros(cu.shape)
     for lo, hi, col in _THIRDS:
         r = np.where(np.isnan(roots), lo, np.clip(roots, lo, hi))
         ends = np.sort(np.column_stack([np.full(len(cu), lo), r, np.full(len(cu), hi)]), axis=1)
-        for j in range(3):
+        for j in range(ends.shape[1] - 1):
             x0, x1 = ends[:, j : j + 1], ends[:, j + 1 : j + 2]
             tq = x0 + (x1 - x0) * gt
             u, p, b = evaluate(cu, tq), evaluate(cp, tq), evaluate(cb, tq)
