@@ -80,9 +80,9 @@ COLUMNS: dict[str, str] = {
     "kkt_stationarity": "largest residual of the equilibrium equations at the free, "
     "unconstrained unknowns, relative to the largest force",
     "kkt_dirichlet": "largest misfit of the Dirichlet values, relative to the displacement scale",
-    "kkt_tangential_bound": "largest friction force beyond its bound, (|Λ_t| − s)⁺, relative "
-    "to the total contact force (only with friction, else nan)",
-    "kkt_tangential_complementarity": "largest min(stick residual |u_t|, slip residual) of "
+    "kkt_tangential_bound": "largest friction force beyond its bound, max(abs(Λ_t) − s, 0), "
+    "relative to the total contact force (only with friction, else nan)",
+    "kkt_tangential_complementarity": "largest min(stick residual abs(u_t), slip residual) of "
     "the tangential law (docs/method.md, *Friction*; only with friction, else nan)",
     "backend": "sparse solver backend used (pardiso or scipy)",
     "t_assemble": "seconds spent assembling the linear system",
