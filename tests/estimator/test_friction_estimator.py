@@ -154,6 +154,15 @@ def test_manufactured_stick_slip_estimator_and_error_decay_alike():
     assert -1.15 <= s_err <= -0.85, f"error slope {s_err:.3f} not ≈ −1"
     index = eta / err
     assert index.max() / index.min() < 1.5, f"efficiency index not bounded: {index}"
+    # η8 lives at the stick–slip transition: its largest node contribution within two edges
+    # of c on every level after the first
+    k8 = NODE_TERMS.index("eta_8")
+    for _, _, _, _, r in rows[1:]:
+        est = estimate(r)
+        top = int(np.argmax(est.eta2_node[k8]))
+        x_top, h = r.space.node_points[top, 0], r.mesh.edge_length[r.contact.edges].max()
+        print(f"largest η8 node contribution at x = {x_top:.4f} (c = {C}, h = {h:.4f})")
+        assert abs(x_top - C) < 2 * h, (x_top, h)
     # the discrete solution has both zones: stick nodes left of c, slip nodes right of it
     r = rows[-1][4]
     x = r.space.node_points[r.contact.nodes, 0]
