@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from dataclasses import fields
@@ -15,6 +16,7 @@ from signorini.examples import example_6_1, example_6_2
 from signorini.loop import COLUMNS, Level, LevelRecord, adaptive
 from signorini.mesh.refine import refine_nvb
 from signorini.output import fitted_slope
+from signorini.problem import Coulomb
 
 
 # ---------------------------------------------------------------------------- helpers
@@ -35,7 +37,7 @@ def dirichlet_nodes_by_coordinates(points: np.ndarray, side: str) -> int:
     return int(on.sum())
 
 
-def check_record(level: Level, has_exact: bool) -> None:
+def check_record(level: Level, has_exact: bool, friction: bool = False) -> None:
     """Every field of the record is filled and agrees with the level's solution."""
     r, res, est = level.record, level.result, level.estimate
     row = r.row()
@@ -45,25 +47,30 @@ def check_record(level: Level, has_exact: bool) -> None:
         assert value is not None, key
         if key in ("error_energy", "error_h1", "efficiency") and not has_exact:
             assert math.isnan(value), key
+        elif key.startswith("kkt_tangential") and not friction:
+            assert math.isnan(value), key
         elif isinstance(value, float):
             assert math.isfinite(value), key
     assert r.ndof == res.ndof and r.ndof_total == res.space.n_dofs
     assert r.n_cells == res.mesh.n_cells
     assert r.eta == est.eta > 0
-    terms = [row[f"eta_{k}"] for k in range(1, 8)]
+    terms = [row[f"eta_{k}"] for k in range(1, 9)]
     np.testing.assert_array_equal(terms, est.eta_terms)
     assert math.fsum(t * t for t in terms) == pytest.approx(r.eta**2, rel=1e-12)
+    assert (r.eta_8 > 0) == friction
     pdas = res.pdas
+    solves = pdas.iterations if friction else pdas.n_solves  # friction: one solve per step
     assert (r.pdas_iterations, r.n_solves, r.n_factorizations) == (
         pdas.iterations,
-        pdas.n_solves,
+        solves,
         pdas.n_factorizations,
     )
-    assert (r.n_analyses, r.n_updates) == (pdas.n_analyses, pdas.n_updates)
+    assert (r.n_analyses, r.n_updates) == (pdas.n_analyses, 0 if friction else pdas.n_updates)
     assert r.pdas_iterations >= 1 and r.n_solves >= 1 and r.n_factorizations >= 1
     assert r.n_active == int(res.active.sum()) and r.n_constrained == res.contact.size
     assert r.n_full_contact + r.n_semi_contact + r.n_no_contact == r.n_constrained
     assert r.n_full_contact == int((res.classes == FULL_CONTACT).sum())
+    assert r.n_stick + r.n_slip == r.n_active and (r.n_stick > 0) == friction
     assert r.contact_force == pytest.approx(res.contact_force.sum(), rel=1e-14)
     assert r.contact_force > 0
     assert r.backend == pdas.backend != ""
@@ -373,3 +380,27 @@ def test_history_reports_the_kkt_residuals_of_each_level():
             assert value == getattr(kkt, name), (lv.record.level, name)
             assert 0.0 <= value < 1e-12, (lv.record.level, name, value)
         assert lv.record.row()["kkt_primal"] == lv.record.kkt_primal
+
+
+def test_adaptive_with_coulomb_friction_records_and_warm_starts():
+    """The loop with Coulomb friction: every record field filled (the tangential KKT
+    residuals at round-off, stick and slip counts), and each level warm-started from the
+    prolongated solution, which takes fewer semismooth Newton steps than a cold start."""
+    base = example_6_2()
+    conditions = dict(base.conditions)
+    conditions["right"] = dataclasses.replace(conditions["right"], friction=Coulomb(0.3))
+    problem = dataclasses.replace(base, conditions=conditions)
+    levels = list(adaptive(problem, max_ndof=3000))
+    for level in levels:
+        check_record(level, has_exact=False, friction=True)
+        assert level.record.kkt_tangential_complementarity < 1e-12
+    print("levels:", [(lv.record.ndof, lv.record.pdas_iterations) for lv in levels])
+    k = len(levels) - 2
+    start = levels[k]
+    cold = next(adaptive(problem, max_ndof=3000, mesh=start.next_mesh, first_level=k + 1))
+    warm = levels[k + 1]
+    print("warm/cold iterations:", warm.record.pdas_iterations, cold.record.pdas_iterations)
+    assert warm.record.pdas_iterations < cold.record.pdas_iterations
+    np.testing.assert_allclose(
+        warm.result.u, cold.result.u, atol=1e-12 * np.abs(cold.result.u).max()
+    )

@@ -21,8 +21,9 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from .algebra.backends import BACKENDS
+from .algebra.friction_kkt import FrictionKKT
 from .contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
-from .contact.solution import ContactResult, solve
+from .contact.solution import SLIP, STICK, ContactResult, solve
 from .estimator.marking import check_theta, mark_doerfler
 from .estimator.residual import ETA5_VARIANTS, Estimate, estimate
 from .mesh.mesh import Mesh
@@ -49,6 +50,9 @@ COLUMNS: dict[str, str] = {
         "same unit as eta"
         for k in range(1, 8)
     },
+    "eta_8": 'the friction work term η_8 (docs/method.md, *Estimator*, "With friction"), '
+    "unsquared, same unit as eta; 0 without friction (with friction eta_4 is "
+    "‖σ_t(u_h) + p_t,h‖ weighted as before)",
     "error_energy": "energy norm of u − u_h (only with an exact solution, else nan), "
     "same unit as eta",
     "error_h1": "H¹ seminorm of u − u_h (only with an exact solution, else nan), "
@@ -64,6 +68,9 @@ COLUMNS: dict[str, str] = {
     "n_full_contact": "contact nodes in full contact",
     "n_semi_contact": "contact nodes in semi contact",
     "n_no_contact": "contact nodes without contact",
+    "n_stick": "contact nodes in contact that stick (u_t = 0 imposed; 0 without friction)",
+    "n_slip": "contact nodes in contact that slip (friction force at its bound; without "
+    "friction every node in contact)",
     "contact_force": "sum of the nodal contact forces Λ_z, unit of force per thickness",
     "n_marked": "cells marked for refinement on this level (0 on the last level)",
     "kkt_primal": "largest penetration u·n − ψ, relative to the contact's displacement scale "
@@ -73,6 +80,10 @@ COLUMNS: dict[str, str] = {
     "kkt_stationarity": "largest residual of the equilibrium equations at the free, "
     "unconstrained unknowns, relative to the largest force",
     "kkt_dirichlet": "largest misfit of the Dirichlet values, relative to the displacement scale",
+    "kkt_tangential_bound": "largest friction force beyond its bound, max(abs(Λ_t) − s, 0), "
+    "relative to the total contact force (only with friction, else nan)",
+    "kkt_tangential_complementarity": "largest min(stick residual abs(u_t), slip residual) of "
+    "the tangential law (docs/method.md, *Friction*; only with friction, else nan)",
     "backend": "sparse solver backend used (pardiso or scipy)",
     "t_assemble": "seconds spent assembling the linear system",
     "t_solve": "seconds spent in the active set solver",
@@ -104,10 +115,11 @@ class LevelRecord:
         Triangles of the mesh.
     eta : float
         The estimator η_h of (5.1) (unit of the energy norm, √energy).
-    eta_1, eta_2, eta_3, eta_4, eta_5, eta_6, eta_7 : float
-        Its contributions, unsquared, with ``eta² = eta_1² + … + eta_7²`` (docs/method.md,
+    eta_1, eta_2, eta_3, eta_4, eta_5, eta_6, eta_7, eta_8 : float
+        Its contributions, unsquared, with ``eta² = eta_1² + … + eta_8²`` (docs/method.md,
         *Estimator*; the squared per-cell indicators are
-        :attr:`Estimate.eta2 <signorini.Estimate.eta2>`).
+        :attr:`Estimate.eta2 <signorini.Estimate.eta2>`); ``eta_8``, the friction work, is 0
+        without friction.
     error_energy, error_h1 : float
         Energy norm and H¹ seminorm of ``u − u_h`` when the problem has an exact solution,
         else NaN.
@@ -120,13 +132,20 @@ class LevelRecord:
         Contact nodes in the final active set; all nodes on the contact parts.
     n_full_contact, n_semi_contact, n_no_contact : int
         Contact nodes by class (paper Section 4; docs/method.md, *Estimator*).
+    n_stick, n_slip : int
+        Contact nodes in contact that stick or slip (``ContactResult.state``; without friction
+        every node in contact slips).
     contact_force : float
         Sum of the nodal contact forces Λ_z (force per unit thickness).
     n_marked : int
         Cells marked for refinement (0 on the last level).
     kkt_primal, kkt_dual, kkt_complementarity, kkt_stationarity, kkt_dirichlet : float
         The KKT residuals of the discrete problem, each relative to the quantity it is about
-        (:class:`signorini.algebra.kkt.KKTResiduals`; docs/method.md, *Solver*).
+        (:class:`signorini.algebra.kkt.KKTResiduals`; docs/method.md, *Solver*); with
+        friction those of :class:`signorini.algebra.friction_kkt.FrictionKKT`.
+    kkt_tangential_bound, kkt_tangential_complementarity : float
+        With friction, the residuals of the tangential law (docs/method.md, *Friction*);
+        NaN without.
     backend : str
         Sparse solver backend used.
     t_assemble, t_solve, t_estimate, t_mark, t_refine : float
@@ -149,6 +168,7 @@ class LevelRecord:
     eta_5: float
     eta_6: float
     eta_7: float
+    eta_8: float
     error_energy: float = math.nan
     error_h1: float = math.nan
     efficiency: float = math.nan
@@ -162,6 +182,8 @@ class LevelRecord:
     n_full_contact: int = 0
     n_semi_contact: int = 0
     n_no_contact: int = 0
+    n_stick: int = 0
+    n_slip: int = 0
     contact_force: float = 0.0
     n_marked: int = 0
     kkt_primal: float = math.nan
@@ -169,6 +191,8 @@ class LevelRecord:
     kkt_complementarity: float = math.nan
     kkt_stationarity: float = math.nan
     kkt_dirichlet: float = math.nan
+    kkt_tangential_bound: float = math.nan
+    kkt_tangential_complementarity: float = math.nan
     backend: str = ""
     t_assemble: float = 0.0
     t_solve: float = 0.0
@@ -329,7 +353,8 @@ def adaptive(
     backend : {"auto", "pardiso", "scipy"}
         Sparse solver backend.
     warm_start : bool
-        Start each PDAS from the previous level's prolongated solution and contact set.
+        Start each PDAS from the previous level's prolongated solution and contact set (with
+        friction, the semismooth Newton method from its update rule at that solution).
     mesh : Mesh, optional
         Mesh of the first level (default: the problem's).
     u0 : (n_nodes, 2) float array, optional
@@ -362,18 +387,10 @@ def adaptive(
         At the call, for an argument of the wrong type or out of range (naming it):
         ``theta`` outside (0, 1], ``max_ndof`` not a positive number, ``tol`` negative or
         NaN, ``max_levels`` < 1, an unknown ``eta5`` or ``backend``, ``first_level`` not
-        in ``[0, max_levels)``, an initial mesh with more than ``max_ndof`` unknowns, or a
-        problem with friction (no estimator for it yet).
+        in ``[0, max_levels)``, or an initial mesh with more than ``max_ndof`` unknowns.
     """
     if not isinstance(problem, ContactProblem):
         raise ValueError(f"problem must be a ContactProblem, got {type(problem).__name__}")
-    frictional = [p for p in problem.contact_parts if problem.conditions[p].friction is not None]
-    if frictional:
-        raise ValueError(
-            f"problem: contact parts {frictional} have friction; solve() computes frictional "
-            "contact, but the adaptive loop needs its residual estimator, which is not "
-            "available yet for friction"
-        )
     args = check_loop_arguments(
         theta=theta,
         max_ndof=max_ndof,
@@ -491,19 +508,22 @@ def _record(level: int, result: ContactResult, est: Estimate) -> LevelRecord:
         ndof_total=result.space.n_dofs,
         n_cells=result.mesh.n_cells,
         eta=est.eta,
-        **{f"eta_{k + 1}": float(terms[k]) for k in range(7)},
+        **{f"eta_{k + 1}": float(terms[k]) for k in range(8)},
         pdas_iterations=result.pdas.iterations,
-        n_solves=result.pdas.n_solves,
+        # the frictional solver does one linear solve per iteration and reports no updates
+        n_solves=getattr(result.pdas, "n_solves", result.pdas.iterations),
         n_factorizations=result.pdas.n_factorizations,
         n_analyses=result.pdas.n_analyses,
-        n_updates=result.pdas.n_updates,
+        n_updates=getattr(result.pdas, "n_updates", 0),
         n_active=int(result.active.sum()),
         n_constrained=result.contact.size,
         n_full_contact=int((classes == FULL_CONTACT).sum()),
         n_semi_contact=int((classes == SEMI_CONTACT).sum()),
         n_no_contact=int((classes == NO_CONTACT).sum()),
+        n_stick=int((result.state == STICK).sum()),
+        n_slip=int((result.state == SLIP).sum()),
         contact_force=result.total_contact_force,
-        **result.pdas.kkt.columns(),
+        **_kkt_columns(result.pdas),
         backend=result.pdas.backend,
         t_assemble=result.timings["assemble"],
         t_solve=result.timings["solve"],
@@ -513,3 +533,20 @@ def _record(level: int, result: ContactResult, est: Estimate) -> LevelRecord:
         rec.error_energy, rec.error_h1 = err["error_energy"], err["error_h1"]
         rec.efficiency = est.eta / err["error_energy"] if err["error_energy"] > 0 else math.nan
     return rec
+
+
+def _kkt_columns(report) -> dict[str, float]:
+    """The KKT history columns of a solve: the five of the normal law, and with friction
+    (a :class:`~signorini.algebra.friction_kkt.FrictionKKT`) the two of the tangential law."""
+    kkt = report.kkt
+    if not isinstance(kkt, FrictionKKT):
+        return kkt.columns()
+    return {
+        "kkt_primal": kkt.primal,
+        "kkt_dual": kkt.dual,
+        "kkt_complementarity": kkt.complementarity,
+        "kkt_stationarity": kkt.stationarity,
+        "kkt_dirichlet": kkt.dirichlet,
+        "kkt_tangential_bound": kkt.tangential_bound,
+        "kkt_tangential_complementarity": kkt.tangential_complementarity,
+    }

@@ -20,11 +20,9 @@ from scipy.optimize import lsq_linear
 
 from signorini.contact.contact_set import contact_set
 from signorini.contact.solution import INACTIVE, SLIP, STICK, solve
-from signorini.estimator.residual import estimate
 from signorini.fem.material import Material
 from signorini.fem.space import P2Space
 from signorini.fem.stiffness import assemble_stiffness
-from signorini.loop import adaptive
 from signorini.mesh.builders import rectangle
 from signorini.mesh.mesh import Mesh
 from signorini.problem import Contact, ContactProblem, Coulomb, Dirichlet, Neumann, Tresca
@@ -172,8 +170,3 @@ def test_what_is_refused():
         conditions = dict(base.conditions)
         conditions["bottom"] = Contact(friction=Coulomb(0.2))
         solve(ContactProblem(base.mesh, base.material, conditions))
-    pb = pressed_block(Coulomb(0.2), nx=4)
-    with pytest.raises(ValueError, match=r"contact parts \['bottom'\] have friction"):
-        adaptive(pb)
-    with pytest.raises(ValueError, match="its frictional extension is not available yet"):
-        estimate(solve(pb))

@@ -16,7 +16,7 @@ from scipy.integrate import quad
 from signorini.contact.contact_set import FULL_CONTACT, SEMI_CONTACT
 from signorini.contact.solution import solve
 from signorini.estimator.h_half_norm import hhalf_norm2_positive_part, l2_norm2_positive_part
-from signorini.estimator.residual import ETA5_VARIANTS, TERMS, estimate
+from signorini.estimator.residual import ETA5_VARIANTS, NODE_TERMS, TERMS, estimate
 from signorini.examples import example_6_1, example_6_2
 from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle
@@ -24,8 +24,9 @@ from signorini.mesh.refine import refine_nvb, refine_uniform
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
 
 EXAMPLES = {"6.1": example_6_1, "6.2": example_6_2}
-#: row of each term in Estimate.eta2_cell / eta2_node
+#: row of each term in Estimate.eta2_cell and in Estimate.eta2_node (all but η7)
 ROW = {name: k for k, name in enumerate(TERMS)}
+NODE_ROW = {name: k for k, name in enumerate(NODE_TERMS)}
 
 
 # ---------------------------------------------------------------------------- helpers
@@ -272,16 +273,18 @@ def test_indicator_bookkeeping(name, seed):
     result = solve(problem, mesh)
     est = estimate(result)
     n_nodes = result.space.n_nodes
-    assert est.eta2_cell.shape == (7, mesh.n_cells) and est.eta2_node.shape == (6, n_nodes)
+    assert est.eta2_cell.shape == (8, mesh.n_cells) and est.eta2_node.shape == (7, n_nodes)
     assert est.eta2_cell.min() >= 0 and est.eta2_node.min() >= 0
     # element indicators sum to η_h², term by term and in total
     assert est.eta2.sum() == pytest.approx(est.eta**2, rel=1e-13)
     assert est.eta2_terms.sum() == pytest.approx(est.eta**2, rel=1e-13)
-    np.testing.assert_allclose(est.eta_terms, [est.as_dict()[f"eta_{k}"] for k in range(1, 8)])
-    # each η_k², k ≤ 6, is the sum of its node contributions
+    np.testing.assert_allclose(est.eta_terms, [est.as_dict()[f"eta_{k}"] for k in range(1, 9)])
+    # each η_k², k ≠ 7, is the sum of its node contributions; η8 = 0 without friction
+    node_terms = est.eta2_terms[[ROW[name] for name in NODE_TERMS]]
     np.testing.assert_allclose(
-        est.eta2_node.sum(axis=1), est.eta2_terms[:6], rtol=1e-12, atol=1e-14 * est.eta**2
+        est.eta2_node.sum(axis=1), node_terms, rtol=1e-12, atol=1e-14 * est.eta**2
     )
+    assert est.eta_terms[ROW["eta_8"]] == 0.0
     # node contributions vanish at Dirichlet nodes and where a term does not apply
     X = result.space.node_points
     dirichlet = dirichlet_node_mask(problem, X)

@@ -37,8 +37,8 @@ from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, Probl
 
 RTOL = 1e-11
 EXAMPLES = {"6.1": example_6_1, "6.2": example_6_2}
-#: how η_k scales with c, k = 1 … 7
-POWER = np.array([1, 1, 1, 1, 1, 0.5, 0])
+#: how η_k scales with c, k = 1 … 8
+POWER = np.array([1, 1, 1, 1, 1, 0.5, 0, 0.5])
 
 
 def scaled(problem, c: float):

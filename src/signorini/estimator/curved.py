@@ -204,8 +204,10 @@ def contact_integrals(
     w: np.ndarray,
     pressure: np.ndarray | None,
     direction: np.ndarray,
+    friction: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``‖σ_t(u_h)‖²_e`` (η4) and ``‖σ_nn(u_h) [+ p_h]‖²_e`` (η5) on the contact edges of
+    """``‖σ_t(u_h) [+ p_t,h]‖²_e`` (η4; ``friction (k, 3)`` the nodal friction stresses, or
+    ``None``) and ``‖σ_nn(u_h) [+ p_h]‖²_e`` (η5) on the contact edges of
     isoparametric cells: the traction ``σ(u_h) n(t)`` with the normal of the quadratic edge
     at each point, split along the constraint direction field (:func:`direction_field` of
     the nodal ``direction (k, 3, 2)``), integrated with ``|x'(t)|``. Returns rows into
@@ -215,7 +217,8 @@ def contact_integrals(
     sn, _, speed, _ = curved.traction(mesh.edge2cell[e, 0], mesh.edge_local[e, 0], t)
     d = direction_field(direction[rows], t)
     p = None if pressure is None else pressure[rows]
-    return rows, tangential_stress(sn, d, w, speed), normal_stress(sn, d, t, w, speed, p)
+    f = None if friction is None else friction[rows]
+    return rows, tangential_stress(sn, d, w, speed, t, f), normal_stress(sn, d, t, w, speed, p)
 
 
 def edge_node_points(space: P2Space, edges: EdgeSet) -> tuple[np.ndarray, np.ndarray]:

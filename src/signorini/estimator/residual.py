@@ -11,7 +11,13 @@ For every non-Dirichlet P2 node p (docs/method.md, *Estimator*), with ``h_p = ma
      ``h_p ‖σ_nn(u_h) + p_h‖²`` (``consistent``) on ``γ_{p,C}``
 η6   ``s_p d_p``, ``d_p = ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p ds``            semi-contact nodes
 η7   ``‖(u_h·n − ψ)⁺‖²_{H^{1/2}(Γ_C)}``                              global
+η8   ``∫_{γ̃_p} (max(b_h, |p_t,h|) |u_t| − p_t,h u_t) ds``            contact nodes
 ==== =========================================================== =====================
+
+With Tresca or Coulomb friction η4 becomes ``h_p ‖σ_t(u_h) + p_t,h‖²_{γ_{p,C}}`` (p_t,h the
+quadratic interpolant of the nodal friction stresses) and η8, the defect of the friction work,
+is added; without friction both are the frictionless values exactly (η8 = 0;
+docs/method.md, *Estimator*, "With friction").
 
 γ_{p,I}, γ_{p,N}, γ_{p,C} are the interior, Neumann and contact edges that contain p (as a
 vertex or as their midpoint): the only edges where the P2 basis function ψ_p is not zero.
@@ -23,10 +29,10 @@ piecewise quadratic with kinks at nodes, as in Example 6.2).
 Each term is one function of :mod:`signorini.estimator.terms` (arrays in, integrals out):
 η1 ``interior_residual``, η2 ``stress_jump``, η3 ``neumann_residual``,
 η4 ``tangential_stress``, η5 ``normal_stress``, η6 ``complementarity``,
-η7 ``penetration``; :func:`estimate` is the table that feeds them, by name. Every node
-term is a sum of cell or edge integrals; each cell receives its share (edge terms split
-equally between the edge's cells, ``terms.spread_edge_integrals``), so the element
-indicators sum exactly to η_h².
+η7 ``penetration``, η8 ``friction_work``; :func:`estimate` is the table that feeds them, by
+name. Every node term is a sum of cell or edge integrals; each cell receives its share (edge
+terms split equally between the edge's cells, ``terms.spread_edge_integrals``), so the
+element indicators sum exactly to η_h².
 
 On a mesh with curved parts the integrals of the isoparametric cells and their edges are
 replaced by those along the quadratic maps (:mod:`signorini.estimator.curved`), and η4, η5
@@ -57,6 +63,7 @@ from .curved import (
     edge_node_points,
     neumann_integrals,
 )
+from .friction import friction_edges, move_dirichlet_thirds
 from .terms import (
     EdgeSet,
     TermShares,
@@ -64,6 +71,7 @@ from .terms import (
     complementarity,
     direction_field,
     edge_traction,
+    friction_work,
     interior_residual,
     neumann_residual,
     normal_stress,
@@ -75,11 +83,13 @@ from .terms import (
     tangential_stress,
 )
 
-__all__ = ["ETA5_VARIANTS", "TERMS", "Estimate", "estimate", "stress_unit"]
+__all__ = ["ETA5_VARIANTS", "NODE_TERMS", "TERMS", "Estimate", "estimate", "stress_unit"]
 
 ETA5_VARIANTS = ("consistent", "paper")
-#: the terms of (5.1), in the row order of ``Estimate.eta2_cell`` and ``Estimate.eta2_node``
-TERMS = ("eta_1", "eta_2", "eta_3", "eta_4", "eta_5", "eta_6", "eta_7")
+#: the terms of (5.1) and the friction work η8, in the row order of ``Estimate.eta2_cell``
+TERMS = ("eta_1", "eta_2", "eta_3", "eta_4", "eta_5", "eta_6", "eta_7", "eta_8")
+#: the terms with node contributions (all but the global η7), the rows of ``Estimate.eta2_node``
+NODE_TERMS = tuple(name for name in TERMS if name != "eta_7")
 #: line quadrature degree for the polynomial edge terms η2, η4, η5 (σ(u_h) is linear)
 EDGE_DEGREE = 7
 #: line quadrature degree for the Neumann residual with non-polynomial data g: finer, so
@@ -93,8 +103,8 @@ CELL_DEGREE = 8
 STRESS_RANGE = (2.0**-256, 2.0**256)
 #: power of the stress unit in each term's square, in the order of ``TERMS``: η1² … η5² are
 #: squares of stresses (times lengths), η6² = s_p d_p is a stress times a length² times a
-#: displacement, η7² a squared displacement
-UNIT_POWER = (2, 2, 2, 2, 2, 1, 0)
+#: displacement, η7² a squared displacement, η8² (stress × displacement × length) as η6²
+UNIT_POWER = (2, 2, 2, 2, 2, 1, 0, 1)
 
 
 @dataclass(frozen=True)
@@ -103,18 +113,20 @@ class Estimate:
 
     Consistent units: if E is in MPa and lengths in mm (so displacements are in mm), η1 …
     η5 are in MPa·mm (stress × length), η6 in MPa^{1/2}·mm (η6² = s_p d_p: stress × length²),
-    and η7 in mm (a displacement; its square is ‖v‖²_{L²} (mm³) plus the H^{1/2} seminorm
-    (mm²), so η7 is not homogeneous in length alone). η_h adds the squares as the paper does.
+    η7 in mm (a displacement; its square is ‖v‖²_{L²} (mm³) plus the H^{1/2} seminorm
+    (mm²), so η7 is not homogeneous in length alone), and η8 as η6 (η8² = ∫ p_t u_t ds:
+    stress × length²). η_h adds the squares as the paper does; η8 = 0 without friction.
 
     Attributes
     ----------
-    eta2_cell : (7, n_cells) float array
-        Share of each cell in η_k² / unit^{a_k}, k = 1..7 (rows in the order of ``TERMS``,
-        ``a = UNIT_POWER = (2, 2, 2, 2, 2, 1, 0)``). Each row sums to η_k² / unit^{a_k};
+    eta2_cell : (8, n_cells) float array
+        Share of each cell in η_k² / unit^{a_k}, k = 1..8 (rows in the order of ``TERMS``,
+        ``a = UNIT_POWER = (2, 2, 2, 2, 2, 1, 0, 1)``). Each row sums to η_k² / unit^{a_k};
         with ``unit = 1`` (every ordinary problem) these are the squares themselves.
-    eta2_node : (6, n_nodes) float array
-        Node contributions η_{k,p}² / unit^{a_k}, k = 1..6, as the paper writes them (zero at
-        Dirichlet nodes and where a term does not apply). η7 is global.
+    eta2_node : (7, n_nodes) float array
+        Node contributions η_{k,p}² / unit^{a_k} of the terms ``NODE_TERMS`` (η1 … η6, η8), as
+        the paper writes them (zero at Dirichlet nodes and where a term does not apply). η7
+        is global.
     eta5_variant : str
         The η5 variant used (one of ``ETA5_VARIANTS``).
     unit : float
@@ -142,13 +154,13 @@ class Estimate:
 
     @property
     def eta2_terms(self) -> np.ndarray:
-        """``(7,)`` the squared contributions η_k² (they overflow to inf when ``unit`` is
+        """``(8,)`` the squared contributions η_k² (they overflow to inf when ``unit`` is
         beyond about 1e154; :attr:`eta_terms` does not)."""
         return np.ldexp(self.eta2_cell.sum(axis=1), self._exponents[0])
 
     @property
     def eta_terms(self) -> np.ndarray:
-        """``(7,)`` the contributions η_k."""
+        """``(8,)`` the contributions η_k."""
         power = (np.frexp(self.unit)[1] - 1) * np.array(UNIT_POWER) // 2
         return np.ldexp(np.sqrt(self.eta2_cell.sum(axis=1)), power)
 
@@ -168,7 +180,7 @@ class Estimate:
         return float(np.ldexp(np.sqrt(total), r))
 
     def as_dict(self) -> dict[str, float]:
-        """``{"eta": η_h, "eta_1": η1, …, "eta_7": η7}``, the names of the history columns."""
+        """``{"eta": η_h, "eta_1": η1, …, "eta_8": η8}``, the names of the history columns."""
         out = {"eta": self.eta}
         out.update({name: float(v) for name, v in zip(TERMS, self.eta_terms, strict=True)})
         return out
@@ -184,6 +196,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     eta5 : {"consistent", "paper"}
         ``"paper"`` is η5 as printed (the full normal stress on Γ_C); ``"consistent"``
         balances it by the discrete pressure, ``σ_nn(u_h) + p_h`` (docs/method.md, *Estimator*).
+        With friction η4 is ``‖σ_t(u_h) + p_t,h‖`` in both variants.
 
     Returns
     -------
@@ -192,15 +205,10 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     Raises
     ------
     ValueError
-        For an unknown ``eta5``, or a result with friction.
+        For an unknown ``eta5``.
     """
     if eta5 not in ETA5_VARIANTS:
         raise ValueError(f"eta5 must be one of {ETA5_VARIANTS}, got {eta5!r}")
-    if result.contact.friction_law.any():
-        raise ValueError(
-            "result: the residual estimator (5.1) assumes frictionless contact (σ_t = 0 on "
-            "Γ_C); its frictional extension is not available yet"
-        )
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells
     h_p = _node_mesh_size(mesh.h, space.cell_nodes, result.dirichlet_nodes, n_nodes)
@@ -230,6 +238,8 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     misfit = _traction_misfit(problem, mesh, traction, t_n, unit)
     contact = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
     pressure = _edge_pressure(result) / unit if eta5 == "consistent" else None
+    friction = friction_edges(result, unit)  # None without friction
+    p_t = None if friction is None else friction.friction
     gap = cs.edge_normal_gap(result.u)  # u_h·n − ψ_h at [start, end, midpoint]
     density = _semi_contact_density(result) / unit
     x0, x1 = mesh.points[cs.edge_nodes[:, 0]], mesh.points[cs.edge_nodes[:, 1]]
@@ -237,18 +247,24 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     R = interior_residual(mesh.area, div_sigma, f, w_cell)
     J3 = neumann_residual(misfit, w_n, neumann.length)
     contact_traction = _on_boundary(mesh, traction, contact.index, t)
-    J4, J5 = _contact_stress(cs, contact.length, contact_traction, t, w, pressure)
+    J4, J5 = _contact_stress(cs, contact.length, contact_traction, t, w, pressure, p_t)
     parts6 = complementarity(gap, density, contact.length)
+    parts8 = np.zeros_like(parts6)
+    if friction is not None:
+        parts8 = friction_work(friction.slip, p_t, friction.bound, contact.length)
     if curved is not None:  # docs/method.md, *Estimator*, "On curved boundaries"
         R[curved.cells] = curved.interior_residual(None if f is None else f[curved.cells])
         rows, values = neumann_integrals(curved, problem, mesh, neumann, t_n, w_n)
         J3[rows] = values
         rows, values, values5 = contact_integrals(
-            curved, mesh, contact, t, w, pressure, cs.edge_direction
+            curved, mesh, contact, t, w, pressure, cs.edge_direction, p_t
         )
         J4[rows], J5[rows] = values, values5
         rows, points = edge_node_points(space, contact)
         parts6[rows] = complementarity(gap[rows], density[rows], contact.length[rows], points)
+        if friction is not None:
+            slip, bound = friction.slip[rows], friction.bound[rows]
+            parts8[rows] = friction_work(slip, p_t[rows], bound, contact.length[rows], points)
 
     def on_edges(edges: EdgeSet, J: np.ndarray) -> TermShares:
         return spread_edge_integrals(edges, J, h_p, n_cells)
@@ -261,10 +277,13 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
         "eta_5": on_edges(contact, J5),
         "eta_6": spread_node_parts(contact, parts6, n_nodes, n_cells),
         "eta_7": TermShares(None, boundary_cell_shares(contact, penetration(x0, x1, gap), n_cells)),
+        "eta_8": spread_node_parts(
+            contact, move_dirichlet_thirds(parts8, cs.edge_local), n_nodes, n_cells
+        ),
     }
     return Estimate(
         eta2_cell=np.stack([shares[name].cell for name in TERMS]),
-        eta2_node=np.stack([shares[name].node for name in TERMS[:6]]),
+        eta2_node=np.stack([shares[name].node for name in NODE_TERMS]),
         eta5_variant=eta5,
         unit=unit,
     )
@@ -366,19 +385,22 @@ def _contact_stress(
     t: np.ndarray,
     w: np.ndarray,
     pressure: np.ndarray | None,
+    friction: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """η4's and η5's integrals ``(n_ce,)`` on the contact edges of lengths ``length``, from
     ``σ(u_h) n (n_ce, q, 2)`` at the points ``t``: split along the edge's normal where every
     nodal constraint direction is that normal (the paper's case), else along the direction
     field (:func:`~signorini.estimator.terms.direction_field`; docs/method.md, *Estimator*,
-    "On curved boundaries")."""
-    J4 = tangential_stress(traction, cs.edge_normal, w, length)
+    "On curved boundaries"); with the nodal friction stresses ``friction (n_ce, 3)`` η4 is
+    ``‖σ_t + p_t,h‖²``."""
+    J4 = tangential_stress(traction, cs.edge_normal, w, length, t, friction)
     J5 = normal_stress(traction, cs.edge_normal, t, w, length, pressure)
     varying = np.flatnonzero((cs.edge_direction != cs.edge_normal[:, None, :]).any(axis=(1, 2)))
     if varying.size:
         d = direction_field(cs.edge_direction[varying], t)
         tr, ell = traction[varying], length[varying]
-        J4[varying] = tangential_stress(tr, d, w, ell)
+        f = None if friction is None else friction[varying]
+        J4[varying] = tangential_stress(tr, d, w, ell, t, f)
         p = None if pressure is None else pressure[varying]
         J5[varying] = normal_stress(tr, d, t, w, ell, p)
     return J4, J5

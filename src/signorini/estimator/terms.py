@@ -1,7 +1,8 @@
-"""The seven terms of the residual estimator (paper, Section 5, (5.1)), one function each.
+"""The terms of the residual estimator (paper, Section 5, (5.1), and η8 with friction), one
+function each.
 
 Every term function takes arrays and returns the paper's integrals, one per cell (η1),
-per edge (η2–η5, η7) or per edge node (η6); the distributing helpers turn them into node
+per edge (η2–η5, η7) or per edge node (η6, η8); the distributing helpers turn them into node
 contributions ``η_{k,p}²`` and cell shares. :func:`signorini.estimator.residual.estimate`
 is the table that calls them; docs/method.md, *Estimator*, states the choices.
 
@@ -11,14 +12,16 @@ term  function                     integral
 η1    :func:`interior_residual`    ``‖f + div σ(u_h)‖²_T`` per cell
 η2    :func:`stress_jump`          ``‖⟦σ(u_h)⟧‖²_e`` per interior edge
 η3    :func:`neumann_residual`     ``‖σ(u_h)n − g‖²_e`` per Neumann edge
-η4    :func:`tangential_stress`    ``‖σ_t(u_h)‖²_e`` per contact edge
+η4    :func:`tangential_stress`    ``‖σ_t(u_h) [+ p_t,h]‖²_e`` per contact edge
 η5    :func:`normal_stress`        ``‖σ_nn(u_h) [+ p_h]‖²_e`` per contact edge
 η6    :func:`complementarity`      ``s_p ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p`` per edge node
 η7    :func:`penetration`          share of ``‖(u_h·n − ψ)⁺‖²_{H^{1/2}(Γ_C)}``
+η8    :func:`friction_work`        ``∫_{γ̃_p} (max(b_h, |p_t,h|)|u_t| − p_t,h u_t)``
+                                   per edge node
 ====  ===========================  ================================================
 
 The functions carry the names of what they measure; ``estimate`` files their results under
-the term names ``"eta_1"`` … ``"eta_7"`` (``eta2…`` names elsewhere are squared indicators).
+the term names ``"eta_1"`` … ``"eta_8"`` (``eta2…`` names elsewhere are squared indicators).
 """
 
 from __future__ import annotations
@@ -28,9 +31,9 @@ from typing import NamedTuple
 import numpy as np
 
 from ..fem.p2 import edge_basis
-from ..mesh.geometry import segment_normals
 from .h_half_norm import hhalf_norm2_positive_part
-from .thirds import third_integrals
+from .thirds import friction_work_thirds, third_integrals
+from .traction import direction_field, edge_traction
 
 __all__ = [
     "EdgeSet",
@@ -43,6 +46,7 @@ __all__ = [
     "normal_stress",
     "complementarity",
     "penetration",
+    "friction_work",
     "direction_field",
     "boundary_cell_shares",
     "spread_cell_integrals",
@@ -160,58 +164,6 @@ def boundary_cell_shares(edges: EdgeSet, values: np.ndarray, n_cells: int) -> np
     return out
 
 
-# --------------------------------------------------------------------------- σ(u_h) n on edges
-
-
-def edge_traction(
-    sigma_vertex: np.ndarray,
-    points: np.ndarray,
-    cells: np.ndarray,
-    cell: np.ndarray,
-    k: np.ndarray,
-    t: np.ndarray,
-) -> np.ndarray:
-    """``σ(u_h) n`` along local edge ``k`` of ``cell``, n the cell's outward normal.
-
-    σ(u_h) is linear on each cell (P2 displacements), so it is interpolated from its
-    values at the vertices.
-
-    Parameters
-    ----------
-    sigma_vertex : (n_cells, 3, 2, 2) float array
-        σ(u_h) of each cell at its vertices.
-    points, cells : mesh arrays
-    cell, k : (m,) int arrays
-        Cell and local edge of each edge.
-    t : (q,) float array
-        Parameters along the edge, in the cell's counter-clockwise direction.
-
-    Returns
-    -------
-    (m, q, 2) float array
-    """
-    s0 = sigma_vertex[cell, k]
-    s1 = sigma_vertex[cell, (k + 1) % 3]
-    sig = (1 - t)[None, :, None, None] * s0[:, None] + t[None, :, None, None] * s1[:, None]
-    _, n = segment_normals(points[cells[cell, k]], points[cells[cell, (k + 1) % 3]])
-    return np.einsum("eqij,ej->eqi", sig, n)
-
-
-def direction_field(direction: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """The constraint direction along contact edges: the normalised quadratic interpolant of
-    the nodal directions n_z ``(k, 3, 2)`` at ``[start, end, midpoint]``, at parameters
-    ``t (q,)``: ``(k, q, 2)`` unit vectors (docs/method.md, *Estimator*, "On curved
-    boundaries"). Where the interpolant vanishes (nodal directions opposed across one edge,
-    e.g. an edge spanning a slot of an obstacle) the midpoint node's direction is used."""
-    d = np.einsum("qa,kac->kqc", edge_basis(t), direction)
-    size = np.hypot(d[..., 0], d[..., 1])[..., None]
-    small = size <= 1e-8
-    if small.any():
-        d = np.where(small, direction[:, None, 2], d)
-        size = np.where(small, 1.0, size)
-    return d / size
-
-
 def _point_weights(w: np.ndarray, length: np.ndarray) -> np.ndarray:
     """``(k, q)`` quadrature weights along edges: ``w`` times the edge length ``(k,)`` or
     times ``|x'(t)|`` at each point ``(k, q)``."""
@@ -277,9 +229,14 @@ def neumann_residual(residual: np.ndarray, w: np.ndarray, length: np.ndarray) ->
 
 
 def tangential_stress(
-    traction: np.ndarray, normal: np.ndarray, w: np.ndarray, length: np.ndarray
+    traction: np.ndarray,
+    normal: np.ndarray,
+    w: np.ndarray,
+    length: np.ndarray,
+    t: np.ndarray | None = None,
+    friction: np.ndarray | None = None,
 ) -> np.ndarray:
-    """``‖σ_t(u_h)‖²_e`` per contact edge (η4).
+    """``‖σ_t(u_h)‖²_e`` per contact edge (η4), or ``‖σ_t(u_h) + p_t,h‖²_e`` with friction.
 
     Parameters
     ----------
@@ -291,7 +248,19 @@ def tangential_stress(
     w : (q,) float array
     length : (k,) float array
         Edge lengths; ``|x'(t)|`` at each point ``(k, q)`` on a quadratic edge.
+    t : (q,) float array, optional
+        The quadrature points on [0, 1] (needed with ``friction``).
+    friction : (k, 3) float array, optional
+        The nodal friction stresses ``p_t,z = Λ_t,z / w_z`` at ``[start, end, midpoint]``
+        (0 at Dirichlet nodes); ``p_t,h`` is their quadratic interpolant, and the residual
+        is the scalar ``σ(u_h) n · τ + p_t,h`` with ``τ = (−d_y, d_x)`` for the direction d
+        (docs/method.md, *Estimator*, "With friction"). ``None`` without friction.
     """
+    if friction is not None:
+        d = normal if normal.ndim == 3 else np.broadcast_to(normal[:, None, :], traction.shape)
+        residual = traction[..., 1] * d[..., 0] - traction[..., 0] * d[..., 1]
+        residual = residual + friction @ edge_basis(t).T
+        return (_point_weights(w, length) * residual**2).sum(axis=1)
     if normal.ndim == 3:
         snn = np.einsum("eqi,eqi->eq", traction, normal)
         st = traction - snn[..., None] * normal
@@ -358,6 +327,38 @@ def complementarity(
         Each node's part from this edge.
     """
     return density * third_integrals(-gap, length, points)
+
+
+def friction_work(
+    slip: np.ndarray,
+    friction: np.ndarray,
+    bound: np.ndarray,
+    length: np.ndarray,
+    points: np.ndarray | None = None,
+) -> np.ndarray:
+    """``∫_{γ̃_p} (max(b_h, |p_t,h|) |u_t| − p_t,h u_t) ds`` per contact edge node (η8): the
+    defect of the friction work ``p_t u_t = s |u_t|`` of the tangential law (docs/method.md,
+    *Estimator*, "With friction").
+
+    Parameters
+    ----------
+    slip : (k, 3) float array
+        ``u_h·t_z`` (minus the reference slip) at ``[start, end, midpoint]``.
+    friction : (k, 3) float array
+        The nodal friction stresses ``p_t,z`` at the same nodes (0 at Dirichlet nodes).
+    bound : (k, 3) float array
+        The nodal slip bounds ``b_z`` (Tresca ``s_z / w_z``, Coulomb ``F p_z``; 0 at
+        Dirichlet nodes and on frictionless parts).
+    length : (k,) float array
+    points : (k, 3, 2) float array, optional
+        Node points of quadratic edges: integrate along them.
+
+    Returns
+    -------
+    (k, 3) float array
+        The edge's integrals over the thirds of its start, end and midpoint nodes.
+    """
+    return friction_work_thirds(slip, friction, bound, length, points)
 
 
 def penetration(x0: np.ndarray, x1: np.ndarray, gap: np.ndarray) -> np.ndarray:

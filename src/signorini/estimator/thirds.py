@@ -1,6 +1,8 @@
-"""η6's integrals: ``∫_{γ̃_p} v⁺ φ_p ds`` over the thirds of contact edges (paper (4.12);
-docs/method.md, *Estimator*), on straight edges exactly and along quadratic edges with
-``|x'(t)|`` (docs/method.md, *Estimator*, "On curved boundaries")."""
+"""Integrals over the thirds of contact edges: η6's ``∫_{γ̃_p} v⁺ φ_p ds`` (paper (4.12);
+docs/method.md, *Estimator*) and η8's friction work defect ``∫_{γ̃_p} (max(b, |p_t|) |u_t| −
+p_t u_t) ds`` (docs/method.md, *Estimator*, "With friction"), on straight edges exactly and
+along quadratic edges with ``|x'(t)|``
+(docs/method.md, *Estimator*, "On curved boundaries")."""
 
 from __future__ import annotations
 
@@ -9,7 +11,7 @@ import numpy as np
 from ..fem.edge_trace import evaluate, monomial_coefficients, roots_in_unit_interval
 from ..fem.quadrature import gauss_legendre
 
-__all__ = ["CURVED_THIRD_POINTS", "third_integrals"]
+__all__ = ["CURVED_THIRD_POINTS", "friction_work_thirds", "third_integrals"]
 
 #: Gauss points per sub-interval of η6's integrals along a quadratic edge, where ``|x'(t)|``
 #: makes the integrand non-polynomial (it is nearly constant: 5 points, degree 9)
@@ -67,6 +69,66 @@ def third_integrals(
             if points is not None:
                 hat = hat * _speed(points, tq)
             out[:, col] += (x1 - x0)[:, 0] * (gw * np.maximum(vq, 0.0) * hat).sum(axis=1)
+    if points is not None:
+        return out
+    return out * np.asarray(length)[:, None]
+
+
+#: the thirds of [0, 1] as ``(lo, hi, column)``, column 0, 1, 2 = start, end, midpoint
+_THIRDS = ((0.0, 1 / 3, 0), (2 / 3, 1.0, 1), (1 / 3, 2 / 3, 2))
+
+
+def friction_work_thirds(
+    slip: np.ndarray,
+    force: np.ndarray,
+    bound: np.ndarray,
+    length: np.ndarray,
+    points: np.ndarray | None = None,
+) -> np.ndarray:
+    """``∫ (max(b, |p_t|) |u_t| − p_t u_t) ds`` over each third of each edge (η8).
+
+    The three quadratics are given by their values at ``[start, end, midpoint]``. Each third
+    is cut at the roots of ``u_t``, ``p_t − b`` and ``p_t + b``, so that on each piece the
+    integrand is one polynomial of degree 4 and the 3-point Gauss rule (degree 5) is exact.
+    Along quadratic edges (``points`` given) the integrand carries ``|x'(t)|`` and
+    ``CURVED_THIRD_POINTS`` Gauss points are used on each piece.
+
+    Parameters
+    ----------
+    slip : (k, 3) float array
+        ``u_t`` (displacement).
+    force : (k, 3) float array
+        ``p_t`` (stress).
+    bound : (k, 3) float array
+        ``b``, the slip bound (stress).
+    length : (k,) float array
+        Edge lengths (not used with ``points``).
+    points : (k, 3, 2) float array, optional
+        Node points ``[start, end, midpoint]`` of quadratic edges ``x(t)``.
+
+    Returns
+    -------
+    (k, 3) float array
+        The integrals over the start, end and middle thirds: each ``≥ 0`` (the integrand
+        is, pointwise).
+    """
+    cu, cp, cb = (
+        monomial_coefficients(np.asarray(v, dtype=np.float64)) for v in (slip, force, bound)
+    )
+    roots = np.column_stack([roots_in_unit_interval(c) for c in (cu, cp - cb, cp + cb)])
+    gt, gw = gauss_legendre(3 if points is None else CURVED_THIRD_POINTS)
+    out = np.zeros(cu.shape)
+    for lo, hi, col in _THIRDS:
+        r = np.where(np.isnan(roots), lo, np.clip(roots, lo, hi))
+        ends = np.sort(np.column_stack([np.full(len(cu), lo), r, np.full(len(cu), hi)]), axis=1)
+        for j in range(ends.shape[1] - 1):
+            x0, x1 = ends[:, j : j + 1], ends[:, j + 1 : j + 2]
+            tq = x0 + (x1 - x0) * gt
+            u, p, b = evaluate(cu, tq), evaluate(cp, tq), evaluate(cb, tq)
+            work = np.maximum(np.maximum(b, np.abs(p)) * np.abs(u) - p * u, 0.0)
+            if points is not None:
+                work = work * _speed(points, tq)
+            out[:, col] += (x1 - x0)[:, 0] * (gw * work).sum(axis=1)
     if points is not None:
         return out
     return out * np.asarray(length)[:, None]

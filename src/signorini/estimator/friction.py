@@ -1,0 +1,75 @@
+"""What the frictional extension of the estimator reads on the contact edges (docs/method.md,
+*Estimator*, "With friction").
+
+With Tresca or Coulomb friction, η4 balances the tangential stress by the discrete friction
+stress, ``‖σ_t(u_h) + p_t,h‖``, and η8 measures the defect of the friction work,
+``∫ (max(b_h, |p_t,h|) |u_t| − p_t,h u_t)``. Both are quadratics on each contact edge through
+nodal values at ``[start, end, midpoint]``:
+
+- ``p_t,z = Λ_t,z / w_z``, the consistent friction stress (``ContactResult.tangential_pressure``;
+  the obstacle acts on the body with ``−Λ_t t``, so ``p_t ≈ −σ_t``);
+- ``b_z``, the slip bound as a stress: Tresca ``s_z / w_z`` with ``s_z = ∫ s ψ_z``, Coulomb
+  ``F p_z`` (so that ``|p_t,z| ≤ b_z`` is the solver's nodal law ``|Λ_t,z| ≤ s_z`` or
+  ``≤ F Λ_z`` divided by ``w_z``); 0 on frictionless parts;
+- ``u_t(z) = u_h(z)·t_z``, ``t_z = (−n_y, n_x)`` for the constraint direction n_z.
+
+At a Dirichlet end point of Γ_C the stresses are 0 and ``u_t = u_D·t``; its third of the edge
+is given to the edge's midpoint (Dirichlet nodes carry no term).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..contact.contact_set import COULOMB, TRESCA
+from ..contact.solution import ContactResult
+
+__all__ = ["FrictionEdges", "friction_edges", "move_dirichlet_thirds"]
+
+
+class FrictionEdges(NamedTuple):
+    """The frictional quantities at ``[start, end, midpoint]`` of each contact edge, each
+    ``(n_ce, 3)``: ``friction`` p_t,z and ``bound`` b_z (stresses, divided by the estimator's
+    stress unit), ``slip`` u_t (displacement)."""
+
+    friction: np.ndarray
+    bound: np.ndarray
+    slip: np.ndarray
+
+
+def friction_edges(result: ContactResult, unit: float = 1.0) -> FrictionEdges | None:
+    """The nodal inputs of η4 and η8 with friction on the contact edges, stresses divided by
+    the stress unit ``unit``; ``None`` for a result without friction (then η4 is the paper's
+    ``‖σ_t(u_h)‖`` and η8 = 0)."""
+    cs = result.contact
+    if not cs.friction_law.any():
+        return None
+    bound = np.zeros(cs.size)
+    tresca, coulomb = cs.friction_law == TRESCA, cs.friction_law == COULOMB
+    bound[tresca] = cs.friction_bound[tresca] / cs.basis_integral[tresca]
+    bound[coulomb] = cs.friction_coefficient[coulomb] * result.pressure[coulomb]
+    loc = cs.edge_local
+    inside = loc >= 0
+    row = np.maximum(loc, 0)
+    d = cs.edge_direction
+    tangent = np.stack([-d[..., 1], d[..., 0]], axis=-1)
+    slip = np.einsum("ejc,ejc->ej", np.asarray(result.u)[cs.edge_nodes], tangent)
+    return FrictionEdges(
+        friction=np.where(inside, result.tangential_pressure[row], 0.0) / unit,
+        bound=np.where(inside, bound[row], 0.0) / unit,
+        slip=slip,
+    )
+
+
+def move_dirichlet_thirds(parts: np.ndarray, edge_local: np.ndarray) -> np.ndarray:
+    """Per-node parts ``(n_ce, 3)`` with the part of a Dirichlet end point (``edge_local``
+    ``-1``) added to the edge's midpoint, so that Dirichlet nodes carry none and the parts
+    still sum to the edge's integral."""
+    out = parts.copy()
+    for col in (0, 1):
+        at = edge_local[:, col] < 0
+        out[at, 2] += out[at, col]
+        out[at, col] = 0.0
+    return out
