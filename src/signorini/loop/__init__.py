@@ -1,0 +1,252 @@
+"""The adaptive loop SOLVE → ESTIMATE → MARK → REFINE (paper, Section 6).
+
+The only orchestrator of the package: it calls the solver, the estimator, the marking and
+the refinement, warm-starts each solve from the previous level, and yields one
+:class:`Level` at a time so that callers can write results as soon as a level is done.
+A level also carries the mesh and warm start of the next one (:attr:`Level.next_mesh`,
+:attr:`Level.next_u0`), so an interrupted run can be continued from its last finished level
+with ``adaptive(..., mesh=level.next_mesh, u0=level.next_u0, first_level=k + 1)`` and gives
+the same levels as an uninterrupted run.
+"""
+
+from __future__ import annotations
+
+import logging
+import numbers
+import time
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..contact.solution import ContactResult, solve
+from ..estimator.marking import mark_doerfler
+from ..estimator.residual import Estimate, estimate
+from ..mesh.mesh import Mesh
+from ..mesh.refine import refine_nvb, refine_uniform
+from ..problem.problem import ContactProblem
+from .arguments import check_loop_arguments
+from .record import COLUMNS, LevelRecord, level_record
+
+__all__ = ["COLUMNS", "LevelRecord", "Level", "adaptive", "check_loop_arguments"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class Level:
+    """Everything known about one level of the loop.
+
+    Attributes
+    ----------
+    record : LevelRecord
+        The level's row of the convergence history.
+    result : ContactResult
+        The discrete solution on the level's mesh (``result.mesh``).
+    estimate : Estimate
+        The a posteriori estimator of that solution.
+    marked : (n_cells,) bool array or None
+        Cells marked for refinement; None on the last level.
+    next_mesh : Mesh or None
+        The refined mesh the next level solves on; None on the last level.
+    next_u0 : (n_nodes_next, 2) float array or None
+        The next level's warm start: ``result.u`` prolongated to ``next_mesh`` (None on the
+        last level or without warm start). With ``next_mesh`` it is all the loop needs to
+        continue from this level (:func:`adaptive`, ``first_level``).
+    """
+
+    record: LevelRecord
+    result: ContactResult
+    estimate: Estimate
+    marked: np.ndarray | None  # cells marked for refinement (None on the last level)
+    next_mesh: Mesh | None = None
+    next_u0: np.ndarray | None = None
+
+
+def adaptive(
+    problem: ContactProblem,
+    *,
+    theta: float = 0.4,
+    max_ndof: int = 100_000,
+    tol: float = 0.0,
+    max_levels: int = 100,
+    uniform: bool = False,
+    eta5: str = "consistent",
+    backend: str = "auto",
+    warm_start: bool = True,
+    mesh: Mesh | None = None,
+    u0: np.ndarray | None = None,
+    first_level: int = 0,
+    fallback: bool = False,
+    metrics: Callable[[ContactResult], Mapping[str, float]] | None = None,
+) -> Iterator[Level]:
+    """Run SOLVE → ESTIMATE → MARK → REFINE, yielding each finished level.
+
+    Stops after the level whose refinement would exceed ``max_ndof`` free unknowns, when
+    ``η_h ≤ tol``, or after ``max_levels`` levels. The four steps stay in one function
+    (:func:`_levels`, about 50 lines of code) so that the loop reads top to bottom as in
+    docs/method.md, *Marking and refinement*. The arguments are checked when ``adaptive``
+    is called, before any work.
+
+    Parameters
+    ----------
+    problem : ContactProblem
+    theta : float
+        Dörfler parameter in (0, 1] (ignored when ``uniform``).
+    max_ndof : int
+        Budget of free unknowns (:attr:`LevelRecord.ndof`): no level exceeds it.
+    tol : float
+        Stop once the estimator reaches this value (>= 0).
+    max_levels : int
+        Stop after the level with index ``max_levels - 1`` (at least 1).
+    uniform : bool
+        Refine every cell (NVB with all edges bisected) instead of Dörfler marking.
+    eta5 : {"consistent", "paper"}
+        Variant of the estimator's η5 (docs/method.md, *Estimator*).
+    backend : {"auto", "pardiso", "scipy"}
+        Sparse solver backend.
+    warm_start : bool
+        Start each PDAS from the previous level's prolongated solution and contact set (with
+        friction, the semismooth Newton method from its update rule at that solution).
+    mesh : Mesh, optional
+        Mesh of the first level (default: the problem's).
+    u0 : (n_nodes, 2) float array, optional
+        Warm start of the first level's solve on ``mesh`` (P2 nodal displacements: vertices
+        first, then edge midpoints); its nodes in contact form the initial active set.
+        Default: a cold start.
+    first_level : int
+        Index of the first level (default 0). To continue a run from its level ``k``, pass
+        ``mesh=level.next_mesh, u0=level.next_u0, first_level=k + 1`` and the run's other
+        arguments: the levels are those an uninterrupted run yields.
+    fallback : bool
+        Where PDAS cycles or reaches its iteration bound, finish that level's solve with the
+        primal active set method instead of raising (:func:`signorini.solve`); the record's
+        ``n_solves`` counts both.
+    metrics : callable, optional
+        ``metrics(result) -> {column: value}``: measurements of each level's solution beyond
+        the record's own (e.g. the Hertz example's errors against the Hertz solution,
+        :data:`signorini.examples.METRICS`); they go into :attr:`LevelRecord.extra`, hence into
+        the row of ``history.csv``. Names must be new columns, values real numbers.
+
+    Yields
+    ------
+    Level
+        The record, solution, estimate and marked cells of each level, as soon as it is
+        done.
+
+    Raises
+    ------
+    ValueError
+        At the call, for an argument of the wrong type or out of range (naming it):
+        ``theta`` outside (0, 1], ``max_ndof`` not a positive number, ``tol`` negative or
+        NaN, ``max_levels`` < 1, an unknown ``eta5`` or ``backend``, ``first_level`` not
+        in ``[0, max_levels)``, or an initial mesh with more than ``max_ndof`` unknowns.
+    """
+    if not isinstance(problem, ContactProblem):
+        raise ValueError(f"problem must be a ContactProblem, got {type(problem).__name__}")
+    args = check_loop_arguments(
+        theta=theta,
+        max_ndof=max_ndof,
+        tol=tol,
+        max_levels=max_levels,
+        uniform=uniform,
+        eta5=eta5,
+        backend=backend,
+        first_level=first_level,
+    )
+    if metrics is not None and not callable(metrics):
+        raise ValueError(f"metrics must be a function of a ContactResult, got {metrics!r}")
+    if mesh is not None and not isinstance(mesh, Mesh):
+        raise ValueError(f"mesh must be a Mesh, got {type(mesh).__name__}")
+    mesh = problem.mesh if mesh is None else mesh
+    if problem.free_ndof(mesh) > args["max_ndof"]:
+        raise ValueError(
+            f"the initial mesh already has {problem.free_ndof(mesh)} unknowns, "
+            f"more than max_ndof={max_ndof}"
+        )
+    return _levels(
+        problem,
+        mesh,
+        u0,
+        warm_start=bool(warm_start),
+        fallback=bool(fallback),
+        metrics=metrics,
+        **args,
+    )
+
+
+def _levels(
+    problem: ContactProblem,
+    mesh: Mesh,
+    u0: np.ndarray | None,
+    *,
+    theta: float,
+    max_ndof: float,
+    tol: float,
+    max_levels: int,
+    uniform: bool,
+    eta5: str,
+    backend: str,
+    warm_start: bool,
+    fallback: bool,
+    first_level: int,
+    metrics: Callable[[ContactResult], Mapping[str, float]] | None = None,
+) -> Iterator[Level]:
+    """The loop of :func:`adaptive`, on checked arguments."""
+    for level in range(first_level, max_levels):
+        result = solve(problem, mesh, u0=u0, backend=backend, fallback=fallback)
+        u0 = None
+        t0 = time.perf_counter()
+        est = estimate(result, eta5=eta5)
+        t_est = time.perf_counter() - t0
+        record = level_record(level, result, est)
+        record.t_estimate = t_est
+        if metrics is not None:
+            record.extra.update(_measured(metrics, result))
+        last = level == max_levels - 1 or est.eta <= tol
+        marked = next_mesh = None
+        if not last:
+            t0 = time.perf_counter()
+            marked = (
+                np.ones(mesh.n_cells, dtype=bool) if uniform else mark_doerfler(est.eta2, theta)
+            )
+            record.t_mark = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            refinement = refine_uniform(mesh) if uniform else refine_nvb(mesh, marked)
+            next_mesh = refinement.mesh
+            last = problem.free_ndof(next_mesh) > max_ndof
+            if not last and warm_start:
+                u0 = result.space.prolongate(result.u, refinement)
+            record.t_refine = time.perf_counter() - t0
+            if last:
+                marked = next_mesh = None  # the budget ends the run: this marking is discarded
+            else:
+                record.n_marked = int(marked.sum())
+        log.info(
+            "level %d: ndof=%d eta=%.4e pdas=%d",
+            level,
+            record.ndof,
+            record.eta,
+            record.pdas_iterations,
+        )
+        yield Level(record, result, est, marked, next_mesh, u0)
+        if last:
+            return
+        mesh = next_mesh
+
+
+def _measured(
+    metrics: Callable[[ContactResult], Mapping[str, float]], result: ContactResult
+) -> dict[str, float]:
+    """``metrics(result)`` checked: new column names, real values (NaN where undefined)."""
+    values = metrics(result)
+    if not isinstance(values, Mapping):
+        raise ValueError(f"metrics must return a mapping column -> value, got {values!r}")
+    out = {}
+    for name, value in values.items():
+        if not isinstance(name, str) or name in COLUMNS or name == "extra":
+            raise ValueError(f"metrics: {name!r} is not a new column name")
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise ValueError(f"metrics: the value of {name!r} must be a real number, got {value!r}")
+        out[name] = float(value)
+    return out

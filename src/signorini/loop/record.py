@@ -1,0 +1,242 @@
+"""One level's row of the convergence history: :data:`COLUMNS` (what each column means,
+with its unit) and :class:`LevelRecord`, filled from a level's solution and estimate by
+:func:`level_record`."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+from ..algebra.friction_kkt import FrictionKKT
+from ..contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
+from ..contact.solution import SLIP, STICK, ContactResult
+from ..estimator.residual import Estimate
+
+__all__ = ["COLUMNS", "LevelRecord", "kkt_columns", "level_record"]
+
+#: What each :class:`LevelRecord` field (= each column of a run's ``history.csv``) means,
+#: with its unit. Units are those of the problem's data ("consistent units": if E is in MPa
+#: and lengths in mm, forces are in N/mm of thickness and energies in N·mm/mm).
+COLUMNS: dict[str, str] = {
+    "level": "index of the level, 0 for the initial mesh",
+    "ndof": "the paper's Ndof: free scalar unknowns, i.e. 2 × (vertices + edges) of the P2 "
+    "space minus 2 per node on a Dirichlet part (both components of a Dirichlet node are "
+    "excluded; contact unknowns are counted)",
+    "ndof_total": "all scalar P2 unknowns, 2 × (vertices + edges), Dirichlet ones included",
+    "n_cells": "triangles of the mesh",
+    "eta": "the estimator η_h of (5.1), in units of energy norm (√energy)",
+    **{
+        f"eta_{k}": f"contribution η_{k} of the estimator, unsquared (η² = Σ η_k²), "
+        "same unit as eta"
+        for k in range(1, 8)
+    },
+    "eta_8": 'the friction work term η_8 (docs/method.md, *Estimator*, "With friction"), '
+    "unsquared, same unit as eta; 0 without friction (with friction eta_4 is "
+    "‖σ_t(u_h) + p_t,h‖ weighted as before)",
+    "error_energy": "energy norm of u − u_h (only with an exact solution, else nan), "
+    "same unit as eta",
+    "error_h1": "H¹ seminorm of u − u_h (only with an exact solution, else nan), "
+    "unit of displacement",
+    "efficiency": "eta / error_energy (only with an exact solution, else nan), no unit",
+    "pdas_iterations": "primal-dual active set iterations",
+    "n_solves": "linear solves done by the active set method",
+    "n_factorizations": "numerical factorizations of the stiffness matrix",
+    "n_analyses": "symbolic analyses (orderings) of the stiffness matrix",
+    "n_updates": "solves done with a low-rank update of an existing factor",
+    "n_active": "contact nodes in the final active set (u·n = ψ imposed)",
+    "n_constrained": "nodes on the contact parts (vertices and edge midpoints)",
+    "n_full_contact": "contact nodes in full contact",
+    "n_semi_contact": "contact nodes in semi contact",
+    "n_no_contact": "contact nodes without contact",
+    "n_stick": "contact nodes in contact that stick (u_t = 0 imposed; 0 without friction)",
+    "n_slip": "contact nodes in contact that slip (friction force at its bound; without "
+    "friction every node in contact)",
+    "contact_force": "sum of the nodal contact forces Λ_z, unit of force per thickness",
+    "n_marked": "cells marked for refinement on this level (0 on the last level)",
+    "kkt_primal": "largest penetration u·n − ψ, relative to the contact's displacement scale "
+    "(docs/method.md, *Solver*), no unit",
+    "kkt_dual": "largest negative contact force, relative to the total contact force",
+    "kkt_complementarity": "largest min(|Λ_z| / force scale, |u·n − ψ| / displacement scale)",
+    "kkt_stationarity": "largest residual of the equilibrium equations at the free, "
+    "unconstrained unknowns, relative to the largest force",
+    "kkt_dirichlet": "largest misfit of the Dirichlet values, relative to the displacement scale",
+    "kkt_tangential_bound": "largest friction force beyond its bound, max(abs(Λ_t) − s, 0), "
+    "relative to the total contact force (only with friction, else nan)",
+    "kkt_tangential_complementarity": "largest min(stick residual abs(u_t), slip residual) of "
+    "the tangential law (docs/method.md, *Friction*; only with friction, else nan)",
+    "backend": "sparse solver backend used (pardiso or scipy)",
+    "t_assemble": "seconds spent assembling the linear system",
+    "t_solve": "seconds spent in the active set solver",
+    "t_estimate": "seconds spent computing the estimator",
+    "t_mark": "seconds spent in Dörfler marking",
+    "t_refine": "seconds spent refining the mesh (and prolongating the warm start)",
+}
+
+
+@dataclass
+class LevelRecord:
+    """One row of the convergence history: what the numerics measured on one level.
+
+    Units are those of the problem's data (consistent units: if E is in MPa and lengths in
+    mm, forces are in N/mm of thickness). :data:`COLUMNS` holds the same descriptions as
+    text; the command line writes them beside ``history.csv`` as ``history.md``.
+
+    Attributes
+    ----------
+    level : int
+        Index of the level, 0 for the initial mesh.
+    ndof : int
+        The paper's Ndof, the number of **free** scalar unknowns: ``ndof_total`` minus 2
+        for every node (vertex or edge midpoint) on a Dirichlet part. Contact unknowns are
+        counted. Other codes that count all unknowns report ``ndof_total``.
+    ndof_total : int
+        All scalar P2 unknowns, ``2 × (n_vertices + n_edges)``.
+    n_cells : int
+        Triangles of the mesh.
+    eta : float
+        The estimator η_h of (5.1) (unit of the energy norm, √energy).
+    eta_1, eta_2, eta_3, eta_4, eta_5, eta_6, eta_7, eta_8 : float
+        Its contributions, unsquared, with ``eta² = eta_1² + … + eta_8²`` (docs/method.md,
+        *Estimator*; the squared per-cell indicators are
+        :attr:`Estimate.eta2 <signorini.Estimate.eta2>`); ``eta_8``, the friction work, is 0
+        without friction.
+    error_energy, error_h1 : float
+        Energy norm and H¹ seminorm of ``u − u_h`` when the problem has an exact solution,
+        else NaN.
+    efficiency : float
+        ``eta / error_energy`` (NaN without an exact solution).
+    pdas_iterations, n_solves, n_factorizations, n_analyses, n_updates : int
+        Active set iterations; linear solves; numerical factorizations; symbolic analyses;
+        solves done by a low-rank update of an existing factor.
+    n_active, n_constrained : int
+        Contact nodes in the final active set; all nodes on the contact parts.
+    n_full_contact, n_semi_contact, n_no_contact : int
+        Contact nodes by class (paper Section 4; docs/method.md, *Estimator*).
+    n_stick, n_slip : int
+        Contact nodes in contact that stick or slip (``ContactResult.state``; without friction
+        every node in contact slips).
+    contact_force : float
+        Sum of the nodal contact forces Λ_z (force per unit thickness).
+    n_marked : int
+        Cells marked for refinement (0 on the last level).
+    kkt_primal, kkt_dual, kkt_complementarity, kkt_stationarity, kkt_dirichlet : float
+        The KKT residuals of the discrete problem, each relative to the quantity it is about
+        (:class:`signorini.algebra.kkt.KKTResiduals`; docs/method.md, *Solver*); with
+        friction those of :class:`signorini.algebra.friction_kkt.FrictionKKT`.
+    kkt_tangential_bound, kkt_tangential_complementarity : float
+        With friction, the residuals of the tangential law (docs/method.md, *Friction*);
+        NaN without.
+    backend : str
+        Sparse solver backend used.
+    t_assemble, t_solve, t_estimate, t_mark, t_refine : float
+        Seconds spent in each step of the loop.
+    extra : dict
+        Further columns; :meth:`row` merges them into the row. A caller writing the row
+        adds its own columns to the dict :meth:`row` returns (the command line adds its
+        output time ``t_output``).
+    """
+
+    level: int
+    ndof: int
+    ndof_total: int
+    n_cells: int
+    eta: float
+    eta_1: float
+    eta_2: float
+    eta_3: float
+    eta_4: float
+    eta_5: float
+    eta_6: float
+    eta_7: float
+    eta_8: float
+    error_energy: float = math.nan
+    error_h1: float = math.nan
+    efficiency: float = math.nan
+    pdas_iterations: int = 0
+    n_solves: int = 0
+    n_factorizations: int = 0
+    n_analyses: int = 0
+    n_updates: int = 0
+    n_active: int = 0
+    n_constrained: int = 0
+    n_full_contact: int = 0
+    n_semi_contact: int = 0
+    n_no_contact: int = 0
+    n_stick: int = 0
+    n_slip: int = 0
+    contact_force: float = 0.0
+    n_marked: int = 0
+    kkt_primal: float = math.nan
+    kkt_dual: float = math.nan
+    kkt_complementarity: float = math.nan
+    kkt_stationarity: float = math.nan
+    kkt_dirichlet: float = math.nan
+    kkt_tangential_bound: float = math.nan
+    kkt_tangential_complementarity: float = math.nan
+    backend: str = ""
+    t_assemble: float = 0.0
+    t_solve: float = 0.0
+    t_estimate: float = 0.0
+    t_mark: float = 0.0
+    t_refine: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+    def row(self) -> dict:
+        """Flat dict for a CSV row."""
+        d = asdict(self)
+        extra = d.pop("extra")
+        d.update(extra)
+        return d
+
+
+def level_record(level: int, result: ContactResult, est: Estimate) -> LevelRecord:
+    terms = est.eta_terms
+    classes = result.classes
+    rec = LevelRecord(
+        level=level,
+        ndof=result.ndof,
+        ndof_total=result.space.n_dofs,
+        n_cells=result.mesh.n_cells,
+        eta=est.eta,
+        **{f"eta_{k + 1}": float(terms[k]) for k in range(8)},
+        pdas_iterations=result.pdas.iterations,
+        # the frictional solver does one linear solve per iteration and reports no updates
+        n_solves=getattr(result.pdas, "n_solves", result.pdas.iterations),
+        n_factorizations=result.pdas.n_factorizations,
+        n_analyses=result.pdas.n_analyses,
+        n_updates=getattr(result.pdas, "n_updates", 0),
+        n_active=int(result.active.sum()),
+        n_constrained=result.contact.size,
+        n_full_contact=int((classes == FULL_CONTACT).sum()),
+        n_semi_contact=int((classes == SEMI_CONTACT).sum()),
+        n_no_contact=int((classes == NO_CONTACT).sum()),
+        n_stick=int((result.state == STICK).sum()),
+        n_slip=int((result.state == SLIP).sum()),
+        contact_force=result.total_contact_force,
+        **kkt_columns(result.pdas),
+        backend=result.pdas.backend,
+        t_assemble=result.timings["assemble"],
+        t_solve=result.timings["solve"],
+    )
+    if result.problem.exact is not None:
+        err = result.errors()
+        rec.error_energy, rec.error_h1 = err["error_energy"], err["error_h1"]
+        rec.efficiency = est.eta / err["error_energy"] if err["error_energy"] > 0 else math.nan
+    return rec
+
+
+def kkt_columns(report) -> dict[str, float]:
+    """The KKT history columns of a solve: the five of the normal law, and with friction
+    (a :class:`~signorini.algebra.friction_kkt.FrictionKKT`) the two of the tangential law."""
+    kkt = report.kkt
+    if not isinstance(kkt, FrictionKKT):
+        return kkt.columns()
+    return {
+        "kkt_primal": kkt.primal,
+        "kkt_dual": kkt.dual,
+        "kkt_complementarity": kkt.complementarity,
+        "kkt_stationarity": kkt.stationarity,
+        "kkt_dirichlet": kkt.dirichlet,
+        "kkt_tangential_bound": kkt.tangential_bound,
+        "kkt_tangential_complementarity": kkt.tangential_complementarity,
+    }
