@@ -2,39 +2,59 @@
 
 The public API, from the mesh to the adaptive loop::
 
-    from signorini import (Mesh, rectangle, read_mesh, Material, ContactProblem, Dirichlet,
-                           Neumann, Contact, solve, estimate, mark_doerfler, refine_nvb,
-                           adaptive)
+    from signorini import (Mesh, rectangle, read_mesh, Circle, Material, ContactProblem,
+                           Dirichlet, Neumann, Contact, HalfPlane, Coulomb, Tresca, solve,
+                           solve_path, estimate, mark_doerfler, refine_nvb, adaptive)
 """
 
 from .algebra import PDASConvergenceError
-from .contact import ContactResult, solve
+from .contact import ContactResult, solve, solve_path
 from .estimator import Estimate, estimate, mark_doerfler
 from .examples import example_6_1, example_6_2
 from .fem import Material, P2Space
 from .loop import Level, LevelRecord, adaptive
 from .mesh import Mesh, MeshError, read_mesh, rectangle, refine_nvb, refine_uniform
+from .mesh.curves import Circle, Line, ProjectedCurve
 from .output import write_vtu
-from .problem import Contact, ContactProblem, Dirichlet, ExactSolution, Neumann, ProblemError
+from .problem import (
+    Contact,
+    ContactProblem,
+    Coulomb,
+    Dirichlet,
+    ExactSolution,
+    Neumann,
+    ProblemError,
+    Tresca,
+)
+from .problem.obstacles import Disc, HalfPlane, Polyline, SignedDistance
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "Circle",
     "Contact",
     "ContactProblem",
     "ContactResult",
+    "Coulomb",
     "Dirichlet",
+    "Disc",
     "Estimate",
     "ExactSolution",
+    "HalfPlane",
     "Level",
     "LevelRecord",
+    "Line",
     "Material",
     "Mesh",
     "MeshError",
     "Neumann",
     "P2Space",
     "PDASConvergenceError",
+    "Polyline",
     "ProblemError",
+    "ProjectedCurve",
+    "SignedDistance",
+    "Tresca",
     "adaptive",
     "estimate",
     "example_6_1",
@@ -45,5 +65,6 @@ __all__ = [
     "refine_nvb",
     "refine_uniform",
     "solve",
+    "solve_path",
     "write_vtu",
 ]
