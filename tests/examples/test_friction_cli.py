@@ -78,3 +78,29 @@ def test_run_partial_slip_resumed_after_an_interrupt(tmp_path, capsys, monkeypat
             assert float(rb[key]) == pytest.approx(float(ra[key]), rel=1e-9), key
     described = (full / "history.md").read_text()
     assert "c_over_a_theory" in described and "Cattaneo" in described
+
+
+def test_adaptive_benchmark_with_coulomb_friction(tmp_path):
+    """benchmarks/adaptive.py --friction coulomb on a small budget: its ``iters`` column is the
+    history's semismooth Newton iterations, every level has a floor, and it ends on
+    ``ratio_to_floor=X``."""
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[2]
+    script = root / "benchmarks" / "adaptive.py"
+    argv = [sys.executable, str(script), "--friction", "coulomb", "--max-ndof", "3000"]
+    out = subprocess.run(
+        [*argv, "--out", str(tmp_path)], capture_output=True, text=True, timeout=300, check=True
+    ).stdout
+    lines = out.strip().splitlines()
+    header = lines[0].split()
+    table = [dict(zip(header, line.split(), strict=True)) for line in lines[1 : lines.index("")]]
+    history = rows_of(tmp_path / "history.csv")
+    assert [row["iters"] for row in table] == [r["pdas_iterations"] for r in history]
+    assert all(float(row["floor"]) > 0 for row in table)
+    assert all(int(r["n_stick"]) > 0 for r in history[5:])
+    iterations = next(line for line in lines if line.startswith("semismooth Newton iterations"))
+    assert iterations.split(": ")[1].split() == [row["iters"] for row in table]
+    assert lines[-1].startswith("ratio_to_floor=") and float(lines[-1].split("=")[1]) > 0
+    print("\n" + iterations + "; " + lines[-1])

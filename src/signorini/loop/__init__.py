@@ -221,7 +221,8 @@ def _levels(
             steps = solve_path([*path, problem], mesh, backend=backend, u0=u0)
             result, warm = steps[-1], steps[0]
         else:
-            steps = result = warm = solve(problem, mesh, u0=u0, backend=backend, fallback=fallback)
+            result = warm = solve(problem, mesh, u0=u0, backend=backend, fallback=fallback)
+            steps = [result]
         u0 = None
         t0 = time.perf_counter()
         est = estimate(result, eta5=eta5)
