@@ -164,3 +164,41 @@ def test_partial_slip_is_a_load_path_of_two_steps_on_one_mesh():
         adaptive(problem, path=before[0])
     with pytest.raises(ValueError, match="another mesh"):
         adaptive(problem, path=[partial_slip_path(h_bottom=0.05)[0]])
+
+
+def test_example_6_2_friction_laws_give_the_stated_stick_and_slip_zones():
+    """On the initial mesh refined three times (2 048 cells, h = 1/32 on Γ_C): Coulomb F = 0.3
+    sticks around the kink y = 1/2 and slips towards the ends of the contact zone; Tresca
+    s = 30 slips around the kink (but at it) and sticks at the ends; both have about the
+    frictionless contact zone y ≈ 0.19 … 0.81, to an edge (examples/friction.py)."""
+    from signorini import solve
+    from signorini.contact.solution import SLIP, STICK
+    from signorini.examples import example_6_2, example_6_2_tresca
+    from signorini.mesh.refine import refine_uniform
+
+    mesh = example_6_2().mesh
+    for _ in range(3):
+        mesh = refine_uniform(mesh).mesh
+    frictionless = solve(example_6_2(), mesh)
+    y0 = frictionless.space.node_points[frictionless.contact.nodes, 1][frictionless.active]
+    for problem, centre, ends in (
+        (example_6_2_coulomb(), STICK, SLIP),
+        (example_6_2_tresca(), SLIP, STICK),
+    ):
+        r = solve(problem, mesh)
+        points, sides = transitions(r, axis=1)
+        y = r.space.node_points[r.contact.nodes, 1]
+        in_contact = y[r.state > 0]
+        print(f"\n{problem.name}: transitions at y = {np.round(points, 3)}")
+        print(
+            f"contact on [{in_contact.min():.4f}, {in_contact.max():.4f}], frictionless "
+            f"[{y0.min():.4f}, {y0.max():.4f}]"
+        )
+        assert abs(in_contact.min() - y0.min()) <= 1 / 32 + 1e-12
+        assert abs(in_contact.max() - y0.max()) <= 1 / 32 + 1e-12
+        ring = (np.abs(y - 0.5) > 0.05) & (np.abs(y - 0.5) < 0.15)
+        edge = r.state > 0
+        edge &= (y < in_contact.min() + 0.03) | (y > in_contact.max() - 0.03)
+        assert np.all(r.state[ring] == centre), (problem.name, r.state[ring])
+        assert np.all(r.state[edge] == ends), (problem.name, r.state[edge])
+        assert r.pdas.kkt.max < 1e-10

@@ -1,4 +1,5 @@
-"""Ready-made problems: the paper's Examples 6.1 and 6.2, and two on curved geometry.
+"""Ready-made problems: the paper's Examples 6.1 and 6.2 (also with friction), and three on
+curved geometry.
 
 - :mod:`.paper`: the paper's numerical experiments (Section 6);
 - :mod:`.hertz`: an elastic half-disc pressed onto a rigid plane, with the Hertz solution;
