@@ -7,8 +7,14 @@ matrix (analysis + factorization + solve with a fresh solver), measured in the s
 not counted in our total. At the end it prints the ratios of issue #4, each measured in this
 run, and as its last line ``ratio_to_floor=X``.
 
+With ``--friction coulomb`` (or ``tresca``) the same run solves Example 6.2 with friction on
+its contact part (``signorini.examples.friction``: F = 0.3, or s = 30) by the semismooth
+Newton method; the table gains ``iters``, its iterations per level, and the floor stays the
+same: one complete direct (Cholesky) solve of the level's stiffness matrix.
+
     python benchmarks/adaptive.py                 # to just above 10⁶ unknowns
     python benchmarks/adaptive.py --max-ndof 200000
+    python benchmarks/adaptive.py --friction coulomb
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ import numpy as np
 from signorini import adaptive, example_6_2
 from signorini.algebra import eliminate_symmetric, make_solver
 from signorini.contact import assemble
+from signorini.examples import example_6_2_coulomb, example_6_2_tresca
 from signorini.output import HistoryWriter, write_vtu
 from signorini.runtime import retain_freed_memory
 
@@ -63,11 +70,22 @@ def main() -> None:
     parser.add_argument("--backend", default="auto")
     parser.add_argument("--vtu", action="store_true", help="also write a VTU file per level")
     parser.add_argument("--out", type=Path, default=None, help="folder for history/VTU")
+    parser.add_argument(
+        "--friction",
+        choices=("none", "coulomb", "tresca"),
+        default="none",
+        help="Example 6.2 with Coulomb (F = 0.3) or Tresca (s = 30) friction on Γ_C",
+    )
     args = parser.parse_args()
     retain_freed_memory()
     out = args.out or Path(tempfile.mkdtemp(prefix="signorini-bench-"))
     history = HistoryWriter(out / "history.csv")
-    problem = example_6_2()
+    problem = {
+        "none": example_6_2,
+        "coulomb": example_6_2_coulomb,
+        "tresca": example_6_2_tresca,
+    }[args.friction]()
+    friction = args.friction != "none"
 
     cols = (
         "level",
@@ -85,11 +103,12 @@ def main() -> None:
         "total",
         "floor",
         "ratio",
-    )
+    ) + (("iters",) if friction else ())
     print(" ".join(f"{c:>9s}" for c in cols))
     total = floor = 0.0
     phases = dict.fromkeys(("assemble", "pdas", "estimate", "mark", "refine", "output"), 0.0)
     solves_after_5: list[int] = []
+    iterations: list[int] = []
     last_nnz = 0
     generator = adaptive(problem, theta=args.theta, max_ndof=args.max_ndof, backend=args.backend)
     while True:
@@ -138,7 +157,8 @@ def main() -> None:
             level_total,
             level_floor,
             level_total / level_floor,
-        )
+        ) + ((r.pdas_iterations,) if friction else ())
+        iterations.append(r.pdas_iterations)
         print(
             " ".join(f"{v:9.3f}" if isinstance(v, float) else f"{v!s:>9s}" for v in values),
             flush=True,
@@ -157,6 +177,11 @@ def main() -> None:
         print(
             f"PDAS linear solves per level after level 5: {np.mean(solves_after_5):.2f} "
             f"(target <= 1.5)"
+        )
+    if friction:
+        print(
+            f"semismooth Newton iterations per level ({args.friction}): "
+            + " ".join(str(k) for k in iterations)
         )
     print(
         f"estimator + marking + refinement: {overhead:.2f} s = {100 * overhead / total:.1f} % "

@@ -206,8 +206,17 @@ def test_example_6_2_solution_is_symmetric(levels_6_2):
 
 # ------------------------------------------------------------------------------------ lookup
 def test_get_example():
-    assert set(EXAMPLES) == {"example-6.1", "example-6.2", "hertz", "punch"}
-    assert get_example("example-6.2").name == "example-6.2"
+    assert set(EXAMPLES) == {
+        "example-6.1",
+        "example-6.2",
+        "example-6.2-tresca",
+        "example-6.2-coulomb",
+        "hertz",
+        "punch",
+        "partial-slip",
+    }
+    for name in EXAMPLES:
+        assert get_example(name).name == name
     with pytest.raises(ValueError, match="unknown example 'example-6.3'"):
         get_example("example-6.3")
 

@@ -32,7 +32,7 @@ import numpy as np
 
 from .algebra.backends import BACKENDS
 from .estimator.residual import ETA5_VARIANTS
-from .examples import EXAMPLES, METRICS, Metrics, get_example
+from .examples import EXAMPLES, METRICS, Metrics, get_example, get_load_path
 from .loop import COLUMNS, Level, adaptive, check_loop_arguments
 from .mesh.curves import Line
 from .mesh.mesh import Mesh
@@ -73,7 +73,8 @@ def _parser() -> argparse.ArgumentParser:
 
     p = argparse.ArgumentParser(
         prog="signorini",
-        description="Adaptive P2 finite elements for the frictionless Signorini problem.",
+        description="Adaptive P2 finite elements for the Signorini problem, with or without "
+        "friction.",
     )
     p.add_argument("--version", action="version", version=f"signorini {signorini.__version__}")
     sub = p.add_subparsers(dest="command", required=True)
@@ -419,6 +420,7 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
     problem = load_problem(name)
     label = _label(name)
     metrics = METRICS.get(name) if name in EXAMPLES else None
+    path = get_load_path(name) if name in EXAMPLES else None
     if args.resume is not None:
         state = folder.restart()
         status.folder, status.done = folder, state.level
@@ -456,6 +458,7 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
         "backend": opts["backend"],
         "fallback": opts["fallback"],
         "metrics": metrics,
+        "path": path,
     }
     status.phase = "at level 0" if state is None else f"at level {state.level + 1}"
     last = None
@@ -498,7 +501,7 @@ def run(args: argparse.Namespace, status: _Status | None = None) -> int:
         say(f"figures: {', '.join(str(p.name) for p in written)}")
     if opts["compare_uniform"] and not opts["uniform"] and last is not None:
         status.phase = "during the uniform comparison"
-        _compare_uniform(problem, opts, args.no_figures, folder, say, metrics)
+        _compare_uniform(problem, opts, args.no_figures, folder, say, metrics, path)
     folder.set_status("finished")
     say(f"solver backend: {last.record.backend}" if last else "no level finished")
     return 0
@@ -511,6 +514,7 @@ def _compare_uniform(
     folder: RunFolder,
     say,
     metrics: Metrics | None = None,
+    path: list[ContactProblem] | None = None,
 ) -> None:
     """Uniform refinement to the same budget, and one plot of both convergence histories."""
     from . import plots
@@ -529,6 +533,7 @@ def _compare_uniform(
         fallback=opts["fallback"],
         max_levels=opts["max_levels"],
         metrics=metrics,
+        path=path,
     )
     _write_levels(levels, history, folder, vtu=False, save_state=False, say=say)
     if no_figures:

@@ -11,11 +11,13 @@ from __future__ import annotations
 import logging
 from collections.abc import Sequence
 
+import numpy as np
+
 from ..mesh.mesh import Mesh
 from ..problem.problem import ContactProblem
 from .solution import ContactResult, solve
 
-__all__ = ["solve_path"]
+__all__ = ["check_path", "solve_path"]
 
 log = logging.getLogger(__name__)
 
@@ -26,6 +28,7 @@ def solve_path(
     *,
     backend: str = "auto",
     max_iter: int = 50,
+    u0: np.ndarray | None = None,
 ) -> list[ContactResult]:
     """Solve a prescribed load path: one problem per load step, each from the previous step.
 
@@ -42,6 +45,10 @@ def solve_path(
         Sparse solver backend, see :func:`signorini.algebra.make_solver`.
     max_iter : int
         Bound on the active set iterations of each step.
+    u0 : (n_nodes, 2) float array, optional
+        Warm start of the first step on ``mesh`` (as for :func:`~signorini.contact.solve`;
+        e.g. the first step of a coarser mesh prolongated); the later steps start from the
+        previous step.
 
     Returns
     -------
@@ -55,19 +62,22 @@ def solve_path(
         If ``problems`` is empty or holds something else than problems, or two steps have
         different contact parts or initial meshes (naming the step).
     """
-    problems = _checked(problems)
+    problems = check_path(problems)
     mesh = problems[0].mesh if mesh is None else mesh
     results: list[ContactResult] = []
     for i, problem in enumerate(problems):
         previous = results[-1] if results else None
-        results.append(solve(problem, mesh, previous=previous, backend=backend, max_iter=max_iter))
+        start = u0 if previous is None else None
+        results.append(
+            solve(problem, mesh, u0=start, previous=previous, backend=backend, max_iter=max_iter)
+        )
         log.info("load step %d of %d solved", i + 1, len(problems))
     return results
 
 
-def _checked(problems: object) -> list[ContactProblem]:
-    """The steps as a list, checked: problems on one initial mesh with one set of contact
-    parts."""
+def check_path(problems: object) -> list[ContactProblem]:
+    """The steps of a load path as a list, checked: problems on one initial mesh with one
+    set of contact parts (a ``ValueError`` naming the step otherwise)."""
     if isinstance(problems, ContactProblem) or not isinstance(problems, Sequence):
         raise ValueError(
             f"problems must be a sequence of ContactProblem (one per load step), got "

@@ -14,11 +14,12 @@ from __future__ import annotations
 import logging
 import numbers
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..contact.load_path import check_path, solve_path
 from ..contact.solution import ContactResult, solve
 from ..estimator.marking import mark_doerfler
 from ..estimator.residual import Estimate, estimate
@@ -50,9 +51,10 @@ class Level:
     next_mesh : Mesh or None
         The refined mesh the next level solves on; None on the last level.
     next_u0 : (n_nodes_next, 2) float array or None
-        The next level's warm start: ``result.u`` prolongated to ``next_mesh`` (None on the
-        last level or without warm start). With ``next_mesh`` it is all the loop needs to
-        continue from this level (:func:`adaptive`, ``first_level``).
+        The next level's warm start: ``result.u`` prolongated to ``next_mesh`` (with a load
+        path, the first step's solution; None on the last level or without warm start).
+        With ``next_mesh`` it is all the loop needs to continue from this level
+        (:func:`adaptive`, ``first_level``).
     """
 
     record: LevelRecord
@@ -79,6 +81,7 @@ def adaptive(
     first_level: int = 0,
     fallback: bool = False,
     metrics: Callable[[ContactResult], Mapping[str, float]] | None = None,
+    path: Sequence[ContactProblem] | None = None,
 ) -> Iterator[Level]:
     """Run SOLVE → ESTIMATE → MARK → REFINE, yielding each finished level.
 
@@ -127,6 +130,15 @@ def adaptive(
         the record's own (e.g. the Hertz example's errors against the Hertz solution,
         :data:`signorini.examples.METRICS`); they go into :attr:`LevelRecord.extra`, hence into
         the row of ``history.csv``. Names must be new columns, values real numbers.
+    path : sequence of ContactProblem, optional
+        The load steps before ``problem`` of a quasi-static load path (Coulomb friction is
+        path-dependent; docs/method.md, *Load paths*), on the same initial mesh with the same
+        contact parts. Each level then solves the whole path ``[*path, problem]`` on its mesh
+        (:func:`~signorini.contact.load_path.solve_path`, each step from the previous one),
+        and estimates, marks and measures the last step. ``u0`` and :attr:`Level.next_u0`
+        are then the warm start of the first step (its solution on the previous level,
+        prolongated); the record's iteration counts and solve timings are summed over the
+        steps, its KKT residuals are the last step's. ``fallback`` does not apply to it.
 
     Yields
     ------
@@ -140,7 +152,9 @@ def adaptive(
         At the call, for an argument of the wrong type or out of range (naming it):
         ``theta`` outside (0, 1], ``max_ndof`` not a positive number, ``tol`` negative or
         NaN, ``max_levels`` < 1, an unknown ``eta5`` or ``backend``, ``first_level`` not
-        in ``[0, max_levels)``, or an initial mesh with more than ``max_ndof`` unknowns.
+        in ``[0, max_levels)``, an initial mesh with more than ``max_ndof`` unknowns, or a
+        ``path`` whose steps are not problems on ``problem``'s initial mesh with its contact
+        parts.
     """
     if not isinstance(problem, ContactProblem):
         raise ValueError(f"problem must be a ContactProblem, got {type(problem).__name__}")
@@ -158,6 +172,13 @@ def adaptive(
         raise ValueError(f"metrics must be a function of a ContactResult, got {metrics!r}")
     if mesh is not None and not isinstance(mesh, Mesh):
         raise ValueError(f"mesh must be a Mesh, got {type(mesh).__name__}")
+    if path is not None:
+        if isinstance(path, ContactProblem) or not isinstance(path, Sequence):
+            raise ValueError(
+                f"path must be a sequence of ContactProblem (the load steps before problem), "
+                f"got {type(path).__name__}"
+            )
+        path = check_path([*path, problem])[:-1]
     mesh = problem.mesh if mesh is None else mesh
     if problem.free_ndof(mesh) > args["max_ndof"]:
         raise ValueError(
@@ -171,6 +192,7 @@ def adaptive(
         warm_start=bool(warm_start),
         fallback=bool(fallback),
         metrics=metrics,
+        path=path or None,
         **args,
     )
 
@@ -191,16 +213,24 @@ def _levels(
     fallback: bool,
     first_level: int,
     metrics: Callable[[ContactResult], Mapping[str, float]] | None = None,
+    path: Sequence[ContactProblem] | None = None,
 ) -> Iterator[Level]:
     """The loop of :func:`adaptive`, on checked arguments."""
     for level in range(first_level, max_levels):
-        result = solve(problem, mesh, u0=u0, backend=backend, fallback=fallback)
+        if path:
+            steps = solve_path([*path, problem], mesh, backend=backend, u0=u0)
+            result, warm = steps[-1], steps[0]
+        else:
+            result = warm = solve(problem, mesh, u0=u0, backend=backend, fallback=fallback)
+            steps = [result]
         u0 = None
         t0 = time.perf_counter()
         est = estimate(result, eta5=eta5)
         t_est = time.perf_counter() - t0
         record = level_record(level, result, est)
         record.t_estimate = t_est
+        if path:
+            _add_path_counts(record, steps)
         if metrics is not None:
             record.extra.update(_measured(metrics, result))
         last = level == max_levels - 1 or est.eta <= tol
@@ -216,7 +246,7 @@ def _levels(
             next_mesh = refinement.mesh
             last = problem.free_ndof(next_mesh) > max_ndof
             if not last and warm_start:
-                u0 = result.space.prolongate(result.u, refinement)
+                u0 = warm.space.prolongate(warm.u, refinement)
             record.t_refine = time.perf_counter() - t0
             if last:
                 marked = next_mesh = None  # the budget ends the run: this marking is discarded
@@ -233,6 +263,20 @@ def _levels(
         if last:
             return
         mesh = next_mesh
+
+
+def _add_path_counts(record: LevelRecord, steps: Sequence[ContactResult]) -> None:
+    """A load path's level: the record's iteration counts and solve timings summed over the
+    steps (:func:`level_record` wrote the last step's)."""
+    for r in steps[:-1]:
+        report = r.pdas
+        record.pdas_iterations += report.iterations
+        record.n_solves += getattr(report, "n_solves", report.iterations)
+        record.n_factorizations += report.n_factorizations
+        record.n_analyses += report.n_analyses
+        record.n_updates += getattr(report, "n_updates", 0)
+        record.t_assemble += r.timings["assemble"]
+        record.t_solve += r.timings["solve"]
 
 
 def _measured(

@@ -36,6 +36,7 @@ from ..output.history import HistoryLike, check_last, history_columns
 from .slopes import draw_slope_triangle, fit_note, slope_label
 from .style import (
     CONTRIBUTIONS,
+    FRICTION_CONTRIBUTION,
     RC,
     STYLES,
     fit_title,
@@ -390,7 +391,8 @@ def plot_contributions(
     title: str | None = None,
     last: int | None = None,
 ) -> list[Path]:
-    """Figs. 6.2 / 6.4: the estimator contributions ``η_1 … η_7`` of (5.1) against ``N_dof``.
+    """Figs. 6.2 / 6.4: the estimator contributions ``η_1 … η_7`` of (5.1) against ``N_dof``,
+    and for a frictional run the friction work ``η_8``.
 
     A value that is exactly zero, or round-off (below ``ROUNDOFF`` times ``η_h`` of its level,
     e.g. ``η_7 ≈ 1e-17``), is drawn as a hollow marker on the ``≈0`` strip below the log axes
@@ -403,6 +405,8 @@ def plot_contributions(
     ----------
     history : mapping of str to (n_levels,) array, or path of a CSV history
         Needs ``ndof`` and at least one of ``eta_1`` … ``eta_7`` (absent ones are skipped).
+        ``eta_8`` is drawn when the run is frictional: positive on some level, or some
+        node sticks (``n_stick``); a frictionless run's ``eta_8 ≡ 0`` is left out.
     path : str or os.PathLike
         Output path without extension.
     title : str, optional
@@ -417,8 +421,14 @@ def plot_contributions(
     """
     if last is not None:
         check_last(last)
-    h = history_columns(history, ("ndof",), (*CONTRIBUTIONS, "eta"))
+    h = history_columns(
+        history, ("ndof",), (*CONTRIBUTIONS, FRICTION_CONTRIBUTION, "n_stick", "eta")
+    )
     keys = [k for k in CONTRIBUTIONS if k in h]
+    if FRICTION_CONTRIBUTION in h and (
+        np.any(h[FRICTION_CONTRIBUTION] > 0) or np.any(h.get("n_stick", 0) > 0)
+    ):
+        keys.append(FRICTION_CONTRIBUTION)
     if not keys:
         raise ValueError(f"the history has none of the columns {', '.join(CONTRIBUTIONS)}")
     # η_h of each level, the scale of round-off (from the terms if the column is absent)

@@ -27,6 +27,7 @@ from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
 __all__ = [
     "STYLES",
     "CONTRIBUTIONS",
+    "FRICTION_CONTRIBUTION",
     "RC",
     "DPI",
     "SINGLE_COLUMN",
@@ -46,6 +47,10 @@ log = logging.getLogger(__name__)
 #: The history columns of the estimator's contributions η_1 … η_7 (paper, (5.1)).
 CONTRIBUTIONS = tuple(f"eta_{k}" for k in range(1, 8))
 
+#: The history column of the friction work η_8 (docs/method.md, *Estimator*, "With
+#: friction"): a contribution of frictional runs only.
+FRICTION_CONTRIBUTION = "eta_8"
+
 #: Colour, marker and label of every plotted quantity (keyed by its history column), the
 #: same in all figures.
 STYLES: dict[str, dict[str, str]] = {
@@ -60,6 +65,7 @@ STYLES: dict[str, dict[str, str]] = {
     "eta_5": {"color": "#e377c2", "marker": "D", "label": r"$\eta_5$"},
     "eta_6": {"color": "#7f7f7f", "marker": "p", "label": r"$\eta_6$"},
     "eta_7": {"color": "#bcbd22", "marker": "h", "label": r"$\eta_7$"},
+    "eta_8": {"color": "#393b79", "marker": "*", "label": r"$\eta_8$"},
     "pressure": {"color": "#08306b", "marker": "o", "label": r"$p_h$"},
     "contact": {"color": "#d62728", "marker": "", "label": r"$\Gamma_C$"},
     "obstacle": {"color": "#333333", "marker": "", "label": "obstacle"},
