@@ -497,3 +497,25 @@ def test_problem_without_contact_has_no_contact_terms():
     assert [terms[f"eta_{k}"] for k in (4, 5, 6, 7)] == [0.0] * 4
     assert terms["eta_1"] > 0 and terms["eta_3"] > 0
     assert est.eta2.sum() == pytest.approx(est.eta**2, rel=1e-14)
+
+
+def test_round_off_negative_contact_force_gives_no_negative_eta6():
+    """A semi-contact node whose Λ_p is a round-off negative (as the frictional solver may
+    leave it) must not make η6² negative and η6 NaN."""
+    import dataclasses
+
+    from signorini.contact.contact_set import SEMI_CONTACT
+    from signorini.contact.solution import solve
+    from signorini.estimator.residual import estimate
+    from signorini.examples import example_6_2
+
+    result = solve(example_6_2())
+    semi = result.classes == SEMI_CONTACT
+    assert semi.any()
+    reference = estimate(result)
+    force = result.contact_force.copy()
+    force[semi] = -1e-30 * force.max()
+    tampered = dataclasses.replace(result, contact_force=force)
+    est = estimate(tampered)
+    assert np.isfinite(est.eta_terms).all() and est.eta_terms[5] == 0.0
+    assert reference.eta_terms[5] > 0  # the untouched solution has η6 > 0 there

@@ -415,8 +415,9 @@ def _edge_pressure(result: ContactResult) -> np.ndarray:
 
 def _semi_contact_density(result: ContactResult) -> np.ndarray:
     """The density ``s_p`` (4.1) at ``[start, end, midpoint]`` of each contact edge where p is
-    a semi-contact node, else 0: ``(n_ce, 3)``."""
+    a semi-contact node, else 0: ``(n_ce, 3)``. A negative Λ_p is round-off (the solver's
+    KKT check bounds it) and counts as 0: η6² = s_p d_p must not turn negative."""
     loc = result.contact.edge_local
     semi = result.classes == SEMI_CONTACT
     use = (loc >= 0) & semi[np.maximum(loc, 0)]
-    return np.where(use, result.density[np.maximum(loc, 0)], 0.0)
+    return np.where(use, np.maximum(result.density[np.maximum(loc, 0)], 0.0), 0.0)
