@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..algebra.friction import INACTIVE, SLIP, solve_friction
+from ..algebra.friction import INACTIVE, SLIP, STICK, solve_friction
 from ..algebra.friction_result import FrictionResult
 from ..fem.space import P2Space
 from ..problem.fields import ProblemError
@@ -33,6 +33,7 @@ __all__ = [
     "check_previous",
     "slip_reference",
     "solve_frictional",
+    "states_from_displacement",
 ]
 
 
@@ -121,6 +122,30 @@ def slip_reference(previous: object, cs: ContactSet) -> np.ndarray:
     return x[2 * cs.nodes + 1]
 
 
+def states_from_displacement(
+    u0: np.ndarray, cs: ContactSet, reference: np.ndarray, active0: np.ndarray, rtol: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Initial node states read off a displacement (the previous level's solution
+    prolongated): in contact where ``active0``; there STICK where the slip
+    ``u0(z)·t_z − reference`` is zero (below ``rtol · max|u0|``: a stick zone prolongates to
+    exact zeros), else SLIP in the slip's direction (the friction force ``Λ_t`` has the sign
+    of the slip). Out of contact the direction is kept too (classical Tresca acts there;
+    the caller drops it for Coulomb).
+
+    Returns
+    -------
+    state0, direction0 : (k,) int arrays
+        ``INACTIVE``/``STICK``/``SLIP`` and ``−1, 0, 1``.
+    """
+    n = cs.normal
+    slip = np.einsum("kc,kc->k", u0[cs.nodes], np.column_stack([-n[:, 1], n[:, 0]]))
+    slip = slip - reference
+    moving = np.abs(slip) > rtol * np.abs(u0).max(initial=0.0)
+    direction = np.where(moving, np.sign(slip), 0.0).astype(np.int64)
+    state = np.where(active0, np.where(moving, SLIP, STICK), INACTIVE)
+    return state, direction
+
+
 def solve_frictional(
     assembled: Assembled,
     K,
@@ -130,6 +155,8 @@ def solve_frictional(
     backend: str,
     max_iter: int,
     previous: object = None,
+    active0: np.ndarray | None = None,
+    warm_rtol: float = 0.0,
 ) -> FrictionSolve:
     """Solve the frictional contact problem of an assembled system (``K``, ``F`` possibly
     divided by the stiffness unit: the forces returned are in that unit).
@@ -139,13 +166,19 @@ def solve_frictional(
     assembled : Assembled
     K, F : the system to solve, in node frames
     u0 : (n_nodes, 2) float array or None
-        Warm start: the update rule evaluated at it.
+        Warm start (e.g. the previous level's solution prolongated): with ``active0`` the
+        initial states are read off it (:func:`states_from_displacement`), else the update
+        rule is evaluated at it.
     backend : str
     max_iter : int
     previous : ContactResult, optional
         The previous load step (checked by :func:`check_previous`): the law acts on the slip
         from its tangential displacements (:func:`slip_reference`); without ``u0`` its states
         (same law) or its displacement (else) are the warm start.
+    active0 : (k,) bool array, optional
+        The nodes in contact in ``u0`` (the frictionless warm-start rule of ``solve``).
+    warm_rtol : float
+        The relative size below which a tangential displacement of ``u0`` counts as zero.
     """
     cs = assembled.contact
     law = check_friction_set(cs)
@@ -158,7 +191,12 @@ def solve_frictional(
             warm = {"state0": report.state, "direction0": report.direction}
         elif u0 is None:
             u0 = previous.u
-    if u0 is not None:
+    if u0 is not None and active0 is not None:
+        state0, direction0 = states_from_displacement(u0, cs, reference, active0, warm_rtol)
+        if law != "tresca":  # Coulomb: no friction force without contact, so no direction
+            direction0[state0 == INACTIVE] = 0
+        warm = {"state0": state0, "direction0": direction0}
+    elif u0 is not None:
         warm = {"x0": to_frames(u0.ravel(), cs.frame_nodes, cs.frames)}
     common = {
         "dirichlet": assembled.dirichlet,

@@ -285,7 +285,15 @@ def solve(
     t0 = time.perf_counter()
     if cs.friction_law.any():
         fr = solve_frictional(
-            assembled, K, F, u0=u0, backend=backend, max_iter=max_iter, previous=previous
+            assembled,
+            K,
+            F,
+            u0=u0,
+            backend=backend,
+            max_iter=max_iter,
+            previous=previous,
+            active0=active0,
+            warm_rtol=WARM_START_RTOL,
         )
         seconds = time.perf_counter() - t0
         u = to_cartesian(fr.x, cs.frame_nodes, cs.frames).reshape(-1, 2)
