@@ -17,6 +17,7 @@ from signorini.examples.punch import punch
 from signorini.fem.space import P2Space
 from signorini.mesh.mesh import Mesh
 from signorini.mesh.refine import refine_uniform
+from signorini.problem import ContactProblem, Neumann
 
 
 @pytest.fixture(scope="module")
@@ -103,6 +104,9 @@ def test_warm_starts_small_meshes_and_the_switch_leave_pdas_alone(fine, cold):
     small = refine_uniform(refine_uniform(problem.mesh).mesh).mesh
     assert problem.free_ndof(small) < NESTED_MIN_NDOF
     assert "nested" not in solve(problem, small).timings
+    conditions = {**problem.conditions, "right": Neumann()}
+    no_contact = ContactProblem(problem.mesh, problem.material, conditions)
+    assert "nested" not in solve(no_contact, mesh).timings
 
 
 def test_transfer_to_the_same_mesh_is_the_identity_also_at_a_corner():

@@ -258,10 +258,11 @@ def solve(
         tangential displacements, and it is the warm start (its node states, or its
         displacement; ``u0`` replaces it). Without friction only the warm start.
     nested : bool
-        Without a warm start, without friction and on a mesh other than the problem's
-        initial one with at least ``NESTED_MIN_NDOF`` free unknowns, start PDAS from the
-        active set of a coarse solve (:mod:`signorini.contact.nested`; docs/method.md,
-        *Solver*). The solution is the same; False starts from the empty active set.
+        With contact, without a warm start, without friction and on a mesh other than the
+        problem's initial one with at least ``NESTED_MIN_NDOF`` free unknowns, start PDAS
+        from the active set of a coarse solve (:mod:`signorini.contact.nested`;
+        docs/method.md, *Solver*). The solution is the same; False starts from the empty
+        active set.
 
     Raises
     ------
@@ -295,6 +296,7 @@ def solve(
         nested
         and active0 is None
         and mesh is not problem.mesh
+        and cs.size > 0
         and not cs.friction_law.any()
         and space.n_dofs - assembled.dirichlet.size >= NESTED_MIN_NDOF
     ):
