@@ -16,7 +16,7 @@ import numpy as np
 from ..algebra.backends import make_solver
 from ..algebra.friction import INACTIVE, SLIP, STICK
 from ..algebra.pdas import solve_pdas
-from ..algebra.result import PDASResult
+from ..algebra.result import PDASConvergenceError, PDASResult
 from ..fem.norms import energy_error2, h1_seminorm_error2
 from ..fem.space import P2Space
 from ..mesh.mesh import Mesh
@@ -24,6 +24,7 @@ from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
 from .frictional import check_previous, solve_frictional
+from .nested import NESTED_MIN_NDOF, coarse_mesh, transfer_active
 from .node_frames import to_cartesian
 from .profile import ContactProfile, contact_profile
 from .system import Assembled, assemble
@@ -229,6 +230,7 @@ def solve(
     fallback: bool = False,
     assembled: Assembled | None = None,
     previous: ContactResult | None = None,
+    nested: bool = True,
 ) -> ContactResult:
     """Solve the discrete Signorini problem (3.2) on ``mesh`` by the primal-dual active set
     method (docs/method.md, *Solver*); with Tresca or Coulomb friction on a contact part, by
@@ -255,6 +257,12 @@ def solve(
         parts (docs/method.md, *Load paths*): the friction law acts on the slip from its
         tangential displacements, and it is the warm start (its node states, or its
         displacement; ``u0`` replaces it). Without friction only the warm start.
+    nested : bool
+        With contact, without a warm start, without friction and on a mesh other than the
+        problem's initial one with at least ``NESTED_MIN_NDOF`` free unknowns, start PDAS
+        from the active set of a coarse solve (:mod:`signorini.contact.nested`;
+        docs/method.md, *Solver*). The solution is the same; False starts from the empty
+        active set.
 
     Raises
     ------
@@ -283,6 +291,17 @@ def solve(
     unit = stiffness_unit(assembled.K)
     K, F = (assembled.K, assembled.F) if unit == 1.0 else (assembled.K / unit, assembled.F / unit)
     t0 = time.perf_counter()
+    timings = {"assemble": assembled.seconds}
+    if (
+        nested
+        and active0 is None
+        and mesh is not problem.mesh
+        and cs.size > 0
+        and not cs.friction_law.any()
+        and space.n_dofs - assembled.dirichlet.size >= NESTED_MIN_NDOF
+    ):
+        active0 = _nested_active_set(problem, assembled, backend, max_iter, fallback)
+        timings["nested"] = time.perf_counter() - t0
     if cs.friction_law.any():
         fr = solve_frictional(
             assembled,
@@ -346,5 +365,27 @@ def solve(
         active=res.active,
         pdas=res,
         dirichlet_nodes=assembled.dirichlet[::2] // 2,
-        timings={"assemble": assembled.seconds, "solve": seconds},
+        timings=timings | {"solve": seconds},
     )
+
+
+def _nested_active_set(
+    problem: ContactProblem, assembled: Assembled, backend: str, max_iter: int, fallback: bool
+) -> np.ndarray | None:
+    """The initial active set of a cold solve on ``assembled``'s mesh from a solve on the
+    coarse mesh of :func:`~.nested.coarse_mesh` (itself nested where it qualifies), or None
+    where there is no coarse mesh or its PDAS fails (the fine PDAS then starts empty)."""
+    space, cs = assembled.space, assembled.contact
+    coarse = coarse_mesh(problem.mesh, space.mesh, problem.contact_parts)
+    if coarse is None:
+        return None
+    try:
+        result = solve(problem, coarse, backend=backend, max_iter=max_iter, fallback=fallback)
+    except PDASConvergenceError:
+        return None
+    log.info(
+        "nested iteration: coarse mesh of %d unknowns, %d PDAS iterations",
+        result.ndof,
+        result.pdas.iterations,
+    )
+    return transfer_active(result.space, result.contact, result.active, space, cs)
