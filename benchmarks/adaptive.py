@@ -4,8 +4,15 @@ Per level it prints the unknowns, the time of each phase (assembly, PDAS with it
 solves, factorizations and whether the symbolic analysis was reused, estimator, marking,
 refinement, output) and the *floor*: one complete direct solve of that level's stiffness
 matrix (analysis + factorization + solve with a fresh solver), measured in the same run and
-not counted in our total. At the end it prints the ratios of issue #4, each measured in this
-run, and as its last line ``ratio_to_floor=X``.
+not counted in our total. Each level's row ends with its peak resident memory (``peakMiB``:
+``VmHWM``, reset when the level starts, read before the floor's solve) and that over the
+memory of its Cholesky factor (``peak/L``, 8 bytes per non-zero PARDISO reports); the summary
+gives PARDISO's own memory on the last level (``iparm[14..16]``). At the end it prints the
+ratios of issue #4, each measured in this run, and as its last line ``ratio_to_floor=X``.
+
+Measured to 5·10⁶ unknowns (``--max-ndof 6000000``, 2 cores shared with other jobs): 50
+levels to 5 394 800 unknowns in 221 s (sum of floors 139 s); peak 14 065 MiB on the last
+level, 3.54 x its factor (3972 MiB); 3.89 x at 994 748 unknowns.
 
 With ``--friction coulomb`` (or ``tresca``) the same run solves Example 6.2 with friction on
 its contact part (``signorini.examples.friction``: F = 0.3, or s = 30) by the semismooth
@@ -15,6 +22,7 @@ same: one complete direct (Cholesky) solve of the level's stiffness matrix.
     python benchmarks/adaptive.py                 # to just above 10⁶ unknowns
     python benchmarks/adaptive.py --max-ndof 200000
     python benchmarks/adaptive.py --friction coulomb
+    python benchmarks/adaptive.py --max-ndof 6000000   # to 5.4 million unknowns, 14 GiB
 """
 
 from __future__ import annotations
