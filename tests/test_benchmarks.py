@@ -97,3 +97,39 @@ def test_inclined_block_example_runs(tmp_path):
     penetration = float(last.split("largest penetration ")[1])
     assert force > 10.0 and penetration < 1e-12
     assert (tmp_path / "solution.vtu").is_file() and (tmp_path / "deformed.png").is_file()
+
+
+def test_throughput_benchmark_prints_a_table_of_positive_rates():
+    """benchmarks/throughput.py on two small levels: one Markdown row per requested size, at
+    the first level of Example 6.2 with at least that many unknowns, every rate positive, the
+    share of the dense peak the factorization's rate over the printed peak."""
+    out = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "benchmarks" / "throughput.py"),
+            "--sizes",
+            "2000",
+            "5000",
+            "--blas-n",
+            "200",
+            "--repeat",
+            "2",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=True,
+    ).stdout
+    print(out)
+    lines = out.strip().splitlines()
+    assert lines[0].startswith("| unknowns |") and set(lines[1]) <= set("|-: ")
+    rows = [[cell.strip() for cell in line.strip("|").split("|")] for line in lines[2:4]]
+    assert lines[4] == ""
+    ndof = [int(row[0].replace(" ", "")) for row in rows]
+    assert ndof == [2368, 6144]  # Example 6.2, theta = 0.4: first levels >= 2000 and >= 5000
+    for row in rows:
+        values = [float(cell.rstrip(" %")) for cell in row[1:]]
+        assert all(v > 0 for v in values[:-1]), row
+        gflops, share = values[-2], values[-1]
+        peak = float(lines[5].split("dense peak: ")[1].split()[0])
+        assert share == pytest.approx(100 * gflops / peak, rel=0.05, abs=0.01), (share, peak)

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from linalg_problems import block_spd
 
 from signorini.algebra import (
@@ -123,3 +124,21 @@ def test_negative_pivot_names_the_equation():
     with pytest.raises(FactorizationError, match="PARDISO phase 22 failed with error -4") as info:
         PardisoSolver(A.tocsr())
     assert info.value.code == -4 and info.value.backend == "pardiso"
+
+
+@pytest.mark.skipif(not HAS_PARDISO, reason="PARDISO not available")
+def test_reported_operation_count_and_memory_of_a_dense_factorization():
+    """A dense SPD matrix stored sparse: PARDISO's operation count is about the n³/3 of a
+    dense Cholesky factorization, and its factorization memory holds at least the n(n+1)/2
+    doubles of the triangular factor; the analysis reports before any factorization is
+    needed again."""
+    n = 400
+    B = np.random.default_rng(0).standard_normal((n, n))
+    A = sp.csr_matrix(B @ B.T + n * np.eye(n))
+    with PardisoSolver(A) as solver:
+        ratio = solver.factor_mflop * 1e6 / (n**3 / 3)
+        memory = solver.memory_kib
+    assert 0.9 <= ratio <= 1.5, ratio
+    assert set(memory) == {"analysis_peak", "permanent", "factorization"}
+    assert memory["factorization"] * 1024 >= 8 * n * (n + 1) // 2, memory
+    assert memory["analysis_peak"] > 0 and memory["permanent"] > 0, memory

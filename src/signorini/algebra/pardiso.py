@@ -149,8 +149,11 @@ class PardisoSolver(SPDSolver):
     positions in the full matrix are found once per pattern, so a refactorization only gathers
     values. Settings (``iparm``, 0-based): user values (``[0] = 1``), nested dissection
     ordering from parallel METIS (``[1] = 3``), no iterative refinement by default (``[7] = 0``),
-    double precision, in-core, 0-based indices (``[34] = 1``). A zero or negative pivot stops
-    the factorization with error -4, reported as :class:`FactorizationError` with the equation.
+    double precision, in-core, 0-based indices (``[34] = 1``); the analysis reports the factor's
+    non-zeros (``[17]``, :attr:`factor_nnz`) and the factorization's operation count (``[18]``,
+    :attr:`factor_mflop`), and PARDISO its memory (``[14..16]``, :attr:`memory_kib`). A zero
+    or negative pivot stops the factorization with error -4, reported as
+    :class:`FactorizationError` with the equation.
 
     MKL is found by :func:`pardiso_function`; when it cannot be loaded the constructor raises
     :class:`~.solvers.BackendUnavailableError`. The MKL handle is freed by :meth:`close` (also
@@ -177,6 +180,7 @@ class PardisoSolver(SPDSolver):
         iparm[7] = 0  # iterative refinement steps (none unless pivots are perturbed)
         iparm[9] = 8  # pivot perturbation 1e-8 (only for indefinite types)
         iparm[17] = -1  # report the number of non-zeros of the factor in iparm[17]
+        iparm[18] = -1  # report the factorization's operation count (Mflop) in iparm[18]
         iparm[26] = 0  # no matrix checker (indices are sorted and checked here)
         iparm[27] = 0  # double precision
         iparm[34] = 1  # 0-based indexing
@@ -193,6 +197,31 @@ class PardisoSolver(SPDSolver):
     def factor_nnz(self) -> int:
         """Non-zeros in the Cholesky factor (reported by the last analysis)."""
         return int(self._iparm[17])
+
+    @property
+    def factor_mflop(self) -> int:
+        """Floating-point operations of one numerical factorization, in millions (``iparm[18]``,
+        reported by the last analysis); 0 before the first analysis."""
+        return int(self._iparm[18])
+
+    @property
+    def memory_kib(self) -> dict[str, int]:
+        """PARDISO's own memory as reported by the last analysis and factorization, in KiB.
+
+        Returns
+        -------
+        dict
+            ``analysis_peak`` (``iparm[14]``, peak of the analysis), ``permanent``
+            (``iparm[15]``, kept from the analysis for the factorization and solves) and
+            ``factorization`` (``iparm[16]``, the factor and the working memory of the
+            factorization and solves). PARDISO's peak is ``max(analysis_peak, permanent +
+            factorization)``.
+        """
+        return {
+            "analysis_peak": int(self._iparm[14]),
+            "permanent": int(self._iparm[15]),
+            "factorization": int(self._iparm[16]),
+        }
 
     def _call(self, phase: int, b: np.ndarray | None = None, x: np.ndarray | None = None) -> None:
         nrhs = 1 if b is None or b.ndim == 1 else b.shape[1]

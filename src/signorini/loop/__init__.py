@@ -262,6 +262,9 @@ def _levels(
         yield Level(record, result, est, marked, next_mesh, u0)
         if last:
             return
+        # this level's solution, estimator and refinement maps are the caller's now: not held
+        # here while the next level is solved (whose factorization is the run's memory peak)
+        del result, warm, steps, est, marked, refinement
         mesh = next_mesh
 
 
