@@ -58,7 +58,7 @@ from .friction_result import (
 )
 from .friction_system import CoulombSystem, TrescaSystem
 from .qp import check_vector
-from .solvers import SPDSolver
+from .solvers import SPDSolver, solver_usage
 
 __all__ = ["INACTIVE", "SLIP", "STICK", "solve_friction"]
 
@@ -175,12 +175,12 @@ def solve_friction(
     own_solver = solver is None
     if own_solver:
         solver = make_solver(backend) if tresca else make_lu_solver(backend)
-    before = _usage(solver)
+    before = solver_usage(solver)
     try:
         system = TrescaSystem(problem, solver) if tresca else CoulombSystem(problem, solver)
         x, states, history = _iterate(system, states, rule, max_iter)
     finally:
-        used = {key: value - before[key] for key, value in _usage(solver).items()}
+        used = {key: value - before[key] for key, value in solver_usage(solver).items()}
         backend_name = solver.backend
         if own_solver:
             solver.close()
@@ -288,16 +288,6 @@ def _initial_states(
     if problem.everywhere:  # out of contact: direction 0 means stuck (FrictionResult)
         stick |= ~active & (direction == 0) & forced
     return active, stick, np.where(stick, 0.0, direction)
-
-
-def _usage(solver: SPDSolver) -> dict[str, float]:
-    return {
-        "n_factorizations": solver.n_factorizations,
-        "n_analyses": solver.n_analyses,
-        "analysis": solver.time_analysis,
-        "factorization": solver.time_factorization,
-        "solve": solver.time_solve,
-    }
 
 
 def _iterate(

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .friction_kkt import FrictionKKT
+from .result import with_history
 
 __all__ = [
     "INACTIVE",
@@ -129,9 +130,7 @@ class FrictionConvergenceError(RuntimeError):
         state: np.ndarray | None = None,
         direction: np.ndarray | None = None,
     ) -> None:
-        lines = "\n".join(str(step) for step in history[-20:])
-        skipped = f"\n  ({len(history) - 20} earlier steps not shown)" if len(history) > 20 else ""
-        super().__init__(f"{message}\niteration history:{skipped}\n{lines}")
+        super().__init__(with_history(message, history))
         self.history = history
         self.reason = reason
         self.x = x

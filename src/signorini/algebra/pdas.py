@@ -41,7 +41,7 @@ from .kkt import qp_residuals
 from .primal import primal_active_set
 from .qp import BoundQP, check_qp, check_vector
 from .result import PDASConvergenceError, PDASResult, PDASStep
-from .solvers import SPDSolver
+from .solvers import SPDSolver, solver_usage
 
 __all__ = ["solve_pdas"]
 
@@ -147,7 +147,7 @@ def solve_pdas(
     elif not isinstance(solver, SPDSolver):
         raise ValueError(f"solver must be an SPDSolver, got {type(solver).__name__}")
 
-    before = _solver_usage(solver)
+    before = solver_usage(solver)
     try:
         system = ActiveSetSystem(qp, solver, max_update=max_update)
         history: list[PDASStep] = []
@@ -157,7 +157,7 @@ def solve_pdas(
             x, multiplier, active = _after_failure(system, x, active, failure, fallback, history)
             method = "primal-active-set"
     finally:
-        used = {key: value - before[key] for key, value in _solver_usage(solver).items()}
+        used = {key: value - before[key] for key, value in solver_usage(solver).items()}
         backend_name = solver.backend
         if own_solver:
             solver.close()
@@ -232,18 +232,6 @@ def _initial_active_set(qp: BoundQP, c_scale: float, x0: object, active0: object
         multiplier0 = qp.F[c] - qp.K[c] @ x_start if m else np.zeros(0)
         return multiplier0 + c_scale * (x_start[c] - qp.gap) > 0
     return np.zeros(m, dtype=bool)
-
-
-def _solver_usage(solver: SPDSolver) -> dict[str, float]:
-    """The solver's counters and timers (seconds), to be differenced around a call."""
-    return {
-        "n_solves": solver.n_solves,
-        "n_factorizations": solver.n_factorizations,
-        "n_analyses": solver.n_analyses,
-        "analysis": solver.time_analysis,
-        "factorization": solver.time_factorization,
-        "solve": solver.time_solve,
-    }
 
 
 def _iterate(

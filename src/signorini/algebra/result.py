@@ -8,7 +8,14 @@ import numpy as np
 
 from .kkt import KKTResiduals
 
-__all__ = ["PDASConvergenceError", "PDASResult", "PDASStep"]
+__all__ = ["PDASConvergenceError", "PDASResult", "PDASStep", "with_history"]
+
+
+def with_history(message: str, history: list) -> str:
+    """An error message followed by the last 20 steps of an iteration's history."""
+    lines = "\n".join(str(step) for step in history[-20:])
+    skipped = f"\n  ({len(history) - 20} earlier steps not shown)" if len(history) > 20 else ""
+    return f"{message}\niteration history:{skipped}\n{lines}"
 
 
 @dataclass(frozen=True)
@@ -120,9 +127,7 @@ class PDASConvergenceError(RuntimeError):
         x: np.ndarray | None = None,
         active: np.ndarray | None = None,
     ) -> None:
-        lines = "\n".join(str(step) for step in history[-20:])
-        skipped = f"\n  ({len(history) - 20} earlier steps not shown)" if len(history) > 20 else ""
-        super().__init__(f"{message}\niteration history:{skipped}\n{lines}")
+        super().__init__(with_history(message, history))
         self.history = history
         self.reason = reason
         self.x = x

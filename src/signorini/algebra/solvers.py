@@ -23,6 +23,7 @@ __all__ = [
     "SINGULAR_CAUSES",
     "SPDSolver",
     "SingularSystemError",
+    "solver_usage",
 ]
 
 
@@ -293,3 +294,15 @@ class SPDSolver:
 
     def _solve(self, b: np.ndarray) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
+
+
+def solver_usage(solver: SPDSolver) -> dict[str, float]:
+    """The solver's counters and timers (seconds), to be differenced around a call."""
+    return {
+        "n_solves": solver.n_solves,
+        "n_factorizations": solver.n_factorizations,
+        "n_analyses": solver.n_analyses,
+        "analysis": solver.time_analysis,
+        "factorization": solver.time_factorization,
+        "solve": solver.time_solve,
+    }
