@@ -119,3 +119,42 @@ def cell_values(field, vertices: np.ndarray) -> np.ndarray:
     """Interleaved nodal values (m, 12) of a vector field on the P2 cells ``vertices``."""
     nodes = p2.physical_points(vertices, p2.REFERENCE_NODES)  # (m, 6, 2)
     return field(nodes).reshape(len(vertices), 12)
+
+
+def stress_of(grad: np.ndarray, material) -> np.ndarray:
+    """Plane-strain stress ``λ tr(ε) I + 2μ ε`` of displacement gradients ``(..., 2, 2)``."""
+    eps = 0.5 * (grad + np.swapaxes(grad, -1, -2))
+    tr = eps[..., 0, 0] + eps[..., 1, 1]
+    return material.lam * tr[..., None, None] * np.eye(2) + 2 * material.mu * eps
+
+
+class GradientField:
+    """The smooth displacement ``u = ∇(−cos(a x) cos(a y) / a)`` = ``(sin(ax) cos(ay),
+    cos(ax) sin(ay))`` with its gradient, stress, traction and the body force
+    ``f = −div σ = 2 a² (λ + 2μ) u`` of a material: a manufactured solution for curved
+    domains (its divergence-free part vanishes, so ``−div σ = −(λ + 2μ) ∇ div u``)."""
+
+    def __init__(self, a: float, material) -> None:
+        self.a, self.material = a, material
+
+    def u(self, x: np.ndarray) -> np.ndarray:
+        a = self.a
+        return np.column_stack(
+            [np.sin(a * x[:, 0]) * np.cos(a * x[:, 1]), np.cos(a * x[:, 0]) * np.sin(a * x[:, 1])]
+        )
+
+    def grad(self, x: np.ndarray) -> np.ndarray:
+        a = self.a
+        cc = a * np.cos(a * x[:, 0]) * np.cos(a * x[:, 1])
+        ss = -a * np.sin(a * x[:, 0]) * np.sin(a * x[:, 1])
+        return np.stack([np.stack([cc, ss], -1), np.stack([ss, cc], -1)], -2)
+
+    def stress(self, x: np.ndarray) -> np.ndarray:
+        return stress_of(self.grad(x), self.material)
+
+    def traction(self, x: np.ndarray, normal: np.ndarray) -> np.ndarray:
+        return np.einsum("nij,nj->ni", self.stress(x), normal)
+
+    def body_force(self, x: np.ndarray) -> np.ndarray:
+        m = self.material
+        return 2 * self.a**2 * (m.lam + 2 * m.mu) * self.u(x)

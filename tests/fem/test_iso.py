@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
+from fem_problems import GradientField, stress_of
 
 from signorini.contact.system import assemble
 from signorini.fem import iso
@@ -22,27 +23,12 @@ MATERIAL = Material.from_young(1.0, 0.3)
 A = 1.5  # u = grad(-cos(A x) cos(A y) / A)
 
 
-def exact_u(x):
-    return np.column_stack(
-        [np.sin(A * x[:, 0]) * np.cos(A * x[:, 1]), np.cos(A * x[:, 0]) * np.sin(A * x[:, 1])]
-    )
-
-
-def exact_grad(x):
-    cc = A * np.cos(A * x[:, 0]) * np.cos(A * x[:, 1])
-    ss = -A * np.sin(A * x[:, 0]) * np.sin(A * x[:, 1])
-    return np.stack([np.stack([cc, ss], -1), np.stack([ss, cc], -1)], -2)
+FIELD = GradientField(A, MATERIAL)
+exact_u, exact_grad, body_force = FIELD.u, FIELD.grad, FIELD.body_force
 
 
 def stress(x, grad):
-    g = grad(x)
-    eps = 0.5 * (g + np.swapaxes(g, -1, -2))
-    tr = eps[..., 0, 0] + eps[..., 1, 1]
-    return MATERIAL.lam * tr[..., None, None] * np.eye(2) + 2 * MATERIAL.mu * eps
-
-
-def body_force(x):  # -div sigma = -(mu Lap u + (lam + mu) grad div u) = 2 A^2 (lam + 2 mu) u
-    return 2 * A**2 * (MATERIAL.lam + 2 * MATERIAL.mu) * exact_u(x)
+    return stress_of(grad(x), MATERIAL)
 
 
 def annulus_sector(n_r: int = 2, n_t: int = 4) -> Mesh:

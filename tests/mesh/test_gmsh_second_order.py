@@ -9,6 +9,7 @@ import meshio
 import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
+from fem_problems import GradientField
 
 from signorini.contact.solution import solve
 from signorini.contact.system import assemble
@@ -27,28 +28,8 @@ A = 1.0  # u = grad(-cos(A x) cos(A y) / A), as in tests/fem/test_iso.py
 ARCS = {"inner": 1.0, "outer": 2.0}
 
 
-def exact_u(x):
-    return np.column_stack(
-        [np.sin(A * x[:, 0]) * np.cos(A * x[:, 1]), np.cos(A * x[:, 0]) * np.sin(A * x[:, 1])]
-    )
-
-
-def exact_grad(x):
-    cc = A * np.cos(A * x[:, 0]) * np.cos(A * x[:, 1])
-    ss = -A * np.sin(A * x[:, 0]) * np.sin(A * x[:, 1])
-    return np.stack([np.stack([cc, ss], -1), np.stack([ss, cc], -1)], -2)
-
-
-def traction(x, normal):
-    g = exact_grad(x)
-    eps = 0.5 * (g + np.swapaxes(g, -1, -2))
-    tr = eps[..., 0, 0] + eps[..., 1, 1]
-    sigma = MATERIAL.lam * tr[..., None, None] * np.eye(2) + 2 * MATERIAL.mu * eps
-    return np.einsum("nij,nj->ni", sigma, normal)
-
-
-def body_force(x):  # -div sigma = 2 A^2 (lam + 2 mu) u
-    return 2 * A**2 * (MATERIAL.lam + 2 * MATERIAL.mu) * exact_u(x)
+FIELD = GradientField(A, MATERIAL)
+exact_u, exact_grad, traction, body_force = FIELD.u, FIELD.grad, FIELD.traction, FIELD.body_force
 
 
 def sector(n_t: int, *, curved: bool = True) -> Mesh:
