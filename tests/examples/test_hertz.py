@@ -170,21 +170,21 @@ def test_without_contact_the_measurements_are_nan():
 def test_mesh_figure_finds_the_arc_of_a_refined_mesh():
     """The mesh figure marks Γ_C on the arc, whose refined edges lie on the circle, not on the
     initial mesh's chords."""
-    from signorini.cli import _part_segments
     from signorini.mesh.refine import refine_nvb, refine_uniform
+    from signorini.plots.run_figures import part_segments
 
     initial = hertz().mesh
     mesh = refine_uniform(refine_nvb(initial, initial.h > 0.3).mesh).mesh
     mesh = refine_nvb(mesh, np.arange(0, mesh.n_cells, 3)).mesh
     arc = mesh.points[mesh.boundary[mesh.boundary_part == mesh.part_index("arc")]]
-    found = _part_segments(initial, "arc", mesh.points, mesh.cells)
+    found = part_segments(initial, "arc", mesh.points, mesh.cells)
 
     def key(segments):
         return sorted(tuple(sorted(map(tuple, np.round(s, 12)))) for s in segments)
 
     assert len(arc) > 2 * initial.part_edges("arc").size
     assert key(found) == key(arc)
-    top = _part_segments(initial, "top", mesh.points, mesh.cells)
+    top = part_segments(initial, "top", mesh.points, mesh.cells)
     assert np.array_equal(top, initial.points[initial.edges[initial.part_edges("top")]])
 
 
