@@ -43,17 +43,22 @@ from signorini.output import HistoryWriter, write_vtu
 from signorini.runtime import retain_freed_memory
 
 
-def floor_seconds(problem, mesh, backend: str) -> tuple[float, int, dict[str, int]]:
-    """One analysis + factorization + solve of the level's matrix (Dirichlet DOFs
-    eliminated), with a fresh solver; also the factor's non-zeros and PARDISO's own memory
-    (``iparm[14..16]`` in KiB) when known."""
+def reduced_system(problem, mesh):
+    """The level's stiffness matrix and load with the Dirichlet DOFs eliminated (what the
+    floor factorizes)."""
     a = assemble(problem, mesh)
     fixed = np.zeros(a.K.shape[0], dtype=bool)
     fixed[a.dirichlet] = True
     x_fixed = np.zeros(a.K.shape[0])
     x_fixed[a.dirichlet] = a.dirichlet_values
-    K, b = eliminate_symmetric(a.K, a.F, fixed, x_fixed)
-    del a
+    return eliminate_symmetric(a.K, a.F, fixed, x_fixed)
+
+
+def floor_seconds(problem, mesh, backend: str) -> tuple[float, int, dict[str, int]]:
+    """One analysis + factorization + solve of the level's matrix (Dirichlet DOFs
+    eliminated), with a fresh solver; also the factor's non-zeros and PARDISO's own memory
+    (``iparm[14..16]`` in KiB) when known."""
+    K, b = reduced_system(problem, mesh)
     with make_solver(backend, check_symmetry=False) as solver:
         t0 = time.perf_counter()
         solver.factorize(K)

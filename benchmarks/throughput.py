@@ -23,11 +23,10 @@ import argparse
 import time
 
 import numpy as np
+from adaptive import reduced_system  # benchmarks/adaptive.py: the floor's system
 
 from signorini import adaptive, example_6_2
-from signorini.algebra import eliminate_symmetric
 from signorini.algebra.pardiso import PardisoSolver
-from signorini.contact import assemble
 from signorini.runtime import retain_freed_memory
 
 
@@ -46,13 +45,7 @@ def dense_peak_gflops(n: int, repeat: int) -> float:
 def factorization_rate(problem, mesh, repeat: int) -> tuple[float, float, float]:
     """PARDISO's operation count of the level's factorization (Mflop), the fastest numerical
     factorization (seconds) and its rate (GFlop/s)."""
-    a = assemble(problem, mesh)
-    fixed = np.zeros(a.K.shape[0], dtype=bool)
-    fixed[a.dirichlet] = True
-    x_fixed = np.zeros(a.K.shape[0])
-    x_fixed[a.dirichlet] = a.dirichlet_values
-    K, _ = eliminate_symmetric(a.K, a.F, fixed, x_fixed)
-    del a
+    K, _ = reduced_system(problem, mesh)
     with PardisoSolver(check_symmetry=False) as solver:
         solver.factorize(K)  # analysis and a first factorization
         best = np.inf
