@@ -18,7 +18,7 @@ from .elimination import SymmetricEliminator
 from .qp import BoundQP
 from .solvers import SINGULAR_CAUSES, FactorizationError, SingularSystemError, SPDSolver
 
-__all__ = ["ActiveSetSystem", "SOLVE_RTOL", "UPDATE_RTOL"]
+__all__ = ["ActiveSetSystem", "SOLVE_RTOL", "UPDATE_RTOL", "check_residual"]
 
 #: Largest relative residual ``max |b - A x| / max |b|`` of a direct solve; above it the
 #: matrix is reported singular. A backward stable solve of an SPD system has a residual of
@@ -29,6 +29,20 @@ SOLVE_RTOL = 1e-6
 #: Largest residual of a low-rank updated solve, relative to ``max(max |b|, max |diag A| max |x|)``;
 #: above it the system is refactorized.
 UPDATE_RTOL = 1e-12
+
+
+def check_residual(residual: np.ndarray | float, b: np.ndarray, backend: str) -> None:
+    """Raise :class:`SingularSystemError` unless ``max|residual| / max|b| ≤ SOLVE_RTOL``
+    (a NaN fails too): a direct solve whose answer does not satisfy its system."""
+    relative = np.abs(residual).max(initial=0.0) / max(np.abs(b).max(initial=0.0), 1e-300)
+    if not relative <= SOLVE_RTOL:  # also NaN
+        raise SingularSystemError(
+            f"the linear system is singular or too ill-conditioned: its solution has the "
+            f"relative residual max|b - A x| / max|b| = {relative:.1e} (backend {backend}, "
+            f"bound {SOLVE_RTOL:.0e}). {SINGULAR_CAUSES}",
+            backend=backend,
+            residual=relative,
+        )
 
 
 class ActiveSetSystem:
@@ -122,15 +136,7 @@ class ActiveSetSystem:
                 ) from err
             self.factored = self.fixed.copy()
             x = self.solver.solve(b)
-            residual = self.residual(b, x) / max(np.abs(b).max(initial=0.0), 1e-300)
-            if not residual <= SOLVE_RTOL:  # also NaN
-                raise SingularSystemError(
-                    f"the linear system is singular or too ill-conditioned: its solution has "
-                    f"the relative residual max|b - A x| / max|b| = {residual:.1e} "
-                    f"(backend {self.solver.backend}, bound {SOLVE_RTOL:.0e}). {SINGULAR_CAUSES}",
-                    backend=self.solver.backend,
-                    residual=residual,
-                )
+            check_residual(self.residual(b, x), b, self.solver.backend)
         x[self.fixed] = self.values[self.fixed]
         return x, F[c] - self.K_c @ x
 

@@ -47,13 +47,30 @@ def _warn_fallback(reason: str) -> None:
     warnings.warn(
         f"the fast sparse solver (MKL PARDISO) is not usable, falling back to SuperLU: {reason}",
         SolverFallbackWarning,
-        stacklevel=3,  # the caller of make_solver
+        stacklevel=4,  # the caller of make_solver (or make_lu_solver)
     )
 
 
 def available_backends() -> tuple[str, ...]:
     """Backends that work on this machine, best first (``"scipy"`` is always there)."""
     return ("pardiso", "scipy") if pardiso_problem() is None else ("scipy",)
+
+
+def _takes_pardiso(backend: str) -> bool:
+    """Whether ``backend`` means PARDISO here: ``"pardiso"`` (raising when it cannot be
+    used), ``"auto"`` when it loads and works (else a warning once); never ``"scipy"``."""
+    valid = ("auto", *BACKENDS)
+    if backend not in valid:
+        raise ValueError(f"unknown backend {backend!r}; valid backends are {', '.join(valid)}")
+    if backend == "scipy":
+        return False
+    problem = pardiso_problem()
+    if problem is None:
+        return True
+    if backend == "pardiso":
+        raise BackendUnavailableError(f"the pardiso backend is not usable here: {problem}")
+    _warn_fallback(problem)
+    return False
 
 
 def make_solver(
@@ -83,16 +100,8 @@ def make_solver(
     BackendUnavailableError
         If ``"pardiso"`` is asked for and cannot be used (a :class:`RuntimeError`).
     """
-    valid = ("auto", *BACKENDS)
-    if backend not in valid:
-        raise ValueError(f"unknown backend {backend!r}; valid backends are {', '.join(valid)}")
-    if backend != "scipy":
-        problem = pardiso_problem()
-        if problem is None:
-            return PardisoSolver(A, **options)
-        if backend == "pardiso":
-            raise BackendUnavailableError(f"the pardiso backend is not usable here: {problem}")
-        _warn_fallback(problem)
+    if _takes_pardiso(backend):
+        return PardisoSolver(A, **options)
     return SuperLUSolver(A, **options)
 
 
@@ -120,14 +129,6 @@ def make_lu_solver(backend: str = "auto", A: sp.spmatrix | None = None) -> SPDSo
     BackendUnavailableError
         If ``"pardiso"`` is asked for and cannot be used.
     """
-    valid = ("auto", *BACKENDS)
-    if backend not in valid:
-        raise ValueError(f"unknown backend {backend!r}; valid backends are {', '.join(valid)}")
-    if backend != "scipy":
-        problem = pardiso_problem()
-        if problem is None:
-            return PardisoLUSolver(A)
-        if backend == "pardiso":
-            raise BackendUnavailableError(f"the pardiso backend is not usable here: {problem}")
-        _warn_fallback(problem)
+    if _takes_pardiso(backend):
+        return PardisoLUSolver(A)
     return SuperLULUSolver(A)

@@ -22,9 +22,9 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from .active_system import SOLVE_RTOL, ActiveSetSystem
+from .active_system import ActiveSetSystem, check_residual
 from .friction_kkt import FrictionProblem, slip_bound
-from .solvers import SINGULAR_CAUSES, SingularSystemError, SPDSolver
+from .solvers import SPDSolver
 from .sparse import csr_row_indices, diagonal_positions
 
 __all__ = ["CoulombSystem", "TrescaSystem"]
@@ -146,14 +146,6 @@ class CoulombSystem:
         self.time_assembly += time.perf_counter() - t0
         self.solver.factorize(A)  # the pattern is compared, and analysed only the first time
         x = self.solver.solve(b)
-        residual = np.abs(A @ x - b).max(initial=0.0) / max(np.abs(b).max(initial=0.0), 1e-300)
-        if not residual <= SOLVE_RTOL:  # also NaN
-            raise SingularSystemError(
-                f"the linear system is singular or too ill-conditioned: its solution has the "
-                f"relative residual max|b - A x| / max|b| = {residual:.1e} (backend "
-                f"{self.solver.backend}, bound {SOLVE_RTOL:.0e}). {SINGULAR_CAUSES}",
-                backend=self.solver.backend,
-                residual=residual,
-            )
+        check_residual(A @ x - b, b, self.solver.backend)
         x[fixed] = values[fixed]
         return x
