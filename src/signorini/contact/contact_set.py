@@ -22,6 +22,7 @@ boundaries*).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -151,12 +152,12 @@ class ContactSet:
         a corner's second constraint)."""
         return 2 * self.nodes + self.second
 
-    @property
+    @cached_property
     def frame_nodes(self) -> np.ndarray:
         """``(m,)`` the distinct constrained nodes (sorted)."""
         return self.nodes[~self.second]
 
-    @property
+    @cached_property
     def frames(self) -> np.ndarray:
         """``(m, 2, 2)`` the frame ``Q_z`` of each of :attr:`frame_nodes` (``u = Q_z y``):
         the rotation ``[n t]`` for one constraint, ``A_z^{-1}`` with rows ``n, m`` of ``A_z``
