@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import csv
+import re
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from signorini.algebra import available_backends
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -133,3 +136,31 @@ def test_throughput_benchmark_prints_a_table_of_positive_rates():
         gflops, share = values[-2], values[-1]
         peak = float(lines[5].split("dense peak: ")[1].split()[0])
         assert share == pytest.approx(100 * gflops / peak, rel=0.05, abs=0.01), (share, peak)
+
+
+@pytest.mark.skipif(
+    "pardiso" not in available_backends(), reason="compares orderings for MKL PARDISO"
+)
+def test_ordering_benchmark_compares_both_orderings_on_both_meshes():
+    """benchmarks/ordering.py on a small budget: two meshes, both orderings timed, factor
+    sizes and agreement printed, the last line the ratio of the adaptive mesh's solves."""
+    out = subprocess.run(
+        [sys.executable, str(ROOT / "benchmarks" / "ordering.py"), "--max-ndof", "20000"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=True,
+    ).stdout
+    print(out)
+    lines = out.strip().splitlines()
+    assert lines[0].startswith("uniform mesh") and "Example 6.2, adaptive mesh" in out
+    totals = [float(x) for x in re.findall(r"complete (\d+\.\d+) s;", out)]
+    assert len(totals) == 4 and all(t > 0 for t in totals)
+    ratios = [float(x) for x in re.findall(r"complete solve (\d+\.\d+),", out)]
+    for ratio, own, ours in ((ratios[0], *totals[:2]), (ratios[1], *totals[2:])):
+        # the seconds are printed rounded to 1 ms, the ratio to 0.001
+        assert (ours - 5e-4) / (own + 5e-4) - 5e-4 <= ratio <= (ours + 5e-4) / (own - 5e-4) + 5e-4
+    agreements = [float(x) for x in re.findall(r"solutions agree to (\S+) ", out)]
+    assert len(agreements) == 2 and max(agreements) < 1e-10
+    assert re.fullmatch(r"ordering_ratio=\d+\.\d{3}", lines[-1])
+    assert float(lines[-1].split("=")[1]) == ratios[1]

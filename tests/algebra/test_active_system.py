@@ -1,4 +1,4 @@
-"""One active set's linear system: refactorization or Woodbury update
+"""One active set's linear system: refactorization or bordered update
 (signorini.algebra.active_system)."""
 
 from __future__ import annotations
@@ -58,9 +58,50 @@ def test_small_changes_update_large_changes_refactorize(backend):
     assert system.time_elimination > 0
 
 
+class CountingSolver:
+    """A solver that records the number of right-hand sides of each solve."""
+
+    def __init__(self, solver):
+        self.inner, self.columns = solver, []
+
+    def __getattr__(self, name):
+        return getattr(self.inner, name)
+
+    def solve(self, b):
+        self.columns.append(1 if b.ndim == 1 else b.shape[1])
+        return self.inner.solve(b)
+
+
+@pytest.mark.parametrize("backend", BACKEND_LIST)
+def test_bordered_update_frees_and_fixes_with_k_plus_one_right_hand_sides(backend):
+    """An update that frees 2 DOFs and fixes 2 others: one solve with 5 right-hand sides
+    (not the 2k + 1 = 9 of a Woodbury correction), the solution of the new system to
+    round-off, then a further change from the same factor."""
+    rng = np.random.default_rng(5)
+    qp = check_qp(*random_problem(rng, 90, 12, 4, dense=False))
+    solver = CountingSolver(make_solver(backend))
+    system = ActiveSetSystem(qp, solver, max_update=4)
+    first = np.zeros(12, dtype=bool)
+    first[[0, 3, 5, 8]] = True
+    system.solve(first)
+    second = first.copy()
+    second[[3, 8]] = False  # freed
+    second[[1, 10]] = True  # fixed
+    third = second.copy()
+    third[1] = False  # 3 changes against the factorized set (first): still an update
+    for active in (second, third):
+        x, multiplier = system.solve(active)
+        reference = reference_solution(qp, active)
+        assert np.abs(x - reference).max() < 1e-12 * np.abs(reference).max()
+        assert np.allclose(multiplier, qp.F[qp.constrained] - qp.K[qp.constrained] @ x, atol=0)
+    assert solver.columns == [1, 5, 4]
+    assert (solver.n_factorizations, system.n_updates) == (1, 2)
+
+
 @pytest.mark.parametrize("backend", BACKEND_LIST)
 def test_low_rank_updates_agree_with_refactorization(backend):
-    """Small active-set changes reuse the factorization (Woodbury) with the same result."""
+    """Small active-set changes reuse the factorization (bordered update) with the same
+    result."""
     rng = np.random.default_rng(21)
     used = 0
     for _ in range(6):

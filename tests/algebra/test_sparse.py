@@ -8,6 +8,7 @@ import scipy.sparse as sp
 from linalg_problems import block_spd
 
 from signorini.algebra.sparse import (
+    abs_matvec,
     as_csr,
     csr_row_indices,
     diagonal_positions,
@@ -75,3 +76,18 @@ def test_symmetry_defect_and_index_lists():
     assert symmetry_defect(sp.csr_matrix((3, 3))) == 0.0
     assert list_indices(np.arange(3)) == "0, 1, 2"
     assert list_indices(np.arange(8)) == "0, 1, 2, 3, 4 (and 3 more)"
+
+
+@pytest.mark.parametrize(
+    ("n", "density", "chunk"),
+    [(1000, 0.01, 37), (500, 0.05, 1 << 20), (300, 0.0, 10), (200, 0.3, 5)],
+)
+def test_abs_matvec_equals_the_product_of_absolute_values(n, density, chunk):
+    """Blocks smaller than a row, larger than the matrix, and an empty matrix."""
+    A = sp.random(n, n, density, format="csr", random_state=1)
+    A.data -= 0.5
+    v = np.random.default_rng(0).standard_normal(n)
+    expected = abs(A) @ np.abs(v)
+    assert np.abs(abs_matvec(A, v, chunk=chunk) - expected).max(initial=0.0) <= 1e-13 * max(
+        np.abs(expected).max(initial=0.0), 1.0
+    )

@@ -11,7 +11,7 @@ semismooth Newton extension to Tresca and Coulomb friction.
 ``backends``           ``make_solver``, ``make_lu_solver``, ``available_backends``
 ``qp``                 the bound-constrained QP's data, checked at the public entry
 ``kkt``                KKT residuals of a point
-``active_system``      one active set's linear system: refactorization or Woodbury update
+``active_system``      one active set's linear system: refactorization or bordered update
 ``primal``             the primal active set fallback
 ``result``             steps, result and failure of an active set solve
 ``pdas``               ``solve_pdas``: the PDAS iteration

@@ -4,7 +4,7 @@ Each active set iteration (docs/method.md, *Solver*) solves the QP's equality pr
 Dirichlet DOFs and the active constrained DOFs fixed, eliminated symmetrically in place
 (:mod:`.elimination`), so all systems share ``K``'s pattern and the solver's symbolic analysis.
 When only a few DOFs change (the free boundary moving by a node), the previous factorization is
-reused with a Woodbury correction.
+reused with a bordered system of the changed DOFs.
 """
 
 from __future__ import annotations
@@ -12,7 +12,6 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import scipy.sparse as sp
 
 from .elimination import SymmetricEliminator
 from .qp import BoundQP
@@ -49,9 +48,9 @@ class ActiveSetSystem:
     """The fixed-pattern linear systems of one call: eliminate, factorize, solve.
 
     When the fixed set differs from the factorized one in at most ``max_update`` DOFs, the
-    new system is solved with the existing factorization and a Woodbury correction of rank
-    at most ``2 k`` (k changed DOFs) instead of a new factorization; the result is checked by
-    its residual and the system refactorized if the check fails.
+    new system is solved with the existing factorization and a bordered system of the k
+    changed DOFs (one solve with k + 1 right-hand sides) instead of a new factorization; the
+    result is checked by its residual and the system refactorized if the check fails.
 
     Parameters
     ----------
@@ -115,7 +114,7 @@ class ActiveSetSystem:
         if self.factored is not None and self.max_update > 0:
             changed = np.flatnonzero(self.fixed != self.factored)
             if 0 < changed.size <= self.max_update:
-                x = self._solve_updated(b, changed)
+                x = self._solve_updated(F, b, changed)
         if x is None:
             keep = self.eliminator.keep_mask(self.fixed)
             # the solver factorizes K with the eliminated entries dropped: no copy of K
@@ -140,39 +139,44 @@ class ActiveSetSystem:
         x[self.fixed] = self.values[self.fixed]
         return x, F[c] - self.K_c @ x
 
-    def _columns(self, fixed: np.ndarray, cols: np.ndarray) -> sp.csc_matrix:
-        """Columns ``cols`` of the matrix eliminated for ``fixed`` (symmetric: rows of K)."""
-        rows = self.K[cols].tocoo()  # row r of K is column cols[r]
-        j = cols[rows.row]
-        ok = ~fixed[rows.col] & ~fixed[j]  # entries that survive the elimination
-        data = np.where(ok, rows.data, 0.0)
-        on_diag = rows.col == j
-        data[on_diag] = rows.data[on_diag]
-        return sp.csc_matrix((data, (rows.col, rows.row)), shape=(self.K.shape[0], cols.size))
+    def _solve_updated(
+        self, F: np.ndarray, b: np.ndarray, changed: np.ndarray
+    ) -> np.ndarray | None:
+        """Solve with the current factor and a bordered system for the changed DOFs, or None
+        if unreliable (docs/method.md, *Solver*, "Low-rank updates").
 
-    def _solve_updated(self, b: np.ndarray, changed: np.ndarray) -> np.ndarray | None:
-        """Solve with the current factor and a Woodbury correction, or None if unreliable.
-
-        With ``E = A_new − A_old`` supported on the rows and columns ``D = changed``,
-        ``E = U Vᵀ`` for ``U = [P_D, E_{:,D}]``, ``V = [E_{:,D} − P_D E_DD, P_D]``.
+        With ``f`` the free DOFs of the factorization, ``R`` the DOFs freed since, ``D`` those
+        fixed since and ``B = [K_fR, P_D]``, the new solution is ``x_f = z − W y`` with
+        ``z = K_ff⁻¹ g``, ``W = K_ff⁻¹ B`` (one solve with ``|R| + |D| + 1`` right-hand
+        sides) and ``y = (x_R, λ_D)`` from the Schur complement ``(C − Bᵀ W) y = (h, v_D) −
+        Bᵀ z``, ``C = diag(K_RR, 0)``; ``g``, ``h`` are the load minus the columns of the DOFs
+        fixed in both, on ``f`` and on ``R``.
         """
-        n, k = self.K.shape[0], changed.size
-        E = self._columns(self.fixed, changed) - self._columns(self.factored, changed)
-        E = E.toarray()  # (n, k): k is small
-        P = np.zeros((n, k))
-        P[changed, np.arange(k)] = 1.0
-        E_dd = E[changed]
-        U = np.hstack([P, E])
-        V = np.hstack([E - P @ E_dd, P])
-        Z = self.solver.solve(np.column_stack([b, U]))  # A_old⁻¹ [b, U] in one call
-        y, W = Z[:, 0], Z[:, 1:]
-        capacitance = np.eye(2 * k) + V.T @ W
+        fixed0, fixed1, values, K = self.factored, self.fixed, self.values, self.K
+        released = changed[fixed0[changed]]
+        added = changed[fixed1[changed]]
+        r, k = released.size, changed.size
+        t = F - K @ np.where(fixed0 & fixed1, values, 0.0)
+        K_Rf = K[released]  # rows R = columns R (K is symmetric)
+        K_Rf = K_Rf.multiply(~fixed0[None, :]).tocsr()  # only the columns free in the factor
+        rhs = np.zeros((K.shape[0], k + 1), order="F")
+        rhs[:, 0] = np.where(fixed0, 0.0, t)
+        rhs[:, 1 : r + 1] = K_Rf.T.toarray()
+        rhs[added, np.arange(r + 1, k + 1)] = 1.0
+        Z = self.solver.solve(rhs)  # K_ff⁻¹ [g, B] in one call (zero on the fixed DOFs)
+        z, W = Z[:, 0], Z[:, 1:]
+        schur = -np.vstack([K_Rf @ W, W[added]])
+        schur[:r, :r] += K[released][:, released].toarray()
+        load = np.concatenate([t[released], values[added]])
         try:
-            x = y - W @ np.linalg.solve(capacitance, V.T @ y)
+            y = np.linalg.solve(schur, load - np.concatenate([K_Rf @ z, z[added]]))
         except np.linalg.LinAlgError:
             return None
+        x = z - W @ y
+        x[released] = y[:r]
+        x[fixed1] = values[fixed1]
         # accepted at round-off: relative to the size of both sides of A x = b
-        diagonal = self.K.data[self.eliminator.diagonal_positions]
+        diagonal = K.data[self.eliminator.diagonal_positions]
         scale = max(np.abs(b).max(), np.abs(diagonal).max() * np.abs(x).max(), 1e-300)
         if not self.residual(b, x) <= UPDATE_RTOL * scale:
             return None

@@ -20,8 +20,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
+from .kkt import force_scale
 from .qp import BoundQP, _index_array, check_qp, check_vector
 from .sparse import as_csr
 
@@ -217,9 +217,7 @@ def friction_kkt(
     qp = problem.qp
     K, F, n_dof, t_dof = qp.K, qp.F, problem.normal, problem.tangent
     r = F - K @ x
-    absK = sp.csr_matrix((np.abs(K.data), K.indices, K.indptr), shape=K.shape)
-    force = max(np.abs(F).max(initial=0.0), (absK @ np.abs(x)).max(initial=0.0))
-    force = force if force > 0 else 1.0
+    force = force_scale(K, F, x)
     lam_n, lam_t = r[n_dof], r[t_dof]
     slack = x[n_dof] - problem.gap
     slide = x[t_dof] - problem.reference

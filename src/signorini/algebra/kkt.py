@@ -18,8 +18,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from .qp import BoundQP, check_qp, check_vector
+from .sparse import abs_matvec
 
-__all__ = ["KKTResiduals", "kkt_residuals"]
+__all__ = ["KKTResiduals", "force_scale", "kkt_residuals"]
 
 _SQRT_EPS = float(np.sqrt(np.finfo(np.float64).eps))
 
@@ -121,6 +122,13 @@ def kkt_residuals(
     return qp_residuals(qp, check_vector(x, qp.n, "x"))
 
 
+def force_scale(K: sp.csr_matrix, F: np.ndarray, x: np.ndarray) -> float:
+    """The scale of the forces at ``x``: ``max(max |F|, max |K| |x|)`` (1 where both vanish),
+    against which the equilibrium and force residuals are measured."""
+    force = max(np.abs(F).max(initial=0.0), abs_matvec(K, x).max(initial=0.0))
+    return float(force) if force > 0 else 1.0
+
+
 def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
     """:func:`kkt_residuals` on checked data (no checks).
 
@@ -136,9 +144,7 @@ def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
     K, F, c, g = qp.K, qp.F, qp.constrained, qp.gap
     d, xd = qp.dirichlet, qp.dirichlet_values
     r = F - K @ x
-    absK = sp.csr_matrix((np.abs(K.data), K.indices, K.indptr), shape=K.shape)
-    force = max(np.abs(F).max(initial=0.0), (absK @ np.abs(x)).max(initial=0.0))
-    force = force if force > 0 else 1.0
+    force = force_scale(K, F, x)
     multiplier = r[c]
     slack = x[c] - g
     touching = slack >= 0

@@ -113,8 +113,9 @@ def solve_pdas(
         of raising.
     max_update : int
         When the active set changes by at most this many DOFs, solve with the existing
-        factorization and a low-rank (Woodbury) correction, checked by its residual, instead
-        of refactorizing (0 disables). A correction for k changed DOFs costs 2k + 1 solves.
+        factorization and a bordered system of the changed DOFs, checked by its residual,
+        instead of refactorizing (0 disables). It costs one solve with k + 1 right-hand sides
+        for k changed DOFs.
 
     Returns
     -------

@@ -23,6 +23,7 @@ __all__ = [
     "SINGULAR_CAUSES",
     "SPDSolver",
     "SingularSystemError",
+    "checked_ordering",
     "solver_usage",
 ]
 
@@ -101,6 +102,12 @@ class SPDSolver:
         Factorized right away if given.
     check_symmetry : bool
         Check ``max |A - A^T| <= 1e-12 max |A|`` at each analysis (costs one transpose).
+    ordering : (n,) int array, optional
+        A fill-reducing ordering for the symbolic analysis: ``ordering[k]`` is the unknown
+        eliminated k-th (new position → original index), e.g. a nested dissection of the mesh's
+        vertex graph (docs/method.md, *Ordering of the unknowns*). Checked and used at each
+        analysis (it may be set as an attribute before one); ``None`` lets the backend order
+        (PARDISO: METIS nested dissection of the matrix graph; SuperLU: minimum degree).
 
     Attributes
     ----------
@@ -118,8 +125,16 @@ class SPDSolver:
     backend: str = ""
     reuses_analysis: bool = False
 
-    def __init__(self, A: sp.spmatrix | None = None, *, check_symmetry: bool = True) -> None:
+    def __init__(
+        self,
+        A: sp.spmatrix | None = None,
+        *,
+        check_symmetry: bool = True,
+        ordering: np.ndarray | None = None,
+    ) -> None:
         self.check_symmetry = check_symmetry
+        self.ordering = ordering
+        self._perm: np.ndarray | None = None  # the checked ordering of the last analysis
         self.n_analyses = 0
         self.n_factorizations = 0
         self.n_solves = 0
@@ -188,6 +203,7 @@ class SPDSolver:
         if not self.same_pattern(A):
             rows = csr_row_indices(A)
             self._check_new_pattern(A, rows)
+            self._perm = checked_ordering(self.ordering, A.shape[0])
             self._factorized = False
             t0 = time.perf_counter()
             self._analyze(A, rows)
@@ -294,6 +310,33 @@ class SPDSolver:
 
     def _solve(self, b: np.ndarray) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
+
+
+def checked_ordering(ordering: object, n: int) -> np.ndarray | None:
+    """``ordering`` as an int64 permutation of ``0 … n−1``, or None; a ValueError naming
+    ``ordering`` otherwise."""
+    if ordering is None:
+        return None
+    perm = np.asarray(ordering)
+    if perm.shape != (n,) or not np.issubdtype(perm.dtype, np.integer):
+        raise ValueError(
+            f"ordering must be an integer array of shape ({n},) (one entry per unknown), got "
+            f"dtype {perm.dtype} and shape {perm.shape}"
+        )
+    perm = perm.astype(np.int64)
+    outside = np.flatnonzero((perm < 0) | (perm >= n))
+    if outside.size:
+        raise ValueError(
+            f"ordering has entries outside 0..{n - 1} at positions {list_indices(outside)}"
+        )
+    seen = np.zeros(n, dtype=bool)
+    seen[perm] = True
+    if not seen.all():
+        raise ValueError(
+            f"ordering is not a permutation: unknowns {list_indices(np.flatnonzero(~seen))} "
+            "never appear"
+        )
+    return perm
 
 
 def solver_usage(solver: SPDSolver) -> dict[str, float]:

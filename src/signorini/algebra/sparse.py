@@ -11,6 +11,7 @@ import numpy as np
 import scipy.sparse as sp
 
 __all__ = [
+    "abs_matvec",
     "as_csr",
     "csr_row_indices",
     "diagonal_positions",
@@ -116,6 +117,43 @@ def diagonal_positions(A: sp.csr_matrix, rows: np.ndarray) -> np.ndarray:
     on_diag = np.flatnonzero(A.indices == rows)
     pos[rows[on_diag]] = on_diag
     return pos
+
+
+def abs_matvec(A: sp.csr_matrix, v: np.ndarray, chunk: int = 1 << 20) -> np.ndarray:
+    """``|A| |v|`` (entrywise absolute values) without a copy of ``|A.data|``.
+
+    Rows are taken in blocks of about ``chunk`` stored entries, whose absolute values go
+    through one reused buffer: at 1.2 M unknowns (46 M entries) the copy of ``|A.data|`` took
+    0.5 s, most of it writing fresh memory.
+
+    Parameters
+    ----------
+    A : scipy.sparse.csr_matrix, shape (n, m)
+    v : (m,) float array
+
+    Returns
+    -------
+    (n,) float array
+    """
+    n = A.shape[0]
+    av = np.abs(v)
+    out = np.zeros(n)
+    buffer = np.empty(min(chunk, A.nnz))
+    indptr = A.indptr
+    # row boundaries of the blocks: the first row that starts at or after each multiple of chunk
+    cuts = np.unique(np.searchsorted(indptr, np.arange(0, A.nnz, chunk), side="left"))
+    bounds = np.append(cuts[cuts < n], n)
+    for r0, r1 in zip(
+        bounds[:-1], bounds[1:], strict=True
+    ):  # a few dozen blocks: not a loop over rows
+        s, e = indptr[r0], indptr[r1]
+        block = buffer[: e - s] if e - s <= buffer.size else np.empty(e - s)
+        np.abs(A.data[s:e], out=block)
+        part = sp.csr_matrix(
+            (block, A.indices[s:e], indptr[r0 : r1 + 1] - s), shape=(r1 - r0, A.shape[1])
+        )
+        out[r0:r1] = part @ av
+    return out
 
 
 def list_indices(indices: np.ndarray, limit: int = 5) -> str:

@@ -25,12 +25,16 @@ class SuperLUSolver(SPDSolver):
     diagonal of ``U`` costs some 15-30 % of the factorization; pass ``check_pivots=False`` to
     skip it.
 
+    With an ``ordering`` (:class:`~.solvers.SPDSolver`) SuperLU factorizes the symmetrically
+    permuted matrix in that order (``permc_spec="NATURAL"``) instead of its own.
+
     Parameters
     ----------
     A : scipy sparse matrix, optional
     check_symmetry : bool
     check_pivots : bool
     pivot_rtol : float
+    ordering : (n,) int array, optional
     """
 
     backend = "scipy"
@@ -43,11 +47,12 @@ class SuperLUSolver(SPDSolver):
         check_symmetry: bool = True,
         check_pivots: bool = True,
         pivot_rtol: float = 1e-13,
+        ordering: np.ndarray | None = None,
     ) -> None:
         self.check_pivots = check_pivots
         self.pivot_rtol = pivot_rtol
         self._lu: spla.SuperLU | None = None
-        super().__init__(A, check_symmetry=check_symmetry)
+        super().__init__(A, check_symmetry=check_symmetry, ordering=ordering)
 
     def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
         self._diag_pos = diagonal_positions(A, rows)
@@ -56,11 +61,11 @@ class SuperLUSolver(SPDSolver):
         self._lu = None
         data = A.data if keep is None else A.data * keep
         # A is symmetric, so its CSR arrays read as CSC describe A itself (no copy).
-        C = sp.csc_matrix((data, A.indices, A.indptr), shape=A.shape)
+        C = _in_order(sp.csc_matrix((data, A.indices, A.indptr), shape=A.shape), self._perm)
         try:
             lu = spla.splu(
                 C,
-                permc_spec="MMD_AT_PLUS_A",
+                permc_spec="MMD_AT_PLUS_A" if self._perm is None else "NATURAL",
                 diag_pivot_thresh=0.0,
                 options={"SymmetricMode": True},
             )
@@ -81,6 +86,8 @@ class SuperLUSolver(SPDSolver):
             if bad.size:
                 k = int(bad[np.argmin(pivots[bad])])
                 equation = int(np.flatnonzero(lu.perm_c == k)[0])
+                if self._perm is not None:
+                    equation = int(self._perm[equation])
                 raise FactorizationError(
                     f"the matrix is not positive definite (numerically): pivot "
                     f"{pivots[k]:.3e} at equation {equation}, max diagonal {scale:.3e}",
@@ -90,7 +97,7 @@ class SuperLUSolver(SPDSolver):
         self._lu = lu
 
     def _solve(self, b: np.ndarray) -> np.ndarray:
-        return self._lu.solve(b)
+        return _solve_in_order(lambda c: self._lu.solve(c), b, self._perm)
 
     def close(self) -> None:
         self._lu = None
@@ -105,17 +112,21 @@ class SuperLULUSolver(SPDSolver):
     uses the transposed factors. No reuse of the symbolic analysis (as :class:`SuperLUSolver`);
     the symmetry of ``A`` is not checked.
 
+    With an ``ordering`` the permuted matrix is factorized in that column order
+    (``permc_spec="NATURAL"``), rows still pivoted by threshold.
+
     Parameters
     ----------
     A : scipy sparse matrix, optional
+    ordering : (n,) int array, optional
     """
 
     backend = "scipy"
     reuses_analysis = False
 
-    def __init__(self, A: sp.spmatrix | None = None) -> None:
+    def __init__(self, A: sp.spmatrix | None = None, *, ordering: np.ndarray | None = None) -> None:
         self._lu: spla.SuperLU | None = None
-        super().__init__(A, check_symmetry=False)
+        super().__init__(A, check_symmetry=False, ordering=ordering)
 
     def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
         pass
@@ -123,9 +134,13 @@ class SuperLULUSolver(SPDSolver):
     def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
         self._lu = None
         data = A.data if keep is None else A.data * keep
-        transposed = sp.csc_matrix((data, A.indices, A.indptr), shape=A.shape)
+        transposed = _in_order(
+            sp.csc_matrix((data, A.indices, A.indptr), shape=A.shape), self._perm
+        )
         try:
-            self._lu = spla.splu(transposed)
+            self._lu = spla.splu(
+                transposed, permc_spec="COLAMD" if self._perm is None else "NATURAL"
+            )
         except RuntimeError as err:
             raise FactorizationError(
                 f"SuperLU could not factorize the matrix ({err}): it is singular",
@@ -133,8 +148,24 @@ class SuperLULUSolver(SPDSolver):
             ) from err
 
     def _solve(self, b: np.ndarray) -> np.ndarray:
-        return self._lu.solve(b, trans="T")
+        return _solve_in_order(lambda c: self._lu.solve(c, trans="T"), b, self._perm)
 
     def close(self) -> None:
         self._lu = None
         super().close()
+
+
+def _in_order(C: sp.csc_matrix, perm: np.ndarray | None) -> sp.csc_matrix:
+    """``C`` with rows and columns taken in the order ``perm`` (``C`` itself without one)."""
+    if perm is None:
+        return C
+    return C[perm][:, perm].tocsc()
+
+
+def _solve_in_order(solve, b: np.ndarray, perm: np.ndarray | None) -> np.ndarray:
+    """The solution of the original system from ``solve`` of the permuted one."""
+    if perm is None:
+        return solve(b)
+    x = np.empty_like(b)
+    x[perm] = solve(b[perm])
+    return x

@@ -25,6 +25,7 @@ from ..fem.space import P2Space
 from ..problem.fields import ProblemError
 from .contact_set import COULOMB, TRESCA, ContactSet
 from .node_frames import to_frames
+from .ordering import ordered_solver
 from .system import Assembled
 
 __all__ = [
@@ -207,16 +208,18 @@ def solve_frictional(
         **warm,
     }
     nodes = cs.nodes
-    if law == "tresca":
-        res = solve_friction(
-            K, F, 2 * nodes, 2 * nodes + 1, cs.gap, bound=cs.friction_bound,
-            tresca_everywhere=True, **common,
-        )  # fmt: skip
-    else:
-        res = solve_friction(
-            K, F, 2 * nodes, 2 * nodes + 1, cs.gap, coefficient=cs.friction_coefficient,
-            **common,
-        )  # fmt: skip
+    # Tresca: symmetric systems (Cholesky); Coulomb: non-symmetric ones (LU)
+    with ordered_solver(assembled.space, backend, lu=law != "tresca") as solver:
+        if law == "tresca":
+            res = solve_friction(
+                K, F, 2 * nodes, 2 * nodes + 1, cs.gap, bound=cs.friction_bound,
+                tresca_everywhere=True, solver=solver, **common,
+            )  # fmt: skip
+        else:
+            res = solve_friction(
+                K, F, 2 * nodes, 2 * nodes + 1, cs.gap, coefficient=cs.friction_coefficient,
+                solver=solver, **common,
+            )  # fmt: skip
     state = res.state.astype(np.int64)
     # a frictionless node in contact slides freely: its friction force (0) is at its bound
     state[(state != INACTIVE) & (cs.friction_law == 0)] = SLIP

@@ -13,7 +13,6 @@ from functools import cached_property
 
 import numpy as np
 
-from ..algebra.backends import make_solver
 from ..algebra.friction import INACTIVE, SLIP, STICK
 from ..algebra.pdas import solve_pdas
 from ..algebra.result import PDASConvergenceError, PDASResult
@@ -26,6 +25,7 @@ from .contact_set import ContactSet, node_classes
 from .frictional import check_previous, solve_frictional
 from .nested import NESTED_MIN_NDOF, coarse_mesh, transfer_active
 from .node_frames import to_cartesian
+from .ordering import ordered_solver
 from .profile import ContactProfile, contact_profile
 from .system import Assembled, assemble
 
@@ -331,7 +331,7 @@ def solve(
             tangential_reference=fr.reference,
         )
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
-    with make_solver(backend, check_symmetry=False) as solver:
+    with ordered_solver(space, backend, check_symmetry=False) as solver:
         res = solve_pdas(
             K,
             F,

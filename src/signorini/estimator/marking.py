@@ -53,9 +53,22 @@ def mark_doerfler(eta2: np.ndarray, theta: float = 0.4) -> np.ndarray:
     if theta == 1.0 or total == 0.0:
         return np.ones(eta2.size, dtype=bool)  # uniform refinement
     marked = np.zeros(eta2.size, dtype=bool)
-    order = np.argsort(-eta2, kind="stable")
+    order = np.argsort(-_tie_key(eta2), kind="stable")
     cumulative = np.cumsum(eta2[order])
     # first index where the running sum reaches θ·total (guard against round-off at the end)
     k = int(np.searchsorted(cumulative, theta * total * (1 - 1e-14), side="left")) + 1
     marked[order[: min(k, eta2.size)]] = True
     return marked
+
+
+#: Indicators closer than this, relative to the largest, count as equal when they are sorted:
+#: the cell with the smaller index comes first. Symmetric problems have pairs of equal
+#: indicators whose last bits depend on round-off (the ordering of the unknowns, the
+#: summation order): without it, which of a pair is refined would too.
+TIE_RTOL = 1e-10
+
+
+def _tie_key(eta2: np.ndarray) -> np.ndarray:
+    """``η_T²`` rounded to multiples of ``TIE_RTOL · max η_T²`` (the sort key of marking)."""
+    step = TIE_RTOL * eta2.max(initial=0.0)
+    return np.round(eta2 / step) if step > 0 else eta2

@@ -126,14 +126,12 @@ def spread_edge_integrals(
     TermShares
     """
     node_part = h_p[edges.nodes] * J[:, None]
-    node = np.zeros(h_p.size)
-    np.add.at(node, edges.nodes.ravel(), node_part.ravel())
+    node = np.bincount(edges.nodes.ravel(), weights=node_part.ravel(), minlength=h_p.size)
     total = node_part.sum(axis=1)
     c0, c1 = edges.cells[:, 0], edges.cells[:, 1]
     two = c1 >= 0
-    cell = np.zeros(n_cells)
-    np.add.at(cell, c0, np.where(two, 0.5, 1.0) * total)
-    np.add.at(cell, c1[two], 0.5 * total[two])
+    cell = np.bincount(c0, weights=np.where(two, 0.5, 1.0) * total, minlength=n_cells)
+    cell += np.bincount(c1[two], weights=0.5 * total[two], minlength=n_cells)
     return TermShares(node, cell)
 
 
@@ -152,16 +150,13 @@ def spread_node_parts(edges: EdgeSet, parts: np.ndarray, n_nodes: int, n_cells: 
     -------
     TermShares
     """
-    node = np.zeros(n_nodes)
-    np.add.at(node, edges.nodes.ravel(), parts.ravel())
+    node = np.bincount(edges.nodes.ravel(), weights=parts.ravel(), minlength=n_nodes)
     return TermShares(node, boundary_cell_shares(edges, parts.sum(axis=1), n_cells))
 
 
 def boundary_cell_shares(edges: EdgeSet, values: np.ndarray, n_cells: int) -> np.ndarray:
     """Values ``(k,)`` of boundary edges to their cells: ``(n_cells,)``."""
-    out = np.zeros(n_cells)
-    np.add.at(out, edges.cells[:, 0], values)
-    return out
+    return np.bincount(edges.cells[:, 0], weights=values, minlength=n_cells)
 
 
 def _point_weights(w: np.ndarray, length: np.ndarray) -> np.ndarray:

@@ -94,6 +94,33 @@ class P2Space:
         """``(n_cells, 3, 2)`` vertex coordinates of each cell."""
         return self.mesh.points[self.mesh.cells]
 
+    def dof_order(self, vertex_order: np.ndarray) -> np.ndarray:
+        """The order of the DOFs that extends an order of the mesh's vertices
+        (docs/method.md, *Ordering of the unknowns*): each edge's node right after the earlier
+        of its two vertices, the two DOFs of a node together.
+
+        A nested dissection of the vertex graph stays one of the P2 graph this way: the nodes
+        of a cell are its vertices and edges, and an edge's node goes where its earlier vertex
+        is, so no coupling crosses a separator.
+
+        Parameters
+        ----------
+        vertex_order : (n_points,) int array
+            ``vertex_order[k]``: the vertex eliminated k-th (a permutation).
+
+        Returns
+        -------
+        (n_dofs,) int64 array
+            ``order[k]``: the DOF eliminated k-th.
+        """
+        n_points = self.mesh.n_points
+        position = np.empty(n_points, dtype=np.int64)
+        position[vertex_order] = np.arange(n_points)
+        edges = self.mesh.edges
+        key = np.concatenate([2 * position, 2 * position[edges].min(axis=1) + 1])
+        nodes = np.argsort(key, kind="stable")
+        return np.stack([2 * nodes, 2 * nodes + 1], axis=-1).ravel()
+
     def edge_nodes(self, edge_index: np.ndarray) -> np.ndarray:
         """``(k, 3)`` nodes ``[start, end, midpoint]`` of boundary edges, counter-clockwise."""
         edge_index = np.asarray(edge_index, dtype=np.int64)
@@ -123,9 +150,11 @@ class P2Space:
     def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
         """Exact interpolation of a P2 field of this space on the refined mesh.
 
-        Each new node lies in the parent cell of some new cell; the parent's quadratic is
-        evaluated there, so P2 functions are reproduced exactly (docs/method.md, *Marking and
-        refinement*).
+        A node of the refined mesh that is a node of this one keeps its value: the old
+        vertices, a bisection's new vertex (the node of the bisected edge), the nodes of the
+        cells that were not refined. Each other node lies in the parent cell of a new cell,
+        where the parent's quadratic is evaluated; so P2 functions are reproduced exactly
+        (docs/method.md, *Marking and refinement*), and the work grows with the new nodes.
 
         Parameters
         ----------
@@ -149,33 +178,48 @@ class P2Space:
             raise ValueError(f"u has {u.shape[0]} nodes, the space has {self.n_nodes}")
         fine = P2Space(refinement.mesh)
         parent = np.asarray(refinement.parent)
-        if parent.shape != (fine.mesh.n_cells,) or (
-            parent.size and (parent.min() < 0 or parent.max() >= self.mesh.n_cells)
+        if (
+            parent.shape != (fine.mesh.n_cells,)
+            or (parent.size and (parent.min() < 0 or parent.max() >= self.mesh.n_cells))
+            or np.shape(refinement.edge_point) != (self.mesh.n_edges,)
+            or fine.mesh.n_points < self.mesh.n_points
         ):
             raise ValueError(
                 "the refinement is not a refinement of this space's mesh (its parent "
                 f"cells do not index the {self.mesh.n_cells} cells)"
             )
-        P = self.vertices[parent]  # (m, 3, 2)
-        X = _reference_nodes(self.mesh, refinement, fine)[fine.cell_nodes]  # (m, 6, 2)
-        J = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=-1)  # columns
-        rhs = (X - P[:, None, 0, :]).transpose(0, 2, 1)  # (m, 2, 6)
-        xi = np.linalg.solve(J, rhs).transpose(0, 2, 1)  # (m, 6, 2)
-        bary = np.concatenate([1 - xi.sum(-1, keepdims=True), xi], axis=-1)
-        if bary.min(initial=0.0) < -1e-8:
-            raise ValueError(
-                "the refinement is not a refinement of this space's mesh (a new "
-                "cell is not inside its parent cell)"
-            )
-        phi = basis_barycentric(bary)  # (m, 6, 6): new local node, parent local node
-        coarse = u[self.cell_nodes[parent]]  # (m, 6) or (m, 6, 2)
-        if u.ndim == 1:
-            vals = np.einsum("mij,mj->mi", phi, coarse)
-            out = np.empty(fine.n_nodes)
-        else:
-            vals = np.einsum("mij,mjc->mic", phi, coarse)
-            out = np.empty((fine.n_nodes,) + u.shape[1:])
-        out[fine.cell_nodes.ravel()] = vals.reshape((-1,) + u.shape[1:])
+        coarse_cells, fine_cells = self.mesh.cells, fine.mesh.cells
+        coarse_nodes, fine_nodes = self.cell_nodes, fine.cell_nodes
+        out = np.empty((fine.n_nodes,) + u.shape[1:])
+        known = np.zeros(fine.n_nodes, dtype=bool)
+        # a cell that was not refined keeps its vertices, edges and local order: copy its nodes
+        same = np.flatnonzero((fine_cells == coarse_cells[parent]).all(axis=1))
+        out[fine_nodes[same]] = u[coarse_nodes[parent[same]]]
+        known[fine_nodes[same]] = True
+        # the old vertices keep their numbers; a bisection's new vertex is the old edge's node
+        n_old = self.mesh.n_points
+        out[:n_old] = u[:n_old]
+        split = np.flatnonzero(refinement.edge_point >= 0)
+        out[refinement.edge_point[split]] = u[n_old + split]
+        known[:n_old] = True
+        known[refinement.edge_point[split]] = True
+        # the other nodes (midpoints of new edges): the parent's quadratic where they lie
+        cell, local = np.nonzero(~known[fine_nodes])
+        if cell.size:
+            nodes = fine_nodes[cell, local]
+            P = self.vertices[parent[cell]]  # (k, 3, 2)
+            X = _reference_nodes(self.mesh, refinement, fine)[nodes]  # (k, 2)
+            J = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=-1)  # columns
+            xi = np.linalg.solve(J, (X - P[:, 0])[..., None])[..., 0]  # (k, 2)
+            bary = np.concatenate([1 - xi.sum(-1, keepdims=True), xi], axis=-1)
+            if bary.min(initial=0.0) < -1e-8:
+                raise ValueError(
+                    "the refinement is not a refinement of this space's mesh (a new "
+                    "cell is not inside its parent cell)"
+                )
+            phi = basis_barycentric(bary)  # (k, 6): the parent's local nodes
+            coarse = u[coarse_nodes[parent[cell]]]  # (k, 6) or (k, 6, 2)
+            out[nodes] = np.einsum("kj,kj...->k...", phi, coarse)
         return out
 
 

@@ -1,0 +1,168 @@
+"""The fill-reducing ordering of a mesh's unknowns (signorini.contact.ordering) and the
+solvers' ``ordering`` argument (signorini.algebra)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from linalg_problems import p2_elasticity
+
+from signorini import adaptive, example_6_2, solve
+from signorini.algebra import SymmetricEliminator, available_backends, make_solver
+from signorini.algebra.pardiso import PardisoSolver, metis_ordering
+from signorini.contact import assemble
+from signorini.contact.ordering import dof_ordering, ordered_solver, vertex_graph
+from signorini.fem.space import P2Space
+from signorini.mesh.builders import rectangle
+
+HAS_PARDISO = "pardiso" in available_backends()
+needs_pardiso = pytest.mark.skipif(not HAS_PARDISO, reason="MKL PARDISO is not available")
+
+
+@pytest.fixture(scope="module")
+def adaptive_mesh():
+    """Example 6.2's adaptive mesh near 40 000 unknowns (graded towards the contact)."""
+    for level in adaptive(example_6_2(), max_ndof=45_000):
+        mesh = level.result.mesh
+    return mesh
+
+
+def factor_size(K, keep, ordering=None):
+    """(non-zeros of the Cholesky factor, Mflop of one factorization) reported by PARDISO."""
+    with PardisoSolver(check_symmetry=False, ordering=ordering) as solver:
+        solver.factorize(K, keep=keep)
+        return solver.factor_nnz, solver.factor_mflop
+
+
+def eliminated(problem, mesh):
+    a = assemble(problem, mesh)
+    fixed = np.zeros(a.K.shape[0], dtype=bool)
+    fixed[a.dirichlet] = True
+    return a, SymmetricEliminator(a.K).keep_mask(fixed)
+
+
+def test_dof_order_puts_each_edge_node_after_its_earlier_vertex():
+    mesh = rectangle(nx=5, ny=3)
+    space = P2Space(mesh)
+    vertex_order = np.random.default_rng(2).permutation(mesh.n_points)
+    order = space.dof_order(vertex_order)
+    assert np.array_equal(np.sort(order), np.arange(space.n_dofs))
+    assert np.array_equal(order[1::2], order[0::2] + 1)  # the two DOFs of a node together
+    node_position = np.empty(space.n_nodes, dtype=np.int64)
+    node_position[order[0::2] // 2] = np.arange(space.n_nodes)
+    vertex_position = node_position[: mesh.n_points]
+    # the vertices keep their relative order
+    assert np.array_equal(np.argsort(vertex_position), vertex_order)
+    earlier = vertex_position[mesh.edges].min(axis=1)
+    edge_position = node_position[mesh.n_points :]
+    assert (edge_position > earlier).all()
+    # ... before the vertex that follows the earlier one
+    following = np.sort(vertex_position)
+    nxt = following[np.searchsorted(following, earlier, side="right").clip(max=following.size - 1)]
+    last = earlier == following[-1]
+    assert (edge_position[~last] < nxt[~last]).all()
+
+
+@needs_pardiso
+def test_metis_ordering_is_a_permutation_and_pardiso_uses_a_given_one():
+    """A nested dissection of the vertex graph; handed to PARDISO it changes the factor,
+    and the natural order of a long strip (a band) fills in far more than it."""
+    K, _ = p2_elasticity(40, 40)
+    graph = sp.csr_matrix(K != 0)
+    order = metis_ordering(graph)
+    assert np.array_equal(np.sort(order), np.arange(K.shape[0]))
+    keep = None
+    K = K + sp.eye(K.shape[0])  # positive definite without boundary conditions
+    nnz_metis, _ = factor_size(K, keep, ordering=order)
+    nnz_natural, _ = factor_size(K, keep, ordering=np.arange(K.shape[0]))
+    nnz_own, _ = factor_size(K, keep)
+    assert nnz_natural > 2 * nnz_metis
+    assert nnz_metis < 1.3 * nnz_own
+
+
+@needs_pardiso
+def test_vertex_graph_ordering_is_no_worse_than_pardisos_own(adaptive_mesh):
+    """Measured on Example 6.2's graded adaptive mesh and on a uniform one: the P2 order
+    from METIS on the vertex graph gives a factorization no costlier than PARDISO's METIS
+    on the whole matrix, and a Cholesky factor at most 10 % larger (docs/method.md,
+    *Ordering of the unknowns*; measured here 0.95 / 0.79 adaptive, 1.08 / 1.02 uniform)."""
+    problem = example_6_2()
+    for mesh in (adaptive_mesh, rectangle(nx=60, ny=60)):
+        a, keep = eliminated(problem, mesh)
+        own = factor_size(a.K, keep)
+        ours = factor_size(a.K, keep, ordering=dof_ordering(a.space))
+        print(f"{a.K.shape[0]} unknowns: factor nnz {ours[0] / own[0]:.3f}, Mflop "
+              f"{ours[1] / max(own[1], 1):.3f} of PARDISO's own ordering")  # fmt: skip
+        assert ours[0] <= 1.10 * own[0]
+        assert ours[1] <= 1.05 * own[1]
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_solution_does_not_depend_on_the_ordering(backend):
+    """The backend's own ordering, a random one and the vertex-graph one (``solve``'s with
+    PARDISO) on Example 6.2's mesh of about 3000 unknowns: the same solution to round-off."""
+    problem = example_6_2()
+    for level in adaptive(problem, max_ndof=3000):
+        mesh = level.result.mesh
+    a, keep = eliminated(problem, mesh)
+    fixed = np.zeros(a.K.shape[0], dtype=bool)
+    fixed[a.dirichlet] = True
+    b = SymmetricEliminator(a.K).rhs(a.K, a.F, fixed, np.zeros(a.K.shape[0]))
+    orderings = [None, np.random.default_rng(0).permutation(a.K.shape[0])]
+    if HAS_PARDISO:
+        orderings.append(dof_ordering(a.space))
+    solutions = []
+    for ordering in orderings:
+        with make_solver(backend, check_symmetry=False, ordering=ordering) as solver:
+            solver.factorize(a.K, keep=keep)
+            solutions.append(solver.solve(b))
+    scale = np.abs(solutions[0]).max()
+    for x in solutions[1:]:
+        assert np.abs(x - solutions[0]).max() <= 1e-10 * scale
+    with ordered_solver(a.space, backend) as solver:
+        assert (solver.ordering is not None) == (solver.backend == "pardiso")
+
+
+@needs_pardiso
+def test_solve_uses_the_ordering_and_agrees_with_pardisos_own(adaptive_mesh, monkeypatch):
+    problem = example_6_2()
+    ordered = solve(problem, adaptive_mesh, backend="pardiso", nested=False)
+    import signorini.contact.solution as solution
+
+    monkeypatch.setattr(
+        solution,
+        "ordered_solver",
+        lambda space, backend, **options: make_solver(backend, **options),
+    )
+    own = solve(problem, adaptive_mesh, backend="pardiso", nested=False)
+    assert ordered.pdas.iterations == own.pdas.iterations
+    assert np.abs(ordered.u - own.u).max() <= 1e-10 * np.abs(own.u).max()
+    assert (
+        np.abs(ordered.contact_force - own.contact_force).max()
+        <= 1e-10 * np.abs(own.contact_force).max()
+    )
+
+
+@pytest.mark.parametrize(
+    ("ordering", "message"),
+    [
+        (np.arange(5), r"shape \(6,\)"),
+        (np.arange(6.0), "integer array"),
+        (np.array([0, 1, 2, 3, 4, 6]), "outside 0..5"),
+        (np.array([0, 1, 2, 3, 4, 4]), "not a permutation: unknowns 5"),
+    ],
+)
+@pytest.mark.parametrize("backend", available_backends())
+def test_a_bad_ordering_is_refused_naming_it(ordering, message, backend):
+    K = sp.csr_matrix(np.eye(6) * 2 + np.eye(6, k=1) * 0.5 + np.eye(6, k=-1) * 0.5)
+    with make_solver(backend, ordering=ordering) as solver:
+        with pytest.raises(ValueError, match="ordering") as info:
+            solver.factorize(K)
+    assert info.match(message)
+
+
+def test_vertex_graph_has_an_entry_per_edge_both_ways():
+    mesh = rectangle(nx=3, ny=2)
+    G = vertex_graph(mesh)
+    assert G.nnz == 2 * mesh.n_edges and (G != G.T).nnz == 0 and G.diagonal().sum() == 0
