@@ -16,6 +16,7 @@ from signorini.algebra import (
     available_backends,
     backends,
     make_solver,
+    mkl,
     pardiso,
     solve_pdas,
 )
@@ -26,12 +27,12 @@ def broken_pardiso(monkeypatch):
     """PARDISO cannot load (no MKL found), with every cache cleared before and after."""
 
     def clear():
-        pardiso.pardiso_function.cache_clear()
+        mkl.pardiso_function.cache_clear()
         pardiso.pardiso_problem.cache_clear()
         backends._warn_fallback.cache_clear()
 
     clear()
-    monkeypatch.setattr(pardiso, "mkl_runtime_candidates", lambda: [])
+    monkeypatch.setattr(mkl, "mkl_runtime_candidates", lambda: [])
     yield
     clear()
 

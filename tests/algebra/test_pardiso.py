@@ -18,9 +18,11 @@ from signorini.algebra import (
     FactorizationError,
     SymmetricEliminator,
     available_backends,
+    mkl,
     pardiso,
 )
-from signorini.algebra.pardiso import PardisoSolver, mkl_runtime_candidates, pardiso_problem
+from signorini.algebra.mkl import mkl_runtime_candidates
+from signorini.algebra.pardiso import PardisoSolver, pardiso_problem
 
 HAS_PARDISO = "pardiso" in available_backends()
 
@@ -37,7 +39,7 @@ def pardiso_probe_reset():
     """Clear the cached library and probe before and after the test."""
 
     def clear():
-        pardiso.pardiso_function.cache_clear()
+        mkl.pardiso_function.cache_clear()
         pardiso.pardiso_problem.cache_clear()
 
     clear()
@@ -62,7 +64,7 @@ def test_pypardiso_is_not_imported():
 
 
 def test_missing_library_is_reported(monkeypatch, pardiso_probe_reset):
-    monkeypatch.setattr(pardiso, "mkl_runtime_candidates", lambda: [])
+    monkeypatch.setattr(mkl, "mkl_runtime_candidates", lambda: [])
     reason = pardiso_problem()
     assert reason is not None and "mkl_rt could not be loaded (no file found)" in reason
     with pytest.raises(BackendUnavailableError, match="no file found"):
@@ -77,7 +79,7 @@ def test_unloadable_and_symbolless_libraries_are_reported(
     libm = ctypes.util.find_library("m")
     if libm is None:
         pytest.skip("no C math library to stand in for a library without pardiso")
-    monkeypatch.setattr(pardiso, "mkl_runtime_candidates", lambda: [str(garbage), libm])
+    monkeypatch.setattr(mkl, "mkl_runtime_candidates", lambda: [str(garbage), libm])
     reason = pardiso_problem()
     assert reason is not None
     assert str(garbage) in reason and libm in reason and "pardiso" in reason

@@ -7,7 +7,8 @@ semismooth Newton extension to Tresca and Coulomb friction.
 ``elimination``        symmetric elimination of fixed DOFs in place (pattern kept)
 ``solvers``            the SPD solver interface (analysis once per pattern), its errors
 ``superlu``            SuperLU backends (always available): SPD, and LU for non-symmetric
-``pardiso``            MKL PARDISO through ctypes (SPD, non-symmetric LU), how MKL is found
+``mkl``                how MKL's runtime library is found and loaded
+``pardiso``            MKL PARDISO through ctypes (SPD, non-symmetric LU); METIS orderings
 ``backends``           ``make_solver``, ``make_lu_solver``, ``available_backends``
 ``qp``                 the bound-constrained QP's data, checked at the public entry
 ``kkt``                KKT residuals of a point

@@ -4,12 +4,11 @@ Real symmetric positive definite mode (``mtype = 2``, sparse Cholesky) on the up
 0-based CSR form, with the phases called separately: 11 (analysis, once per pattern), 22
 (numerical factorization), 33 (solve).
 
-MKL's single dynamic library ``mkl_rt`` is found through public routes only, in this order:
-the files of the installed ``mkl`` distribution (``importlib.metadata``; the ``fast`` extra
-installs it with ``pypardiso``), the ``lib`` folder of the Python prefix (conda), and
-:func:`ctypes.util.find_library`. :func:`pardiso_problem` loads it, solves a 2 x 2 system, and
-says why PARDISO cannot be used (``None`` when it can); :func:`~.backends.make_solver` turns
-that reason into a warning or an error.
+MKL is found and loaded by :mod:`.mkl`. :func:`pardiso_problem` loads it, solves a 2 x 2
+system, and says why PARDISO cannot be used (``None`` when it can);
+:func:`~.backends.make_solver` turns that reason into a warning or an error.
+:func:`metis_ordering` returns PARDISO's METIS ordering of a graph (docs/method.md,
+*Ordering of the unknowns*).
 
 pydiso's ``MKLPardisoSolver`` (the same MKL calls from Cython, with the analysis reused) was
 measured against this module on the matrices PDAS factorizes (``benchmarks/pardiso_wrappers.py``,
@@ -21,17 +20,12 @@ memory is 1.4 times ours, so it is not used.
 from __future__ import annotations
 
 import ctypes
-import ctypes.util
-import importlib.metadata
-import re
-import sys
-from collections.abc import Callable
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
 
+from .mkl import pardiso_function
 from .solvers import BackendUnavailableError, FactorizationError, SPDSolver
 from .sparse import upper_positions
 
@@ -39,14 +33,8 @@ __all__ = [
     "metis_ordering",
     "PardisoLUSolver",
     "PardisoSolver",
-    "mkl_runtime_candidates",
-    "pardiso_function",
     "pardiso_problem",
 ]
-
-#: File names of MKL's single dynamic library on Linux, macOS and Windows.
-_MKL_RT = re.compile(r"(lib)?mkl_rt(\.\d+)*\.(so(\.\d+)*|dylib|dll)")
-
 
 # PARDISO error codes (MKL reference manual, "pardiso"), with what they mean here.
 _PARDISO_ERRORS = {
@@ -65,82 +53,6 @@ _PARDISO_ERRORS = {
     -13: "interrupted by the progress callback",
     -15: "internal error during iterative refinement or reordering",
 }
-
-
-def mkl_runtime_candidates() -> list[str]:
-    """Paths (or a loader name) of MKL's single dynamic library ``mkl_rt``, best first.
-
-    Returns
-    -------
-    list of str
-        From the installed ``mkl`` distribution's file list, then the Python prefix's ``lib``
-        (``Library/bin`` on Windows) folder, then the system loader's search; may be empty.
-    """
-    candidates: list[str] = []
-    try:
-        dist = importlib.metadata.distribution("mkl")
-    except importlib.metadata.PackageNotFoundError:
-        dist = None
-    if dist is not None:
-        files = [f for f in dist.files or () if _MKL_RT.fullmatch(Path(f).name)]
-        candidates += [str(Path(dist.locate_file(f)).resolve()) for f in files]
-    for folder in (Path(sys.prefix, "lib"), Path(sys.prefix, "Library", "bin")):
-        if folder.is_dir():
-            candidates += [str(p) for p in sorted(folder.iterdir()) if _MKL_RT.fullmatch(p.name)]
-    found = ctypes.util.find_library("mkl_rt")
-    if found:
-        candidates.append(found)
-    return list(dict.fromkeys(candidates))  # without repetitions, order kept
-
-
-@lru_cache(maxsize=1)
-def pardiso_function() -> Callable[..., None]:
-    """The ``pardiso`` symbol of MKL's runtime library, with its argument types.
-
-    Returns
-    -------
-    callable
-        The C function ``pardiso`` (64-bit handle ``pt``, 32-bit integers).
-
-    Raises
-    ------
-    BackendUnavailableError
-        If no candidate of :func:`mkl_runtime_candidates` loads and exports ``pardiso``; the
-        message lists what was tried.
-    """
-    tried = []
-    for path in mkl_runtime_candidates():
-        try:
-            func = ctypes.CDLL(path).pardiso
-        except (OSError, AttributeError) as err:  # not loadable, or no pardiso symbol
-            tried.append(f"{path}: {err}")
-            continue
-        i32p = ctypes.POINTER(ctypes.c_int32)
-        func.argtypes = [
-            ctypes.POINTER(ctypes.c_int64),  # pt: internal handle, 64 pointers
-            i32p,  # maxfct
-            i32p,  # mnum
-            i32p,  # mtype
-            i32p,  # phase
-            i32p,  # n
-            ctypes.c_void_p,  # a
-            i32p,  # ia
-            i32p,  # ja
-            i32p,  # perm
-            i32p,  # nrhs
-            i32p,  # iparm
-            i32p,  # msglvl
-            ctypes.c_void_p,  # b
-            ctypes.c_void_p,  # x
-            i32p,  # error
-        ]
-        func.restype = None
-        return func
-    detail = "; ".join(tried) if tried else "no file found"
-    raise BackendUnavailableError(
-        f"MKL's runtime library mkl_rt could not be loaded ({detail}); install it with "
-        "`pip install signorini[fast]` (or `pip install mkl`)"
-    )
 
 
 class PardisoSolver(SPDSolver):

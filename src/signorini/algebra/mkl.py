@@ -1,0 +1,101 @@
+"""MKL's runtime library, found through public routes only, and its ``pardiso`` symbol.
+
+MKL's single dynamic library ``mkl_rt`` is looked for in this order: the files of the
+installed ``mkl`` distribution (``importlib.metadata``; the ``fast`` extra installs it with
+``pypardiso``), the ``lib`` folder of the Python prefix (conda), and
+:func:`ctypes.util.find_library`. :mod:`.pardiso` calls what :func:`pardiso_function` loads.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import importlib.metadata
+import re
+import sys
+from collections.abc import Callable
+from functools import lru_cache
+from pathlib import Path
+
+from .solvers import BackendUnavailableError
+
+__all__ = ["mkl_runtime_candidates", "pardiso_function"]
+
+#: File names of MKL's single dynamic library on Linux, macOS and Windows.
+_MKL_RT = re.compile(r"(lib)?mkl_rt(\.\d+)*\.(so(\.\d+)*|dylib|dll)")
+
+
+def mkl_runtime_candidates() -> list[str]:
+    """Paths (or a loader name) of MKL's single dynamic library ``mkl_rt``, best first.
+
+    Returns
+    -------
+    list of str
+        From the installed ``mkl`` distribution's file list, then the Python prefix's ``lib``
+        (``Library/bin`` on Windows) folder, then the system loader's search; may be empty.
+    """
+    candidates: list[str] = []
+    try:
+        dist = importlib.metadata.distribution("mkl")
+    except importlib.metadata.PackageNotFoundError:
+        dist = None
+    if dist is not None:
+        files = [f for f in dist.files or () if _MKL_RT.fullmatch(Path(f).name)]
+        candidates += [str(Path(dist.locate_file(f)).resolve()) for f in files]
+    for folder in (Path(sys.prefix, "lib"), Path(sys.prefix, "Library", "bin")):
+        if folder.is_dir():
+            candidates += [str(p) for p in sorted(folder.iterdir()) if _MKL_RT.fullmatch(p.name)]
+    found = ctypes.util.find_library("mkl_rt")
+    if found:
+        candidates.append(found)
+    return list(dict.fromkeys(candidates))  # without repetitions, order kept
+
+
+@lru_cache(maxsize=1)
+def pardiso_function() -> Callable[..., None]:
+    """The ``pardiso`` symbol of MKL's runtime library, with its argument types.
+
+    Returns
+    -------
+    callable
+        The C function ``pardiso`` (64-bit handle ``pt``, 32-bit integers).
+
+    Raises
+    ------
+    BackendUnavailableError
+        If no candidate of :func:`mkl_runtime_candidates` loads and exports ``pardiso``; the
+        message lists what was tried.
+    """
+    tried = []
+    for path in mkl_runtime_candidates():
+        try:
+            func = ctypes.CDLL(path).pardiso
+        except (OSError, AttributeError) as err:  # not loadable, or no pardiso symbol
+            tried.append(f"{path}: {err}")
+            continue
+        i32p = ctypes.POINTER(ctypes.c_int32)
+        func.argtypes = [
+            ctypes.POINTER(ctypes.c_int64),  # pt: internal handle, 64 pointers
+            i32p,  # maxfct
+            i32p,  # mnum
+            i32p,  # mtype
+            i32p,  # phase
+            i32p,  # n
+            ctypes.c_void_p,  # a
+            i32p,  # ia
+            i32p,  # ja
+            i32p,  # perm
+            i32p,  # nrhs
+            i32p,  # iparm
+            i32p,  # msglvl
+            ctypes.c_void_p,  # b
+            ctypes.c_void_p,  # x
+            i32p,  # error
+        ]
+        func.restype = None
+        return func
+    detail = "; ".join(tried) if tried else "no file found"
+    raise BackendUnavailableError(
+        f"MKL's runtime library mkl_rt could not be loaded ({detail}); install it with "
+        "`pip install signorini[fast]` (or `pip install mkl`)"
+    )
