@@ -157,8 +157,8 @@ class ActiveSetSystem:
         added = changed[fixed1[changed]]
         r, k = released.size, changed.size
         t = F - K @ np.where(fixed0 & fixed1, values, 0.0)
-        K_Rf = K[released]  # rows R = columns R (K is symmetric)
-        K_Rf = K_Rf.multiply(~fixed0[None, :]).tocsr()  # only the columns free in the factor
+        rows_R = K[released]  # rows R = columns R (K is symmetric)
+        K_Rf = rows_R.multiply(~fixed0[None, :]).tocsr()  # only the columns free in the factor
         rhs = np.zeros((K.shape[0], k + 1), order="F")
         rhs[:, 0] = np.where(fixed0, 0.0, t)
         rhs[:, 1 : r + 1] = K_Rf.T.toarray()
@@ -166,7 +166,7 @@ class ActiveSetSystem:
         Z = self.solver.solve(rhs)  # K_ff⁻¹ [g, B] in one call (zero on the fixed DOFs)
         z, W = Z[:, 0], Z[:, 1:]
         schur = -np.vstack([K_Rf @ W, W[added]])
-        schur[:r, :r] += K[released][:, released].toarray()
+        schur[:r, :r] += rows_R[:, released].toarray()
         load = np.concatenate([t[released], values[added]])
         try:
             y = np.linalg.solve(schur, load - np.concatenate([K_Rf @ z, z[added]]))

@@ -193,6 +193,14 @@ class PardisoSolver(SPDSolver):
                 self._pt[:] = 0
 
     def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
+        self._load_upper(A, rows)
+        self._use_ordering()
+        self._handle_used = True
+        self._call(11)
+
+    def _load_upper(self, A: sp.csr_matrix, rows: np.ndarray | None = None) -> None:
+        """Release the handle and hold the upper triangle of ``A`` in PARDISO's 32-bit CSR
+        arrays, with its positions in ``A.data`` for later refactorizations."""
         self._release()
         positions, indptr = upper_positions(A, rows)
         if positions.size >= 2**31 - 1:
@@ -202,9 +210,6 @@ class PardisoSolver(SPDSolver):
         self._ja = A.indices[positions].astype(np.int32)
         self._a = A.data[positions]
         self._n_eq = A.shape[0]
-        self._use_ordering()
-        self._handle_used = True
-        self._call(11)
 
     def computed_ordering(self, A: sp.csr_matrix) -> np.ndarray:
         """PARDISO's own fill-reducing ordering of canonical CSR ``A`` (an analysis with
@@ -215,12 +220,7 @@ class PardisoSolver(SPDSolver):
         (n,) int64 array
             ``order[k]``: the unknown eliminated k-th.
         """
-        self._release()
-        positions, indptr = upper_positions(A)
-        self._ia = indptr.astype(np.int32)
-        self._ja = A.indices[positions].astype(np.int32)
-        self._a = A.data[positions]
-        self._n_eq = A.shape[0]
+        self._load_upper(A)
         self._perm32 = np.zeros(A.shape[0], dtype=np.int32)
         self._iparm[4] = 2
         self._handle_used = True
@@ -347,15 +347,17 @@ def metis_ordering(graph: sp.spmatrix) -> np.ndarray:
     BackendUnavailableError
         If MKL cannot be loaded.
     """
-    G = sp.csr_matrix(graph, dtype=np.float64)
-    n = G.shape[0]
+    pattern = sp.coo_matrix(graph)
+    n = pattern.shape[0]
     if n == 0:
         return np.zeros(0, dtype=np.int64)
-    G = G - sp.diags(G.diagonal())
-    G.data[:] = -1.0
-    G.eliminate_zeros()
-    degree = -np.asarray(G.sum(axis=1)).ravel()
-    L = (G + sp.diags(degree + 1.0)).tocsr()
+    edge = pattern.row != pattern.col
+    adjacency = sp.csr_matrix(
+        (np.ones(edge.sum()), (pattern.row[edge], pattern.col[edge])), shape=(n, n)
+    )
+    adjacency.data[:] = 1.0  # an edge stored twice counts once
+    degree = np.diff(adjacency.indptr)
+    L = (sp.diags(degree + 1.0) - adjacency).tocsr()
     L.sort_indices()
     with PardisoSolver(check_symmetry=False) as solver:
         return solver.computed_ordering(L)

@@ -143,9 +143,8 @@ def abs_matvec(A: sp.csr_matrix, v: np.ndarray, chunk: int = 1 << 20) -> np.ndar
     # row boundaries of the blocks: the first row that starts at or after each multiple of chunk
     cuts = np.unique(np.searchsorted(indptr, np.arange(0, A.nnz, chunk), side="left"))
     bounds = np.append(cuts[cuts < n], n)
-    for r0, r1 in zip(
-        bounds[:-1], bounds[1:], strict=True
-    ):  # a few dozen blocks: not a loop over rows
+    # a few dozen blocks: not a loop over rows
+    for r0, r1 in zip(bounds[:-1], bounds[1:], strict=True):
         s, e = indptr[r0], indptr[r1]
         block = buffer[: e - s] if e - s <= buffer.size else np.empty(e - s)
         np.abs(A.data[s:e], out=block)

@@ -50,7 +50,7 @@ def dof_ordering(space: P2Space) -> np.ndarray:
 def ordered_solver(space: P2Space, backend: str, *, lu: bool = False, **options) -> SPDSolver:
     """A solver for the systems of ``space`` (``make_solver``, or ``make_lu_solver`` with
     ``lu``) that analyses them with :func:`dof_ordering` when it is PARDISO; SuperLU keeps its
-    own ordering (its minimum degree does as well on these matrices without METIS)."""
+    own minimum degree ordering (without MKL there is no METIS to compute ours)."""
     solver = make_lu_solver(backend) if lu else make_solver(backend, **options)
     if solver.backend == "pardiso":
         solver.ordering = dof_ordering(space)

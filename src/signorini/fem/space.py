@@ -186,7 +186,8 @@ class P2Space:
         ):
             raise ValueError(
                 "the refinement is not a refinement of this space's mesh (its parent "
-                f"cells do not index the {self.mesh.n_cells} cells)"
+                f"cells do not index the {self.mesh.n_cells} cells, or its bisected edges or "
+                "points do not match the mesh's)"
             )
         coarse_cells, fine_cells = self.mesh.cells, fine.mesh.cells
         coarse_nodes, fine_nodes = self.cell_nodes, fine.cell_nodes
