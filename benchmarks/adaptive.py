@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from signorini import adaptive, example_6_2
-from signorini.algebra import eliminate_symmetric, make_solver
+from signorini.algebra import SOLVERS, eliminate_symmetric, make_solver, solver_factory
 from signorini.contact import assemble
 from signorini.examples import example_6_2_coulomb, example_6_2_tresca
 from signorini.output import HistoryWriter, write_vtu
@@ -61,7 +61,7 @@ def floor_seconds(problem, mesh, backend: str) -> tuple[float, int, dict[str, in
     eliminated), with a fresh solver; also the factor's non-zeros and PARDISO's own memory
     (``iparm[14..16]`` in KiB) when known."""
     K, b = reduced_system(problem, mesh)
-    with make_solver(backend, check_symmetry=False) as solver:
+    with make_solver(SOLVERS[backend], check_symmetry=False) as solver:
         t0 = time.perf_counter()
         solver.factorize(K)
         solver.solve(b)
@@ -105,7 +105,7 @@ def main() -> None:
         help="budget of unknowns (the default ends just above 10^6)",
     )
     parser.add_argument("--theta", type=float, default=0.4)
-    parser.add_argument("--backend", default="auto")
+    parser.add_argument("--backend", default="auto", choices=tuple(SOLVERS))
     parser.add_argument("--vtu", action="store_true", help="also write a VTU file per level")
     parser.add_argument("--out", type=Path, default=None, help="folder for history/VTU")
     parser.add_argument(
@@ -153,7 +153,9 @@ def main() -> None:
     memory: dict[str, int] = {}
     level_peaks: list[int] = []  # bytes, each level's own
     with_floors = 0  # bytes: the process's peak, floor measurements included
-    generator = adaptive(problem, theta=args.theta, max_ndof=args.max_ndof, backend=args.backend)
+    generator = adaptive(
+        problem, theta=args.theta, max_ndof=args.max_ndof, solver=solver_factory(args.backend)
+    )
     while True:
         resettable = reset_peak()
         t0 = time.perf_counter()

@@ -19,6 +19,7 @@ import time
 import numpy as np
 
 from signorini import estimate, example_6_2, refine_uniform
+from signorini.algebra import SOLVERS
 from signorini.contact import assemble, solve
 from signorini.runtime import retain_freed_memory
 
@@ -37,7 +38,7 @@ def rate(seconds: float, ndof: int) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[100_000, 400_000, 1_000_000])
-    parser.add_argument("--backend", default="auto")
+    parser.add_argument("--backend", default="auto", choices=tuple(SOLVERS))
     args = parser.parse_args()
     retain_freed_memory()
     print(
@@ -63,7 +64,7 @@ def main() -> None:
         ndof = assembled.space.n_dofs
         t_pdas, result = timed(
             lambda a=assembled, mesh=mesh, p=problem: solve(
-                p, mesh, assembled=a, backend=args.backend
+                p, mesh, assembled=a, solver=SOLVERS[args.backend]
             )
         )
         t_est, _ = timed(lambda r=result: estimate(r))

@@ -21,7 +21,14 @@ import time
 
 import numpy as np
 
-from signorini.algebra import available_backends, make_lu_solver, solve_friction, solve_pdas
+from signorini.algebra import (
+    SOLVERS,
+    available_backends,
+    make_solver,
+    solve_friction,
+    solve_pdas,
+    superlu_solver,
+)
 from signorini.algebra.pardiso import PardisoLUSolver
 from signorini.contact.system import assemble
 from signorini.fem.material import Material
@@ -55,7 +62,7 @@ def timed(function, *args, **kwargs):
 def compare_laws(system, repeat: int) -> None:
     K, F, normal, tangent, gap, d, xd = system
     for backend in available_backends():
-        frictionless = solve_pdas(K, F, normal, gap, d, xd, backend=backend)
+        frictionless = solve_pdas(K, F, normal, gap, d, xd, solver=SOLVERS[backend])
         top = frictionless.multiplier.max()
         laws = {
             "Tresca classical 0.1": {"bound": 0.1 * top, "tresca_everywhere": True},
@@ -66,10 +73,10 @@ def compare_laws(system, repeat: int) -> None:
         best = dict.fromkeys(["pdas", *laws], np.inf)
         results = {}
         for _ in range(repeat):
-            _, t = timed(solve_pdas, K, F, normal, gap, d, xd, backend=backend)
+            _, t = timed(solve_pdas, K, F, normal, gap, d, xd, solver=SOLVERS[backend])
             best["pdas"] = min(best["pdas"], t)
             for name, law in laws.items():
-                results[name], t = timed(solve_friction, *system, backend=backend, **law)
+                results[name], t = timed(solve_friction, *system, solver=SOLVERS[backend], **law)
                 best[name] = min(best[name], t)
         print(f"{backend}: solve_pdas {frictionless.iterations} iterations")
         for name, r in results.items():
@@ -81,7 +88,7 @@ def compare_laws(system, repeat: int) -> None:
 
 
 def compare_lu(system, repeat: int) -> None:
-    makers = {"SuperLU": lambda: make_lu_solver("scipy")}
+    makers = {"SuperLU": lambda: make_solver(superlu_solver, symmetric=False)}
     if "pardiso" in available_backends():
         makers["PARDISO mtype 11"] = PardisoLUSolver
         makers["  without matching"] = lambda: PardisoLUSolver(matching=False)

@@ -26,7 +26,7 @@ import numpy as np
 from adaptive import reduced_system  # benchmarks/adaptive.py: the floor's system
 
 from signorini import adaptive, example_6_2
-from signorini.algebra.pardiso import PardisoSolver
+from signorini.algebra.pardiso import PardisoSolver, pardiso_solver
 from signorini.runtime import retain_freed_memory
 
 
@@ -63,7 +63,7 @@ def measure(sizes: list[int], theta: float, repeat: int) -> list[dict[str, float
     targets = sorted(sizes)
     rows: list[dict[str, float]] = []
     pending: dict[str, float] | None = None  # a chosen level waiting for the next one's size
-    generator = adaptive(problem, theta=theta, max_ndof=np.inf, backend="pardiso")
+    generator = adaptive(problem, theta=theta, max_ndof=np.inf, solver=pardiso_solver)
     for level in generator:
         r = level.record
         if pending is not None:

@@ -26,7 +26,9 @@ def run(name: str, variant: str, uniform: bool, max_ndof: int, out: Path) -> Pat
     mode = "uniform" if uniform else "adaptive"
     path = out / f"{name}_{mode}_{variant}.csv"
     history = HistoryWriter(path)
-    for level in adaptive(EXAMPLES[name](), max_ndof=max_ndof, uniform=uniform, eta5=variant):
+    for level in adaptive(
+        EXAMPLES[name](), max_ndof=max_ndof, uniform=uniform, eta5_variant=variant
+    ):
         history.append(level.record.row())
     return path
 

@@ -176,7 +176,7 @@ def test_run_options_eta5_no_vtu_quiet(tmp_path, capsys):
     assert sorted(os.listdir(out)) == ["history.csv", "history.md", "signorini-run.json"]
     _, rows = read_history(out / "history.csv")
     assert len(rows) == 2
-    paper = estimate(solve(example_6_1()), eta5="paper").eta_terms[4]
+    paper = estimate(solve(example_6_1()), eta5_variant="paper").eta_terms[4]
     assert float(rows[0]["eta_5"]) == paper
     assert not math.isclose(paper, estimate(solve(example_6_1())).eta_terms[4], rel_tol=0.5)
 
@@ -377,16 +377,16 @@ def test_out_naming_a_file_or_a_foreign_folder(tmp_path, capsys):
 
 def interrupt_after_level(monkeypatch, k: int) -> None:
     """Make the command line receive Ctrl-C right after level ``k`` is written."""
-    import signorini.cli as cli
+    import signorini.cli.levels as cli_levels
 
-    progress = cli._progress
+    progress = cli_levels.progress
 
     def stop(level):
         if level.record.level == k:
             raise KeyboardInterrupt
         return progress(level)
 
-    monkeypatch.setattr(cli, "_progress", stop)
+    monkeypatch.setattr(cli_levels, "progress", stop)
 
 
 def test_resume_after_an_interrupt_gives_the_uninterrupted_run(tmp_path, capsys, monkeypatch):
@@ -557,13 +557,13 @@ def test_history_md_describes_every_column(tmp_path):
 
 
 def test_figures_are_announced_before_they_are_drawn(tmp_path, capsys, monkeypatch):
-    import signorini.cli as cli
+    import signorini.cli.figures as cli_figures
 
     def figures(example, out, last=None):
         print("DRAWING")
         return []
 
-    monkeypatch.setattr(cli, "_figures", figures)
+    monkeypatch.setattr(cli_figures, "figures", figures)
     argv = ["run", "example-6.1", "--uniform", "--max-ndof", "600", "--no-vtu"]
     assert main([*argv, "--out", str(tmp_path / "a")]) == 0
     out = capsys.readouterr().out.splitlines()
@@ -685,7 +685,7 @@ def test_resume_after_an_interrupt_while_drawing_redraws_from_the_last_level(
 ):
     """Every level finished, the figures did not: --resume solves the last level again
     (warm started from its saved solution) only to draw them, and writes no new level."""
-    import signorini.cli as cli
+    import signorini.cli.figures as cli_figures
 
     drawn = []
 
@@ -696,7 +696,7 @@ def test_resume_after_an_interrupt_while_drawing_redraws_from_the_last_level(
         drawn.append(last)
         return []
 
-    monkeypatch.setattr(cli, "_figures", figures)
+    monkeypatch.setattr(cli_figures, "figures", figures)
     out = tmp_path / "d"
     argv = ["run", "example-6.2", "--max-ndof", "700", "--out", str(out), "--no-vtu"]
     assert main(argv) == 130
@@ -796,7 +796,7 @@ def test_the_deformed_figure_of_a_frictional_result_marks_stick_and_slip(tmp_pat
 
     from plots.figure_checks import synthetic_history, write_csv
 
-    import signorini.cli as cli
+    import signorini.cli.figures as cli_figures
     import signorini.plots
     from signorini.fem.material import Material
     from signorini.mesh.builders import rectangle
@@ -827,7 +827,7 @@ def test_the_deformed_figure_of_a_frictional_result_marks_stick_and_slip(tmp_pat
             },
         )
         res = solve(problem)
-        cli._figures(
+        cli_figures.figures(
             "block", tmp_path, SimpleNamespace(result=res, record=SimpleNamespace(level=0))
         )
     with_friction, without = seen

@@ -9,6 +9,7 @@ import scipy.sparse as sp
 from linalg_problems import p2_elasticity, random_problem
 
 from signorini.algebra import (
+    SOLVERS,
     FactorizationError,
     SingularSystemError,
     available_backends,
@@ -40,7 +41,7 @@ def reference_solution(qp, active):
 def test_small_changes_update_large_changes_refactorize(backend):
     rng = np.random.default_rng(31)
     qp = check_qp(*random_problem(rng, 80, 10, 4, dense=False))
-    solver = make_solver(backend)
+    solver = make_solver(SOLVERS[backend])
     system = ActiveSetSystem(qp, solver, max_update=2)
     sets = [np.zeros(10, dtype=bool)]
     sets.append(sets[-1].copy())
@@ -79,7 +80,7 @@ def test_bordered_update_frees_and_fixes_with_k_plus_one_right_hand_sides(backen
     round-off, then a further change from the same factor."""
     rng = np.random.default_rng(5)
     qp = check_qp(*random_problem(rng, 90, 12, 4, dense=False))
-    solver = CountingSolver(make_solver(backend))
+    solver = CountingSolver(make_solver(SOLVERS[backend]))
     system = ActiveSetSystem(qp, solver, max_update=4)
     first = np.zeros(12, dtype=bool)
     first[[0, 3, 5, 8]] = True
@@ -106,8 +107,8 @@ def test_low_rank_updates_agree_with_refactorization(backend):
     used = 0
     for _ in range(6):
         K, F, c, g, d, xd = random_problem(rng, 120, 12, 6, dense=False)
-        exact = solve_pdas(K, F, c, g, d, xd, backend=backend, max_update=0)
-        updated = solve_pdas(K, F, c, g, d, xd, backend=backend, max_update=12)
+        exact = solve_pdas(K, F, c, g, d, xd, solver=SOLVERS[backend], max_update=0)
+        updated = solve_pdas(K, F, c, g, d, xd, solver=SOLVERS[backend], max_update=12)
         assert exact.n_updates == 0
         assert updated.n_factorizations + updated.n_updates == updated.iterations
         assert np.array_equal(updated.active, exact.active)
@@ -130,13 +131,15 @@ def test_near_singular_solve_is_reported(backend):
     F = np.zeros(2 * n1)
     F[n1 + 1 :: 2] = -1e-3
     with pytest.raises(SingularSystemError, match="singular or too ill-conditioned") as info:
-        solve_pdas(K, F, np.zeros(0, dtype=int), np.zeros(0), d, 0.0, backend=backend)
+        solve_pdas(K, F, np.zeros(0, dtype=int), np.zeros(0), d, 0.0, solver=SOLVERS[backend])
     err = info.value
     assert isinstance(err, FactorizationError)
     assert err.backend == backend and err.residual > 1e-4
     assert "no Dirichlet condition" in str(err)
     # the held block alone is solved, its residual checked and far below the bound
-    result = solve_pdas(K1, np.ones(n1), np.zeros(0, dtype=int), np.zeros(0), d, backend=backend)
+    result = solve_pdas(
+        K1, np.ones(n1), np.zeros(0, dtype=int), np.zeros(0), d, solver=SOLVERS[backend]
+    )
     assert result.kkt.stationarity < 1e-14
 
 
@@ -153,7 +156,7 @@ def test_failed_factorization_names_the_usual_causes(backend, case):
     F = np.zeros(K.shape[0])
     F[1::2] = -1e-3
     with pytest.raises(FactorizationError) as info:
-        solve_pdas(K, F, np.zeros(0, dtype=int), np.zeros(0), d, 0.0, backend=backend)
+        solve_pdas(K, F, np.zeros(0, dtype=int), np.zeros(0), d, 0.0, solver=SOLVERS[backend])
     message = str(info.value)
     # a failed factorization, or (PARDISO on the strip) a factorization whose solve fails
     # the residual check

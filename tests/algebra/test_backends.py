@@ -1,4 +1,4 @@
-"""Choice of backend (signorini.algebra.backends): "auto", explicit names, loud fallback."""
+"""The backends by name (signorini.algebra.backends): "auto", the registry, loud fallback."""
 
 from __future__ import annotations
 
@@ -10,15 +10,20 @@ import pytest
 import scipy.sparse as sp
 
 from signorini.algebra import (
-    BACKENDS,
+    SOLVERS,
     BackendUnavailableError,
     SolverFallbackWarning,
+    auto_solver,
     available_backends,
     backends,
     make_solver,
     mkl,
     pardiso,
+    pardiso_solver,
     solve_pdas,
+    solver_factory,
+    solver_name,
+    superlu_solver,
 )
 
 
@@ -51,13 +56,25 @@ def test_auto_takes_pardiso_when_mkl_is_installed():
 
 def test_unknown_backend_lists_valid():
     with pytest.raises(ValueError, match="unknown backend 'mumps'.*auto, pardiso, scipy"):
-        make_solver("mumps")
-    assert BACKENDS == ("pardiso", "scipy")
+        solver_factory("mumps")
+    assert tuple(SOLVERS) == ("auto", "pardiso", "scipy")
+
+
+def test_the_registry_names_each_factory_once():
+    for name, factory in SOLVERS.items():
+        assert solver_factory(name) is factory and solver_name(factory) == name
+    assert solver_name(auto_solver) == "auto" and solver_name(superlu_solver) == "scipy"
+    with pytest.raises(ValueError, match="not a registered backend"):
+        solver_name(lambda request: None)
+    with pytest.raises(ValueError, match="solver must be an SPDSolver or a solver factory"):
+        make_solver("scipy")  # a name is not a factory
+    with pytest.raises(ValueError, match="returned int, not an SPDSolver"):
+        make_solver(lambda request: 3)
 
 
 def test_auto_falls_back_to_superlu_with_one_warning(broken_pardiso):
     with pytest.warns(SolverFallbackWarning, match="falling back to SuperLU: .*mkl_rt") as caught:
-        solver = make_solver("auto")
+        solver = make_solver(auto_solver)
     assert len(caught) == 1 and caught[0].filename == __file__  # points at the caller
     assert solver.backend == "scipy" and not solver.reuses_analysis
     assert available_backends() == ("scipy",)
@@ -70,7 +87,7 @@ def test_auto_falls_back_to_superlu_with_one_warning(broken_pardiso):
 
 def test_explicit_pardiso_raises_when_unavailable(broken_pardiso):
     with pytest.raises(BackendUnavailableError, match="pardiso backend is not usable here: MKL"):
-        make_solver("pardiso")
+        make_solver(pardiso_solver)
     with pytest.raises(RuntimeError, match="no file found"):
-        solve_pdas(sp.identity(3, format="csr"), np.ones(3), [0], 0.5, backend="pardiso")
-    assert make_solver("scipy").backend == "scipy"  # asked for by name: no warning needed
+        solve_pdas(sp.identity(3, format="csr"), np.ones(3), [0], 0.5, solver=pardiso_solver)
+    assert make_solver(superlu_solver).backend == "scipy"  # asked for: no warning needed

@@ -19,7 +19,14 @@ import scipy.sparse.linalg as spla
 from contact_problems import pressed_block
 from linalg_problems import block_spd
 
-from signorini.algebra import available_backends, make_lu_solver, make_solver, solve_pdas
+from signorini.algebra import (
+    SOLVERS,
+    available_backends,
+    make_solver,
+    pardiso_solver,
+    solve_pdas,
+    superlu_solver,
+)
 from signorini.algebra.friction import INACTIVE, SLIP, STICK, solve_friction
 from signorini.algebra.friction_result import FrictionConvergenceError
 
@@ -214,8 +221,8 @@ def test_coulomb_meets_both_laws_and_is_a_fixed_point_of_tresca(coefficient):
 @pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO is not installed")
 def test_coulomb_superlu_and_pardiso_agree():
     S = block()
-    a = solve_friction(*args(S), coefficient=0.5, backend="scipy")
-    b = solve_friction(*args(S), coefficient=0.5, backend="pardiso")
+    a = solve_friction(*args(S), coefficient=0.5, solver=superlu_solver)
+    b = solve_friction(*args(S), coefficient=0.5, solver=pardiso_solver)
     assert (a.backend, b.backend) == ("scipy", "pardiso")
     assert rel(a.x, b.x) < 1e-11, rel(a.x, b.x)
     assert b.n_analyses == 1 and b.n_factorizations == b.iterations
@@ -224,12 +231,12 @@ def test_coulomb_superlu_and_pardiso_agree():
 @pytest.mark.parametrize("backend", available_backends())
 def test_a_kept_solver_analyses_the_pattern_once_across_calls(backend):
     S = block()
-    with make_lu_solver(backend) as solver:
+    with make_solver(SOLVERS[backend], symmetric=False) as solver:
         first = solve_friction(*args(S), coefficient=0.5, solver=solver)
         second = solve_friction(*args(S), coefficient=0.2, solver=solver)
     assert (first.n_analyses, second.n_analyses) == (1, 0)
     assert second.n_factorizations == second.iterations
-    with make_solver(backend) as solver:
+    with make_solver(SOLVERS[backend]) as solver:
         first = solve_friction(*args(S), bound=1e-3, solver=solver)
         second = solve_friction(*args(S), bound=2e-3, solver=solver)
     assert (first.n_analyses, second.n_analyses) == (1, 0)

@@ -7,8 +7,14 @@ import pytest
 import scipy.sparse as sp
 from linalg_problems import block_spd
 
-from signorini.algebra import FactorizationError, available_backends
-from signorini.algebra.backends import make_lu_solver
+from signorini.algebra import (
+    SOLVERS,
+    FactorizationError,
+    available_backends,
+    make_solver,
+    solver_factory,
+    superlu_solver,
+)
 
 
 def non_symmetric(seed: int) -> sp.csr_matrix:
@@ -24,7 +30,7 @@ def test_lu_solves_a_non_symmetric_system_and_keeps_its_analysis(backend):
     A = non_symmetric(0)
     assert abs(A - A.T).max() > 0.1 * abs(A).max()
     b = np.random.default_rng(1).standard_normal(A.shape[0])
-    solver = make_lu_solver(backend)
+    solver = make_solver(SOLVERS[backend], symmetric=False)
     assert solver.backend == backend
     solver.factorize(A)
     x = solver.solve(b)
@@ -43,9 +49,9 @@ def test_superlu_lu_reports_a_singular_matrix():
     A = non_symmetric(2)
     A.data[A.indptr[3] : A.indptr[4]] = 0.0  # row 3 zero, pattern kept
     with pytest.raises(FactorizationError, match="singular"):
-        make_lu_solver("scipy", A)
+        make_solver(superlu_solver, A, symmetric=False)
 
 
-def test_make_lu_solver_rejects_an_unknown_backend():
+def test_an_unknown_backend_name_is_refused():
     with pytest.raises(ValueError, match="unknown backend 'umfpack'"):
-        make_lu_solver("umfpack")
+        solver_factory("umfpack")

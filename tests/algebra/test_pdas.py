@@ -22,6 +22,7 @@ from linalg_problems import (
 )
 
 from signorini.algebra import (
+    SOLVERS,
     PDASConvergenceError,
     available_backends,
     eliminate_symmetric,
@@ -195,12 +196,12 @@ def test_matches_scipy_slsqp():
 def test_warm_start_from_exact_active_set_takes_one_solve(backend):
     rng = np.random.default_rng(8)
     K, F, c, g, d, xd = random_problem(rng, 60, 30, 5, dense=False)
-    cold = solve_pdas(K, F, c, g, d, xd, backend=backend)
+    cold = solve_pdas(K, F, c, g, d, xd, solver=SOLVERS[backend])
     assert cold.iterations >= 2 and cold.active.any()
-    warm = solve_pdas(K, F, c, g, d, xd, active0=cold.active, backend=backend)
+    warm = solve_pdas(K, F, c, g, d, xd, active0=cold.active, solver=SOLVERS[backend])
     assert (warm.iterations, warm.n_solves, warm.n_factorizations) == (1, 1, 1)
     assert np.allclose(warm.x, cold.x, rtol=0, atol=1e-12 * np.abs(cold.x).max())
-    from_x = solve_pdas(K, F, c, g, d, xd, x0=cold.x, backend=backend)
+    from_x = solve_pdas(K, F, c, g, d, xd, x0=cold.x, solver=SOLVERS[backend])
     assert from_x.iterations == 1
     assert np.array_equal(from_x.active, cold.active)
     assert warm.backend == backend
@@ -210,7 +211,7 @@ def test_warm_start_from_exact_active_set_takes_one_solve(backend):
 def test_solver_reuse_across_calls(backend):
     rng = np.random.default_rng(9)
     K, F, c, g, d, xd = random_problem(rng, 80, 20, 4, dense=False)
-    solver = make_solver(backend)
+    solver = make_solver(SOLVERS[backend])
     first = solve_pdas(K, F, c, g, d, xd, solver=solver)
     second = solve_pdas(K, F, c, 0.5 * g, d, xd, solver=solver)
     assert first.n_analyses == 1
@@ -242,7 +243,7 @@ def test_backends_agree():
         pytest.skip("only one backend available")
     rng = np.random.default_rng(10)
     K, F, c, g, d, xd = random_problem(rng, 120, 50, 10, dense=False)
-    a, b = (solve_pdas(K, F, c, g, d, xd, backend=name) for name in BACKEND_LIST)
+    a, b = (solve_pdas(K, F, c, g, d, xd, solver=SOLVERS[name]) for name in BACKEND_LIST)
     assert np.array_equal(a.active, b.active)
     assert np.abs(a.x - b.x).max() < 1e-11 * np.abs(a.x).max()
 
@@ -372,7 +373,7 @@ def small():
         (lambda p: p.update(active0=np.ones(2, dtype=bool)), "active0 must be a boolean"),
         (lambda p: p.update(active0=np.ones(3)), "active0 must be a boolean"),
         (lambda p: p.update(x0=np.ones(3)), r"x0 must have shape \(8,\)"),
-        (lambda p: p.update(backend="cholmod"), "unknown backend 'cholmod'"),
+        (lambda p: p.update(solver=42), r"SPDSolver or a solver factory \(.*\), got 42"),
         (lambda p: p.update(solver="pardiso"), "solver must be an SPDSolver"),
     ],
 )
@@ -413,7 +414,7 @@ def test_just_touching_converges_cold_and_warm(backend):
         "warm x0": {"x0": x_exact},
     }
     for name, start in starts.items():
-        result = solve_pdas(K, F, c, 0.1, d, xd, backend=backend, **start)
+        result = solve_pdas(K, F, c, 0.1, d, xd, solver=SOLVERS[backend], **start)
         assert result.method == "pdas", name
         assert result.iterations == 1, (name, [str(s) for s in result.history])
         assert np.abs(result.x - x_exact).max() < 1e-10, name

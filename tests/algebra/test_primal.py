@@ -7,7 +7,7 @@ import pytest
 import scipy.sparse as sp
 from linalg_problems import CYCLING_F, CYCLING_G, CYCLING_K, brute_force_qp, random_problem
 
-from signorini.algebra import PDASConvergenceError, make_solver
+from signorini.algebra import PDASConvergenceError, make_solver, superlu_solver
 from signorini.algebra.active_system import ActiveSetSystem
 from signorini.algebra.primal import primal_active_set
 from signorini.algebra.qp import check_qp
@@ -15,7 +15,7 @@ from signorini.algebra.qp import check_qp
 
 def test_solves_the_problem_plain_pdas_cycles_on():
     qp = check_qp(sp.csr_matrix(CYCLING_K), CYCLING_F, np.arange(4), CYCLING_G)
-    system = ActiveSetSystem(qp, make_solver("scipy"))
+    system = ActiveSetSystem(qp, make_solver(superlu_solver))
     history = []
     x, multiplier, active = primal_active_set(system, np.zeros(4), 1.0, 50, history)
     x_ref, multiplier_ref, active_ref = brute_force_qp(
@@ -33,7 +33,7 @@ def test_any_start_reaches_the_minimizer(seed):
     rng = np.random.default_rng(seed)
     K, F, c, g, d, xd = random_problem(rng, 9, 6, 1)
     qp = check_qp(K, F, c, g, d, xd)
-    system = ActiveSetSystem(qp, make_solver("scipy"))
+    system = ActiveSetSystem(qp, make_solver(superlu_solver))
     start = rng.standard_normal(9)  # infeasible in general: projected first
     x, multiplier, active = primal_active_set(system, start, 1.0, 100, [])
     x_ref, multiplier_ref, _ = brute_force_qp(K, F, c, g, d, xd)
@@ -43,7 +43,7 @@ def test_any_start_reaches_the_minimizer(seed):
 
 def test_step_bound_raises_with_the_fallback_history():
     qp = check_qp(sp.csr_matrix(CYCLING_K), CYCLING_F, np.arange(4), CYCLING_G)
-    system = ActiveSetSystem(qp, make_solver("scipy"))
+    system = ActiveSetSystem(qp, make_solver(superlu_solver))
     earlier = ["pdas step"]  # steps before the fallback are not part of its failure
     with pytest.raises(PDASConvergenceError, match="did not finish in 1 steps") as info:
         primal_active_set(system, np.zeros(4), 1.0, 1, earlier)

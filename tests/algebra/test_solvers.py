@@ -10,6 +10,7 @@ import scipy.sparse as sp
 from linalg_problems import block_spd, p2_elasticity, random_spd_dense, rigid_motions
 
 from signorini.algebra import (
+    SOLVERS,
     FactorizationError,
     SymmetricEliminator,
     available_backends,
@@ -35,7 +36,7 @@ def test_solution_matches_dense(backend, nx, ny):
     A = block_spd(nx, ny, rng)
     n = A.shape[0]
     b = rng.standard_normal(n)
-    with make_solver(backend, A) as solver:
+    with make_solver(SOLVERS[backend], A) as solver:
         x = solver.solve(b)
         B = rng.standard_normal((n, 3))
         X = solver.solve(B)
@@ -51,7 +52,7 @@ def test_backends_agree_on_dense_random_matrix():
     rng = np.random.default_rng(3)
     A = sp.csr_matrix(random_spd_dense(40, rng))
     b = rng.standard_normal(40)
-    xs = [make_solver(name, A).solve(b) for name in BACKEND_LIST]
+    xs = [make_solver(SOLVERS[name], A).solve(b) for name in BACKEND_LIST]
     reference = np.linalg.solve(A.toarray(), b)
     for x in xs:
         assert np.abs(x - reference).max() < 1e-11 * np.abs(reference).max()
@@ -61,7 +62,7 @@ def test_refactorization_reuses_analysis(backend):
     rng = np.random.default_rng(7)
     A = block_spd(10, 9, rng)
     b = rng.standard_normal(A.shape[0])
-    solver = make_solver(backend)
+    solver = make_solver(SOLVERS[backend])
     solver.factorize(A)
     x1 = solver.solve(b)
     # same pattern, different values: scale, then add to the diagonal in place
@@ -103,7 +104,7 @@ def test_not_positive_definite_raises(backend, kind):
     else:
         A = block_spd(6, 6, rng, shift=0.0)  # constant vectors (per component) are null
         assert np.abs(A @ np.tile([1.0, 0.0], 36)).max() < 1e-12
-    solver = make_solver(backend)
+    solver = make_solver(SOLVERS[backend])
     with pytest.raises(FactorizationError, match="not positive definite|singular") as info:
         solver.factorize(A)
     assert info.value.backend == backend
@@ -116,7 +117,7 @@ def test_not_positive_definite_raises(backend, kind):
 def test_negative_definite_reports_equation(backend):
     A = -sp.identity(5, format="csr")
     with pytest.raises(FactorizationError) as info:
-        make_solver(backend, A)
+        make_solver(SOLVERS[backend], A)
     assert info.value.equation is not None and 0 <= info.value.equation < 5
 
 
@@ -133,12 +134,12 @@ def test_negative_definite_reports_equation(backend):
 )
 def test_bad_matrix_raises_value_error(backend, matrix, message):
     with pytest.raises(ValueError, match=message):
-        make_solver(backend, matrix)
+        make_solver(SOLVERS[backend], matrix)
 
 
 def test_bad_rhs_raises(backend):
     A = sp.identity(4, format="csr") * 2.0
-    solver = make_solver(backend, A)
+    solver = make_solver(SOLVERS[backend], A)
     with pytest.raises(ValueError, match="shape"):
         solver.solve(np.ones(5))
     with pytest.raises(ValueError, match="non-finite"):
@@ -172,7 +173,7 @@ def test_timings_elasticity_200k(capsys):
     A2, b2 = eliminate_symmetric(K, F, fixed2, 0.0)
     lines = [f"P2 elasticity, n = {n}, nnz = {K.nnz}"]
     for name in BACKEND_LIST:
-        solver = make_solver(name)
+        solver = make_solver(SOLVERS[name])
         t0 = time.perf_counter()
         solver.factorize(A)
         x = solver.solve(b)
@@ -201,7 +202,7 @@ def test_refactorize_equals_factorize_with_keep(backend):
     b = rng.standard_normal(n)
     elim = SymmetricEliminator(K)
     masks = [rng.random(n) < p for p in (0.1, 0.3, 0.5)]
-    solver = make_solver(backend)
+    solver = make_solver(SOLVERS[backend])
     with pytest.raises(RuntimeError, match="before factorize"):
         solver.refactorize(elim.keep_mask(masks[0]))
     solver.factorize(K, keep=elim.keep_mask(masks[0]))
@@ -209,7 +210,7 @@ def test_refactorize_equals_factorize_with_keep(backend):
         solver.refactorize(elim.keep_mask(fixed))
         A, rhs = elim.apply(K, b, fixed, 0.0)
         x = solver.solve(rhs)
-        reference = make_solver(backend, A).solve(rhs)
+        reference = make_solver(SOLVERS[backend], A).solve(rhs)
         assert np.abs(x - reference).max() <= 1e-12 * np.abs(reference).max()
         assert rel_residual(A, x, rhs) < 1e-10
     assert (solver.n_analyses, solver.n_factorizations) == (1, 3)

@@ -8,14 +8,14 @@ import scipy.sparse as sp
 from linalg_problems import block_spd
 
 from signorini.algebra import FactorizationError
-from signorini.algebra.superlu import SuperLUSolver
+from signorini.algebra.superlu import SuperLULUSolver, SuperLUSolver
 
 
 def test_pivot_check_is_what_rejects_an_indefinite_matrix():
-    # diag(2, -1, 3): SuperLU factorizes it without complaint; only the pivot check sees the
-    # negative pivot, and reports the equation
+    # diag(2, -1, 3): SuperLU factorizes it without complaint (as LU, which has no pivot
+    # check); only the SPD solver's pivot check sees the negative pivot, and reports the equation
     A = sp.diags([2.0, -1.0, 3.0]).tocsr()
-    unchecked = SuperLUSolver(A, check_pivots=False)
+    unchecked = SuperLULUSolver(A)
     assert np.allclose(unchecked.solve(np.ones(3)), [0.5, -1.0, 1 / 3], rtol=1e-15)
     with pytest.raises(FactorizationError, match="not positive definite") as info:
         SuperLUSolver(A)

@@ -9,7 +9,13 @@ import scipy.sparse as sp
 from linalg_problems import p2_elasticity
 
 from signorini import adaptive, example_6_2, solve
-from signorini.algebra import SymmetricEliminator, available_backends, make_solver
+from signorini.algebra import (
+    SOLVERS,
+    SymmetricEliminator,
+    available_backends,
+    make_solver,
+    pardiso_solver,
+)
 from signorini.algebra.pardiso import PardisoSolver, metis_ordering
 from signorini.contact import assemble
 from signorini.contact.ordering import dof_ordering, ordered_solver, vertex_graph
@@ -114,28 +120,29 @@ def test_solution_does_not_depend_on_the_ordering(backend):
         orderings.append(dof_ordering(a.space))
     solutions = []
     for ordering in orderings:
-        with make_solver(backend, check_symmetry=False, ordering=ordering) as solver:
+        with make_solver(SOLVERS[backend], check_symmetry=False) as solver:
+            solver.ordering = ordering
             solver.factorize(a.K, keep=keep)
             solutions.append(solver.solve(b))
     scale = np.abs(solutions[0]).max()
     for x in solutions[1:]:
         assert np.abs(x - solutions[0]).max() <= 1e-10 * scale
-    with ordered_solver(a.space, backend) as solver:
+    with ordered_solver(a.space, SOLVERS[backend]) as solver:
         assert (solver.ordering is not None) == (solver.backend == "pardiso")
 
 
 @needs_pardiso
 def test_solve_uses_the_ordering_and_agrees_with_pardisos_own(adaptive_mesh, monkeypatch):
     problem = example_6_2()
-    ordered = solve(problem, adaptive_mesh, backend="pardiso", nested=False)
+    ordered = solve(problem, adaptive_mesh, solver=pardiso_solver, nested=False)
     import signorini.contact.solution as solution
 
     monkeypatch.setattr(
         solution,
         "ordered_solver",
-        lambda space, backend, **options: make_solver(backend, **options),
+        lambda space, solver, **options: make_solver(solver, **options),
     )
-    own = solve(problem, adaptive_mesh, backend="pardiso", nested=False)
+    own = solve(problem, adaptive_mesh, solver=pardiso_solver, nested=False)
     assert ordered.pdas.iterations == own.pdas.iterations
     assert np.abs(ordered.u - own.u).max() <= 1e-10 * np.abs(own.u).max()
     assert (
@@ -156,7 +163,8 @@ def test_solve_uses_the_ordering_and_agrees_with_pardisos_own(adaptive_mesh, mon
 @pytest.mark.parametrize("backend", available_backends())
 def test_a_bad_ordering_is_refused_naming_it(ordering, message, backend):
     K = sp.csr_matrix(np.eye(6) * 2 + np.eye(6, k=1) * 0.5 + np.eye(6, k=-1) * 0.5)
-    with make_solver(backend, ordering=ordering) as solver:
+    with make_solver(SOLVERS[backend]) as solver:
+        solver.ordering = ordering
         with pytest.raises(ValueError, match="ordering") as info:
             solver.factorize(K)
     assert info.match(message)

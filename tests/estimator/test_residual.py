@@ -338,7 +338,7 @@ def test_full_contact_has_no_eta6_eta7():
 def test_node_terms_against_independent_computation(name, steps, eta5):
     problem = EXAMPLES[name]()
     result = solve(problem, random_nvb(problem.mesh, 11, steps=steps, fraction=0.4))
-    est = estimate(result, eta5=eta5)
+    est = estimate(result, eta5_variant=eta5)
     ref = reference_node_terms(result, eta5)
     for k in range(5):
         scale = ref[k].max()
@@ -446,7 +446,7 @@ def test_eta5_variants_on_uniform_meshes_example_6_1():
     ndof, eta5, eta = [], {v: [] for v in ETA5_VARIANTS}, {v: [] for v in ETA5_VARIANTS}
     for _ in range(4):
         result = solve(problem, mesh)
-        ests = {v: estimate(result, eta5=v) for v in ETA5_VARIANTS}
+        ests = {v: estimate(result, eta5_variant=v) for v in ETA5_VARIANTS}
         other = [ROW[name] for name in TERMS if name != "eta_5"]
         np.testing.assert_array_equal(
             ests["paper"].eta2_cell[other], ests["consistent"].eta2_cell[other]
@@ -475,9 +475,9 @@ def test_eta5_variants_on_uniform_meshes_example_6_1():
 def test_estimate_rejects_unknown_variant_and_records_the_one_used():
     result = solve(example_6_1())
     with pytest.raises(ValueError, match="eta5"):
-        estimate(result, eta5="literal")
+        estimate(result, eta5_variant="literal")
     for variant in ETA5_VARIANTS:
-        assert estimate(result, eta5=variant).eta5_variant == variant
+        assert estimate(result, eta5_variant=variant).eta5_variant == variant
 
 
 def test_problem_without_contact_has_no_contact_terms():

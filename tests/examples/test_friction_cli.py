@@ -51,19 +51,19 @@ def test_run_partial_slip_resumed_after_an_interrupt(tmp_path, capsys, monkeypat
     """partial-slip solves press and pull on every level; interrupted after level 2 and
     resumed, it gives the history of the uninterrupted run (counts exactly, numbers to
     round-off) with the Cattaneo–Mindlin columns."""
-    import signorini.cli as cli
+    import signorini.cli.levels as cli_levels
 
     full, part = tmp_path / "full", tmp_path / "part"
     args = ["run", "partial-slip", "--max-ndof", "2500", "--no-figures", "--quiet"]
     assert main([*args, "--out", str(full)]) == 0
-    progress = cli._progress
+    progress = cli_levels.progress
 
     def stop(level):
         if level.record.level == 2:
             raise KeyboardInterrupt
         return progress(level)
 
-    monkeypatch.setattr(cli, "_progress", stop)
+    monkeypatch.setattr(cli_levels, "progress", stop)
     assert main([*args, "--out", str(part)]) == 130
     assert "--resume" in capsys.readouterr().err
     monkeypatch.undo()

@@ -13,9 +13,9 @@ import pytest
 
 from signorini import adaptive
 from signorini.examples import (
-    METRICS,
+    EXAMPLES,
+    PARTIAL_SLIP_METRICS,
     example_6_2_coulomb,
-    get_load_path,
     partial_slip,
     partial_slip_path,
 )
@@ -38,7 +38,7 @@ def coulomb_levels():
 def slip_levels():
     steps = partial_slip_path()
     return list(
-        adaptive(steps[-1], path=steps[:-1], max_ndof=BUDGET_SLIP, metrics=METRICS["partial-slip"])
+        adaptive(steps[-1], path=steps[:-1], max_ndof=BUDGET_SLIP, metrics=PARTIAL_SLIP_METRICS)
     )
 
 
@@ -156,10 +156,10 @@ def test_partial_slip_rate_refinement_kkt_and_cattaneo_mindlin(slip_levels):
 def test_partial_slip_is_a_load_path_of_two_steps_on_one_mesh():
     """The registry gives the press as the step before the example's problem (the pull),
     and the loop refuses a path that is not one."""
-    before = get_load_path("partial-slip")
+    before = EXAMPLES["partial-slip"].steps_before()
     problem = partial_slip()
     assert len(before) == 1 and before[0].conditions["top"].value[0] == 0.0
-    assert problem.conditions["top"].value[0] > 0 and get_load_path("example-6.2") is None
+    assert problem.conditions["top"].value[0] > 0 and EXAMPLES["example-6.2"].steps_before() is None
     with pytest.raises(ValueError, match="path must be a sequence of ContactProblem"):
         adaptive(problem, path=before[0])
     with pytest.raises(ValueError, match="another mesh"):

@@ -5,11 +5,12 @@ semismooth Newton extension to Tresca and Coulomb friction.
 =====================  ==========================================================================
 ``sparse``             CSR helpers: checks, row indices, upper triangle, diagonal positions
 ``elimination``        symmetric elimination of fixed DOFs in place (pattern kept)
-``solvers``            the SPD solver interface (analysis once per pattern), its errors
-``superlu``            SuperLU backends (always available): SPD, and LU for non-symmetric
+``solvers``            the SPD solver interface (analysis once per pattern), its errors; the
+                       solver factory protocol and its request
+``superlu``            SuperLU backend (always available): SPD, LU for non-symmetric; factory
 ``mkl``                how MKL's runtime library is found and loaded
-``pardiso``            MKL PARDISO through ctypes (SPD, non-symmetric LU); METIS orderings
-``backends``           ``make_solver``, ``make_lu_solver``, ``available_backends``
+``pardiso``            MKL PARDISO through ctypes (SPD, non-symmetric LU), its factory; METIS
+``backends``           the backends by name (``SOLVERS``, ``"auto"``), ``make_solver``
 ``qp``                 the bound-constrained QP's data, checked at the public entry
 ``kkt``                KKT residuals of a point
 ``active_system``      one active set's linear system: refactorization or bordered update
@@ -24,23 +25,33 @@ semismooth Newton extension to Tresca and Coulomb friction.
 """
 
 from .backends import (
-    BACKENDS,
+    SOLVERS,
     SolverFallbackWarning,
+    auto_solver,
     available_backends,
-    make_lu_solver,
     make_solver,
+    solver_factory,
+    solver_name,
 )
 from .elimination import SymmetricEliminator, eliminate_symmetric
 from .friction import INACTIVE, SLIP, STICK, solve_friction
 from .friction_kkt import FrictionKKT
 from .friction_result import FrictionConvergenceError, FrictionResult, FrictionStep
 from .kkt import KKTResiduals, kkt_residuals
+from .pardiso import pardiso_solver
 from .pdas import solve_pdas
 from .result import PDASConvergenceError, PDASResult, PDASStep
-from .solvers import BackendUnavailableError, FactorizationError, SingularSystemError, SPDSolver
+from .solvers import (
+    BackendUnavailableError,
+    FactorizationError,
+    SingularSystemError,
+    SolverFactory,
+    SolverRequest,
+    SPDSolver,
+)
+from .superlu import superlu_solver
 
 __all__ = [
-    "BACKENDS",
     "BackendUnavailableError",
     "FactorizationError",
     "FrictionConvergenceError",
@@ -55,14 +66,21 @@ __all__ = [
     "PDASConvergenceError",
     "PDASResult",
     "PDASStep",
+    "SOLVERS",
     "SPDSolver",
+    "SolverFactory",
     "SolverFallbackWarning",
+    "SolverRequest",
     "SymmetricEliminator",
+    "auto_solver",
     "available_backends",
     "eliminate_symmetric",
     "kkt_residuals",
-    "make_lu_solver",
     "make_solver",
+    "pardiso_solver",
     "solve_friction",
     "solve_pdas",
+    "solver_factory",
+    "solver_name",
+    "superlu_solver",
 ]

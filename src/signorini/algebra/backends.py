@@ -1,43 +1,53 @@
-"""Choice of the SPD solver backend: :func:`make_solver` and :func:`available_backends`.
+"""The solver backends by name: the registry :data:`SOLVERS` and :func:`make_solver`.
+
+A solver backend is a :class:`~.solvers.SolverFactory`: a callable that takes a
+:class:`~.solvers.SolverRequest` and returns a new :class:`~.solvers.SPDSolver`. The
+package's functions take the factory itself (``solve(problem, solver=superlu_solver)``);
+names exist only here and at the command line (``--backend``), and a run folder records its
+backend by name (:func:`solver_name`).
 
 ``"pardiso"``
-    MKL PARDISO (:mod:`.pardiso`): sparse Cholesky with the symbolic analysis done once per
-    pattern.
+    :func:`~.pardiso.pardiso_solver`: MKL PARDISO, sparse Cholesky or LU with the symbolic
+    analysis done once per pattern; raises :class:`~.solvers.BackendUnavailableError` with
+    the reason where it cannot be used.
 ``"scipy"``
-    SuperLU (:mod:`.superlu`), always there, with no reuse of the analysis.
+    :func:`~.superlu.superlu_solver`: SuperLU, always there, with no reuse of the analysis.
 ``"auto"``
-    PARDISO when it loads and solves a small test system; otherwise SuperLU, and a
-    :class:`SolverFallbackWarning` says why (once per reason and process). The solver's
-    :attr:`~.solvers.SPDSolver.backend` (the ``backend`` column of the history) tells which
-    one was taken. Asking for ``"pardiso"`` where it cannot load raises
-    :class:`~.solvers.BackendUnavailableError` with the reason.
+    :func:`auto_solver`, the default everywhere: PARDISO when it loads and solves a small test
+    system; otherwise SuperLU, and a :class:`SolverFallbackWarning` says why (once per reason
+    and process). The solver's :attr:`~.solvers.SPDSolver.backend` (the ``backend`` column of
+    the history) tells which one was taken.
+
+A new backend is one module (an :class:`~.solvers.SPDSolver` subclass and its factory) and
+one line of :data:`SOLVERS`.
 """
 
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from functools import cache
 
+import numpy as np
 import scipy.sparse as sp
 
-from .pardiso import PardisoLUSolver, PardisoSolver, pardiso_problem
-from .solvers import BackendUnavailableError, SPDSolver
-from .superlu import SuperLULUSolver, SuperLUSolver
+from .pardiso import pardiso_problem, pardiso_solver
+from .solvers import BackendUnavailableError, SolverFactory, SolverRequest, SPDSolver
+from .superlu import superlu_solver
 
 __all__ = [
-    "BACKENDS",
+    "SOLVERS",
     "SolverFallbackWarning",
+    "auto_solver",
     "available_backends",
-    "make_lu_solver",
     "make_solver",
+    "solver_factory",
+    "solver_name",
 ]
-
-#: Names accepted by :func:`make_solver` besides ``"auto"``.
-BACKENDS: tuple[str, ...] = ("pardiso", "scipy")
 
 
 class SolverFallbackWarning(RuntimeWarning):
-    """``backend="auto"`` could not load PARDISO and uses SuperLU (much slower at 10⁵+
+    """The ``"auto"`` backend could not load PARDISO and uses SuperLU (much slower at 10⁵+
     unknowns)."""
 
 
@@ -47,88 +57,130 @@ def _warn_fallback(reason: str) -> None:
     warnings.warn(
         f"the fast sparse solver (MKL PARDISO) is not usable, falling back to SuperLU: {reason}",
         SolverFallbackWarning,
-        stacklevel=4,  # the caller of make_solver (or make_lu_solver)
+        stacklevel=4,  # the caller of make_solver
+    )
+
+
+def auto_solver(request: SolverRequest) -> SPDSolver:
+    """The default solver factory: PARDISO where it loads and works, else SuperLU with a
+    :class:`SolverFallbackWarning` (once per process and reason)."""
+    problem = pardiso_problem()
+    if problem is None:
+        return pardiso_solver(request)
+    _warn_fallback(problem)
+    return superlu_solver(request)
+
+
+#: The solver factories by the name the command line and a run folder's manifest use.
+SOLVERS: dict[str, SolverFactory] = {
+    "auto": auto_solver,
+    "pardiso": pardiso_solver,
+    "scipy": superlu_solver,
+}
+
+
+def solver_factory(name: str) -> SolverFactory:
+    """The factory registered as ``name`` in :data:`SOLVERS`.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, listing the valid ones.
+    """
+    try:
+        return SOLVERS[name]
+    except (KeyError, TypeError):
+        raise ValueError(
+            f"unknown backend {name!r}; valid backends are {', '.join(SOLVERS)}"
+        ) from None
+
+
+def solver_name(solver: object) -> str:
+    """The name under which ``solver`` (a factory) is registered in :data:`SOLVERS`.
+
+    Raises
+    ------
+    ValueError
+        If it is not registered (a run folder records its solver by name).
+    """
+    for name, factory in SOLVERS.items():
+        if factory is solver:
+            return name
+    raise ValueError(
+        f"solver {solver!r} is not a registered backend ({', '.join(SOLVERS)}): only those "
+        "can be recorded by name"
     )
 
 
 def available_backends() -> tuple[str, ...]:
-    """Backends that work on this machine, best first (``"scipy"`` is always there)."""
-    return ("pardiso", "scipy") if pardiso_problem() is None else ("scipy",)
-
-
-def _takes_pardiso(backend: str) -> bool:
-    """Whether ``backend`` means PARDISO here: ``"pardiso"`` (raising when it cannot be
-    used), ``"auto"`` when it loads and works (else a warning once); never ``"scipy"``."""
-    valid = ("auto", *BACKENDS)
-    if backend not in valid:
-        raise ValueError(f"unknown backend {backend!r}; valid backends are {', '.join(valid)}")
-    if backend == "scipy":
-        return False
-    problem = pardiso_problem()
-    if problem is None:
-        return True
-    if backend == "pardiso":
-        raise BackendUnavailableError(f"the pardiso backend is not usable here: {problem}")
-    _warn_fallback(problem)
-    return False
+    """The registered backends (``"auto"`` aside) that make a solver on this machine, in the
+    order of :data:`SOLVERS` (``"scipy"`` is always there)."""
+    names = []
+    for name, factory in SOLVERS.items():
+        if factory is auto_solver:
+            continue
+        try:
+            factory(SolverRequest()).close()
+        except BackendUnavailableError:
+            continue
+        names.append(name)
+    return tuple(names)
 
 
 def make_solver(
-    backend: str = "auto", A: sp.spmatrix | None = None, **options: object
+    solver: SolverFactory | None = None,
+    A: sp.spmatrix | None = None,
+    *,
+    symmetric: bool = True,
+    check_symmetry: bool = True,
+    ordering: Callable[[], np.ndarray] | None = None,
 ) -> SPDSolver:
-    """Create an SPD solver.
+    """A new solver from a factory, for symmetric positive definite or general matrices.
 
     Parameters
     ----------
-    backend : {"auto", "pardiso", "scipy"}
-        ``"auto"`` takes PARDISO when it loads and works, SuperLU otherwise (with a
-        :class:`SolverFallbackWarning`).
+    solver : SolverFactory, optional
+        Default :func:`auto_solver`.
     A : scipy sparse matrix, shape (n, n), optional
         Factorized right away if given.
-    **options
-        Passed to the solver class (e.g. ``check_symmetry=False``).
+    symmetric, check_symmetry : bool
+        As in :class:`~.solvers.SolverRequest`: Cholesky (with or without the symmetry
+        check) or LU.
+    ordering : callable () -> (n,) int array, optional
+        A fill-reducing ordering offered to the factory, computed only if the backend uses
+        it (PARDISO does, SuperLU does not). To impose an ordering on any backend, set
+        :attr:`~.solvers.SPDSolver.ordering` on the solver instead.
 
     Returns
     -------
     SPDSolver
-        Its :attr:`~SPDSolver.backend` names the backend taken.
+        Its :attr:`~.solvers.SPDSolver.backend` names the backend taken; the caller closes it.
 
     Raises
     ------
     ValueError
-        For an unknown backend name.
+        If ``solver`` is not a factory, or the factory returns no :class:`SPDSolver`.
     BackendUnavailableError
-        If ``"pardiso"`` is asked for and cannot be used (a :class:`RuntimeError`).
+        If the factory's backend cannot be used here (a :class:`RuntimeError`).
     """
-    if _takes_pardiso(backend):
-        return PardisoSolver(A, **options)
-    return SuperLUSolver(A, **options)
-
-
-def make_lu_solver(backend: str = "auto", A: sp.spmatrix | None = None) -> SPDSolver:
-    """Create a sparse LU solver for general (non-symmetric) matrices, with the interface of
-    :class:`~.solvers.SPDSolver` (no symmetry check).
-
-    Parameters
-    ----------
-    backend : {"auto", "pardiso", "scipy"}
-        ``"pardiso"``: :class:`~.pardiso.PardisoLUSolver` (analysis reused per pattern);
-        ``"scipy"``: :class:`~.superlu.SuperLULUSolver`; ``"auto"`` as in
-        :func:`make_solver`.
-    A : scipy sparse matrix, shape (n, n), optional
-        Factorized right away if given.
-
-    Returns
-    -------
-    SPDSolver
-
-    Raises
-    ------
-    ValueError
-        For an unknown backend name.
-    BackendUnavailableError
-        If ``"pardiso"`` is asked for and cannot be used.
-    """
-    if _takes_pardiso(backend):
-        return PardisoLUSolver(A)
-    return SuperLULUSolver(A)
+    factory = auto_solver if solver is None else solver
+    if isinstance(factory, SPDSolver):
+        raise ValueError(f"solver is a solver already ({factory!r}): make_solver takes a factory")
+    if isinstance(factory, str) or not callable(factory):
+        raise ValueError(
+            "solver must be an SPDSolver or a solver factory (e.g. "
+            f"signorini.algebra.superlu_solver), got {solver!r}"
+        )
+    request = SolverRequest(
+        symmetric=bool(symmetric),
+        check_symmetry=bool(check_symmetry),
+        ordering=ordering,
+    )
+    made = factory(request)
+    if not isinstance(made, SPDSolver):
+        raise ValueError(
+            f"the solver factory {factory!r} returned {type(made).__name__}, not an SPDSolver"
+        )
+    if A is not None:
+        made.factorize(A)
+    return made

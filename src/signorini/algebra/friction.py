@@ -46,7 +46,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from .backends import make_lu_solver, make_solver
+from .backends import make_solver
 from .friction_kkt import FrictionProblem, check_friction, friction_kkt, slip_bound
 from .friction_result import (
     INACTIVE,
@@ -58,7 +58,7 @@ from .friction_result import (
 )
 from .friction_system import CoulombSystem, TrescaSystem
 from .qp import check_vector
-from .solvers import SPDSolver, solver_usage
+from .solvers import SolverFactory, SPDSolver, solver_usage
 
 __all__ = ["INACTIVE", "SLIP", "STICK", "solve_friction"]
 
@@ -96,8 +96,7 @@ def solve_friction(
     c: float | None = None,
     max_iter: int = 50,
     kkt_tol: float = 1e-8,
-    solver: SPDSolver | None = None,
-    backend: str = "auto",
+    solver: SPDSolver | SolverFactory | None = None,
 ) -> FrictionResult:
     """Solve the frictional contact problem (Tresca or Coulomb) by semismooth Newton.
 
@@ -144,10 +143,10 @@ def solve_friction(
     kkt_tol : float
         Largest relative KKT residual (:class:`~.friction_kkt.FrictionKKT`) accepted when the
         states repeat.
-    solver : SPDSolver, optional
-        A solver to use and keep: SPD for Tresca (:func:`~.backends.make_solver`), LU for
-        Coulomb (:func:`~.backends.make_lu_solver`). By default one is made with ``backend``.
-    backend : {"auto", "pardiso", "scipy"}
+    solver : SPDSolver or SolverFactory, optional
+        An :class:`SPDSolver` to use and keep (not closed): SPD for Tresca, LU for Coulomb.
+        A factory (:class:`~.solvers.SolverFactory`, default
+        :func:`~.backends.auto_solver`) makes the kind the law needs for this call.
 
     Returns
     -------
@@ -168,13 +167,13 @@ def solve_friction(
         K, F, normal, tangent, gap, dirichlet, dirichlet_values, bound, coefficient, reference,
         tresca_everywhere,
     )  # fmt: skip
-    _check_options(max_iter, kkt_tol, solver)
+    _check_options(max_iter, kkt_tol)
     rule = _rule_constants(problem, c)
     states = _initial_states(problem, rule, state0, direction0, x0)
     tresca = problem.law == "tresca"
-    own_solver = solver is None
+    own_solver = not isinstance(solver, SPDSolver)
     if own_solver:
-        solver = make_solver(backend) if tresca else make_lu_solver(backend)
+        solver = make_solver(solver, symmetric=tresca)
     before = solver_usage(solver)
     try:
         system = TrescaSystem(problem, solver) if tresca else CoulombSystem(problem, solver)
@@ -228,13 +227,11 @@ def solve_friction(
 # ----------------------------------------------------------------------------------------------
 
 
-def _check_options(max_iter: object, kkt_tol: object, solver: object) -> None:
+def _check_options(max_iter: object, kkt_tol: object) -> None:
     if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
         raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
     if not isinstance(kkt_tol, (int, float)) or not kkt_tol > 0:
         raise ValueError(f"kkt_tol must be a positive number, got {kkt_tol!r}")
-    if solver is not None and not isinstance(solver, SPDSolver):
-        raise ValueError(f"solver must be an SPDSolver, got {type(solver).__name__}")
 
 
 def _rule_constants(problem: FrictionProblem, c: object) -> tuple[float, float]:

@@ -80,7 +80,7 @@ class CoulombSystem:
     problem : FrictionProblem
         With ``law == "coulomb"``.
     solver : SPDSolver
-        A general sparse LU (:func:`~.backends.make_lu_solver`).
+        A general sparse LU (a factory's solver for ``symmetric=False``).
     """
 
     symmetric = False

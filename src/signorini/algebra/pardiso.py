@@ -6,7 +6,8 @@ Real symmetric positive definite mode (``mtype = 2``, sparse Cholesky) on the up
 
 MKL is found and loaded by :mod:`.mkl`. :func:`pardiso_problem` loads it, solves a 2 x 2
 system, and says why PARDISO cannot be used (``None`` when it can);
-:func:`~.backends.make_solver` turns that reason into a warning or an error.
+:func:`pardiso_solver` (the backend's solver factory) turns it into an error, the ``"auto"``
+choice of :mod:`.backends` into a warning.
 :func:`metis_ordering` returns PARDISO's METIS ordering of a graph (docs/method.md,
 *Ordering of the unknowns*).
 
@@ -26,7 +27,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .mkl import pardiso_function
-from .solvers import BackendUnavailableError, FactorizationError, SPDSolver
+from .solvers import BackendUnavailableError, FactorizationError, SolverRequest, SPDSolver
 from .sparse import upper_positions
 
 __all__ = [
@@ -34,6 +35,7 @@ __all__ = [
     "PardisoLUSolver",
     "PardisoSolver",
     "pardiso_problem",
+    "pardiso_solver",
 ]
 
 # PARDISO error codes (MKL reference manual, "pardiso"), with what they mean here.
@@ -321,6 +323,30 @@ class PardisoLUSolver(PardisoSolver):
         self._use_ordering()
         self._handle_used = True
         self._call(11)
+
+
+def pardiso_solver(request: SolverRequest) -> PardisoSolver:
+    """The PARDISO backend's solver factory (:class:`~.solvers.SolverFactory`).
+
+    :class:`PardisoSolver` (Cholesky) for a symmetric request, :class:`PardisoLUSolver`
+    otherwise; the request's ordering, if any, is computed and handed to PARDISO as its user
+    permutation (docs/method.md, *Ordering of the unknowns*).
+
+    Raises
+    ------
+    BackendUnavailableError
+        If PARDISO cannot be used here (:func:`pardiso_problem` says why).
+    """
+    problem = pardiso_problem()
+    if problem is not None:
+        raise BackendUnavailableError(f"the pardiso backend is not usable here: {problem}")
+    if request.symmetric:
+        solver = PardisoSolver(check_symmetry=request.check_symmetry)
+    else:
+        solver = PardisoLUSolver()
+    if request.ordering is not None:
+        solver.ordering = request.ordering()
+    return solver
 
 
 def metis_ordering(graph: sp.spmatrix) -> np.ndarray:

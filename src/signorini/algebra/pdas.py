@@ -41,7 +41,7 @@ from .kkt import qp_residuals
 from .primal import primal_active_set
 from .qp import BoundQP, check_qp, check_vector
 from .result import PDASConvergenceError, PDASResult, PDASStep
-from .solvers import SPDSolver, solver_usage
+from .solvers import SolverFactory, SPDSolver, solver_usage
 
 __all__ = ["solve_pdas"]
 
@@ -67,8 +67,7 @@ def solve_pdas(
     active0: np.ndarray | None = None,
     c: float | None = None,
     max_iter: int = 50,
-    solver: SPDSolver | None = None,
-    backend: str = "auto",
+    solver: SPDSolver | SolverFactory | None = None,
     fallback: bool = False,
     max_update: int = 4,
 ) -> PDASResult:
@@ -103,11 +102,11 @@ def solve_pdas(
         the constrained DOFs (docs/method.md, *Solver*).
     max_iter : int
         Bound on PDAS iterations (linear solves).
-    solver : SPDSolver, optional
-        A solver to use and keep (its symbolic analysis is reused when ``K`` has the pattern
-        it was analysed for). By default one is made with ``backend`` and released afterwards.
-    backend : {"auto", "pardiso", "scipy"}
-        Backend for the default solver (ignored when ``solver`` is given).
+    solver : SPDSolver or SolverFactory, optional
+        An :class:`SPDSolver` is used and kept (not closed; its symbolic analysis is reused
+        when ``K`` has the pattern it was analysed for). A factory
+        (:class:`~.solvers.SolverFactory`, default :func:`~.backends.auto_solver`) makes one
+        for this call, released afterwards.
     fallback : bool
         If PDAS cycles or reaches ``max_iter``, finish with a primal active set method instead
         of raising.
@@ -142,11 +141,9 @@ def solve_pdas(
     _check_count(max_update, "max_update", minimum=0)
     c_scale = _rule_constant(qp, c)
     active = _initial_active_set(qp, c_scale, x0, active0)
-    own_solver = solver is None
+    own_solver = not isinstance(solver, SPDSolver)
     if own_solver:
-        solver = make_solver(backend)
-    elif not isinstance(solver, SPDSolver):
-        raise ValueError(f"solver must be an SPDSolver, got {type(solver).__name__}")
+        solver = make_solver(solver)
 
     before = solver_usage(solver)
     try:

@@ -5,12 +5,22 @@ PDAS solves one linear system per iteration, and all of them have the *same* spa
 (fill-reducing ordering, elimination tree, storage of the factor) once and only repeat the
 numerical factorization. :class:`SPDSolver` checks the matrix, detects pattern changes, counts
 and times the phases; a backend (:mod:`.superlu`, :mod:`.pardiso`) supplies three hooks:
-``_analyze``, ``_factorize``, ``_solve``. :func:`~.backends.make_solver` picks the backend.
+``_analyze``, ``_factorize``, ``_solve``.
+
+Callers that solve many systems (one per active set iteration, one sequence per mesh) do not
+make solvers themselves: they ask a *solver factory* (:class:`SolverFactory`), a callable
+that takes a :class:`SolverRequest` (symmetric or not, check the symmetry or not, a
+fill-reducing ordering on demand) and returns a new :class:`SPDSolver`. A backend module
+supplies one (:func:`~.pardiso.pardiso_solver`, :func:`~.superlu.superlu_solver`); the
+registry of :mod:`.backends` names them for the command line.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import scipy.sparse as sp
@@ -23,6 +33,8 @@ __all__ = [
     "SINGULAR_CAUSES",
     "SPDSolver",
     "SingularSystemError",
+    "SolverFactory",
+    "SolverRequest",
     "checked_ordering",
     "solver_usage",
 ]
@@ -154,19 +166,6 @@ class SPDSolver:
     def n(self) -> int:
         """Size of the analysed matrix (0 before the first factorization)."""
         return self._n
-
-    @property
-    def stats(self) -> dict[str, float | int | str]:
-        """Counters and timers as a dictionary."""
-        return {
-            "backend": self.backend,
-            "n_analyses": self.n_analyses,
-            "n_factorizations": self.n_factorizations,
-            "n_solves": self.n_solves,
-            "time_analysis": self.time_analysis,
-            "time_factorization": self.time_factorization,
-            "time_solve": self.time_solve,
-        }
 
     def same_pattern(self, A: sp.csr_matrix) -> bool:
         """Whether canonical CSR ``A`` has the pattern of the last analysis."""
@@ -310,6 +309,50 @@ class SPDSolver:
 
     def _solve(self, b: np.ndarray) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class SolverRequest:
+    """What a caller asks of a :class:`SolverFactory` for one sequence of linear systems.
+
+    New fields get defaults, so that a factory written today keeps working when the request
+    grows (a distributed backend may read more of it).
+
+    Attributes
+    ----------
+    symmetric : bool
+        True: the matrices are symmetric positive definite (a Cholesky factorization, e.g.
+        the frictionless and Tresca systems); False: general matrices (an LU factorization,
+        e.g. Coulomb's non-symmetric systems), whose symmetry is not checked.
+    check_symmetry : bool
+        With ``symmetric``: check ``max |A - A^T| <= 1e-12 max |A|`` at each analysis (the
+        contact layer's assembled matrices are symmetric by construction and skip it).
+    ordering : callable () -> (n,) int array, optional
+        A fill-reducing ordering of the unknowns (:attr:`SPDSolver.ordering`), computed only
+        when called: a factory whose backend orders better by itself, or cannot use a given
+        ordering, does not call it (the contact layer's METIS ordering of the mesh's vertex
+        graph, :func:`signorini.contact.ordering.dof_ordering`, needs MKL).
+    """
+
+    symmetric: bool = True
+    check_symmetry: bool = True
+    ordering: Callable[[], np.ndarray] | None = None
+
+
+class SolverFactory(Protocol):
+    """A callable that makes a new solver for one sequence of linear systems.
+
+    ``factory(request) -> SPDSolver``: a solver that has not factorized yet, for the kind of
+    matrices :class:`SolverRequest` describes. Whoever calls the factory owns the solver and
+    closes it (:meth:`SPDSolver.close`). A factory may raise
+    :class:`BackendUnavailableError` when its backend cannot be used here.
+
+    A backend is an :class:`SPDSolver` subclass (or two: Cholesky and LU) and a factory
+    function in one module; registering it by name is one line of
+    :data:`signorini.algebra.backends.SOLVERS`.
+    """
+
+    def __call__(self, request: SolverRequest, /) -> SPDSolver: ...
 
 
 def checked_ordering(ordering: object, n: int) -> np.ndarray | None:

@@ -6,10 +6,14 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .solvers import FactorizationError, SPDSolver
+from .solvers import FactorizationError, SolverRequest, SPDSolver
 from .sparse import diagonal_positions
 
-__all__ = ["SuperLULUSolver", "SuperLUSolver"]
+__all__ = ["PIVOT_RTOL", "SuperLULUSolver", "SuperLUSolver", "superlu_solver"]
+
+#: a pivot of SuperLU's symmetric-mode factorization at most this times the largest diagonal
+#: entry of the matrix means the matrix is not (numerically) positive definite
+PIVOT_RTOL = 1e-13
 
 
 class SuperLUSolver(SPDSolver):
@@ -21,9 +25,8 @@ class SuperLUSolver(SPDSolver):
 
     Positive definiteness is checked after the factorization: with diagonal pivoting the
     diagonal of ``U`` holds the pivots of ``L D L^T``; the matrix is accepted when no row
-    interchange happened and every pivot exceeds ``pivot_rtol * max(diag A)``. Extracting the
-    diagonal of ``U`` costs some 15-30 % of the factorization; pass ``check_pivots=False`` to
-    skip it.
+    interchange happened and every pivot exceeds :data:`PIVOT_RTOL` ``* max(diag A)``
+    (extracting the diagonal of ``U`` costs some 15-30 % of the factorization).
 
     With an ``ordering`` (:class:`~.solvers.SPDSolver`) SuperLU factorizes the symmetrically
     permuted matrix in that order (``permc_spec="NATURAL"``) instead of its own.
@@ -32,8 +35,6 @@ class SuperLUSolver(SPDSolver):
     ----------
     A : scipy sparse matrix, optional
     check_symmetry : bool
-    check_pivots : bool
-    pivot_rtol : float
     ordering : (n,) int array, optional
     """
 
@@ -45,12 +46,8 @@ class SuperLUSolver(SPDSolver):
         A: sp.spmatrix | None = None,
         *,
         check_symmetry: bool = True,
-        check_pivots: bool = True,
-        pivot_rtol: float = 1e-13,
         ordering: np.ndarray | None = None,
     ) -> None:
-        self.check_pivots = check_pivots
-        self.pivot_rtol = pivot_rtol
         self._lu: spla.SuperLU | None = None
         super().__init__(A, check_symmetry=check_symmetry, ordering=ordering)
 
@@ -74,26 +71,25 @@ class SuperLUSolver(SPDSolver):
                 f"SuperLU could not factorize the matrix ({err}): it is singular",
                 backend=self.backend,
             ) from err
-        if self.check_pivots:
-            if not np.array_equal(lu.perm_r, lu.perm_c):
-                raise FactorizationError(
-                    "SuperLU needed off-diagonal pivots: the matrix is not positive definite",
-                    backend=self.backend,
-                )
-            pivots = lu.U.diagonal()
-            scale = float(A.data[self._diag_pos].max())
-            bad = np.flatnonzero(pivots <= self.pivot_rtol * max(scale, np.finfo(float).tiny))
-            if bad.size:
-                k = int(bad[np.argmin(pivots[bad])])
-                equation = int(np.flatnonzero(lu.perm_c == k)[0])
-                if self._perm is not None:
-                    equation = int(self._perm[equation])
-                raise FactorizationError(
-                    f"the matrix is not positive definite (numerically): pivot "
-                    f"{pivots[k]:.3e} at equation {equation}, max diagonal {scale:.3e}",
-                    backend=self.backend,
-                    equation=equation,
-                )
+        if not np.array_equal(lu.perm_r, lu.perm_c):
+            raise FactorizationError(
+                "SuperLU needed off-diagonal pivots: the matrix is not positive definite",
+                backend=self.backend,
+            )
+        pivots = lu.U.diagonal()
+        scale = float(A.data[self._diag_pos].max())
+        bad = np.flatnonzero(pivots <= PIVOT_RTOL * max(scale, np.finfo(float).tiny))
+        if bad.size:
+            k = int(bad[np.argmin(pivots[bad])])
+            equation = int(np.flatnonzero(lu.perm_c == k)[0])
+            if self._perm is not None:
+                equation = int(self._perm[equation])
+            raise FactorizationError(
+                f"the matrix is not positive definite (numerically): pivot "
+                f"{pivots[k]:.3e} at equation {equation}, max diagonal {scale:.3e}",
+                backend=self.backend,
+                equation=equation,
+            )
         self._lu = lu
 
     def _solve(self, b: np.ndarray) -> np.ndarray:
@@ -153,6 +149,16 @@ class SuperLULUSolver(SPDSolver):
     def close(self) -> None:
         self._lu = None
         super().close()
+
+
+def superlu_solver(request: SolverRequest) -> SPDSolver:
+    """The SuperLU backend's solver factory (:class:`~.solvers.SolverFactory`), always
+    available: :class:`SuperLUSolver` for a symmetric request, :class:`SuperLULUSolver`
+    otherwise. The request's ordering is not used: SuperLU keeps its own (minimum degree,
+    COLAMD), and the contact layer's needs MKL's METIS."""
+    if request.symmetric:
+        return SuperLUSolver(check_symmetry=request.check_symmetry)
+    return SuperLULUSolver()
 
 
 def _in_order(C: sp.csc_matrix, perm: np.ndarray | None) -> sp.csc_matrix:

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..algebra.friction import INACTIVE, SLIP, STICK, solve_friction
 from ..algebra.friction_result import FrictionResult
+from ..algebra.solvers import SolverFactory, SPDSolver
 from ..fem.space import P2Space
 from ..problem.fields import ProblemError
 from .contact_set import COULOMB, TRESCA, ContactSet
@@ -153,7 +154,7 @@ def solve_frictional(
     F: np.ndarray,
     *,
     u0: np.ndarray | None,
-    backend: str,
+    solver: SPDSolver | SolverFactory | None,
     max_iter: int,
     previous: object = None,
     active0: np.ndarray | None = None,
@@ -170,7 +171,8 @@ def solve_frictional(
         Warm start (e.g. the previous level's solution prolongated): with ``active0`` the
         initial states are read off it (:func:`states_from_displacement`), else the update
         rule is evaluated at it.
-    backend : str
+    solver : SolverFactory or SPDSolver or None
+        As in :func:`~signorini.contact.solve`.
     max_iter : int
     previous : ContactResult, optional
         The previous load step (checked by :func:`check_previous`): the law acts on the slip
@@ -204,21 +206,20 @@ def solve_frictional(
         "dirichlet_values": assembled.dirichlet_values,
         "reference": reference,
         "max_iter": max_iter,
-        "backend": backend,
         **warm,
     }
     nodes = cs.nodes
     # Tresca: symmetric systems (Cholesky); Coulomb: non-symmetric ones (LU)
-    with ordered_solver(assembled.space, backend, lu=law != "tresca") as solver:
+    with ordered_solver(assembled.space, solver, symmetric=law == "tresca") as linear:
         if law == "tresca":
             res = solve_friction(
                 K, F, 2 * nodes, 2 * nodes + 1, cs.gap, bound=cs.friction_bound,
-                tresca_everywhere=True, solver=solver, **common,
+                tresca_everywhere=True, solver=linear, **common,
             )  # fmt: skip
         else:
             res = solve_friction(
                 K, F, 2 * nodes, 2 * nodes + 1, cs.gap, coefficient=cs.friction_coefficient,
-                solver=solver, **common,
+                solver=linear, **common,
             )  # fmt: skip
     state = res.state.astype(np.int64)
     # a frictionless node in contact slides freely: its friction force (0) is at its bound

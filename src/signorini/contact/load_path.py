@@ -13,6 +13,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..algebra.solvers import SolverFactory, SPDSolver
 from ..mesh.mesh import Mesh
 from ..problem.problem import ContactProblem
 from .solution import ContactResult, solve
@@ -26,7 +27,7 @@ def solve_path(
     problems: Sequence[ContactProblem],
     mesh: Mesh | None = None,
     *,
-    backend: str = "auto",
+    solver: SPDSolver | SolverFactory | None = None,
     max_iter: int = 50,
     u0: np.ndarray | None = None,
 ) -> list[ContactResult]:
@@ -41,8 +42,8 @@ def solve_path(
         friction) differ.
     mesh : Mesh, optional
         The mesh of every step; defaults to the problems' initial mesh.
-    backend : str
-        Sparse solver backend, see :func:`signorini.algebra.make_solver`.
+    solver : SolverFactory or SPDSolver, optional
+        The linear solver of every step, as in :func:`~signorini.contact.solve`.
     max_iter : int
         Bound on the active set iterations of each step.
     u0 : (n_nodes, 2) float array, optional
@@ -69,7 +70,7 @@ def solve_path(
         previous = results[-1] if results else None
         start = u0 if previous is None else None
         results.append(
-            solve(problem, mesh, u0=start, previous=previous, backend=backend, max_iter=max_iter)
+            solve(problem, mesh, u0=start, previous=previous, solver=solver, max_iter=max_iter)
         )
         log.info("load step %d of %d solved", i + 1, len(problems))
     return results

@@ -8,16 +8,23 @@ mesh's *vertex* graph (an eighth of the unknowns, a fiftieth of the matrix's ent
 then only does its symbolic factorization. Measured there (``python benchmarks/ordering.py``):
 ordering 0.37 s, analysis 0.98 s, a factor with 0.92 times the non-zeros and 0.81 times the
 operations; the complete solve 0.57 times PARDISO's own.
+
+:func:`ordered_solver` is where the contact layer turns the ``solver`` argument of
+:func:`~signorini.contact.solve` into the solver of one mesh's systems: a factory is asked
+for a new one, offered this ordering (computed only if the backend takes it); a solver
+object is used as it is.
 """
 
 from __future__ import annotations
 
+from contextlib import AbstractContextManager, nullcontext
+
 import numpy as np
 import scipy.sparse as sp
 
-from ..algebra.backends import make_lu_solver, make_solver
+from ..algebra.backends import make_solver
 from ..algebra.pardiso import metis_ordering
-from ..algebra.solvers import SPDSolver
+from ..algebra.solvers import SolverFactory, SPDSolver
 from ..fem.space import P2Space
 from ..mesh.mesh import Mesh
 
@@ -47,11 +54,31 @@ def dof_ordering(space: P2Space) -> np.ndarray:
     return space.dof_order(metis_ordering(vertex_graph(space.mesh)))
 
 
-def ordered_solver(space: P2Space, backend: str, *, lu: bool = False, **options) -> SPDSolver:
-    """A solver for the systems of ``space`` (``make_solver``, or ``make_lu_solver`` with
-    ``lu``) that analyses them with :func:`dof_ordering` when it is PARDISO; SuperLU keeps its
-    own minimum degree ordering (without MKL there is no METIS to compute ours)."""
-    solver = make_lu_solver(backend) if lu else make_solver(backend, **options)
-    if solver.backend == "pardiso":
-        solver.ordering = dof_ordering(space)
-    return solver
+def ordered_solver(
+    space: P2Space,
+    solver: SPDSolver | SolverFactory | None = None,
+    *,
+    symmetric: bool = True,
+    check_symmetry: bool = True,
+) -> AbstractContextManager[SPDSolver]:
+    """The solver of ``space``'s systems, as a context manager.
+
+    Parameters
+    ----------
+    space : P2Space
+    solver : SPDSolver or SolverFactory, optional
+        A factory (default :func:`~signorini.algebra.auto_solver`) makes a new solver,
+        offered :func:`dof_ordering` (PARDISO takes it; SuperLU keeps its own minimum degree
+        ordering), and closed at the end of the ``with`` block. An :class:`SPDSolver` is used
+        as it is and not closed: its owner closes it.
+    symmetric, check_symmetry : bool
+        What the factory is asked for (:class:`~signorini.algebra.SolverRequest`).
+    """
+    if isinstance(solver, SPDSolver):
+        return nullcontext(solver)
+    return make_solver(
+        solver,
+        symmetric=symmetric,
+        check_symmetry=check_symmetry,
+        ordering=lambda: dof_ordering(space),
+    )

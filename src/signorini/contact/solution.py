@@ -16,6 +16,7 @@ import numpy as np
 from ..algebra.friction import INACTIVE, SLIP, STICK
 from ..algebra.pdas import solve_pdas
 from ..algebra.result import PDASConvergenceError, PDASResult
+from ..algebra.solvers import SolverFactory, SPDSolver
 from ..fem.norms import energy_error2, h1_seminorm_error2
 from ..fem.space import P2Space
 from ..mesh.mesh import Mesh
@@ -225,7 +226,7 @@ def solve(
     mesh: Mesh | None = None,
     *,
     u0: np.ndarray | None = None,
-    backend: str = "auto",
+    solver: SPDSolver | SolverFactory | None = None,
     max_iter: int = 50,
     fallback: bool = False,
     assembled: Assembled | None = None,
@@ -244,8 +245,13 @@ def solve(
     u0 : (n_nodes, 2) array, optional
         Warm start (e.g. the previous level's solution prolongated to ``mesh``): its nodes in
         contact form the initial active set.
-    backend : str
-        Sparse solver backend, see :func:`signorini.algebra.make_solver`.
+    solver : SolverFactory or SPDSolver, optional
+        The linear solver. A factory (:class:`~signorini.algebra.SolverFactory`, default
+        :func:`~signorini.algebra.auto_solver`: PARDISO, else SuperLU; a backend by name:
+        :data:`signorini.algebra.SOLVERS`) is called once per sequence of systems (the
+        solve, and the coarse solve of nested iteration) and its solvers are closed. An
+        :class:`~signorini.algebra.SPDSolver` is used for every system as it is (no ordering
+        set) and not closed; with Coulomb friction it must factorize non-symmetric matrices.
     max_iter : int
         Bound on PDAS iterations.
     fallback : bool
@@ -300,7 +306,7 @@ def solve(
         and not cs.friction_law.any()
         and space.n_dofs - assembled.dirichlet.size >= NESTED_MIN_NDOF
     ):
-        active0 = _nested_active_set(problem, assembled, backend, max_iter, fallback)
+        active0 = _nested_active_set(problem, assembled, solver, max_iter, fallback)
         timings["nested"] = time.perf_counter() - t0
     if cs.friction_law.any():
         fr = solve_frictional(
@@ -308,7 +314,7 @@ def solve(
             K,
             F,
             u0=u0,
-            backend=backend,
+            solver=solver,
             max_iter=max_iter,
             previous=previous,
             active0=active0,
@@ -331,7 +337,7 @@ def solve(
             tangential_reference=fr.reference,
         )
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
-    with ordered_solver(space, backend, check_symmetry=False) as solver:
+    with ordered_solver(space, solver, check_symmetry=False) as linear:
         res = solve_pdas(
             K,
             F,
@@ -341,7 +347,7 @@ def solve(
             assembled.dirichlet_values,
             active0=active0,
             max_iter=max_iter,
-            solver=solver,
+            solver=linear,
             fallback=fallback,
         )
     seconds = time.perf_counter() - t0
@@ -370,7 +376,11 @@ def solve(
 
 
 def _nested_active_set(
-    problem: ContactProblem, assembled: Assembled, backend: str, max_iter: int, fallback: bool
+    problem: ContactProblem,
+    assembled: Assembled,
+    solver: SPDSolver | SolverFactory | None,
+    max_iter: int,
+    fallback: bool,
 ) -> np.ndarray | None:
     """The initial active set of a cold solve on ``assembled``'s mesh from a solve on the
     coarse mesh of :func:`~.nested.coarse_mesh` (itself nested where it qualifies), or None
@@ -380,7 +390,7 @@ def _nested_active_set(
     if coarse is None:
         return None
     try:
-        result = solve(problem, coarse, backend=backend, max_iter=max_iter, fallback=fallback)
+        result = solve(problem, coarse, solver=solver, max_iter=max_iter, fallback=fallback)
     except PDASConvergenceError:
         return None
     log.info(

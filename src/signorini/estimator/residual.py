@@ -86,6 +86,7 @@ from .terms import (
 
 __all__ = ["ETA5_VARIANTS", "NODE_TERMS", "TERMS", "Estimate", "estimate", "stress_unit"]
 
+#: the variants of η5 (docs/method.md, *Estimator*); the first is the default
 ETA5_VARIANTS = ("consistent", "paper")
 #: the terms of (5.1) and the friction work η8, in the row order of ``Estimate.eta2_cell``
 TERMS = ("eta_1", "eta_2", "eta_3", "eta_4", "eta_5", "eta_6", "eta_7", "eta_8")
@@ -187,14 +188,14 @@ class Estimate:
         return out
 
 
-def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
+def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Estimate:
     """Compute η_h and all its contributions for a discrete solution (paper, Section 5).
 
     Parameters
     ----------
     result : ContactResult
         The discrete solution.
-    eta5 : {"consistent", "paper"}
+    eta5_variant : {"consistent", "paper"}
         ``"paper"`` is η5 as printed (the full normal stress on Γ_C); ``"consistent"``
         balances it by the discrete pressure, ``σ_nn(u_h) + p_h`` (docs/method.md, *Estimator*).
         With friction η4 is ``‖σ_t(u_h) + p_t,h‖`` in both variants.
@@ -206,10 +207,10 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     Raises
     ------
     ValueError
-        For an unknown ``eta5``.
+        For an unknown ``eta5_variant``.
     """
-    if eta5 not in ETA5_VARIANTS:
-        raise ValueError(f"eta5 must be one of {ETA5_VARIANTS}, got {eta5!r}")
+    if eta5_variant not in ETA5_VARIANTS:
+        raise ValueError(f"eta5_variant must be one of {ETA5_VARIANTS}, got {eta5_variant!r}")
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells
     h_p = _node_mesh_size(mesh.h, space.cell_nodes, result.dirichlet_nodes, n_nodes)
@@ -238,7 +239,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     t_n, w_n = line_rule(NEUMANN_DEGREE)
     misfit = _traction_misfit(problem, mesh, traction, t_n, unit)
     contact = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
-    pressure = _edge_pressure(result) / unit if eta5 == "consistent" else None
+    pressure = _edge_pressure(result) / unit if eta5_variant == "consistent" else None
     friction = friction_edges(result, unit)  # None without friction
     p_t = None if friction is None else friction.friction
     gap = cs.edge_normal_gap(result.u)  # u_h·n − ψ_h at [start, end, midpoint]
@@ -285,7 +286,7 @@ def estimate(result: ContactResult, eta5: str = "consistent") -> Estimate:
     return Estimate(
         eta2_cell=np.stack([shares[name].cell for name in TERMS]),
         eta2_node=np.stack([shares[name].node for name in NODE_TERMS]),
-        eta5_variant=eta5,
+        eta5_variant=eta5_variant,
         unit=unit,
     )
 

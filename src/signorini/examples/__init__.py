@@ -8,63 +8,96 @@ curved geometry.
 - :mod:`.partial_slip`: the Hertz half-disc pressed on a plane with Coulomb friction, then
   pulled sideways (Cattaneo–Mindlin), a load path of two steps.
 
-:data:`EXAMPLES` names them for the command line (``signorini run hertz``); an example may
-also supply per-level measurements for the history (:data:`METRICS`) and the load steps
-solved before it on every level (:data:`LOAD_PATHS`).
+:data:`EXAMPLES` holds one :class:`Example` record per built-in example, by the name the
+command line takes (``signorini run hertz``): its problem, and where it has them its
+per-level measurements for the history and its known pressure (:class:`Metrics`) and the load
+steps solved before it on every level. Adding an example is one module and one record.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from ..problem import ContactProblem
 from .friction import example_6_2_coulomb, example_6_2_tresca
 from .hertz import HERTZ_METRICS, hertz
-from .metrics import Metrics
+from .metrics import Metrics, PressureComparison
 from .paper import example_6_1, example_6_2
 from .partial_slip import PARTIAL_SLIP_METRICS, partial_slip, partial_slip_path
 from .punch import punch
 
 __all__ = [
     "EXAMPLES",
-    "LOAD_PATHS",
-    "METRICS",
+    "Example",
+    "HERTZ_METRICS",
     "Metrics",
+    "PARTIAL_SLIP_METRICS",
+    "PressureComparison",
     "example_6_1",
     "example_6_2",
     "example_6_2_coulomb",
     "example_6_2_tresca",
     "get_example",
-    "get_load_path",
     "hertz",
     "partial_slip",
     "partial_slip_path",
     "punch",
 ]
 
-#: The examples by the name the command line takes (``signorini run example-6.2``).
-EXAMPLES: dict[str, Callable[..., ContactProblem]] = {
-    "example-6.1": example_6_1,
-    "example-6.2": example_6_2,
-    "example-6.2-tresca": example_6_2_tresca,
-    "example-6.2-coulomb": example_6_2_coulomb,
-    "hertz": hertz,
-    "punch": punch,
-    "partial-slip": partial_slip,
+
+@dataclass(frozen=True)
+class Example:
+    """A built-in example, as the command line runs it.
+
+    Attributes
+    ----------
+    name : str
+        The command line's name (``signorini run <name>``); also the problem's name.
+    problem : callable () -> ContactProblem
+        The problem on its default initial mesh.
+    metrics : Metrics, optional
+        Per-level measurements beyond the loop's own (further columns of ``history.csv``),
+        and the known pressure drawn beside the computed one (:attr:`pressure`).
+    load_path : callable () -> list of ContactProblem, optional
+        The steps of a path-dependent example's load path, its problem the last: every level
+        of the loop solves the steps before it first (:meth:`steps_before`).
+    """
+
+    name: str
+    problem: Callable[[], ContactProblem]
+    metrics: Metrics | None = None
+    load_path: Callable[[], list[ContactProblem]] | None = None
+
+    @property
+    def pressure(self) -> Callable | None:
+        """The known pressure beside the computed one (``metrics.pressure``), or None."""
+        return None if self.metrics is None else self.metrics.pressure
+
+    def steps_before(self) -> list[ContactProblem] | None:
+        """The load steps before the example's problem (``adaptive(..., path=...)``), or None
+        for an example without a load path."""
+        return None if self.load_path is None else self.load_path()[:-1]
+
+
+#: Every built-in example by the name the command line takes (``signorini run example-6.2``).
+EXAMPLES: dict[str, Example] = {
+    example.name: example
+    for example in (
+        Example("example-6.1", example_6_1),
+        Example("example-6.2", example_6_2),
+        Example("example-6.2-tresca", example_6_2_tresca),
+        Example("example-6.2-coulomb", example_6_2_coulomb),
+        Example("hertz", hertz, metrics=HERTZ_METRICS),
+        Example("punch", punch),
+        Example("partial-slip", partial_slip, PARTIAL_SLIP_METRICS, partial_slip_path),
+    )
 }
-
-#: Per-level measurements of an example beyond the loop's own, by the example's name: the
-#: command line writes them as further columns of ``history.csv``.
-METRICS: dict[str, Metrics] = {"hertz": HERTZ_METRICS, "partial-slip": PARTIAL_SLIP_METRICS}
-
-#: The load paths of path-dependent examples, by name: the steps, the example's problem the
-#: last; every level of the loop solves the steps before it first (``adaptive(...,
-#: path=steps[:-1])``).
-LOAD_PATHS: dict[str, Callable[..., list[ContactProblem]]] = {"partial-slip": partial_slip_path}
 
 
 def get_example(name: str) -> ContactProblem:
-    """The example named ``name`` (a key of :data:`EXAMPLES`) on its default initial mesh.
+    """The problem of the built-in example named ``name`` (a key of :data:`EXAMPLES`) on its
+    default initial mesh.
 
     Raises
     ------
@@ -72,14 +105,7 @@ def get_example(name: str) -> ContactProblem:
         For an unknown name; the message lists the known ones.
     """
     try:
-        return EXAMPLES[name]()
-    except KeyError:
+        example = EXAMPLES[name]
+    except (KeyError, TypeError):
         raise ValueError(f"unknown example {name!r}; choose one of {sorted(EXAMPLES)}") from None
-
-
-def get_load_path(name: str) -> list[ContactProblem] | None:
-    """The load steps solved before the example named ``name`` on every level (the first
-    steps of its :data:`LOAD_PATHS` entry), or None for an example without a load path."""
-    if name not in LOAD_PATHS:
-        return None
-    return LOAD_PATHS[name]()[:-1]
+    return example.problem()

@@ -15,7 +15,7 @@ import logging
 import numbers
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -26,10 +26,10 @@ from ..estimator.residual import Estimate, estimate
 from ..mesh.mesh import Mesh
 from ..mesh.refine import refine_nvb, refine_uniform
 from ..problem.problem import ContactProblem
-from .arguments import check_loop_arguments
+from .options import AdaptiveOptions, OptionError, check_count
 from .record import COLUMNS, LevelRecord, level_record
 
-__all__ = ["COLUMNS", "LevelRecord", "Level", "adaptive", "check_loop_arguments"]
+__all__ = ["COLUMNS", "AdaptiveOptions", "Level", "LevelRecord", "OptionError", "adaptive"]
 
 log = logging.getLogger(__name__)
 
@@ -67,50 +67,29 @@ class Level:
 
 def adaptive(
     problem: ContactProblem,
+    options: AdaptiveOptions | None = None,
     *,
-    theta: float = 0.4,
-    max_ndof: int = 100_000,
-    tol: float = 0.0,
-    max_levels: int = 100,
-    uniform: bool = False,
-    eta5: str = "consistent",
-    backend: str = "auto",
-    warm_start: bool = True,
     mesh: Mesh | None = None,
     u0: np.ndarray | None = None,
     first_level: int = 0,
-    fallback: bool = False,
     metrics: Callable[[ContactResult], Mapping[str, float]] | None = None,
     path: Sequence[ContactProblem] | None = None,
+    **changes: object,
 ) -> Iterator[Level]:
     """Run SOLVE → ESTIMATE → MARK → REFINE, yielding each finished level.
 
     Stops after the level whose refinement would exceed ``max_ndof`` free unknowns, when
-    ``η_h ≤ tol``, or after ``max_levels`` levels. The four steps stay in one function
-    (:func:`_levels`, about 50 lines of code) so that the loop reads top to bottom as in
-    docs/method.md, *Marking and refinement*. The arguments are checked when ``adaptive``
-    is called, before any work.
+    ``η_h ≤ tol``, or after ``max_levels`` levels (:class:`AdaptiveOptions`). The four
+    steps stay in one function (:func:`_levels`, about 50 lines of code) so that the loop
+    reads top to bottom as in docs/method.md, *Marking and refinement*. The arguments are
+    checked when ``adaptive`` is called, before any work.
 
     Parameters
     ----------
     problem : ContactProblem
-    theta : float
-        Dörfler parameter in (0, 1] (ignored when ``uniform``).
-    max_ndof : int
-        Budget of free unknowns (:attr:`LevelRecord.ndof`): no level exceeds it.
-    tol : float
-        Stop once the estimator reaches this value (>= 0).
-    max_levels : int
-        Stop after the level with index ``max_levels - 1`` (at least 1).
-    uniform : bool
-        Refine every cell (NVB with all edges bisected) instead of Dörfler marking.
-    eta5 : {"consistent", "paper"}
-        Variant of the estimator's η5 (docs/method.md, *Estimator*).
-    backend : {"auto", "pardiso", "scipy"}
-        Sparse solver backend.
-    warm_start : bool
-        Start each PDAS from the previous level's prolongated solution and contact set (with
-        friction, the semismooth Newton method from its update rule at that solution).
+    options : AdaptiveOptions, optional
+        How the loop runs: θ, the budgets, the tolerance, uniform refinement, the η5 variant,
+        warm start, the fallback and the linear solver. Default ``AdaptiveOptions()``.
     mesh : Mesh, optional
         Mesh of the first level (default: the problem's).
     u0 : (n_nodes, 2) float array, optional
@@ -119,17 +98,14 @@ def adaptive(
         Default: a cold start.
     first_level : int
         Index of the first level (default 0). To continue a run from its level ``k``, pass
-        ``mesh=level.next_mesh, u0=level.next_u0, first_level=k + 1`` and the run's other
-        arguments: the levels are those an uninterrupted run yields.
-    fallback : bool
-        Where PDAS cycles or reaches its iteration bound, finish that level's solve with the
-        primal active set method instead of raising (:func:`signorini.solve`); the record's
-        ``n_solves`` counts both.
+        ``mesh=level.next_mesh, u0=level.next_u0, first_level=k + 1`` and the run's options:
+        the levels are those an uninterrupted run yields.
     metrics : callable, optional
         ``metrics(result) -> {column: value}``: measurements of each level's solution beyond
         the record's own (e.g. the Hertz example's errors against the Hertz solution,
-        :data:`signorini.examples.METRICS`); they go into :attr:`LevelRecord.extra`, hence into
-        the row of ``history.csv``. Names must be new columns, values real numbers.
+        :attr:`signorini.examples.Example.metrics`); they go into :attr:`LevelRecord.extra`,
+        hence into the row of ``history.csv``. Names must be new columns, values real
+        numbers.
     path : sequence of ContactProblem, optional
         The load steps before ``problem`` of a quasi-static load path (Coulomb friction is
         path-dependent; docs/method.md, *Load paths*), on the same initial mesh with the same
@@ -139,6 +115,10 @@ def adaptive(
         are then the warm start of the first step (its solution on the previous level,
         prolongated); the record's iteration counts and solve timings are summed over the
         steps, its KKT residuals are the last step's. ``fallback`` does not apply to it.
+    **changes
+        Fields of :class:`AdaptiveOptions` that replace those of ``options``:
+        ``adaptive(problem, theta=0.5, max_ndof=10**6)`` is
+        ``adaptive(problem, AdaptiveOptions(theta=0.5, max_ndof=10**6))``.
 
     Yields
     ------
@@ -149,25 +129,33 @@ def adaptive(
     Raises
     ------
     ValueError
-        At the call, for an argument of the wrong type or out of range (naming it):
-        ``theta`` outside (0, 1], ``max_ndof`` not a positive number, ``tol`` negative or
-        NaN, ``max_levels`` < 1, an unknown ``eta5`` or ``backend``, ``first_level`` not
-        in ``[0, max_levels)``, an initial mesh with more than ``max_ndof`` unknowns, or a
+        At the call, for an argument of the wrong type or out of range (naming it): an
+        option (:class:`~.options.OptionError`, naming the field), ``first_level`` not in
+        ``[0, max_levels)``, an initial mesh with more than ``max_ndof`` unknowns, or a
         ``path`` whose steps are not problems on ``problem``'s initial mesh with its contact
         parts.
+    TypeError
+        For a keyword that is no field of :class:`AdaptiveOptions`.
     """
     if not isinstance(problem, ContactProblem):
         raise ValueError(f"problem must be a ContactProblem, got {type(problem).__name__}")
-    args = check_loop_arguments(
-        theta=theta,
-        max_ndof=max_ndof,
-        tol=tol,
-        max_levels=max_levels,
-        uniform=uniform,
-        eta5=eta5,
-        backend=backend,
-        first_level=first_level,
-    )
+    if options is None:
+        options = AdaptiveOptions()
+    elif not isinstance(options, AdaptiveOptions):
+        raise ValueError(f"options must be an AdaptiveOptions, got {type(options).__name__}")
+    unknown = sorted(set(changes) - {f.name for f in fields(AdaptiveOptions)})
+    if unknown:
+        raise TypeError(
+            f"adaptive() got unexpected keyword arguments {unknown}; the options are "
+            f"{[f.name for f in fields(AdaptiveOptions)]}"
+        )
+    if changes:
+        options = replace(options, **changes)
+    first_level = check_count(first_level, "first_level", 0)
+    if first_level >= options.max_levels:
+        raise ValueError(
+            f"first_level must be below max_levels={options.max_levels}, got {first_level}"
+        )
     if metrics is not None and not callable(metrics):
         raise ValueError(f"metrics must be a function of a ContactResult, got {metrics!r}")
     if mesh is not None and not isinstance(mesh, Mesh):
@@ -180,52 +168,35 @@ def adaptive(
             )
         path = check_path([*path, problem])[:-1]
     mesh = problem.mesh if mesh is None else mesh
-    if problem.free_ndof(mesh) > args["max_ndof"]:
+    if problem.free_ndof(mesh) > options.max_ndof:
         raise ValueError(
             f"the initial mesh already has {problem.free_ndof(mesh)} unknowns, "
-            f"more than max_ndof={max_ndof}"
+            f"more than max_ndof={options.max_ndof}"
         )
-    return _levels(
-        problem,
-        mesh,
-        u0,
-        warm_start=bool(warm_start),
-        fallback=bool(fallback),
-        metrics=metrics,
-        path=path or None,
-        **args,
-    )
+    return _levels(problem, mesh, u0, options, first_level, metrics, path or None)
 
 
 def _levels(
     problem: ContactProblem,
     mesh: Mesh,
     u0: np.ndarray | None,
-    *,
-    theta: float,
-    max_ndof: float,
-    tol: float,
-    max_levels: int,
-    uniform: bool,
-    eta5: str,
-    backend: str,
-    warm_start: bool,
-    fallback: bool,
+    options: AdaptiveOptions,
     first_level: int,
-    metrics: Callable[[ContactResult], Mapping[str, float]] | None = None,
-    path: Sequence[ContactProblem] | None = None,
+    metrics: Callable[[ContactResult], Mapping[str, float]] | None,
+    path: Sequence[ContactProblem] | None,
 ) -> Iterator[Level]:
     """The loop of :func:`adaptive`, on checked arguments."""
-    for level in range(first_level, max_levels):
+    uniform, solver = options.uniform, options.solver
+    for level in range(first_level, options.max_levels):
         if path:
-            steps = solve_path([*path, problem], mesh, backend=backend, u0=u0)
+            steps = solve_path([*path, problem], mesh, solver=solver, u0=u0)
             result, warm = steps[-1], steps[0]
         else:
-            result = warm = solve(problem, mesh, u0=u0, backend=backend, fallback=fallback)
+            result = warm = solve(problem, mesh, u0=u0, solver=solver, fallback=options.fallback)
             steps = [result]
         u0 = None
         t0 = time.perf_counter()
-        est = estimate(result, eta5=eta5)
+        est = estimate(result, eta5_variant=options.eta5_variant)
         t_est = time.perf_counter() - t0
         record = level_record(level, result, est)
         record.t_estimate = t_est
@@ -233,19 +204,21 @@ def _levels(
             _add_path_counts(record, steps)
         if metrics is not None:
             record.extra.update(_measured(metrics, result))
-        last = level == max_levels - 1 or est.eta <= tol
+        last = level == options.max_levels - 1 or est.eta <= options.tol
         marked = next_mesh = None
         if not last:
             t0 = time.perf_counter()
             marked = (
-                np.ones(mesh.n_cells, dtype=bool) if uniform else mark_doerfler(est.eta2, theta)
+                np.ones(mesh.n_cells, dtype=bool)
+                if uniform
+                else mark_doerfler(est.eta2, options.theta)
             )
             record.t_mark = time.perf_counter() - t0
             t0 = time.perf_counter()
             refinement = refine_uniform(mesh) if uniform else refine_nvb(mesh, marked)
             next_mesh = refinement.mesh
-            last = problem.free_ndof(next_mesh) > max_ndof
-            if not last and warm_start:
+            last = problem.free_ndof(next_mesh) > options.max_ndof
+            if not last and options.warm_start:
                 u0 = warm.space.prolongate(warm.u, refinement)
             record.t_refine = time.perf_counter() - t0
             if last:

@@ -1,0 +1,82 @@
+"""A run's figures, and the uniform refinement it is compared with (``--compare-uniform``).
+matplotlib is imported only when figures are drawn."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from pathlib import Path
+
+from ..examples import Metrics
+from ..loop import AdaptiveOptions, Level, adaptive
+from ..output import HistoryWriter
+from ..output.run import RunFolder
+from ..problem.problem import ContactProblem
+from .levels import write_levels
+
+__all__ = ["compare_uniform", "draw_figures", "figures", "pressure_figure"]
+
+
+def figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
+    """The run's figures (:func:`signorini.plots.run_figures.run_figures`)."""
+    from ..plots.run_figures import run_figures
+
+    return run_figures(example, out, last)
+
+
+def pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> list[Path]:
+    """The last level's pressure beside the known one the example's ``metrics`` give."""
+    from ..plots.run_figures import pressure_figure as draw
+
+    return draw(example, out, last, metrics)
+
+
+def draw_figures(
+    label: str,
+    folder: RunFolder,
+    last: Level,
+    metrics: Metrics | None,
+    say: Callable[[str], None],
+) -> None:
+    """Announce, draw and record the figures of a run whose last level is ``last``."""
+    out = folder.path
+    say(f"drawing the figures of {label} (convergence history, mesh, deformed body) ...")
+    written = figures(label, out, last)
+    if metrics is not None and metrics.pressure is not None:
+        written += pressure_figure(label, out, last, metrics)
+    folder.add_files(*(str(p.relative_to(out)) for p in written))
+    say(f"figures: {', '.join(str(p.name) for p in written)}")
+
+
+def compare_uniform(
+    problem: ContactProblem,
+    options: AdaptiveOptions,
+    no_figures: bool,
+    folder: RunFolder,
+    say: Callable[[str], None],
+    metrics: Metrics | None = None,
+    path: Sequence[ContactProblem] | None = None,
+) -> None:
+    """Uniform refinement to the same budget (with the run's options, but no tolerance), and
+    one plot of both convergence histories."""
+    from .. import plots
+
+    out = folder.path
+    uni = out / "uniform"
+    folder.add_files("uniform/history.csv")
+    history = HistoryWriter(uni / "history.csv")
+    say(f"{problem.name}: uniform refinement for comparison -> {uni}")
+    uniform = replace(options, uniform=True, tol=AdaptiveOptions.tol)
+    levels = adaptive(problem, uniform, metrics=metrics, path=path)
+    write_levels(levels, history, folder, vtu=False, save_state=False, say=say)
+    if no_figures:
+        return
+    say("drawing adaptive against uniform refinement ...")
+    histories = {"adaptive": out / "history.csv", "uniform": uni / "history.csv"}
+    written = plots.plot_adaptive_vs_uniform(histories, out / "adaptive_vs_uniform", key="eta")
+    if problem.exact is not None:
+        written += plots.plot_adaptive_vs_uniform(
+            histories, out / "adaptive_vs_uniform_error", key="error_energy"
+        )
+    folder.add_files(*(str(Path(p).relative_to(out)) for p in written))
+    say(f"figures: {', '.join(str(p.name) for p in written)}")
