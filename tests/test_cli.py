@@ -425,6 +425,44 @@ def test_resume_after_an_interrupt_gives_the_uninterrupted_run(tmp_path, capsys,
     assert "is finished: nothing to resume" in capsys.readouterr().out
 
 
+def test_resume_of_a_run_whose_manifest_has_the_old_option_names(tmp_path, capsys, monkeypatch):
+    """Runs written before the options were one object recorded the η5 variant as ``eta5``
+    and the solver as ``backend``: --resume reads them, checks flags given again against
+    them, and continues the run as it was."""
+    full, part = tmp_path / "full", tmp_path / "part"
+    args = ["run", "example-6.2", "--max-ndof", "1500", "--eta5", "paper", "--no-figures"]
+    assert main([*args, "--backend", "scipy", "--out", str(full), "--quiet"]) == 0
+    interrupt_after_level(monkeypatch, 3)
+    assert main([*args, "--backend", "scipy", "--out", str(part)]) == 130
+    monkeypatch.undo()
+    capsys.readouterr()
+    manifest = json.loads((part / "signorini-run.json").read_text())
+    assert manifest["arguments"]["eta5_variant"] == "paper"
+    assert manifest["arguments"]["solver"] == "scipy"
+    manifest["arguments"] = {
+        "uniform": False,
+        "theta": 0.4,
+        "max_ndof": 1500,
+        "tol": 0.0,
+        "max_levels": 100,
+        "eta5": "paper",
+        "backend": "scipy",
+        "fallback": False,
+        "no_vtu": False,
+        "compare_uniform": False,
+    }
+    (part / "signorini-run.json").write_text(json.dumps(manifest))
+    assert main(["run", "--resume", str(part), "--eta5", "consistent"]) == 2
+    assert "--eta5 consistent (the run has paper)" in capsys.readouterr().err
+    assert main(["run", "--resume", str(part), "--backend", "auto"]) == 2
+    assert "--backend auto (the run has scipy)" in capsys.readouterr().err
+    assert main(["run", "--resume", str(part), "--eta5", "paper", "--quiet", "--no-figures"]) == 0
+    a = history_without_timings(full / "history.csv")
+    b = history_without_timings(part / "history.csv")
+    assert len(a) > 5 and {r["backend"] for r in b} == {"scipy"}
+    assert_same_history(a, b)
+
+
 def test_resume_refuses_a_folder_that_is_not_a_run(tmp_path, capsys):
     assert main(["run", "--resume", str(tmp_path)]) == 2
     assert "holds no signorini-run.json" in capsys.readouterr().err
