@@ -139,18 +139,7 @@ def adaptive(
     """
     if not isinstance(problem, ContactProblem):
         raise ValueError(f"problem must be a ContactProblem, got {type(problem).__name__}")
-    if options is None:
-        options = AdaptiveOptions()
-    elif not isinstance(options, AdaptiveOptions):
-        raise ValueError(f"options must be an AdaptiveOptions, got {type(options).__name__}")
-    unknown = sorted(set(changes) - {f.name for f in fields(AdaptiveOptions)})
-    if unknown:
-        raise TypeError(
-            f"adaptive() got unexpected keyword arguments {unknown}; the options are "
-            f"{[f.name for f in fields(AdaptiveOptions)]}"
-        )
-    if changes:
-        options = replace(options, **changes)
+    options = _changed(options, changes)
     first_level = check_count(first_level, "first_level", 0)
     if first_level >= options.max_levels:
         raise ValueError(
@@ -174,6 +163,22 @@ def adaptive(
             f"more than max_ndof={options.max_ndof}"
         )
     return _levels(problem, mesh, u0, options, first_level, metrics, path or None)
+
+
+def _changed(options: AdaptiveOptions | None, changes: Mapping[str, object]) -> AdaptiveOptions:
+    """``options`` (default ``AdaptiveOptions()``) with the fields in ``changes`` replaced,
+    checked; a ``TypeError`` for a name that is no field."""
+    if options is None:
+        options = AdaptiveOptions()
+    elif not isinstance(options, AdaptiveOptions):
+        raise ValueError(f"options must be an AdaptiveOptions, got {type(options).__name__}")
+    names = [f.name for f in fields(AdaptiveOptions)]
+    unknown = sorted(set(changes) - set(names))
+    if unknown:
+        raise TypeError(
+            f"adaptive() got unexpected keyword arguments {unknown}; the options are {names}"
+        )
+    return replace(options, **changes) if changes else options
 
 
 def _levels(
