@@ -23,7 +23,7 @@ def check_theta(theta: float, name: str = "theta") -> float:
     return theta
 
 
-def mark_doerfler(eta2: np.ndarray, theta: float = 0.4) -> np.ndarray:
+def mark_doerfler(eta2: np.ndarray, theta: float) -> np.ndarray:
     """The smallest set of cells M with ``Σ_{T∈M} η_T² ≥ θ Σ_T η_T²``.
 
     The cells with the largest indicators are taken first (a sort, no Python loop), so the

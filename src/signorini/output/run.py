@@ -121,7 +121,11 @@ class RunFolder:
         problem : dict
             How the run names its problem (JSON-serialisable).
         arguments : dict
-            The run's arguments (JSON-serialisable).
+            The run's settings, JSON-serialisable, stored as they are: the command line
+            gives the loop's options by field name (``AdaptiveOptions.to_record()``, the
+            solver by its registry name) and its own file flags; ``--resume`` rebuilds the
+            options from them (``AdaptiveOptions.from_record``, which also reads the keys
+            ``eta5`` and ``backend`` of manifests written before).
         overwrite : bool
             Remove a previous run's files from a non-empty folder instead of refusing it.
 
