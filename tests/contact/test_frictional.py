@@ -33,9 +33,13 @@ from signorini.problem.obstacles import Disc
 MATERIAL = Material.from_young(1.0, 0.3)
 
 
-def pressed_block(friction, angle: float = 0.0, nx: int = 8) -> ContactProblem:
+def pressed_block(
+    friction, angle: float = 0.0, nx: int = 8, right_friction: object = "same"
+) -> ContactProblem:
     """The block (0, 2) × (0, 1) (rotated by ``angle``) pushed down and sideways by its top
-    onto a rigid cylinder below its bottom: contact in the middle, stick and slip zones."""
+    onto a rigid cylinder below its bottom: contact in the middle, stick and slip zones.
+    With ``right_friction`` the bottom is two contact parts, ``bottom`` (x < 1) with
+    ``friction`` and ``bottom_right`` (x > 1) with ``right_friction``."""
     c, s = np.cos(angle), np.sin(angle)
     R = np.array([[c, -s], [s, c]])
     base = rectangle(0.0, 2.0, 0.0, 1.0, nx=nx, ny=nx // 2)
@@ -43,26 +47,76 @@ def pressed_block(friction, angle: float = 0.0, nx: int = 8) -> ContactProblem:
     def on(coord, value):
         return lambda x: np.abs((x @ R)[:, coord] - value) < 1e-12
 
-    mesh = Mesh.from_arrays(
-        base.points @ R.T,
-        base.cells,
-        {"left": on(0, 0.0), "right": on(0, 2.0), "top": on(1, 1.0), "bottom": on(1, 0.0)},
-    )
+    parts = {"left": on(0, 0.0), "right": on(0, 2.0), "top": on(1, 1.0)}
+    if right_friction == "same":
+        parts["bottom"] = on(1, 0.0)
+    else:
+        parts["bottom"] = lambda x: on(1, 0.0)(x) & ((x @ R)[:, 0] < 1.0)
+        parts["bottom_right"] = lambda x: on(1, 0.0)(x) & ((x @ R)[:, 0] > 1.0)
+    mesh = Mesh.from_arrays(base.points @ R.T, base.cells, parts)
     cylinder = Disc(R @ [1.0, -12.5], 12.5)  # touches the bottom at x = 1
-    return ContactProblem(
-        mesh,
-        MATERIAL,
-        {
-            "left": Neumann(),
-            "right": Neumann(),
-            "top": Dirichlet(R @ [0.012, -0.02]),
-            "bottom": Contact(obstacle=cylinder, friction=friction),
-        },
-    )
+    conditions = {
+        "left": Neumann(),
+        "right": Neumann(),
+        "top": Dirichlet(R @ [0.012, -0.02]),
+        "bottom": Contact(obstacle=cylinder, friction=friction),
+    }
+    if right_friction != "same":
+        conditions["bottom_right"] = Contact(obstacle=cylinder, friction=right_friction)
+    return ContactProblem(mesh, MATERIAL, conditions)
 
 
-def tresca_reference(pb: ContactProblem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """u (n_nodes, 2), λ_n and λ_t of the Tresca problem by its dual over a box."""
+def law_residuals(res, bound: np.ndarray) -> dict[str, float]:
+    """The tangential law of every constraint with the nodal slip bounds ``bound (k,)``, from
+    the computed forces and displacements alone, relative to the largest contact force and
+    displacement: the force within its bound, stick without tangential displacement, slip at
+    the bound along the friction force."""
+    lam_t, scale, disp = res.tangential_force, res.contact_force.max(), np.abs(res.u).max()
+    n = res.contact.normal
+    u_t = np.einsum("kc,kc->k", res.u[res.contact.nodes], np.column_stack([-n[:, 1], n[:, 0]]))
+    stick, slip = res.state == STICK, res.state == SLIP
+    return {
+        "beyond bound": float(np.maximum(np.abs(lam_t) - bound, 0).max() / scale),
+        "stick moves": float(np.abs(u_t[stick]).max(initial=0) / disp),
+        "slip off bound": float(np.abs(np.abs(lam_t[slip]) - bound[slip]).max(initial=0) / scale),
+        "slip against force": float(
+            np.maximum(-u_t[slip] * lam_t[slip], 0).max(initial=0) / (scale * disp)
+        ),
+    }
+
+
+def test_tresca_and_coulomb_parts_in_one_problem():
+    """The bottom's left half with Tresca, its right half with Coulomb: both laws node by
+    node; and with the Coulomb nodes' bound frozen at F Λ_n of the solution, the whole
+    problem is a Tresca problem, whose minimiser (by its dual, no semismooth Newton) is the
+    same solution."""
+    F = 0.3
+    bound = 0.25 * solve(pressed_block(None, nx=16)).pressure.max()
+    pb = pressed_block(Tresca(bound), nx=16, right_friction=Coulomb(F))
+    res = solve(pb)
+    law = res.contact.friction
+    tresca, coulomb = law.index == 0, law.index == 1
+    assert law.laws == (Tresca(bound), Coulomb(F)) and not res.report.symmetric
+    for nodes in (tresca, coulomb):  # both laws have stick and slip nodes in contact
+        assert (res.state[nodes] == STICK).any() and (res.state[nodes] == SLIP).any()
+    assert res.report.kkt.max < 1e-11, res.report.kkt
+    s = np.where(tresca, law.weight, F * res.contact_force)
+    worst = law_residuals(res, s)
+    print(f"Tresca + Coulomb: law residuals {worst}")
+    assert max(worst.values()) < 1e-11, worst
+    u_ref, lam_n, lam_t = tresca_reference(pb, s)
+    err_u = np.abs(res.u - u_ref).max() / np.abs(u_ref).max()
+    err_n = np.abs(res.contact_force - lam_n).max() / lam_n.max()
+    err_t = np.abs(res.tangential_force - lam_t).max() / lam_n.max()
+    print(f"frozen Coulomb bound: |u − u_ref|/|u| = {err_u:.1e}, Λ_n {err_n:.1e}, Λ_t {err_t:.1e}")
+    assert err_u < 1e-8 and err_n < 1e-8 and err_t < 1e-8
+
+
+def tresca_reference(
+    pb: ContactProblem, bound: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """u (n_nodes, 2), λ_n and λ_t of the Tresca problem by its dual over a box, with the
+    nodal bounds ``bound (k,)`` (default the contact set's Tresca weights ∫ s ψ_z ds)."""
     space = P2Space(pb.mesh)
     cs = contact_set(pb, space)
     n = space.n_dofs
@@ -76,25 +130,30 @@ def tresca_reference(pb: ContactProblem) -> tuple[np.ndarray, np.ndarray, np.nda
     fixed[2 * d] = fixed[2 * d + 1] = True
     free = ~fixed
     k = cs.size
-    t = np.column_stack([-cs.normal[:, 1], cs.normal[:, 0]])
-    B = np.zeros((2 * k, n))
+    s = cs.friction.weight if bound is None else bound
+    rubs = np.flatnonzero(s > 0)  # a node without a bound has no tangential multiplier
+    r = rubs.size
+    t = np.column_stack([-cs.normal[:, 1], cs.normal[:, 0]])  # independently of cs.tangent
+    B = np.zeros((k + r, n))
     B[np.arange(k), 2 * cs.nodes], B[np.arange(k), 2 * cs.nodes + 1] = cs.normal.T
-    B[k + np.arange(k), 2 * cs.nodes], B[k + np.arange(k), 2 * cs.nodes + 1] = t.T
+    B[k + np.arange(r), 2 * cs.nodes[rubs]] = t[rubs, 0]
+    B[k + np.arange(r), 2 * cs.nodes[rubs] + 1] = t[rubs, 1]
     chol = la.cho_factor(K[np.ix_(free, free)])
     rhs = -K[np.ix_(free, fixed)] @ u_d.ravel()[fixed]
     Bf = B[:, free]
     H = Bf @ la.cho_solve(chol, Bf.T)
-    c = Bf @ la.cho_solve(chol, rhs) - np.concatenate([cs.gap, np.zeros(k)])
+    c = Bf @ la.cho_solve(chol, rhs) - np.concatenate([cs.gap, np.zeros(r)])
     L = np.linalg.cholesky(H)
-    s = cs.friction_bound
-    lower = np.concatenate([np.zeros(k), -s])
-    upper = np.concatenate([np.full(k, np.inf), s])
+    lower = np.concatenate([np.zeros(k), -s[rubs]])
+    upper = np.concatenate([np.full(k, np.inf), s[rubs]])
     sol = lsq_linear(L.T, la.solve_triangular(L, c, lower=True), bounds=(lower, upper),
                      method="bvls", tol=1e-15)  # fmt: skip
     lam = sol.x
     u = u_d.ravel().copy()
     u[free] = la.cho_solve(chol, rhs - Bf.T @ lam)
-    return u.reshape(-1, 2), lam[:k], lam[k:]
+    lam_t = np.zeros(k)
+    lam_t[rubs] = lam[k:]
+    return u.reshape(-1, 2), lam[:k], lam_t
 
 
 def test_tresca_equals_the_minimiser_of_its_convex_energy():
@@ -112,7 +171,7 @@ def test_tresca_equals_the_minimiser_of_its_convex_energy():
           f"Λ_t {err_t:.1e}; states {counts}")  # fmt: skip
     assert err_u < 1e-7 and err_n < 1e-7 and err_t < 1e-7
     assert min(counts.values()) > 0  # no contact, stick and slip all occur
-    assert res.pdas.kkt.max < 1e-10
+    assert res.report.kkt.max < 1e-10
     # friction pulls against the sideways push: the obstacle's force on the body points left
     assert res.contact_force_vector[0] < 0 < res.contact_force_vector[1]
 
@@ -133,9 +192,9 @@ def test_coulomb_laws_hold_node_by_node():
     lam_n, lam_t = res.contact_force, res.tangential_force
     scale = lam_n.max()
     stick, slip = res.state == STICK, res.state == SLIP
-    print(f"Coulomb F = {F}: stick {stick.sum()}, slip {slip.sum()}, KKT {res.pdas.kkt.max:.1e}")
+    print(f"Coulomb F = {F}: stick {stick.sum()}, slip {slip.sum()}, KKT {res.report.kkt.max:.1e}")
     assert stick.any() and slip.any()
-    assert res.pdas.kkt.max < 1e-10
+    assert res.report.kkt.max < 1e-10
     assert (np.abs(lam_t) <= F * lam_n + 1e-10 * scale).all()
     assert np.abs(np.abs(lam_t[slip]) - F * lam_n[slip]).max() < 1e-10 * scale
     # the nodes that stick did not move tangentially; the ones that slip moved against Λ_t
@@ -160,12 +219,6 @@ def test_frictional_solution_is_rotation_invariant():
 
 
 def test_what_is_refused():
-    with pytest.raises(ProblemError, match="Tresca and with Coulomb friction in one problem"):
-        base = corner_problem()
-        conditions = dict(base.conditions)
-        conditions["bottom"] = Contact(friction=Tresca(0.1))
-        conditions["right"] = Contact(friction=Coulomb(0.1))
-        solve(ContactProblem(base.mesh, base.material, conditions))
     with pytest.raises(ProblemError, match="is a corner of contact parts 'bottom'"):
         base = corner_problem()
         conditions = dict(base.conditions)
@@ -188,9 +241,9 @@ def test_warm_start_reads_the_states_off_the_displacement():
     )
     assert np.array_equal(state0, res.state)
     slip = res.state == SLIP
-    assert np.array_equal(direction0[slip], res.pdas.direction[slip])
+    assert np.array_equal(direction0[slip], res.report.direction[slip])
     again = solve(pb, u0=res.u)
-    assert again.pdas.iterations == 1
+    assert again.report.iterations == 1
     assert np.abs(again.u - res.u).max() < 1e-12 * np.abs(res.u).max()
 
 

@@ -136,7 +136,7 @@ def test_solve_uses_the_ordering_and_agrees_with_pardisos_own(adaptive_mesh, mon
         lambda space, backend, **options: make_solver(backend, **options),
     )
     own = solve(problem, adaptive_mesh, backend="pardiso", nested=False)
-    assert ordered.pdas.iterations == own.pdas.iterations
+    assert ordered.report.iterations == own.report.iterations
     assert np.abs(ordered.u - own.u).max() <= 1e-10 * np.abs(own.u).max()
     assert (
         np.abs(ordered.contact_force - own.contact_force).max()
