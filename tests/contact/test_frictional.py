@@ -12,14 +12,18 @@ semismooth Newton.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pytest
 import scipy.linalg as la
 from contact_problems import corner_problem
 from scipy.optimize import lsq_linear
 
+from signorini.algebra import FrictionResult
 from signorini.contact.contact_set import contact_set
 from signorini.contact.solution import INACTIVE, SLIP, STICK, solve
+from signorini.estimator.friction import friction_edges
 from signorini.fem.material import Material
 from signorini.fem.space import P2Space
 from signorini.fem.stiffness import assemble_stiffness
@@ -174,6 +178,53 @@ def test_tresca_equals_the_minimiser_of_its_convex_energy():
     assert res.report.kkt.max < 1e-10
     # friction pulls against the sideways push: the obstacle's force on the body points left
     assert res.contact_force_vector[0] < 0 < res.contact_force_vector[1]
+
+
+@dataclass(frozen=True)
+class Cohesive:
+    """A toy law, written here and nowhere else: cohesion ``c`` (a stress) plus Coulomb
+    friction, ``s_z = ∫ c ψ_z ds + F Λ_n`` on the nodes in contact."""
+
+    cohesion: float
+    coefficient: float
+    symmetric = False
+    everywhere = False
+
+    def nodal_weight(self, integrate, size):
+        return integrate(lambda x: np.full(len(x), self.cohesion))
+
+    def slip_bound(self, weight, normal_force, in_contact):
+        return (weight + self.coefficient * np.maximum(normal_force, 0.0)) * in_contact
+
+    def bound_derivative(self, weight, in_contact):
+        return np.full(weight.shape, self.coefficient)
+
+
+def test_a_new_law_is_one_class():
+    """The toy law through the public solve(): its law node by node, and with its bound
+    frozen at the solution's ``∫ c ψ_z + F Λ_n`` the problem is a Tresca problem whose
+    minimiser (by its dual) is the same solution."""
+    c, F = 0.05 * solve(pressed_block(None, nx=16)).pressure.max(), 0.2
+    res = solve(pressed_block(Cohesive(c, F), nx=16))
+    assert isinstance(res.report, FrictionResult) and not res.report.symmetric
+    assert (res.state == STICK).any() and (res.state == SLIP).any()
+    w = res.contact.friction.weight
+    assert np.allclose(w, c * res.contact.basis_integral, rtol=1e-13, atol=0)
+    s = (w + F * res.contact_force) * res.active
+    worst = law_residuals(res, s)
+    print(f"cohesive law: KKT {res.report.kkt.max:.1e}, law residuals {worst}")
+    assert res.report.kkt.max < 1e-11 and max(worst.values()) < 1e-11, worst
+    u_ref, lam_n, lam_t = tresca_reference(res.problem, s)
+    err_u = np.abs(res.u - u_ref).max() / np.abs(u_ref).max()
+    err_n = np.abs(res.contact_force - lam_n).max() / lam_n.max()
+    err_t = np.abs(res.tangential_force - lam_t).max() / lam_n.max()
+    print(f"frozen cohesive bound: |u − u_ref|/|u| = {err_u:.1e}, Λ_n {err_n:.1e}, Λ_t {err_t:.1e}")
+    assert err_u < 1e-8 and err_n < 1e-8 and err_t < 1e-8
+    # the estimator asks the law too: its bound as a stress is s_z / w_z
+    edges = friction_edges(res)
+    loc = res.contact.edge_local
+    inside = loc >= 0
+    assert np.array_equal(edges.bound[inside], (s / res.contact.basis_integral)[loc[inside]])
 
 
 @pytest.mark.parametrize("friction", [Tresca(0.0), Coulomb(0.0)])
