@@ -227,6 +227,17 @@ def test_a_new_law_is_one_class():
     assert np.array_equal(edges.bound[inside], (s / res.contact.basis_integral)[loc[inside]])
 
 
+def test_tresca_in_contact_only_is_tresca_with_the_bound_cut_to_the_contact_set():
+    bound = 0.2 * solve(pressed_block(None)).pressure.max()
+    res = solve(pressed_block(Tresca(bound, everywhere=False)))
+    assert not np.any(res.tangential_force[~res.active]) and res.report.symmetric
+    assert (res.state == STICK).any() and (res.state == SLIP).any()
+    assert res.report.kkt.max < 1e-11
+    u_ref, lam_n, lam_t = tresca_reference(res.problem, res.contact.friction.weight * res.active)
+    assert np.abs(res.u - u_ref).max() < 1e-8 * np.abs(u_ref).max()
+    assert np.abs(res.tangential_force - lam_t).max() < 1e-8 * lam_n.max()
+
+
 @pytest.mark.parametrize("friction", [Tresca(0.0), Coulomb(0.0)])
 def test_zero_friction_is_the_frictionless_solution(friction):
     ref = solve(pressed_block(None))

@@ -25,6 +25,7 @@ MATERIAL = Material.from_young(10.0, 0.3)
         (lambda: Tresca(float("nan")), r"Tresca\(bound=...\) must be .*got nan"),
         (lambda: Tresca("0.3"), r"Tresca\(bound=...\) must be .*got '0\.3'"),
         (lambda: Tresca(lambda: 1.0), r"Tresca\(bound=...\)"),
+        (lambda: Tresca(1.0, everywhere="yes"), r"Tresca\(everywhere=...\) must be True or Fa"),
         (lambda: Coulomb(-0.2), r"Coulomb\(coefficient=...\) must be a finite number >= 0"),
         (lambda: Coulomb(float("inf")), r"Coulomb\(coefficient=...\) must be"),
         (lambda: Contact(friction=0.3), r"Contact\(friction=...\) must be None, Tresca"),
