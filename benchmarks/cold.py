@@ -61,7 +61,7 @@ def timed_solve(problem, mesh, assembled, nested: bool):
 
 
 def describe(name: str, result, seconds: float, floor: float) -> None:
-    p = result.pdas
+    p = result.report
     t = p.times
     print(
         f"{name}: {seconds:.3f} s = {seconds / floor:.3f} x floor; fine PDAS {p.iterations} "

@@ -71,11 +71,11 @@ def main() -> None:
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
         print(
             f"{ndof:10d} {rate(t_ref, ndof):>14s} {rate(t_asm, ndof):>14s} "
-            f"{rate(t_pdas, ndof):>14s} ({result.pdas.iterations:2d} it) "
+            f"{rate(t_pdas, ndof):>14s} ({result.report.iterations:2d} it) "
             f"{rate(t_est, ndof):>14s} {peak:9.0f}",
             flush=True,
         )
-        backend = result.pdas.backend
+        backend = result.report.backend
         del assembled, result, ref, mesh
     print(f"sparse solver backend: {backend}")
 

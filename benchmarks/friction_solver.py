@@ -24,6 +24,7 @@ import numpy as np
 from signorini.algebra import (
     SOLVERS,
     available_backends,
+    check_friction,
     make_solver,
     solve_friction,
     solve_pdas,
@@ -33,7 +34,7 @@ from signorini.algebra.pardiso import PardisoLUSolver
 from signorini.contact.system import assemble
 from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle
-from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
+from signorini.problem import Contact, ContactProblem, Coulomb, Dirichlet, Neumann, Tresca
 
 
 def pressed_block(nx: int):
@@ -53,6 +54,12 @@ def pressed_block(nx: int):
     return a.K, a.F, 2 * z, 2 * z + 1, a.contact.gap, a.dirichlet, a.dirichlet_values
 
 
+def friction(system, law, weight, **kwargs):
+    """``solve_friction`` of ``system`` with one law at every node and its weight (Tresca:
+    the bound, Coulomb: the coefficient), the problem's checks included."""
+    return solve_friction(check_friction(*system, laws=law, weight=weight), **kwargs)
+
+
 def timed(function, *args, **kwargs):
     t0 = time.perf_counter()
     result = function(*args, **kwargs)
@@ -65,18 +72,18 @@ def compare_laws(system, repeat: int) -> None:
         frictionless = solve_pdas(K, F, normal, gap, d, xd, solver=SOLVERS[backend])
         top = frictionless.multiplier.max()
         laws = {
-            "Tresca classical 0.1": {"bound": 0.1 * top, "tresca_everywhere": True},
-            "Tresca in contact 0.2": {"bound": 0.2 * top},
-            "Coulomb 0.2": {"coefficient": 0.2},
-            "Coulomb 0.5": {"coefficient": 0.5},
+            "Tresca classical 0.1": (Tresca(0.0), 0.1 * top),
+            "Tresca in contact 0.2": (Tresca(0.0, everywhere=False), 0.2 * top),
+            "Coulomb 0.2": (Coulomb(0.2), 0.2),
+            "Coulomb 0.5": (Coulomb(0.5), 0.5),
         }
         best = dict.fromkeys(["pdas", *laws], np.inf)
         results = {}
         for _ in range(repeat):
             _, t = timed(solve_pdas, K, F, normal, gap, d, xd, solver=SOLVERS[backend])
             best["pdas"] = min(best["pdas"], t)
-            for name, law in laws.items():
-                results[name], t = timed(solve_friction, *system, solver=SOLVERS[backend], **law)
+            for name, (law, weight) in laws.items():
+                results[name], t = timed(friction, system, law, weight, solver=SOLVERS[backend])
                 best[name] = min(best[name], t)
         print(f"{backend}: solve_pdas {frictionless.iterations} iterations")
         for name, r in results.items():
@@ -97,7 +104,7 @@ def compare_lu(system, repeat: int) -> None:
     for _ in range(repeat):
         for name, make in makers.items():
             with make() as solver:
-                results[name], t = timed(solve_friction, *system, coefficient=0.5, solver=solver)
+                results[name], t = timed(friction, system, Coulomb(0.5), 0.5, solver=solver)
             best[name] = min(best[name], t)
     x = results["SuperLU"].x
     print("Coulomb F = 0.5, LU backends (time / SuperLU's):")

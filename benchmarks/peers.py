@@ -188,8 +188,8 @@ def main() -> None:
     ours = solve(problem)
     t_ours = time.perf_counter() - t0
     print(
-        f"signorini: {t_ours:.2f} s ({ours.pdas.iterations} PDAS iterations, "
-        f"{ours.pdas.n_analyses} analysis, backend {ours.pdas.backend})",
+        f"signorini: {t_ours:.2f} s ({ours.report.iterations} PDAS iterations, "
+        f"{ours.report.n_analyses} analysis, backend {ours.report.backend})",
         flush=True,
     )
     try:

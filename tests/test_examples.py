@@ -102,7 +102,7 @@ def test_example_6_1_contact_force_and_pressure(levels_6_1):
     for r in levels_6_1:
         x = r.space.node_points[r.contact.nodes, 0]
         p_err.append(np.abs(r.pressure - 3 * (2 - x)).max())
-        assert r.active.all() and r.pdas.kkt.max < 1e-12
+        assert r.active.all() and r.report.kkt.max < 1e-12
     p_err = np.array(p_err)
     for r, f, e in zip(levels_6_1, force, p_err, strict=True):
         print(
@@ -158,7 +158,7 @@ def test_example_6_2_contact_zone_is_one_interval(levels_6_2):
         print(
             f"Ndof {r.ndof:6d}: contact zone [{lows[-1]:.6f}, {highs[-1]:.6f}] "
             f"({idx.size} of {y.size} nodes, spacing {spacing:.5f}), ΣΛ = {force[-1]:.8f}, "
-            f"{r.pdas.iterations} PDAS iterations"
+            f"{r.report.iterations} PDAS iterations"
         )
         assert idx[-1] - idx[0] + 1 == idx.size, "the active set has a gap"
         assert lows[-1] < 0.5 < highs[-1]
@@ -166,7 +166,7 @@ def test_example_6_2_contact_zone_is_one_interval(levels_6_2):
         # Λ > 0 inside the zone, 0 outside; the obstacle is never penetrated
         lam = r.contact_force[np.argsort(r.space.node_points[r.contact.nodes, 1])]
         assert np.all(lam[idx] > 0) and np.all(lam[~active] == 0)
-        assert r.pdas.kkt.max < 1e-12
+        assert r.report.kkt.max < 1e-12
     lows, highs, force = map(np.array, (lows, highs, force))
     spacing = 0.125 / 2.0 ** np.arange(LEVELS)  # node spacing on x = 1 at each level
     d_force = np.abs(np.diff(force))

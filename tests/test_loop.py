@@ -58,7 +58,7 @@ def check_record(level: Level, has_exact: bool, friction: bool = False) -> None:
     np.testing.assert_array_equal(terms, est.eta_terms)
     assert math.fsum(t * t for t in terms) == pytest.approx(r.eta**2, rel=1e-12)
     assert (r.eta_8 > 0) == friction
-    pdas = res.pdas
+    pdas = res.report
     solves = pdas.iterations if friction else pdas.n_solves  # friction: one solve per step
     assert (r.pdas_iterations, r.n_solves, r.n_factorizations) == (
         pdas.iterations,
@@ -374,7 +374,7 @@ def test_history_reports_the_kkt_residuals_of_each_level():
     """Every level's record carries its five relative KKT residuals, all at round-off."""
     names = ("primal", "dual", "complementarity", "stationarity", "dirichlet")
     for lv in adaptive(example_6_2(), max_ndof=3000):
-        kkt = lv.result.pdas.kkt
+        kkt = lv.result.report.kkt
         for name in names:
             value = getattr(lv.record, f"kkt_{name}")
             assert value == getattr(kkt, name), (lv.record.level, name)

@@ -7,7 +7,7 @@ The public API, from the mesh to the adaptive loop::
                            solve_path, estimate, mark_doerfler, refine_nvb, adaptive)
 """
 
-from .algebra import PDASConvergenceError
+from .algebra import ConvergenceError, FrictionConvergenceError, PDASConvergenceError
 from .contact import ContactResult, solve, solve_path
 from .estimator import Estimate, estimate, mark_doerfler
 from .examples import example_6_1, example_6_2
@@ -35,11 +35,13 @@ __all__ = [
     "Contact",
     "ContactProblem",
     "ContactResult",
+    "ConvergenceError",
     "Coulomb",
     "Dirichlet",
     "Disc",
     "Estimate",
     "ExactSolution",
+    "FrictionConvergenceError",
     "HalfPlane",
     "Level",
     "LevelRecord",

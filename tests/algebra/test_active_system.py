@@ -11,6 +11,7 @@ from linalg_problems import p2_elasticity, random_problem
 from signorini.algebra import (
     SOLVERS,
     FactorizationError,
+    PDASOptions,
     SingularSystemError,
     available_backends,
     make_solver,
@@ -107,8 +108,12 @@ def test_low_rank_updates_agree_with_refactorization(backend):
     used = 0
     for _ in range(6):
         K, F, c, g, d, xd = random_problem(rng, 120, 12, 6, dense=False)
-        exact = solve_pdas(K, F, c, g, d, xd, solver=SOLVERS[backend], max_update=0)
-        updated = solve_pdas(K, F, c, g, d, xd, solver=SOLVERS[backend], max_update=12)
+        exact = solve_pdas(
+            K, F, c, g, d, xd, solver=SOLVERS[backend], options=PDASOptions(max_update=0)
+        )
+        updated = solve_pdas(
+            K, F, c, g, d, xd, solver=SOLVERS[backend], options=PDASOptions(max_update=12)
+        )
         assert exact.n_updates == 0
         assert updated.n_factorizations + updated.n_updates == updated.iterations
         assert np.array_equal(updated.active, exact.active)

@@ -27,8 +27,17 @@ from signorini.algebra import (
     solve_pdas,
     superlu_solver,
 )
-from signorini.algebra.friction import INACTIVE, SLIP, STICK, solve_friction
+from signorini.algebra.friction import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
+from signorini.algebra.friction_kkt import check_friction
 from signorini.algebra.friction_result import FrictionConvergenceError
+from signorini.problem.friction import Coulomb, Tresca
+
+#: The laws as the solver asks them; each node's data is its weight (Tresca: the bound s,
+#: Coulomb: the coefficient F), so the data the objects were built with is not used here.
+TRESCA = Tresca(0.0)
+TRESCA_IN_CONTACT = Tresca(0.0, everywhere=False)
+COULOMB = Coulomb(0.0)
+OPTIONS = ("max_iter", "kkt_tol", "c")
 
 
 @cache
@@ -39,6 +48,17 @@ def block():
 
 def args(S):
     return S.K, S.F, S.normal, S.tangent, S.gap, S.dirichlet, S.dirichlet_values
+
+
+def run(S, law, weight, *, reference=None, K=None, law_index=None, **kwargs):
+    """solve_friction on the system ``S`` (or with the matrix ``K``) with one law, the weight
+    per node, and the keyword arguments of solve_friction or FrictionOptions."""
+    system = args(S) if K is None else (K, *args(S)[1:])
+    problem = check_friction(
+        *system, laws=law, weight=weight, law_index=law_index, reference=reference
+    )
+    options = {key: kwargs.pop(key) for key in OPTIONS if key in kwargs}
+    return solve_friction(problem, options=FrictionOptions(**options), **kwargs)
 
 
 @cache
@@ -99,7 +119,7 @@ def energy(S, x, bound):
 def test_classical_tresca_is_the_minimiser_computed_by_duality():
     S = block()
     bound = 0.1 * frictionless().multiplier.max()
-    r = solve_friction(*args(S), bound=bound, tresca_everywhere=True)
+    r = run(S, TRESCA, bound)
     x_ref, lam_n, lam_t = tresca_by_duality(S, bound)
     counts = np.bincount(r.state, minlength=3)
     assert counts.min() >= 3, f"states INACTIVE, STICK, SLIP occur {counts} times"
@@ -139,7 +159,7 @@ def test_classical_tresca_on_random_node_blocked_systems(seed):
         dirichlet_values=np.zeros(0),
     )
     bound = rng.uniform(0.0, 1.0, 8)
-    r = solve_friction(*args(S), bound=bound, tresca_everywhere=True)
+    r = run(S, TRESCA, bound)
     x, _, lam_t = tresca_by_duality(S, bound)
     assert rel(r.x, x) < 1e-10, rel(r.x, x)
     assert np.abs(r.multiplier_t - lam_t).max() < 1e-10 * np.abs(S.F).max()
@@ -148,7 +168,7 @@ def test_classical_tresca_on_random_node_blocked_systems(seed):
 def test_tresca_in_contact_only_is_classical_tresca_with_the_bound_cut_to_the_contact_set():
     S = block()
     bound = 0.2 * frictionless().multiplier.max()
-    r = solve_friction(*args(S), bound=bound)
+    r = run(S, TRESCA_IN_CONTACT, bound)
     in_contact = r.state != INACTIVE
     assert not np.any(r.multiplier_t[~in_contact]), "friction force out of contact"
     counts = np.bincount(r.state, minlength=3)
@@ -157,11 +177,11 @@ def test_tresca_in_contact_only_is_classical_tresca_with_the_bound_cut_to_the_co
     assert rel(r.x, x_ref) < 1e-7, rel(r.x, x_ref)
 
 
-@pytest.mark.parametrize("law", ["bound", "coefficient"])
+@pytest.mark.parametrize("law", [TRESCA_IN_CONTACT, COULOMB])
 def test_zero_friction_reproduces_the_frictionless_solver(law):
     S = block()
     ref = frictionless()
-    r = solve_friction(*args(S), **{law: 0.0})
+    r = run(S, law, 0.0)
     assert np.array_equal(r.state != INACTIVE, ref.active)
     assert rel(r.x, ref.x) < 1e-13, rel(r.x, ref.x)
     assert rel(r.multiplier_n, ref.multiplier) < 1e-12, rel(r.multiplier_n, ref.multiplier)
@@ -171,7 +191,7 @@ def test_zero_friction_reproduces_the_frictionless_solver(law):
 
 def test_a_very_large_bound_sticks_every_contact_node():
     S = block()
-    r = solve_friction(*args(S), bound=1e6)
+    r = run(S, TRESCA_IN_CONTACT, 1e6)
     active = r.state != INACTIVE
     assert np.array_equal(r.state[active], np.full(active.sum(), STICK))
     assert active.sum() > 10
@@ -198,7 +218,7 @@ def test_a_very_large_bound_sticks_every_contact_node():
 @pytest.mark.parametrize("coefficient", [0.2, 0.5])
 def test_coulomb_meets_both_laws_and_is_a_fixed_point_of_tresca(coefficient):
     S = block()
-    r = solve_friction(*args(S), coefficient=coefficient)
+    r = run(S, COULOMB, coefficient)
     assert not r.symmetric
     assert r.kkt.max <= 1e-10, r.kkt
     counts = np.bincount(r.state, minlength=3)
@@ -213,7 +233,7 @@ def test_coulomb_meets_both_laws_and_is_a_fixed_point_of_tresca(coefficient):
     assert np.abs(np.abs(lam_t[slip]) - coefficient * lam_n[slip]).max() < 1e-12 * scale
     assert np.all(lam_t[slip] * slide[slip] > 0), "slip along the friction force"
     # Tresca with the bound F Λ_n has the same solution
-    t = solve_friction(*args(S), bound=coefficient * r.multiplier_n)
+    t = run(S, TRESCA_IN_CONTACT, coefficient * r.multiplier_n)
     assert rel(t.x, r.x) < 1e-9, rel(t.x, r.x)
     assert np.array_equal(t.state, r.state)
 
@@ -221,8 +241,8 @@ def test_coulomb_meets_both_laws_and_is_a_fixed_point_of_tresca(coefficient):
 @pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO is not installed")
 def test_coulomb_superlu_and_pardiso_agree():
     S = block()
-    a = solve_friction(*args(S), coefficient=0.5, solver=superlu_solver)
-    b = solve_friction(*args(S), coefficient=0.5, solver=pardiso_solver)
+    a = run(S, COULOMB, 0.5, solver=superlu_solver)
+    b = run(S, COULOMB, 0.5, solver=pardiso_solver)
     assert (a.backend, b.backend) == ("scipy", "pardiso")
     assert rel(a.x, b.x) < 1e-11, rel(a.x, b.x)
     assert b.n_analyses == 1 and b.n_factorizations == b.iterations
@@ -232,13 +252,13 @@ def test_coulomb_superlu_and_pardiso_agree():
 def test_a_kept_solver_analyses_the_pattern_once_across_calls(backend):
     S = block()
     with make_solver(SOLVERS[backend], symmetric=False) as solver:
-        first = solve_friction(*args(S), coefficient=0.5, solver=solver)
-        second = solve_friction(*args(S), coefficient=0.2, solver=solver)
+        first = run(S, COULOMB, 0.5, solver=solver)
+        second = run(S, COULOMB, 0.2, solver=solver)
     assert (first.n_analyses, second.n_analyses) == (1, 0)
     assert second.n_factorizations == second.iterations
     with make_solver(SOLVERS[backend]) as solver:
-        first = solve_friction(*args(S), bound=1e-3, solver=solver)
-        second = solve_friction(*args(S), bound=2e-3, solver=solver)
+        first = run(S, TRESCA_IN_CONTACT, 1e-3, solver=solver)
+        second = run(S, TRESCA_IN_CONTACT, 2e-3, solver=solver)
     assert (first.n_analyses, second.n_analyses) == (1, 0)
 
 
@@ -247,11 +267,11 @@ def test_a_load_step_from_its_own_solution_does_not_slip():
     a zero slip increment: the same solution, and every contact node sticks or is at its
     bound without moving."""
     S = block()
-    r = solve_friction(*args(S), coefficient=0.5)
-    again = solve_friction(*args(S), coefficient=0.5, reference=r.x[S.tangent])
+    r = run(S, COULOMB, 0.5)
+    again = run(S, COULOMB, 0.5, reference=r.x[S.tangent])
     assert rel(again.x, r.x) < 1e-10, rel(again.x, r.x)
     assert again.kkt.max < 1e-10
-    shifted = solve_friction(*args(S), coefficient=0.5, reference=r.x[S.tangent] + 1e-3)
+    shifted = run(S, COULOMB, 0.5, reference=r.x[S.tangent] + 1e-3)
     assert rel(shifted.x, r.x) > 1e-3  # the reference is used
 
 
@@ -260,69 +280,64 @@ def test_a_load_step_from_its_own_solution_does_not_slip():
 # ----------------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize(
-    "law",
-    [
-        {"bound": 0.05, "tresca_everywhere": True},
-        {"bound": 0.05},
-        {"coefficient": 0.5},
-    ],
-)
-def test_warm_start_from_the_converged_states_takes_one_solve(law):
+@pytest.mark.parametrize("law, weight", [(TRESCA, 0.05), (TRESCA_IN_CONTACT, 0.05), (COULOMB, 0.5)])
+def test_warm_start_from_the_converged_states_takes_one_solve(law, weight):
     S = block()
-    law = dict(law)
-    if "bound" in law:
-        law["bound"] *= frictionless().multiplier.max() * 2
-    r = solve_friction(*args(S), **law)
+    if law is not COULOMB:
+        weight *= frictionless().multiplier.max() * 2
+    r = run(S, law, weight)
     assert r.iterations > 2
-    again = solve_friction(*args(S), **law, state0=r.state, direction0=r.direction)
+    again = run(S, law, weight, state0=r.state, direction0=r.direction)
     assert again.iterations == 1, again.history
     assert rel(again.x, r.x) < 1e-13
-    from_x = solve_friction(*args(S), **law, x0=r.x)
+    from_x = run(S, law, weight, x0=r.x)
     assert from_x.iterations <= 2, from_x.history
 
 
 def test_non_convergence_raises_with_the_history():
     S = block()
     with pytest.raises(FrictionConvergenceError, match="max_iter = 2") as err:
-        solve_friction(*args(S), coefficient=0.5, max_iter=2)
+        run(S, COULOMB, 0.5, max_iter=2)
     assert err.value.reason == "max_iter" and len(err.value.history) == 2
     assert "iteration history" in str(err.value)
     with pytest.raises(FrictionConvergenceError, match="KKT residual") as err:
-        solve_friction(*args(S), coefficient=0.5, kkt_tol=1e-30)
+        run(S, COULOMB, 0.5, kkt_tol=1e-30)
     assert err.value.reason == "kkt" and err.value.x.shape == S.F.shape
 
 
 @pytest.mark.parametrize(
     "change, message",
     [
-        ({"coefficient": -0.1}, "coefficient must be non-negative"),
-        ({"bound": np.nan}, "bound has non-finite"),
-        ({"bound": -1.0}, "bound must be non-negative"),
-        ({"bound": np.ones(3)}, r"bound must have shape \(33,\)"),
-        ({"gap": np.zeros(5), "bound": 1.0}, r"gap must have shape \(33,\)"),
-        ({"tangent": "normal", "bound": 1.0}, "normal and tangent share 33 DOFs"),
-        ({"tangent": "dirichlet", "bound": 1.0}, "tangent must name one DOF per"),
-        ({"tangent": "first dirichlet", "bound": 1.0}, "tangent and dirichlet share 1 DOFs"),
-        ({}, "exactly one of bound"),
-        ({"bound": 1.0, "coefficient": 0.1}, "exactly one of bound"),
-        ({"coefficient": 0.1, "tresca_everywhere": True}, "Tresca law only"),
-        ({"bound": 1.0, "state0": np.full(33, 3)}, "state0 must have shape"),
-        ({"bound": 1.0, "state0": np.full(33, SLIP)}, "direction0 is needed"),
-        ({"bound": 1.0, "max_iter": 0}, "max_iter must be a positive integer"),
-        ({"bound": 1.0, "c": -1.0}, "c must be positive"),
-        ({"bound": 1.0, "reference": np.inf}, "reference has non-finite"),
+        ({"weight": -0.1}, "weight must be non-negative"),
+        ({"weight": np.nan}, "weight has non-finite"),
+        ({"weight": np.ones(3)}, r"weight must have shape \(33,\)"),
+        ({"gap": np.zeros(5)}, r"gap must have shape \(33,\)"),
+        ({"tangent": "normal"}, "normal and tangent share 33 DOFs"),
+        ({"tangent": "dirichlet"}, "tangent must name one DOF per"),
+        ({"tangent": "first dirichlet"}, "tangent and dirichlet share 1 DOFs"),
+        ({"laws": "tresca"}, "laws must be a friction law or a sequence of them"),
+        ({"laws": (TRESCA, 0.3)}, "laws must be a friction law or a sequence of them"),
+        ({"law_index": np.full(33, 1)}, r"law_index must lie in \[-1, 1\)"),
+        ({"law_index": np.zeros(5, dtype=int)}, r"law_index must be an integer array"),
+        ({"state0": np.full(33, 3)}, "state0 must have shape"),
+        ({"state0": np.full(33, SLIP)}, "direction0 is needed"),
+        ({"max_iter": 0}, "max_iter must be a positive integer"),
+        ({"c": -1.0}, "c must be positive"),
+        ({"kkt_tol": 0.0}, "kkt_tol must be a positive number"),
+        ({"reference": np.inf}, "reference has non-finite"),
+        ({"problem": "the system"}, "problem must be a FrictionProblem"),
     ],
 )
 def test_bad_input_is_named(change, message):
     S = block()
-    kwargs = dict(
+    data = dict(
         zip(
             ["K", "F", "normal", "tangent", "gap", "dirichlet", "dirichlet_values"],
             args(S),
             strict=True,
         )
     )
+    data.update(laws=TRESCA_IN_CONTACT, weight=1.0)
     change = dict(change)
     if change.get("tangent") == "normal":
         change["tangent"] = S.normal
@@ -330,9 +345,13 @@ def test_bad_input_is_named(change, message):
         change["tangent"] = S.dirichlet
     elif change.get("tangent") == "first dirichlet":
         change["tangent"] = np.concatenate([S.tangent[:-1], S.dirichlet[:1]])
-    kwargs.update(change)
+    solve_keys = ("state0", "direction0", "problem")
+    solve_args = {key: change.pop(key) for key in solve_keys if key in change}
+    options = {key: change.pop(key) for key in OPTIONS if key in change}
+    data.update(change)
     with pytest.raises(ValueError, match=message):
-        solve_friction(**kwargs)
+        problem = solve_args.pop("problem", None) or check_friction(**data)
+        solve_friction(problem, options=FrictionOptions(**options), **solve_args)
 
 
 def test_the_coulomb_matrix_keeps_the_pattern_of_a_non_blocked_k():
@@ -347,6 +366,6 @@ def test_the_coulomb_matrix_keeps_the_pattern_of_a_non_blocked_k():
         shape=S.K.shape,
     )
     assert K.nnz == S.K.nnz + 1
-    r = solve_friction(K, *args(S)[1:], coefficient=0.5)
-    ref = solve_friction(*args(S), coefficient=0.5)
+    r = run(S, COULOMB, 0.5, K=K)
+    ref = run(S, COULOMB, 0.5)
     assert rel(r.x, ref.x) < 1e-12

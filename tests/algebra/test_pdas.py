@@ -24,6 +24,7 @@ from linalg_problems import (
 from signorini.algebra import (
     SOLVERS,
     PDASConvergenceError,
+    PDASOptions,
     available_backends,
     eliminate_symmetric,
     make_solver,
@@ -81,7 +82,7 @@ def test_kkt_on_random_problems(seed, n, frac_c, frac_d, dense):
     if n_d == n_total - m and n_d > 0:
         n_d -= 1
     K, F, c, g, d, xd = random_problem(rng, n, m, n_d, dense=dense)
-    result = solve_pdas(K, F, c, g, d, xd, fallback=True)
+    result = solve_pdas(K, F, c, g, d, xd, options=PDASOptions(fallback=True))
     assert_kkt(result)
     assert np.array_equal(result.x[d], xd)
     assert np.array_equal(result.x[c[result.active]], g[result.active])
@@ -125,7 +126,7 @@ def test_meets_kkt_and_matches_brute_force_qp(seed, n, m, n_d):
     n_d = min(n_d, n - m)
     rng = np.random.default_rng(seed)
     K, F, c, g, d, xd = random_problem(rng, n, m, n_d)
-    result = solve_pdas(K, F, c, g, d, xd, fallback=True)
+    result = solve_pdas(K, F, c, g, d, xd, options=PDASOptions(fallback=True))
     x, multiplier = result.x, result.multiplier
     # KKT: feasibility, sign, complementarity, stationarity off the bounds, Dirichlet values
     r = F - K @ x
@@ -263,7 +264,7 @@ def test_cycling_is_detected_and_fallback_solves():
     assert "iteration history" in str(err) and "fallback=True" in str(err)
     # the advice names every place it can be given
     assert "adaptive()" in str(err) and "--fallback" in str(err)
-    result = solve_pdas(K, CYCLING_F, np.arange(4), CYCLING_G, fallback=True)
+    result = solve_pdas(K, CYCLING_F, np.arange(4), CYCLING_G, options=PDASOptions(fallback=True))
     assert result.method == "primal-active-set"
     assert any(step.method == "primal-active-set" for step in result.history)
     x_ref, multiplier_ref, active_ref = brute_force_qp(
@@ -280,10 +281,10 @@ def test_max_iter_reached():
     full = solve_pdas(K, F, c, g)
     assert full.iterations >= 3
     with pytest.raises(PDASConvergenceError, match="max_iter = 1") as info:
-        solve_pdas(K, F, c, g, max_iter=1)
+        solve_pdas(K, F, c, g, options=PDASOptions(max_iter=1))
     assert info.value.reason == "max_iter"
     assert len(info.value.history) == 1 and info.value.x.shape == (K.shape[0],)
-    rescued = solve_pdas(K, F, c, g, max_iter=1, fallback=True)
+    rescued = solve_pdas(K, F, c, g, options=PDASOptions(max_iter=1, fallback=True))
     assert rescued.method == "primal-active-set"
     assert np.abs(rescued.x - full.x).max() < 1e-10 * np.abs(full.x).max()
 
@@ -382,7 +383,8 @@ def test_bad_input_names_the_argument(small, change, message):
     params = {"K": K, "F": F, "constrained": c, "gap": g, "dirichlet": d, "dirichlet_values": xd}
     change(params)
     with pytest.raises(ValueError, match=message):
-        solve_pdas(**params)
+        options = {key: params.pop(key) for key in ("c", "max_iter", "max_update") if key in params}
+        solve_pdas(**params, options=PDASOptions(**options))
 
 
 def test_no_constraints_is_a_linear_solve():

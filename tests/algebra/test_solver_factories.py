@@ -88,7 +88,7 @@ def test_a_toy_backend_solves_the_friction_examples(example):
     """Tresca asks the factory for a symmetric solver, Coulomb for an LU one."""
     problem = example()
     toy, ref = solve(problem, solver=dense_solver), solve(problem)
-    assert toy.pdas.backend == "dense" and toy.pdas.iterations == ref.pdas.iterations
+    assert toy.report.backend == "dense" and toy.report.iterations == ref.report.iterations
     assert_same_solution(toy, ref)
     np.testing.assert_array_equal(toy.state, ref.state)
     scale = np.abs(ref.tangential_force).max()
@@ -129,7 +129,9 @@ def test_a_solver_object_is_used_as_it_is_and_not_closed():
         assert solver.n_analyses == 1 and solver.n > 0  # still factorized: not closed
         again = solve(problem, solver=solver)  # the same pattern: the analysis is kept
         assert solver.n_analyses == 1
-        assert solver.n_factorizations == first.pdas.n_factorizations + again.pdas.n_factorizations
+        assert (
+            solver.n_factorizations == first.report.n_factorizations + again.report.n_factorizations
+        )
         assert solver.ordering is None  # no ordering set on the caller's solver
     np.testing.assert_array_equal(first.u, again.u)
 

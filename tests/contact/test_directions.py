@@ -79,11 +79,11 @@ def test_corner_has_two_constraints_and_matches_the_dual_qp(shapes):
     err_lam = np.abs(res.contact_force - lam_ref).max() / np.abs(lam_ref).max()
     print(
         f"corner ({'shapes' if shapes else 'gaps'}): |u - u_ref| / |u| = {err_u:.2e}, "
-        f"|Λ - λ_ref| / |λ| = {err_lam:.2e}, KKT {res.pdas.kkt.max:.2e}"
+        f"|Λ - λ_ref| / |λ| = {err_lam:.2e}, KKT {res.report.kkt.max:.2e}"
     )
     assert err_u < 1e-10, err_u
     assert err_lam < 1e-10, err_lam
-    assert res.pdas.kkt.max < 1e-10
+    assert res.report.kkt.max < 1e-10
     x = res.space.node_points[res.contact.nodes]
     corner = np.flatnonzero(np.all(np.abs(x - [1.0, 0.0]) < TOL, axis=1))
     assert corner.size == 2
@@ -159,7 +159,7 @@ def test_polygonal_part_takes_the_mean_of_its_edges_normals_at_a_vertex():
     res = solve(pb)
     u_ref, _ = reference_solution(pb)
     assert np.abs(res.u - u_ref).max() < 1e-10 * np.abs(u_ref).max()
-    assert res.active.any() and res.pdas.kkt.max < 1e-10
+    assert res.active.any() and res.report.kkt.max < 1e-10
 
 
 def quarter_annulus(n: int = 4) -> Mesh:
@@ -200,10 +200,10 @@ def test_curved_part_constrains_along_the_curve_normal():
     assert np.abs(cs.normal - x / 2.0).max() < 1e-15
     u_ref, lam_ref = reference_solution(pb)
     err = np.abs(res.u - u_ref).max() / np.abs(u_ref).max()
-    print(f"curved contact part: |u - u_ref| / |u| = {err:.2e}, KKT {res.pdas.kkt.max:.2e}")
+    print(f"curved contact part: |u - u_ref| / |u| = {err:.2e}, KKT {res.report.kkt.max:.2e}")
     assert err < 1e-10, err
     assert 0 < res.active.sum() < cs.size
-    assert res.pdas.kkt.max < 1e-10
+    assert res.report.kkt.max < 1e-10
     # the weights are integrals along the quadratic edges, which are O(h⁴) from the arc of
     # length π (the chords are O(h²) off: 8 chords of 2 · 2 sin(π/32) give 3.1365)
     chords = 8 * 2 * 2 * np.sin(np.pi / 32)
@@ -259,7 +259,7 @@ def test_curve_without_normal_takes_the_mean_rule():
     assert np.abs(cs.normal[inner_vertex] - x[inner_vertex] / 2).max() < 1e-14
     # at a midpoint the chord's normal: radial at the chord's middle, i.e. through the node
     assert np.abs(cs.normal[~cs.is_vertex] - x[~cs.is_vertex] / 2).max() < 1e-14
-    assert res.pdas.kkt.max < 1e-10
+    assert res.report.kkt.max < 1e-10
 
 
 def test_obstacle_without_a_distance_at_a_node_names_the_part():

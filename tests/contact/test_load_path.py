@@ -55,13 +55,13 @@ def test_the_law_acts_on_the_slip_increment(friction):
     scale = np.abs(second.u).max()
     print(
         f"\n{friction}: stick {stick.sum()}, slip {slipping.sum()}, max |slip| on stick "
-        f"{np.abs(slip[stick]).max() / scale:.1e} (relative), KKT {second.pdas.kkt.max:.1e}"
+        f"{np.abs(slip[stick]).max() / scale:.1e} (relative), KKT {second.report.kkt.max:.1e}"
     )
     assert stick.any() and slipping.any()
     assert np.abs(slip[stick]).max() <= 1e-12 * scale
     assert (slip[slipping] * second.tangential_force[slipping] >= -1e-12 * scale).all()
     assert np.abs(slip[slipping]).max() > 1e-3 * scale
-    assert second.pdas.kkt.max < 1e-10
+    assert second.report.kkt.max < 1e-10
 
 
 def test_a_repeated_step_is_one_solve_of_the_same_solution():
@@ -71,8 +71,8 @@ def test_a_repeated_step_is_one_solve_of_the_same_solution():
         first = solve(block(0.01, friction=friction))
         again = solve(block(0.01, friction=friction), previous=first)
         du = np.abs(again.u - first.u).max() / np.abs(first.u).max()
-        print(f"{friction}: {first.pdas.iterations} then {again.pdas.iterations}, Δu {du:.1e}")
-        assert again.pdas.iterations == 1
+        print(f"{friction}: {first.report.iterations} then {again.report.iterations}, Δu {du:.1e}")
+        assert again.report.iterations == 1
         assert du < 1e-12, du
         assert np.array_equal(again.state, first.state)
 
@@ -87,7 +87,7 @@ def test_friction_switched_on_after_a_frictionless_step():
     stick = second.state == STICK
     assert stick.any()
     np.testing.assert_allclose(tangential(second)[stick], tangential(first)[stick], atol=1e-15)
-    assert second.pdas.kkt.max < 1e-10
+    assert second.report.kkt.max < 1e-10
 
 
 def test_unloading_reverses_the_slip():

@@ -50,9 +50,9 @@ def test_nested_solve_is_the_cold_solution_in_fewer_iterations(fine, cold):
     du, dl = _agreement(nested, cold)
     assert du <= 1e-10 and dl <= 1e-10, (du, dl)
     assert np.array_equal(nested.active, cold.active)
-    assert nested.pdas.kkt.max <= 1e-9, nested.pdas.kkt.max
+    assert nested.report.kkt.max <= 1e-9, nested.report.kkt.max
     # the empty start needs 12 iterations here; the coarse active set at most 3
-    its = (nested.pdas.iterations, cold.pdas.iterations)
+    its = (nested.report.iterations, cold.report.iterations)
     assert its[0] <= 3 and its[1] >= 3 * its[0], its
 
 
@@ -100,7 +100,7 @@ def test_a_mesh_that_is_not_a_refinement_still_gets_the_same_solution():
 def test_warm_starts_small_meshes_and_the_switch_leave_pdas_alone(fine, cold):
     problem, mesh = fine
     warm = solve(problem, mesh, u0=cold.u)
-    assert "nested" not in warm.timings and warm.pdas.iterations == 1
+    assert "nested" not in warm.timings and warm.report.iterations == 1
     small = refine_uniform(refine_uniform(problem.mesh).mesh).mesh
     assert problem.free_ndof(small) < NESTED_MIN_NDOF
     assert "nested" not in solve(problem, small).timings

@@ -143,7 +143,7 @@ def test_solve_uses_the_ordering_and_agrees_with_pardisos_own(adaptive_mesh, mon
         lambda space, solver, **options: make_solver(solver, **options),
     )
     own = solve(problem, adaptive_mesh, solver=pardiso_solver, nested=False)
-    assert ordered.pdas.iterations == own.pdas.iterations
+    assert ordered.report.iterations == own.report.iterations
     assert np.abs(ordered.u - own.u).max() <= 1e-10 * np.abs(own.u).max()
     assert (
         np.abs(ordered.contact_force - own.contact_force).max()

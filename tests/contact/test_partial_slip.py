@@ -78,7 +78,7 @@ def measure(res: ContactResult) -> dict[str, float]:
     centre = (lam_n * x).sum() / P
     a = 2 * np.sqrt((lam_n * (x - centre) ** 2).sum() / P)
     order = np.argsort(x)
-    xs, state, direction = x[order], res.state[order], res.pdas.direction[order]
+    xs, state, direction = x[order], res.state[order], res.report.direction[order]
     stick = np.flatnonzero(state == STICK)
     first, last = stick[0], stick[-1]
     assert stick.size == last - first + 1, "the stick zone is not one interval"
@@ -94,7 +94,7 @@ def test_the_stick_zone_follows_cattaneo_mindlin_on_loading_and_unloading(path):
     h = H_CONTACT
     steps, results = path
     for res in results:
-        assert res.pdas.kkt.max < 1e-10, res.pdas.kkt
+        assert res.report.kkt.max < 1e-10, res.report.kkt
     m = [measure(res) for res in results]
     a = m[0]["a"]
     print(

@@ -156,11 +156,11 @@ def test_large_gap_equals_the_neumann_problem():
     x[free] = spla.spsolve(S.K[free][:, free].tocsc(), (S.F - S.K @ x)[free])
     err = np.abs(r.u.ravel() - x).max() / np.abs(x).max()
     print(
-        f"large gap: {r.pdas.iterations} PDAS iteration(s), difference to the linear solve "
+        f"large gap: {r.report.iterations} PDAS iteration(s), difference to the linear solve "
         f"{err:.1e}"
     )
     assert not r.active.any() and np.all(r.contact_force == 0)
-    assert r.pdas.iterations == 1
+    assert r.report.iterations == 1
     assert err < 1e-10
 
 
@@ -372,10 +372,10 @@ def test_warm_start_from_the_solution_takes_one_iteration(name, kind):
     r = solve(pb, mesh)
     again = solve(pb, mesh, u0=r.u)
     print(
-        f"Example {name}, {kind}: cold start {r.pdas.iterations} iterations, warm start "
-        f"{again.pdas.iterations}"
+        f"Example {name}, {kind}: cold start {r.report.iterations} iterations, warm start "
+        f"{again.report.iterations}"
     )
-    assert again.pdas.iterations == 1
+    assert again.report.iterations == 1
     assert np.array_equal(again.active, r.active)
     assert np.abs(again.u - r.u).max() <= 1e-12 * np.abs(r.u).max()
 
@@ -388,10 +388,10 @@ def test_warm_start_after_refinement_saves_iterations():
     cold = solve(pb, ref.mesh)
     warm = solve(pb, ref.mesh, u0=u0)
     print(
-        f"Example 6.2 after one refinement: cold {cold.pdas.iterations}, warm "
-        f"{warm.pdas.iterations} iterations"
+        f"Example 6.2 after one refinement: cold {cold.report.iterations}, warm "
+        f"{warm.report.iterations} iterations"
     )
-    assert warm.pdas.iterations < cold.pdas.iterations
+    assert warm.report.iterations < cold.report.iterations
     assert np.abs(warm.u - cold.u).max() <= 1e-12 * np.abs(cold.u).max()
 
 

@@ -82,5 +82,5 @@ def test_warm_start_ignores_the_gap_far_away():
     u0 = exact.u.copy()
     u0[exact.contact.nodes[node], 1] += 1e-9  # n = (0, −1): u·n − ψ = −1e-9
     warm = solve(problem, u0=u0)
-    assert warm.pdas.history[0].n_active == exact.active.sum() - 1
+    assert warm.report.history[0].n_active == exact.active.sum() - 1
     np.testing.assert_array_equal(warm.active, exact.active)

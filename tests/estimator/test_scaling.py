@@ -133,7 +133,7 @@ def test_solve_with_young_modulus_near_the_float_limit():
     np.testing.assert_allclose(
         r.contact_force / c, r0.contact_force, rtol=0, atol=RTOL * r0.contact_force.max()
     )
-    np.testing.assert_array_equal(r.pdas.multiplier, r.contact_force)
+    np.testing.assert_array_equal(r.report.multiplier, r.contact_force)
     eta = estimate(r).eta_terms
     np.testing.assert_allclose(eta[:5] / c, estimate(r0).eta_terms[:5], rtol=RTOL)
 

@@ -201,4 +201,4 @@ def test_example_6_2_friction_laws_give_the_stated_stick_and_slip_zones():
         edge &= (y < in_contact.min() + 0.03) | (y > in_contact.max() - 0.03)
         assert np.all(r.state[ring] == centre), (problem.name, r.state[ring])
         assert np.all(r.state[edge] == ends), (problem.name, r.state[edge])
-        assert r.pdas.kkt.max < 1e-10
+        assert r.report.kkt.max < 1e-10

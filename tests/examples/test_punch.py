@@ -24,7 +24,7 @@ def corner_rows(result) -> np.ndarray:
 
 
 def test_every_level_meets_kkt_to_1e_10(levels):
-    worst = max(level.result.pdas.kkt.max for level in levels)
+    worst = max(level.result.report.kkt.max for level in levels)
     print(f"\nlargest relative KKT residual over {len(levels)} levels: {worst:.2e}")
     assert worst <= 1e-10
 

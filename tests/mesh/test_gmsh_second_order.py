@@ -327,7 +327,7 @@ def test_contact_on_a_files_arc_is_the_contact_on_the_exact_circle(tmp_path):
     diff = np.abs(a.u - b.u).max() / np.abs(b.u).max()
     print(f"|u_file - u_circle| / |u| = {diff:.2e}, active {a.active.sum()} of {a.active.size}")
     assert np.array_equal(a.active, b.active) and 0 < a.active.sum() < a.active.size
-    assert diff <= 1e-10 and a.pdas.kkt.max <= 1e-10
+    assert diff <= 1e-10 and a.report.kkt.max <= 1e-10
 
 
 def moved_midpoint(edge_of: str, shift) -> meshio.Mesh:

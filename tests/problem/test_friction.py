@@ -1,5 +1,6 @@
 """Friction laws (signorini.problem.friction): their data checks, and the per-constraint
-friction data of the contact set (law, Tresca bound s_z = ∫ s ψ_z ds, Coulomb coefficient)."""
+friction data of the contact set (law, its weight: Tresca bound s_z = ∫ s ψ_z ds, Coulomb
+coefficient)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 import pytest
 from contact_problems import corner_problem
 
-from signorini.contact.contact_set import COULOMB, FRICTIONLESS, TRESCA, contact_set
+from signorini.contact.contact_set import contact_set
 from signorini.fem.material import Material
 from signorini.fem.space import P2Space
 from signorini.mesh.builders import rectangle
@@ -24,6 +25,7 @@ MATERIAL = Material.from_young(10.0, 0.3)
         (lambda: Tresca(float("nan")), r"Tresca\(bound=...\) must be .*got nan"),
         (lambda: Tresca("0.3"), r"Tresca\(bound=...\) must be .*got '0\.3'"),
         (lambda: Tresca(lambda: 1.0), r"Tresca\(bound=...\)"),
+        (lambda: Tresca(1.0, everywhere="yes"), r"Tresca\(everywhere=...\) must be True or Fa"),
         (lambda: Coulomb(-0.2), r"Coulomb\(coefficient=...\) must be a finite number >= 0"),
         (lambda: Coulomb(float("inf")), r"Coulomb\(coefficient=...\) must be"),
         (lambda: Contact(friction=0.3), r"Contact\(friction=...\) must be None, Tresca"),
@@ -51,7 +53,8 @@ def test_tresca_bound_is_the_integral_of_s_times_the_basis_function():
     # s linear in x: the Gauss rule integrates s ψ_z exactly; s_z = ∫ s ψ_z ds
     pb = bottom_contact(Tresca(lambda x: 1.0 + 0.5 * x[:, 0]))
     cs = contact_set(pb, P2Space(pb.mesh))
-    assert (cs.friction_law == TRESCA).all()
+    assert cs.friction.laws == (pb.conditions["bottom"].friction,)
+    assert (cs.friction.index == 0).all()
     x = P2Space(pb.mesh).node_points[cs.nodes][:, 0]
     # reference: on each edge [a, b] of length h, ∫ (1 + x/2) ψ_j dx in closed form
     h = 0.5
@@ -69,20 +72,20 @@ def test_tresca_bound_is_the_integral_of_s_times_the_basis_function():
         }
         for node_x, value in integrals.items():
             expected[np.abs(x - node_x) < 1e-12] += value
-    assert np.abs(cs.friction_bound - expected).max() < 1e-14
-    assert (cs.friction_coefficient == 0).all()
+    assert np.abs(cs.friction.weight - expected).max() < 1e-14
 
 
 def test_constant_tresca_bound_is_s_times_w_z_and_coulomb_coefficient_per_constraint():
     pb = bottom_contact(Tresca(0.3))
     cs = contact_set(pb, P2Space(pb.mesh))
-    assert np.allclose(cs.friction_bound, 0.3 * cs.basis_integral, rtol=1e-14, atol=0)
+    assert np.allclose(cs.friction.weight, 0.3 * cs.basis_integral, rtol=1e-14, atol=0)
     pb = bottom_contact(Coulomb(0.4))
     cs = contact_set(pb, P2Space(pb.mesh))
-    assert (cs.friction_law == COULOMB).all() and (cs.friction_coefficient == 0.4).all()
-    assert (cs.friction_bound == 0).all()
+    assert cs.friction.laws == (Coulomb(0.4),) and (cs.friction.index == 0).all()
+    assert (cs.friction.weight == 0.4).all()
     pb = bottom_contact(None)
-    assert (contact_set(pb, P2Space(pb.mesh)).friction_law == FRICTIONLESS).all()
+    cs = contact_set(pb, P2Space(pb.mesh))
+    assert (cs.friction.index == -1).all() and not cs.has_friction
 
 
 def test_negative_bound_function_names_the_part():
@@ -101,7 +104,9 @@ def test_corner_constraints_are_frictionless():
     pb = ContactProblem(base.mesh, base.material, conditions, body_force=base.body_force)
     cs = contact_set(pb, P2Space(pb.mesh))
     corner = cs.nodes == cs.nodes[cs.second][0]
-    assert (cs.friction_law[corner] == FRICTIONLESS).all()
-    assert (cs.friction_law[~corner & (cs.part == 0)] == COULOMB).all()
-    assert (cs.friction_law[~corner & (cs.part == 1)] == TRESCA).all()
-    assert (cs.friction_bound[corner] == 0).all()
+    law = cs.friction
+    assert law.laws == (Coulomb(0.5), Tresca(1.0))
+    assert (law.index[corner] == -1).all()
+    assert (law.index[~corner & (cs.part == 0)] == 0).all()
+    assert (law.index[~corner & (cs.part == 1)] == 1).all()
+    assert (law.weight[corner] == 0).all()

@@ -15,10 +15,11 @@ semismooth Newton extension to Tresca and Coulomb friction.
 ``kkt``                KKT residuals of a point
 ``active_system``      one active set's linear system: refactorization or bordered update
 ``primal``             the primal active set fallback
-``result``             steps, result and failure of an active set solve
+``result``             the report of both solvers, PDAS steps and result, the convergence errors
 ``pdas``               ``solve_pdas``: the PDAS iteration
+``laws``               the friction-law protocol and per-node law groups
 ``friction_kkt``       the frictional contact problem's data, checks and KKT residuals
-``friction_system``    one iteration's system: symmetric (Tresca) or non-symmetric (Coulomb)
+``friction_system``    one iteration's system: symmetric, or non-symmetric where s' ≠ 0
 ``friction_result``    node states, steps, result and failure of a frictional solve
 ``friction``           ``solve_friction``: semismooth Newton for Tresca and Coulomb friction
 =====================  ==========================================================================
@@ -34,13 +35,14 @@ from .backends import (
     solver_name,
 )
 from .elimination import SymmetricEliminator, eliminate_symmetric
-from .friction import INACTIVE, SLIP, STICK, solve_friction
-from .friction_kkt import FrictionKKT
+from .friction import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
+from .friction_kkt import FrictionKKT, FrictionProblem, check_friction
 from .friction_result import FrictionConvergenceError, FrictionResult, FrictionStep
 from .kkt import KKTResiduals, kkt_residuals
+from .laws import FrictionLaw, LawGroups
 from .pardiso import pardiso_solver
-from .pdas import solve_pdas
-from .result import PDASConvergenceError, PDASResult, PDASStep
+from .pdas import PDASOptions, solve_pdas
+from .result import ConvergenceError, PDASConvergenceError, PDASResult, PDASStep, SolveReport
 from .solvers import (
     BackendUnavailableError,
     FactorizationError,
@@ -53,9 +55,13 @@ from .superlu import superlu_solver
 
 __all__ = [
     "BackendUnavailableError",
+    "ConvergenceError",
     "FactorizationError",
     "FrictionConvergenceError",
     "FrictionKKT",
+    "FrictionLaw",
+    "FrictionOptions",
+    "FrictionProblem",
     "FrictionResult",
     "FrictionStep",
     "INACTIVE",
@@ -63,17 +69,21 @@ __all__ = [
     "STICK",
     "SingularSystemError",
     "KKTResiduals",
+    "LawGroups",
     "PDASConvergenceError",
+    "PDASOptions",
     "PDASResult",
     "PDASStep",
     "SOLVERS",
     "SPDSolver",
+    "SolveReport",
     "SolverFactory",
     "SolverFallbackWarning",
     "SolverRequest",
     "SymmetricEliminator",
     "auto_solver",
     "available_backends",
+    "check_friction",
     "eliminate_symmetric",
     "kkt_residuals",
     "make_solver",

@@ -2,8 +2,9 @@
 
 The problem (:mod:`.friction_kkt`; docs/method.md, *Friction: the algebraic problem and its
 solver*): at each frictional contact node a normal DOF ``x_n ≤ g`` with the Signorini
-conditions, and a tangential DOF with Tresca's law (slip bound ``s``) or Coulomb's
-(``s = F Λ_n``, static one-step form), on the slip ``x_t − x_ref`` relative to a reference
+conditions, and a tangential DOF with the node's friction law (:mod:`.laws`; its slip bound
+``s``, e.g. Tresca's given bound or Coulomb's ``F Λ_n`` in the static one-step form; laws may
+differ from node to node), on the slip ``x_t − x_ref`` relative to a reference
 tangential displacement (the previous load step's in a quasi-static path). ``Λ = F − K x``
 on these rows are the nodal contact forces.
 
@@ -13,8 +14,9 @@ The method of Hüeber, Stadler and Wohlmuth [1]_ in its 2D form: every node is
 linear system of these states (:mod:`.friction_system`) and updates them with the rule
 
 - in contact where ``Λ_n + c (x_n − g) > 0``;
-- among those, stick where ``|Λ_t + c (x_t − x_ref)| < s``, with ``s`` Tresca's bound or
-  ``F (Λ_n + c (x_n − g))`` (Coulomb), else slip with ``σ = sign(Λ_t + c (x_t − x_ref))``,
+- among those (and out of contact where a law acts everywhere), stick where
+  ``|Λ_t + c (x_t − x_ref)| < s``, with ``s`` the law's bound at ``Λ_n + c (x_n − g)``, else
+  slip with ``σ = sign(Λ_t + c (x_t − x_ref))``,
 
 the semismooth Newton step for the equations ``Λ_n = max(0, Λ_n + c (x_n − g))`` and
 ``Λ_t = P_[−s, s](Λ_t + c (x_t − x_ref))``, of which in 2D the slip branch ``Λ_t = σ s`` is
@@ -24,12 +26,13 @@ not the diagonal itself as in :func:`~.pdas.solve_pdas`: it only decides whether
 slipping against its force sticks (small ``c``) or flips its direction (large ``c``), and
 flipping made the iteration cycle (docs/method.md, *Friction*).
 
-Tresca's bound acts by default only on nodes in contact (``Λ_n > 0``, where a Tresca bound
-models a known contact pressure); with ``tresca_everywhere=True`` it acts on every node, which
-is the classical Tresca problem: the minimisation of
-``1/2 x^T K x − F^T x + Σ s |x_t − x_ref|`` subject to ``x_n ≤ g``. Both have SPD systems;
-the contact-only law is discontinuous where ``Λ_n`` vanishes and can make the iteration
-cycle at the edge of the contact zone (docs/method.md, *Friction*).
+When every law in play has a bound independent of ``Λ_n`` (Tresca) the systems are SPD;
+otherwise they are solved by LU (:mod:`.friction_system`). A Tresca bound acts on every node
+(``everywhere``), the classical Tresca problem: the minimisation of
+``1/2 x^T K x − F^T x + Σ s |x_t − x_ref|`` subject to ``x_n ≤ g``; or only on nodes in
+contact (``Λ_n > 0``, where the bound models a known contact pressure), which is
+discontinuous where ``Λ_n`` vanishes and can make the iteration cycle at the edge of the
+contact zone (docs/method.md, *Friction*).
 
 References
 ----------
@@ -42,12 +45,12 @@ from __future__ import annotations
 
 import logging
 import time
+from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
 from .backends import make_solver
-from .friction_kkt import FrictionProblem, check_friction, friction_kkt, slip_bound
+from .friction_kkt import FrictionProblem, friction_kkt
 from .friction_result import (
     INACTIVE,
     SLIP,
@@ -56,11 +59,11 @@ from .friction_result import (
     FrictionResult,
     FrictionStep,
 )
-from .friction_system import CoulombSystem, TrescaSystem
+from .friction_system import CoupledSystem, SymmetricSystem, friction_system
 from .qp import check_vector
 from .solvers import SolverFactory, SPDSolver, solver_usage
 
-__all__ = ["INACTIVE", "SLIP", "STICK", "solve_friction"]
+__all__ = ["INACTIVE", "SLIP", "STICK", "FrictionOptions", "solve_friction"]
 
 logger = logging.getLogger(__name__)
 
@@ -77,76 +80,82 @@ _STATE_RTOL = 1e-9
 States = tuple[np.ndarray, np.ndarray, np.ndarray]  # active, stick (m,) bool; direction (m,)
 
 
-def solve_friction(
-    K: sp.spmatrix,
-    F: np.ndarray,
-    normal: np.ndarray,
-    tangent: np.ndarray,
-    gap: np.ndarray | float,
-    dirichlet: np.ndarray | None = None,
-    dirichlet_values: np.ndarray | float | None = None,
-    *,
-    bound: np.ndarray | float | None = None,
-    coefficient: np.ndarray | float | None = None,
-    reference: np.ndarray | float | None = None,
-    tresca_everywhere: bool = False,
-    state0: np.ndarray | None = None,
-    direction0: np.ndarray | None = None,
-    x0: np.ndarray | None = None,
-    c: float | None = None,
-    max_iter: int = 50,
-    kkt_tol: float = 1e-8,
-    solver: SPDSolver | SolverFactory | None = None,
-) -> FrictionResult:
-    """Solve the frictional contact problem (Tresca or Coulomb) by semismooth Newton.
+@dataclass(frozen=True)
+class FrictionOptions:
+    """How :func:`solve_friction` iterates.
 
-    Parameters
+    Attributes
     ----------
-    K : scipy sparse matrix, shape (n, n)
-        Symmetric, positive definite on the non-Dirichlet DOFs, with the contact nodes'
-        DOFs rotated into their (normal, tangential) frames.
-    F : (n,) float array
-        Load vector (force units).
-    normal, tangent : (m,) int arrays or (n,) bool masks
-        The normal and the tangential DOF of each frictional contact node (as masks, nodes in
-        increasing DOF order).
-    gap : float or (m,) float array
-        ``g``: the bound ``x_n ≤ g`` (length units).
-    dirichlet : (n_d,) int array or (n,) bool mask, optional
-    dirichlet_values : float, (n_d,) or (n,) float array, optional
-        Default 0.
-    bound : float or (m,) float array, optional
-        Tresca: the slip bound ``s ≥ 0`` of each node (force units, e.g. ``∫ s ψ_z ds``).
-    coefficient : float or (m,) float array, optional
-        Coulomb: the friction coefficient ``F ≥ 0``. Exactly one of ``bound`` and
-        ``coefficient`` is given.
-    reference : float or (m,) float array, optional
-        ``x_ref``: the tangential displacement of no slip (default 0; the previous load step's
-        in a quasi-static path, so that the law acts on the slip increment).
-    tresca_everywhere : bool
-        Tresca only: the bound acts on every node (the classical problem, a convex
-        minimisation), not only on the nodes in contact (the default).
-    state0, direction0 : (m,) int arrays, optional
-        Warm start: the states (:data:`INACTIVE`, :data:`STICK`, :data:`SLIP`) and slip
-        directions (±1 where slipping, else 0) of a previous result. ``direction0`` is
-        required where ``state0`` is SLIP with a positive bound or coefficient.
-    x0 : (n,) float array, optional
-        Warm start by the update rule at ``x0`` (ignored when ``state0`` is given). Default
-        (neither): every node INACTIVE.
-    c : float, optional
-        The positive constant of the update rule; default :data:`C_FACTOR` times the mean
-        diagonal of ``K`` over the normal DOFs (docs/method.md, *Friction*: with the mean
-        diagonal itself, as in :func:`~.pdas.solve_pdas`, the slip directions flip and the
-        iteration cycles).
     max_iter : int
         Bound on iterations (linear solves).
     kkt_tol : float
         Largest relative KKT residual (:class:`~.friction_kkt.FrictionKKT`) accepted when the
         states repeat.
+    c : float, optional
+        The positive constant of the update rule; default :data:`C_FACTOR` times the mean
+        diagonal of ``K`` over the normal DOFs (docs/method.md, *Friction*: with the mean
+        diagonal itself, as in :func:`~.pdas.solve_pdas`, the slip directions flip and the
+        iteration cycles).
+
+    Raises
+    ------
+    ValueError
+        Naming the attribute, for a ``max_iter`` below 1, a ``kkt_tol`` or ``c`` not positive.
+    """
+
+    max_iter: int = 50
+    kkt_tol: float = 1e-8
+    c: float | None = None
+
+    def __post_init__(self) -> None:
+        max_iter, kkt_tol = self.max_iter, self.kkt_tol
+        if (
+            isinstance(max_iter, bool)
+            or not isinstance(max_iter, (int, np.integer))
+            or max_iter < 1
+        ):
+            raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
+        if not isinstance(kkt_tol, (int, float)) or not kkt_tol > 0:
+            raise ValueError(f"kkt_tol must be a positive number, got {kkt_tol!r}")
+        if self.c is not None:
+            try:
+                value = float(self.c)
+            except (TypeError, ValueError):
+                raise ValueError(f"c must be a positive number, got {self.c!r}") from None
+            if not np.isfinite(value) or value <= 0:
+                raise ValueError(f"c must be positive and finite, got {value}")
+
+
+def solve_friction(
+    problem: FrictionProblem,
+    *,
+    state0: np.ndarray | None = None,
+    direction0: np.ndarray | None = None,
+    x0: np.ndarray | None = None,
+    options: FrictionOptions | None = None,
+    solver: SPDSolver | SolverFactory | None = None,
+) -> FrictionResult:
+    r"""Solve the frictional contact problem (laws per node) by semismooth Newton.
+
+    Parameters
+    ----------
+    problem : FrictionProblem
+        The checked data (:func:`~.friction_kkt.check_friction`): ``K``, ``F``, the normal
+        and tangential DOFs, gaps, Dirichlet data, the laws per node and their weights, the
+        reference of no slip.
+    state0, direction0 : (m,) int arrays, optional
+        Warm start: the states (:data:`INACTIVE`, :data:`STICK`, :data:`SLIP`) and slip
+        directions (±1 where slipping, else 0) of a previous result. ``direction0`` is
+        required where ``state0`` is SLIP at a node whose bound can be positive.
+    x0 : (n,) float array, optional
+        Warm start by the update rule at ``x0`` (ignored when ``state0`` is given). Default
+        (neither): every node INACTIVE.
+    options : FrictionOptions, optional
+        ``max_iter``, ``kkt_tol``, ``c``; default :class:`FrictionOptions`\ ().
     solver : SPDSolver or SolverFactory, optional
-        An :class:`SPDSolver` to use and keep (not closed): SPD for Tresca, LU for Coulomb.
-        A factory (:class:`~.solvers.SolverFactory`, default
-        :func:`~.backends.auto_solver`) makes the kind the law needs for this call.
+        An :class:`SPDSolver` to use and keep (not closed): SPD when every law is symmetric,
+        else LU. A factory (:class:`~.solvers.SolverFactory`, default
+        :func:`~.backends.auto_solver`) makes the kind the laws need for this call.
 
     Returns
     -------
@@ -163,21 +172,22 @@ def solve_friction(
         If a system is singular.
     """
     t_start = time.perf_counter()
-    problem = check_friction(
-        K, F, normal, tangent, gap, dirichlet, dirichlet_values, bound, coefficient, reference,
-        tresca_everywhere,
-    )  # fmt: skip
-    _check_options(max_iter, kkt_tol)
-    rule = _rule_constants(problem, c)
+    if not isinstance(problem, FrictionProblem):
+        raise ValueError(
+            f"problem must be a FrictionProblem (from check_friction), got {type(problem).__name__}"
+        )
+    options = FrictionOptions() if options is None else options
+    if not isinstance(options, FrictionOptions):
+        raise ValueError(f"options must be a FrictionOptions, got {type(options).__name__}")
+    rule = _rule_constants(problem, options.c)
     states = _initial_states(problem, rule, state0, direction0, x0)
-    tresca = problem.law == "tresca"
     own_solver = not isinstance(solver, SPDSolver)
     if own_solver:
-        solver = make_solver(solver, symmetric=tresca)
+        solver = make_solver(solver, symmetric=problem.symmetric)
     before = solver_usage(solver)
     try:
-        system = TrescaSystem(problem, solver) if tresca else CoulombSystem(problem, solver)
-        x, states, history = _iterate(system, states, rule, max_iter)
+        system = friction_system(problem, solver)
+        x, states, history = _iterate(system, states, rule, options.max_iter)
     finally:
         used = {key: value - before[key] for key, value in solver_usage(solver).items()}
         backend_name = solver.backend
@@ -185,8 +195,10 @@ def solve_friction(
             solver.close()
     active, stick, direction = states
     kkt = friction_kkt(problem, x, active)
-    if not kkt.max <= kkt_tol:
-        message = f"the states repeat, but the KKT residual {kkt.max:.2e} exceeds {kkt_tol:.0e}"
+    if not kkt.max <= options.kkt_tol:
+        message = (
+            f"the states repeat, but the KKT residual {kkt.max:.2e} exceeds {options.kkt_tol:.0e}"
+        )
         direction = direction.astype(np.int8)
         raise FrictionConvergenceError(message, history, "kkt", x, _state(*states), direction)
     multiplier_n, multiplier_t = _multipliers(problem, x, states)
@@ -195,8 +207,8 @@ def solve_friction(
     times["total"] = time.perf_counter() - t_start
     state = _state(active, stick, direction)
     logger.info(
-        "%s friction: %d solves, stick %d, slip %d of %d nodes, KKT residual %.2e",
-        problem.law,
+        "friction (%s systems): %d solves, stick %d, slip %d of %d nodes, KKT residual %.2e",
+        "symmetric" if system.symmetric else "non-symmetric",
         len(history),
         int((state == STICK).sum()),
         int((state == SLIP).sum()),
@@ -210,9 +222,9 @@ def solve_friction(
         state=state,
         direction=direction.astype(np.int8),
         iterations=len(history),
+        n_solves=len(history),
         history=history,
         kkt=kkt,
-        law=problem.law,
         backend=backend_name,
         symmetric=system.symmetric,
         c_scale=rule[0],
@@ -227,27 +239,12 @@ def solve_friction(
 # ----------------------------------------------------------------------------------------------
 
 
-def _check_options(max_iter: object, kkt_tol: object) -> None:
-    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
-        raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
-    if not isinstance(kkt_tol, (int, float)) or not kkt_tol > 0:
-        raise ValueError(f"kkt_tol must be a positive number, got {kkt_tol!r}")
-
-
-def _rule_constants(problem: FrictionProblem, c: object) -> tuple[float, float]:
-    """``(c, d)``: the constant of the update rule (given and checked, or :data:`C_FACTOR`
+def _rule_constants(problem: FrictionProblem, c: float | None) -> tuple[float, float]:
+    """``(c, d)``: the constant of the update rule (given, or :data:`C_FACTOR`
     ``d``) and the mean diagonal ``d`` of ``K`` over the normal DOFs (1 without nodes)."""
     diagonal = problem.qp.K.diagonal()[problem.normal]
     d = float(diagonal.mean()) if diagonal.size else 1.0
-    if c is None:
-        return C_FACTOR * d, d
-    try:
-        value = float(c)
-    except (TypeError, ValueError):
-        raise ValueError(f"c must be a positive number, got {c!r}") from None
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"c must be positive and finite, got {value}")
-    return value, d
+    return (C_FACTOR * d, d) if c is None else (float(c), d)
 
 
 def _initial_states(
@@ -260,17 +257,18 @@ def _initial_states(
     """The states of the first solve: decoded from ``state0``/``direction0`` (checked), the
     update rule at ``x0``, or every node inactive."""
     m = problem.m
+    law = problem.friction
     none = np.zeros(m, dtype=bool), np.zeros(m, dtype=bool), np.zeros(m)
     if state0 is None:
-        if x0 is None:  # no contact; with tresca_everywhere, stick where there is a bound
-            return none[0], (problem.weight > 0) & problem.everywhere, none[2]
+        if x0 is None:  # no contact; where a law acts everywhere, stick where it can rub
+            return none[0], law.can_rub & law.everywhere, none[2]
         x = check_vector(x0, problem.qp.n, "x0")
         r = problem.qp.F - problem.qp.K @ x
         return _update(problem, rule, x, r[problem.normal], r[problem.tangent], none)
     state = np.asarray(state0)
     if state.shape != (m,) or not np.isin(state, (INACTIVE, STICK, SLIP)).all():
         raise ValueError(f"state0 must have shape ({m},) and hold INACTIVE, STICK or SLIP")
-    forced = problem.weight > 0
+    forced = law.can_rub
     if direction0 is None:
         if (forced & (state == SLIP)).any():
             raise ValueError("direction0 is needed where state0 is SLIP")
@@ -282,13 +280,16 @@ def _initial_states(
         direction = direction.astype(np.float64)
     active = state != INACTIVE
     stick = state == STICK
-    if problem.everywhere:  # out of contact: direction 0 means stuck (FrictionResult)
-        stick |= ~active & (direction == 0) & forced
+    # out of contact where a law acts everywhere: direction 0 means stuck (FrictionResult)
+    stick |= law.everywhere & ~active & (direction == 0) & forced
     return active, stick, np.where(stick, 0.0, direction)
 
 
 def _iterate(
-    system: TrescaSystem | CoulombSystem, states: States, rule: tuple[float, float], max_iter: int
+    system: SymmetricSystem | CoupledSystem,
+    states: States,
+    rule: tuple[float, float],
+    max_iter: int,
 ) -> tuple[np.ndarray, States, list[FrictionStep]]:
     """The active set loop from ``states``: the last iterate, its states and the history.
 
@@ -367,13 +368,13 @@ def _update(
     value_n = lam_n + c * (x[p.normal] - p.gap)
     band_n = np.where(active, band_force, band_disp)
     new_active = np.where(np.abs(value_n) <= band_n, active, value_n > 0)
-    s = p.weight * np.maximum(value_n, 0.0) if p.law == "coulomb" else p.weight
-    acts = np.ones(p.m, dtype=bool) if p.everywhere else new_active
+    s = p.slip_bound(value_n, new_active)
+    acts = p.friction.everywhere | new_active
     y = lam_t + c * (x[p.tangent] - p.reference)
     margin = np.abs(y) - s
     band_t = np.where(stick, band_force, band_disp)
     new_stick = np.where(np.abs(margin) <= band_t, stick, margin < 0) & acts
-    slip = acts & ~new_stick & (p.weight > 0)
+    slip = acts & ~new_stick & p.friction.can_rub
     new_direction = np.where(slip, np.where(np.abs(y) > band_t, np.sign(y), direction), 0.0)
     return new_active, new_stick, new_direction
 
@@ -407,5 +408,5 @@ def _multipliers(p: FrictionProblem, x: np.ndarray, states: States) -> tuple[np.
     active, stick, direction = states
     r = p.qp.F - p.qp.K @ x
     multiplier_n = np.where(active, r[p.normal], 0.0)
-    imposed = direction * slip_bound(p, multiplier_n, active)
+    imposed = direction * p.slip_bound(multiplier_n, active)
     return multiplier_n, np.where(stick, r[p.tangent], imposed)

@@ -7,11 +7,13 @@ rows, ``Λ = F − K x`` (``Λ_n ≥ 0`` is the contact force; the obstacle acts
 
 - normal: ``x_n ≤ g``, ``Λ_n ≥ 0``, ``Λ_n (x_n − g) = 0``;
 - tangential: ``|Λ_t| ≤ s``; ``|Λ_t| < s ⇒ x_t = x_ref`` (stick); ``|Λ_t| = s ⇒
-  x_t − x_ref = α Λ_t`` with ``α ≥ 0`` (slip), where the slip bound ``s`` is the Tresca bound
-  (on every node, or only on nodes in contact), or ``F Λ_n`` (Coulomb).
+  x_t − x_ref = α Λ_t`` with ``α ≥ 0`` (slip), where the slip bound ``s`` is that of each
+  node's friction law (:mod:`.laws`: e.g. the Tresca bound, on every node or only on nodes in
+  contact, or ``F Λ_n`` for Coulomb); laws may differ from node to node.
 
-:func:`check_friction` turns the arguments of :func:`~.friction.solve_friction` into a
-:class:`FrictionProblem` or raises a :class:`ValueError` naming the argument;
+:func:`check_friction` turns the problem's arrays and laws into the :class:`FrictionProblem`
+that :func:`~.friction.solve_friction` solves, or raises a :class:`ValueError` naming the
+argument;
 :func:`friction_kkt` measures how far a point is from satisfying both laws.
 """
 
@@ -22,15 +24,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from .kkt import force_scale
+from .laws import LawGroups, check_laws
 from .qp import BoundQP, _index_array, check_qp, check_vector
 from .sparse import as_csr
 
-__all__ = ["FrictionKKT", "FrictionProblem", "check_friction", "friction_kkt", "slip_bound"]
+__all__ = ["FrictionKKT", "FrictionProblem", "check_friction", "friction_kkt"]
 
 _SQRT_EPS = float(np.sqrt(np.finfo(np.float64).eps))
-
-#: The friction laws :func:`check_friction` knows.
-LAWS = ("tresca", "coulomb")
 
 
 @dataclass(frozen=True)
@@ -49,11 +49,8 @@ class FrictionProblem:
         ``g``: the bound ``x_n ≤ g``.
     reference : (m,) float array
         ``x_ref``: the tangential displacement of no slip (the previous load step's).
-    law : {"tresca", "coulomb"}
-    weight : (m,) float array
-        The Tresca bound ``s ≥ 0`` (force units) or the Coulomb coefficient ``F ≥ 0``.
-    everywhere : bool
-        Tresca only: the bound acts on every node, in contact or not (the classical problem).
+    friction : LawGroups
+        The friction law of each node and its weight (:mod:`.laws`).
     """
 
     qp: BoundQP
@@ -61,14 +58,22 @@ class FrictionProblem:
     tangent: np.ndarray
     gap: np.ndarray
     reference: np.ndarray
-    law: str
-    weight: np.ndarray
-    everywhere: bool = False
+    friction: LawGroups
 
     @property
     def m(self) -> int:
         """Number of frictional contact nodes."""
         return self.normal.size
+
+    @property
+    def symmetric(self) -> bool:
+        """Whether every law in play has a bound independent of ``Λ_n`` (symmetric
+        systems)."""
+        return self.friction.symmetric
+
+    def slip_bound(self, normal_force: np.ndarray, in_contact: np.ndarray) -> np.ndarray:
+        """The slip bound ``s (m,)`` of each node's law at ``Λ_n = normal_force``."""
+        return self.friction.slip_bound(normal_force, in_contact)
 
 
 def check_friction(
@@ -77,23 +82,50 @@ def check_friction(
     normal: object,
     tangent: object,
     gap: object,
-    dirichlet: object,
-    dirichlet_values: object,
-    bound: object,
-    coefficient: object,
-    reference: object,
-    everywhere: bool,
+    dirichlet: object = None,
+    dirichlet_values: object = None,
+    *,
+    laws: object,
+    weight: object,
+    law_index: object = None,
+    reference: object = None,
 ) -> FrictionProblem:
     """Check and normalise the data of the frictional contact problem.
 
-    Exactly one of ``bound`` (Tresca) and ``coefficient`` (Coulomb) is given.
+    Parameters
+    ----------
+    K : scipy sparse matrix, shape (n, n)
+        Symmetric, positive definite on the non-Dirichlet DOFs, with the contact nodes'
+        DOFs rotated into their (normal, tangential) frames.
+    F : (n,) float array
+        Load vector (force units).
+    normal, tangent : (m,) int arrays or (n,) bool masks
+        The normal and the tangential DOF of each frictional contact node (as masks, nodes in
+        increasing DOF order).
+    gap : float or (m,) float array
+        ``g``: the bound ``x_n ≤ g`` (length units).
+    dirichlet : (n_d,) int array or (n,) bool mask, optional
+    dirichlet_values : float, (n_d,) or (n,) float array, optional
+        Default 0.
+    laws : FrictionLaw or sequence of FrictionLaw
+        The friction laws (:class:`~.laws.FrictionLaw`, e.g.
+        :class:`signorini.problem.friction.Tresca`, :class:`~signorini.problem.friction.Coulomb`).
+    weight : float or (m,) float array
+        Each node's weight for its law (Tresca: the slip bound ``s ≥ 0`` in force units, e.g.
+        ``∫ s ψ_z ds``; Coulomb: the coefficient ``F ≥ 0``).
+    law_index : (m,) int array, optional
+        The law of each node, an index into ``laws``, ``-1`` for none (no friction force);
+        default the first law at every node.
+    reference : float or (m,) float array, optional
+        ``x_ref``: the tangential displacement of no slip (default 0; the previous load step's
+        in a quasi-static path, so that the law acts on the slip increment).
 
     Raises
     ------
     ValueError
         Naming the argument: wrong shape or type, non-finite values, indices out of range or
         repeated, a DOF both normal and tangential or both contact and Dirichlet, a negative
-        bound or coefficient, both or neither law, ``everywhere`` with Coulomb.
+        weight, something else than friction laws, a law index out of range.
     """
     K = as_csr(K, "K")
     n = K.shape[0]
@@ -116,17 +148,10 @@ def check_friction(
         if reference is None
         else check_vector(reference, m, "reference", allow_scalar=True)
     )
-    if (bound is None) == (coefficient is None):
-        raise ValueError("give exactly one of bound (Tresca) and coefficient (Coulomb)")
-    law, name = ("tresca", "bound") if coefficient is None else ("coulomb", "coefficient")
-    weight = check_vector(bound if law == "tresca" else coefficient, m, name, allow_scalar=True)
-    if (weight < 0).any():
-        raise ValueError(f"{name} must be non-negative, got min {weight.min():.3g}")
-    if everywhere and law == "coulomb":
-        raise ValueError("tresca_everywhere applies to the Tresca law only")
+    friction = check_laws(laws, law_index, weight, m)
     constrained = np.concatenate([normal, tangent])
     qp = check_qp(K, F, constrained, np.concatenate([g, ref]), dirichlet, dirichlet_values)
-    return FrictionProblem(qp, normal, tangent, g, ref, law, weight, bool(everywhere))
+    return FrictionProblem(qp, normal, tangent, g, ref, friction)
 
 
 def _disjoint(a: np.ndarray, b: np.ndarray, name_a: str, name_b: str) -> None:
@@ -136,16 +161,6 @@ def _disjoint(a: np.ndarray, b: np.ndarray, name_a: str, name_b: str) -> None:
             f"{name_a} and {name_b} share {common.size} DOFs (first: {common[0]}); a DOF is "
             "either normal, tangential or Dirichlet"
         )
-
-
-def slip_bound(
-    problem: FrictionProblem, multiplier_n: np.ndarray, in_contact: np.ndarray
-) -> np.ndarray:
-    """The slip bound ``s (m,)`` of each node: Tresca's ``s`` (times ``in_contact`` unless
-    ``everywhere``), or Coulomb's ``F max(Λ_n, 0)``."""
-    if problem.law == "coulomb":
-        return problem.weight * np.maximum(multiplier_n, 0.0)
-    return problem.weight if problem.everywhere else problem.weight * in_contact
 
 
 @dataclass(frozen=True)
@@ -196,6 +211,20 @@ class FrictionKKT:
             self.dirichlet,
         )
 
+    def columns(self) -> dict[str, float]:
+        """The seven relative residuals as history columns: those of
+        :meth:`~.kkt.KKTResiduals.columns` and ``kkt_tangential_bound``,
+        ``kkt_tangential_complementarity``."""
+        return {
+            "kkt_primal": self.primal,
+            "kkt_dual": self.dual,
+            "kkt_complementarity": self.complementarity,
+            "kkt_stationarity": self.stationarity,
+            "kkt_dirichlet": self.dirichlet,
+            "kkt_tangential_bound": self.tangential_bound,
+            "kkt_tangential_complementarity": self.tangential_complementarity,
+        }
+
 
 def friction_kkt(
     problem: FrictionProblem, x: np.ndarray, in_contact: np.ndarray | None = None
@@ -207,8 +236,8 @@ def friction_kkt(
     problem : FrictionProblem
     x : (n,) float array
     in_contact : (m,) bool array, optional
-        The nodes where the Tresca bound acts when it does not act everywhere (the solver's
-        final contact set); default ``Λ_n > 0``. Not used by Coulomb.
+        The nodes in contact for laws that act only there (the solver's final contact set);
+        default ``Λ_n > 0``.
 
     Returns
     -------
@@ -230,7 +259,7 @@ def friction_kkt(
     disp = disp if disp > 0 else 1.0
     total = float(np.maximum(lam_n, 0.0).sum())
     fc = total if total > _SQRT_EPS * force else force
-    s = slip_bound(problem, lam_n, lam_n > 0 if in_contact is None else in_contact)
+    s = problem.slip_bound(lam_n, lam_n > 0 if in_contact is None else in_contact)
     stick = np.abs(slide) / disp
     wrong_way = np.maximum(-lam_t * slide, 0.0) / (fc * disp)
     slip = np.maximum(np.abs(np.abs(lam_t) - s) / fc, wrong_way)

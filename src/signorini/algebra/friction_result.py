@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from .friction_kkt import FrictionKKT
-from .result import with_history
+from .result import ConvergenceError, SolveReport
 
 __all__ = [
     "INACTIVE",
@@ -53,15 +54,18 @@ class FrictionStep:
         )
 
 
-@dataclass
-class FrictionResult:
-    """Solution of :func:`~.friction.solve_friction` and how it was obtained.
+@dataclass(kw_only=True)
+class FrictionResult(SolveReport):
+    """Solution of :func:`~.friction.solve_friction` and how it was obtained
+    (:class:`~.result.SolveReport`; ``n_solves`` counts one linear solve per iteration and
+    ``n_updates`` is 0, as the history has always recorded them, although the symmetric
+    systems solve some iterations by a bordered update of the previous factor, which the
+    counters do not show; ``times`` holds ``analysis``, ``factorization``, ``solve``,
+    ``assembly`` (forming the systems), ``total``; ``kkt`` is a
+    :class:`~.friction_kkt.FrictionKKT`, the residuals of both laws).
 
     Attributes
     ----------
-    x : (n,) float array
-        The solution, in the frame of ``K`` (normal and tangential components at contact
-        nodes).
     multiplier_n, multiplier_t : (m,) float arrays
         The nodal contact forces ``Λ_n = F_n − (K x)_n`` (0 off contact) and
         ``Λ_t = F_t − (K x)_t`` (its imposed value ``±s`` on slipping nodes, 0 where no
@@ -70,45 +74,24 @@ class FrictionResult:
         :data:`INACTIVE`, :data:`STICK` or :data:`SLIP` per node.
     direction : (m,) int8 array
         ``sign Λ_t`` on nodes whose friction force is at a positive bound (slipping), 0
-        elsewhere. With ``tresca_everywhere`` a node out of contact also obeys the tangential
-        law: its state is INACTIVE, its direction 0 where it sticks and ±1 where it slips.
-    iterations : int
-        Linear solves.
-    history : list of FrictionStep
-    kkt : FrictionKKT
-        Relative residuals of both laws at ``x``.
-    law : {"tresca", "coulomb"}
-    backend : str
-        Linear solver backend.
+        elsewhere. Where a law acts everywhere (classical Tresca) a node out of contact also
+        obeys the tangential law: its state is INACTIVE, its direction 0 where it sticks and
+        ±1 where it slips.
     symmetric : bool
-        Whether the systems were symmetric (Tresca: Cholesky) or not (Coulomb: LU).
-    c_scale : float
-        The constant ``c`` of the update rule.
-    n_factorizations, n_analyses : int
-        Work done by the linear solver during this call.
-    times : dict of str to float
-        Seconds: ``analysis``, ``factorization``, ``solve``, ``assembly`` (forming the
-        systems), ``total``.
+        Whether the systems were symmetric (every law with ``s' = 0``: Cholesky) or not (LU).
     """
 
-    x: np.ndarray
+    kkt: FrictionKKT
     multiplier_n: np.ndarray
     multiplier_t: np.ndarray
     state: np.ndarray
     direction: np.ndarray
-    iterations: int
-    history: list[FrictionStep]
-    kkt: FrictionKKT
-    law: str
-    backend: str
     symmetric: bool
-    c_scale: float
-    n_factorizations: int = 0
-    n_analyses: int = 0
-    times: dict[str, float] = field(default_factory=dict)
+
+    FORCES: ClassVar[tuple[str, ...]] = ("multiplier_n", "multiplier_t")
 
 
-class FrictionConvergenceError(RuntimeError):
+class FrictionConvergenceError(ConvergenceError):
     """The frictional active set iteration cycled, hit its bound, or stopped at a point whose
     KKT residuals are too large.
 
@@ -130,9 +113,6 @@ class FrictionConvergenceError(RuntimeError):
         state: np.ndarray | None = None,
         direction: np.ndarray | None = None,
     ) -> None:
-        super().__init__(with_history(message, history))
-        self.history = history
-        self.reason = reason
-        self.x = x
+        super().__init__(message, history, reason, x)
         self.state = state
         self.direction = direction

@@ -5,14 +5,17 @@ iterate solves ``K x = F`` on the free rows with
 
 - ``x_n = g`` on nodes in contact and ``x_t = x_ref`` on sticking nodes, imposed by
   eliminating the DOF (Dirichlet-like, rows and columns zeroed in place, diagonal kept);
-- ``Λ_t = F_t − (K x)_t = σ s`` on slipping nodes (``σ`` the slip direction).
+- ``Λ_t = F_t − (K x)_t = σ s`` on slipping nodes (``σ`` the slip direction), with the
+  node's law's bound ``s = s0 + s' Λ_n`` (:mod:`.laws`: ``s0`` its bound at ``Λ_n = 0``,
+  ``s'`` its derivative).
 
-Tresca's ``s`` is data, so that row is ``(K x)_t = F_t − σ s``: a change of the load, and the
-system stays symmetric (:class:`TrescaSystem`, on :class:`~.active_system.ActiveSetSystem`
-and an SPD solver). Coulomb's ``s = F Λ_n`` is the residual of another row, so the row
-becomes ``(K_t − σ F K_n) x = F_t − σ F F_n``: the matrix is not symmetric
-(:class:`CoulombSystem`, on a sparse LU). Both keep one sparsity pattern per call, so the
-solver analyses it once.
+Where ``s' = 0`` (Tresca) ``s`` is data, so that row is ``(K x)_t = F_t − σ s0``: a change of
+the load. When every law in play has ``s' = 0`` the system stays symmetric
+(:class:`SymmetricSystem`, on :class:`~.active_system.ActiveSetSystem` and an SPD solver).
+Where ``s' ≠ 0`` (Coulomb: ``s = F Λ_n``) ``Λ_n`` is the residual of another row, so the row
+becomes ``(K_t − σ s' K_n) x = F_t − σ s' F_n − σ s0``: the matrix is not symmetric
+(:class:`CoupledSystem`, on a sparse LU), and nodes of both kinds may be mixed. Both keep one
+sparsity pattern per call, so the solver analyses it once.
 """
 
 from __future__ import annotations
@@ -23,20 +26,29 @@ import numpy as np
 import scipy.sparse as sp
 
 from .active_system import ActiveSetSystem, check_residual
-from .friction_kkt import FrictionProblem, slip_bound
+from .friction_kkt import FrictionProblem
 from .solvers import SPDSolver
 from .sparse import csr_row_indices, diagonal_positions
 
-__all__ = ["CoulombSystem", "TrescaSystem"]
+__all__ = ["CoupledSystem", "SymmetricSystem", "friction_system"]
 
 
-class TrescaSystem:
-    """The symmetric systems of the Tresca law: held DOFs eliminated, slip forces in the load.
+def friction_system(problem: FrictionProblem, solver: SPDSolver):
+    """The system of ``problem``: :class:`SymmetricSystem` when every law in play is
+    symmetric (``solver`` SPD), else :class:`CoupledSystem` (``solver`` an LU)."""
+    if problem.symmetric:
+        return SymmetricSystem(problem, solver)
+    return CoupledSystem(problem, solver)
+
+
+class SymmetricSystem:
+    """The symmetric systems of laws with ``s' = 0`` (Tresca): held DOFs eliminated, slip
+    forces in the load.
 
     Parameters
     ----------
     problem : FrictionProblem
-        With ``law == "tresca"``.
+        Whose laws are all symmetric.
     solver : SPDSolver
         A symmetric positive definite solver.
     max_update : int
@@ -61,24 +73,23 @@ class TrescaSystem:
         (±1 on slipping nodes): ``x (n,)``."""
         p = self.problem
         load = p.qp.F.copy()
-        load[p.tangent] -= direction * slip_bound(p, np.zeros(p.m), active)
+        load[p.tangent] -= direction * p.slip_bound(np.zeros(p.m), active)
         x, _ = self.inner.solve(np.concatenate([active, stick]), load)
         return x
 
 
-class CoulombSystem:
-    """The non-symmetric systems of the Coulomb law on a fixed pattern.
+class CoupledSystem:
+    """The non-symmetric systems of laws with ``s' ≠ 0`` (Coulomb), on a fixed pattern.
 
-    The pattern is that of ``K`` with every tangential row widened by the columns of its
-    node's normal row (in a node-blocked ``K`` both rows have the same columns, so this adds
-    nothing). The positions of ``K``'s entries and of the copies of the normal rows in it are
-    found once; each solve writes the values, zeroes the held rows and columns (diagonal kept)
-    and refactorizes.
+    The pattern is that of ``K`` with the tangential row of every node whose law has
+    ``s' ≠ 0`` widened by the columns of its normal row (in a node-blocked ``K`` both rows
+    have the same columns, so this adds nothing). The positions of ``K``'s entries and of the
+    copies of the normal rows in it are found once; each solve writes the values, zeroes the
+    held rows and columns (diagonal kept) and refactorizes.
 
     Parameters
     ----------
     problem : FrictionProblem
-        With ``law == "coulomb"``.
     solver : SPDSolver
         A general sparse LU (a factory's solver for ``symmetric=False``).
     """
@@ -92,9 +103,13 @@ class CoulombSystem:
         K = qp.K
         n = K.shape[0]
         rows_K = csr_row_indices(K)
-        # the entries of the normal rows, and where their copies go in the tangential rows
+        contact = np.ones(problem.m, dtype=bool)
+        self.derivative = problem.friction.bound_derivative(contact)  # s' in contact
+        self.offset = problem.slip_bound(np.zeros(problem.m), contact)  # s0 in contact
+        coupled = np.flatnonzero(self.derivative != 0)
+        # the entries of the coupled normal rows, and where their copies go in the tangential
         row_node = np.full(n, -1)
-        row_node[problem.normal] = np.arange(problem.m)
+        row_node[problem.normal[coupled]] = coupled
         self.copy_src = np.flatnonzero(row_node[rows_K] >= 0)
         self.copy_node = row_node[rows_K[self.copy_src]]
         copy_rows = problem.tangent[self.copy_node]
@@ -127,13 +142,15 @@ class CoulombSystem:
         t0 = time.perf_counter()
         p, qp = self.problem, self.problem.qp
         n = qp.n
-        factor = np.where(active & ~stick, direction * p.weight, 0.0)  # σ F on slip rows
+        factor = np.where(active & ~stick, direction * self.derivative, 0.0)  # σ s' on slip rows
         data = np.zeros(self.indices.size)
         data[self.pos_K] = qp.K.data
         data[self.pos_copy] -= factor[self.copy_node] * qp.K.data[self.copy_src]
         A = sp.csr_matrix((data, self.indices, self.indptr), shape=(n, n))
         rhs = qp.F.copy()
         rhs[p.tangent] -= factor * qp.F[p.normal]
+        if self.offset.any():  # σ s0 on slip rows (direction is 0 elsewhere)
+            rhs[p.tangent] -= direction * p.slip_bound(np.zeros(p.m), active)
         fixed, values = self.fixed, self.values
         fixed[p.normal] = active
         values[p.normal] = np.where(active, p.gap, 0.0)

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import logging
 import time
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -43,7 +44,7 @@ from .qp import BoundQP, check_qp, check_vector
 from .result import PDASConvergenceError, PDASResult, PDASStep
 from .solvers import SolverFactory, SPDSolver, solver_usage
 
-__all__ = ["solve_pdas"]
+__all__ = ["PDASOptions", "solve_pdas"]
 
 logger = logging.getLogger(__name__)
 
@@ -53,6 +54,45 @@ logger = logging.getLogger(__name__)
 # of x grows with the condition number of K (measured: |x_c - g| / |g| = 2e-12 at 33k unknowns),
 # so the band is far above eps and far below any decision that matters.
 _ACTIVE_RTOL = 1e-9
+
+
+@dataclass(frozen=True)
+class PDASOptions:
+    """How :func:`solve_pdas` iterates.
+
+    Attributes
+    ----------
+    max_iter : int
+        Bound on PDAS iterations (linear solves).
+    c : float, optional
+        The positive constant of the active set rule; default the mean diagonal of ``K`` over
+        the constrained DOFs (docs/method.md, *Solver*).
+    fallback : bool
+        If PDAS cycles or reaches ``max_iter``, finish with a primal active set method instead
+        of raising.
+    max_update : int
+        When the active set changes by at most this many DOFs, solve with the existing
+        factorization and a bordered system of the changed DOFs, checked by its residual,
+        instead of refactorizing (0 disables). It costs one solve with k + 1 right-hand sides
+        for k changed DOFs.
+
+    Raises
+    ------
+    ValueError
+        Naming the attribute: ``max_iter`` below 1, ``max_update`` below 0, ``c`` not
+        positive and finite.
+    """
+
+    max_iter: int = 50
+    c: float | None = None
+    fallback: bool = False
+    max_update: int = 4
+
+    def __post_init__(self) -> None:
+        _check_count(self.max_iter, "max_iter", minimum=1)
+        _check_count(self.max_update, "max_update", minimum=0)
+        if self.c is not None and not (np.isfinite(float(self.c)) and float(self.c) > 0):
+            raise ValueError(f"c must be positive and finite, got {float(self.c)}")
 
 
 def solve_pdas(
@@ -65,13 +105,10 @@ def solve_pdas(
     *,
     x0: np.ndarray | None = None,
     active0: np.ndarray | None = None,
-    c: float | None = None,
-    max_iter: int = 50,
+    options: PDASOptions | None = None,
     solver: SPDSolver | SolverFactory | None = None,
-    fallback: bool = False,
-    max_update: int = 4,
 ) -> PDASResult:
-    """Solve ``min 1/2 x^T K x - F^T x`` subject to ``x_c <= g`` and ``x_d = x_D`` by PDAS.
+    r"""Solve ``min 1/2 x^T K x - F^T x`` subject to ``x_c <= g`` and ``x_d = x_D`` by PDAS.
 
     Parameters
     ----------
@@ -97,24 +134,13 @@ def solve_pdas(
         Default (neither given): the empty set, so the first iterate is the unconstrained
         solution and the second active set is the set of DOFs where it violates the bound.
         Starting from the exact active set costs one linear solve.
-    c : float, optional
-        The positive constant of the active set rule; default the mean diagonal of ``K`` over
-        the constrained DOFs (docs/method.md, *Solver*).
-    max_iter : int
-        Bound on PDAS iterations (linear solves).
+    options : PDASOptions, optional
+        ``max_iter``, ``c``, ``fallback``, ``max_update``; default :class:`PDASOptions`\ ().
     solver : SPDSolver or SolverFactory, optional
         An :class:`SPDSolver` is used and kept (not closed; its symbolic analysis is reused
         when ``K`` has the pattern it was analysed for). A factory
         (:class:`~.solvers.SolverFactory`, default :func:`~.backends.auto_solver`) makes one
         for this call, released afterwards.
-    fallback : bool
-        If PDAS cycles or reaches ``max_iter``, finish with a primal active set method instead
-        of raising.
-    max_update : int
-        When the active set changes by at most this many DOFs, solve with the existing
-        factorization and a bordered system of the changed DOFs, checked by its residual,
-        instead of refactorizing (0 disables). It costs one solve with k + 1 right-hand sides
-        for k changed DOFs.
 
     Returns
     -------
@@ -125,7 +151,7 @@ def solve_pdas(
     ValueError
         For malformed input, naming the argument.
     PDASConvergenceError
-        If the active set cycles or ``max_iter`` is reached and ``fallback`` is False.
+        If the active set cycles or ``max_iter`` is reached and ``options.fallback`` is False.
     signorini.algebra.solvers.FactorizationError
         If ``K`` restricted to the free DOFs is not positive definite.
 
@@ -133,13 +159,13 @@ def solve_pdas(
     -----
     This function checks the input and collects the result; the method itself is in the named
     steps below it (:func:`_initial_active_set`, :func:`_iterate`, :func:`_after_failure`).
-    Its length beyond ~80 lines is the documentation of the thirteen parameters.
     """
     t_start = time.perf_counter()
     qp = check_qp(K, F, constrained, gap, dirichlet, dirichlet_values)
-    _check_count(max_iter, "max_iter", minimum=1)
-    _check_count(max_update, "max_update", minimum=0)
-    c_scale = _rule_constant(qp, c)
+    options = PDASOptions() if options is None else options
+    if not isinstance(options, PDASOptions):
+        raise ValueError(f"options must be a PDASOptions, got {type(options).__name__}")
+    c_scale = _rule_constant(qp, options.c)
     active = _initial_active_set(qp, c_scale, x0, active0)
     own_solver = not isinstance(solver, SPDSolver)
     if own_solver:
@@ -147,12 +173,16 @@ def solve_pdas(
 
     before = solver_usage(solver)
     try:
-        system = ActiveSetSystem(qp, solver, max_update=max_update)
+        system = ActiveSetSystem(qp, solver, max_update=options.max_update)
         history: list[PDASStep] = []
-        x, multiplier, active, failure = _iterate(system, active, c_scale, max_iter, history)
+        x, multiplier, active, failure = _iterate(
+            system, active, c_scale, options.max_iter, history
+        )
         method = "pdas"
         if failure is not None:
-            x, multiplier, active = _after_failure(system, x, active, failure, fallback, history)
+            x, multiplier, active = _after_failure(
+                system, x, active, failure, options.fallback, history
+            )
             method = "primal-active-set"
     finally:
         used = {key: value - before[key] for key, value in solver_usage(solver).items()}

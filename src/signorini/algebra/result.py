@@ -1,14 +1,29 @@
-"""What an active set solve reports: its steps, its result, its failure."""
+"""What an active set solve reports: its steps, its result, its failure.
+
+:class:`SolveReport` is what both solvers, the primal-dual active set method for frictionless
+contact (:class:`PDASResult`) and the semismooth Newton method for friction
+(:class:`~.friction_result.FrictionResult`), report in the same words: counters, KKT
+residuals as named relative numbers (``kkt.columns()``, ``kkt.max``), the iteration history,
+the backend and the times. :class:`ConvergenceError` is the failure of either.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import ClassVar
 
 import numpy as np
 
 from .kkt import KKTResiduals
 
-__all__ = ["PDASConvergenceError", "PDASResult", "PDASStep", "with_history"]
+__all__ = [
+    "ConvergenceError",
+    "PDASConvergenceError",
+    "PDASResult",
+    "PDASStep",
+    "SolveReport",
+    "with_history",
+]
 
 
 def with_history(message: str, history: list) -> str:
@@ -60,54 +75,106 @@ class PDASStep:
         )
 
 
-@dataclass
-class PDASResult:
-    """Solution of :func:`~.pdas.solve_pdas` and how it was obtained.
+@dataclass(kw_only=True)
+class SolveReport:
+    """What an active set solve reports, frictionless or frictional.
 
     Attributes
     ----------
     x : (n,) float array
-        The minimizer (in the frame of ``K``).
+        The solution (in the frame of ``K``).
+    iterations : int
+        Iterations of the active set loop(s) (one linear system each).
+    n_solves, n_factorizations, n_analyses, n_updates : int
+        Work done by the linear solver during this call: solves, numerical factorizations,
+        symbolic analyses, and iterations solved with the previous factorization and a
+        low-rank correction.
+    history : list
+        One step per iteration (:class:`PDASStep`, :class:`~.friction_result.FrictionStep`),
+        each printable on one line.
+    kkt : KKTResiduals or FrictionKKT
+        The relative KKT residuals at ``x``: ``kkt.max`` and ``kkt.columns()``, the named
+        history columns.
+    backend : str
+        Linear solver backend.
+    c_scale : float
+        The constant ``c`` of the active set rule.
+    times : dict of str to float
+        Seconds, e.g. ``analysis``, ``factorization``, ``solve``, ``total``.
+    """
+
+    x: np.ndarray
+    iterations: int
+    n_solves: int
+    n_factorizations: int = 0
+    n_analyses: int = 0
+    n_updates: int = 0
+    history: list
+    kkt: KKTResiduals
+    backend: str
+    c_scale: float
+    times: dict[str, float] = field(default_factory=dict)
+
+    #: the attributes that are forces (multiplied by :meth:`scaled`'s unit)
+    FORCES: ClassVar[tuple[str, ...]] = ()
+
+    def scaled(self, unit: float) -> SolveReport:
+        """The report of a system that was solved divided by ``unit`` (the stiffness unit of
+        :func:`signorini.contact.solution.stiffness_unit`), with its forces and ``c_scale``
+        in the unit of the undivided system; ``self`` when ``unit`` is 1."""
+        if unit == 1.0:
+            return self
+        forces = {name: getattr(self, name) * unit for name in self.FORCES}
+        return replace(self, c_scale=self.c_scale * unit, **forces)
+
+
+@dataclass(kw_only=True)
+class PDASResult(SolveReport):
+    """Solution of :func:`~.pdas.solve_pdas` and how it was obtained (:class:`SolveReport`).
+
+    Attributes
+    ----------
     multiplier : (m,) float array
         Multiplier Λ on the constrained DOFs, ``F_c - (K x)_c`` on the active set and 0 off it
         (the nodal contact force Λ_z of the paper, eqs. (3.5), (3.9), (3.17)).
     active : (m,) bool array
         Final active set over the constrained DOFs.
-    iterations : int
-        Linear solves of the active set loop(s), PDAS and fallback together.
-    n_solves, n_factorizations, n_analyses : int
-        Work done by the linear solver during this call.
-    history : list of PDASStep
-    kkt : KKTResiduals
-    backend : str
-        Linear solver backend.
     method : str
         ``"pdas"``, or ``"primal-active-set"`` when the fallback finished the job.
-    c_scale : float
-        The constant ``c`` of the active set rule.
-    times : dict of str to float
-        Seconds: ``analysis``, ``factorization``, ``solve``, ``elimination``, ``total``.
-    n_updates : int
-        Iterations solved with the previous factorization and a low-rank correction.
+
+    ``iterations`` counts the PDAS and the fallback's solves together; ``times`` holds
+    ``analysis``, ``factorization``, ``solve``, ``elimination``, ``total``.
     """
 
-    x: np.ndarray
     multiplier: np.ndarray
     active: np.ndarray
-    iterations: int
-    n_solves: int
-    n_factorizations: int
-    n_analyses: int
-    history: list[PDASStep]
-    kkt: KKTResiduals
-    backend: str
     method: str
-    c_scale: float
-    times: dict[str, float] = field(default_factory=dict)
-    n_updates: int = 0
+
+    FORCES: ClassVar[tuple[str, ...]] = ("multiplier",)
 
 
-class PDASConvergenceError(RuntimeError):
+class ConvergenceError(RuntimeError):
+    """An active set iteration (PDAS or the frictional semismooth Newton method) cycled, hit
+    its bound, or stopped at a point whose KKT residuals are too large.
+
+    Attributes
+    ----------
+    history : list
+        The steps of the iteration.
+    reason : str
+        ``"cycling"``, ``"max_iter"`` or ``"kkt"``.
+    x : numpy array or None
+        The last iterate.
+    """
+
+    def __init__(self, message: str, history: list, reason: str, x: np.ndarray | None) -> None:
+        super().__init__(with_history(message, history))
+        self.history = history
+        self.reason = reason
+        self.x = x
+
+
+class PDASConvergenceError(ConvergenceError):
     """The active set iteration cycled or hit its bound.
 
     Attributes
@@ -127,8 +194,5 @@ class PDASConvergenceError(RuntimeError):
         x: np.ndarray | None = None,
         active: np.ndarray | None = None,
     ) -> None:
-        super().__init__(with_history(message, history))
-        self.history = history
-        self.reason = reason
-        self.x = x
+        super().__init__(message, history, reason, x)
         self.active = active

@@ -7,24 +7,19 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..algebra.laws import LawGroups
 from ..fem import iso, p2
 from ..fem.quadrature import gauss_legendre
 from ..fem.space import P2Space
 from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
-from ..problem.friction import Coulomb, Tresca
 from ..problem.problem import ContactProblem
 
 __all__ = [
-    "COULOMB",
-    "FRICTIONLESS",
-    "TRESCA",
     "directions_and_gaps",
     "edge_weights",
     "friction_data",
 ]
-
-FRICTIONLESS, TRESCA, COULOMB = 0, 1, 2
 
 
 def _body_normals(
@@ -113,33 +108,54 @@ def friction_data(
     edge_local: np.ndarray,
     part: np.ndarray,
     second: np.ndarray,
-) -> dict[str, np.ndarray]:
-    """Friction law, Tresca bound ``s_z = ∫ s ψ_z ds`` and Coulomb coefficient per
-    constraint; a corner node's constraints are frictionless."""
+) -> LawGroups:
+    """The friction laws per constraint: each frictional part's law, the law of each
+    constraint and its nodal weight (:meth:`~signorini.algebra.laws.FrictionLaw.nodal_weight`,
+    e.g. Tresca's ``s_z = ∫ s ψ_z ds``, Coulomb's F); a corner node's constraints are
+    frictionless."""
     k = part.size
-    law = np.zeros(k, dtype=np.int64)
-    bound, coefficient = np.zeros(k), np.zeros(k)
+    index = np.full(k, -1, dtype=np.int64)
+    weight = np.zeros(k)
+    laws = []
     corner = second | np.concatenate([second[1:], [False]])
-    parts = tuple(problem.contact_parts)
-    t, w = gauss_legendre(4)
-    for i, name in enumerate(parts):
-        friction = problem.conditions[name].friction
+    for i, name in enumerate(problem.contact_parts):
+        law = problem.conditions[name].friction
+        if law is None:
+            continue
         mine = (part == i) & ~corner
-        if isinstance(friction, Coulomb):
-            law[mine], coefficient[mine] = COULOMB, float(friction.coefficient)
-        elif isinstance(friction, Tresca):
-            law[mine] = TRESCA
-            sel = np.flatnonzero(edge_part == i)
-            points = space.node_points[edge_nodes[sel]]
-            x, speed, _ = iso.edge_geometry(points[:, :2], points[:, 2], t)
-            what = f"the Tresca bound of contact part {name!r}"
-            s = evaluate_field(friction.bound_field(), x.reshape(-1, 2), what, shape=())
-            if (s < 0).any():
-                raise ProblemError(f"{what} must be >= 0; it is {s.min():.6g} somewhere")
-            # ∫ s ψ_j |x'(t)| dt on each edge, j = start, end, midpoint
-            share = (s.reshape(-1, t.size) * speed * w) @ p2.edge_basis(t)
-            loc = edge_local[sel].ravel()
-            inside = loc >= 0
-            mine_bound = np.bincount(loc[inside], weights=share.ravel()[inside], minlength=k)
-            bound[mine] += mine_bound[mine]
-    return {"friction_law": law, "friction_bound": bound, "friction_coefficient": coefficient}
+        what = f"the {type(law).__name__} bound of contact part {name!r}"
+        values = np.asarray(
+            law.nodal_weight(
+                _integrator(space, edge_part == i, (edge_nodes, edge_local), what, k), k
+            ),
+            dtype=np.float64,
+        )
+        if values.shape != (k,) or not np.isfinite(values).all() or (values < 0).any():
+            raise ProblemError(f"{what}: its nodal weights must be {k} finite numbers >= 0")
+        index[mine] = len(laws)
+        weight[mine] += values[mine]
+        laws.append(law)
+    return LawGroups(tuple(laws), index, weight)
+
+
+def _integrator(space: P2Space, on_part: np.ndarray, edges: tuple, what: str, k: int):
+    """``integrate(f)``: ``∫ f ψ_z ds`` over the edges ``on_part`` (of ``edges``, the contact
+    edges' nodes and constraint rows) per constraint ``(k,)``,
+    by a 4-point Gauss rule along the (quadratic) edges; ``f`` must be ``≥ 0``."""
+    edge_nodes, edge_local = edges
+    t, w = gauss_legendre(4)
+    sel = np.flatnonzero(on_part)
+
+    def integrate(field) -> np.ndarray:
+        points = space.node_points[edge_nodes[sel]]
+        x, speed, _ = iso.edge_geometry(points[:, :2], points[:, 2], t)
+        s = evaluate_field(field, x.reshape(-1, 2), what, shape=())
+        if (s < 0).any():
+            raise ProblemError(f"{what} must be >= 0; it is {s.min():.6g} somewhere")
+        # ∫ s ψ_j |x'(t)| dt on each edge, j = start, end, midpoint
+        share = (s.reshape(-1, t.size) * speed * w) @ p2.edge_basis(t)
+        loc = edge_local[sel].ravel()
+        inside = loc >= 0
+        return np.bincount(loc[inside], weights=share.ravel()[inside], minlength=k)
+
+    return integrate

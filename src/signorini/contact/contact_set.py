@@ -26,18 +26,12 @@ from functools import cached_property
 
 import numpy as np
 
+from ..algebra.laws import LawGroups
 from ..fem.space import P2Space
 from ..mesh.geometry import segment_normals
 from ..problem.fields import ProblemError
 from ..problem.problem import ContactProblem
-from .constraint_data import (
-    COULOMB,
-    FRICTIONLESS,
-    TRESCA,
-    directions_and_gaps,
-    edge_weights,
-    friction_data,
-)
+from .constraint_data import directions_and_gaps, edge_weights, friction_data
 
 __all__ = [
     "ContactSet",
@@ -46,9 +40,6 @@ __all__ = [
     "SEMI_CONTACT",
     "FULL_CONTACT",
     "node_classes",
-    "FRICTIONLESS",
-    "TRESCA",
-    "COULOMB",
     "SAME_DIRECTION",
     "MIN_CORNER_ANGLE",
 ]
@@ -112,14 +103,14 @@ class ContactSet:
     edge_local : (n_ce, 3) int array
         Row of the constraint of each contact edge's nodes (for the edge's part), ``-1`` at
         Dirichlet nodes.
-    friction_law : (k,) int array
-        ``FRICTIONLESS``, ``TRESCA`` or ``COULOMB`` per constraint; a corner's constraints
-        are frictionless (docs/method.md, *Friction*).
-    friction_bound : (k,) float array
-        Tresca: ``s_z = ∫ s ψ_z ds`` over the constraint's part(s) (force per unit
-        thickness); 0 elsewhere.
-    friction_coefficient : (k,) float array
-        Coulomb: the coefficient F of the constraint's part; 0 elsewhere.
+    friction : LawGroups
+        The friction laws of the frictional parts (:mod:`signorini.algebra.laws`), the law
+        of each constraint (``-1``: frictionless; a corner's constraints are frictionless)
+        and its nodal weight (Tresca: ``s_z = ∫ s ψ_z ds`` over the constraint's part, force
+        per unit thickness; Coulomb: its coefficient F); docs/method.md, *Friction*.
+
+    Derived: ``tangent`` (the tangent space of each constraint as a basis beside its
+    normal), ``edge_tangent``, ``frames``, ``has_friction``.
     """
 
     nodes: np.ndarray
@@ -138,13 +129,28 @@ class ContactSet:
     edge_direction: np.ndarray
     edge_normal: np.ndarray
     edge_local: np.ndarray
-    friction_law: np.ndarray
-    friction_bound: np.ndarray
-    friction_coefficient: np.ndarray
+    friction: LawGroups
 
     @property
     def size(self) -> int:
         return self.nodes.size
+
+    @property
+    def has_friction(self) -> bool:
+        """Whether some constraint has a friction law."""
+        return self.friction.any
+
+    @cached_property
+    def tangent(self) -> np.ndarray:
+        """``(k, 1, 2)`` an orthonormal basis of the tangent space of each constraint, beside
+        its normal: ``t_z = (−n_y, n_x)`` (``[n_z t_z]`` is a rotation)."""
+        return _tangents(self.normal)
+
+    @cached_property
+    def edge_tangent(self) -> np.ndarray:
+        """``(n_ce, 3, 1, 2)`` the tangent basis beside :attr:`edge_direction` at
+        ``[start, end, midpoint]`` of each contact edge."""
+        return _tangents(self.edge_direction)
 
     @property
     def constrained_dofs(self) -> np.ndarray:
@@ -163,11 +169,7 @@ class ContactSet:
         the rotation ``[n t]`` for one constraint, ``A_z^{-1}`` with rows ``n, m`` of ``A_z``
         for a corner's two (docs/method.md, *Contact directions*)."""
         first = np.flatnonzero(~self.second)
-        n = self.normal[first]
-        Q = np.stack(
-            [np.stack([n[:, 0], -n[:, 1]], axis=-1), np.stack([n[:, 1], n[:, 0]], axis=-1)],
-            axis=1,
-        )
+        Q = np.stack([self.normal[first], self.tangent[first, 0]], axis=-1)
         corner = np.flatnonzero(self.second)
         if corner.size:
             A = np.stack([self.normal[corner - 1], self.normal[corner]], axis=1)
@@ -187,6 +189,11 @@ class ContactSet:
         """``u·n_z − ψ`` at ``[start, end, midpoint]`` of each contact edge, ``(n_ce, 3)``."""
         un = np.einsum("ejc,ejc->ej", u[self.edge_nodes], self.edge_direction)
         return un - self.edge_gap
+
+
+def _tangents(normal: np.ndarray) -> np.ndarray:
+    """``(..., 1, 2)`` the tangent ``(−n_y, n_x)`` of unit normals ``(..., 2)``, as a basis."""
+    return np.stack([-normal[..., 1], normal[..., 0]], axis=-1)[..., None, :]
 
 
 def _locate(sorted_keys: np.ndarray, query: np.ndarray, rows: np.ndarray | None = None):
@@ -219,9 +226,7 @@ def _empty(parts: tuple[str, ...]) -> ContactSet:
         edge_direction=np.zeros((0, 3, 2)),
         edge_normal=np.zeros((0, 2)),
         edge_local=no_edges,
-        friction_law=no_int,
-        friction_bound=np.zeros(0),
-        friction_coefficient=np.zeros(0),
+        friction=LawGroups((), no_int, np.zeros(0)),
     )
 
 
@@ -330,7 +335,7 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
         edge_direction=direction,
         edge_normal=chord,
         edge_local=edge_local,
-        **friction_data(
+        friction=friction_data(
             problem, space, edge_part, edge_nodes, edge_local, ukey[lead] % n_parts, second
         ),
     )

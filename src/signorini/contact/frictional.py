@@ -1,12 +1,14 @@
-"""SOLVE with friction: the assembled system of a problem whose contact parts carry Tresca or
-Coulomb friction, handed to the semismooth Newton method of :mod:`signorini.algebra.friction`
+"""SOLVE with friction: the assembled system of a problem whose contact parts carry friction
+laws (Tresca, Coulomb, or any :class:`~signorini.algebra.laws.FrictionLaw`, mixed part by
+part), handed to the semismooth Newton method of :mod:`signorini.algebra.friction`
 (docs/method.md, *Friction: the algebraic problem and its solver*).
 
 Every constraint is one contact node with its normal DOF ``2z`` and tangential DOF ``2z + 1``
-in the node frame ``[n t]``; frictionless parts of the same problem take the bound 0 (Tresca)
-or the coefficient 0 (Coulomb). Tresca is the classical problem, the bound acting on every
-node of Γ_C (the minimiser of ``½ a(u, u) − L(u) + Σ_z s_z |u_t(z)|`` subject to
-``u(z)·n_z ≤ ψ(z)``).
+in the node frame ``[n t]``; each node has its part's law (the contact set's
+:class:`~signorini.algebra.laws.LawGroups`), frictionless parts none (no friction force). The
+systems are symmetric (Cholesky) when every law in play is (Tresca), else LU. Tresca is by
+default the classical problem, the bound acting on every node of Γ_C (the minimiser of
+``½ a(u, u) − L(u) + Σ_z s_z |u_t(z)|`` subject to ``u(z)·n_z ≤ ψ(z)``).
 
 A load step of a quasi-static path (docs/method.md, *Load paths*) gets the previous step's
 result: its tangential displacements ``u(z)·t_z`` are the reference ``x_t,ref`` of the law (it
@@ -19,18 +21,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..algebra.friction import INACTIVE, SLIP, STICK, solve_friction
-from ..algebra.friction_result import FrictionResult
+from ..algebra.friction import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
+from ..algebra.friction_kkt import check_friction
+from ..algebra.laws import LawGroups
+from ..algebra.result import SolveReport
 from ..algebra.solvers import SolverFactory, SPDSolver
 from ..fem.space import P2Space
 from ..problem.fields import ProblemError
-from .contact_set import COULOMB, TRESCA, ContactSet
+from .contact_set import ContactSet
 from .node_frames import to_frames
 from .ordering import ordered_solver
 from .system import Assembled
 
 __all__ = [
-    "FrictionSolve",
+    "Solved",
     "check_friction_set",
     "check_previous",
     "slip_reference",
@@ -40,33 +44,45 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class FrictionSolve:
-    """What the frictional solve gives per constraint (k of them) and its report."""
+class Solved:
+    """What a solve of the algebraic problem gives per constraint (k of them), in the unit of
+    the system it solved, and its report (frictionless or frictional alike).
+
+    Attributes
+    ----------
+    x : (n,) float array
+        The solution in node frames.
+    normal_force, tangential_force : (k,) float arrays
+        ``Λ_n`` and ``Λ_t`` (0 without friction).
+    state : (k,) int array
+        ``INACTIVE``, ``STICK`` or ``SLIP``; a frictionless node in contact slips.
+    direction : (k,) int8 array
+        The slip direction ``sign Λ_t`` where a friction force is at a positive bound, else 0.
+    reference : (k,) float array
+        The tangential displacement of no slip (0 for a single step and without friction).
+    report : SolveReport
+    """
 
     x: np.ndarray
     normal_force: np.ndarray
     tangential_force: np.ndarray
     state: np.ndarray
-    report: FrictionResult
+    direction: np.ndarray
     reference: np.ndarray
+    report: SolveReport
 
 
-def check_friction_set(cs: ContactSet) -> str:
-    """The law (``"tresca"`` or ``"coulomb"``) of a contact set with friction.
+def check_friction_set(cs: ContactSet) -> None:
+    """Refuse friction at a node where two contact parts meet at an angle.
 
     Raises
     ------
     ProblemError
-        If Tresca and Coulomb parts are mixed, or a node where two contact parts meet at an
-        angle (two constraints) lies on a part with friction.
+        If a node where two contact parts meet at an angle (two constraints) lies on a part
+        with friction.
     """
-    laws = set(cs.friction_law[cs.friction_law > 0].tolist())
-    if laws == {TRESCA, COULOMB}:
-        raise ProblemError(
-            "contact parts with Tresca and with Coulomb friction in one problem are not "
-            "supported; give all frictional parts the same law"
-        )
-    friction_parts = np.unique(cs.part[cs.friction_law > 0])
+    law = cs.friction
+    friction_parts = np.unique(cs.part[law.index >= 0])
     corner = np.isin(cs.nodes, cs.nodes[cs.second])
     at_corner = corner & np.isin(cs.part, friction_parts)
     if at_corner.any():
@@ -77,7 +93,19 @@ def check_friction_set(cs: ContactSet) -> str:
             "supported; end the frictional part before the corner (e.g. a frictionless part "
             "for the last edge) or join the parts"
         )
-    return "tresca" if TRESCA in laws else "coulomb"
+
+
+def same_law_kinds(a: LawGroups, b: LawGroups) -> bool:
+    """Whether every node has a law of the same class in ``a`` and ``b`` (or none in both):
+    then the node states of one are a warm start of the other."""
+    if a.size != b.size:
+        return False
+
+    def kinds(groups: LawGroups) -> np.ndarray:
+        names = np.array([type(law).__qualname__ for law in groups.laws] + [""], dtype=object)
+        return names[groups.index]  # -1 picks ""
+
+    return bool(np.array_equal(kinds(a), kinds(b)))
 
 
 def check_previous(previous: object, space: P2Space, cs: ContactSet) -> None:
@@ -90,7 +118,7 @@ def check_previous(previous: object, space: P2Space, cs: ContactSet) -> None:
         If ``previous`` is not a result, was solved on another mesh (other P2 nodes, curved
         midpoints included, or cells), or has other contact parts or nodes.
     """
-    if not all(hasattr(previous, name) for name in ("u", "contact", "space", "pdas")):
+    if not all(hasattr(previous, name) for name in ("u", "contact", "space", "report")):
         raise ValueError(
             f"previous must be the ContactResult of the previous load step, got "
             f"{type(previous).__name__}"
@@ -132,15 +160,14 @@ def states_from_displacement(
     ``u0(z)·t_z − reference`` is zero (below ``rtol · max|u0|``: a stick zone prolongates to
     exact zeros), else SLIP in the slip's direction (the friction force ``Λ_t`` has the sign
     of the slip). Out of contact the direction is kept too (classical Tresca acts there;
-    the caller drops it for Coulomb).
+    the caller drops it where the node's law acts only in contact).
 
     Returns
     -------
     state0, direction0 : (k,) int arrays
         ``INACTIVE``/``STICK``/``SLIP`` and ``−1, 0, 1``.
     """
-    n = cs.normal
-    slip = np.einsum("kc,kc->k", u0[cs.nodes], np.column_stack([-n[:, 1], n[:, 0]]))
+    slip = np.einsum("kc,kc->k", u0[cs.nodes], cs.tangent[:, 0])
     slip = slip - reference
     moving = np.abs(slip) > rtol * np.abs(u0).max(initial=0.0)
     direction = np.where(moving, np.sign(slip), 0.0).astype(np.int64)
@@ -159,7 +186,7 @@ def solve_frictional(
     previous: object = None,
     active0: np.ndarray | None = None,
     warm_rtol: float = 0.0,
-) -> FrictionSolve:
+) -> Solved:
     """Solve the frictional contact problem of an assembled system (``K``, ``F`` possibly
     divided by the stiffness unit: the forces returned are in that unit).
 
@@ -177,51 +204,40 @@ def solve_frictional(
     previous : ContactResult, optional
         The previous load step (checked by :func:`check_previous`): the law acts on the slip
         from its tangential displacements (:func:`slip_reference`); without ``u0`` its states
-        (same law) or its displacement (else) are the warm start.
+        (laws of the same classes node by node) or its displacement (else) are the warm start.
     active0 : (k,) bool array, optional
         The nodes in contact in ``u0`` (the frictionless warm-start rule of ``solve``).
     warm_rtol : float
         The relative size below which a tangential displacement of ``u0`` counts as zero.
     """
     cs = assembled.contact
-    law = check_friction_set(cs)
+    check_friction_set(cs)
+    law = cs.friction
     warm = {}
     reference = np.zeros(cs.size)
     if previous is not None:
         reference = slip_reference(previous, cs)
-        report = previous.pdas
-        if u0 is None and isinstance(report, FrictionResult) and report.law == law:
-            warm = {"state0": report.state, "direction0": report.direction}
+        if u0 is None and same_law_kinds(previous.contact.friction, law):
+            warm = {"state0": previous.state, "direction0": previous.direction}
         elif u0 is None:
             u0 = previous.u
     if u0 is not None and active0 is not None:
         state0, direction0 = states_from_displacement(u0, cs, reference, active0, warm_rtol)
-        if law != "tresca":  # Coulomb: no friction force without contact, so no direction
-            direction0[state0 == INACTIVE] = 0
+        # no friction force out of contact where the law acts only in contact: no direction
+        direction0[(state0 == INACTIVE) & ~law.everywhere] = 0
         warm = {"state0": state0, "direction0": direction0}
     elif u0 is not None:
         warm = {"x0": to_frames(u0.ravel(), cs.frame_nodes, cs.frames)}
-    common = {
-        "dirichlet": assembled.dirichlet,
-        "dirichlet_values": assembled.dirichlet_values,
-        "reference": reference,
-        "max_iter": max_iter,
-        **warm,
-    }
     nodes = cs.nodes
-    # Tresca: symmetric systems (Cholesky); Coulomb: non-symmetric ones (LU)
-    with ordered_solver(assembled.space, solver, symmetric=law == "tresca") as linear:
-        if law == "tresca":
-            res = solve_friction(
-                K, F, 2 * nodes, 2 * nodes + 1, cs.gap, bound=cs.friction_bound,
-                tresca_everywhere=True, solver=linear, **common,
-            )  # fmt: skip
-        else:
-            res = solve_friction(
-                K, F, 2 * nodes, 2 * nodes + 1, cs.gap, coefficient=cs.friction_coefficient,
-                solver=linear, **common,
-            )  # fmt: skip
+    problem = check_friction(
+        K, F, 2 * nodes, 2 * nodes + 1, cs.gap, assembled.dirichlet, assembled.dirichlet_values,
+        laws=law.laws, weight=law.weight, law_index=law.index, reference=reference,
+    )  # fmt: skip
+    options = FrictionOptions(max_iter=max_iter)
+    # symmetric laws only (Tresca): symmetric systems (Cholesky); else non-symmetric ones (LU)
+    with ordered_solver(assembled.space, solver, symmetric=problem.symmetric) as linear:
+        res = solve_friction(problem, options=options, solver=linear, **warm)
     state = res.state.astype(np.int64)
     # a frictionless node in contact slides freely: its friction force (0) is at its bound
-    state[(state != INACTIVE) & (cs.friction_law == 0)] = SLIP
-    return FrictionSolve(res.x, res.multiplier_n, res.multiplier_t, state, res, reference)
+    state[(state != INACTIVE) & (law.index < 0)] = SLIP
+    return Solved(res.x, res.multiplier_n, res.multiplier_t, state, res.direction, reference, res)

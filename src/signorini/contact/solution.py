@@ -1,21 +1,24 @@
-"""SOLVE: the discrete Signorini problem (3.2) on one mesh, solved by PDAS.
+"""SOLVE: the discrete Signorini problem (3.2) on one mesh, solved by PDAS, or with friction
+by the semismooth Newton method of :mod:`.frictional`.
 
 The only module that joins the assembled system, the contact boundary and the algebraic
-solver; :class:`ContactResult` carries the solution and everything derived from it.
+solvers: both are behind one call (:func:`_solve_system`) that gives a
+:class:`~.frictional.Solved`, from which :class:`ContactResult` is built once; it carries the
+solution, the solver's report and everything derived from them.
 """
 
 from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 
 from ..algebra.friction import INACTIVE, SLIP, STICK
-from ..algebra.pdas import solve_pdas
-from ..algebra.result import PDASConvergenceError, PDASResult
+from ..algebra.pdas import PDASOptions, solve_pdas
+from ..algebra.result import PDASConvergenceError, SolveReport
 from ..algebra.solvers import SolverFactory, SPDSolver
 from ..fem.norms import energy_error2, h1_seminorm_error2
 from ..fem.space import P2Space
@@ -23,7 +26,7 @@ from ..mesh.mesh import Mesh
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
-from .frictional import check_previous, solve_frictional
+from .frictional import Solved, check_previous, solve_frictional
 from .nested import NESTED_MIN_NDOF, coarse_mesh, transfer_active
 from .node_frames import to_cartesian
 from .ordering import ordered_solver
@@ -102,22 +105,28 @@ class ContactResult:
     active : (k,) bool array
         Final active set of the PDAS iteration (``u(z)·n = ψ(z)`` imposed): the actual
         contact nodes.
-    pdas : PDASResult or FrictionResult
-        How the active set solver got there: iterations, KKT residuals (relative), timings.
-        A :class:`~signorini.algebra.PDASResult` without friction (``pdas.multiplier``
-        equals ``contact_force``), a :class:`~signorini.algebra.FrictionResult` with it
-        (KKT residuals of both laws). When E is extreme the system was solved divided by
-        ``stiffness_unit(K)``, so ``pdas.kkt.force_scale`` is in that unit.
+    report : SolveReport
+        How the solver got there (:class:`~signorini.algebra.SolveReport`): iterations,
+        solver counters, KKT residuals (relative, ``report.kkt.columns()``), history,
+        backend, timings. A :class:`~signorini.algebra.PDASResult` without friction
+        (``report.multiplier`` equals ``contact_force``), a
+        :class:`~signorini.algebra.FrictionResult` with it (KKT residuals of both laws).
+        When E is extreme the system was solved divided by ``stiffness_unit(K)``, so
+        ``report.kkt.force_scale`` is in that unit.
     dirichlet_nodes : (n_D,) int array
         The P2 nodes on the closure of Γ_D (both components prescribed).
     timings : dict
         Seconds spent in ``assemble`` and ``solve``.
     tangential_force : (k,) float array
-        Nodal friction forces Λ_t,z (along ``t = (−n_y, n_x)``; the obstacle acts on the body
-        with ``−Λ_t t``); 0 without friction.
+        Nodal friction forces Λ_t,z (along the constraint's tangent ``contact.tangent``,
+        ``t = (−n_y, n_x)``; the obstacle acts on the body with ``−Λ_t t``); 0 without
+        friction.
     state : (k,) int array
         ``INACTIVE`` (no contact), ``STICK`` or ``SLIP`` per constraint; a frictionless
         node in contact slips (its friction force, 0, is at its bound).
+    direction : (k,) int8 array
+        The slip direction ``sign Λ_t,z`` where the friction force is at a positive bound,
+        else 0 (always 0 without friction).
     tangential_reference : (k,) float array
         The tangential displacement of no slip per constraint, which the friction law's slip
         ``u(z)·t_z − tangential_reference`` is measured from: the previous load step's
@@ -135,20 +144,13 @@ class ContactResult:
     contact: ContactSet
     contact_force: np.ndarray
     active: np.ndarray
-    pdas: PDASResult
+    report: SolveReport
     dirichlet_nodes: np.ndarray
+    tangential_force: np.ndarray
+    state: np.ndarray
+    direction: np.ndarray
+    tangential_reference: np.ndarray
     timings: dict = field(default_factory=dict)
-    tangential_force: np.ndarray | None = None
-    state: np.ndarray | None = None
-    tangential_reference: np.ndarray | None = None
-
-    def __post_init__(self) -> None:
-        if self.tangential_force is None:
-            self.tangential_force = np.zeros(self.contact.size)
-        if self.tangential_reference is None:
-            self.tangential_reference = np.zeros(self.contact.size)
-        if self.state is None:
-            self.state = np.where(self.active, SLIP, INACTIVE)
 
     @property
     def mesh(self) -> Mesh:
@@ -185,8 +187,7 @@ class ContactResult:
     def contact_force_vector(self) -> np.ndarray:
         """``(2,)`` the resultant force of the obstacles on the body,
         ``−Σ_z (Λ_z n_z + Λ_t,z t_z)`` (docs/method.md, *Contact directions*)."""
-        n = self.contact.normal
-        t = np.column_stack([-n[:, 1], n[:, 0]])
+        n, t = self.contact.normal, self.contact.tangent[:, 0]
         return -(self.contact_force @ n) - self.tangential_force @ t
 
     @cached_property
@@ -281,7 +282,7 @@ def solve(
     space, cs = assembled.space, assembled.contact
     if previous is not None:
         check_previous(previous, space, cs)
-        if u0 is None and not cs.friction_law.any():
+        if u0 is None and not cs.has_friction:
             u0 = previous.u
     active0 = None
     if u0 is not None:
@@ -303,41 +304,64 @@ def solve(
         and active0 is None
         and mesh is not problem.mesh
         and cs.size > 0
-        and not cs.friction_law.any()
+        and not cs.has_friction
         and space.n_dofs - assembled.dirichlet.size >= NESTED_MIN_NDOF
     ):
         active0 = _nested_active_set(problem, assembled, solver, max_iter, fallback)
         timings["nested"] = time.perf_counter() - t0
-    if cs.friction_law.any():
-        fr = solve_frictional(
-            assembled,
-            K,
-            F,
-            u0=u0,
-            solver=solver,
-            max_iter=max_iter,
-            previous=previous,
-            active0=active0,
-            warm_rtol=WARM_START_RTOL,
-        )
-        seconds = time.perf_counter() - t0
-        u = to_cartesian(fr.x, cs.frame_nodes, cs.frames).reshape(-1, 2)
-        return ContactResult(
-            problem=problem,
-            space=space,
-            u=u,
-            contact=cs,
-            contact_force=fr.normal_force * unit,
-            active=fr.state != INACTIVE,
-            pdas=fr.report,
-            dirichlet_nodes=assembled.dirichlet[::2] // 2,
-            timings={"assemble": assembled.seconds, "solve": seconds},
-            tangential_force=fr.tangential_force * unit,
-            state=fr.state,
-            tangential_reference=fr.reference,
-        )
+    solved = _solve_system(
+        assembled, (K, F), u0=u0, active0=active0, previous=previous,
+        options=PDASOptions(max_iter=max_iter, fallback=fallback), solver=solver,
+    )  # fmt: skip
+    timings["solve"] = time.perf_counter() - t0
+    report = solved.report.scaled(unit)
+    log.info(
+        "solved %s: %d unknowns, %d iterations, %d in contact of %d",
+        problem.name,
+        space.n_dofs,
+        report.iterations,
+        int((solved.state != INACTIVE).sum()),
+        cs.size,
+    )
+    return ContactResult(
+        problem=problem,
+        space=space,
+        u=to_cartesian(solved.x, cs.frame_nodes, cs.frames).reshape(-1, 2),
+        contact=cs,
+        contact_force=solved.normal_force if unit == 1.0 else solved.normal_force * unit,
+        active=solved.state != INACTIVE,
+        report=report,
+        dirichlet_nodes=assembled.dirichlet[::2] // 2,
+        tangential_force=solved.tangential_force * unit,
+        state=solved.state,
+        direction=solved.direction,
+        tangential_reference=solved.reference,
+        timings=timings,
+    )
+
+
+def _solve_system(
+    assembled: Assembled,
+    system: tuple,
+    *,
+    u0: np.ndarray | None,
+    active0: np.ndarray | None,
+    previous: ContactResult | None,
+    options: PDASOptions,
+    solver: SPDSolver | SolverFactory | None,
+) -> Solved:
+    """The algebraic problem of ``assembled`` with the matrix and load ``system = (K, F)``:
+    frictional (:func:`~.frictional.solve_frictional`) when a contact part has a friction
+    law, else the bound-constrained QP by PDAS. Forces in the unit of ``system``."""
+    K, F = system
+    cs = assembled.contact
+    if cs.has_friction:
+        return solve_frictional(
+            assembled, K, F, u0=u0, solver=solver, max_iter=options.max_iter,
+            previous=previous, active0=active0, warm_rtol=WARM_START_RTOL,
+        )  # fmt: skip
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
-    with ordered_solver(space, solver, check_symmetry=False) as linear:
+    with ordered_solver(assembled.space, solver, check_symmetry=False) as linear:
         res = solve_pdas(
             K,
             F,
@@ -346,33 +370,12 @@ def solve(
             assembled.dirichlet,
             assembled.dirichlet_values,
             active0=active0,
-            max_iter=max_iter,
+            options=options,
             solver=linear,
-            fallback=fallback,
         )
-    seconds = time.perf_counter() - t0
-    if unit != 1.0:
-        res = replace(res, multiplier=res.multiplier * unit, c_scale=res.c_scale * unit)
-    u = to_cartesian(res.x, cs.frame_nodes, cs.frames).reshape(-1, 2)
-    log.info(
-        "solved %s: %d unknowns, %d PDAS iterations, %d active of %d",
-        problem.name,
-        space.n_dofs,
-        res.iterations,
-        int(res.active.sum()),
-        cs.size,
-    )
-    return ContactResult(
-        problem=problem,
-        space=space,
-        u=u,
-        contact=cs,
-        contact_force=res.multiplier,
-        active=res.active,
-        pdas=res,
-        dirichlet_nodes=assembled.dirichlet[::2] // 2,
-        timings=timings | {"solve": seconds},
-    )
+    zero = np.zeros(cs.size)
+    state = np.where(res.active, SLIP, INACTIVE)
+    return Solved(res.x, res.multiplier, zero, state, zero.astype(np.int8), zero, res)
 
 
 def _nested_active_set(
@@ -396,6 +399,6 @@ def _nested_active_set(
     log.info(
         "nested iteration: coarse mesh of %d unknowns, %d PDAS iterations",
         result.ndof,
-        result.pdas.iterations,
+        result.report.iterations,
     )
     return transfer_active(result.space, result.contact, result.active, space, cs)

@@ -8,10 +8,11 @@ nodal values at ``[start, end, midpoint]``:
 
 - ``p_t,z = Λ_t,z / w_z``, the consistent friction stress (``ContactResult.tangential_pressure``;
   the obstacle acts on the body with ``−Λ_t t``, so ``p_t ≈ −σ_t``);
-- ``b_z``, the slip bound as a stress: Tresca ``s_z / w_z`` with ``s_z = ∫ s ψ_z``, Coulomb
-  ``F p_z`` (so that ``|p_t,z| ≤ b_z`` is the solver's nodal law ``|Λ_t,z| ≤ s_z`` or
-  ``≤ F Λ_z`` divided by ``w_z``); 0 on frictionless parts;
-- ``u_t(z) = u_h(z)·t_z``, ``t_z = (−n_y, n_x)`` for the constraint direction n_z.
+- ``b_z = s_z / w_z``, the slip bound as a stress, with ``s_z`` the node's friction law's bound
+  at the contact force ``Λ_z`` (:mod:`signorini.algebra.laws`; Tresca ``s_z = ∫ s ψ_z``,
+  so ``b_z = s_z / w_z``; Coulomb ``F Λ_z``, so ``b_z = F p_z``): ``|p_t,z| ≤ b_z`` is the
+  solver's nodal law ``|Λ_t,z| ≤ s_z`` divided by ``w_z``; 0 on frictionless parts;
+- ``u_t(z) = u_h(z)·t_z``, ``t_z`` the constraint's tangent (``ContactSet.edge_tangent``).
 
 At a Dirichlet end point of Γ_C the stresses are 0 and ``u_t = u_D·t``; its third of the edge
 is given to the edge's midpoint (Dirichlet nodes carry no term).
@@ -23,7 +24,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..contact.contact_set import COULOMB, TRESCA
 from ..contact.solution import ContactResult
 
 __all__ = ["FrictionEdges", "friction_edges", "move_dirichlet_thirds"]
@@ -44,17 +44,13 @@ def friction_edges(result: ContactResult, unit: float = 1.0) -> FrictionEdges | 
     the stress unit ``unit``; ``None`` for a result without friction (then η4 is the paper's
     ``‖σ_t(u_h)‖`` and η8 = 0)."""
     cs = result.contact
-    if not cs.friction_law.any():
+    if not cs.has_friction:
         return None
-    bound = np.zeros(cs.size)
-    tresca, coulomb = cs.friction_law == TRESCA, cs.friction_law == COULOMB
-    bound[tresca] = cs.friction_bound[tresca] / cs.basis_integral[tresca]
-    bound[coulomb] = cs.friction_coefficient[coulomb] * result.pressure[coulomb]
+    bound = cs.friction.slip_bound(result.contact_force, result.active) / cs.basis_integral
     loc = cs.edge_local
     inside = loc >= 0
     row = np.maximum(loc, 0)
-    d = cs.edge_direction
-    tangent = np.stack([-d[..., 1], d[..., 0]], axis=-1)
+    tangent = cs.edge_tangent[..., 0, :]
     slip = np.einsum("ejc,ejc->ej", np.asarray(result.u)[cs.edge_nodes], tangent)
     return FrictionEdges(
         friction=np.where(inside, result.tangential_pressure[row], 0.0) / unit,

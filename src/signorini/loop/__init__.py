@@ -250,12 +250,12 @@ def _add_path_counts(record: LevelRecord, steps: Sequence[ContactResult]) -> Non
     """A load path's level: the record's iteration counts and solve timings summed over the
     steps (:func:`level_record` wrote the last step's)."""
     for r in steps[:-1]:
-        report = r.pdas
+        report = r.report
         record.pdas_iterations += report.iterations
-        record.n_solves += getattr(report, "n_solves", report.iterations)
+        record.n_solves += report.n_solves
         record.n_factorizations += report.n_factorizations
         record.n_analyses += report.n_analyses
-        record.n_updates += getattr(report, "n_updates", 0)
+        record.n_updates += report.n_updates
         record.t_assemble += r.timings["assemble"]
         record.t_solve += r.timings["solve"]
 

@@ -7,12 +7,11 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field
 
-from ..algebra.friction_kkt import FrictionKKT
 from ..contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
 from ..contact.solution import SLIP, STICK, ContactResult
 from ..estimator.residual import Estimate
 
-__all__ = ["COLUMNS", "LevelRecord", "kkt_columns", "level_record"]
+__all__ = ["COLUMNS", "LevelRecord", "level_record"]
 
 #: What each :class:`LevelRecord` field (= each column of a run's ``history.csv``) means,
 #: with its unit. Units are those of the problem's data ("consistent units": if E is in MPa
@@ -192,6 +191,7 @@ class LevelRecord:
 def level_record(level: int, result: ContactResult, est: Estimate) -> LevelRecord:
     terms = est.eta_terms
     classes = result.classes
+    report = result.report
     rec = LevelRecord(
         level=level,
         ndof=result.ndof,
@@ -199,12 +199,11 @@ def level_record(level: int, result: ContactResult, est: Estimate) -> LevelRecor
         n_cells=result.mesh.n_cells,
         eta=est.eta,
         **{f"eta_{k + 1}": float(terms[k]) for k in range(8)},
-        pdas_iterations=result.pdas.iterations,
-        # the frictional solver does one linear solve per iteration and reports no updates
-        n_solves=getattr(result.pdas, "n_solves", result.pdas.iterations),
-        n_factorizations=result.pdas.n_factorizations,
-        n_analyses=result.pdas.n_analyses,
-        n_updates=getattr(result.pdas, "n_updates", 0),
+        pdas_iterations=report.iterations,
+        n_solves=report.n_solves,
+        n_factorizations=report.n_factorizations,
+        n_analyses=report.n_analyses,
+        n_updates=report.n_updates,
         n_active=int(result.active.sum()),
         n_constrained=result.contact.size,
         n_full_contact=int((classes == FULL_CONTACT).sum()),
@@ -213,8 +212,8 @@ def level_record(level: int, result: ContactResult, est: Estimate) -> LevelRecor
         n_stick=int((result.state == STICK).sum()),
         n_slip=int((result.state == SLIP).sum()),
         contact_force=result.total_contact_force,
-        **kkt_columns(result.pdas),
-        backend=result.pdas.backend,
+        **report.kkt.columns(),  # without friction no tangential columns: they stay NaN
+        backend=report.backend,
         t_assemble=result.timings["assemble"],
         t_solve=result.timings["solve"],
     )
@@ -223,20 +222,3 @@ def level_record(level: int, result: ContactResult, est: Estimate) -> LevelRecor
         rec.error_energy, rec.error_h1 = err["error_energy"], err["error_h1"]
         rec.efficiency = est.eta / err["error_energy"] if err["error_energy"] > 0 else math.nan
     return rec
-
-
-def kkt_columns(report) -> dict[str, float]:
-    """The KKT history columns of a solve: the five of the normal law, and with friction
-    (a :class:`~signorini.algebra.friction_kkt.FrictionKKT`) the two of the tangential law."""
-    kkt = report.kkt
-    if not isinstance(kkt, FrictionKKT):
-        return kkt.columns()
-    return {
-        "kkt_primal": kkt.primal,
-        "kkt_dual": kkt.dual,
-        "kkt_complementarity": kkt.complementarity,
-        "kkt_stationarity": kkt.stationarity,
-        "kkt_dirichlet": kkt.dirichlet,
-        "kkt_tangential_bound": kkt.tangential_bound,
-        "kkt_tangential_complementarity": kkt.tangential_complementarity,
-    }

@@ -54,7 +54,7 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     np.maximum.at(state, cs.nodes, result.state.astype(np.int32))
     p_t = result.tangential_pressure
     np.add.at(tangential, cs.nodes, p_t)
-    t = np.column_stack([-cs.normal[:, 1], cs.normal[:, 0]])
+    t = cs.tangent[:, 0]
     np.add.at(traction[:, :2], cs.nodes, -result.pressure[:, None] * cs.normal - p_t[:, None] * t)
     cell_data = {}
     if estimate is not None:

@@ -75,7 +75,7 @@ def run_figures(example: str, out: Path, last: Level | None = None) -> list[Path
         **zoom,
     )
     friction = {}
-    if cs.friction_law.any():  # stick and slip nodes marked, the friction stress drawn
+    if cs.has_friction:  # stick and slip nodes marked, the friction stress drawn
         friction = {
             "state": res.state,
             "contact_displacement": res.u[cs.nodes],

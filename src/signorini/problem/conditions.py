@@ -36,7 +36,7 @@ from .fields import (
     check_numbers,
     constant_field,
 )
-from .friction import Coulomb, Friction, Tresca
+from .friction import LAW_MEMBERS, Friction
 from .obstacles import Obstacle
 
 __all__ = ["Condition", "Contact", "Dirichlet", "ExactSolution", "Neumann"]
@@ -161,9 +161,10 @@ class Contact:
         :class:`~signorini.problem.obstacles.Disc`,
         :class:`~signorini.problem.obstacles.Polyline` or
         :class:`~signorini.problem.obstacles.SignedDistance`.
-    friction : Tresca, Coulomb or None
-        The friction law on the part (:mod:`signorini.problem.friction`); ``None`` for
-        frictionless contact.
+    friction : Tresca, Coulomb, another friction law, or None
+        The friction law on the part (:mod:`signorini.problem.friction`, or any object of the
+        protocol :class:`signorini.algebra.laws.FrictionLaw`); ``None`` for frictionless
+        contact.
 
     Raises
     ------
@@ -180,10 +181,12 @@ class Contact:
     friction: Friction | None = None
 
     def __post_init__(self) -> None:
-        if self.friction is not None and not isinstance(self.friction, Tresca | Coulomb):
+        friction = self.friction
+        if friction is not None and not all(hasattr(friction, a) for a in LAW_MEMBERS):
             raise ProblemError(
                 "Contact(friction=...) must be None, Tresca(bound) or Coulomb(coefficient) "
-                f"from signorini.problem.friction, got {self.friction!r}"
+                "from signorini.problem.friction, or a friction law with "
+                f"{', '.join(LAW_MEMBERS)}, got {self.friction!r}"
             )
         if callable(self.gap):
             check_function(self.gap, "Contact(gap=...)", _GAP)

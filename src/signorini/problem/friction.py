@@ -11,6 +11,11 @@ Signorini conditions in the normal direction:
 Discretely the laws hold node-wise with the nodal contact forces (3.17): ``|Λ_t,z| ≤ s_z``
 with ``s_z = ∫ s ψ_z ds`` (Tresca) or ``|Λ_t,z| ≤ F Λ_n,z`` (Coulomb).
 
+Both implement the friction-law protocol :class:`signorini.algebra.laws.FrictionLaw` that the
+contact layer, the solver and the estimator ask (its slip bound from a nodal weight and the
+normal force, the bound's derivative, whether the systems stay symmetric): a new law is one
+class with the same five members, given as ``Contact(friction=...)``.
+
 The laws check their data when they are built (numbers must be finite and ``≥ 0``, a function
 must accept points ``x (n, 2)``); a bound function's values are checked where it is evaluated
 (:func:`signorini.problem.fields.evaluate_field`, then ``≥ 0``).
@@ -20,12 +25,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from .fields import ProblemError, check_function, check_numbers, constant_field
 
-__all__ = ["Coulomb", "Friction", "Tresca"]
+__all__ = ["LAW_MEMBERS", "Coulomb", "Friction", "Tresca"]
 
 _BOUND = "a finite number >= 0 or a function s(x) of points x (n, 2) returning values >= 0"
 _COEFFICIENT = "a finite number >= 0"
@@ -41,6 +47,10 @@ class Tresca:
         The slip bound ``s ≥ 0`` in stress units (MPa if E is in MPa): a number, or a function
         ``s(x)`` of the points ``x (n, 2)`` returning ``(n,)`` values ``≥ 0``
         (docs/method.md, *User functions*).
+    everywhere : bool
+        The bound acts on every node of the part (the classical Tresca problem, a convex
+        minimisation; the default), or only on the nodes in contact (a bound that models a
+        known contact pressure).
 
     Raises
     ------
@@ -50,8 +60,16 @@ class Tresca:
     """
 
     bound: Callable[[np.ndarray], np.ndarray] | float
+    everywhere: bool = True
+
+    #: the bound does not depend on the normal force
+    symmetric: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
+        if not isinstance(self.everywhere, bool):
+            raise ProblemError(
+                f"Tresca(everywhere=...) must be True or False; got {self.everywhere!r}"
+            )
         if callable(self.bound):
             check_function(self.bound, "Tresca(bound=...)", _BOUND)
             return
@@ -64,6 +82,20 @@ class Tresca:
         if callable(self.bound):
             return self.bound
         return constant_field(np.asarray(self.bound, dtype=np.float64).reshape(()), shape=())
+
+    def nodal_weight(self, integrate, size: int) -> np.ndarray:
+        """The nodal bounds ``s_z = ∫ s ψ_z ds`` (force units)."""
+        return integrate(self.bound_field())
+
+    def slip_bound(
+        self, weight: np.ndarray, normal_force: np.ndarray, in_contact: np.ndarray
+    ) -> np.ndarray:
+        """``s_z`` (where the bound acts: everywhere, or in contact)."""
+        return weight if self.everywhere else weight * in_contact
+
+    def bound_derivative(self, weight: np.ndarray, in_contact: np.ndarray) -> np.ndarray:
+        """0: the bound is data."""
+        return np.zeros(weight.shape)
 
 
 @dataclass(frozen=True)
@@ -83,6 +115,11 @@ class Coulomb:
 
     coefficient: float
 
+    #: the bound ``F Λ_n`` depends on the normal force: non-symmetric systems
+    symmetric: ClassVar[bool] = False
+    #: no normal force, no friction force
+    everywhere: ClassVar[bool] = False
+
     def __post_init__(self) -> None:
         check_numbers(self.coefficient, 1, "Coulomb(coefficient=...)", _COEFFICIENT)
         if float(np.asarray(self.coefficient, dtype=np.float64)) < 0:
@@ -90,5 +127,24 @@ class Coulomb:
                 f"Coulomb(coefficient=...) must be {_COEFFICIENT}; got {self.coefficient!r}"
             )
 
+    def nodal_weight(self, integrate, size: int) -> np.ndarray:
+        """The coefficient ``F`` at every node."""
+        return np.full(size, float(self.coefficient))
+
+    def slip_bound(
+        self, weight: np.ndarray, normal_force: np.ndarray, in_contact: np.ndarray
+    ) -> np.ndarray:
+        """``F max(Λ_n, 0)``."""
+        return weight * np.maximum(normal_force, 0.0)
+
+    def bound_derivative(self, weight: np.ndarray, in_contact: np.ndarray) -> np.ndarray:
+        """``F``."""
+        return weight
+
 
 Friction = Tresca | Coulomb
+"""The built-in friction laws; ``Contact(friction=...)`` takes any object with their five
+members (:class:`signorini.algebra.laws.FrictionLaw`)."""
+
+#: what a friction law has (:class:`signorini.algebra.laws.FrictionLaw`)
+LAW_MEMBERS = ("symmetric", "everywhere", "nodal_weight", "slip_bound", "bound_derivative")
