@@ -19,7 +19,6 @@ from matplotlib.transforms import offset_copy
 from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
-from ..algebra.friction_result import INACTIVE, SLIP, STICK
 from ..mesh.mesh import boundary_edges
 from .mesh import line_width, mesh_arrays
 from .style import RC, STYLES, fit_title, new_figure, save_figure, trim_height
@@ -30,6 +29,7 @@ __all__ = [
     "displacement_scale",
     "scale_text",
     "free_boundary_ends",
+    "NODE_STATES",
 ]
 
 #: Largest displacement drawn, as a fraction of the body's size, when it is rescaled.
@@ -39,6 +39,9 @@ TRUE_SCALE_RANGE = (0.02, 0.25)
 #: The obstacle drawn from gaps is left out where the drawn gap exceeds this fraction of the
 #: body's size (a shape far from most of a curved contact part, e.g. the plane under a disc).
 OBSTACLE_REACH = 0.25
+
+#: The states a contact node may be in, as ``plot_deformed(state=...)`` names them.
+NODE_STATES = ("inactive", "stick", "slip")
 
 #: How the stick and slip nodes of a frictional contact and its friction stress are drawn.
 FRICTION_STYLES: dict[str, dict[str, str]] = {
@@ -262,8 +265,8 @@ def _draw_states(ax: Any, at: np.ndarray, state: np.ndarray, legend: bool = True
     """Markers on the contact nodes that stick and that slip, at the points ``at (k, 2)``
     (labelled for the legend, or not)."""
     size = 3.0 if state.size <= 200 else 1.5
-    for key, value in (("stick", STICK), ("slip", SLIP)):
-        on = state == value
+    for key in ("stick", "slip"):
+        on = state == key
         if not on.any():
             continue
         st = FRICTION_STYLES[key]
@@ -338,6 +341,13 @@ def plot_deformed(
         the same scale as the body, so a body that does not penetrate the obstacle is not
         drawn through it; left out where ``scale * |gap|`` exceeds :data:`OBSTACLE_REACH`
         times the body's size. Not together with ``obstacle``.
+    state : (k,) str array, optional
+        Each contact node's state, one of :data:`NODE_STATES` (``"inactive"``, ``"stick"``,
+        ``"slip"``): the stick and slip nodes are marked. Needs ``contact_displacement``.
+    contact_displacement : (k, 2) float array, optional
+        The displacement of the contact nodes (where their states are marked).
+    tangential_pressure : (k,) float array, optional
+        The friction stress p_t at ``contact_points``, drawn with the pressure.
 
     Returns
     -------
@@ -441,6 +451,6 @@ def _checked_states(
             f"state must have shape ({cp.shape[0]},) and contact_displacement {cp.shape} to "
             f"match contact_points, got {st.shape} and {uc.shape}"
         )
-    if not np.isin(st, (INACTIVE, STICK, SLIP)).all():
-        raise ValueError("state must hold 0 (inactive), 1 (stick) or 2 (slip)")
+    if not np.isin(st, NODE_STATES).all():
+        raise ValueError(f"state must hold the labels {', '.join(map(repr, NODE_STATES))}")
     return uc, st
