@@ -19,7 +19,7 @@ from matplotlib.transforms import offset_copy
 from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
-from ..mesh.mesh import boundary_edges
+from ..mesh.topology import boundary_edges
 from .mesh import line_width, mesh_arrays
 from .style import RC, STYLES, fit_title, new_figure, save_figure, trim_height
 

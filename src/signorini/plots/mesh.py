@@ -23,7 +23,7 @@ from matplotlib.patches import Rectangle
 from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
-from ..mesh.mesh import boundary_edges
+from ..mesh.topology import boundary_edges
 from .style import RC, fit_title, new_figure, save_figure, trim_height
 
 __all__ = [
