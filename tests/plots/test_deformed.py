@@ -7,12 +7,8 @@ import pytest
 
 from signorini.mesh.builders import rectangle
 from signorini.plots import plot_deformed
-from signorini.plots.deformed import (
-    NODE_STATES,
-    contact_coordinate,
-    displacement_scale,
-    free_boundary_ends,
-)
+from signorini.plots.contact_line import contact_coordinate, free_boundary_ends
+from signorini.plots.deformed import NODE_STATES, displacement_scale
 
 from .figure_checks import check_written
 

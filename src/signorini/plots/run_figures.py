@@ -20,7 +20,7 @@ from .. import plots
 from ..mesh.curves import Line
 from ..mesh.mesh import Mesh
 from ..output import read_history
-from .deformed import free_boundary_ends
+from .contact_line import free_boundary_ends
 from .mesh import boundary_groups
 
 __all__ = ["KnownPressure", "part_segments", "pressure_figure", "run_figures"]
