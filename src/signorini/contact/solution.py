@@ -304,7 +304,7 @@ def solve(
         and mesh is not problem.mesh
         and cs.size > 0
         and not cs.has_friction
-        and space.n_dofs - assembled.dirichlet.size >= NESTED_MIN_NDOF
+        and free_ndof(space, problem.dirichlet_nodes(space)) >= NESTED_MIN_NDOF
     ):
         active0 = _nested_active_set(problem, assembled, solver, max_iter, fallback)
         timings["nested"] = time.perf_counter() - t0
