@@ -5,6 +5,10 @@ The public API, from the mesh to the adaptive loop::
     from signorini import (Mesh, rectangle, read_mesh, Circle, Material, ContactProblem,
                            Dirichlet, Neumann, Contact, HalfPlane, Coulomb, Tresca, solve,
                            solve_path, estimate, mark_doerfler, refine_nvb, adaptive)
+
+A boundary curve of one's own subclasses :class:`Curve` (like :class:`Line`, :class:`Circle`,
+:class:`ProjectedCurve`), a rigid obstacle of one's own :class:`Obstacle` (like
+:class:`HalfPlane`, :class:`Disc`, :class:`Polyline`, :class:`SignedDistance`).
 """
 
 from .algebra import ConvergenceError, FrictionConvergenceError, PDASConvergenceError
@@ -14,7 +18,7 @@ from .examples import example_6_1, example_6_2
 from .fem import Material, P2Space
 from .loop import Level, LevelRecord, adaptive
 from .mesh import Mesh, MeshError, read_mesh, rectangle, refine_nvb, refine_uniform
-from .mesh.curves import Circle, Line, ProjectedCurve
+from .mesh.curves import Circle, Curve, Line, ProjectedCurve
 from .output import write_vtu
 from .problem import (
     Contact,
@@ -26,7 +30,7 @@ from .problem import (
     ProblemError,
     Tresca,
 )
-from .problem.obstacles import Disc, HalfPlane, Polyline, SignedDistance
+from .problem.obstacles import Disc, HalfPlane, Obstacle, Polyline, SignedDistance
 
 __version__ = "0.1.0"
 
@@ -37,6 +41,7 @@ __all__ = [
     "ContactResult",
     "ConvergenceError",
     "Coulomb",
+    "Curve",
     "Dirichlet",
     "Disc",
     "Estimate",
@@ -50,6 +55,7 @@ __all__ = [
     "Mesh",
     "MeshError",
     "Neumann",
+    "Obstacle",
     "P2Space",
     "PDASConvergenceError",
     "Polyline",

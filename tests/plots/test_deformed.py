@@ -7,7 +7,8 @@ import pytest
 
 from signorini.mesh.builders import rectangle
 from signorini.plots import plot_deformed
-from signorini.plots.deformed import contact_coordinate, displacement_scale, free_boundary_ends
+from signorini.plots.contact_line import contact_coordinate, free_boundary_ends
+from signorini.plots.deformed import NODE_STATES, displacement_scale
 
 from .figure_checks import check_written
 
@@ -147,7 +148,8 @@ def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
     u = np.column_stack([0.01 * p[:, 1], -0.02 * (1.0 - p[:, 1])])
     bottom = np.column_stack([np.linspace(0.0, 1.0, 9), np.zeros(9)])  # vertices and midpoints
     u_bottom = np.column_stack([np.zeros(9), np.full(9, -0.02)])
-    state = np.array([0, 0, 2, 1, 1, 1, 2, 2, 0])
+    codes = np.array([0, 0, 2, 1, 1, 1, 2, 2, 0])
+    state = np.array(NODE_STATES)[codes]  # the labels "inactive", "stick", "slip"
     pressure = np.array([0, 0, 1, 2, 3, 2, 1, 0.5, 0.0])
     p_t = np.array([0, 0, 0.5, 0.4, 0.1, -0.2, 0.5, 0.25, 0.0])
     kwargs = {"contact_points": bottom, "pressure": pressure, "scale": 5.0}
@@ -161,13 +163,13 @@ def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
     drawn = bottom + 5.0 * u_bottom
     for label, value in (("stick", 1), ("slip", 2)):
         np.testing.assert_array_equal(
-            np.column_stack(friction["lines"][label]), drawn[state == value]
+            np.column_stack(friction["lines"][label]), drawn[codes == value]
         )
     np.testing.assert_array_equal(friction["lines"]["$p_{t,h}$"][1], p_t)
     # the friction stress panel: its curve, then the stick and the slip nodes on it
     (x_pt, y_pt), (x_stick, y_stick), (x_slip, y_slip) = friction["lines_by_axes"][-1][1:4]
-    np.testing.assert_array_equal(y_stick, p_t[state == 1])
-    np.testing.assert_array_equal(x_slip, bottom[state == 2, 0])
+    np.testing.assert_array_equal(y_stick, p_t[codes == 1])
+    np.testing.assert_array_equal(x_slip, bottom[codes == 2, 0])
     assert friction["ylabel"][-1] == "contact stresses"
     assert frictionless["legend"] == ["reference"]
     assert list(frictionless["lines"]) == ["$p_h$"]
@@ -175,9 +177,7 @@ def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
     with pytest.raises(ValueError, match="state needs contact_points and contact_displacement"):
         plot_deformed(p, c, u, tmp_path / "x", **kwargs, state=state)
     with pytest.raises(ValueError, match="state must hold"):
-        plot_deformed(
-            p, c, u, tmp_path / "x", **kwargs, state=state + 1, contact_displacement=u_bottom
-        )
+        plot_deformed(p, c, u, tmp_path / "x", **kwargs, state=codes, contact_displacement=u_bottom)
     with pytest.raises(ValueError, match="tangential_pressure must have shape"):
         plot_deformed(p, c, u, tmp_path / "x", **kwargs, tangential_pressure=p_t[:3])
 

@@ -365,3 +365,18 @@ def test_a_slender_body_is_warned_about(height, warns):
         ratio = (1.0 + height**2) / height
         assert f"{ratio:.3g}" in str(slender[0].message)
         assert slender[0].filename == __file__  # points at the user's line
+
+
+def test_ndof_has_one_definition_shared_by_the_problem_and_the_result():
+    """The paper's Ndof, 2 n_nodes − 2 n_D, from ``free_ndof``: the budget the loop checks
+    before solving and the ``ndof`` of the solved result agree."""
+    from signorini.contact import solve
+    from signorini.examples import example_6_1
+    from signorini.problem.problem import free_ndof
+
+    pb = example_6_1()
+    space = P2Space(pb.mesh)
+    n_d = pb.dirichlet_nodes(space).size
+    assert n_d > 0
+    assert free_ndof(space, pb.dirichlet_nodes(space)) == 2 * space.n_nodes - 2 * n_d
+    assert pb.free_ndof(pb.mesh) == solve(pb).ndof == 2 * space.n_nodes - 2 * n_d

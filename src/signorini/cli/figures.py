@@ -19,16 +19,17 @@ __all__ = ["compare_uniform", "draw_figures", "figures", "pressure_figure"]
 
 def figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
     """The run's figures (:func:`signorini.plots.run_figures.run_figures`)."""
+    from ..loop.arrays import level_arrays
     from ..plots.run_figures import run_figures
 
-    return run_figures(example, out, last)
+    return run_figures(example, out, None if last is None else level_arrays(last))
 
 
 def pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> list[Path]:
     """The last level's pressure beside the known one the example's ``metrics`` give."""
     from ..plots.run_figures import pressure_figure as draw
 
-    return draw(example, out, last, metrics)
+    return draw(example, out, metrics.pressure(last.result))
 
 
 def draw_figures(

@@ -24,7 +24,7 @@ from ..fem.norms import energy_error2, h1_seminorm_error2
 from ..fem.space import P2Space
 from ..mesh.mesh import Mesh
 from ..problem.fields import evaluate_field
-from ..problem.problem import ContactProblem
+from ..problem.problem import ContactProblem, free_ndof
 from .contact_set import ContactSet, node_classes
 from .frictional import Solved, check_previous, solve_frictional
 from .nested import NESTED_MIN_NDOF, coarse_mesh, transfer_active
@@ -158,9 +158,8 @@ class ContactResult:
 
     @property
     def ndof(self) -> int:
-        """Free scalar unknowns (the paper's Ndof): ``2 n_nodes − 2 n_D``, all P2 DOFs minus
-        both DOFs of every Dirichlet node; constrained contact DOFs are counted."""
-        return self.space.n_dofs - 2 * self.dirichlet_nodes.size
+        """Free scalar unknowns (the paper's Ndof: :func:`~signorini.problem.problem.free_ndof`)."""
+        return free_ndof(self.space, self.dirichlet_nodes)
 
     @property
     def density(self) -> np.ndarray:
@@ -305,7 +304,7 @@ def solve(
         and mesh is not problem.mesh
         and cs.size > 0
         and not cs.has_friction
-        and space.n_dofs - assembled.dirichlet.size >= NESTED_MIN_NDOF
+        and free_ndof(space, problem.dirichlet_nodes(space)) >= NESTED_MIN_NDOF
     ):
         active0 = _nested_active_set(problem, assembled, solver, max_iter, fallback)
         timings["nested"] = time.perf_counter() - t0

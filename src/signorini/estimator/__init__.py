@@ -5,9 +5,12 @@
   and cells.
 - ``h_half_norm``: the H^{1/2}(Γ_C) norm of the penetration (η7).
 - ``marking``: Dörfler marking.
+- ``names``: the terms by name (:data:`TERMS`), from which the history columns and the
+  figures' legends are derived.
 """
 
 from .marking import mark_doerfler
+from .names import TERM_TABLE, TERMS
 from .residual import Estimate, estimate
 
-__all__ = ["Estimate", "estimate", "mark_doerfler"]
+__all__ = ["TERMS", "TERM_TABLE", "Estimate", "estimate", "mark_doerfler"]

@@ -65,6 +65,7 @@ from .curved import (
     neumann_integrals,
 )
 from .friction import friction_edges, move_dirichlet_thirds
+from .names import TERMS
 from .terms import (
     EdgeSet,
     TermShares,
@@ -88,8 +89,6 @@ __all__ = ["ETA5_VARIANTS", "NODE_TERMS", "TERMS", "Estimate", "estimate", "stre
 
 #: the variants of η5 (docs/method.md, *Estimator*); the first is the default
 ETA5_VARIANTS = ("consistent", "paper")
-#: the terms of (5.1) and the friction work η8, in the row order of ``Estimate.eta2_cell``
-TERMS = ("eta_1", "eta_2", "eta_3", "eta_4", "eta_5", "eta_6", "eta_7", "eta_8")
 #: the terms with node contributions (all but the global η7), the rows of ``Estimate.eta2_node``
 NODE_TERMS = tuple(name for name in TERMS if name != "eta_7")
 #: line quadrature degree for the polynomial edge terms η2, η4, η5 (σ(u_h) is linear)

@@ -9,6 +9,7 @@ from dataclasses import asdict, dataclass, field
 
 from ..contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
 from ..contact.solution import SLIP, STICK, ContactResult
+from ..estimator.names import TERM_TABLE
 from ..estimator.residual import Estimate
 
 __all__ = ["COLUMNS", "LevelRecord", "level_record"]
@@ -24,14 +25,7 @@ COLUMNS: dict[str, str] = {
     "ndof_total": "all scalar P2 unknowns, 2 × (vertices + edges), Dirichlet ones included",
     "n_cells": "triangles of the mesh",
     "eta": "the estimator η_h of (5.1), in units of energy norm (√energy)",
-    **{
-        f"eta_{k}": f"contribution η_{k} of the estimator, unsquared (η² = Σ η_k²), "
-        "same unit as eta"
-        for k in range(1, 8)
-    },
-    "eta_8": 'the friction work term η_8 (docs/method.md, *Estimator*, "With friction"), '
-    "unsquared, same unit as eta; 0 without friction (with friction eta_4 is "
-    "‖σ_t(u_h) + p_t,h‖ weighted as before)",
+    **{term.name: term.description for term in TERM_TABLE},
     "error_energy": "energy norm of u − u_h (only with an exact solution, else nan), "
     "same unit as eta",
     "error_h1": "H¹ seminorm of u − u_h (only with an exact solution, else nan), "

@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from .curves import QuadraticBoundary
-from .mesh import Mesh, MeshError, _edge_keys
+from .mesh import Mesh, MeshError
+from .topology import edge_keys
 
 __all__ = ["read_mesh"]
 
@@ -169,10 +170,10 @@ def _with_quadratic_boundaries(mesh: Mesh, given: tuple[np.ndarray, np.ndarray])
     pairs, mids = given
     if not len(pairs):
         return mesh
-    edge_keys = _edge_keys(mesh.edges, mesh.n_points)  # sorted by construction
-    keys = _edge_keys(pairs, mesh.n_points)
-    pos = np.minimum(np.searchsorted(edge_keys, keys), mesh.n_edges - 1)
-    found = edge_keys[pos] == keys
+    mesh_keys = edge_keys(mesh.edges, mesh.n_points)  # sorted by construction
+    keys = edge_keys(pairs, mesh.n_points)
+    pos = np.minimum(np.searchsorted(mesh_keys, keys), mesh.n_edges - 1)
+    found = mesh_keys[pos] == keys
     edge, mids = pos[found], mids[found]
     scale = max(float(np.hypot(*np.ptp(mesh.points, axis=0))), float(np.abs(mesh.points).max()))
     tol = STRAIGHT_TOL * scale

@@ -24,9 +24,7 @@ one value per point.
 
 from __future__ import annotations
 
-import inspect
 import logging
-import warnings
 from collections.abc import Callable, Mapping
 from functools import cached_property
 
@@ -34,6 +32,8 @@ import numpy as np
 
 from .curves import Curve
 from .geometry import signed_area
+from .parts import check_parts, part_indices
+from .topology import boundary_edges, edge_keys, edge_topology, longest_edge_first
 from .validation import (
     MeshError,
     as_cells,
@@ -49,29 +49,6 @@ logger = logging.getLogger(__name__)
 
 _NO_CELLS = np.zeros(0, dtype=np.int64)
 _NO_CELLS.flags.writeable = False
-
-
-def _edge_keys(pairs: np.ndarray, n_points: int) -> np.ndarray:
-    """Unique int64 key of each undirected vertex pair ``(n, 2)``."""
-    lo = np.minimum(pairs[:, 0], pairs[:, 1]).astype(np.int64)
-    hi = np.maximum(pairs[:, 0], pairs[:, 1]).astype(np.int64)
-    return lo * np.int64(n_points) + hi
-
-
-def boundary_edges(cells: np.ndarray) -> np.ndarray:
-    """Edges ``(n_boundary, 2)`` that belong to exactly one cell, oriented counter-clockwise.
-
-    Parameters
-    ----------
-    cells : (n_cells, 3) int array
-        Counter-clockwise triangles.
-    """
-    cells = np.asarray(cells, dtype=np.int64)
-    local = cells[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    n = int(cells.max()) + 1 if cells.size else 0
-    keys = _edge_keys(local, n)
-    _, first, counts = np.unique(keys, return_index=True, return_counts=True)
-    return local[first[counts == 1]]
 
 
 class Mesh:
@@ -187,7 +164,7 @@ class Mesh:
             are not arrays of numbers, ``parts`` that is not a mapping); then at the first
             fault of the mesh, naming it.
         """
-        names = _check_parts(parts)
+        names = check_parts(parts)
         points = as_points(points)
         cells = as_cells(cells, len(points))
         area = nondegenerate_area(points, cells)
@@ -200,49 +177,9 @@ class Mesh:
                 flipped.size,
                 cells.shape[0],
             )
-        cells = _longest_edge_first(points, cells)
+        cells = longest_edge_first(points, cells)
         bnd = boundary_edges(cells)
-        part_of = np.full(len(bnd), -1, dtype=np.int64)
-        keys = _edge_keys(bnd, len(points))
-        order = np.argsort(keys)
-        listed = None  # edges named by an explicit list; predicates only claim the others
-        for index in sorted(range(len(names)), key=lambda i: callable(parts[names[i]])):
-            name = names[index]
-            spec = parts[name]
-            if callable(spec):
-                if listed is None:
-                    listed = part_of >= 0
-                mid = 0.5 * (points[bnd[:, 0]] + points[bnd[:, 1]])
-                hit = _select(name, spec, mid)
-                where = np.flatnonzero(hit & ~listed)
-            else:
-                pairs = np.asarray(spec)
-                if pairs.size == 0:
-                    where = np.zeros(0, dtype=np.int64)
-                else:
-                    if pairs.ndim == 1 and pairs.size % 2 == 0:
-                        pairs = pairs.reshape(-1, 2)
-                    pairs = as_cells(pairs, len(points), what="boundary edges")
-                    k = _edge_keys(pairs, len(points))
-                    pos = np.searchsorted(keys, k, sorter=order)
-                    pos = np.minimum(pos, len(keys) - 1)
-                    found = keys[order[pos]] == k
-                    if not found.all():
-                        bad = pairs[~found][0]
-                        raise MeshError(
-                            f"boundary part {name!r}: ({bad[0]}, {bad[1]}) is not a "
-                            "boundary edge of the mesh"
-                        )
-                    where = order[pos]
-            taken = where[part_of[where] >= 0]
-            if taken.size:
-                other = names[part_of[taken[0]]]
-                bad = bnd[taken[0]]
-                raise MeshError(
-                    f"boundary edge ({bad[0]}, {bad[1]}) is claimed by both parts "
-                    f"{other!r} and {name!r}"
-                )
-            part_of[where] = index
+        part_of = part_indices(points, bnd, parts, names)
         mesh = cls(points, cells, bnd, part_of, names)
         if flipped.size:
             mesh.reoriented = _frozen(flipped)
@@ -321,29 +258,7 @@ class Mesh:
     # ------------------------------------------------------------------ topology
     @cached_property
     def _topology(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        local = self.cells[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-        keys = _edge_keys(local, self.n_points)
-        uniq, first, inverse, counts = np.unique(
-            keys, return_index=True, return_inverse=True, return_counts=True
-        )
-        if counts.max(initial=0) > 2:
-            bad = np.flatnonzero(counts > 2)
-            pairs = local[first[bad]]
-            raise MeshError(
-                f"non-manifold mesh: {bad.size} edge(s) shared by more than two cells, first "
-                f"({pairs[0, 0]}, {pairs[0, 1]})"
-            )
-        edges = np.sort(local[first], axis=1)
-        cell2edge = inverse.reshape(-1, 3)
-        n_edges = uniq.size
-        # edge2cell: column 0 = the first cell seen, column 1 = the other (or -1)
-        owner = np.repeat(np.arange(self.n_cells, dtype=np.int64), 3)
-        edge2cell = np.full((n_edges, 2), -1, dtype=np.int64)
-        edge2cell[:, 0] = owner[first]
-        second = np.ones(inverse.size, dtype=bool)
-        second[first] = False
-        edge2cell[inverse[second], 1] = owner[second]
-        return _frozen(edges), _frozen(cell2edge), _frozen(edge2cell)
+        return edge_topology(self.cells, self.n_points)
 
     @property
     def edges(self) -> np.ndarray:
@@ -376,8 +291,8 @@ class Mesh:
     @cached_property
     def boundary_edge(self) -> np.ndarray:
         """``(n_boundary,)`` mesh edge index of each row of :attr:`boundary`."""
-        keys = _edge_keys(self.edges, self.n_points)  # sorted by construction
-        k = _edge_keys(self.boundary, self.n_points)
+        keys = edge_keys(self.edges, self.n_points)  # sorted by construction
+        k = edge_keys(self.boundary, self.n_points)
         pos = np.minimum(np.searchsorted(keys, k), keys.size - 1)
         if keys.size == 0 or not np.array_equal(keys[pos], k):
             bad = np.flatnonzero(keys[pos] != k)
@@ -474,88 +389,7 @@ class Mesh:
         )
 
 
-# ---------------------------------------------------------------------- helpers
-def _check_parts(parts: object) -> list[str]:
-    """The part names of ``parts``, after checking that it is a mapping from str to an edge
-    list or a selector (before any work on the mesh)."""
-    if not isinstance(parts, Mapping):
-        raise MeshError(
-            "parts must be a mapping {name: (k, 2) boundary vertex pairs or selector f(x)}, "
-            f"got {type(parts).__name__}"
-        )
-    for name, spec in parts.items():
-        if not isinstance(name, str):
-            raise MeshError(f"part names must be strings, got {name!r}")
-        if callable(spec):
-            continue
-        if isinstance(spec, (str, bytes)):
-            raise MeshError(
-                f"boundary part {name!r} must be a (k, 2) array of boundary vertex pairs or a "
-                f"selector f(x), got the string {spec[:40]!r}"
-            )
-        try:
-            a = np.asarray(spec)
-        except (TypeError, ValueError):  # ragged nested sequences
-            a = np.array([None])
-        if a.size and a.dtype.kind not in "iuf":
-            raise MeshError(
-                f"boundary part {name!r} must be a (k, 2) array of boundary vertex pairs or a "
-                f"selector f(x), got {type(spec).__name__}"
-            )
-    return list(parts)
-
-
-def _takes_x_and_y(f: Callable) -> bool:
-    """Whether ``f`` is an old-style selector ``f(x, y)``: exactly two required positional
-    parameters and no ``*args``."""
-    try:
-        params = inspect.signature(f).parameters.values()
-    except (TypeError, ValueError):  # no signature (some builtins): the documented form
-        return False
-    positional = (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
-    required = [p for p in params if p.kind in positional and p.default is inspect.Parameter.empty]
-    star = any(p.kind is inspect.Parameter.VAR_POSITIONAL for p in params)
-    return len(required) == 2 and not star
-
-
-def _select(name: str, f: Callable, mid: np.ndarray) -> np.ndarray:
-    """The selector of part ``name`` at the edge midpoints ``mid (n, 2)``: a ``(n,)`` bool
-    array, or a :class:`MeshError` naming the part."""
-    try:
-        if _takes_x_and_y(f):
-            warnings.warn(
-                f"the selector of boundary part {name!r} takes (x, y); selectors take the "
-                "points x of shape (n, 2): write `lambda x: ...` with x[:, 0] and x[:, 1] "
-                "for the coordinates (the form f(x, y) will stop working)",
-                DeprecationWarning,
-                stacklevel=3,
-            )
-            hit = f(mid[:, 0], mid[:, 1])
-        else:
-            hit = f(mid)
-    except Exception as exc:
-        raise MeshError(
-            f"the selector of boundary part {name!r} raised {type(exc).__name__}: {exc}"
-        ) from exc
-    hit = np.asarray(hit)
-    if hit.dtype.kind not in "biuf" or hit.size != len(mid):
-        raise MeshError(
-            f"the selector of boundary part {name!r} must return one bool per edge "
-            f"midpoint, shape ({len(mid)},), got shape {hit.shape} of {hit.dtype}"
-        )
-    return hit.astype(bool).reshape(-1)
-
-
 def _frozen(a: np.ndarray) -> np.ndarray:
     """Mark a cached array read-only (a Mesh is immutable)."""
     a.flags.writeable = False
     return a
-
-
-def _longest_edge_first(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
-    """Rotate each cell's vertices cyclically so that local edge 0 is its longest edge."""
-    p = points[cells]
-    length2 = ((p[:, [1, 2, 0]] - p) ** 2).sum(-1)  # edge k: vertex k -> k+1
-    k = np.argmax(length2, axis=1)
-    rows = np.arange(len(cells))[:, None]
-    return cells[rows, (k[:, None] + np.arange(3)[None, :]) % 3]

@@ -4,12 +4,16 @@ Every function takes dictionaries of arrays or arrays, never the package's solve
 so that a figure can be redrawn from the files a run leaves (``history.csv``, meshes).
 
 - :mod:`.style`: colours, markers and labels of every quantity, figure creation and saving;
-- :mod:`.convergence`: the figures against ``N_dof`` (Figs. 6.1, 6.2, 6.3(a), 6.4);
+- :mod:`.convergence`: the figures against ``N_dof`` (Figs. 6.1, 6.2, 6.3(a), 6.4), on the
+  frame of :mod:`.frame`;
 - :mod:`.slopes`: fitted slopes in legends (over the finer half of the run, stated in the
   legend) and slope triangles;
 - :mod:`.mesh`: a triangulation (Fig. 6.3(b)); :mod:`.deformed`: the deformed body and the
-  contact pressure; :mod:`.pressure`: a computed pressure beside a known one;
-- :mod:`.report`: the figures a finished run gets, chosen by what its history contains.
+  contact pressure (against the coordinate of :mod:`.contact_line`); :mod:`.pressure`: a
+  computed pressure beside a known one;
+- :mod:`.report`: the figures a finished run gets, chosen by what its history contains;
+  :mod:`.run_figures`: a run folder's figures, from its history and its last level as plain
+  arrays.
 
 :func:`read_history` and :func:`fitted_slope` belong to :mod:`signorini.output.history` and
 are re-exported here.

@@ -19,17 +19,16 @@ from matplotlib.transforms import offset_copy
 from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
-from ..algebra.friction_result import INACTIVE, SLIP, STICK
-from ..mesh.mesh import boundary_edges
+from ..mesh.topology import boundary_edges
+from .contact_line import contact_coordinate
 from .mesh import line_width, mesh_arrays
 from .style import RC, STYLES, fit_title, new_figure, save_figure, trim_height
 
 __all__ = [
     "plot_deformed",
-    "contact_coordinate",
     "displacement_scale",
     "scale_text",
-    "free_boundary_ends",
+    "NODE_STATES",
 ]
 
 #: Largest displacement drawn, as a fraction of the body's size, when it is rescaled.
@@ -39,6 +38,9 @@ TRUE_SCALE_RANGE = (0.02, 0.25)
 #: The obstacle drawn from gaps is left out where the drawn gap exceeds this fraction of the
 #: body's size (a shape far from most of a curved contact part, e.g. the plane under a disc).
 OBSTACLE_REACH = 0.25
+
+#: The states a contact node may be in, as ``plot_deformed(state=...)`` names them.
+NODE_STATES = ("inactive", "stick", "slip")
 
 #: How the stick and slip nodes of a frictional contact and its friction stress are drawn.
 FRICTION_STYLES: dict[str, dict[str, str]] = {
@@ -98,65 +100,6 @@ def _vertex_displacement(displacement: ArrayLike, n_points: int) -> np.ndarray:
             f"{n_points}, got {np.shape(displacement)}"
         )
     return u[:n_points]
-
-
-def contact_coordinate(cp: np.ndarray) -> tuple[np.ndarray, str]:
-    """Abscissa along the contact boundary and its axis label.
-
-    Parameters
-    ----------
-    cp : (k, 2) float array
-        Points on the contact boundary, in any order.
-
-    Returns
-    -------
-    t : (k,) float array
-        ``x`` or ``y`` for an axis-parallel boundary, else the arclength ``s`` along the
-        points' principal direction (starting at 0, increasing with the direction's largest
-        component).
-    label : str
-        ``"$x$"``, ``"$y$"`` or ``"$s$ (along $\\Gamma_C$)"``.
-    """
-    span = np.ptp(cp, axis=0)
-    tol = 1e-12 * max(float(span.max()), 1.0)
-    if span[1] <= tol:
-        return cp[:, 0], r"$x$"
-    if span[0] <= tol:
-        return cp[:, 1], r"$y$"
-    centred = cp - cp.mean(axis=0)
-    direction = np.linalg.svd(centred, full_matrices=False)[2][0]
-    if direction[np.argmax(np.abs(direction))] < 0:
-        direction = -direction
-    t = centred @ direction
-    return t - t.min(), r"$s$ (along $\Gamma_C$)"
-
-
-def free_boundary_ends(contact_points: ArrayLike, active: ArrayLike) -> np.ndarray:
-    """Where the contact zone ends: midpoints between neighbouring contact nodes, one active
-    and one not, in order along the boundary (:func:`contact_coordinate`).
-
-    Parameters
-    ----------
-    contact_points : (k, 2) float array
-        The contact nodes, in any order.
-    active : (k,) bool array
-        Which of them are in contact.
-
-    Returns
-    -------
-    (m, 2) float array
-        The ends (none when the whole boundary, or none of it, is in contact).
-    """
-    cp = np.asarray(contact_points, dtype=np.float64).reshape(-1, 2)
-    on = np.asarray(active, dtype=bool).reshape(-1)
-    if on.shape != (cp.shape[0],):
-        raise ValueError(f"active must have shape ({cp.shape[0]},), got {on.shape}")
-    if cp.shape[0] < 2:
-        return np.zeros((0, 2))
-    order = np.argsort(contact_coordinate(cp)[0], kind="stable")
-    q, a = cp[order], on[order]
-    change = np.flatnonzero(a[1:] != a[:-1])
-    return 0.5 * (q[change] + q[change + 1])
 
 
 def _draw_body(
@@ -262,8 +205,8 @@ def _draw_states(ax: Any, at: np.ndarray, state: np.ndarray, legend: bool = True
     """Markers on the contact nodes that stick and that slip, at the points ``at (k, 2)``
     (labelled for the legend, or not)."""
     size = 3.0 if state.size <= 200 else 1.5
-    for key, value in (("stick", STICK), ("slip", SLIP)):
-        on = state == value
+    for key in ("stick", "slip"):
+        on = state == key
         if not on.any():
             continue
         st = FRICTION_STYLES[key]
@@ -302,10 +245,10 @@ def plot_deformed(
     drawn piecewise linearly), coloured by the unscaled ``|u_h|`` with Gouraud shading; the
     reference configuration's boundary is dashed. The title's last line states the scale.
     When ``pressure`` is given, a second axes below shows it against the coordinate along the
-    contact boundary (:func:`contact_coordinate`), with the friction stress
-    ``tangential_pressure`` when that is given. With ``state`` the contact nodes that stick
-    and that slip are marked on the drawn body (at ``contact_points + scale *
-    contact_displacement``). The figure's height follows the drawn body's aspect ratio.
+    contact boundary (:func:`~signorini.plots.contact_line.contact_coordinate`), with the
+    friction stress ``tangential_pressure`` when that is given. With ``state`` the contact
+    nodes that stick and that slip are marked on the drawn body (at ``contact_points + scale
+    * contact_displacement``). The figure's height follows the drawn body's aspect ratio.
 
     Parameters
     ----------
@@ -338,6 +281,13 @@ def plot_deformed(
         the same scale as the body, so a body that does not penetrate the obstacle is not
         drawn through it; left out where ``scale * |gap|`` exceeds :data:`OBSTACLE_REACH`
         times the body's size. Not together with ``obstacle``.
+    state : (k,) str array, optional
+        Each contact node's state, one of :data:`NODE_STATES` (``"inactive"``, ``"stick"``,
+        ``"slip"``): the stick and slip nodes are marked. Needs ``contact_displacement``.
+    contact_displacement : (k, 2) float array, optional
+        The displacement of the contact nodes (where their states are marked).
+    tangential_pressure : (k,) float array, optional
+        The friction stress p_t at ``contact_points``, drawn with the pressure.
 
     Returns
     -------
@@ -441,6 +391,6 @@ def _checked_states(
             f"state must have shape ({cp.shape[0]},) and contact_displacement {cp.shape} to "
             f"match contact_points, got {st.shape} and {uc.shape}"
         )
-    if not np.isin(st, (INACTIVE, STICK, SLIP)).all():
-        raise ValueError("state must hold 0 (inactive), 1 (stick) or 2 (slip)")
+    if not np.isin(st, NODE_STATES).all():
+        raise ValueError(f"state must hold the labels {', '.join(map(repr, NODE_STATES))}")
     return uc, st

@@ -23,7 +23,7 @@ from matplotlib.patches import Rectangle
 from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
-from ..mesh.mesh import boundary_edges
+from ..mesh.topology import boundary_edges
 from .style import RC, fit_title, new_figure, save_figure, trim_height
 
 __all__ = [
@@ -189,7 +189,7 @@ def plot_mesh(
         Colours of the highlighted groups, in order (repeated if there are more groups).
     zoom : (x, y, half_width), optional
         A second panel below shows the square window of this centre and half width (e.g.
-        around a free-boundary end, :func:`~signorini.plots.deformed.free_boundary_ends`);
+        around a free-boundary end, :func:`~signorini.plots.contact_line.free_boundary_ends`);
         the window is outlined on the whole mesh.
     zoom_title : str
         Title of the zoom panel.

@@ -1,27 +1,51 @@
 """The figures of a run folder: the convergence figures from its history, and from its last
 level the mesh (with Γ_D, Γ_N, Γ_C marked), the deformed body and, for an example that knows
 its pressure, the pressure beside the known one. Called by the command line after a run and
-by ``signorini figures``."""
+by ``signorini figures``.
+
+The last level comes as plain data: a mapping of arrays (:func:`run_figures` lists its keys;
+:func:`signorini.loop.arrays.level_arrays` builds it from a level of the loop), and the known
+pressure as a record of arrays (:class:`KnownPressure`).
+"""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any, Protocol
 
 import numpy as np
 
 from .. import plots
-from ..examples import Metrics
-from ..loop import Level
 from ..mesh.curves import Line
 from ..mesh.mesh import Mesh
 from ..output import read_history
-from .deformed import free_boundary_ends
+from .contact_line import free_boundary_ends
 from .mesh import boundary_groups
 
-__all__ = ["part_segments", "pressure_figure", "run_figures"]
+__all__ = ["KnownPressure", "part_segments", "pressure_figure", "run_figures"]
+
+#: How the figure of the mesh labels the parts of each kind (``last["parts"]``' keys).
+PART_LABELS = {
+    "dirichlet": r"Dirichlet $\Gamma_D$",
+    "neumann": r"Neumann $\Gamma_N$",
+    "contact": r"contact $\Gamma_C$",
+}
 
 
-def run_figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
+class KnownPressure(Protocol):
+    """A computed contact pressure beside a known one (e.g.
+    :class:`signorini.examples.metrics.PressureComparison`)."""
+
+    x: np.ndarray
+    pressure: np.ndarray
+    x_reference: np.ndarray
+    reference: np.ndarray
+    label: str
+    title: str
+
+
+def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) -> list[Path]:
     """The run's convergence figures; with its last level also the mesh and the deformed body.
 
     The mesh figure shows the finest level of at most ``plots.READABLE_CELLS`` cells (read back
@@ -29,36 +53,44 @@ def run_figures(example: str, out: Path, last: Level | None = None) -> list[Path
     mesh), with Γ_D, Γ_N and Γ_C marked. The deformed body is drawn with a stated displacement
     scale, the obstacle at its gap with the same scale; with friction its stick and slip nodes
     marked and the friction stress drawn with the pressure.
+
+    Parameters
+    ----------
+    example : str
+        The run's name (file names and titles).
+    out : pathlib.Path
+        The run folder, with its ``history.csv``.
+    last : mapping, optional
+        The last level as plain data (:func:`signorini.loop.arrays.level_arrays`):
+        ``level`` (int), ``points (n, 2)``, ``cells (m, 3)``, ``displacement (n_nodes, 2)``
+        (vertices first), ``initial`` (the problem's initial :class:`~signorini.mesh.Mesh`,
+        whose parts refinement splits), ``parts`` (part names by kind: ``"dirichlet"``,
+        ``"neumann"``, ``"contact"``), and per contact node ``contact_points (k, 2)``,
+        ``active (k,)``, ``pressure (k,)``, ``gap (k,)``, ``normal (k, 2)``; with friction
+        also ``state (k,)`` (labels, :data:`~signorini.plots.deformed.NODE_STATES`),
+        ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)``.
     """
     written = list(plots.make_figures(out / "history.csv", out, example))
     if last is None:
         return written
-    res = last.result
-    mesh = res.mesh
     # the level the mesh figure shows
     history = read_history(out / "history.csv")
     k = plots.readable_level(history["n_cells"])
-    level, points, cells = last.record.level, mesh.points, mesh.cells
+    level, points, cells = last["level"], last["points"], last["cells"]
     if k != level and (out / f"level_{k:03d}.vtu").is_file():
         p, c = plots.read_level_mesh(out / f"level_{k:03d}.vtu")
         if c.shape[0] == int(history["n_cells"][k]):
             level, points, cells = k, p, c
-    problem = res.problem
-    initial = problem.mesh
-    kinds = {
-        r"Dirichlet $\Gamma_D$": problem.dirichlet_parts,
-        r"Neumann $\Gamma_N$": problem.neumann_parts,
-        r"contact $\Gamma_C$": problem.contact_parts,
-    }
+    initial = last["initial"]
     segments = {
         label: np.concatenate(
-            [part_segments(initial, n, points, cells) for n in parts] or [np.zeros((0, 2, 2))]
+            [part_segments(initial, n, points, cells) for n in last["parts"][kind]]
+            or [np.zeros((0, 2, 2))]
         )
-        for label, parts in kinds.items()
+        for kind, label in PART_LABELS.items()
     }
     # a zoom on the first end of the contact zone, if it ends inside Γ_C
-    cs = res.contact
-    ends = free_boundary_ends(res.space.node_points[cs.nodes], res.active)
+    ends = free_boundary_ends(last["contact_points"], last["active"])
     zoom = {}
     if len(ends):
         half = 0.06 * float(np.ptp(points, axis=0).max())
@@ -74,22 +106,21 @@ def run_figures(example: str, out: Path, last: Level | None = None) -> list[Path
         colors=("#1f77b4", "#2ca02c", "#d62728"),
         **zoom,
     )
-    friction = {}
-    if cs.has_friction:  # stick and slip nodes marked, the friction stress drawn
-        friction = {
-            "state": res.state,
-            "contact_displacement": res.u[cs.nodes],
-            "tangential_pressure": res.tangential_pressure,
-        }
+    # with friction: stick and slip nodes marked, the friction stress drawn
+    friction = {
+        key: last[key]
+        for key in ("state", "contact_displacement", "tangential_pressure")
+        if key in last
+    }
     written += plots.plot_deformed(
-        mesh.points,
-        mesh.cells,
-        res.u[: mesh.n_points],
+        last["points"],
+        last["cells"],
+        last["displacement"][: last["points"].shape[0]],
         out / "deformed",
-        contact_points=res.space.node_points[cs.nodes],
-        pressure=res.pressure,
-        gap=cs.gap,
-        normal=cs.normal,
+        contact_points=last["contact_points"],
+        pressure=last["pressure"],
+        gap=last["gap"],
+        normal=last["normal"],
         title=f"{example}: deformed body",
         **friction,
     )
@@ -117,10 +148,10 @@ def part_segments(initial: Mesh, part: str, points: np.ndarray, cells: np.ndarra
     return points[near[on]]
 
 
-def pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> list[Path]:
-    """The last level's pressure beside the known one the example's ``metrics`` give
-    (``<example>_pressure``; e.g. Hertz's for ``hertz``)."""
-    known = metrics.pressure(last.result)
+def pressure_figure(example: str, out: Path, known: KnownPressure) -> list[Path]:
+    """The last level's pressure beside the known one (``<example>_pressure``; e.g. Hertz's
+    for ``hertz``), as an example's metrics give it
+    (:attr:`Metrics.pressure <signorini.examples.Metrics.pressure>` of the last level)."""
     return plots.plot_pressure_comparison(
         known.x,
         known.pressure,

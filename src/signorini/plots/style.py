@@ -24,10 +24,13 @@ from matplotlib.figure import Figure
 from matplotlib.font_manager import FontProperties
 from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
 
+from ..estimator.names import TERM_TABLE
+
 __all__ = [
     "STYLES",
     "CONTRIBUTIONS",
-    "FRICTION_CONTRIBUTION",
+    "FRICTION_CONTRIBUTIONS",
+    "TERM_LOOKS",
     "RC",
     "DPI",
     "SINGLE_COLUMN",
@@ -45,11 +48,24 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 #: The history columns of the estimator's contributions η_1 … η_7 (paper, (5.1)).
-CONTRIBUTIONS = tuple(f"eta_{k}" for k in range(1, 8))
+CONTRIBUTIONS = tuple(term.name for term in TERM_TABLE if not term.friction)
 
-#: The history column of the friction work η_8 (docs/method.md, *Estimator*, "With
-#: friction"): a contribution of frictional runs only.
-FRICTION_CONTRIBUTION = "eta_8"
+#: The history columns of the contributions of frictional runs only: the friction work η_8
+#: (docs/method.md, *Estimator*, "With friction").
+FRICTION_CONTRIBUTIONS = tuple(term.name for term in TERM_TABLE if term.friction)
+
+#: Colour and marker of each estimator term, in the order of
+#: :data:`~signorini.estimator.names.TERM_TABLE`.
+TERM_LOOKS: tuple[tuple[str, str], ...] = (
+    ("#ff7f0e", "^"),
+    ("#2ca02c", "v"),
+    ("#9467bd", "<"),
+    ("#8c564b", ">"),
+    ("#e377c2", "D"),
+    ("#7f7f7f", "p"),
+    ("#bcbd22", "h"),
+    ("#393b79", "*"),
+)
 
 #: Colour, marker and label of every plotted quantity (keyed by its history column), the
 #: same in all figures.
@@ -58,14 +74,10 @@ STYLES: dict[str, dict[str, str]] = {
     "error_h1": {"color": "#17becf", "marker": "x", "label": r"$|u-u_h|_{H^1}$"},
     "eta": {"color": "#d62728", "marker": "s", "label": r"$\eta_h$"},
     "efficiency": {"color": "#222222", "marker": "o", "label": r"$\eta_h/\|u-u_h\|_a$"},
-    "eta_1": {"color": "#ff7f0e", "marker": "^", "label": r"$\eta_1$"},
-    "eta_2": {"color": "#2ca02c", "marker": "v", "label": r"$\eta_2$"},
-    "eta_3": {"color": "#9467bd", "marker": "<", "label": r"$\eta_3$"},
-    "eta_4": {"color": "#8c564b", "marker": ">", "label": r"$\eta_4$"},
-    "eta_5": {"color": "#e377c2", "marker": "D", "label": r"$\eta_5$"},
-    "eta_6": {"color": "#7f7f7f", "marker": "p", "label": r"$\eta_6$"},
-    "eta_7": {"color": "#bcbd22", "marker": "h", "label": r"$\eta_7$"},
-    "eta_8": {"color": "#393b79", "marker": "*", "label": r"$\eta_8$"},
+    **{
+        term.name: {"color": color, "marker": marker, "label": term.label}
+        for term, (color, marker) in zip(TERM_TABLE, TERM_LOOKS, strict=True)
+    },
     "pressure": {"color": "#08306b", "marker": "o", "label": r"$p_h$"},
     "contact": {"color": "#d62728", "marker": "", "label": r"$\Gamma_C$"},
     "obstacle": {"color": "#333333", "marker": "", "label": "obstacle"},

@@ -31,7 +31,18 @@ from ..mesh.mesh import Mesh
 from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann
 from .fields import ProblemError, VectorField, check_function
 
-__all__ = ["ContactProblem", "SlenderBodyWarning"]
+__all__ = ["ContactProblem", "SlenderBodyWarning", "free_ndof"]
+
+
+def free_ndof(space: P2Space, dirichlet_nodes: np.ndarray) -> int:
+    """The paper's Ndof: the free scalar unknowns of ``space``, ``2 n_nodes − 2 n_D``.
+
+    All DOFs of the space minus both DOFs of each of the ``n_D`` nodes ``dirichlet_nodes``
+    on the closure of Γ_D; constrained contact DOFs are counted (docs/method.md, *Data
+    conventions*). The one definition of the count that budgets (``max_ndof``) and histories
+    (``ndof``) use.
+    """
+    return space.n_dofs - 2 * len(dirichlet_nodes)
 
 
 @dataclass(frozen=True)
@@ -140,10 +151,9 @@ class ContactProblem:
         return space.part_nodes(self.dirichlet_parts)
 
     def free_ndof(self, mesh: Mesh) -> int:
-        """Free scalar unknowns on ``mesh``, the paper's Ndof: all P2 DOFs minus the Dirichlet
-        DOFs (docs/method.md, *Data conventions*)."""
+        """Free scalar unknowns on ``mesh``, the paper's Ndof (:func:`free_ndof`)."""
         space = P2Space(mesh)
-        return space.n_dofs - 2 * self.dirichlet_nodes(space).size
+        return free_ndof(space, self.dirichlet_nodes(space))
 
     def _segment_normal(self, name: str) -> np.ndarray | None:
         """Outward unit normal of a straight contact part with a gap function, checked against

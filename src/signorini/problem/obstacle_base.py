@@ -1,0 +1,114 @@
+"""The obstacle protocol (docs/method.md, *Obstacles as shapes*): :class:`Obstacle`, the base
+every shape subclasses, and the argument checks the built-in shapes share.
+
+An obstacle answers :meth:`Obstacle.gap_and_direction` for points ``x (n, 2)``: with ``q``
+the point of the obstacle closest to ``z``, ``n_z`` is the obstacle's unit normal at ``q``
+pointing *into* the obstacle and ``psi(z)`` the signed distance from ``z`` to the obstacle
+(positive outside, negative when ``z`` penetrates), so that ``q = z + psi(z) n_z``. The one
+call site is the contact layer's constraint data (``contact/constraint_data.py``).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+import numpy as np
+
+__all__ = [
+    "TIE",
+    "Obstacle",
+    "checked_point",
+    "checked_positive",
+    "cross",
+    "finite_array",
+    "unit_vectors",
+]
+
+#: candidates whose distance is within TIE * scale of the smallest are all closest
+TIE = 1e-12
+
+
+def finite_array(value, owner: str, name: str) -> np.ndarray:
+    """``value`` as a finite float64 array (a copy)."""
+    try:
+        array = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{owner}: {name} must be numeric, got {value!r}") from err
+    if not np.isfinite(array).all():
+        raise ValueError(f"{owner}: {name} has non-finite entries")
+    return array
+
+
+def checked_point(value, owner: str, name: str) -> np.ndarray:
+    array = finite_array(value, owner, name)
+    if array.shape != (2,):
+        raise ValueError(f"{owner}: {name} must have shape (2,), got {array.shape}")
+    return array
+
+
+def checked_positive(value, owner: str, name: str, allow_zero: bool = False) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{owner}: {name} must be a number, got {value!r}") from err
+    if not np.isfinite(number) or number < 0 or (number == 0 and not allow_zero):
+        bound = ">= 0" if allow_zero else "> 0"
+        raise ValueError(f"{owner}: {name} must be finite and {bound}, got {value!r}")
+    return number
+
+
+def unit_vectors(vectors: np.ndarray) -> np.ndarray:
+    return vectors / np.hypot(vectors[..., 0], vectors[..., 1])[..., None]
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+class Obstacle(ABC):
+    """A rigid obstacle, the base of every shape: :meth:`gap_and_direction` checks the points
+    and asks the subclass's :meth:`_gap_and_direction`, the one method a new shape writes.
+
+    A shape of one's own is a subclass, e.g. a flat foundation ``y >= -d`` below the body::
+
+        class Floor(Obstacle):
+            def __init__(self, depth):
+                self.depth = depth
+
+            def _gap_and_direction(self, x):
+                return x[:, 1] + self.depth, np.tile([0.0, -1.0], (len(x), 1))
+
+    and is given as ``Contact(obstacle=Floor(0.1))``.
+    """
+
+    def gap_and_direction(self, x) -> tuple[np.ndarray, np.ndarray]:
+        """Signed distance and constraint direction at the points ``x``.
+
+        Parameters
+        ----------
+        x : (n, 2) float array
+            Points, e.g. the body's boundary nodes.
+
+        Returns
+        -------
+        psi : (n,) float array
+            Signed distance from each point to the obstacle: positive outside, negative inside.
+        n : (n, 2) float array
+            Unit normal of the obstacle at the closest point, pointing into the obstacle;
+            ``x + psi[:, None] * n`` is that closest point.
+        """
+        try:
+            points = np.asarray(x, dtype=np.float64)
+        except (TypeError, ValueError) as err:
+            raise ValueError(f"{self!r}: x must be a numeric (n, 2) array") from err
+        if points.ndim != 2 or points.shape[1] != 2:
+            raise ValueError(f"{self!r}: x must have shape (n, 2), got {points.shape}")
+        if not np.isfinite(points).all():
+            k = int(np.flatnonzero(~np.isfinite(points).all(axis=1))[0])
+            raise ValueError(f"{self!r}: x[{k}] is not finite: {points[k]}")
+        return self._gap_and_direction(points)
+
+    @abstractmethod
+    def _gap_and_direction(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``psi (n,)`` and ``n (n, 2)`` as :meth:`gap_and_direction` returns them, at the
+        checked points ``x (n, 2)`` (finite float64)."""
