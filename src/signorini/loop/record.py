@@ -9,7 +9,7 @@ from dataclasses import asdict, dataclass, field
 
 from ..contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
 from ..contact.solution import SLIP, STICK, ContactResult
-from ..estimator.names import TERM_TABLE
+from ..estimator.names import TERM_TABLE, TERMS
 from ..estimator.residual import Estimate
 
 __all__ = ["COLUMNS", "LevelRecord", "level_record"]
@@ -183,7 +183,6 @@ class LevelRecord:
 
 
 def level_record(level: int, result: ContactResult, est: Estimate) -> LevelRecord:
-    terms = est.eta_terms
     classes = result.classes
     report = result.report
     rec = LevelRecord(
@@ -192,7 +191,7 @@ def level_record(level: int, result: ContactResult, est: Estimate) -> LevelRecor
         ndof_total=result.space.n_dofs,
         n_cells=result.mesh.n_cells,
         eta=est.eta,
-        **{f"eta_{k + 1}": float(terms[k]) for k in range(8)},
+        **{name: float(value) for name, value in zip(TERMS, est.eta_terms, strict=True)},
         pdas_iterations=report.iterations,
         n_solves=report.n_solves,
         n_factorizations=report.n_factorizations,
