@@ -119,7 +119,7 @@ def main() -> None:
     print(table(rows, peak))
     print()
     print(
-        f"dense peak: {peak:.1f} GFlop/s (NumPy float64 product of order {args.blas_n}, "
+        f"dense peak: {peak:.4g} GFlop/s (NumPy float64 product of order {args.blas_n}, "
         f"best of {args.repeat}); factorization: MKL PARDISO, numerical phase only"
     )
 
