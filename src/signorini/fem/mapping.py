@@ -26,7 +26,6 @@ determinants and normals here are those of plane (d = 2) cells and edges.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from typing import Union
 
 import numpy as np
 
@@ -152,7 +151,7 @@ class QuadraticEdges:
         return np.hypot(dx[..., 0], dx[..., 1])
 
 
-Edges = Union[StraightEdges, QuadraticEdges]
+Edges = StraightEdges | QuadraticEdges
 
 
 def edge_groups(
@@ -245,6 +244,11 @@ class AffineCells:
         """``(m, 1, 2, d, d)`` ``∂²u_i/∂x_j∂x_k`` of a P2 field (constant on each cell)."""
         return p2.field_hessian(self.vertices, u_cell)[:, None]
 
+    def rows(self, slot: np.ndarray) -> AffineCells:
+        """The cells at rows ``slot`` of this group, as a group."""
+        cells = slot if isinstance(self.cells, slice) else self.cells[slot]
+        return AffineCells(self.vertices[slot], cells)
+
     def local_edges(self, slot: np.ndarray, k: np.ndarray) -> StraightEdges:
         """Local edge ``k`` of the cells at rows ``slot`` of this group."""
         flat = self.vertices.reshape(-1, self.vertices.shape[-1])
@@ -311,12 +315,17 @@ class IsoparametricCells:
         """``(m, q, 2, d, d)`` ``∂²u_i/∂x_j∂x_k`` of a P2 field, exact through the map."""
         return iso.field_derivatives(self.nodes, u_cell, xi)[1]
 
+    def rows(self, slot: np.ndarray) -> IsoparametricCells:
+        """The cells at rows ``slot`` of this group, as a group."""
+        cells = slot if isinstance(self.cells, slice) else self.cells[slot]
+        return IsoparametricCells(self.nodes[slot], cells)
+
     def local_edges(self, slot: np.ndarray, k: np.ndarray) -> QuadraticEdges:
         """Local edge ``k`` of the cells at rows ``slot``: the map restricted to it."""
         return QuadraticEdges(self.nodes[slot[:, None], EDGE_NODES[k]])
 
 
-Cells = Union[AffineCells, IsoparametricCells]
+Cells = AffineCells | IsoparametricCells
 
 
 class CellMap:
@@ -368,9 +377,7 @@ class CellMap:
         """``(n_cells, q, d)`` the images of the reference points ``xi (q, 2)``."""
         return self.per_cell(lambda g: g.points(xi))
 
-    def split(
-        self, cell: np.ndarray
-    ) -> Iterator[tuple[slice | np.ndarray, Cells, np.ndarray]]:
+    def split(self, cell: np.ndarray) -> Iterator[tuple[slice | np.ndarray, Cells, np.ndarray]]:
         """The given cells ``(e,)`` by group: ``(rows into cell, group, rows in the group)``."""
         if len(self.groups) == 1:
             yield _ALL, self.groups[0], cell

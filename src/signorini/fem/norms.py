@@ -51,7 +51,9 @@ def _grad_error_loop(cells, u_cell, grad_exact, degree, density):
 
     def error(g: Cells, u: np.ndarray):
         gradient = g.gradient_field(u)
-        return lambda x, xi: density(np.asarray(grad_exact(x), dtype=np.float64) - gradient(xi)[:, 0])
+        return lambda x, xi: density(
+            np.asarray(grad_exact(x), dtype=np.float64) - gradient(xi)[:, 0]
+        )
 
     return _pointwise(cells, u_cell, degree, error)
 

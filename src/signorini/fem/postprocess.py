@@ -14,7 +14,7 @@ from ..mesh.geometry import segment_normals
 from . import p2
 from .material import Material, stress
 
-__all__ = ["cell_stress", "div_stress", "edge_traction", "traction"]
+__all__ = ["cell_stress", "div_stress", "edge_traction", "stress_divergence", "traction"]
 
 
 def cell_stress(
@@ -121,7 +121,14 @@ def div_stress(vertices: np.ndarray, u_cell: np.ndarray, material: Material) -> 
     -------
     ndarray of float64, shape (m, 2)
     """
-    H = p2.field_hessian(vertices, u_cell)  # (m, i, j, k)
-    lap = H[:, :, 0, 0] + H[:, :, 1, 1]
-    grad_div = H[:, 0, 0, :] + H[:, 1, 1, :]
+    return stress_divergence(p2.field_hessian(vertices, u_cell), material)
+
+
+def stress_divergence(hess: np.ndarray, material: Material) -> np.ndarray:
+    """``div sigma(u)`` ``(..., 2)`` from the Hessian ``(..., 2, 2, 2)`` of ``u``,
+    ``hess[..., i, j, k] = d^2 u_i / d x_j d x_k`` (e.g. through a cell's map,
+    :meth:`signorini.fem.mapping.IsoparametricCells.field_hessians`):
+    ``mu Laplace u_i + (lam + mu) d_i div u``."""
+    lap = hess[..., 0, 0] + hess[..., 1, 1]
+    grad_div = hess[..., 0, 0, :] + hess[..., 1, 1, :]
     return material.mu * lap + (material.lam + material.mu) * grad_div

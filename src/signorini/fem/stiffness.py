@@ -79,7 +79,11 @@ def _stiffness_basis(
                         full[:, i, j, k, l, :, :, 1, 1] += mu * r
     out = np.empty((R.shape[0], len(_P_PAIRS), 144))
     for s, (p, q) in enumerate(_P_PAIRS):
-        blk = full[(slice(None),) + p] if p == q else full[(slice(None),) + p] + full[(slice(None),) + q]
+        blk = (
+            full[(slice(None),) + p]
+            if p == q
+            else full[(slice(None),) + p] + full[(slice(None),) + q]
+        )
         out[:, s] = (blk.transpose(0, 1, 3, 2, 4) if dof_order else blk).reshape(R.shape[0], 144)
     out = out.reshape(-1, 144)
     out.setflags(write=False)
