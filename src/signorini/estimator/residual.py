@@ -34,10 +34,12 @@ name. Every node term is a sum of cell or edge integrals; each cell receives its
 terms split equally between the edge's cells, ``terms.spread_edge_integrals``), so the
 element indicators sum exactly to η_h².
 
-On a mesh with curved parts the integrals of the isoparametric cells and their edges are
-replaced by those along the quadratic maps (:mod:`signorini.estimator.curved`), and η4, η5
-split the traction along the constraint direction field where n_z is not the edge's normal
-(docs/method.md, *Estimator*, "On curved boundaries").
+Each integral is taken once, through the geometry of its cell or edge
+(:mod:`signorini.fem.mapping`, :func:`geometry`): the closed forms of straight cells where
+the Jacobian is constant, the quadratic maps of the isoparametric cells along curved parts
+and their quadratic edges elsewhere; η4, η5 split the traction along the constraint direction
+field where n_z is not the edge's normal (docs/method.md, *Estimator*, "On curved
+boundaries").
 """
 
 from __future__ import annotations
