@@ -58,9 +58,12 @@ class CellStress:
         mesh = space.mesh
         return cls(space.mapping, mesh.points, mesh.cells, u_cell, material, sigma, unit)
 
-    def _traction(self, group: Cells, slot, cell, k, t, edges: Edges) -> np.ndarray:
+    def _traction(self, group: Cells, slot, cell, k, t, edges: Edges | None) -> np.ndarray:
+        """σ(u_h) n on local edges ``k`` of ``cell`` (rows ``slot`` of ``group``); ``edges``
+        their geometry where already built."""
         if isinstance(group, AffineCells):
             return edge_traction(self.sigma_vertex, self.points, self.cell_vertices, cell, k, t)
+        edges = group.local_edges(slot, k) if edges is None else edges
         grad = group.rows(slot).field_gradients(self.u_cell[cell], edge_reference_points(k, t))
         sig = stress(self.material, grad) / self.unit
         return np.einsum("eqij,eqj->eqi", sig, edges.normals(t))
@@ -72,17 +75,18 @@ class CellStress:
         (q,)`` (counter-clockwise around the cell), n the outward normal, group by group:
         ``(rows, traction (r, q, 2), edges)`` with the edges' geometry."""
         for rows, g, slot, edges in self.cells.local_edges(cell, k):
-            c, kk = cell[rows], k[rows]
-            yield rows, self._traction(g, slot, c, kk, t, edges), edges
+            yield rows, self._traction(g, slot, cell[rows], k[rows], t, edges), edges
 
     def traction(self, cell: np.ndarray, k: np.ndarray, t: np.ndarray) -> np.ndarray:
         """``σ(u_h) n`` ``(e, q, 2)`` along local edge ``k`` of each ``cell`` (as
-        :meth:`on_edges`, in one array)."""
-        if len(self.cells.groups) == 1 and isinstance(self.cells.groups[0], AffineCells):
-            return edge_traction(self.sigma_vertex, self.points, self.cell_vertices, cell, k, t)
+        :meth:`on_edges`, in one array, without the edges' geometry)."""
+        parts = list(self.cells.split(cell))
+        if len(parts) == 1:
+            _, g, slot = parts[0]
+            return self._traction(g, slot, cell, k, t, None)
         out = np.empty((len(cell), len(t), 2))
-        for rows, values, _ in self.on_edges(cell, k, t):
-            out[rows] = values
+        for rows, g, slot in parts:
+            out[rows] = self._traction(g, slot, cell[rows], k[rows], t, None)
         return out
 
 

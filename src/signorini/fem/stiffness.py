@@ -102,7 +102,11 @@ def _geometric_factors(J: np.ndarray, det: np.ndarray) -> np.ndarray:
 
 
 def element_blocks(
-    cells: Cells, material: Material, degree: int | None = None, dof_order: bool = False
+    cells: Cells,
+    material: Material,
+    degree: int | None = None,
+    dof_order: bool = False,
+    out: np.ndarray | None = None,
 ) -> np.ndarray:
     """Element stiffness of a group of cells (:mod:`signorini.fem.mapping`), shape
     ``(m, 144)``: ``[c, a, b, i, j] = a(phi_b e_j, phi_a e_i)`` on cell ``c`` in node-block
@@ -117,13 +121,15 @@ def element_blocks(
     ``(cof J grad phi_a) . C (cof J grad phi_b)``, exact on affine cells (degree 2); on the
     quadratic maps of isoparametric cells (degree 4) the rational remainder is far below the
     discretisation error (Ciarlet-Raviart: degree 2k - 2 suffices for the optimal rate).
+    ``out (m, 144)``, if given, receives the result.
     """
     degree = 2 * cells.order if degree is None else degree
     xi, _ = triangle_rule(degree)
     J, det = cells.jacobians(xi)  # (m, p, 2, 2), p = 1 (constant) or q
     m, n_p = det.shape
     fac = _geometric_factors(J.reshape(-1, 2, 2), det.reshape(-1)).reshape(m, -1)
-    return fac @ _stiffness_basis(material.lam, material.mu, dof_order, degree, n_p > 1)
+    basis = _stiffness_basis(material.lam, material.mu, dof_order, degree, n_p > 1)
+    return np.matmul(fac, basis, out=out)
 
 
 def element_stiffness(vertices: np.ndarray, material: Material) -> np.ndarray:
@@ -304,5 +310,13 @@ def assemble_stiffness(
         n = int(n_dofs)
     if mapping is None:
         mapping = CellMap(cells)
-    blocks = mapping.per_cell(lambda g: element_blocks(g, material))
+    if len(mapping.groups) == 1:
+        blocks = element_blocks(mapping.groups[0], material)
+    else:  # group after group into one array (no scatter), the cells' nodes in that order
+        blocks = np.empty((mapping.n_cells, 144))
+        start = 0
+        for g in mapping.groups:
+            element_blocks(g, material, out=blocks[start : start + len(g)])
+            start += len(g)
+        nodes = nodes[np.concatenate([g.cells for g in mapping.groups])]
     return _assemble_node_blocks(nodes, n // 2, blocks.reshape(-1, 6, 6, 2, 2))
