@@ -184,3 +184,6 @@ def test_cell_map_puts_each_group_in_mesh_order():
     assert [(list(r), list(s)) for r, _, s in parts] == [([1, 3], [0, 3]), ([0, 2], [1, 0])]
     only = CellMap(vertices)
     assert len(only.groups) == 1 and only.per_cell(lambda g: g.points(xi)) is not None
+    every = CellMap(vertices, (np.arange(6), nodes))  # no affine cell at all
+    assert len(every.groups) == 1 and isinstance(every.groups[0], IsoparametricCells)
+    np.testing.assert_array_equal(every.points(xi), IsoparametricCells(nodes).points(xi))

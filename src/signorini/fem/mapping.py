@@ -357,6 +357,10 @@ class CellMap:
         self.slot = np.empty(self.n_cells, dtype=np.int64)
         self.slot[affine] = np.arange(affine.size)
         self.slot[cells] = np.arange(len(cells))
+        if affine.size == 0:  # every cell is isoparametric (a coarse mesh of a curved body)
+            self.groups = (IsoparametricCells(nodes),)
+            self.group, self.slot = np.zeros(0, dtype=np.int8), np.zeros(0, dtype=np.int64)
+            return
         self.groups = (AffineCells(vertices[affine], affine), IsoparametricCells(nodes, cells))
 
     def per_cell(self, func: Callable[[Cells], np.ndarray]) -> np.ndarray:
