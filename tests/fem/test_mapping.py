@@ -16,7 +16,12 @@ from signorini.fem.mapping import (
     StraightEdges,
     edge_groups,
 )
+from signorini.fem.material import Material, stress
+from signorini.fem.postprocess import cell_stress
 from signorini.fem.quadrature import line_rule, triangle_rule
+from signorini.fem.space import P2Space
+
+from .test_iso import curved_sector
 
 #: one cell with v1 - v0 = (3, 1), v2 - v0 = (1, 4): J = [[3, 1], [1, 4]], det J = 11
 VERTICES = np.array([[[1.0, 2.0], [4.0, 3.0], [2.0, 6.0]]])
@@ -187,3 +192,22 @@ def test_cell_map_puts_each_group_in_mesh_order():
     every = CellMap(vertices, (np.arange(6), nodes))  # no affine cell at all
     assert len(every.groups) == 1 and isinstance(every.groups[0], IsoparametricCells)
     np.testing.assert_array_equal(every.points(xi), IsoparametricCells(nodes).points(xi))
+
+
+def test_the_stress_of_an_interpolated_linear_field_is_exact_through_the_map():
+    """On the annulus sector with its arcs, σ(I_h u) of a linear u at points of every cell:
+    exact through the cell map; the straight reading of the isoparametric cells' coefficients
+    is not."""
+    material = Material.from_young(1.0, 0.3)
+    B = np.array([[0.3, -0.7], [0.2, 0.5]])
+    space = P2Space(curved_sector())
+    u_cell = space.cell_values(space.interpolate(lambda x: x @ B.T + 0.1))
+    xi, _ = triangle_rule(4)
+    expected = stress(material, B)
+    sigma = cell_stress(space.mapping, u_cell, material, xi)
+    assert sigma.shape == (space.mesh.n_cells, len(xi), 2, 2)
+    assert np.abs(sigma - expected).max() < 1e-13
+    straight = cell_stress(space.vertices, u_cell, material, xi)
+    assert np.abs(straight - expected).max() > 1e-2
+    per_cell = np.broadcast_to(xi, (space.mesh.n_cells,) + xi.shape)
+    assert np.abs(cell_stress(space.mapping, u_cell, material, per_cell) - sigma).max() < 1e-15
