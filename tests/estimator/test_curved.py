@@ -5,15 +5,12 @@ does there, and the adaptive loop on a half-disc pressed onto a rigid plane."""
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 from scipy.integrate import quad
 
 from signorini.contact.solution import solve
 from signorini.estimator import residual
-from signorini.estimator.curved import contact_integrals, curved_cells, div_stress
-from signorini.estimator.residual import estimate
+from signorini.estimator.residual import contact_stress, estimate
 from signorini.estimator.terms import (
     EdgeSet,
     direction_field,
@@ -21,10 +18,13 @@ from signorini.estimator.terms import (
     tangential_stress,
     third_integrals,
 )
+from signorini.estimator.traction import CellStress
 from signorini.fem import iso, p2
+from signorini.fem.mapping import CellMap, IsoparametricCells
 from signorini.fem.material import Material, stress
 from signorini.fem.norms import energy_error2
 from signorini.fem.postprocess import div_stress as affine_div_stress
+from signorini.fem.postprocess import stress_divergence
 from signorini.fem.quadrature import line_rule
 from signorini.fem.space import P2Space
 from signorini.loop import adaptive
@@ -47,7 +47,9 @@ from ..fem.test_iso import (
 def straight_estimator(monkeypatch) -> None:
     """Make ``estimate`` treat every cell as the straight triangle of its vertices (the
     estimator before curved boundaries)."""
-    monkeypatch.setattr(residual, "curved_cells", lambda *args: None)
+    monkeypatch.setattr(
+        residual, "geometry", lambda space: (CellMap(space.vertices), np.zeros(0, np.int64))
+    )
 
 
 def slope(ndof, values) -> float:
@@ -129,7 +131,7 @@ def test_div_stress_of_the_interpolant_converges_on_curved_cells_only_through_th
         x = iso.geometry(nodes, xi)[0]
         exact = -body_force(x.reshape(-1, 2)).reshape(x.shape)  # div σ(u) = −f
         _, hess = iso.field_derivatives(nodes, u, xi)
-        iso_err.append(np.abs(div_stress(hess, MATERIAL) - exact).max())
+        iso_err.append(np.abs(stress_divergence(hess, MATERIAL) - exact).max())
         affine = affine_div_stress(space.vertices[cells], u, MATERIAL)
         affine_err.append(np.abs(affine[:, None] - exact).max())
     rate = np.log2(np.array(iso_err[:-1]) / iso_err[1:])
@@ -166,23 +168,23 @@ def test_tangential_stress_of_a_radial_field_vanishes_with_the_local_normal():
         mesh = lame_mesh(n)
         space = P2Space(mesh)
         u = space.interpolate(lame)
-        fake = SimpleNamespace(space=space, u=u, problem=SimpleNamespace(material=material))
-        curved = curved_cells(fake, 1.0, 8)
         e = mesh.part_edges("outer")
         edges = EdgeSet(e, space.edge_nodes(e), mesh.edge2cell[e], mesh.edge_length[e])
         x = space.node_points[edges.nodes]
         direction = x / np.hypot(x[..., 0], x[..., 1])[..., None]  # the arc's normal n_z
-        rows, J4, _ = contact_integrals(curved, mesh, edges, t, w, None, direction)
-        assert rows.size == e.size
+        ab = mesh.points[mesh.oriented_boundary(e)]
+        d = ab[:, 1] - ab[:, 0]
+        normal = np.column_stack([d[:, 1], -d[:, 0]]) / np.hypot(d[:, 0], d[:, 1])[:, None]
+        stresses = CellStress.of(space, u, material)
+        J4, _ = contact_stress(stresses, mesh, edges, normal, direction, t, w)
+        kinds = [type(g) for _, g, _ in space.mapping.split(edges.cells[:, 0])]
+        assert kinds == [IsoparametricCells]  # every arc edge's cell is isoparametric
         local.append(np.sqrt(J4.sum()))
         u_cell = space.cell_values(u)
         sigma = stress(material, p2.field_gradients(space.vertices, u_cell, p2.REFERENCE_NODES[:3]))
         sn = edge_traction(
             sigma, mesh.points, mesh.cells, edges.cells[:, 0], mesh.edge_local[e, 0], t
         )
-        ab = mesh.points[mesh.oriented_boundary(e)]
-        d = ab[:, 1] - ab[:, 0]
-        normal = np.column_stack([d[:, 1], -d[:, 0]]) / np.hypot(d[:, 0], d[:, 1])[:, None]
         chord.append(np.sqrt(tangential_stress(sn, normal, w, edges.length).sum()))
     r_local = np.log2(np.array(local[:-1]) / local[1:])
     r_chord = np.log2(np.array(chord[:-1]) / chord[1:])
@@ -230,9 +232,7 @@ def level_row(res, exact_gradient):
     gradient, on the isoparametric cells where there are any."""
     est = estimate(res)
     sp = res.space
-    e2 = energy_error2(
-        sp.vertices, sp.cell_values(res.u), exact_gradient, MATERIAL, curved=sp.curved
-    )
+    e2 = energy_error2(sp.mapping, sp.cell_values(res.u), exact_gradient, MATERIAL)
     return res.ndof, est.eta, float(np.sqrt(e2.sum())), est
 
 
@@ -380,13 +380,13 @@ def test_adaptive_loop_on_a_half_disc_pressed_onto_a_rigid_plane():
     assert h[near_end].min() < 0.1 * h.max()
     # η4 splits the traction along the obstacle's direction n_z (the discrete contact force
     # acts along it), not along the body's normal, which is a/R off at the contact ends
-    curved = curved_cells(res, est.unit, 8)
+    stresses = CellStress.of(res.space, res.u, res.problem.material, est.unit)
     cs, mesh = res.contact, res.mesh
     edges = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
     t, w = line_rule(7)
     body = res.space.node_points[cs.edge_nodes] - [0.0, 1.0]
     eta4 = {
-        name: np.sqrt(contact_integrals(curved, mesh, edges, t, w, None, d)[1].sum())
+        name: np.sqrt(contact_stress(stresses, mesh, edges, cs.edge_normal, d, t, w)[0].sum())
         for name, d in (("n_z", cs.edge_direction), ("body normal", body))
     }
     print(f"‖σ_t(u_h)‖ on Γ_C at Ndof {ndof[-1]}: {eta4}")
@@ -464,11 +464,12 @@ def test_a_gap_along_the_curve_normal_splits_along_the_body_normal():
             cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges]
         )
         t, w = line_rule(7)
-        curved = curved_cells(res, est.unit, 8)
-        _, J4, _ = contact_integrals(curved, mesh, edges, t, w, None, cs.edge_direction)
+        stresses = CellStress.of(res.space, res.u, res.problem.material, est.unit)
+        J4, _ = contact_stress(stresses, mesh, edges, cs.edge_normal, cs.edge_direction, t, w)
         # the paper's split: along the normal n(t) of the quadratic edges at each point
         e = cs.edges
-        sn, _, speed, normal = curved.traction(mesh.edge2cell[e, 0], mesh.edge_local[e, 0], t)
+        ((_, sn, arc),) = stresses.on_edges(mesh.edge2cell[e, 0], mesh.edge_local[e, 0], t)
+        speed, normal = arc.speeds(t), arc.normals(t)
         J4n = tangential_stress(sn, normal, w, speed)
         diffs.append(abs(np.sqrt(J4.sum()) - np.sqrt(J4n.sum())) / np.sqrt(J4n.sum()))
         print(f"n = {n}: η4 along d {np.sqrt(J4.sum()):.4e}, along n(t) {np.sqrt(J4n.sum()):.4e}")

@@ -11,10 +11,11 @@ from fem_problems import GradientField, stress_of
 from signorini.contact.system import assemble
 from signorini.fem import iso
 from signorini.fem.loads import assemble_body_force, assemble_edge_load
+from signorini.fem.mapping import IsoparametricCells, QuadraticEdges
 from signorini.fem.material import Material
 from signorini.fem.norms import energy_error2
 from signorini.fem.space import P2Space
-from signorini.fem.stiffness import assemble_stiffness
+from signorini.fem.stiffness import assemble_stiffness, element_blocks
 from signorini.mesh import Circle, Mesh, MeshError, rectangle
 from signorini.mesh.refine import refine_nvb, refine_uniform
 from signorini.problem import ContactProblem, Dirichlet, Neumann
@@ -97,9 +98,7 @@ def energy_slope() -> tuple[float, list[float]]:
         if level < 2:
             continue
         space, u = solve_linear(pb, mesh)
-        e2 = energy_error2(
-            space.vertices, space.cell_values(u), exact_grad, MATERIAL, curved=space.curved
-        )
+        e2 = energy_error2(space.mapping, space.cell_values(u), exact_grad, MATERIAL)
         ndof.append(space.n_dofs)
         err.append(float(np.sqrt(e2.sum())))
     return float(np.polyfit(np.log(ndof), np.log(err), 1)[0]), err
@@ -148,9 +147,7 @@ def test_a_linear_field_has_zero_energy_residual_on_curved_cells():
 def test_curved_stiffness_is_symmetric_with_exactly_three_rigid_body_modes():
     mesh = curved_sector()
     space = P2Space(mesh)
-    K = assemble_stiffness(
-        space.vertices, space.cell_dofs, space.n_dofs, MATERIAL, curved=space.curved
-    )
+    K = assemble_stiffness(space.mapping, space.cell_dofs, space.n_dofs, MATERIAL)
     straight = assemble_stiffness(space.vertices, space.cell_dofs, space.n_dofs, MATERIAL)
     assert abs(K - K.T).max() <= 1e-14 * abs(K).max()
     assert abs(K - straight).max() > 1e-3 * abs(K).max()  # the curved cells do differ
@@ -186,7 +183,7 @@ def test_the_isoparametric_area_of_the_sector_converges_like_h4():
     for _ in range(4):
         space = P2Space(mesh)
         one = lambda x: np.broadcast_to([1.0, 0.0], x.shape)  # noqa: E731
-        F = assemble_body_force(space.vertices, space.cell_dofs, space.n_dofs, one, 4, space.curved)
+        F = assemble_body_force(space.mapping, space.cell_dofs, space.n_dofs, one, 4)
         errors.append(abs(F[0::2].sum() - 0.75 * np.pi))
         mesh = refine_uniform(mesh).mesh
     rates = np.log2(np.array(errors[:-1]) / errors[1:])
@@ -203,21 +200,15 @@ def test_curved_edge_load_integrates_along_the_arc():
     dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1, 6)
     one = lambda x, n: np.broadcast_to([1.0, 0.0], x.shape)  # noqa: E731
     ends = mesh.points[nodes[:, :2]]
-    G = assemble_edge_load(ends, dofs, space.n_dofs, one, 8, space.node_points[nodes[:, 2]])
+    arc = QuadraticEdges(space.node_points[nodes])
+    G = assemble_edge_load(arc, dofs, space.n_dofs, one, 8)
     chord = assemble_edge_load(ends, dofs, space.n_dofs, one, 8)
     print(f"arc length {G[0::2].sum()}, chords {chord[0::2].sum()}, exact {np.pi / 2}")
     assert abs(G[0::2].sum() - np.pi / 2) < 2e-4
     assert abs(chord[0::2].sum() - np.pi / 2) > 1e-2
     # the normal passed to the traction is the arc's outward normal (towards the origin)
     seen = []
-    assemble_edge_load(
-        ends,
-        dofs,
-        space.n_dofs,
-        lambda x, n: seen.append((x, n)) or 0 * x,
-        8,
-        space.node_points[nodes[:, 2]],
-    )
+    assemble_edge_load(arc, dofs, space.n_dofs, lambda x, n: seen.append((x, n)) or 0 * x, 8)
     x, n = seen[0]
     assert np.abs(np.hypot(*x.reshape(-1, 2).T) - 1).max() < 1e-3
     assert np.abs(n + x / np.hypot(x[..., 0], x[..., 1])[..., None]).max() < 2e-2
@@ -244,9 +235,10 @@ def test_curved_stiffness_quadrature_degree_is_converged():
     # degree 2 and the chosen degree give the same energy up to a small relative change
     space = P2Space(refine_uniform(curved_sector()).mesh)
     cells, nodes = space.curved
-    k2 = iso.stiffness_blocks(nodes, MATERIAL, degree=2)
-    k = iso.stiffness_blocks(nodes, MATERIAL)
-    k10 = iso.stiffness_blocks(nodes, MATERIAL, degree=10)
+    cells = IsoparametricCells(nodes, cells)
+    k2 = element_blocks(cells, MATERIAL, degree=2)
+    k = element_blocks(cells, MATERIAL)
+    k10 = element_blocks(cells, MATERIAL, degree=10)
     rel = lambda a, b: np.abs(a - b).max() / np.abs(b).max()  # noqa: E731
     print(
         f"curved stiffness vs degree 10: degree 2 {rel(k2, k10):.1e}, degree "
@@ -265,7 +257,7 @@ def test_the_body_force_is_called_only_at_points_of_the_curved_domain():
         seen.append(np.hypot(x[..., 0], x[..., 1]))
         return np.broadcast_to([1.0, 0.0], x.shape)
 
-    F = assemble_body_force(space.vertices, space.cell_dofs, space.n_dofs, f, 8, space.curved)
+    F = assemble_body_force(space.mapping, space.cell_dofs, space.n_dofs, f, 8)
     assert len(seen) == 1 and seen[0].min() >= 1.0
     assert abs(F[0::2].sum() - 0.75 * np.pi) < 1e-5
     assemble_body_force(space.vertices, space.cell_dofs, space.n_dofs, f, 8)
@@ -289,9 +281,7 @@ def test_solve_errors_and_estimate_run_on_a_mesh_with_curved_cells():
     result = solve(pb, mesh)
     space, u = solve_linear(pb, mesh)
     assert np.abs(result.u.ravel() - u).max() <= 1e-10
-    e2 = energy_error2(
-        space.vertices, space.cell_values(u), exact_grad, MATERIAL, curved=space.curved
-    )
+    e2 = energy_error2(space.mapping, space.cell_values(u), exact_grad, MATERIAL)
     assert result.errors()["error_energy"] == pytest.approx(np.sqrt(e2.sum()), rel=1e-8)
     eta = estimate(result)  # affine formulas on the curved cells, for now
     assert np.isfinite(eta.eta) and eta.eta > 0

@@ -11,7 +11,6 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..fem import iso
 from ..fem.loads import assemble_body_force, assemble_edge_load
 from ..fem.space import P2Space
 from ..fem.stiffness import assemble_stiffness
@@ -79,12 +78,7 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     # the space of a validated mesh and problem: no need to re-check the arrays
     with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported just below
         K = assemble_stiffness(
-            space.vertices,
-            space.cell_dofs,
-            n_dofs,
-            problem.material,
-            validate=False,
-            curved=space.curved,
+            space.mapping, space.cell_dofs, n_dofs, problem.material, validate=False
         )
     if not np.isfinite(K.data).all():
         m = problem.material
@@ -95,14 +89,12 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     F = np.zeros(n_dofs)
     if problem.body_force is not None:
         F += assemble_body_force(
-            space.vertices,
+            space.mapping,
             space.cell_dofs,
             n_dofs,
             lambda x: evaluate_field(problem.body_force, x, "body_force"),
             degree=LOAD_DEGREE,
-            curved=space.curved,
         )
-    curved_parts = set(mesh.edge_part[iso.curved_edges(mesh)].tolist())
     for name in problem.neumann_parts:
         cond: Neumann = problem.conditions[name]
         if cond.is_zero:
@@ -115,15 +107,8 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
         def traction(x, n, g=g, name=name):
             return evaluate_field(g, x, f"the traction of Neumann part {name!r}", normal=n)
 
-        curved = mesh.part_index(name) in curved_parts
-        F += assemble_edge_load(
-            mesh.points[nodes[:, :2]],
-            dofs,
-            n_dofs,
-            traction,
-            degree=LOAD_DEGREE,
-            midpoints=space.node_points[nodes[:, 2]] if curved else None,
-        )
+        for rows, geometry in space.boundary_edges(edges):
+            F += assemble_edge_load(geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE)
     # Dirichlet values (a node on two Dirichlet parts takes the later part's value)
     d_nodes = problem.dirichlet_nodes(space)
     d_values = np.empty((d_nodes.size, 2))

@@ -34,36 +34,30 @@ name. Every node term is a sum of cell or edge integrals; each cell receives its
 terms split equally between the edge's cells, ``terms.spread_edge_integrals``), so the
 element indicators sum exactly to η_h².
 
-On a mesh with curved parts the integrals of the isoparametric cells and their edges are
-replaced by those along the quadratic maps (:mod:`signorini.estimator.curved`), and η4, η5
-split the traction along the constraint direction field where n_z is not the edge's normal
-(docs/method.md, *Estimator*, "On curved boundaries").
+Each integral is taken once, through the geometry of its cell or edge
+(:mod:`signorini.fem.mapping`, :func:`geometry`): the closed forms of straight cells where
+the Jacobian is constant, the quadratic maps of the isoparametric cells along curved parts
+and their quadratic edges elsewhere; η4, η5 split the traction along the constraint direction
+field where n_z is not the edge's normal (docs/method.md, *Estimator*, "On curved
+boundaries").
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 import scipy.sparse as sp
 
-from ..contact.contact_set import SEMI_CONTACT, ContactSet
+from ..contact.contact_set import SEMI_CONTACT
 from ..contact.solution import ContactResult
-from ..fem.material import stress
-from ..fem.p2 import REFERENCE_NODES, field_gradients, physical_points
-from ..fem.postprocess import div_stress
+from ..fem.iso import curved_edges
+from ..fem.mapping import CellMap, edge_groups
+from ..fem.postprocess import stress_divergence
 from ..fem.quadrature import line_rule, triangle_rule
-from ..mesh.geometry import segment_normals
+from ..fem.space import P2Space
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
-from .curved import (
-    CurvedCells,
-    contact_integrals,
-    curved_cells,
-    edge_node_points,
-    neumann_integrals,
-)
 from .friction import friction_edges, move_dirichlet_thirds
 from .names import TERMS
 from .terms import (
@@ -72,7 +66,6 @@ from .terms import (
     boundary_cell_shares,
     complementarity,
     direction_field,
-    edge_traction,
     friction_work,
     interior_residual,
     neumann_residual,
@@ -84,8 +77,18 @@ from .terms import (
     stress_jump,
     tangential_stress,
 )
+from .traction import CellStress, vertex_stress
 
-__all__ = ["ETA5_VARIANTS", "NODE_TERMS", "TERMS", "Estimate", "estimate", "stress_unit"]
+__all__ = [
+    "ETA5_VARIANTS",
+    "NODE_TERMS",
+    "TERMS",
+    "Estimate",
+    "estimate",
+    "contact_stress",
+    "geometry",
+    "stress_unit",
+]
 
 #: the variants of η5 (docs/method.md, *Estimator*); the first is the default
 ETA5_VARIANTS = ("consistent", "paper")
@@ -213,30 +216,22 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells
     h_p = _node_mesh_size(mesh.h, space.cell_nodes, result.dirichlet_nodes, n_nodes)
+    cells, quadratic_edges = geometry(space)
 
     # what the terms integrate: the residual in the cells, σ(u_h) n on the edges, the gap
     # every stress-like input (σ(u_h), div σ(u_h), f, g, p_z, s_z) is divided by the stress
     # unit σ₀ (a power of 4, 1 for ordinary stresses): exact, and no square overflows;
     # Estimate puts σ₀ back (docs/method.md, *Estimator*, "Units")
     u_cell = space.cell_values(result.u)
-    sigma = stress(problem.material, field_gradients(space.vertices, u_cell, REFERENCE_NODES[:3]))
+    material = problem.material
+    sigma = vertex_stress(cells, u_cell, material)
     unit = stress_unit(float(np.abs(sigma).max(initial=0.0)))
-    sigma = sigma / unit
-    # isoparametric cells: their integrals replace the affine ones below (None if there are
-    # none, and then nothing below differs from the straight estimator)
-    curved = curved_cells(result, unit, CELL_DEGREE)
-    div_sigma = div_stress(space.vertices, u_cell, problem.material) / unit
-    f, w_cell = _body_force(problem, space.vertices, curved)
-    if f is not None:
-        f = f / unit
-    traction = partial(edge_traction, sigma, mesh.points, mesh.cells)
+    stresses = CellStress(cells, mesh.points, mesh.cells, u_cell, material, sigma / unit, unit)
     t, w = line_rule(EDGE_DEGREE)
     inner = _edge_set(mesh, np.flatnonzero(mesh.edge2cell[:, 1] >= 0))
-    both = traction if curved is None else partial(curved.mixed_traction, traction)
-    jump = _from_both_sides(mesh, both, inner.index, t)
+    jump = _from_both_sides(mesh, stresses.traction, inner.index, t)
     neumann = _edge_set(mesh, _part_edges(mesh, problem.neumann_parts))
     t_n, w_n = line_rule(NEUMANN_DEGREE)
-    misfit = _traction_misfit(problem, mesh, traction, t_n, unit)
     contact = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
     pressure = _edge_pressure(result) / unit if eta5_variant == "consistent" else None
     friction = friction_edges(result, unit)  # None without friction
@@ -245,27 +240,21 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
     density = _semi_contact_density(result) / unit
     x0, x1 = mesh.points[cs.edge_nodes[:, 0]], mesh.points[cs.edge_nodes[:, 1]]
 
-    R = interior_residual(mesh.area, div_sigma, f, w_cell)
-    J3 = neumann_residual(misfit, w_n, neumann.length)
-    contact_traction = _on_boundary(mesh, traction, contact.index, t)
-    J4, J5 = _contact_stress(cs, contact.length, contact_traction, t, w, pressure, p_t)
-    parts6 = complementarity(gap, density, contact.length)
-    parts8 = np.zeros_like(parts6)
-    if friction is not None:
-        parts8 = friction_work(friction.slip, p_t, friction.bound, contact.length)
-    if curved is not None:  # docs/method.md, *Estimator*, "On curved boundaries"
-        R[curved.cells] = curved.interior_residual(None if f is None else f[curved.cells])
-        rows, values = neumann_integrals(curved, problem, mesh, neumann, t_n, w_n)
-        J3[rows] = values
-        rows, values, values5 = contact_integrals(
-            curved, mesh, contact, t, w, pressure, cs.edge_direction, p_t
-        )
-        J4[rows], J5[rows] = values, values5
-        rows, points = edge_node_points(space, contact)
-        parts6[rows] = complementarity(gap[rows], density[rows], contact.length[rows], points)
+    # each integral once per cell or edge, through its own geometry (docs/method.md,
+    # *Estimator*, "On curved boundaries")
+    R = _interior_residual(problem, cells, u_cell, unit)
+    J3 = _neumann_integrals(problem, mesh, stresses, t_n, w_n, unit)
+    J4, J5 = contact_stress(
+        stresses, mesh, contact, cs.edge_normal, cs.edge_direction, t, w, pressure, p_t
+    )
+    parts6 = np.zeros(gap.shape)
+    parts8 = np.zeros(gap.shape)
+    curved = np.isin(cs.edges, quadratic_edges)
+    for rows, edges in edge_groups(space.node_points[cs.edge_nodes], curved):
+        parts6[rows] = complementarity(gap[rows], density[rows], edges)
         if friction is not None:
             slip, bound = friction.slip[rows], friction.bound[rows]
-            parts8[rows] = friction_work(slip, p_t[rows], bound, contact.length[rows], points)
+            parts8[rows] = friction_work(slip, p_t[rows], bound, edges)
 
     def on_edges(edges: EdgeSet, J: np.ndarray) -> TermShares:
         return spread_edge_integrals(edges, J, h_p, n_cells)
@@ -323,17 +312,90 @@ def _node_mesh_size(
     return h_p
 
 
-def _body_force(problem: ContactProblem, vertices: np.ndarray, curved: CurvedCells | None):
-    """``f (n_cells, q, 2)`` at the points of a degree-``CELL_DEGREE`` rule and its weights
-    ``(q,)``, at the points of the quadratic map on isoparametric cells (f is called once);
-    ``(None, None)`` without a body force."""
-    if problem.body_force is None:
-        return None, None
+def geometry(space: P2Space) -> tuple[CellMap, np.ndarray]:
+    """The cells' maps (:attr:`~signorini.fem.space.P2Space.mapping`) and the boundary edges
+    that are quadratics (those on parts carrying a curve other than a line): the geometry
+    every term integrates on."""
+    return space.mapping, curved_edges(space.mesh)
+
+
+def _interior_residual(
+    problem: ContactProblem, cells: CellMap, u_cell: np.ndarray, unit: float
+) -> np.ndarray:
+    """η1's ``‖f + div σ(u_h)‖²_T`` ``(n_cells,)``: div σ(u_h) from the Hessian of u_h through
+    each cell's map (constant on affine cells), f at the points of the degree-``CELL_DEGREE``
+    rule (called once, at the points of the maps), both in the stress unit."""
     xi, w = triangle_rule(CELL_DEGREE)
-    x = physical_points(vertices, xi)
-    if curved is not None:
-        x[curved.cells] = curved.points()
-    return evaluate_field(problem.body_force, x, "body_force"), w
+    f = None
+    if problem.body_force is not None:
+        f = evaluate_field(problem.body_force, cells.points(xi), "body_force") / unit
+
+    def residual(g) -> np.ndarray:
+        div = stress_divergence(g.field_hessians(u_cell[g.cells], xi), problem.material) / unit
+        return interior_residual(
+            0.5 * g.jacobians(xi)[1], div, None if f is None else f[g.cells], w
+        )
+
+    return cells.per_cell(residual)
+
+
+def _neumann_integrals(
+    problem: ContactProblem, mesh, stresses: CellStress, t: np.ndarray, w: np.ndarray, unit: float
+) -> np.ndarray:
+    """η3's ``‖σ(u_h) n − g‖²_e`` on the Neumann edges (part after part), g (divided by the
+    stress unit) at the points and with the normals of each edge's geometry."""
+    out = []
+    for name in problem.neumann_parts:
+        cond = problem.conditions[name]
+        e = mesh.part_edges(name)
+        values = np.zeros(e.size)
+        for rows, sn, edges in stresses.on_edges(mesh.edge2cell[e, 0], mesh.edge_local[e, 0], t):
+            if not cond.is_zero:
+                what = f"the traction of Neumann part {name!r}"
+                g = evaluate_field(cond.field(), edges.points(t), what, normal=edges.normals(t))
+                sn = sn - g / unit
+            values[rows] = neumann_residual(sn, w, edges.speeds(t))
+        out.append(values)
+    return np.concatenate(out) if out else np.zeros(0)
+
+
+def contact_stress(
+    stresses: CellStress,
+    mesh,
+    edges: EdgeSet,
+    normal: np.ndarray,
+    direction: np.ndarray,
+    t: np.ndarray,
+    w: np.ndarray,
+    pressure: np.ndarray | None = None,
+    friction: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """η4's and η5's integrals ``(k,)`` on the contact ``edges`` from ``σ(u_h) n`` at the
+    points ``t`` (weights ``w``): split along the contact part's normal ``normal (k, 2)``
+    on straight edges where every nodal constraint direction ``direction (k, 3, 2)`` is that
+    normal (the paper's case), else along the direction field
+    (:func:`~signorini.estimator.terms.direction_field`; docs/method.md, *Estimator*, "On
+    curved boundaries"); with the nodal friction stresses ``friction (k, 3)`` η4 is
+    ``‖σ_t + p_t,h‖²``, with the nodal pressures ``pressure (k, 3)`` η5 is
+    ``‖σ_nn + p_h‖²``."""
+    J4, J5 = np.zeros(edges.index.size), np.zeros(edges.index.size)
+    e = edges.index
+    for rows, sn, geometry in stresses.on_edges(mesh.edge2cell[e, 0], mesh.edge_local[e, 0], t):
+        ds = geometry.speeds(t)
+        d, n = direction[rows], normal[rows]
+        index = np.arange(e.size)[rows]
+        same = np.zeros(len(d), dtype=bool)
+        if geometry.normals(t).shape[1] == 1:  # a straight edge: is every n_z its normal?
+            same = ~(d != n[:, None, :]).any(axis=(1, 2))
+        for sel in (np.flatnonzero(same), np.flatnonzero(~same)):
+            if sel.size == 0:
+                continue
+            split = n[sel] if same[sel[0]] else direction_field(d[sel], t)
+            p = None if pressure is None else pressure[index[sel]]
+            f = None if friction is None else friction[index[sel]]
+            J4[index[sel]] = tangential_stress(sn[sel], split, w, ds[sel], t, f)
+            J5[index[sel]] = normal_stress(sn[sel], split, t, w, ds[sel], p)
+    return J4, J5
 
 
 def _part_edges(mesh, names) -> np.ndarray:
@@ -347,71 +409,11 @@ def _edge_set(mesh, e: np.ndarray) -> EdgeSet:
     return EdgeSet(e, nodes, mesh.edge2cell[e], mesh.edge_length[e])
 
 
-def _on_boundary(mesh, traction, e: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """σ(u_h) n ``(k, q, 2)`` on boundary edges ``e``, ``t`` counter-clockwise."""
-    return traction(mesh.edge2cell[e, 0], mesh.edge_local[e, 0], t)
-
-
 def _from_both_sides(mesh, traction, e: np.ndarray, t: np.ndarray):
     """σ(u_h) n of both cells of interior edges ``e`` at the same points, each with its
     outward normal (the second cell runs the edge the other way)."""
     c, k = mesh.edge2cell[e], mesh.edge_local[e]
     return traction(c[:, 0], k[:, 0], t), traction(c[:, 1], k[:, 1], 1 - t)
-
-
-def _traction_misfit(
-    problem: ContactProblem, mesh, traction, t: np.ndarray, unit: float = 1.0
-) -> np.ndarray:
-    """``σ(u_h) n − g`` ``(k, q, 2)`` on the Neumann edges (part after part) at points ``t``,
-    with ``traction`` already in the stress unit ``unit`` and g divided by it."""
-    out = []
-    for name in problem.neumann_parts:
-        cond = problem.conditions[name]
-        e = mesh.part_edges(name)
-        sn = _on_boundary(mesh, traction, e, t)
-        if not cond.is_zero:
-            ab = mesh.oriented_boundary(e)
-            a, b = mesh.points[ab[:, 0]], mesh.points[ab[:, 1]]
-            x = a[:, None] + t[None, :, None] * (b - a)[:, None]
-            _, n = segment_normals(a, b)
-            g = cond.field()
-            sn = (
-                sn
-                - evaluate_field(
-                    g, x, f"the traction of Neumann part {name!r}", normal=n[:, None, :]
-                )
-                / unit
-            )
-        out.append(sn)
-    return np.concatenate(out) if out else np.zeros((0, t.size, 2))
-
-
-def _contact_stress(
-    cs: ContactSet,
-    length: np.ndarray,
-    traction: np.ndarray,
-    t: np.ndarray,
-    w: np.ndarray,
-    pressure: np.ndarray | None,
-    friction: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray]:
-    """η4's and η5's integrals ``(n_ce,)`` on the contact edges of lengths ``length``, from
-    ``σ(u_h) n (n_ce, q, 2)`` at the points ``t``: split along the edge's normal where every
-    nodal constraint direction is that normal (the paper's case), else along the direction
-    field (:func:`~signorini.estimator.terms.direction_field`; docs/method.md, *Estimator*,
-    "On curved boundaries"); with the nodal friction stresses ``friction (n_ce, 3)`` η4 is
-    ``‖σ_t + p_t,h‖²``."""
-    J4 = tangential_stress(traction, cs.edge_normal, w, length, t, friction)
-    J5 = normal_stress(traction, cs.edge_normal, t, w, length, pressure)
-    varying = np.flatnonzero((cs.edge_direction != cs.edge_normal[:, None, :]).any(axis=(1, 2)))
-    if varying.size:
-        d = direction_field(cs.edge_direction[varying], t)
-        tr, ell = traction[varying], length[varying]
-        f = None if friction is None else friction[varying]
-        J4[varying] = tangential_stress(tr, d, w, ell, t, f)
-        p = None if pressure is None else pressure[varying]
-        J5[varying] = normal_stress(tr, d, t, w, ell, p)
-    return J4, J5
 
 
 def _edge_pressure(result: ContactResult) -> np.ndarray:

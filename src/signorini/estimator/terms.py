@@ -165,6 +165,15 @@ def _point_weights(w: np.ndarray, length: np.ndarray) -> np.ndarray:
     return w * (length[:, None] if np.ndim(length) == 1 else length)
 
 
+def _per_item(a: np.ndarray | None, ndim: int) -> np.ndarray | None:
+    """``a`` without its point axis (axis 1) where that has length 1: a value constant on
+    each cell or edge (:mod:`signorini.fem.mapping` gives such arrays, ``(k, 1, ...)``), so
+    that it is used in the per-cell or per-edge form; ``ndim`` is the per-point rank."""
+    if a is None or np.ndim(a) != ndim or np.shape(a)[1] != 1:
+        return a
+    return a[:, 0]
+
+
 # --------------------------------------------------------------------------- the terms
 
 
@@ -179,8 +188,10 @@ def interior_residual(
     Parameters
     ----------
     area : (n_cells,) float array
+        Cell areas; ``(n_cells, q)``: ``det J / 2`` at the points of ``w`` on cells whose
+        Jacobian varies (:meth:`signorini.fem.mapping.IsoparametricCells.jacobians`).
     div_sigma : (n_cells, 2) float array
-        ``div σ(u_h)``, constant on each cell.
+        ``div σ(u_h)``, constant on each cell; ``(n_cells, q, 2)`` at the points of ``w``.
     f : (n_cells, q, 2) float array, optional
         The body force at the quadrature points; ``None`` for ``f = 0``.
     w : (q,) float array, optional
@@ -190,10 +201,18 @@ def interior_residual(
     -------
     (n_cells,) float array
     """
-    if f is None:
-        return area * (div_sigma**2).sum(axis=1)
-    r = f + div_sigma[:, None, :]
-    return 2 * area * np.einsum("q,mqc,mqc->m", w, r, r)
+    area, div_sigma = _per_item(area, 2), _per_item(div_sigma, 3)
+    if np.ndim(area) == 1 and div_sigma.ndim == 2:
+        if f is None:
+            return area * (div_sigma**2).sum(axis=1)
+        r = f + div_sigma[:, None, :]
+        return 2 * area * np.einsum("q,mqc,mqc->m", w, r, r)
+    r = div_sigma if div_sigma.ndim == 3 else div_sigma[:, None, :]
+    if f is not None:
+        r = f + r
+    r = np.broadcast_to(r, (len(r), len(w), r.shape[-1]))
+    a = np.broadcast_to(area if np.ndim(area) == 2 else area[:, None], r.shape[:2])
+    return 2 * np.einsum("q,mq,mqc,mqc->m", w, a, r, r)
 
 
 def stress_jump(
@@ -218,6 +237,7 @@ def neumann_residual(residual: np.ndarray, w: np.ndarray, length: np.ndarray) ->
     """``‖σ(u_h) n − g‖²_e`` per Neumann edge (η3), from ``residual (k, q, 2)`` at the
     points of the weights ``w (q,)``; ``length (k,)``, or ``|x'(t)|`` at each point ``(k, q)``
     on a quadratic edge."""
+    length = _per_item(length, 2)
     if np.ndim(length) == 2:
         return np.einsum("eq,eqi,eqi->e", _point_weights(w, length), residual, residual)
     return length * np.einsum("q,eqi,eqi->e", w, residual, residual)
@@ -251,6 +271,9 @@ def tangential_stress(
         is the scalar ``σ(u_h) n · τ + p_t,h`` with ``τ = (−d_y, d_x)`` for the direction d
         (docs/method.md, *Estimator*, "With friction"). ``None`` without friction.
     """
+    length, normal = _per_item(length, 2), _per_item(normal, 3)
+    if normal.ndim == 2 and np.ndim(length) == 2:
+        normal = np.broadcast_to(normal[:, None, :], traction.shape)
     if friction is not None:
         d = normal if normal.ndim == 3 else np.broadcast_to(normal[:, None, :], traction.shape)
         residual = traction[..., 1] * d[..., 0] - traction[..., 0] * d[..., 1]
@@ -289,6 +312,7 @@ def normal_stress(
         The nodal pressures ``p_z`` at ``[start, end, midpoint]`` (0 at Dirichlet nodes);
         ``p_h`` is their quadratic interpolant. ``None`` for the ``paper`` variant.
     """
+    length, normal = _per_item(length, 2), _per_item(normal, 3)
     if normal.ndim == 3:
         snn = np.einsum("eqi,eqi->eq", traction, normal)
     else:
@@ -311,7 +335,8 @@ def complementarity(
         ``u_h·n − ψ_h`` at ``[start, end, midpoint]``.
     density : (k, 3) float array
         ``s_p`` at the same nodes where p is a semi-contact node, else 0.
-    length : (k,) float array
+    length : (k,) float array or StraightEdges or QuadraticEdges
+        Edge lengths, or the edges' geometry (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
         Node points ``[start, end, midpoint]`` of quadratic edges: integrate along them
         (:func:`third_integrals`).
@@ -344,7 +369,8 @@ def friction_work(
     bound : (k, 3) float array
         The nodal slip bounds ``b_z`` (Tresca ``s_z / w_z``, Coulomb ``F p_z``; 0 at
         Dirichlet nodes and on frictionless parts).
-    length : (k,) float array
+    length : (k,) float array or StraightEdges or QuadraticEdges
+        Edge lengths, or the edges' geometry (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
         Node points of quadratic edges: integrate along them.
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..fem.edge_trace import evaluate, monomial_coefficients, roots_in_unit_interval
+from ..fem.mapping import Edges, QuadraticEdges, StraightEdges
 from ..fem.quadrature import gauss_legendre
 
 __all__ = ["CURVED_THIRD_POINTS", "friction_work_thirds", "third_integrals"]
@@ -42,8 +43,9 @@ def third_integrals(
     ----------
     v : (k, 3) float array
         A quadratic on each edge, by its values at ``[start, end, midpoint]``.
-    length : (k,) float array
-        Edge lengths (not used with ``points``).
+    length : (k,) float array or StraightEdges or QuadraticEdges
+        Edge lengths (not used with ``points``), or the edges' geometry
+        (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
         Node points ``[start, end, midpoint]`` of quadratic edges ``x(t)``.
 
@@ -54,9 +56,10 @@ def third_integrals(
         where φ are the half-edge hats of Q^h (3.6).
     """
     v = np.asarray(v, dtype=np.float64)
+    length, edges = _geometry(length, points)
     coef = monomial_coefficients(v)
     roots = roots_in_unit_interval(coef)  # (k, 2), NaN where none
-    gt, gw = gauss_legendre(3 if points is None else CURVED_THIRD_POINTS)
+    gt, gw = gauss_legendre(_points(edges))
     out = np.zeros(v.shape)
     for lo, hi, col, (p0, p1) in _HAT_PIECES:
         r = np.where(np.isnan(roots), lo, np.clip(roots, lo, hi))
@@ -66,10 +69,10 @@ def third_integrals(
             tq = x0 + (x1 - x0) * gt
             vq = evaluate(coef, tq)
             hat = p0 + p1 * tq
-            if points is not None:
-                hat = hat * _speed(points, tq)
+            if edges is not None:
+                hat = hat * edges.speed_at(tq)
             out[:, col] += (x1 - x0)[:, 0] * (gw * np.maximum(vq, 0.0) * hat).sum(axis=1)
-    if points is not None:
+    if edges is not None:
         return out
     return out * np.asarray(length)[:, None]
 
@@ -101,8 +104,9 @@ def friction_work_thirds(
         ``p_t`` (stress).
     bound : (k, 3) float array
         ``b``, the slip bound (stress).
-    length : (k,) float array
-        Edge lengths (not used with ``points``).
+    length : (k,) float array or StraightEdges or QuadraticEdges
+        Edge lengths (not used with ``points``), or the edges' geometry
+        (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
         Node points ``[start, end, midpoint]`` of quadratic edges ``x(t)``.
 
@@ -112,11 +116,12 @@ def friction_work_thirds(
         The integrals over the start, end and middle thirds: each ``≥ 0`` (the integrand
         is, pointwise).
     """
+    length, edges = _geometry(length, points)
     cu, cp, cb = (
         monomial_coefficients(np.asarray(v, dtype=np.float64)) for v in (slip, force, bound)
     )
     roots = np.column_stack([roots_in_unit_interval(c) for c in (cu, cp - cb, cp + cb)])
-    gt, gw = gauss_legendre(3 if points is None else CURVED_THIRD_POINTS)
+    gt, gw = gauss_legendre(_points(edges))
     out = np.zeros(cu.shape)
     for lo, hi, col in _THIRDS:
         r = np.where(np.isnan(roots), lo, np.clip(roots, lo, hi))
@@ -126,18 +131,27 @@ def friction_work_thirds(
             tq = x0 + (x1 - x0) * gt
             u, p, b = evaluate(cu, tq), evaluate(cp, tq), evaluate(cb, tq)
             work = np.maximum(np.maximum(b, np.abs(p)) * np.abs(u) - p * u, 0.0)
-            if points is not None:
-                work = work * _speed(points, tq)
+            if edges is not None:
+                work = work * edges.speed_at(tq)
             out[:, col] += (x1 - x0)[:, 0] * (gw * work).sum(axis=1)
-    if points is not None:
+    if edges is not None:
         return out
     return out * np.asarray(length)[:, None]
 
 
-def _speed(points: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """``|x'(t)|`` ``(k, q)`` of the quadratic edges through ``points (k, 3, 2)`` ``[start,
-    end, midpoint]`` at per-edge parameters ``t (k, q)``."""
-    t = t[..., None]
-    dx = (4 * t - 3) * points[:, None, 0] + (4 * t - 1) * points[:, None, 1]
-    dx = dx + (4 - 8 * t) * points[:, None, 2]
-    return np.hypot(dx[..., 0], dx[..., 1])
+def _geometry(
+    length: np.ndarray | Edges, points: np.ndarray | None
+) -> tuple[np.ndarray | None, QuadraticEdges | None]:
+    """``(lengths, None)`` for straight edges (their constant ``|x'(t)|`` multiplies the
+    integrals once), ``(None, edges)`` for quadratic ones (``|x'(t)|`` at every point)."""
+    if isinstance(length, StraightEdges):
+        return length.length, None
+    if isinstance(length, QuadraticEdges):
+        return None, length
+    return (length, None) if points is None else (None, QuadraticEdges(points))
+
+
+def _points(edges: QuadraticEdges | None) -> int:
+    """Gauss points per piece: 3 (exact) on straight edges, ``CURVED_THIRD_POINTS`` along
+    quadratic ones, where ``|x'(t)|`` makes the integrand non-polynomial."""
+    return 3 if edges is None else CURVED_THIRD_POINTS

@@ -1,15 +1,93 @@
-"""``σ(u_h) n`` on the edges of straight cells, and the direction field the contact terms
-split it along (docs/method.md, *Estimator*, "On curved boundaries"); used by the terms of
-:mod:`signorini.estimator.terms` (which re-exports both)."""
+"""``σ(u_h) n`` on the edges of the cells, through each cell's map, and the direction field
+the contact terms split it along (docs/method.md, *Estimator*, "On curved boundaries"); used
+by the terms of :mod:`signorini.estimator.terms` (which re-exports ``edge_traction`` and
+``direction_field``)."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 
-from ..fem.p2 import edge_basis
+from ..fem.mapping import AffineCells, CellMap, Cells, Edges
+from ..fem.material import Material, stress
+from ..fem.p2 import REFERENCE_NODES, edge_basis, edge_reference_points
 from ..mesh.geometry import segment_normals
 
-__all__ = ["direction_field", "edge_traction"]
+__all__ = ["CellStress", "direction_field", "edge_traction", "vertex_stress"]
+
+
+def vertex_stress(cells: CellMap, u_cell: np.ndarray, material: Material) -> np.ndarray:
+    """σ(u_h) ``(n_cells, 3, 2, 2)`` of each cell at its vertices, through its map, from the
+    interleaved coefficients ``u_cell (n_cells, 12)``."""
+    vertices = REFERENCE_NODES[:3]
+    return cells.per_cell(lambda g: stress(material, g.field_gradients(u_cell[g.cells], vertices)))
+
+
+class CellStress:
+    """σ(u_h) of a discrete solution in a stress unit, along the local edges of its cells.
+
+    On cells with a constant Jacobian σ(u_h) is linear (P2 displacements), so it is
+    interpolated from its vertex values (:func:`edge_traction`); on the isoparametric ones it
+    is taken through the quadratic map at each point, with the normal of the quadratic edge
+    (docs/method.md, *Estimator*, "On curved boundaries").
+
+    Parameters
+    ----------
+    cells : CellMap
+    points, cell_vertices : mesh arrays ``(n_points, 2)``, ``(n_cells, 3)``
+    u_cell : (n_cells, 12) float array
+    material : Material
+    sigma_vertex : (n_cells, 3, 2, 2) float array
+        :func:`vertex_stress`, already divided by ``unit``.
+    unit : float
+        The stress unit σ₀.
+    """
+
+    def __init__(self, cells, points, cell_vertices, u_cell, material, sigma_vertex, unit=1.0):
+        self.cells, self.points, self.cell_vertices = cells, points, cell_vertices
+        self.u_cell, self.material = u_cell, material
+        self.sigma_vertex, self.unit = sigma_vertex, unit
+
+    @classmethod
+    def of(cls, space, u: np.ndarray, material: Material, unit: float = 1.0) -> CellStress:
+        """σ(u_h) of the nodal values ``u (n_nodes, 2)`` of a :class:`~signorini.fem.space.
+        P2Space`, in the stress unit ``unit``."""
+        u_cell = space.cell_values(u)
+        sigma = vertex_stress(space.mapping, u_cell, material) / unit
+        mesh = space.mesh
+        return cls(space.mapping, mesh.points, mesh.cells, u_cell, material, sigma, unit)
+
+    def _traction(self, group: Cells, slot, cell, k, t, edges: Edges | None) -> np.ndarray:
+        """σ(u_h) n on local edges ``k`` of ``cell`` (rows ``slot`` of ``group``); ``edges``
+        their geometry where already built."""
+        if isinstance(group, AffineCells):
+            return edge_traction(self.sigma_vertex, self.points, self.cell_vertices, cell, k, t)
+        edges = group.local_edges(slot, k) if edges is None else edges
+        grad = group.rows(slot).field_gradients(self.u_cell[cell], edge_reference_points(k, t))
+        sig = stress(self.material, grad) / self.unit
+        return np.einsum("eqij,eqj->eqi", sig, edges.normals(t))
+
+    def on_edges(
+        self, cell: np.ndarray, k: np.ndarray, t: np.ndarray
+    ) -> Iterator[tuple[slice | np.ndarray, np.ndarray, Edges]]:
+        """``σ(u_h) n`` along local edge ``k (e,)`` of each ``cell (e,)`` at parameters ``t
+        (q,)`` (counter-clockwise around the cell), n the outward normal, group by group:
+        ``(rows, traction (r, q, 2), edges)`` with the edges' geometry."""
+        for rows, g, slot, edges in self.cells.local_edges(cell, k):
+            yield rows, self._traction(g, slot, cell[rows], k[rows], t, edges), edges
+
+    def traction(self, cell: np.ndarray, k: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """``σ(u_h) n`` ``(e, q, 2)`` along local edge ``k`` of each ``cell`` (as
+        :meth:`on_edges`, in one array, without the edges' geometry)."""
+        parts = list(self.cells.split(cell))
+        if len(parts) == 1:
+            _, g, slot = parts[0]
+            return self._traction(g, slot, cell, k, t, None)
+        out = np.empty((len(cell), len(t), 2))
+        for rows, g, slot in parts:
+            out[rows] = self._traction(g, slot, cell[rows], k[rows], t, None)
+        return out
 
 
 def edge_traction(

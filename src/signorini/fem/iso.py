@@ -5,8 +5,9 @@ A cell with an edge on a boundary part that carries a curve (other than a
 ``x(xi) = sum_a x_a phi_a(xi)`` through its six P2 node points (the curved edge's midpoint
 node on the curve, :attr:`~signorini.fem.space.P2Space.node_points`). Its Jacobian varies
 from point to point, so stiffness, loads and error norms on these cells use per-quadrature-
-point Jacobians; every other cell keeps the affine formulas. All functions are vectorized
-over the curved cells and the quadrature points.
+point Jacobians (:class:`signorini.fem.mapping.IsoparametricCells`, built on the kernels
+here); every other cell keeps the affine formulas. All functions are vectorized over the
+curved cells and the quadrature points.
 
 Arrays: ``nodes (m, 6, 2)`` are the node points of the curved cells in local node order
 (:mod:`signorini.fem.p2`).
@@ -14,14 +15,11 @@ Arrays: ``nodes (m, 6, 2)`` are the node points of the curved cells in local nod
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
 from ..mesh.curves import Line
 from ..mesh.mesh import Mesh
 from . import p2
-from .material import Material
 from .quadrature import triangle_rule
 
 __all__ = [
@@ -30,11 +28,8 @@ __all__ = [
     "curved_cells",
     "geometry",
     "folded",
-    "stiffness_blocks",
     "edge_geometry",
     "field_derivatives",
-    "gradient_errors",
-    "l2_errors",
 ]
 
 #: Quadrature degree of the stiffness on a curved cell. ``det J * J^{-T}`` is the cofactor
@@ -82,49 +77,6 @@ def folded(nodes: np.ndarray) -> np.ndarray:
     xi = np.vstack([p2.REFERENCE_NODES, triangle_rule(STIFFNESS_DEGREE)[0]])
     _, _, det = geometry(nodes, xi)
     return np.flatnonzero(~(det > 0.0).all(axis=1))
-
-
-def _physical_gradients(
-    nodes: np.ndarray, xi: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Points ``(m, q, 2)``, determinants ``(m, q)`` and physical basis gradients
-    ``(m, q, 6, 2)`` of the quadratic maps."""
-    x, J, det = geometry(nodes, xi)
-    if not np.all(det > 0.0):
-        bad = np.flatnonzero(~(det > 0.0).all(axis=1))
-        raise ValueError(
-            f"{bad.size} curved cell(s) have a non-positive Jacobian determinant at a "
-            f"quadrature point (the curve bends too far for the cell; first: curved cell {bad[0]})"
-        )
-    # J^{-T} = [[J11, -J10], [-J01, J00]] / det
-    jit = np.empty_like(J)
-    jit[..., 0, 0] = J[..., 1, 1]
-    jit[..., 0, 1] = -J[..., 1, 0]
-    jit[..., 1, 0] = -J[..., 0, 1]
-    jit[..., 1, 1] = J[..., 0, 0]
-    jit /= det[..., None, None]
-    G = np.matmul(p2.grad_basis(xi)[None], np.swapaxes(jit, -1, -2))  # (m, q, 6, 2)
-    return x, det, G
-
-
-def stiffness_blocks(
-    nodes: np.ndarray, material: Material, degree: int = STIFFNESS_DEGREE
-) -> np.ndarray:
-    """Element stiffness of the isoparametric cells in node-block layout ``(m, 6, 6, 2, 2)``,
-    ``[c, a, b, i, j] = a(phi_b e_j, phi_a e_i)`` on curved cell ``c``."""
-    xi, w = triangle_rule(degree)
-    _, det, G = _physical_gradients(nodes, xi)
-    m, q = det.shape
-    Gw = G * (w[None, :] * det)[..., None, None]
-    # int d_i phi_a d_j phi_b as one batched product over the quadrature points
-    B = np.matmul(Gw.reshape(m, q, 12).transpose(0, 2, 1), G.reshape(m, q, 12))
-    B = B.reshape(m, 6, 2, 6, 2).transpose(0, 1, 3, 2, 4)
-    lam, mu = material.lam, material.mu
-    out = lam * B + mu * B.transpose(0, 1, 2, 4, 3)
-    tr = B[..., 0, 0] + B[..., 1, 1]
-    out[..., 0, 0] += mu * tr
-    out[..., 1, 1] += mu * tr
-    return np.ascontiguousarray(out)
 
 
 def edge_geometry(
@@ -201,34 +153,3 @@ def field_derivatives(
     Jinv = Jinv[:, :, None]
     hess = np.matmul(np.matmul(np.swapaxes(Jinv, -1, -2), inner), Jinv)
     return grad, hess
-
-
-def gradient_errors(
-    nodes: np.ndarray,
-    u_cell: np.ndarray,
-    grad_exact: Callable[[np.ndarray], np.ndarray],
-    degree: int,
-    density: Callable[[np.ndarray], np.ndarray],
-) -> np.ndarray:
-    """``int_T density(grad u - grad u_h)`` on the isoparametric cells, shape ``(m,)``."""
-    xi, w = triangle_rule(degree)
-    x, det, G = _physical_gradients(nodes, xi)
-    u = np.asarray(u_cell, dtype=np.float64).reshape(-1, 6, 2)
-    grad_h = np.einsum("mac,mqaj->mqcj", u, G)
-    m, q = det.shape
-    ge = np.asarray(grad_exact(x.reshape(-1, 2)), dtype=np.float64).reshape(m, q, 2, 2)
-    dens = density((ge - grad_h).reshape(-1, 2, 2)).reshape(m, q)
-    return (dens * det * w[None, :]).sum(axis=1)
-
-
-def l2_errors(
-    nodes: np.ndarray, u_cell: np.ndarray, u_exact: Callable[[np.ndarray], np.ndarray], degree: int
-) -> np.ndarray:
-    """``int_T |u - u_h|^2`` on the isoparametric cells, shape ``(m,)``."""
-    xi, w = triangle_rule(degree)
-    x, _, det = geometry(nodes, xi)
-    u = np.asarray(u_cell, dtype=np.float64).reshape(-1, 6, 2)
-    uh = np.einsum("qa,mac->mqc", p2.basis(xi), u)
-    m, q = det.shape
-    d = np.asarray(u_exact(x.reshape(-1, 2)), dtype=np.float64).reshape(m, q, 2) - uh
-    return (np.einsum("mqc,mqc->mq", d, d) * det * w[None, :]).sum(axis=1)

@@ -11,51 +11,59 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import iso, p2
+from . import p2
+from .mapping import CellMap, Cells
 from .material import Material
 from .quadrature import triangle_rule
 
 __all__ = ["energy_error2", "h1_seminorm_error2", "l2_error2"]
 
 
-def _error_setup(vertices, u_cell, degree):
-    J, det = p2.jacobian(vertices)
+def _pointwise(
+    cells: CellMap | np.ndarray,
+    u_cell: np.ndarray,
+    degree: int,
+    density: Callable[[Cells, np.ndarray], Callable[[np.ndarray, np.ndarray], np.ndarray]],
+) -> np.ndarray:
+    """``sum_q w_q det J(xi_q) e(x_q, xi_q)`` per cell with ``e = density(group, u_group)``,
+    group by group and one quadrature point at a time (the exact solution is called with
+    ``(m, 2)`` points); where ``det J`` is constant on each cell it multiplies the sum once."""
+    mapping = cells if isinstance(cells, CellMap) else CellMap(cells)
     u = np.asarray(u_cell, dtype=np.float64)
     xi, w = triangle_rule(degree)
-    v0 = np.asarray(vertices, dtype=np.float64)[:, 0]
 
-    def point(p: int) -> np.ndarray:  # physical images of quadrature point p, (m, 2)
-        return v0 + J[:, :, 0] * xi[p, 0] + J[:, :, 1] * xi[p, 1]
+    def integral(g: Cells) -> np.ndarray:
+        _, det = g.jacobians(xi)
+        constant = det.shape[1] == 1
+        error = density(g, u[g.cells])
+        out = np.zeros(len(g))
+        for p in range(w.size):
+            at = xi[p : p + 1]
+            value = error(g.points(at)[:, 0], at)
+            out += w[p] * value if constant else w[p] * det[:, p] * value
+        return out * det[:, 0] if constant else out
 
-    return u, J, det, xi, w, point
+    return mapping.per_cell(integral)
 
 
-def _grad_error_loop(vertices, u_cell, grad_exact, degree, density, curved=None):
-    """Sum over quadrature points of density(grad u - grad u_h) * w * det, per cell
-    (isoparametric cells ``curved`` with their per-point Jacobians)."""
-    u, J, det, xi, w, point = _error_setup(vertices, u_cell, degree)
-    coef = p2.gradient_coefficients(u, p2.inverse_transpose(J, det))  # (m, 3, 2, 2)
-    out = np.zeros(det.shape[0])
-    for p in range(w.size):
-        ge = np.asarray(grad_exact(point(p)), dtype=np.float64)
-        diff = ge - coef[:, 0]
-        diff -= xi[p, 0] * coef[:, 1]
-        diff -= xi[p, 1] * coef[:, 2]
-        out += w[p] * density(diff)
-    out *= det
-    if curved is not None:
-        cells, nodes = curved
-        out[cells] = iso.gradient_errors(nodes, u[cells], grad_exact, degree, density)
-    return out
+def _grad_error_loop(cells, u_cell, grad_exact, degree, density):
+    """Sum over quadrature points of density(grad u - grad u_h) * w * det, per cell."""
+
+    def error(g: Cells, u: np.ndarray):
+        gradient = g.gradient_field(u)
+        return lambda x, xi: density(
+            np.asarray(grad_exact(x), dtype=np.float64) - gradient(xi)[:, 0]
+        )
+
+    return _pointwise(cells, u_cell, degree, error)
 
 
 def energy_error2(
-    vertices: np.ndarray,
+    cells: CellMap | np.ndarray,
     u_cell: np.ndarray,
     grad_exact: Callable[[np.ndarray], np.ndarray],
     material: Material,
     degree: int = 10,
-    curved: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Per-cell squared energy error ``a_T(e, e)``, ``e = u - u_h``.
 
@@ -63,7 +71,9 @@ def energy_error2(
 
     Parameters
     ----------
-    vertices : ndarray of float, shape (m, 3, 2)
+    cells : CellMap or ndarray of float, shape (m, 3, 2)
+        The cells' geometry (:attr:`~signorini.fem.space.P2Space.mapping`), or the vertices
+        of straight cells.
     u_cell : ndarray of float, shape (m, 12)
         Interleaved coefficients of ``u_h`` on each cell.
     grad_exact : callable
@@ -72,9 +82,6 @@ def energy_error2(
     material : Material
     degree : int, optional
         Quadrature degree on each cell.
-    curved : (cells (k,), nodes (k, 6, 2)), optional
-        Isoparametric cells (:attr:`~signorini.fem.space.P2Space.curved`), integrated on
-        their quadratic maps (the same for the other norms).
 
     Returns
     -------
@@ -89,21 +96,22 @@ def energy_error2(
         e01 = 0.5 * (ge[:, 0, 1] + ge[:, 1, 0])
         return lam * (e00 + e11) ** 2 + 2.0 * mu * (e00**2 + e11**2 + 2.0 * e01**2)
 
-    return _grad_error_loop(vertices, u_cell, grad_exact, degree, density, curved)
+    return _grad_error_loop(cells, u_cell, grad_exact, degree, density)
 
 
 def h1_seminorm_error2(
-    vertices: np.ndarray,
+    cells: CellMap | np.ndarray,
     u_cell: np.ndarray,
     grad_exact: Callable[[np.ndarray], np.ndarray],
     degree: int = 10,
-    curved: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Per-cell squared H^1 seminorm error ``int_T |grad(u - u_h)|^2``.
 
     Parameters
     ----------
-    vertices : ndarray of float, shape (m, 3, 2)
+    cells : CellMap or ndarray of float, shape (m, 3, 2)
+        The cells' geometry (:attr:`~signorini.fem.space.P2Space.mapping`), or the vertices
+        of straight cells.
     u_cell : ndarray of float, shape (m, 12)
     grad_exact : callable
         ``grad_exact(x)`` with ``x (m, 2)`` returns ``(m, 2, 2)``.
@@ -114,22 +122,23 @@ def h1_seminorm_error2(
     ndarray of float64, shape (m,)
     """
     return _grad_error_loop(
-        vertices, u_cell, grad_exact, degree, lambda ge: np.einsum("mij,mij->m", ge, ge), curved
+        cells, u_cell, grad_exact, degree, lambda ge: np.einsum("mij,mij->m", ge, ge)
     )
 
 
 def l2_error2(
-    vertices: np.ndarray,
+    cells: CellMap | np.ndarray,
     u_cell: np.ndarray,
     u_exact: Callable[[np.ndarray], np.ndarray],
     degree: int = 10,
-    curved: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Per-cell squared L^2 error ``int_T |u - u_h|^2``.
 
     Parameters
     ----------
-    vertices : ndarray of float, shape (m, 3, 2)
+    cells : CellMap or ndarray of float, shape (m, 3, 2)
+        The cells' geometry (:attr:`~signorini.fem.space.P2Space.mapping`), or the vertices
+        of straight cells.
     u_cell : ndarray of float, shape (m, 12)
     u_exact : callable
         ``u_exact(x)`` with ``x (m, 2)`` returns ``(m, 2)``.
@@ -139,15 +148,12 @@ def l2_error2(
     -------
     ndarray of float64, shape (m,)
     """
-    u, _, det, xi, w, point = _error_setup(vertices, u_cell, degree)
-    # u_h at all points: (m, 2, 6) @ (6, q) -> (m, 2, q)
-    uh = np.matmul(np.swapaxes(u.reshape(-1, 6, 2), 1, 2), p2.basis(xi).T)
-    out = np.zeros(det.shape[0])
-    for p in range(w.size):
-        d = np.asarray(u_exact(point(p)), dtype=np.float64) - uh[:, :, p]
-        out += w[p] * np.einsum("mi,mi->m", d, d)
-    out *= det
-    if curved is not None:
-        cells, nodes = curved
-        out[cells] = iso.l2_errors(nodes, u[cells], u_exact, degree)
-    return out
+
+    def error(g: Cells, u: np.ndarray):
+        def squared(x: np.ndarray, xi: np.ndarray) -> np.ndarray:
+            d = np.asarray(u_exact(x), dtype=np.float64) - p2.field_values(u, xi)[:, 0]
+            return np.einsum("mi,mi->m", d, d)
+
+        return squared
+
+    return _pointwise(cells, u_cell, degree, error)

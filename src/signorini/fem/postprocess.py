@@ -12,19 +12,22 @@ import numpy as np
 
 from ..mesh.geometry import segment_normals
 from . import p2
+from .mapping import CellMap
 from .material import Material, stress
 
-__all__ = ["cell_stress", "div_stress", "edge_traction", "traction"]
+__all__ = ["cell_stress", "div_stress", "edge_traction", "stress_divergence", "traction"]
 
 
 def cell_stress(
-    vertices: np.ndarray, u_cell: np.ndarray, material: Material, xi: np.ndarray
+    vertices: CellMap | np.ndarray, u_cell: np.ndarray, material: Material, xi: np.ndarray
 ) -> np.ndarray:
     """Stress ``sigma(u_h)`` at reference points of each cell.
 
     Parameters
     ----------
-    vertices : ndarray of float, shape (m, 3, 2)
+    vertices : CellMap or ndarray of float, shape (m, 3, 2)
+        The cells' geometry (:attr:`~signorini.fem.space.P2Space.mapping`: through the
+        quadratic map on isoparametric cells), or the vertices of straight cells.
     u_cell : ndarray of float, shape (m, 12)
         Interleaved local coefficients.
     material : Material
@@ -35,17 +38,30 @@ def cell_stress(
     -------
     ndarray of float64, shape (m, q, 2, 2)
     """
+    if isinstance(vertices, CellMap):
+        u, xi = np.asarray(u_cell, dtype=np.float64), np.asarray(xi, dtype=np.float64)
+
+        def group_stress(g):
+            points = xi if xi.ndim == 2 else xi[g.cells]
+            return stress(material, g.field_gradients(u[g.cells], points))
+
+        return vertices.per_cell(group_stress)
     return stress(material, p2.field_gradients(vertices, u_cell, xi))
 
 
 def traction(
-    vertices: np.ndarray, u_cell: np.ndarray, material: Material, xi: np.ndarray, normal: np.ndarray
+    vertices: CellMap | np.ndarray,
+    u_cell: np.ndarray,
+    material: Material,
+    xi: np.ndarray,
+    normal: np.ndarray,
 ) -> np.ndarray:
     """Traction ``sigma(u_h) n`` at reference points of each cell.
 
     Parameters
     ----------
-    vertices : ndarray of float, shape (m, 3, 2)
+    vertices : CellMap or ndarray of float, shape (m, 3, 2)
+        As for :func:`cell_stress`.
     u_cell : ndarray of float, shape (m, 12)
     material : Material
     xi : ndarray of float, shape (q, 2) or (m, q, 2)
@@ -121,7 +137,14 @@ def div_stress(vertices: np.ndarray, u_cell: np.ndarray, material: Material) -> 
     -------
     ndarray of float64, shape (m, 2)
     """
-    H = p2.field_hessian(vertices, u_cell)  # (m, i, j, k)
-    lap = H[:, :, 0, 0] + H[:, :, 1, 1]
-    grad_div = H[:, 0, 0, :] + H[:, 1, 1, :]
+    return stress_divergence(p2.field_hessian(vertices, u_cell), material)
+
+
+def stress_divergence(hess: np.ndarray, material: Material) -> np.ndarray:
+    """``div sigma(u)`` ``(..., 2)`` from the Hessian ``(..., 2, 2, 2)`` of ``u``,
+    ``hess[..., i, j, k] = d^2 u_i / d x_j d x_k`` (e.g. through a cell's map,
+    :meth:`signorini.fem.mapping.IsoparametricCells.field_hessians`):
+    ``mu Laplace u_i + (lam + mu) d_i div u``."""
+    lap = hess[..., 0, 0] + hess[..., 1, 1]
+    grad_div = hess[..., 0, 0, :] + hess[..., 1, 1, :]
     return material.mu * lap + (material.lam + material.mu) * grad_div

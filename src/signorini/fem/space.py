@@ -8,7 +8,7 @@ midpoints of local edges 0, 1, 2 (the order of VTK's quadratic triangle / meshio
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from functools import cached_property
 
 import numpy as np
@@ -17,6 +17,7 @@ from ..mesh.mesh import Mesh
 from ..mesh.refine import Refinement
 from ..mesh.validation import MeshError
 from . import iso
+from .mapping import CellMap, QuadraticEdges, StraightEdges, edge_groups
 from .p2 import basis_barycentric
 
 __all__ = ["P2Space"]
@@ -90,6 +91,12 @@ class P2Space:
         return cells, nodes
 
     @cached_property
+    def mapping(self) -> CellMap:
+        """The cells' geometry (:mod:`signorini.fem.mapping`): affine cells, and the
+        isoparametric cells of :attr:`curved` with their quadratic maps."""
+        return CellMap(self.vertices, self.curved)
+
+    @cached_property
     def vertices(self) -> np.ndarray:
         """``(n_cells, 3, 2)`` vertex coordinates of each cell."""
         return self.mesh.points[self.mesh.cells]
@@ -126,6 +133,16 @@ class P2Space:
         edge_index = np.asarray(edge_index, dtype=np.int64)
         ab = self.mesh.oriented_boundary(edge_index)
         return np.column_stack([ab, self.mesh.n_points + edge_index])
+
+    def boundary_edges(
+        self, edge_index: np.ndarray
+    ) -> Iterator[tuple[slice | np.ndarray, StraightEdges | QuadraticEdges]]:
+        """The geometry of boundary edges (:mod:`signorini.fem.mapping`), counter-clockwise
+        as :meth:`edge_nodes`: quadratic through the midpoint node on parts carrying a curve
+        other than a line, straight elsewhere; ``(rows, edges)`` per kind."""
+        edge_index = np.asarray(edge_index, dtype=np.int64)
+        points = self.node_points[self.edge_nodes(edge_index)]
+        return edge_groups(points, np.isin(edge_index, iso.curved_edges(self.mesh)))
 
     def part_nodes(self, names: Iterable[str]) -> np.ndarray:
         """Sorted nodes on the closure of the named boundary parts (vertices and midpoints)."""

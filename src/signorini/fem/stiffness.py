@@ -24,11 +24,12 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
-from . import iso, p2
+from . import p2
+from .mapping import AffineCells, CellMap, Cells
 from .material import Material
 from .quadrature import triangle_rule
 
-__all__ = ["assemble_stiffness", "element_stiffness"]
+__all__ = ["assemble_stiffness", "element_blocks", "element_stiffness"]
 
 
 # On a straight triangle, grad phi_a = J^{-T} ghat_a with ghat_a linear, so
@@ -49,30 +50,42 @@ _P_PAIRS = [
 
 
 @lru_cache(maxsize=32)
-def _stiffness_basis(lam: float, mu: float, dof_order: bool) -> np.ndarray:
-    """Matrix (10, 144) mapping the 10 geometric factors to K.
+def _stiffness_basis(
+    lam: float, mu: float, dof_order: bool, degree: int = 2, per_point: bool = False
+) -> np.ndarray:
+    """Matrix (10, 144) mapping the 10 geometric factors to K, with ``R`` summed over the
+    points of the degree-``degree`` rule; ``(q * 10, 144)``, one block per point, if
+    ``per_point`` (for Jacobians that vary from point to point).
 
     The 144 columns are in node-block layout (a, b, i, j), or in interleaved DOF
     layout (a, i, b, j) if ``dof_order``.
     """
-    xi, w = triangle_rule(2)
+    xi, w = triangle_rule(degree)
     g = p2.grad_basis(xi)
-    R = np.einsum("q,qak,qbl->klab", w, g, g)  # (2, 2, 6, 6)
-    full = np.zeros((2, 2, 2, 2, 6, 6, 2, 2))
+    if per_point:
+        R = np.einsum("q,qak,qbl->qklab", w, g, g)  # (q, 2, 2, 6, 6)
+    else:
+        R = np.einsum("q,qak,qbl->klab", w, g, g)[None]  # (1, 2, 2, 6, 6)
+    full = np.zeros((R.shape[0], 2, 2, 2, 2, 6, 6, 2, 2))
     for i in range(2):
         for j in range(2):
             for k in range(2):
                 for l in range(2):  # noqa: E741
-                    r = R[k, l]
-                    full[i, j, k, l, :, :, i, j] += lam * r
-                    full[i, j, k, l, :, :, j, i] += mu * r
+                    r = R[:, k, l]
+                    full[:, i, j, k, l, :, :, i, j] += lam * r
+                    full[:, i, j, k, l, :, :, j, i] += mu * r
                     if i == j:
-                        full[i, j, k, l, :, :, 0, 0] += mu * r
-                        full[i, j, k, l, :, :, 1, 1] += mu * r
-    out = np.empty((len(_P_PAIRS), 144))
+                        full[:, i, j, k, l, :, :, 0, 0] += mu * r
+                        full[:, i, j, k, l, :, :, 1, 1] += mu * r
+    out = np.empty((R.shape[0], len(_P_PAIRS), 144))
     for s, (p, q) in enumerate(_P_PAIRS):
-        blk = full[p] if p == q else full[p] + full[q]
-        out[s] = (blk.transpose(0, 2, 1, 3) if dof_order else blk).ravel()
+        blk = (
+            full[(slice(None),) + p]
+            if p == q
+            else full[(slice(None),) + p] + full[(slice(None),) + q]
+        )
+        out[:, s] = (blk.transpose(0, 1, 3, 2, 4) if dof_order else blk).reshape(R.shape[0], 144)
+    out = out.reshape(-1, 144)
     out.setflags(write=False)
     return out
 
@@ -88,12 +101,35 @@ def _geometric_factors(J: np.ndarray, det: np.ndarray) -> np.ndarray:
     return out
 
 
-def _element_matrices(
-    J: np.ndarray, det: np.ndarray, material: Material, dof_order: bool
+def element_blocks(
+    cells: Cells,
+    material: Material,
+    degree: int | None = None,
+    dof_order: bool = False,
+    out: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Element stiffness, shape (m, 144): (a, b, i, j) layout, or (a, i, b, j) if ``dof_order``."""
-    fac = _geometric_factors(J, det)
-    return fac @ _stiffness_basis(material.lam, material.mu, dof_order)
+    """Element stiffness of a group of cells (:mod:`signorini.fem.mapping`), shape
+    ``(m, 144)``: ``[c, a, b, i, j] = a(phi_b e_j, phi_a e_i)`` on cell ``c`` in node-block
+    layout, or ``(a, i, b, j)`` if ``dof_order``.
+
+    One integrand for every geometry: ``K = sum_q P(x_q) R_q`` with the 10 geometric factors
+    ``P = det J * Jit (x) Jit`` at the points of the rule and ``R_q`` the reference gradients'
+    products there. Where the Jacobian is constant on each cell (affine cells) ``P`` has one
+    point and ``R`` is summed over the rule first (one GEMM with a (10, 144) matrix).
+
+    ``degree`` defaults to ``2 * cells.order``: the degree of the integrand's numerator
+    ``(cof J grad phi_a) . C (cof J grad phi_b)``, exact on affine cells (degree 2); on the
+    quadratic maps of isoparametric cells (degree 4) the rational remainder is far below the
+    discretisation error (Ciarlet-Raviart: degree 2k - 2 suffices for the optimal rate).
+    ``out (m, 144)``, if given, receives the result.
+    """
+    degree = 2 * cells.order if degree is None else degree
+    xi, _ = triangle_rule(degree)
+    J, det = cells.jacobians(xi)  # (m, p, 2, 2), p = 1 (constant) or q
+    m, n_p = det.shape
+    fac = _geometric_factors(J.reshape(-1, 2, 2), det.reshape(-1)).reshape(m, -1)
+    basis = _stiffness_basis(material.lam, material.mu, dof_order, degree, n_p > 1)
+    return np.matmul(fac, basis, out=out)
 
 
 def element_stiffness(vertices: np.ndarray, material: Material) -> np.ndarray:
@@ -116,8 +152,7 @@ def element_stiffness(vertices: np.ndarray, material: Material) -> np.ndarray:
         Symmetric positive semidefinite matrices, interleaved local DOF order
         ``2 * local_node + component``.
     """
-    J, det = p2.jacobian(vertices)
-    return _element_matrices(J, det, material, dof_order=True).reshape(-1, 12, 12)
+    return element_blocks(AffineCells(vertices), material, dof_order=True).reshape(-1, 12, 12)
 
 
 def _assemble_node_blocks(
@@ -177,9 +212,9 @@ def _assemble_node_blocks(
 
 def _checked_input(
     vertices: np.ndarray, cell_dofs: np.ndarray, n_dofs: int, material: Material
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
-    """Validate the raw arrays of :func:`assemble_stiffness`; return the Jacobians and their
-    determinants, the cell nodes and ``n_dofs``."""
+) -> tuple[np.ndarray, int]:
+    """Validate the raw arrays of :func:`assemble_stiffness`; return the cell nodes and
+    ``n_dofs``."""
     try:
         n = int(n_dofs)
     except (TypeError, ValueError):
@@ -196,7 +231,7 @@ def _checked_input(
     if not np.all(np.isfinite(v)):
         bad = np.flatnonzero(~np.isfinite(v).all(axis=(1, 2)))
         raise ValueError(f"vertices of {bad.size} cell(s) are not finite (first: cell {bad[0]})")
-    J, det = p2.jacobian(v)
+    _, det = p2.jacobian(v)
     if not np.all(det > 0.0):
         bad = np.flatnonzero(~(det > 0.0))
         raise ValueError(
@@ -220,24 +255,25 @@ def _checked_input(
             "cell_dofs must be interleaved: cell_dofs[:, 2a] = 2 * node_a and "
             "cell_dofs[:, 2a + 1] = 2 * node_a + 1"
         )
-    return J, det, ev.astype(np.int64, copy=False) // 2, n
+    return ev.astype(np.int64, copy=False) // 2, n
 
 
 def assemble_stiffness(
-    vertices: np.ndarray,
+    cells: CellMap | np.ndarray,
     cell_dofs: np.ndarray,
     n_dofs: int,
     material: Material,
     *,
     validate: bool = True,
-    curved: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> sp.csr_matrix:
     """Global stiffness matrix of ``a(u, v) = int sigma(u) : eps(v)``.
 
     Parameters
     ----------
-    vertices : array_like of float, shape (m, 3, 2)
-        Cell vertices, counter-clockwise.
+    cells : CellMap or array_like of float, shape (m, 3, 2)
+        The cells' geometry (:attr:`~signorini.fem.space.P2Space.mapping`: affine cells and
+        the isoparametric ones along curved parts, each integrated by :func:`element_blocks`),
+        or the vertices of straight cells, counter-clockwise.
     cell_dofs : array_like of int, shape (m, 12)
         Interleaved global DOFs (``2 * node + component``).
     n_dofs : int
@@ -247,11 +283,6 @@ def assemble_stiffness(
         Check the arrays (shapes, finite counter-clockwise cells, interleaved DOFs in
         range). The assembly of a :class:`~signorini.fem.space.P2Space`, whose arrays are
         right by construction, skips it.
-    curved : (cells (k,), nodes (k, 6, 2)), optional
-        Isoparametric cells (:attr:`~signorini.fem.space.P2Space.curved`): their element
-        matrices are those of the quadratic map through the six node points, integrated with
-        per-quadrature-point Jacobians (:func:`signorini.fem.iso.stiffness_blocks`); they
-        replace the affine ones before the (unchanged) node-block assembly.
 
     Returns
     -------
@@ -268,14 +299,24 @@ def assemble_stiffness(
         ``n_dofs``, badly oriented or non-finite cells, or a material that is not a
         :class:`Material`.
     """
+    mapping = cells if isinstance(cells, CellMap) else None
     if validate:
-        J, det, nodes, n = _checked_input(vertices, cell_dofs, n_dofs, material)
+        vertices = mapping.groups[0].vertices if mapping is not None else cells
+        if mapping is not None and len(mapping.groups) > 1:
+            vertices = mapping.per_cell(lambda g: g.vertices)
+        nodes, n = _checked_input(vertices, cell_dofs, n_dofs, material)
     else:
-        J, det = p2.jacobian(vertices)
         nodes = np.asarray(cell_dofs, dtype=np.int64)[:, 0::2] // 2
         n = int(n_dofs)
-    blocks = _element_matrices(J, det, material, dof_order=False).reshape(-1, 6, 6, 2, 2)
-    if curved is not None:
-        cells, nodes_xy = curved
-        blocks[cells] = iso.stiffness_blocks(nodes_xy, material)
-    return _assemble_node_blocks(nodes, n // 2, blocks)
+    if mapping is None:
+        mapping = CellMap(cells)
+    if len(mapping.groups) == 1:
+        blocks = element_blocks(mapping.groups[0], material)
+    else:  # group after group into one array (no scatter), the cells' nodes in that order
+        blocks = np.empty((mapping.n_cells, 144))
+        start = 0
+        for g in mapping.groups:
+            element_blocks(g, material, out=blocks[start : start + len(g)])
+            start += len(g)
+        nodes = nodes[np.concatenate([g.cells for g in mapping.groups])]
+    return _assemble_node_blocks(nodes, n // 2, blocks.reshape(-1, 6, 6, 2, 2))
