@@ -22,7 +22,7 @@ from ..output.run import STATE, ResumeState, RunFolder
 from ..output.vtu import write_fields
 from .figures import compare_uniform, draw_figures
 from .identity import check_problem, name_the_problem
-from .levels import Clock, Status, write_levels
+from .levels import Clock, Printer, Status, write_levels
 from .problems import RunProblem, label, load, problem_id, with_curves_of
 from .settings import RunSettings, new_settings, resumed_settings
 
@@ -49,7 +49,7 @@ def run(args: argparse.Namespace, status: Status | None = None) -> int:
     """``signorini run``: returns the exit status (0); raises ``ValueError``,
     ``RuntimeError`` or ``OSError`` with a message for the user. The folder's lock is
     released by the caller (``status.folder.close()``) or when the process ends."""
-    status = Status() if status is None else status
+    status = Status(say=Printer(quiet=args.quiet)) if status is None else status
     say = status.say
     if args.resume is not None:
         folder = _open_resumed(args)

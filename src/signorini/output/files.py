@@ -41,9 +41,9 @@ def replacing(path: str | os.PathLike, same_name: bool = False) -> Iterator[Path
     if same_name:
         folder = tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.", suffix=TEMP_SUFFIX)
         try:
-            with replacing(path) as tmp:
-                yield Path(folder) / path.name
-                os.replace(Path(folder) / path.name, tmp)
+            tmp = Path(folder) / path.name  # created by the writer, with open()'s mode
+            yield tmp
+            os.replace(tmp, path)
         finally:
             shutil.rmtree(folder, ignore_errors=True)
         return
