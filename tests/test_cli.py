@@ -171,9 +171,14 @@ def test_run_options_eta5_no_vtu_quiet(tmp_path, capsys):
     )
     printed = capsys.readouterr()
     assert code == 0 and printed.out == ""
-    # the run's files: its history, the columns' description, its manifest (the resume
-    # state is removed once the run finished)
-    assert sorted(os.listdir(out)) == ["history.csv", "history.md", "signorini-run.json"]
+    # the run's files: its history, the columns' description, its manifest and its first
+    # level's problem data (the resume state is removed once the run finished)
+    assert sorted(os.listdir(out)) == [
+        "history.csv",
+        "history.md",
+        "signorini-check.npz",
+        "signorini-run.json",
+    ]
     _, rows = read_history(out / "history.csv")
     assert len(rows) == 2
     paper = estimate(solve(example_6_1()), eta5_variant="paper").eta_terms[4]
@@ -355,7 +360,8 @@ def test_a_folder_holding_a_run_is_refused_and_overwrite_clears_only_that_run(tm
     assert (out / "notes.txt").read_text() == "my notes"
     assert sorted(os.listdir(out)) == sorted(
         ["history.csv", "history.md", "level_000.vtu", "level_001.vtu", "notes.txt"]
-        + ["signorini-run.json"]
+        + ["signorini-run.json", "signorini-check.npz", "fields.md"]
+        + ["levels.pvd", "levels_ndof.pvd"]
     )
 
 
@@ -403,12 +409,13 @@ def test_resume_after_an_interrupt_gives_the_uninterrupted_run(tmp_path, capsys,
     assert json.loads((part / "signorini-run.json").read_text())["status"] == "interrupted"
     monkeypatch.undo()
     # options given again must agree with the run's
-    assert main(["run", "--resume", str(part), "--max-ndof", "3000"]) == 2
+    assert main(["run", "example-6.2", "--resume", str(part), "--max-ndof", "3000"]) == 2
     assert "--max-ndof 3000 (the run has 2500)" in capsys.readouterr().err
     assert main(["run", "example-6.1", "--resume", str(part)]) == 2
-    assert "the run solved 'example-6.2'" in capsys.readouterr().err
+    assert "example-6.1 is not the problem of the run in" in capsys.readouterr().err
     assert len(list(part.glob("level_*.vtu"))) == 6
-    assert main(["run", "--resume", str(part), "--theta", "0.5", "--quiet", "--no-figures"]) == 0
+    resume = ["run", "example-6.2", "--resume", str(part)]
+    assert main([*resume, "--theta", "0.5", "--quiet", "--no-figures"]) == 0
     a, b = (
         history_without_timings(full / "history.csv"),
         history_without_timings(part / "history.csv"),
@@ -421,7 +428,7 @@ def test_resume_after_an_interrupt_gives_the_uninterrupted_run(tmp_path, capsys,
     for name in names[5:]:
         assert_same_vtu(full / name, part / name)
     assert sorted(os.listdir(full)) == sorted(os.listdir(part))
-    assert main(["run", "--resume", str(part)]) == 0
+    assert main(resume) == 0
     assert "is finished: nothing to resume" in capsys.readouterr().out
 
 
@@ -452,11 +459,12 @@ def test_resume_of_a_run_whose_manifest_has_the_old_option_names(tmp_path, capsy
         "compare_uniform": False,
     }
     (part / "signorini-run.json").write_text(json.dumps(manifest))
-    assert main(["run", "--resume", str(part), "--eta5", "consistent"]) == 2
+    resume = ["run", "example-6.2", "--resume", str(part)]
+    assert main([*resume, "--eta5", "consistent"]) == 2
     assert "--eta5 consistent (the run has paper)" in capsys.readouterr().err
-    assert main(["run", "--resume", str(part), "--backend", "auto"]) == 2
+    assert main([*resume, "--backend", "auto"]) == 2
     assert "--backend auto (the run has scipy)" in capsys.readouterr().err
-    assert main(["run", "--resume", str(part), "--eta5", "paper", "--quiet", "--no-figures"]) == 0
+    assert main([*resume, "--eta5", "paper", "--quiet", "--no-figures"]) == 0
     a = history_without_timings(full / "history.csv")
     b = history_without_timings(part / "history.csv")
     assert len(a) > 5 and {r["backend"] for r in b} == {"scipy"}
@@ -531,7 +539,8 @@ def test_sigkill_then_resume_gives_the_uninterrupted_run(tmp_path, capsys):
     assert main(["run", "example-6.2", *args, "--out", str(full), "--no-figures", "--quiet"]) == 0
     before = len(list(part.glob("level_*.vtu")))
     (part / ".level_029.vtu.zz_9q7w3.vtu").write_bytes(b"")  # as SIGKILL in a write leaves
-    assert main(["run", "--resume", str(part), "--quiet", "--no-figures"]) == 0
+    resume = ["run", "example-6.2", "--resume", str(part), "--quiet", "--no-figures"]
+    assert main(resume) == 0
     a = history_without_timings(full / "history.csv")
     b = history_without_timings(part / "history.csv")
     print(f"killed with {before} VTU files; {len(a)} levels")
@@ -704,18 +713,96 @@ def test_a_file_that_is_not_a_problem_file(tmp_path, capsys):
     assert "is not a problem file: it must define a function problem()" in (capsys.readouterr().err)
 
 
-def test_resume_refuses_a_changed_problem_file(tmp_path, capsys):
-    text = GOOD + "def problem():\n    return make()\n"
-    assert run_file(tmp_path, text, "--max-levels", "2") == 0
-    out, source = tmp_path / "out", tmp_path / "user.py"
-    assert main(["run", "--resume", str(out)]) == 0  # the same file: nothing to do
-    assert "is finished: nothing to resume" in capsys.readouterr().out
-    source.write_text(text.replace("0.01", "0.02"))
-    assert main(["run", "--resume", str(out)]) == 2
-    assert capsys.readouterr().err == (
-        f"signorini: error: --resume {out}: {source.resolve()} is not the problem file the run "
-        f"solved ({source}): another file, or its contents changed\n"
+def interrupted_file_run(tmp_path, monkeypatch, text: str, k: int = 1) -> tuple[Path, Path]:
+    """A run of the problem file ``text`` (user.py) interrupted after level ``k``."""
+    interrupt_after_level(monkeypatch, k)
+    assert run_file(tmp_path, text) == 130
+    monkeypatch.undo()
+    return tmp_path / "user.py", tmp_path / "out"
+
+
+def test_resume_never_executes_a_file_the_results_folder_names(tmp_path, capsys, monkeypatch):
+    """A results folder may come from anyone: --resume without PROBLEM executes nothing the
+    manifest names, and says how to write the command."""
+    source, out = interrupted_file_run(
+        tmp_path, monkeypatch, GOOD + "def problem():\n    return make()\n"
     )
+    capsys.readouterr()
+    marker = tmp_path / "executed"
+    evil = tmp_path / "evil.py"
+    evil.write_text(
+        f"open({str(marker)!r}, 'w').close()\n" + GOOD + "def problem():\n    return make()\n"
+    )
+    manifest = json.loads((out / "signorini-run.json").read_text())
+    manifest["problem"] = {"name": str(evil), "label": "evil", "file": str(evil), "sha256": None}
+    (out / "signorini-run.json").write_text(json.dumps(manifest))
+    assert main(["run", "--resume", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert not marker.exists()
+    assert err.startswith(
+        f"signorini: error: name the problem: signorini run PROBLEM --resume {out} (an "
+        "example's name or your problem file, as for a new run). A run folder may come from "
+        "anyone, so signorini never executes a file that it names. The run recorded its "
+        f"problem as {str(evil)!r}"
+    )
+    # named on the command line, the right file resumes; the interrupt line says so
+    assert main(["run", str(source), "--resume", str(out), "--quiet", "--no-figures"]) == 0
+    assert not marker.exists()
+
+
+def test_the_interrupt_line_gives_a_complete_command(tmp_path, capsys, monkeypatch):
+    source = tmp_path / "my problem.py"
+    source.write_text(GOOD + "def problem():\n    return make()\n")
+    interrupt_after_level(monkeypatch, 0)
+    out = tmp_path / "out dir"
+    assert main(["run", str(source), "--out", str(out), "--max-ndof", "300", "--quiet"]) == 130
+    err = capsys.readouterr().err
+    command = err.strip().split("continue with: ")[1]
+    assert command == f"signorini run '{source}' --resume '{out}'"
+    monkeypatch.undo()
+    import shlex
+
+    assert main([*shlex.split(command)[1:], "--quiet", "--no-figures"]) == 0
+    assert json.loads((out / "signorini-run.json").read_text())["status"] == "finished"
+
+
+def test_resume_refuses_a_problem_whose_helper_module_changed(tmp_path, capsys, monkeypatch):
+    """Only the data decide: the problem file is unchanged, the helper module it imports is
+    edited (the gap), and the rebuilt problem's contact data differ from the run's."""
+    (tmp_path / "helper.py").write_text("GAP = 0.01\n")
+    text = "import helper\n" + GOOD + "def problem():\n    return make(helper.GAP)\n"
+    source, out = interrupted_file_run(tmp_path, monkeypatch, text)
+    capsys.readouterr()
+    before = sorted(os.listdir(out))
+    (tmp_path / "helper.py").write_text("GAP = 0.02\n")
+    sys.modules.pop("helper", None)
+    assert main(["run", str(source), "--resume", str(out), "--quiet"]) == 2
+    assert capsys.readouterr().err == (
+        f"signorini: error: --resume {out}: {source} is not the problem of the run in {out}: "
+        "rebuilt, it differs from the run's first level in the contact data (gaps, normals "
+        "or friction) and the first level's solution. Name the problem the run solved, or "
+        "start a new run (another --out, or --overwrite)\n"
+    )
+    assert sorted(os.listdir(out)) == before  # nothing touched
+    (tmp_path / "helper.py").write_text("GAP = 0.01\n")
+    sys.modules.pop("helper", None)
+    assert main(["run", str(source), "--resume", str(out), "--quiet", "--no-figures"]) == 0
+
+
+def test_resume_refuses_a_manifest_whose_problem_name_was_edited(tmp_path, capsys, monkeypatch):
+    out = tmp_path / "r"
+    interrupt_after_level(monkeypatch, 1)
+    assert main([*RUN_62, "--out", str(out)]) == 130
+    monkeypatch.undo()
+    capsys.readouterr()
+    manifest = json.loads((out / "signorini-run.json").read_text())
+    manifest["problem"]["name"] = manifest["problem"]["label"] = "example-6.1"
+    (out / "signorini-run.json").write_text(json.dumps(manifest))
+    assert main(["run", "example-6.1", "--resume", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert f"example-6.1 is not the problem of the run in {out}: rebuilt, it differs" in err
+    assert "first level in the Dirichlet values, the contact data" in err
+    assert main(["run", "example-6.2", "--resume", str(out), "--quiet", "--no-figures"]) == 0
 
 
 def test_resume_after_an_interrupt_while_drawing_redraws_from_the_last_level(
@@ -741,7 +828,7 @@ def test_resume_after_an_interrupt_while_drawing_redraws_from_the_last_level(
     err = capsys.readouterr().err
     assert err.startswith("signorini: interrupted while drawing the figures; levels 0-")
     before = history_without_timings(out / "history.csv")
-    assert main(["run", "--resume", str(out)]) == 0
+    assert main(["run", "example-6.2", "--resume", str(out)]) == 0
     assert "were finished; drawing what is missing" in capsys.readouterr().out
     last = drawn[-1]
     assert last.record.level == len(before) - 1 and last.record.ndof == int(before[-1]["ndof"])
@@ -820,7 +907,7 @@ def test_resume_keeps_the_curves_of_the_problem(tmp_path, capsys, monkeypatch):
     assert main([*args, "--out", str(part)]) == 130
     monkeypatch.undo()
     capsys.readouterr()
-    assert main(["run", "--resume", str(part), "--quiet", "--no-figures"]) == 0
+    assert main(["run", str(source), "--resume", str(part), "--quiet", "--no-figures"]) == 0
     a = history_without_timings(full / "history.csv")
     b = history_without_timings(part / "history.csv")
     assert len(a) > 4

@@ -67,7 +67,8 @@ def test_run_partial_slip_resumed_after_an_interrupt(tmp_path, capsys, monkeypat
     assert main([*args, "--out", str(part)]) == 130
     assert "--resume" in capsys.readouterr().err
     monkeypatch.undo()
-    assert main(["run", "--resume", str(part), "--quiet", "--no-figures"]) == 0
+    resume = ["run", "partial-slip", "--resume", str(part), "--quiet", "--no-figures"]
+    assert main(resume) == 0
     a, b = rows_of(full / "history.csv"), rows_of(part / "history.csv")
     print(f"\n{len(a)} levels; resumed after level 2; last c/a {a[-1]['c_over_a']}")
     assert len(a) == len(b) > 4

@@ -198,7 +198,7 @@ def test_resumed_run_gives_the_hertz_columns_of_the_uninterrupted_run(tmp_path, 
     interrupt_after_level(monkeypatch, 4)
     assert main([*args, "--out", str(part)]) == 130
     monkeypatch.undo()
-    assert main(["run", "--resume", str(part), "--quiet", "--no-figures"]) == 0
+    assert main(["run", "hertz", "--resume", str(part), "--quiet", "--no-figures"]) == 0
     a = history_without_timings(full / "history.csv")
     b = history_without_timings(part / "history.csv")
     assert len(a) > 6 and "p0_rel_error" in a[-1]

@@ -81,3 +81,31 @@ def test_a_killed_write_leaves_a_recognisable_temporary_that_is_removed(tmp_path
     assert sorted(p.name for p in removed) == sorted([left[0], ".level_029.vtu.k2x_9abc.vtu"])
     assert sorted(os.listdir(tmp_path)) == sorted(keep)
     assert files.remove_temporaries(tmp_path / "missing") == []
+
+
+def test_a_same_name_write_killed_leaves_a_folder_that_is_removed(tmp_path):
+    """``replacing(path, same_name=True)`` (figures: matplotlib reads the format from the
+    name) writes ``NAME`` inside a temporary folder; killed, that folder is what is left, and
+    :func:`remove_temporaries` removes it; done, only the target is left."""
+    import subprocess
+    import sys
+
+    target = tmp_path / "mesh.png"
+    with files.replacing(target, same_name=True) as tmp:
+        assert tmp.name == "mesh.png" and tmp.parent != tmp_path
+        tmp.write_bytes(b"png")
+    assert os.listdir(tmp_path) == ["mesh.png"] and target.read_bytes() == b"png"
+    code = (
+        "import os, sys\n"
+        "from signorini.output.files import replacing\n"
+        "with replacing(sys.argv[1], same_name=True) as tmp:\n"
+        "    tmp.write_bytes(b'')\n"
+        "    os._exit(9)\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code, str(target)], timeout=60)
+    assert proc.returncode == 9
+    left = sorted(set(os.listdir(tmp_path)) - {"mesh.png"})
+    assert len(left) == 1 and files.is_temporary(left[0]) and (tmp_path / left[0]).is_dir()
+    assert target.read_bytes() == b"png"  # the finished figure untouched
+    removed = files.remove_temporaries(tmp_path)
+    assert [p.name for p in removed] == left and os.listdir(tmp_path) == ["mesh.png"]

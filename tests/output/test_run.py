@@ -32,6 +32,7 @@ def test_a_non_empty_folder_is_refused(tmp_path):
         RunFolder.create(tmp_path, PROBLEM, {})
     folder, _ = RunFolder.create(tmp_path / "run", PROBLEM, {})
     folder.set_status("finished")
+    folder.close()
     with pytest.raises(
         RunFolderError, match=r"it holds a run of example-6.2 \(finished\). Give --overwrite"
     ):
@@ -59,6 +60,7 @@ def test_overwrite_removes_exactly_the_old_runs_files(tmp_path):
     for name in ours:
         (out / name).write_bytes(b"")
     folder.add_files("listed.dat")
+    folder.close()
     theirs = ["notes.txt", "level_1.vtu", "photo.png", "uniform/mine.csv", "sub/level_000.vtu"]
     (out / "sub").mkdir()
     for name in theirs:
@@ -80,6 +82,7 @@ def test_saved_state_rebuilds_the_mesh_and_warm_start_exactly(tmp_path):
     k = 3
     lv = levels[k]
     folder.save_state(k, lv.next_mesh, lv.next_u0, final=False)
+    folder.close()
     state = RunFolder.open(tmp_path / "r").restart()
     assert (state.level, state.final) == (k, False)
     for name in ("points", "cells", "boundary", "boundary_part"):
@@ -101,9 +104,14 @@ def test_resume_refuses_what_it_cannot_continue(tmp_path):
     with pytest.raises(RunFolderError, match=f"holds no {MANIFEST}"):
         RunFolder.open(tmp_path)
     folder, _ = RunFolder.create(tmp_path / "r", PROBLEM, {})
+    folder.close()
     (tmp_path / "r" / STATE).write_bytes(b"garbage")
     with pytest.raises(RunFolderError, match="is unreadable"):
-        RunFolder.open(tmp_path / "r").restart()
+        reopened = RunFolder.open(tmp_path / "r")
+        try:
+            reopened.restart()
+        finally:
+            reopened.close()
     mesh = example_6_2().mesh
     folder.save_state(2, mesh, None, final=False)
     with pytest.raises(RunFolderError, match="has 0 level"):

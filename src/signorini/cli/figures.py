@@ -14,7 +14,7 @@ from ..output.run import RunFolder
 from ..problem.problem import ContactProblem
 from .levels import write_levels
 
-__all__ = ["compare_uniform", "draw_figures", "figures", "pressure_figure"]
+__all__ = ["compare_uniform", "draw_figures", "figures", "figures_command", "pressure_figure"]
 
 
 def figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
@@ -23,6 +23,23 @@ def figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
     from ..plots.run_figures import run_figures
 
     return run_figures(example, out, None if last is None else level_arrays(last))
+
+
+def figures_command(name: str, out: Path, status) -> list[Path]:
+    """``signorini figures PROBLEM DIR``: redraw the convergence figures of the run in
+    ``DIR``, once the problem named is checked to be the one that produced its levels
+    (:func:`~signorini.cli.identity.check_problem`). The folder is locked while drawing
+    (``status.folder``; released by the caller)."""
+    from ..output.run import RunFolder
+    from .identity import check_problem
+    from .problems import label, load
+
+    folder = RunFolder.open(out, purpose="draw the figures")
+    status.folder = folder
+    job = load(name)
+    options = AdaptiveOptions.from_record(folder.manifest.get("arguments", {}))
+    check_problem(folder, name, job, options, f"figures {name} {out}")
+    return figures(label(name), folder.path)
 
 
 def pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> list[Path]:

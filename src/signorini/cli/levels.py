@@ -1,19 +1,27 @@
-"""Each level of a run written as soon as it is done, its progress line, and where a run is
-when it is interrupted."""
+"""Each level of a run written as soon as it is done, its progress line with the time left,
+where a run is when it is interrupted, and progress output that survives a closed pipe."""
 
 from __future__ import annotations
 
+import math
+import os
+import shlex
+import sys
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..loop import Level
+from ..loop import AdaptiveOptions, Level
 from ..output import HistoryWriter, write_vtu
 from ..output.run import RunFolder
+from ..output.vtu import write_pvd
 
-__all__ = ["Status", "progress", "write_levels"]
+__all__ = ["Clock", "Printer", "Status", "progress", "write_levels"]
+
+#: the time left is shown once a run has taken this many seconds
+LONG_RUN_SECONDS = 10.0
 
 
 def progress(level: Level) -> str:
@@ -29,28 +37,100 @@ def progress(level: Level) -> str:
     return line
 
 
+class Clock:
+    """The wall-clock time of each level and an estimate of the time left.
+
+    The estimate assumes what the loop's levels show: the time of a level is proportional
+    to its number of unknowns (the last level's seconds per unknown, files included), and
+    each level has ``r`` times the unknowns of the one before (``r`` measured on the last
+    two levels). The levels still to come are those of ``ndof_k r^j ≤ max_ndof`` within
+    ``max_levels``; their predicted times are summed. A run that stops on ``tol`` may end
+    sooner. Shown only on runs longer than :data:`LONG_RUN_SECONDS`.
+    """
+
+    def __init__(self, options: AdaptiveOptions) -> None:
+        self.options = options
+        self.start = self.last = time.perf_counter()
+        self.ndof: list[int] = []
+
+    def lap(self, level: Level) -> str:
+        """The suffix of ``level``'s progress line: its wall time, and on a long run the
+        time so far and the estimated time left."""
+        now = time.perf_counter()
+        seconds, self.last = now - self.last, now
+        r = level.record
+        self.ndof.append(int(r.ndof))
+        text = f"  wall {seconds:.1f}s"
+        elapsed = now - self.start
+        if elapsed < LONG_RUN_SECONDS or len(self.ndof) < 2 or r.ndof <= 0:
+            return text
+        left = self.left(r.level, seconds / r.ndof)
+        if left is not None:
+            text += f"  total {elapsed:.0f}s, about {left:.0f}s left"
+        return text
+
+    def left(self, level: int, per_dof: float) -> float | None:
+        """Seconds the remaining levels take, estimated; None without a growth to go by."""
+        growth = self.ndof[-1] / max(self.ndof[-2], 1)
+        if not growth > 1.01:
+            return None
+        ndof, total, k = float(self.ndof[-1]), 0.0, level
+        budget = float(self.options.max_ndof)
+        while k + 1 < self.options.max_levels:
+            ndof *= growth
+            if ndof > budget or not math.isfinite(ndof):
+                break
+            total += per_dof * ndof
+            k += 1
+        return total
+
+
+class Printer:
+    """Progress output on stdout that stops, and lets the run go on, when stdout is closed
+    (``signorini run ... | head -2``): the first failed write redirects stdout to the null
+    device (so the interpreter's last flush does not fail either) and later lines are
+    dropped."""
+
+    def __init__(self, quiet: bool = False) -> None:
+        self.quiet = quiet
+        self.closed = False
+
+    def __call__(self, line: str) -> None:
+        if self.quiet or self.closed:
+            return
+        try:
+            print(line, flush=True)
+        except BrokenPipeError:
+            self.closed = True
+            try:
+                null = os.open(os.devnull, os.O_WRONLY)
+                os.dup2(null, sys.stdout.fileno())
+                os.close(null)
+            except (OSError, ValueError):  # stdout without a descriptor (a test's capture)
+                pass
+
+
 @dataclass
 class Status:
-    """Where a run is, for the one line printed when it is interrupted."""
+    """Where a run is, for the one line printed when it is interrupted, and its output."""
 
     problem: str = ""
     folder: RunFolder | None = None
     done: int = -1  # last level whose files are complete
     phase: str = "while starting"
+    say: Callable[[str], None] = field(default_factory=Printer)
 
-    def interrupted(self) -> str:
+    def interrupted(self, how: str = "interrupted") -> str:
         if self.folder is None:
-            return "signorini: interrupted before the run started; nothing was written"
+            return f"signorini: {how} before the run started; nothing was written"
         out = self.folder.path
         if self.done < 0:
             finished = f"no level finished in {out}"
         else:
             levels = "level 0" if self.done == 0 else f"levels 0-{self.done}"
             finished = f"{levels} finished in {out}"
-        return (
-            f"signorini: interrupted {self.phase}; {finished}; continue with: "
-            f"signorini run {self.problem} --resume {out}"
-        )
+        command = f"signorini run {shlex.quote(self.problem)} --resume {shlex.quote(str(out))}"
+        return f"signorini: {how} {self.phase}; {finished}; continue with: {command}"
 
 
 def write_levels(
@@ -62,18 +142,22 @@ def write_levels(
     save_state: bool,
     say: Callable[[str], None],
     status: Status | None = None,
+    clock: Clock | None = None,
 ) -> Level | None:
-    """Write each level as soon as it is done: its VTU file (if ``vtu``), then its history
-    row with the seconds that file took as ``t_output``, then (if ``save_state``) the state
-    to resume from. Returns the last level (None if there was none)."""
+    """Write each level as soon as it is done: its VTU file (if ``vtu``) and the ``.pvd``
+    collections of the levels, then its history row with the seconds those files took as
+    ``t_output``, then (if ``save_state``) the state to resume from. Returns the last level
+    (None if there was none)."""
     last = None
     for level in levels:
         k = level.record.level
         t0 = time.perf_counter()
         if vtu:
             name = f"level_{k:03d}.vtu"
-            folder.add_files(name)
+            folder.add_files(name, "levels.pvd", "levels_ndof.pvd")
             write_vtu(folder.path / name, level.result, level.estimate)
+            done = [(int(r["level"]), int(r["ndof"])) for r in history.rows]
+            write_pvd(folder.path, [*done, (k, int(level.record.ndof))])
         history.append({**level.record.row(), "t_output": time.perf_counter() - t0})
         if save_state:
             if level.next_mesh is None:  # the last level: keep its own mesh and solution
@@ -83,6 +167,7 @@ def write_levels(
         if status is not None:
             status.done = k
             status.phase = f"at level {k + 1}"
-        say(progress(level))
+        line = progress(level)
+        say(line + (clock.lap(level) if clock is not None else ""))
         last = level
     return last

@@ -65,8 +65,9 @@ def parser() -> argparse.ArgumentParser:
         metavar="PROBLEM",
         nargs="?",
         help=f"one of {', '.join(sorted(EXAMPLES))}, or a Python file defining "
-        "problem() -> ContactProblem (Python code, executed with your rights); may be "
-        "left out with --resume",
+        "problem() -> ContactProblem and optionally load_path() -> the list of "
+        "ContactProblem solved before it (Python code, executed with your rights); also "
+        "with --resume (a results folder never names the code that runs)",
     )
     run.add_argument(
         "--uniform",
@@ -119,17 +120,30 @@ def parser() -> argparse.ArgumentParser:
         type=Path,
         metavar="DIR",
         help="continue the interrupted run in DIR from its last finished level, with its "
-        "options (options given again must agree)",
+        "options (options given again must agree); PROBLEM is named as for a new run and "
+        "checked against the run's first level",
     )
     run.add_argument("--no-vtu", action="store_true", help="do not write VTU files")
     run.add_argument("--no-figures", action="store_true", help="do not draw figures")
-    run.add_argument("--quiet", action="store_true", help="no progress lines")
+    talk = run.add_mutually_exclusive_group()
+    talk.add_argument("--quiet", action="store_true", help="no progress lines")
+    talk.add_argument(
+        "--verbose",
+        action="store_true",
+        help="also the library's log lines (INFO: each solve, factorization and file)",
+    )
     run.add_argument(
         "--compare-uniform",
         action="store_true",
         help="also run uniform refinement to the same budget (into OUT/uniform) and plot both",
     )
-    fig = sub.add_parser("figures", help="redraw the figures of a finished run")
+    fig = sub.add_parser(
+        "figures",
+        help="redraw the figures of a finished run",
+        description="Redraw the convergence figures of the run in DIR from its history.csv. "
+        "PROBLEM is named as for run; it is rebuilt and its first level solved again, and "
+        "refused unless it is the run's problem.",
+    )
     fig.add_argument("example", metavar="PROBLEM", help="the problem's name, as for run")
     fig.add_argument("out", type=Path, help="the run's output folder (with history.csv)")
     return p

@@ -12,14 +12,23 @@ import re
 import sys
 import traceback
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
-from ..examples import EXAMPLES
+from ..examples import EXAMPLES, Metrics
 from ..mesh.mesh import Mesh
 from ..output.run import file_digest
 from ..problem.problem import ContactProblem
 
-__all__ = ["ProblemFileError", "label", "load_problem", "problem_id", "with_curves_of"]
+__all__ = [
+    "ProblemFileError",
+    "RunProblem",
+    "label",
+    "load",
+    "load_problem",
+    "problem_id",
+    "with_curves_of",
+]
 
 
 class ProblemFileError(Exception):
@@ -27,8 +36,9 @@ class ProblemFileError(Exception):
 
 
 def label(name: str) -> str:
-    """File-name friendly label of a problem: the example's name or the file's stem."""
-    return name if name in EXAMPLES else Path(name).stem
+    """File-name friendly label of a problem: the example's name or the file's stem, without
+    leading dots (``...py`` is ``problem``, not the parent folder ``..``)."""
+    return name if name in EXAMPLES else (Path(name).stem.lstrip(".") or "problem")
 
 
 def _user_traceback(exc: BaseException, folder: Path) -> str:
@@ -55,13 +65,32 @@ def _problem_file_error(path: Path, exc: BaseException) -> ProblemFileError:
     )
 
 
+@dataclass(frozen=True)
+class RunProblem:
+    """What a run solves: the problem, its per-level measurements (built-in examples) and
+    the load steps solved before it on every level (``partial-slip``, or a problem file's
+    ``load_path()``)."""
+
+    problem: ContactProblem
+    metrics: Metrics | None = None
+    path: list[ContactProblem] | None = None
+
+
 def load_problem(name: str) -> ContactProblem:
-    """A built-in example by name, or ``problem()`` from a Python file.
+    """A built-in example by name, or ``problem()`` from a Python file (:func:`load`)."""
+    return load(name).problem
+
+
+def load(name: str) -> RunProblem:
+    """A built-in example by name, or ``problem()`` (and ``load_path()``, if the file
+    defines it) from a Python file.
 
     The file is executed once, as a module registered in ``sys.modules`` (so that
     dataclasses and ``from __future__ import annotations`` work) with its folder on
     ``sys.path`` (so that a helper module beside it can be imported). A problem file is
-    Python code and runs with the user's rights.
+    Python code and runs with the user's rights. ``load_path()``, if defined, returns the
+    load steps solved before ``problem()`` on every level (a list of ContactProblem on the
+    same initial mesh; ``adaptive(..., path=...)``, docs/method.md, *Load paths*).
 
     Raises
     ------
@@ -71,7 +100,8 @@ def load_problem(name: str) -> ContactProblem:
         When the file's code raises: the message holds the traceback of its own frames.
     """
     if name in EXAMPLES:
-        return EXAMPLES[name].problem()
+        example = EXAMPLES[name]
+        return RunProblem(example.problem(), example.metrics, example.steps_before())
     path = Path(name)
     what = (
         "a problem file is a Python file (.py) that defines a function problem() taking "
@@ -106,8 +136,15 @@ def load_problem(name: str) -> ContactProblem:
             raise ValueError(
                 f"{path} is not a problem file: it must define a function problem(); {what}"
             )
+        steps = getattr(module, "load_path", None)
+        if steps is not None and not callable(steps):
+            raise ValueError(
+                f"load_path in {path} is a {type(steps).__name__}: define it as a function "
+                "load_path() returning the list of ContactProblem solved before problem()"
+            )
         try:
             problem = factory()
+            path_steps = None if steps is None else steps()
         except Exception as exc:
             raise _problem_file_error(path, exc) from None
     finally:
@@ -117,7 +154,29 @@ def load_problem(name: str) -> ContactProblem:
         raise ValueError(
             f"problem() in {path} returned {type(problem).__name__}, not a ContactProblem"
         )
-    return problem
+    if path_steps is not None:
+        path_steps = _checked_steps(path, path_steps)
+    return RunProblem(problem, None, path_steps)
+
+
+def _checked_steps(path: Path, steps: object) -> list[ContactProblem]:
+    """``load_path()``'s value as a non-empty list of ContactProblem, or a clear error."""
+    if isinstance(steps, ContactProblem) or not isinstance(steps, (list, tuple)):
+        raise ValueError(
+            f"load_path() in {path} returned {type(steps).__name__}, not a list of "
+            "ContactProblem (the steps solved before problem())"
+        )
+    bad = [k for k, s in enumerate(steps) if not isinstance(s, ContactProblem)]
+    if bad:
+        raise ValueError(
+            f"load_path() in {path}: step {bad[0]} is a {type(steps[bad[0]]).__name__}, not "
+            "a ContactProblem"
+        )
+    if not steps:
+        raise ValueError(
+            f"load_path() in {path} returned no step: leave load_path out for a single step"
+        )
+    return list(steps)
 
 
 def with_curves_of(mesh: Mesh, initial: Mesh) -> Mesh:

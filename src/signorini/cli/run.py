@@ -1,9 +1,11 @@
 """``signorini run``: a run as named steps.
 
 :func:`run` opens the interrupted run (``--resume``) or takes a new one's settings, loads the
-problem, claims the output folder, then solves and writes the levels, draws the figures and
-compares with uniform refinement (``--compare-uniform``). Each level's files are written as
-soon as it is done (:mod:`.levels`), so an interrupted run keeps what it finished.
+problem the user names (never one a results folder names), claims and locks the output
+folder, checks that a resumed run's problem is the one that produced its levels, then solves
+and writes the levels, draws the figures and compares with uniform refinement
+(``--compare-uniform``). Each level's files are written as soon as it is done
+(:mod:`.levels`), so an interrupted run keeps what it finished.
 """
 
 from __future__ import annotations
@@ -13,14 +15,15 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from ..examples import EXAMPLES, Metrics
 from ..loop import COLUMNS, Level, adaptive
 from ..output import HistoryWriter, write_columns
-from ..output.run import ResumeState, RunFolder
-from ..problem.problem import ContactProblem
+from ..output.check import CHECK, problem_data, write_check
+from ..output.run import STATE, ResumeState, RunFolder
+from ..output.vtu import write_fields
 from .figures import compare_uniform, draw_figures
-from .levels import Status, write_levels
-from .problems import label, load_problem, problem_id, with_curves_of
+from .identity import check_problem, name_the_problem
+from .levels import Clock, Printer, Status, write_levels
+from .problems import RunProblem, label, load, problem_id, with_curves_of
 from .settings import RunSettings, new_settings, resumed_settings
 
 __all__ = ["run"]
@@ -32,9 +35,7 @@ class _Run:
 
     name: str
     settings: RunSettings
-    problem: ContactProblem
-    metrics: Metrics | None
-    path: list[ContactProblem] | None
+    job: RunProblem
     folder: RunFolder
     state: ResumeState | None
     say: Callable[[str], None]
@@ -46,13 +47,17 @@ class _Run:
 
 def run(args: argparse.Namespace, status: Status | None = None) -> int:
     """``signorini run``: returns the exit status (0); raises ``ValueError``,
-    ``RuntimeError`` or ``OSError`` with a message for the user."""
-    status = Status() if status is None else status
-    say = (lambda s: None) if args.quiet else (lambda s: print(s, flush=True))
+    ``RuntimeError`` or ``OSError`` with a message for the user. The folder's lock is
+    released by the caller (``status.folder.close()``) or when the process ends."""
+    status = Status(say=Printer(quiet=args.quiet)) if status is None else status
+    say = status.say
     if args.resume is not None:
         folder = _open_resumed(args)
+        status.folder = folder
+        if args.example is None:
+            raise name_the_problem(folder, f"run PROBLEM --resume {args.resume}")
         settings = resumed_settings(args, folder.manifest.get("arguments", {}))
-        name = _resumed_problem(args, folder.manifest.get("problem", {}))
+        name = args.example  # checked by its data (_restart), never by the manifest's name
         if folder.manifest.get("status") == "finished":
             say(f"the run in {args.resume} is finished: nothing to resume")
             return 0
@@ -61,34 +66,24 @@ def run(args: argparse.Namespace, status: Status | None = None) -> int:
             raise ValueError("give a PROBLEM (an example's name or a problem file)")
         folder, settings, name = None, new_settings(args), args.example
     status.problem = name
-    problem = load_problem(name)
-    example = EXAMPLES.get(name)
+    job = load(name)
     state = None
     if folder is None:
         folder = _create_folder(args, name, settings, say)
+        status.folder = folder
     else:
-        state = _restart(folder, problem)
-    status.folder = folder
+        state = _restart(folder, name, job, settings, f"--resume {args.resume}")
     if state is not None:
         status.done = state.level
-    job = _Run(
-        name,
-        settings,
-        problem,
-        example.metrics if example else None,
-        example.steps_before() if example else None,
-        folder,
-        state,
-        say,
-    )
-    last = _solve_levels(job, status)
+    work = _Run(name, settings, job, folder, state, say)
+    last = _solve_levels(work, status)
     if last is not None and not args.no_figures:
         status.phase = "while drawing the figures"
-        draw_figures(job.label, folder, last, job.metrics, say)
+        draw_figures(work.label, folder, last, job.metrics, say)
     options = settings.options
     if settings.compare_uniform and not options.uniform and last is not None:
         status.phase = "during the uniform comparison"
-        compare_uniform(problem, options, args.no_figures, folder, say, job.metrics, job.path)
+        compare_uniform(job.problem, options, args.no_figures, folder, say, job.metrics, job.path)
     folder.set_status("finished")
     say(f"solver backend: {last.record.backend}" if last else "no level finished")
     return 0
@@ -96,7 +91,7 @@ def run(args: argparse.Namespace, status: Status | None = None) -> int:
 
 # ---------------------------------------------------------------------- the steps
 def _open_resumed(args: argparse.Namespace) -> RunFolder:
-    """The folder of the run ``--resume`` continues, read only."""
+    """The folder of the run ``--resume`` continues, locked."""
     if args.overwrite:
         raise ValueError("--resume and --overwrite exclude each other")
     if args.out is not None and args.out.resolve() != args.resume.resolve():
@@ -104,37 +99,17 @@ def _open_resumed(args: argparse.Namespace) -> RunFolder:
     return RunFolder.open(args.resume)
 
 
-def _resumed_problem(args: argparse.Namespace, recorded: dict) -> str:
-    """The problem of the resumed run: PROBLEM if given (it must be the run's: the same
-    example, or a file with the same contents), else the one the run recorded."""
-    name = args.example or recorded.get("file") or recorded.get("name")
-    if not name:
-        raise ValueError(f"--resume {args.resume}: the run does not name its problem")
-    now = problem_id(name)
-    is_file = now["file"] or recorded.get("file")
-    same = (
-        now["sha256"] == recorded.get("sha256")  # a file: the same contents
-        if is_file
-        else now["name"] == recorded.get("name")
-    )
-    if not same and is_file:
-        raise ValueError(
-            f"--resume {args.resume}: {name} is not the problem file the run solved "
-            f"({recorded.get('name')}): another file, or its contents changed"
-        )
-    if not same:
-        raise ValueError(
-            f"--resume {args.resume}: the run solved {recorded.get('name')!r}, not {name!r}"
-        )
-    return name
-
-
-def _restart(folder: RunFolder, problem: ContactProblem) -> ResumeState:
-    """The saved state of the resumed run, its mesh with the problem's curves again (the
-    state holds arrays only; the problem is the same, checked by restart)."""
+def _restart(
+    folder: RunFolder, name: str, job: RunProblem, settings: RunSettings, verb: str
+) -> ResumeState:
+    """Check that ``job`` is the run's problem (when a level finished), then the saved
+    state of the resumed run, its mesh with the problem's curves again (the state holds
+    arrays only)."""
+    if (folder.path / STATE).is_file():
+        check_problem(folder, name, job, settings.options, verb)
     state = folder.restart()
     if state.mesh is not None:
-        state.mesh = with_curves_of(state.mesh, problem.mesh)
+        state.mesh = with_curves_of(state.mesh, job.problem.mesh)
     return state
 
 
@@ -147,15 +122,26 @@ def _create_folder(
         out, problem_id(name), settings.record(), overwrite=args.overwrite
     )
     if removed:
-        say(f"removed {len(removed)} file(s) of the previous run in {out}")
+        say(f"removed {len(removed)} file(s) of the previous run in {folder.path}")
     return folder
 
 
-def _solve_levels(job: _Run, status: Status) -> Level | None:
+def _checked_levels(levels, work: _Run):
+    """The levels, the problem data of the first saved (:mod:`signorini.output.check`)
+    before its files are written."""
+    for level in levels:
+        if level.record.level == 0:
+            work.folder.add_files(CHECK)
+            write_check(work.folder.path, problem_data(level.result, work.job.path))
+        yield level
+
+
+def _solve_levels(work: _Run, status: Status) -> Level | None:
     """Solve the levels still missing and write each as soon as it is done; with every level
     finished, solve the last one again (warm) for its figures only. Returns the last level."""
-    out, state, options, say = job.folder.path, job.state, job.settings.options, job.say
-    job.folder.add_files("history.csv", "history.md")
+    out, state, options, say = work.folder.path, work.state, work.settings.options, work.say
+    job = work.job
+    work.folder.add_files("history.csv", "history.md")
     write_columns(
         out / "history.md",
         {
@@ -164,6 +150,10 @@ def _solve_levels(job: _Run, status: Status) -> Level | None:
             "t_output": "seconds spent writing the level's VTU file and recording it",
         },
     )
+    vtu = not work.settings.no_vtu
+    if vtu:
+        work.folder.add_files("fields.md")
+        write_fields(out / "fields.md")
     history = HistoryWriter(out / "history.csv", rows=state.history_rows if state else ())
     mode = "uniform" if options.uniform else f"adaptive, theta={options.theta}"
     say(
@@ -185,13 +175,14 @@ def _solve_levels(job: _Run, status: Status) -> Level | None:
         start = {"mesh": state.mesh, "u0": state.u0, "first_level": state.level + 1}
     else:
         start = {}
-    levels = adaptive(job.problem, options, **start, **loop)
+    levels = _checked_levels(adaptive(job.problem, options, **start, **loop), work)
     return write_levels(
         levels,
         history,
-        job.folder,
-        vtu=not job.settings.no_vtu,
+        work.folder,
+        vtu=vtu,
         save_state=True,
         say=say,
         status=status,
+        clock=Clock(options),
     )

@@ -1,15 +1,18 @@
 """Atomic file replacement: an interrupted run never leaves a half-written file behind.
 
 Each file is written to a temporary file in the same folder, then moved over the target with
-``os.replace``. A temporary file is named ``.<target name>.<8 random characters>.signorini-tmp``;
-if the process is killed before the move, :func:`remove_temporaries` recognises and removes
-it (the command line does so at the start of every run into a folder).
+``os.replace``. A temporary file is named ``.<target name>.<8 random characters>.signorini-tmp``
+(with ``same_name``, a file of the target's own name in a temporary folder of that name, for
+writers that read the format from the name: matplotlib's ``savefig``); if the process is
+killed before the move, :func:`remove_temporaries` recognises and removes it (the command
+line does so at the start of every run into a folder).
 """
 
 from __future__ import annotations
 
 import os
 import re
+import shutil
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -26,14 +29,24 @@ _TEMPORARY = re.compile(r"^\..+\.[a-z0-9_]{8}(\.signorini-tmp|\.tmp|\.vtu)$")
 
 
 @contextmanager
-def replacing(path: str | os.PathLike) -> Iterator[Path]:
+def replacing(path: str | os.PathLike, same_name: bool = False) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; on success it replaces ``path`` atomically.
 
     On any exception (KeyboardInterrupt included) the temporary file is removed and ``path``
-    is left as it was.
+    is left as it was. With ``same_name`` the temporary path has the name of ``path`` (in a
+    temporary folder beside it).
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    if same_name:
+        folder = tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.", suffix=TEMP_SUFFIX)
+        try:
+            tmp = Path(folder) / path.name  # created by the writer, with open()'s mode
+            yield tmp
+            os.replace(tmp, path)
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
+        return
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=TEMP_SUFFIX)
     os.close(fd)
     try:
@@ -75,7 +88,12 @@ def remove_temporaries(folder: str | os.PathLike) -> list[Path]:
         return []
     removed = []
     for entry in os.scandir(folder):
-        if entry.is_file(follow_symlinks=False) and is_temporary(entry.name):
+        if not is_temporary(entry.name):
+            continue
+        if entry.is_file(follow_symlinks=False):
             Path(entry.path).unlink(missing_ok=True)
+            removed.append(Path(entry.path))
+        elif entry.is_dir(follow_symlinks=False) and entry.name.endswith(TEMP_SUFFIX):
+            shutil.rmtree(entry.path, ignore_errors=True)  # a same-name write's folder
             removed.append(Path(entry.path))
     return removed

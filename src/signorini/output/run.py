@@ -20,11 +20,23 @@ The rule (one for every run of the command line):
   mesh and solution, from which the figures can be drawn again. :meth:`RunFolder.restart`
   reads it back, so that the loop continues where it stopped and yields the levels an
   uninterrupted run yields. A finished run removes it.
+- After its first level the run saves that level's problem data in ``signorini-check.npz``
+  (:mod:`.check`): a resumed run, and ``signorini figures``, rebuild the problem the user
+  names and compare, so that one folder never holds the levels of two problems.
+- Paths are resolved (``os.path.realpath``) before any check: ``--out newdir/..`` is the
+  folder it names, and is refused if it is not empty.
+- A run holds an OS lock on its folder (``fcntl.flock`` on the folder itself, released when
+  the process ends, however it ends): a second run into a folder that a live process is
+  writing, or a ``--resume`` of it, is refused; a folder whose writer died (SIGKILL) is not
+  locked, and is reported as stopped, not running.
+- The manifest records the environment of the run (:func:`environment`): the versions of
+  signorini, Python, NumPy, SciPy and the solver library, the date and the host.
 """
 
 from __future__ import annotations
 
 import csv
+import errno
 import hashlib
 import io
 import json
@@ -34,19 +46,34 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
+try:  # POSIX; elsewhere runs are not locked
+    import fcntl
+except ImportError:  # pragma: no cover - Windows
+    fcntl = None
+
 import numpy as np
 
 from ..mesh.mesh import Mesh
+from .environment import environment
 from .files import atomic_write, remove_temporaries, replacing
 
-__all__ = ["MANIFEST", "STATE", "RunFolder", "RunFolderError", "ResumeState", "file_digest"]
+__all__ = [
+    "MANIFEST",
+    "STATE",
+    "RunFolder",
+    "RunFolderError",
+    "ResumeState",
+    "file_digest",
+    "resolved",
+]
 
 MANIFEST = "signorini-run.json"
 STATE = "resume.npz"
 _FORMAT = 1
 # files of a run, by name, in the run's folder and in its "uniform" sub-folder
 _RUN_FILE = re.compile(
-    r"^(level_\d{3,}\.vtu|history\.csv|history\.md|resume\.npz|signorini-run\.json)$"
+    r"^(level_\d{3,}\.vtu|history\.csv|history\.md|fields\.md|resume\.npz|signorini-run\.json"
+    r"|signorini-check\.npz|levels\.pvd|levels_ndof\.pvd)$"
 )
 _FIGURE_NAMES = ("mesh", "deformed", "adaptive_vs_uniform")
 UNIFORM = "uniform"
@@ -54,6 +81,35 @@ UNIFORM = "uniform"
 
 class RunFolderError(ValueError):
     """An output folder that cannot be used as asked (the message says why and what to do)."""
+
+
+def resolved(path: str | os.PathLike) -> Path:
+    """``path`` as the absolute folder it names, ``..`` and symbolic links resolved (a path
+    through a missing folder, ``newdir/..``, is the folder it ends in)."""
+    return Path(os.path.realpath(os.path.abspath(os.fspath(path))))
+
+
+def _lock(path: Path) -> int | None:
+    """An exclusive OS lock on the folder ``path`` (its file descriptor), None if another
+    process holds it. The lock dies with the process that holds it."""
+    if fcntl is None:  # pragma: no cover - Windows
+        return -1
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as exc:
+        os.close(fd)
+        if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+            return None
+        raise
+    return fd
+
+
+def _writer(manifest: dict) -> str:
+    """Who holds the lock, as the manifest says (``pid 123 on host``)."""
+    env = manifest.get("environment", {}) if isinstance(manifest, dict) else {}
+    pid, host = manifest.get("pid"), env.get("host") if isinstance(env, dict) else None
+    return f" (pid {pid}{f' on {host}' if host else ''})" if pid else ""
 
 
 def file_digest(path: str | os.PathLike) -> str:
@@ -104,22 +160,24 @@ class RunFolder:
     interrupted one.
     """
 
-    def __init__(self, path: Path, manifest: dict) -> None:
+    def __init__(self, path: Path, manifest: dict, lock: int | None = None) -> None:
         self.path = path
         self.manifest = manifest
+        self._lock = lock
 
     # ------------------------------------------------------------------ opening
     @classmethod
     def create(
         cls, path: str | os.PathLike, problem: dict, arguments: dict, *, overwrite: bool = False
     ) -> tuple[RunFolder, list[Path]]:
-        """Claim ``path`` for a new run and write its manifest.
+        """Claim ``path`` for a new run, lock it and write its manifest.
 
         Parameters
         ----------
-        path : folder (created if missing)
+        path : folder (created if missing; resolved first, see :func:`resolved`)
         problem : dict
-            How the run names its problem (JSON-serialisable).
+            How the run names its problem (JSON-serialisable; text for the user only:
+            ``--resume`` checks the problem by its data, :mod:`.check`).
         arguments : dict
             The run's settings, JSON-serialisable, stored as they are: the command line
             gives the loop's options by field name (``AdaptiveOptions.to_record()``, the
@@ -132,65 +190,108 @@ class RunFolder:
         Returns
         -------
         (RunFolder, list of Path)
-            The folder, and the files removed (temporary files and, with ``overwrite``, the
-            previous run's files).
+            The folder (locked until :meth:`close` or the process ends), and the files
+            removed (temporary files and, with ``overwrite``, the previous run's files).
 
         Raises
         ------
         RunFolderError
-            If ``path`` is an existing file, or a non-empty folder without ``overwrite``.
+            If ``path`` is an existing file, a folder another live process is writing, or a
+            non-empty folder without ``overwrite``.
         """
-        path = Path(path)
+        path = resolved(path)
         cls._check_is_folder(path)
-        removed = remove_temporaries(path) + remove_temporaries(path / UNIFORM)
-        present = _listing(path)
-        if present and not overwrite:
-            old = cls._read_manifest(path)
-            what = (
-                f"it holds a run of {old.get('problem', {}).get('name', '?')} "
-                f"({old.get('status', '?')})"
-                if old
-                else f"it holds {len(present)} file(s): {_describe(present)}"
-            )
-            raise RunFolderError(
-                f"output folder {path} is not empty: {what}. Give --overwrite to remove "
-                f"that run's files first (only the files a run writes), --resume {path} to "
-                "continue an interrupted run, or another --out folder"
-            )
-        if present:
-            removed += cls._remove_run_files(path)
         path.mkdir(parents=True, exist_ok=True)
-        folder = cls(
-            path,
-            {
-                "format": _FORMAT,
-                "problem": problem,
-                "arguments": arguments,
-                "status": "running",
-                "files": [MANIFEST],
-            },
-        )
-        folder._write_manifest()
+        lock = cls._claim(path, "output folder")
+        try:
+            removed = remove_temporaries(path) + remove_temporaries(path / UNIFORM)
+            present = _listing(path)
+            if present and not overwrite:
+                old = cls._read_manifest(path)
+                what = (
+                    f"it holds a run of {old.get('problem', {}).get('name', '?')} "
+                    f"({cls._status_of(old)})"
+                    if old
+                    else f"it holds {len(present)} file(s): {_describe(present)}"
+                )
+                raise RunFolderError(
+                    f"output folder {path} is not empty: {what}. Give --overwrite to remove "
+                    f"that run's files first (only the files a run writes), --resume {path} "
+                    "to continue an interrupted run, or another --out folder"
+                )
+            if present:
+                removed += cls._remove_run_files(path)
+            folder = cls(
+                path,
+                {
+                    "format": _FORMAT,
+                    "problem": problem,
+                    "arguments": arguments,
+                    "status": "running",
+                    "files": [MANIFEST],
+                    "pid": os.getpid(),
+                    "environment": environment(arguments.get("solver")),
+                },
+                lock,
+            )
+            folder._write_manifest()
+        except BaseException:
+            cls._unlock(lock)
+            raise
         return folder, removed
 
     @classmethod
-    def open(cls, path: str | os.PathLike) -> RunFolder:
-        """The folder of an earlier run, read only (to check it before :meth:`restart`).
+    def open(cls, path: str | os.PathLike, purpose: str = "resume") -> RunFolder:
+        """The folder of an earlier run, locked, to check it before :meth:`restart` (or to
+        draw its figures: ``purpose`` is the verb of the error messages).
 
         Raises
         ------
         RunFolderError
-            If ``path`` is not a folder with a manifest.
+            If ``path`` is not a folder with a manifest, or another live process is writing
+            it.
         """
-        path = Path(path)
+        path = resolved(path)
         if not path.is_dir():
-            raise RunFolderError(f"cannot resume: {path} is not a folder")
+            raise RunFolderError(f"cannot {purpose}: {path} is not a folder")
         manifest = cls._read_manifest(path)
         if manifest is None:
             raise RunFolderError(
-                f"cannot resume: {path} holds no {MANIFEST}, so no run of signorini wrote it"
+                f"cannot {purpose}: {path} holds no {MANIFEST}, so no run of signorini wrote it"
             )
-        return cls(path, manifest)
+        return cls(path, manifest, cls._claim(path, f"cannot {purpose}: the folder"))
+
+    def close(self) -> None:
+        """Release the folder's lock (also released when the process ends)."""
+        lock, self._lock = self._lock, None
+        self._unlock(lock)
+
+    @classmethod
+    def _claim(cls, path: Path, what: str) -> int | None:
+        lock = _lock(path)
+        if lock is None:
+            old = cls._read_manifest(path) or {}
+            name = old.get("problem", {}).get("name", "?") if isinstance(old, dict) else "?"
+            raise RunFolderError(
+                f"{what} {path} is being written by another process{_writer(old)}, a run of "
+                f"{name}: wait until it ends (or stop it: it keeps its finished levels), then "
+                "--resume or --overwrite it"
+            )
+        return lock
+
+    @staticmethod
+    def _unlock(lock: int | None) -> None:
+        if lock is not None and lock >= 0:
+            os.close(lock)  # closing the descriptor releases the flock
+
+    @staticmethod
+    def _status_of(manifest: dict) -> str:
+        """The status a manifest records; "running" of a folder nobody holds (the caller
+        has the lock) means its process ended without saying so (SIGKILL, power loss)."""
+        status = str(manifest.get("status", "?"))
+        if status == "running":
+            return "stopped before finishing: its process ended"
+        return status
 
     def restart(self) -> ResumeState:
         """Prepare the folder to continue the run: remove temporary files and the files of
@@ -217,6 +318,12 @@ class RunFolder:
             m = re.fullmatch(r"level_(\d{3,})\.vtu", name)
             if m and int(m.group(1)) > state.level:
                 (path / name).unlink()
+        self.manifest["pid"] = os.getpid()
+        resumed = self.manifest.get("resumed")
+        self.manifest["resumed"] = [*(resumed if isinstance(resumed, list) else ())]
+        self.manifest["resumed"].append(
+            environment(self.manifest.get("arguments", {}).get("solver"))
+        )
         self.set_status("running")
         return state
 

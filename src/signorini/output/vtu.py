@@ -1,30 +1,120 @@
-"""Discrete solutions as quadratic-triangle VTU files (ParaView), written atomically."""
+"""Discrete solutions as quadratic-triangle VTU files (ParaView), the ``.pvd`` collections of
+a run's levels, and the description of every field (``fields.md``), all written atomically.
+
+:data:`POINT_FIELDS` and :data:`CELL_FIELDS` are the one list of the fields: the writer
+fills them and ``fields.md`` describes them (a field added to the writer is added there).
+"""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
-from .files import replacing
+from ..fem import iso, p2
+from ..fem.material import stress
+from .files import atomic_write, replacing
 
-__all__ = ["write_vtu"]
+__all__ = [
+    "CELL_FIELDS",
+    "POINT_FIELDS",
+    "nodal_stress",
+    "von_mises",
+    "write_fields",
+    "write_pvd",
+    "write_vtu",
+]
+
+#: Point data of a level's VTU file: name -> meaning (units are the problem's).
+POINT_FIELDS: dict[str, str] = {
+    "displacement": "u_h at the node (3 components, z = 0, for ParaView's Warp By Vector)",
+    "stress": "the Cauchy stress of u_h at the node, 6 components in VTK's symmetric-tensor "
+    "order (xx, yy, zz, xy, yz, xz), yz = xz = 0: σ_xx, σ_yy, σ_xy of Hooke's law (2.1) "
+    "from the P2 displacement, averaged over the cells that share the node (one value per "
+    "cell at its own nodes: exact where σ is continuous and polynomial of degree ≤ 1); σ_zz "
+    "= λ(σ_xx + σ_yy)/(2(λ + μ)) in plane strain, 0 in plane stress",
+    "von_mises": "von Mises stress sqrt(((σ_xx−σ_yy)² + (σ_yy−σ_zz)² + (σ_zz−σ_xx)²)/2 + "
+    "3σ_xy²) of the nodal stress, σ_zz included",
+    "pressure": "on Γ_C the consistent nodal pressure p_z = Λ_z / w_z (0 elsewhere)",
+    "contact_force": "on Γ_C the nodal contact force Λ_z (force per unit thickness; 0 elsewhere)",
+    "tangential_pressure": "on Γ_C the consistent friction stress p_t,z = Λ_t,z / w_z along "
+    "t_z = (−n_y, n_x); 0 without friction",
+    "contact_traction": "on Γ_C the obstacle's traction on the body, −p_z n_z − p_t,z t_z "
+    "(3 components)",
+    "active": "1 where u·n_z = ψ is imposed (the node is in contact), else 0",
+    "contact_class": "0 no contact, 1 semi, 2 full contact (the estimator's classes), −1 off Γ_C",
+    "contact_state": "0 inactive, 1 stick, 2 slip (a frictionless node in contact slips), −1 "
+    "off Γ_C",
+}
+#: Cell data of a level's VTU file (with the estimate): name -> meaning.
+CELL_FIELDS: dict[str, str] = {
+    "eta2": "the squared element indicator η_T² (the sum of the contributions)",
+    "eta2_k": "the squared contribution η_k,T² of term k = 1, 2, … (docs/method.md, "
+    "*Estimator*): one field per term",
+}
+
+
+def nodal_stress(result) -> np.ndarray:
+    """The stress of ``result.u`` at the P2 nodes, averaged over the cells sharing each node.
+
+    Each cell gives σ(u_h) at its six nodes (the gradient of its P2 displacement on its own
+    map, curved cells included); a node's value is the mean of the values of its cells. On
+    a linear-elastic field with continuous σ of degree ≤ 1 (a patch test) this is exact.
+
+    Returns
+    -------
+    (n_nodes, 3, 3) float array
+        σ with σ_zz from the material (plane strain: ``λ (σ_xx + σ_yy) / (2 (λ + μ))``).
+    """
+    space = result.space
+    nodes = space.cell_nodes  # (m, 6)
+    m = nodes.shape[0]
+    u_cell = result.u[nodes].reshape(m, 12)
+    grad, _ = iso.field_derivatives(space.node_points[nodes], u_cell, p2.REFERENCE_NODES)
+    material = result.problem.material
+    sig = stress(material, grad).reshape(-1, 4)  # (m * 6, [xx, xy, yx, yy])
+    count = np.bincount(nodes.ravel(), minlength=space.n_nodes).astype(np.float64)
+    mean = (
+        np.column_stack(
+            [
+                np.bincount(nodes.ravel(), weights=sig[:, j], minlength=space.n_nodes)
+                for j in range(4)
+            ]
+        )
+        / np.maximum(count, 1.0)[:, None]
+    )
+    out = np.zeros((space.n_nodes, 3, 3))
+    out[:, :2, :2] = mean.reshape(-1, 2, 2)
+    out[:, 2, 2] = _sigma_zz(material, out[:, 0, 0], out[:, 1, 1])
+    return out
+
+
+def _sigma_zz(material, sxx: np.ndarray, syy: np.ndarray) -> np.ndarray:
+    """σ_zz of the material: 0 in plane stress, ``λ (σ_xx + σ_yy) / (2 (λ + μ))`` (= λ tr ε)
+    in plane strain."""
+    if getattr(material, "plane_stress", False):
+        return np.zeros_like(sxx)
+    return material.lam * (sxx + syy) / (2.0 * (material.lam + material.mu))
+
+
+def von_mises(sig: np.ndarray) -> np.ndarray:
+    """von Mises stress of ``(n, 3, 3)`` stress tensors."""
+    sxx, syy, szz = sig[:, 0, 0], sig[:, 1, 1], sig[:, 2, 2]
+    sxy, syz, sxz = sig[:, 0, 1], sig[:, 1, 2], sig[:, 0, 2]
+    return np.sqrt(
+        0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2)
+        + 3.0 * (sxy**2 + syz**2 + sxz**2)
+    )
 
 
 def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     """Write a discrete solution as a quadratic-triangle VTU file.
 
-    Point data: ``displacement`` (3 components, z = 0, for ParaView's "Warp By Vector"),
-    and on Γ_C ``pressure`` (consistent nodal pressure p_z), ``contact_force`` (Λ_z),
-    ``tangential_pressure`` (the consistent friction stress ``p_t,z = Λ_t,z / w_z`` along
-    ``t_z = (−n_y, n_x)``; 0 without friction), ``contact_traction`` (``−p_z n_z − p_t,z t_z``,
-    3 components: the obstacle's traction on the body as a vector), ``active`` (1 where
-    u·n_z = ψ is imposed), ``contact_class`` (0 none, 1 semi, 2 full, −1 off Γ_C) and
-    ``contact_state`` (0 inactive, 1 stick, 2 slip, −1 off Γ_C; a frictionless node in contact
-    slips). At a corner node with two constraints the scalars are the larger of the two, the
-    tangential pressure and the traction their sums. Cell data: ``eta2`` (element indicators)
-    and ``eta2_k`` per contribution when an estimate is given.
+    The point fields are :data:`POINT_FIELDS`, the cell fields (with an estimate)
+    :data:`CELL_FIELDS`. At a corner node with two constraints the contact scalars are the
+    larger of the two, the tangential pressure and the traction their sums.
 
     Parameters
     ----------
@@ -56,7 +146,14 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     np.add.at(tangential, cs.nodes, p_t)
     t = cs.tangent[:, 0]
     np.add.at(traction[:, :2], cs.nodes, -result.pressure[:, None] * cs.normal - p_t[:, None] * t)
-    cell_data = {}
+    sig = nodal_stress(result)
+    # VTK's symmetric tensor order: xx, yy, zz, xy, yz, xz
+    voigt = np.column_stack(
+        [sig[:, 0, 0], sig[:, 1, 1], sig[:, 2, 2], sig[:, 0, 1], sig[:, 1, 2], sig[:, 0, 2]]
+    )
+    # cell fields: one array per field, in the cells' order (further per-cell data such as a
+    # material region belong here, and in CELL_FIELDS)
+    cell_data: dict[str, list[np.ndarray]] = {}
     if estimate is not None:
         cell_data["eta2"] = [estimate.eta2]
         for k in range(estimate.eta2_cell.shape[0]):
@@ -66,6 +163,8 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
         [("triangle6", space.cell_nodes)],
         point_data={
             "displacement": disp,
+            "stress": voigt,
+            "von_mises": von_mises(sig),
             "pressure": pressure,
             "contact_force": force,
             "tangential_pressure": tangential,
@@ -79,3 +178,53 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     with replacing(path) as tmp:
         meshio.write(tmp, mesh, file_format="vtu")
     return Path(path)
+
+
+def write_pvd(folder: str | os.PathLike, levels: Sequence[tuple[int, int]]) -> list[Path]:
+    """Write ``levels.pvd`` (time = level index) and ``levels_ndof.pvd`` (time = N_dof): the
+    ``level_NNN.vtu`` files of ``levels`` as ParaView collections, so that the time slider
+    steps through the levels (and a plot over time is against N_dof in the second).
+
+    Parameters
+    ----------
+    folder : the run folder
+    levels : sequence of (level, ndof)
+    """
+    folder = Path(folder)
+    written = []
+    for name, key in (("levels.pvd", 0), ("levels_ndof.pvd", 1)):
+        rows = "".join(
+            f'    <DataSet timestep="{entry[key]}" part="0" file="level_{entry[0]:03d}.vtu"/>\n'
+            for entry in levels
+        )
+        text = (
+            '<?xml version="1.0"?>\n'
+            '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
+            "  <Collection>\n" + rows + "  </Collection>\n</VTKFile>\n"
+        )
+        written.append(atomic_write(folder / name, text.encode()))
+    return written
+
+
+def write_fields(path: str | os.PathLike) -> Path:
+    """Write the description of the VTU files' fields as Markdown (``fields.md``)."""
+    lines = [
+        "# Fields of the level_NNN.vtu files",
+        "",
+        "Quadratic triangles (VTK_QUADRATIC_TRIANGLE: 3 vertices, then the midpoints of "
+        "v0-v1, v1-v2, v2-v0). `levels.pvd` collects the levels with the level index as "
+        "time, `levels_ndof.pvd` with N_dof as time. Units are those of the problem's data.",
+        "",
+        "## Point data",
+        "",
+        "| field | meaning |",
+        "|---|---|",
+        *(f"| `{name}` | {text} |" for name, text in POINT_FIELDS.items()),
+        "",
+        "## Cell data",
+        "",
+        "| field | meaning |",
+        "|---|---|",
+        *(f"| `{name}` | {text} |" for name, text in CELL_FIELDS.items()),
+    ]
+    return atomic_write(path, ("\n".join(lines) + "\n").encode())

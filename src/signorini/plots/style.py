@@ -25,6 +25,7 @@ from matplotlib.font_manager import FontProperties
 from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
 
 from ..estimator.names import TERM_TABLE
+from ..output.files import replacing
 
 __all__ = [
     "STYLES",
@@ -184,9 +185,11 @@ def save_figure(fig: Figure, path: str | os.PathLike) -> list[Path]:
     stem = _stem(path)
     stem.parent.mkdir(parents=True, exist_ok=True)
     written = [stem.with_name(stem.name + ".png"), stem.with_name(stem.name + ".pdf")]
-    try:
-        fig.savefig(written[0], dpi=DPI)
-        fig.savefig(written[1], metadata={"CreationDate": None})
+    try:  # atomically: a run killed while drawing leaves no empty or partial file
+        with replacing(written[0], same_name=True) as tmp:
+            fig.savefig(tmp, dpi=DPI)
+        with replacing(written[1], same_name=True) as tmp:
+            fig.savefig(tmp, metadata={"CreationDate": None})
     finally:
         fig.clear()
     log.info("wrote %s", ", ".join(str(p) for p in written))
