@@ -29,8 +29,10 @@ from collections.abc import Callable
 from functools import cache
 
 import numpy as np
+import scipy
 import scipy.sparse as sp
 
+from .mkl import mkl_version
 from .pardiso import pardiso_problem, pardiso_solver
 from .solvers import BackendUnavailableError, SolverFactory, SolverRequest, SPDSolver
 from .superlu import superlu_solver
@@ -42,6 +44,7 @@ __all__ = [
     "available_backends",
     "make_solver",
     "solver_factory",
+    "solver_library",
     "solver_name",
 ]
 
@@ -184,3 +187,16 @@ def make_solver(
     if A is not None:
         made.factorize(A)
     return made
+
+
+def solver_library(solver: object = None) -> str:
+    """The sparse solver library a run uses: MKL PARDISO with MKL's version when the run's
+    solver is ``pardiso`` or ``auto`` and MKL loads, else SciPy's SuperLU."""
+    name = str(solver) if solver is not None else "auto"
+    if name in ("auto", "pardiso"):
+        version = mkl_version()
+        if version is not None:
+            return f"MKL PARDISO ({version})"
+    if name in ("auto", "pardiso", "scipy", "superlu"):
+        return f"SuperLU (SciPy {scipy.__version__})"
+    return f"{name} (SciPy {scipy.__version__} installed)"

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from .solvers import BackendUnavailableError
 
-__all__ = ["mkl_runtime_candidates", "pardiso_function"]
+__all__ = ["mkl_runtime_candidates", "mkl_version", "pardiso_function"]
 
 #: File names of MKL's single dynamic library on Linux, macOS and Windows.
 _MKL_RT = re.compile(r"(lib)?mkl_rt(\.\d+)*\.(so(\.\d+)*|dylib|dll)")
@@ -99,3 +99,20 @@ def pardiso_function() -> Callable[..., None]:
         f"MKL's runtime library mkl_rt could not be loaded ({detail}); install it with "
         "`pip install signorini[fast]` (or `pip install mkl`)"
     )
+
+
+def mkl_version() -> str | None:
+    """MKL's version string (``Intel(R) oneAPI Math Kernel Library Version 2024.2 ...``) if
+    its runtime library can be loaded, else None."""
+    for candidate in mkl_runtime_candidates():
+        try:
+            lib = ctypes.CDLL(candidate)
+            get = lib.MKL_Get_Version_String
+        except (OSError, AttributeError):
+            continue
+        buf = ctypes.create_string_buffer(256)
+        get.argtypes = [ctypes.c_char_p, ctypes.c_int]
+        get.restype = None
+        get(buf, len(buf))
+        return buf.value.decode(errors="replace").strip() or None
+    return None

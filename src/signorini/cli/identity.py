@@ -10,14 +10,19 @@ edited manifest or another problem file is caught by what it changes in these da
 from __future__ import annotations
 
 import shlex
+from collections.abc import Sequence
 from dataclasses import replace
 
+import numpy as np
+
+from ..contact.system import assemble
 from ..loop import AdaptiveOptions, adaptive
-from ..output.check import CHECK, differences, problem_data, read_check
+from ..output.check import CHECK, MESH_ARRAYS, differences, read_check
 from ..output.run import RunFolder, RunFolderError
+from ..problem.problem import ContactProblem
 from .problems import RunProblem
 
-__all__ = ["check_problem", "name_the_problem"]
+__all__ = ["check_problem", "name_the_problem", "problem_data"]
 
 
 def name_the_problem(folder: RunFolder, command: str) -> RunFolderError:
@@ -80,3 +85,52 @@ def check_problem(
 
 def _join(items: list[str]) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def _step_data(problem: ContactProblem, mesh, k: int) -> dict[str, np.ndarray]:
+    """The assembled data of load step ``k`` on ``mesh``."""
+    system = assemble(problem, mesh)
+    cs = system.contact
+    probe = np.sin(1.0 + np.arange(system.K.shape[0]))  # no zero entry, no symmetry
+    return {
+        f"dirichlet.{k}": system.dirichlet_values,
+        f"contact.{k}.gap": cs.gap,
+        f"contact.{k}.normal": cs.normal,
+        f"contact.{k}.nodes": cs.nodes.astype(np.float64),
+        f"contact.{k}.friction": np.concatenate([cs.friction.index, cs.friction.weight]).astype(
+            np.float64
+        ),
+        f"loads.{k}": system.F,
+        f"material.{k}": system.K @ probe,
+    }
+
+
+def problem_data(result, path: Sequence[ContactProblem] | None = None) -> dict[str, np.ndarray]:
+    """The data that identifies the problem of a run, from its first level's ``result``.
+
+    Parameters
+    ----------
+    result : ContactResult
+        The first level's solution (of the last load step with a load path).
+    path : sequence of ContactProblem, optional
+        The load steps solved before ``result.problem`` on every level.
+
+    Returns
+    -------
+    dict of str to array
+        Named arrays; the first part of a name (before a dot) is what they describe.
+    """
+    mesh = result.problem.mesh
+    data: dict[str, np.ndarray] = {
+        f"mesh.{name}": np.asarray(getattr(mesh, name)) for name in MESH_ARRAYS
+    }
+    data["mesh.part_names"] = np.array(mesh.part_names, dtype=str)
+    steps = [*(path or ()), result.problem]
+    data["steps.count"] = np.array([len(steps)], dtype=np.float64)
+    for k, step in enumerate(steps):
+        data.update(_step_data(step, result.space.mesh, k))
+    data["solution.u"] = np.asarray(result.u, dtype=np.float64)
+    data["solution.contact_force"] = np.asarray(result.contact_force, dtype=np.float64)
+    if result.tangential_force is not None:
+        data["solution.tangential_force"] = np.asarray(result.tangential_force, dtype=np.float64)
+    return data

@@ -15,13 +15,15 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from ..algebra.backends import solver_library, solver_name
 from ..loop import COLUMNS, Level, adaptive
 from ..output import HistoryWriter, write_columns
-from ..output.check import CHECK, problem_data, write_check
+from ..output.check import CHECK, write_check
+from ..output.environment import environment
 from ..output.run import STATE, ResumeState, RunFolder
 from ..output.vtu import write_fields
 from .figures import compare_uniform, draw_figures
-from .identity import check_problem, name_the_problem
+from .identity import check_problem, name_the_problem, problem_data
 from .levels import Clock, Printer, Status, write_levels
 from .problems import RunProblem, label, load, problem_id, with_curves_of
 from .settings import RunSettings, new_settings, resumed_settings
@@ -107,10 +109,15 @@ def _restart(
     arrays only)."""
     if (folder.path / STATE).is_file():
         check_problem(folder, name, job, settings.options, verb)
-    state = folder.restart()
+    state = folder.restart(_environment(settings))
     if state.mesh is not None:
         state.mesh = with_curves_of(state.mesh, job.problem.mesh)
     return state
+
+
+def _environment(settings: RunSettings) -> dict[str, str]:
+    """Where the run runs, with the solver library its options name."""
+    return environment(solver_library(solver_name(settings.options.solver)))
 
 
 def _create_folder(
@@ -119,7 +126,11 @@ def _create_folder(
     """Claim the output folder of a new run and record its problem and settings."""
     out: Path = args.out or Path("results") / label(name)
     folder, removed = RunFolder.create(
-        out, problem_id(name), settings.record(), overwrite=args.overwrite
+        out,
+        problem_id(name),
+        settings.record(),
+        overwrite=args.overwrite,
+        environment=_environment(settings),
     )
     if removed:
         say(f"removed {len(removed)} file(s) of the previous run in {folder.path}")

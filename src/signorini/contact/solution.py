@@ -21,6 +21,7 @@ from ..algebra.pdas import PDASOptions, solve_pdas
 from ..algebra.result import PDASConvergenceError, SolveReport
 from ..algebra.solvers import SolverFactory, SPDSolver
 from ..fem.norms import energy_error2, h1_seminorm_error2
+from ..fem.postprocess import nodal_stress
 from ..fem.space import P2Space
 from ..mesh.mesh import Mesh
 from ..problem.fields import evaluate_field
@@ -188,6 +189,12 @@ class ContactResult:
         ``−Σ_z (Λ_z n_z + Λ_t,z t_z)`` (docs/method.md, *Contact directions*)."""
         n, t = self.contact.normal, self.contact.tangent[:, 0]
         return -(self.contact_force @ n) - self.tangential_force @ t
+
+    @cached_property
+    def nodal_stress(self) -> np.ndarray:
+        """``(n_nodes, 3, 3)`` σ(u_h) at the P2 nodes, each the mean of its cells' values, σ_zz
+        from the material (:func:`signorini.fem.postprocess.nodal_stress`)."""
+        return nodal_stress(self.space, self.u, self.problem.material)
 
     @cached_property
     def classes(self) -> np.ndarray:

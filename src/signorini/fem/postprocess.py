@@ -11,11 +11,18 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh.geometry import segment_normals
-from . import p2
+from . import iso, p2
 from .mapping import CellMap
 from .material import Material, stress
 
-__all__ = ["cell_stress", "div_stress", "edge_traction", "stress_divergence", "traction"]
+__all__ = [
+    "cell_stress",
+    "div_stress",
+    "edge_traction",
+    "nodal_stress",
+    "stress_divergence",
+    "traction",
+]
 
 
 def cell_stress(
@@ -148,3 +155,45 @@ def stress_divergence(hess: np.ndarray, material: Material) -> np.ndarray:
     lap = hess[..., 0, 0] + hess[..., 1, 1]
     grad_div = hess[..., 0, 0, :] + hess[..., 1, 1, :]
     return material.mu * lap + (material.lam + material.mu) * grad_div
+
+
+def nodal_stress(space, u: np.ndarray, material) -> np.ndarray:
+    """The stress of the P2 displacement ``u (n_nodes, 2)`` of ``space`` at its nodes, averaged
+    over the cells sharing each node.
+
+    Each cell gives σ(u_h) at its six nodes (the gradient of its P2 displacement on its own
+    map, curved cells included); a node's value is the mean of the values of its cells. On
+    a linear-elastic field with continuous σ of degree ≤ 1 (a patch test) this is exact.
+
+    Returns
+    -------
+    (n_nodes, 3, 3) float array
+        σ with σ_zz from the material (plane strain: ``λ (σ_xx + σ_yy) / (2 (λ + μ))``).
+    """
+    nodes = space.cell_nodes  # (m, 6)
+    m = nodes.shape[0]
+    u_cell = u[nodes].reshape(m, 12)
+    grad, _ = iso.field_derivatives(space.node_points[nodes], u_cell, p2.REFERENCE_NODES)
+    sig = stress(material, grad).reshape(-1, 4)  # (m * 6, [xx, xy, yx, yy])
+    count = np.bincount(nodes.ravel(), minlength=space.n_nodes).astype(np.float64)
+    mean = (
+        np.column_stack(
+            [
+                np.bincount(nodes.ravel(), weights=sig[:, j], minlength=space.n_nodes)
+                for j in range(4)
+            ]
+        )
+        / np.maximum(count, 1.0)[:, None]
+    )
+    out = np.zeros((space.n_nodes, 3, 3))
+    out[:, :2, :2] = mean.reshape(-1, 2, 2)
+    out[:, 2, 2] = _sigma_zz(material, out[:, 0, 0], out[:, 1, 1])
+    return out
+
+
+def _sigma_zz(material, sxx: np.ndarray, syy: np.ndarray) -> np.ndarray:
+    """σ_zz of the material: 0 in plane stress, ``λ (σ_xx + σ_yy) / (2 (λ + μ))`` (= λ tr ε)
+    in plane strain."""
+    if getattr(material, "plane", "strain") == "stress":
+        return np.zeros_like(sxx)
+    return material.lam * (sxx + syy) / (2.0 * (material.lam + material.mu))

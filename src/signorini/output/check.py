@@ -24,23 +24,21 @@ The file is plain arrays (``numpy.load`` without pickles): reading it runs no co
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
-from ..contact.system import assemble
-from ..problem.problem import ContactProblem
 from .files import replacing
 
-__all__ = ["CHECK", "RTOL", "differences", "problem_data", "read_check", "write_check"]
+__all__ = ["CHECK", "MESH_ARRAYS", "RTOL", "differences", "read_check", "write_check"]
 
 #: The file of a run folder holding its first level's problem data.
 CHECK = "signorini-check.npz"
 #: Relative tolerance (of each array's largest entry) of the comparison of computed data.
 RTOL = 1e-8
 
-_MESH = ("points", "cells", "boundary", "boundary_part")
+#: the mesh arrays a run saves to identify its initial mesh
+MESH_ARRAYS = ("points", "cells", "boundary", "boundary_part")
 _WHAT = {
     "mesh": "the initial mesh (points, cells or boundary parts)",
     "dirichlet": "the Dirichlet values",
@@ -50,55 +48,6 @@ _WHAT = {
     "solution": "the first level's solution",
     "steps": "the number of load steps",
 }
-
-
-def _step_data(problem: ContactProblem, mesh, k: int) -> dict[str, np.ndarray]:
-    """The assembled data of load step ``k`` on ``mesh``."""
-    system = assemble(problem, mesh)
-    cs = system.contact
-    probe = np.sin(1.0 + np.arange(system.K.shape[0]))  # no zero entry, no symmetry
-    return {
-        f"dirichlet.{k}": system.dirichlet_values,
-        f"contact.{k}.gap": cs.gap,
-        f"contact.{k}.normal": cs.normal,
-        f"contact.{k}.nodes": cs.nodes.astype(np.float64),
-        f"contact.{k}.friction": np.concatenate(
-            [cs.friction_law, cs.friction_bound, cs.friction_coefficient]
-        ).astype(np.float64),
-        f"loads.{k}": system.F,
-        f"material.{k}": system.K @ probe,
-    }
-
-
-def problem_data(result, path: Sequence[ContactProblem] | None = None) -> dict[str, np.ndarray]:
-    """The data that identifies the problem of a run, from its first level's ``result``.
-
-    Parameters
-    ----------
-    result : ContactResult
-        The first level's solution (of the last load step with a load path).
-    path : sequence of ContactProblem, optional
-        The load steps solved before ``result.problem`` on every level.
-
-    Returns
-    -------
-    dict of str to array
-        Named arrays; the first part of a name (before a dot) is what they describe.
-    """
-    mesh = result.problem.mesh
-    data: dict[str, np.ndarray] = {
-        f"mesh.{name}": np.asarray(getattr(mesh, name)) for name in _MESH
-    }
-    data["mesh.part_names"] = np.array(mesh.part_names, dtype=str)
-    steps = [*(path or ()), result.problem]
-    data["steps.count"] = np.array([len(steps)], dtype=np.float64)
-    for k, step in enumerate(steps):
-        data.update(_step_data(step, result.space.mesh, k))
-    data["solution.u"] = np.asarray(result.u, dtype=np.float64)
-    data["solution.contact_force"] = np.asarray(result.contact_force, dtype=np.float64)
-    if result.tangential_force is not None:
-        data["solution.tangential_force"] = np.asarray(result.tangential_force, dtype=np.float64)
-    return data
 
 
 def write_check(folder: str | os.PathLike, data: dict[str, np.ndarray]) -> Path:

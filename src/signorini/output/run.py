@@ -54,7 +54,6 @@ except ImportError:  # pragma: no cover - Windows
 import numpy as np
 
 from ..mesh.mesh import Mesh
-from .environment import environment
 from .files import atomic_write, remove_temporaries, replacing
 
 __all__ = [
@@ -168,7 +167,13 @@ class RunFolder:
     # ------------------------------------------------------------------ opening
     @classmethod
     def create(
-        cls, path: str | os.PathLike, problem: dict, arguments: dict, *, overwrite: bool = False
+        cls,
+        path: str | os.PathLike,
+        problem: dict,
+        arguments: dict,
+        *,
+        overwrite: bool = False,
+        environment: dict | None = None,
     ) -> tuple[RunFolder, list[Path]]:
         """Claim ``path`` for a new run, lock it and write its manifest.
 
@@ -186,6 +191,8 @@ class RunFolder:
             ``eta5`` and ``backend`` of manifests written before).
         overwrite : bool
             Remove a previous run's files from a non-empty folder instead of refusing it.
+        environment : dict, optional
+            Where the run runs (:func:`~.environment.environment`), recorded as it is.
 
         Returns
         -------
@@ -230,7 +237,7 @@ class RunFolder:
                     "status": "running",
                     "files": [MANIFEST],
                     "pid": os.getpid(),
-                    "environment": environment(arguments.get("solver")),
+                    "environment": dict(environment or {}),
                 },
                 lock,
             )
@@ -293,7 +300,7 @@ class RunFolder:
             return "stopped before finishing: its process ended"
         return status
 
-    def restart(self) -> ResumeState:
+    def restart(self, environment: dict | None = None) -> ResumeState:
         """Prepare the folder to continue the run: remove temporary files and the files of
         levels after the last one saved in ``resume.npz``, and return the saved state with
         the history rows of the saved levels.
@@ -321,9 +328,7 @@ class RunFolder:
         self.manifest["pid"] = os.getpid()
         resumed = self.manifest.get("resumed")
         self.manifest["resumed"] = [*(resumed if isinstance(resumed, list) else ())]
-        self.manifest["resumed"].append(
-            environment(self.manifest.get("arguments", {}).get("solver"))
-        )
+        self.manifest["resumed"].append(dict(environment or {}))
         self.set_status("running")
         return state
 

@@ -13,14 +13,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fem import iso, p2
-from ..fem.material import stress
 from .files import atomic_write, replacing
 
 __all__ = [
     "CELL_FIELDS",
     "POINT_FIELDS",
-    "nodal_stress",
     "von_mises",
     "write_fields",
     "write_pvd",
@@ -54,49 +51,6 @@ CELL_FIELDS: dict[str, str] = {
     "eta2_k": "the squared contribution η_k,T² of term k = 1, 2, … (docs/method.md, "
     "*Estimator*): one field per term",
 }
-
-
-def nodal_stress(result) -> np.ndarray:
-    """The stress of ``result.u`` at the P2 nodes, averaged over the cells sharing each node.
-
-    Each cell gives σ(u_h) at its six nodes (the gradient of its P2 displacement on its own
-    map, curved cells included); a node's value is the mean of the values of its cells. On
-    a linear-elastic field with continuous σ of degree ≤ 1 (a patch test) this is exact.
-
-    Returns
-    -------
-    (n_nodes, 3, 3) float array
-        σ with σ_zz from the material (plane strain: ``λ (σ_xx + σ_yy) / (2 (λ + μ))``).
-    """
-    space = result.space
-    nodes = space.cell_nodes  # (m, 6)
-    m = nodes.shape[0]
-    u_cell = result.u[nodes].reshape(m, 12)
-    grad, _ = iso.field_derivatives(space.node_points[nodes], u_cell, p2.REFERENCE_NODES)
-    material = result.problem.material
-    sig = stress(material, grad).reshape(-1, 4)  # (m * 6, [xx, xy, yx, yy])
-    count = np.bincount(nodes.ravel(), minlength=space.n_nodes).astype(np.float64)
-    mean = (
-        np.column_stack(
-            [
-                np.bincount(nodes.ravel(), weights=sig[:, j], minlength=space.n_nodes)
-                for j in range(4)
-            ]
-        )
-        / np.maximum(count, 1.0)[:, None]
-    )
-    out = np.zeros((space.n_nodes, 3, 3))
-    out[:, :2, :2] = mean.reshape(-1, 2, 2)
-    out[:, 2, 2] = _sigma_zz(material, out[:, 0, 0], out[:, 1, 1])
-    return out
-
-
-def _sigma_zz(material, sxx: np.ndarray, syy: np.ndarray) -> np.ndarray:
-    """σ_zz of the material: 0 in plane stress, ``λ (σ_xx + σ_yy) / (2 (λ + μ))`` (= λ tr ε)
-    in plane strain."""
-    if getattr(material, "plane_stress", False):
-        return np.zeros_like(sxx)
-    return material.lam * (sxx + syy) / (2.0 * (material.lam + material.mu))
 
 
 def von_mises(sig: np.ndarray) -> np.ndarray:
@@ -146,7 +100,7 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     np.add.at(tangential, cs.nodes, p_t)
     t = cs.tangent[:, 0]
     np.add.at(traction[:, :2], cs.nodes, -result.pressure[:, None] * cs.normal - p_t[:, None] * t)
-    sig = nodal_stress(result)
+    sig = result.nodal_stress  # (n_nodes, 3, 3): ContactResult.nodal_stress
     # VTK's symmetric tensor order: xx, yy, zz, xy, yz, xz
     voigt = np.column_stack(
         [sig[:, 0, 0], sig[:, 1, 1], sig[:, 2, 2], sig[:, 0, 1], sig[:, 1, 2], sig[:, 0, 2]]
