@@ -57,7 +57,7 @@ BACKWARD_RTOL = 1e-13
 #: singular, and above which a warning says how many digits the solution may have lost
 #: (:func:`forward_error`; measured on cantilevers: 10 times the actual error).
 FORWARD_RTOL = 0.1
-FORWARD_WARN = 1e-3
+FORWARD_WARN = 1e-2
 
 #: Steps of iterative refinement tried on a solve whose residual fails :data:`SOLVE_RTOL`.
 REFINE_STEPS = 3
