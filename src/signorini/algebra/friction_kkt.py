@@ -243,8 +243,9 @@ def friction_kkt(
     """
     qp = problem.qp
     K, F, n_dof, t_dof = qp.K, qp.F, problem.normal, problem.tangent
-    r = F - K @ x
-    force = force_scale(K, F, x)
+    Kx = K @ x
+    r = F - Kx
+    force = force_scale(K, F, x, Kx)
     lam_n, lam_t = r[n_dof], r[t_dof]
     slack = x[n_dof] - problem.gap
     slide = x[t_dof] - problem.reference

@@ -130,14 +130,22 @@ def kkt_residuals(
     return qp_residuals(qp, check_vector(x, qp.n, "x"))
 
 
-def force_scale(K: sp.csr_matrix, F: np.ndarray, x: np.ndarray) -> float:
+def force_scale(
+    K: sp.csr_matrix,
+    F: np.ndarray,
+    x: np.ndarray,
+    Kx: np.ndarray | None = None,
+    round_off: float | None = None,
+) -> float:
     """The size of the forces at ``x``: ``max(max |F|, max |K x|)`` — loads, reactions and
     contact forces, not the entries of ``|K| |x|``, whose cancellation in ``K x`` is only
     round-off — against which the equilibrium residual is measured; :func:`round_off_scale`
     where the forces themselves are round-off (at most ``64 eps max |K| |x|``: a rigid
-    motion, no load), and 1 where everything vanishes."""
-    force = max(np.abs(F).max(initial=0.0), np.abs(K @ x).max(initial=0.0))
-    round_off = round_off_scale(K, F, x)
+    motion, no load), and 1 where everything vanishes. ``Kx`` and ``round_off``: ``K @ x``
+    and :func:`round_off_scale`, if known."""
+    Kx = K @ x if Kx is None else Kx
+    force = max(np.abs(F).max(initial=0.0), np.abs(Kx).max(initial=0.0))
+    round_off = round_off_scale(K, F, x) if round_off is None else round_off
     return float(force) if force > _ROUNDOFF * round_off else round_off
 
 
@@ -185,8 +193,10 @@ def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
     """
     K, F, c, g = qp.K, qp.F, qp.constrained, qp.gap
     d, xd = qp.dirichlet, qp.dirichlet_values
-    r = F - K @ x
-    force = force_scale(K, F, x)
+    Kx = K @ x
+    r = F - Kx
+    round_off = round_off_scale(K, F, x)
+    force = force_scale(K, F, x, Kx, round_off)
     multiplier = r[c]
     slack = x[c] - g
     touching = slack >= 0
@@ -213,5 +223,5 @@ def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
         disp_scale=float(disp),
         contact_force=contact_force,
         contact_force_scale=float(contact),
-        round_off_scale=round_off_scale(K, F, x),
+        round_off_scale=round_off,
     )
