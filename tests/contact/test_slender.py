@@ -19,6 +19,7 @@ from signorini.contact.solution import solve
 from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, SlenderBodyWarning
+from signorini.problem.friction import Coulomb, Tresca
 
 BACKENDS = available_backends()
 E, NU, H, LOAD = 1000.0, 0.3, 1.0, 1e-3
@@ -114,3 +115,25 @@ def test_beam_on_a_rigid_foundation_is_solved():
         # in contact along all of the bottom but next to the clamp
         x = result.space.node_points[result.contact.nodes, 0]
         assert result.active[x > 3.0 * H].all()
+
+
+@pytest.mark.parametrize("law", [Tresca(1e-3), Coulomb(0.3)])
+def test_beam_on_a_rigid_foundation_with_friction_is_solved(law):
+    """The same beam with friction and a tangential load 1e-3 on its top (0.15 in all): the
+    frictional systems were refused too (residual 1.2e-6 to 4.5e-6); now both backends agree
+    and meet both laws' KKT conditions to round-off; the foundation carries the vertical load
+    but for what the clamp takes, and the tangential load to 1 % (the clamp takes or adds
+    the rest)."""
+    problem = beam_on_foundation()
+    conditions = dict(problem.conditions)
+    conditions["top"] = Neumann((1e-3, -0.01))
+    conditions["bottom"] = Contact(gap=0.0, normal=(0.0, -1.0), friction=law)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SlenderBodyWarning)
+        problem = ContactProblem(problem.mesh, problem.material, conditions)
+    results = [solve(problem, solver=SOLVERS[b]) for b in BACKENDS]
+    for result in results:
+        assert result.report.kkt.max < 1e-12
+        assert 1.5 - 0.02 < result.total_contact_force < 1.5
+        assert abs(abs(result.tangential_force.sum()) - 0.15) < 0.002
+        np.testing.assert_allclose(result.u, results[0].u, rtol=0, atol=1e-10)

@@ -85,7 +85,7 @@ def refine(
     residual: Callable[[np.ndarray], np.ndarray],
     b: np.ndarray,
     x: np.ndarray,
-    norm_A: float,
+    norm_A: Callable[[], float],
     backend: str,
 ) -> np.ndarray:
     """The solution of ``A x = b`` from a first solve ``x`` whose residual may be large only
@@ -112,8 +112,9 @@ def refine(
         ``x ↦ b − A x``.
     b, x : (n,) float arrays
         The right-hand side and the first solution (not modified).
-    norm_A : float
-        ``‖A‖∞``, the largest row sum of ``|A|`` (an upper bound will do).
+    norm_A : callable () -> float
+        ``‖A‖∞``, the largest row sum of ``|A|`` (an upper bound will do); called only when
+        the solve is refined.
     backend : str
 
     Returns
@@ -134,8 +135,9 @@ def refine(
         r = residual(x)
         if _relative(r, b) <= SOLVE_RTOL:
             break
-    backward = _max(r) / max(norm_A * _max(x) + _max(b), 1e-300)
-    forward = forward_error(solve, x, norm_A)
+    norm = norm_A()
+    backward = _max(r) / max(norm * _max(x) + _max(b), 1e-300)
+    forward = forward_error(solve, x, norm)
     logger.info(
         "refined solve: residual %.1e of max|b|, backward error %.1e, forward error %.1e",
         _relative(r, b),
@@ -307,7 +309,7 @@ class ActiveSetSystem:
                 lambda y: self._residual_vector(b, y),
                 b,
                 x,
-                self._norm(),
+                self._norm,
                 self.solver.backend,
             )
         x[self.fixed] = self.values[self.fixed]
