@@ -11,6 +11,7 @@ from linalg_problems import p2_elasticity, random_problem
 from signorini.algebra import (
     SOLVERS,
     FactorizationError,
+    IllConditionedWarning,
     PDASOptions,
     SingularSystemError,
     available_backends,
@@ -124,28 +125,65 @@ def test_low_rank_updates_agree_with_refactorization(backend):
     assert used > 0, f"{backend}: no iteration was solved by a low-rank update"
 
 
-@pytest.mark.parametrize("backend", BACKEND_LIST)
-def test_near_singular_solve_is_reported(backend):
-    # a second block held only by a spring 1e-12 times its stiffness, loaded: both backends
-    # factorize it and returned |x| ~ 1e9 with KKT residuals at round-off
+def _block_on_a_spring(spring):
+    """A clamped P2 block and a second block held only by a spring ``spring`` times the
+    identity, loaded downwards: its displacement is about 1e-3 / spring."""
     K1, xy = p2_elasticity(2, 2)
     n1 = K1.shape[0]
-    K = sp.block_diag([K1, K1 + 1e-12 * sp.eye(n1)], format="csr")
+    K = sp.block_diag([K1, K1 + spring * sp.eye(n1)], format="csr")
     left = np.flatnonzero(xy[:, 0] < 1e-12)
     d = np.r_[2 * left, 2 * left + 1]
     F = np.zeros(2 * n1)
     F[n1 + 1 :: 2] = -1e-3
-    with pytest.raises(SingularSystemError, match="singular or too ill-conditioned") as info:
+    return K1, K, F, d
+
+
+@pytest.mark.parametrize("backend", BACKEND_LIST)
+def test_near_singular_solve_is_reported(backend):
+    # a spring of 1e-14: singular in double precision. PARDISO factorizes it (a round-off
+    # pivot) and its solve is backward stable, but iterative refinement's estimate of the
+    # forward error is 1: refused; SuperLU finds a non-positive pivot
+    K1, K, F, d = _block_on_a_spring(1e-14)
+    with pytest.raises(FactorizationError, match="singular|not positive definite") as info:
         solve_pdas(K, F, np.zeros(0, dtype=int), np.zeros(0), d, 0.0, solver=SOLVERS[backend])
     err = info.value
-    assert isinstance(err, FactorizationError)
-    assert err.backend == backend and err.residual > 1e-4
+    assert err.backend == backend
     assert "no Dirichlet condition" in str(err)
+    if isinstance(err, SingularSystemError):
+        assert "estimated relative error of 1.0e+00" in str(err) and err.residual > 1e-4
     # the held block alone is solved, its residual checked and far below the bound
+    n1 = K1.shape[0]
     result = solve_pdas(
         K1, np.ones(n1), np.zeros(0, dtype=int), np.zeros(0), d, solver=SOLVERS[backend]
     )
     assert result.kkt.stationarity < 1e-14
+
+
+def test_an_ill_conditioned_solve_is_refined_and_warned_about():
+    """A spring of 1e-12 (condition number about 1e13): the residual max|b - A x| / max|b| is
+    5e-3 (refused before), the backward error at round-off; the solution is kept, with a
+    warning of its estimated error, and the backends agree within it. Its equilibrium
+    residual, relative to the forces, reads 6e-3 (honest: the former scale max |K||x| read
+    3e-16), and a second warning says so."""
+    _, K, F, d = _block_on_a_spring(1e-12)
+    solutions = []
+    for backend in BACKEND_LIST:
+        with pytest.warns(IllConditionedWarning) as record:
+            result = solve_pdas(
+                K, F, np.zeros(0, dtype=int), np.zeros(0), d, 0.0, solver=SOLVERS[backend]
+            )
+        messages = [str(w.message) for w in record]
+        solve_warning = next(m for m in messages if "may be off by up to" in m)
+        estimate = float(solve_warning.split("up to ")[1].split()[0])
+        assert 5e-3 < estimate < 2e-2
+        assert any("meets its KKT conditions only to" in m for m in messages)
+        solutions.append((result.x, estimate))
+        assert 0.9e9 < np.abs(result.x).max() < 1.1e9
+        assert 1e-3 < result.kkt.stationarity < 1e-1
+        assert result.kkt.round_off_scale > 1e12 * result.kkt.force_scale
+    for x, estimate in solutions[1:]:
+        error = np.abs(x - solutions[0][0]).max() / np.abs(x).max()
+        assert error < estimate
 
 
 @pytest.mark.parametrize("backend", BACKEND_LIST)
@@ -172,5 +210,5 @@ def test_failed_factorization_names_the_usual_causes(backend, case):
             "the linear system is singular or too ill-conditioned: ",
         )
     )
-    assert "no Dirichlet condition" in message and "aspect ratio 1e3" in message
+    assert "no Dirichlet condition" in message and "refused from 2000" in message
     assert info.value.backend == backend

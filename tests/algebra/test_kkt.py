@@ -78,3 +78,25 @@ def test_stationarity_on_a_free_row_and_zero_scales():
     assert kkt.stationarity == 1.0 and kkt.max == 1.0
     with pytest.raises(ValueError, match=r"x must have shape \(2,\)"):
         kkt_residuals(K, np.zeros(2), np.zeros(3), [0], 0.0)
+
+
+def test_scales_follow_the_forces_not_the_stiffness():
+    """Two DOFs tied by a spring of 1e10 (a stiff material: |K||x| = 2e10 where K x = 1): an
+    out-of-balance force of 0.5 is a third of the forces, and a tensile force at the contact
+    is a fraction of the contact force. The former scale max(|F|, |K||x|) read both as 2e-11."""
+    k = 1e10
+    K = sp.csr_matrix(np.array([[k + 1.0, -k], [-k, k + 1.0]]))
+    x = np.array([1.0, 1.0])  # K x = (1, 1)
+    F = np.array([1.0, 1.5])
+    kkt = kkt_residuals(K, F, x, [0], 2.0)
+    assert kkt.force_scale == 1.5 and kkt.round_off_scale == 2 * k + 1
+    assert kkt.stationarity == pytest.approx(0.5 / 1.5)
+    # x_0 held at its bound 1 with Λ_0 = F_0 − (K x)_0 = −0.25 and a second contact DOF
+    # carrying 0.75: the tensile force is a third of the contact force
+    kkt2 = kkt_residuals(K, np.array([0.75, 1.75]), x, [0, 1], [1.0, 1.0])
+    assert kkt2.contact_force == 0.75 and kkt2.contact_force_scale == 0.75
+    assert kkt2.dual == pytest.approx(0.25 / 0.75)
+    # forces at round-off of |K||x| (a rigid motion, no load): the round-off scale
+    rigid = kkt_residuals(K - sp.identity(2, format="csr"), np.zeros(2), x, [0], 2.0)
+    assert rigid.force_scale == rigid.round_off_scale == 2 * k
+    assert rigid.stationarity == 0.0

@@ -46,6 +46,7 @@ from .result import ConvergenceError, PDASConvergenceError, PDASResult, PDASStep
 from .solvers import (
     BackendUnavailableError,
     FactorizationError,
+    IllConditionedWarning,
     SingularSystemError,
     SolverFactory,
     SolverRequest,
@@ -64,6 +65,7 @@ __all__ = [
     "FrictionProblem",
     "FrictionResult",
     "FrictionStep",
+    "IllConditionedWarning",
     "INACTIVE",
     "SLIP",
     "STICK",

@@ -23,14 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .kkt import force_scale
+from .kkt import contact_scale, force_scale
 from .laws import LawGroups, check_laws
 from .qp import BoundQP, _index_array, check_qp, check_vector
 from .sparse import as_csr
 
 __all__ = ["FrictionKKT", "FrictionProblem", "check_friction", "friction_kkt"]
-
-_SQRT_EPS = float(np.sqrt(np.finfo(np.float64).eps))
 
 
 @dataclass(frozen=True)
@@ -245,8 +243,9 @@ def friction_kkt(
     """
     qp = problem.qp
     K, F, n_dof, t_dof = qp.K, qp.F, problem.normal, problem.tangent
-    r = F - K @ x
-    force = force_scale(K, F, x)
+    Kx = K @ x
+    r = F - Kx
+    force = force_scale(K, F, x, Kx)
     lam_n, lam_t = r[n_dof], r[t_dof]
     slack = x[n_dof] - problem.gap
     slide = x[t_dof] - problem.reference
@@ -258,7 +257,7 @@ def friction_kkt(
     )
     disp = disp if disp > 0 else 1.0
     total = float(np.maximum(lam_n, 0.0).sum())
-    fc = total if total > _SQRT_EPS * force else force
+    fc = contact_scale(K, F, x, n_dof, total, force)
     s = problem.slip_bound(lam_n, lam_n > 0 if in_contact is None else in_contact)
     stick = np.abs(slide) / disp
     wrong_way = np.maximum(-lam_t * slide, 0.0) / (fc * disp)

@@ -20,9 +20,11 @@ import scipy.sparse as sp
 from .qp import BoundQP, check_qp, check_vector
 from .sparse import abs_matvec
 
-__all__ = ["KKTResiduals", "force_scale", "kkt_residuals"]
+__all__ = ["KKTResiduals", "contact_scale", "force_scale", "kkt_residuals", "round_off_scale"]
 
-_SQRT_EPS = float(np.sqrt(np.finfo(np.float64).eps))
+#: Forces are round-off when they are at most this times ``|K| |x| + |F|``, the bound of the
+#: round-off of ``F - K x`` (about eps times the number of entries in a row, 18 to 40 for P2).
+_ROUNDOFF = 64 * float(np.finfo(np.float64).eps)
 
 
 @dataclass(frozen=True)
@@ -31,7 +33,9 @@ class KKTResiduals:
 
     Each residual is relative to the quantity it is about (docs/method.md, *Solver*): the
     contact conditions to the displacements and forces *at the contact*, not to a far-away gap
-    nor to the largest row of ``|K| |x|``.
+    nor to the largest row of ``|K| |x|`` (which grows with the stiffness: for ν → 1/2 or a
+    sliver cell it is 10⁹ times the forces, and a scale built on it hid a tensile contact
+    force of 5 % of the total).
 
     Attributes
     ----------
@@ -48,8 +52,9 @@ class KKTResiduals:
     dirichlet : float
         ``max |x_d - x_D| / disp_scale``.
     force_scale : float
-        ``max(max |F|, max (|K| |x|))`` (1 if both vanish): the size of the forces, which also
-        bounds the round-off in ``F - K x``.
+        ``max(max |F|, max |K x|)``: the size of the forces acting on the body (loads,
+        reactions, contact forces); ``round_off_scale`` where they are round-off of it (below
+        ``64 eps`` of it).
     disp_scale : float
         ``max(max |x|, max |x_D|, max |g|`` over the constrained DOFs that touch or penetrate,
         ``x_c >= g)`` (1 if all vanish): the displacement of the body and the gap only where
@@ -57,8 +62,10 @@ class KKTResiduals:
     contact_force : float
         The total contact force ``Σ max(Λ, 0)``.
     contact_force_scale : float
-        ``contact_force``, or ``force_scale`` when the contact force is below ``√eps`` of it
-        (no contact: the multipliers are round-off).
+        ``contact_force``, or ``force_scale`` when the contact force is round-off (no contact):
+        at most ``64 eps Σ_c (|K| |x| + |F|)_c``, a bound of the round-off of the multipliers.
+    round_off_scale : float
+        ``max(max |F|, max (|K| |x|))``: the size of the round-off of ``F - K x`` over eps.
     """
 
     primal: float
@@ -70,6 +77,7 @@ class KKTResiduals:
     disp_scale: float
     contact_force: float = 0.0
     contact_force_scale: float = 1.0
+    round_off_scale: float = 1.0
 
     @property
     def max(self) -> float:
@@ -122,11 +130,53 @@ def kkt_residuals(
     return qp_residuals(qp, check_vector(x, qp.n, "x"))
 
 
-def force_scale(K: sp.csr_matrix, F: np.ndarray, x: np.ndarray) -> float:
-    """The scale of the forces at ``x``: ``max(max |F|, max |K| |x|)`` (1 where both vanish),
-    against which the equilibrium and force residuals are measured."""
-    force = max(np.abs(F).max(initial=0.0), abs_matvec(K, x).max(initial=0.0))
-    return float(force) if force > 0 else 1.0
+def force_scale(
+    K: sp.csr_matrix,
+    F: np.ndarray,
+    x: np.ndarray,
+    Kx: np.ndarray | None = None,
+    round_off: float | None = None,
+) -> float:
+    """The size of the forces at ``x``: ``max(max |F|, max |K x|)`` — loads, reactions and
+    contact forces, not the entries of ``|K| |x|``, whose cancellation in ``K x`` is only
+    round-off — against which the equilibrium residual is measured; :func:`round_off_scale`
+    where the forces themselves are round-off (at most ``64 eps max |K| |x|``: a rigid
+    motion, no load), and 1 where everything vanishes. ``Kx`` and ``round_off``: ``K @ x``
+    and :func:`round_off_scale`, if known."""
+    Kx = K @ x if Kx is None else Kx
+    force = max(np.abs(F).max(initial=0.0), np.abs(Kx).max(initial=0.0))
+    round_off = round_off_scale(K, F, x) if round_off is None else round_off
+    return float(force) if force > _ROUNDOFF * round_off else round_off
+
+
+def round_off_scale(K: sp.csr_matrix, F: np.ndarray, x: np.ndarray) -> float:
+    """``max(max |F|, max |K| |x|)`` (1 where both vanish): the round-off of ``F - K x`` is
+    about eps times it."""
+    scale = max(np.abs(F).max(initial=0.0), abs_matvec(K, x).max(initial=0.0))
+    return float(scale) if scale > 0 else 1.0
+
+
+def contact_scale(
+    K: sp.csr_matrix, F: np.ndarray, x: np.ndarray, rows: np.ndarray, total: float, force: float
+) -> float:
+    """The scale of the contact forces: their sum ``total``, or ``force`` when it is round-off,
+    at most ``64 eps Σ (|K| |x| + |F|)`` over ``rows`` (the constrained DOFs).
+
+    Parameters
+    ----------
+    K, F, x
+        The system and the point.
+    rows : (m,) int array
+        The constrained DOFs.
+    total : float
+        ``Σ Λ⁺``.
+    force : float
+        :func:`force_scale`.
+    """
+    if rows.size == 0:
+        return force
+    round_off = _ROUNDOFF * float((abs_matvec(K[rows], x) + np.abs(F[rows])).sum())
+    return total if total > round_off else force
 
 
 def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
@@ -143,8 +193,10 @@ def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
     """
     K, F, c, g = qp.K, qp.F, qp.constrained, qp.gap
     d, xd = qp.dirichlet, qp.dirichlet_values
-    r = F - K @ x
-    force = force_scale(K, F, x)
+    Kx = K @ x
+    r = F - Kx
+    round_off = round_off_scale(K, F, x)
+    force = force_scale(K, F, x, Kx, round_off)
     multiplier = r[c]
     slack = x[c] - g
     touching = slack >= 0
@@ -155,20 +207,21 @@ def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
     )
     disp = disp if disp > 0 else 1.0
     contact_force = float(np.maximum(multiplier, 0.0).sum())
-    contact_scale = contact_force if contact_force > _SQRT_EPS * force else force
+    contact = contact_scale(K, F, x, c, contact_force, force)
     other = np.ones(x.size, dtype=bool)
     other[c] = False
     other[d] = False
     return KKTResiduals(
         primal=float(np.maximum(slack, 0.0).max(initial=0.0) / disp),
-        dual=float(np.maximum(-multiplier, 0.0).max(initial=0.0) / contact_scale),
+        dual=float(np.maximum(-multiplier, 0.0).max(initial=0.0) / contact),
         complementarity=float(
-            np.minimum(np.abs(multiplier) / contact_scale, np.abs(slack) / disp).max(initial=0.0)
+            np.minimum(np.abs(multiplier) / contact, np.abs(slack) / disp).max(initial=0.0)
         ),
         stationarity=float(np.abs(r[other]).max(initial=0.0) / force),
         dirichlet=float(np.abs(x[d] - xd).max(initial=0.0) / disp),
         force_scale=float(force),
         disp_scale=float(disp),
         contact_force=contact_force,
-        contact_force_scale=float(contact_scale),
+        contact_force_scale=float(contact),
+        round_off_scale=round_off,
     )

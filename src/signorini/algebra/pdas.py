@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import logging
 import time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,9 +43,10 @@ from .kkt import qp_residuals
 from .primal import primal_active_set
 from .qp import BoundQP, check_qp, check_vector
 from .result import PDASConvergenceError, PDASResult, PDASStep
-from .solvers import SolverFactory, SPDSolver, solver_usage
+from .solvers import IllConditionedWarning, SolverFactory, SPDSolver, solver_usage
+from .sparse import abs_matvec
 
-__all__ = ["PDASOptions", "solve_pdas"]
+__all__ = ["KKT_WARN", "PDASOptions", "solve_pdas"]
 
 logger = logging.getLogger(__name__)
 
@@ -52,8 +54,20 @@ logger = logging.getLogger(__name__)
 # keeps its state when the active set is updated: a degenerate constraint (Λ = 0 and x = g,
 # "just touching") has both Λ and x - g at round-off, whose sign must not decide. The round-off
 # of x grows with the condition number of K (measured: |x_c - g| / |g| = 2e-12 at 33k unknowns),
-# so the band is far above eps and far below any decision that matters.
+# so the band is far above eps and far below any decision that matters. An inactive
+# constraint's band is on c (x - g), relative to max(max |F|, c max |x|) (a displacement band);
+# an active one's is on Λ, relative to the forces max(max |F|, Σ Λ⁺) and never below the
+# round-off of Λ itself, _FORCE_ROUNDOFF max (|K| |x|)_c: not c max |x|, which grows with the
+# stiffness (ν → 1/2, a sliver cell) and kept tensile forces of 5 % of the total active.
 _ACTIVE_RTOL = 1e-9
+_FORCE_ROUNDOFF = 1e3 * float(np.finfo(np.float64).eps)
+
+
+#: A solution whose largest relative KKT residual exceeds this gets an
+#: :class:`~.solvers.IllConditionedWarning`: its forces have fewer than six digits (the
+#: residuals are honest, docs/method.md, *Solver*; measured: 1e-6 at ν = 0.499999999, 1e-7
+#: with a sliver cell of aspect ratio 1e9).
+KKT_WARN = 1e-6
 
 
 @dataclass(frozen=True)
@@ -191,6 +205,15 @@ def solve_pdas(
             solver.close()
 
     kkt = qp_residuals(qp, x)
+    if not kkt.max <= KKT_WARN:
+        warnings.warn(
+            f"the solution meets its KKT conditions only to {kkt.max:.1e} relative "
+            f"({', '.join(f'{k} {v:.1e}' for k, v in kkt.columns().items() if v > KKT_WARN)}): "
+            "the stiffness matrix is too ill-conditioned for double precision (a material "
+            "close to incompressible, sliver cells or a slender body)",
+            IllConditionedWarning,
+            stacklevel=2,
+        )
     times = {key: used[key] for key in ("analysis", "factorization", "solve")}
     times["elimination"] = system.time_elimination
     times["total"] = time.perf_counter() - t_start
@@ -293,7 +316,8 @@ def _iterate(
         history.append(PDASStep.between(it, "pdas", previous, active))
         logger.debug("PDAS %s", history[-1])
         value = multiplier + c_scale * (x[c] - g)
-        new_active = _update_active_set(active, value, force, c_scale, x)
+        bands = _bands(system, active, multiplier, force, c_scale, x)
+        new_active = _update_active_set(active, value, bands)
         if np.array_equal(new_active, active):
             return x, multiplier, active, None
         key = new_active.tobytes()
@@ -309,35 +333,54 @@ def _iterate(
     return x, multiplier, active, ("max_iter", message)
 
 
-def _update_active_set(
-    active: np.ndarray, value: np.ndarray, force: float, c_scale: float, x: np.ndarray
+def _bands(
+    system: ActiveSetSystem,
+    active: np.ndarray,
+    multiplier: np.ndarray,
+    force: float,
+    c_scale: float,
+    x: np.ndarray,
 ) -> np.ndarray:
+    """The round-off band of each constraint for :func:`_update_active_set` (docs/method.md,
+    *Solver*): on an inactive one ``_ACTIVE_RTOL max(max |F|, c max |x|)`` (on ``c (x - g)``,
+    a displacement band), on an active one ``max(_ACTIVE_RTOL max(max |F|, Σ Λ⁺),
+    _FORCE_ROUNDOFF max (|K| |x|)_c)`` (on Λ: relative to the forces, at least Λ's round-off).
+
+    Returns
+    -------
+    (m,) float array
+    """
+    inactive_band = _ACTIVE_RTOL * max(force, c_scale * np.abs(x).max(initial=0.0))
+    if not active.any():
+        return np.full(active.size, inactive_band)
+    contact = float(np.maximum(multiplier, 0.0).sum())
+    round_off = float(abs_matvec(system.K_c, x).max(initial=0.0))
+    active_band = max(_ACTIVE_RTOL * max(force, contact), _FORCE_ROUNDOFF * round_off)
+    return np.where(active, active_band, inactive_band)
+
+
+def _update_active_set(active: np.ndarray, value: np.ndarray, bands: np.ndarray) -> np.ndarray:
     """The active set rule ``Λ + c (x - g) > 0`` with a round-off band (docs/method.md,
     *Solver*).
 
-    A constraint whose ``|Λ + c (x - g)|`` is at most ``_ACTIVE_RTOL`` times the force scale
-    ``max(max |F|, c max |x|)`` keeps its state in ``active``: there both Λ and ``x - g`` are
-    round-off, either state satisfies the KKT conditions to round-off, and deciding by their
-    sign makes PDAS cycle on degenerate complementarity.
+    A constraint whose ``|Λ + c (x - g)|`` is at most its band (:func:`_bands`) keeps its
+    state in ``active``: there both Λ and ``x - g`` are round-off, either state satisfies the
+    KKT conditions to round-off, and deciding by their sign makes PDAS cycle on degenerate
+    complementarity.
 
     Parameters
     ----------
     active : (m,) bool array
         The active set of the last solve.
     value : (m,) float array
-        ``Λ + c (x_c - g)`` of the last solve.
-    force : float
-        ``max |F|``.
-    c_scale : float
-    x : (n,) float array
-        The last iterate.
+        ``Λ + c (x_c - g)`` of the last solve (Λ on the active set, ``c (x_c - g)`` off it).
+    bands : (m,) float array
 
     Returns
     -------
     (m,) bool array
     """
-    threshold = _ACTIVE_RTOL * max(force, c_scale * np.abs(x).max(initial=0.0))
-    return np.where(np.abs(value) <= threshold, active, value > 0)
+    return np.where(np.abs(value) <= bands, active, value > 0)
 
 
 def _after_failure(

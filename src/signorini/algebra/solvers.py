@@ -30,6 +30,7 @@ from .sparse import as_csr, csr_row_indices, diagonal_positions, list_indices, s
 __all__ = [
     "BackendUnavailableError",
     "FactorizationError",
+    "IllConditionedWarning",
     "SINGULAR_CAUSES",
     "SPDSolver",
     "SingularSystemError",
@@ -73,9 +74,9 @@ class FactorizationError(np.linalg.LinAlgError):
 #: :class:`SingularSystemError` and of a failed factorization in an active set solve.
 SINGULAR_CAUSES = (
     "Usually a part of the body is not held: it has no Dirichlet condition and can move "
-    "rigidly. A body or cells so thin that the stiffness matrix is singular in double "
-    "precision do the same (measured: P2 elasticity on a 1 x 1e-4 strip; results lose "
-    "digits from aspect ratio 1e3)."
+    "rigidly. A body so slender that its stiffness matrix is singular in double precision "
+    "does the same (measured with P2 on cantilevers of length/thickness L/h: within 1 % of "
+    "beam theory up to L/h = 1000, 1 % off at 1500, refused from 2000)."
 )
 
 
@@ -95,6 +96,11 @@ class SingularSystemError(FactorizationError):
     def __init__(self, message: str, *, backend: str = "", residual: float = np.nan) -> None:
         super().__init__(message, backend=backend)
         self.residual = residual
+
+
+class IllConditionedWarning(RuntimeWarning):
+    """A linear system was solved, but so ill-conditioned that its solution may have lost
+    digits; the message gives the estimated relative error."""
 
 
 class BackendUnavailableError(RuntimeError):
