@@ -106,6 +106,7 @@ def describe(fig: Figure) -> dict:
             ]
             for ax in fig.axes
         ],
+        "zorders_by_axes": [[ln.get_zorder() for ln in ax.get_lines()] for ax in fig.axes],
         "yticklabels": [[t.get_text() for t in ax.get_yticklabels()] for ax in fig.axes],
     }
 

@@ -51,8 +51,9 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
     The mesh figure shows the finest level of at most ``plots.READABLE_CELLS`` cells (read back
     from its ``level_NNN.vtu``; the last level when that file is missing or holds another
     mesh), with Γ_D, Γ_N and Γ_C marked. The deformed body is drawn with a stated displacement
-    scale, the obstacle at its gap with the same scale; with friction its stick and slip nodes
-    marked and the friction stress drawn with the pressure.
+    scale, the obstacle at true scale, the pressure per contact part against its arc length;
+    with friction its stick and slip nodes marked and the friction stress drawn with the
+    pressure.
 
     Parameters
     ----------
@@ -66,8 +67,10 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         (vertices first), ``initial`` (the problem's initial :class:`~signorini.mesh.Mesh`,
         whose parts refinement splits), ``parts`` (part names by kind: ``"dirichlet"``,
         ``"neumann"``, ``"contact"``), and per contact node ``contact_points (k, 2)``,
-        ``active (k,)``, ``pressure (k,)``, ``gap (k,)``, ``normal (k, 2)``; with friction
-        also ``state (k,)`` (labels, :data:`~signorini.plots.deformed.NODE_STATES`),
+        ``active (k,)``, ``pressure (k,)``, ``gap (k,)``, ``normal (k, 2)``, ``obstacle`` (part
+        name -> the obstacle's outline at true scale) and ``along`` (part name -> rows and
+        arc length); with friction also ``state (k,)`` (labels,
+        :data:`~signorini.plots.deformed.NODE_STATES`),
         ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)``.
     """
     written = list(plots.make_figures(out / "history.csv", out, example))
@@ -119,12 +122,18 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         out / "deformed",
         contact_points=last["contact_points"],
         pressure=last["pressure"],
-        gap=last["gap"],
-        normal=last["normal"],
+        obstacle=_joined(last["obstacle"].values()),
+        along=last["along"],
         title=f"{example}: deformed body",
         **friction,
     )
     return written
+
+
+def _joined(lines) -> np.ndarray | None:
+    """Polylines ``(j, 2)`` joined into one, a NaN row between them (None if there are none)."""
+    lines = [np.vstack([line, np.full((1, 2), np.nan)]) for line in lines if len(line)]
+    return np.vstack(lines) if lines else None
 
 
 def part_segments(initial: Mesh, part: str, points: np.ndarray, cells: np.ndarray) -> np.ndarray:
