@@ -19,7 +19,14 @@ import numpy as np
 from .contact_line import contact_coordinate
 from .style import STYLES
 
-__all__ = ["FRICTION_STYLES", "NARROWEST", "draw_stresses", "draw_states", "part_widths"]
+__all__ = [
+    "FRICTION_STYLES",
+    "NARROWEST",
+    "draw_stresses",
+    "draw_rug",
+    "draw_states",
+    "part_widths",
+]
 
 #: How the stick and slip nodes of a frictional contact and its friction stress are drawn.
 FRICTION_STYLES: dict[str, dict[str, str]] = {
@@ -61,9 +68,9 @@ def draw_states(ax: Any, at: np.ndarray, state: np.ndarray, legend: bool = True)
         )
 
 
-def _draw_rug(ax: Any, t: np.ndarray, state: np.ndarray) -> None:
+def draw_rug(ax: Any, t: np.ndarray, state: np.ndarray, legend: bool = False) -> None:
     """The stick and slip nodes as ticks in a strip at the bottom of the axes, below the
-    curves (which stay visible)."""
+    curves (which stay visible); labelled for the legend, or not."""
     transform = ax.get_xaxis_transform()  # x in data, y in axes coordinates
     for key in ("stick", "slip"):
         on = state == key
@@ -78,7 +85,7 @@ def _draw_rug(ax: Any, t: np.ndarray, state: np.ndarray) -> None:
             marker="|",
             markersize=4.0,
             color=st["color"],
-            label=f"_{st['label']}",
+            label=st["label"] if legend else f"_{st['label']}",
             zorder=2,
         )
 
@@ -100,7 +107,7 @@ def _draw_part(
             zorder=4,
         )
     if state is not None:
-        _draw_rug(ax, t, state)
+        draw_rug(ax, t, state)
     ax.axhline(0.0, color="0.5", linewidth=0.6, zorder=1)
     ax.grid(True, linestyle="-")
 

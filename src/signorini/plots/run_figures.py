@@ -160,7 +160,9 @@ def part_segments(initial: Mesh, part: str, points: np.ndarray, cells: np.ndarra
 def pressure_figure(example: str, out: Path, known: KnownPressure) -> list[Path]:
     """The last level's pressure beside the known one (``<example>_pressure``; e.g. Hertz's
     for ``hertz``), as an example's metrics give it
-    (:attr:`Metrics.pressure <signorini.examples.Metrics.pressure>` of the last level)."""
+    (:attr:`Metrics.pressure <signorini.examples.Metrics.pressure>` of the last level); with
+    friction also the friction stress beside a known one, the stick and slip nodes marked,
+    zoomed on the contact zone (``partial-slip``: Cattaneo–Mindlin's)."""
     return plots.plot_pressure_comparison(
         known.x,
         known.pressure,
@@ -169,4 +171,9 @@ def pressure_figure(example: str, out: Path, known: KnownPressure) -> list[Path]
         out / f"{example}_pressure",
         label=known.label,
         title=known.title,
+        **{
+            key: getattr(known, key)
+            for key in ("tangential", "tangential_reference", "tangential_label", "state", "window")
+            if getattr(known, key, None) is not None
+        },
     )
