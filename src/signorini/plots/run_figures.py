@@ -23,7 +23,7 @@ from ..output import read_history
 from .contact_line import free_boundary_ends
 from .mesh import boundary_groups
 
-__all__ = ["KnownPressure", "part_segments", "pressure_figure", "run_figures"]
+__all__ = ["KnownPressure", "mesh_title", "part_segments", "pressure_figure", "run_figures"]
 
 #: How the figure of the mesh labels the parts of each kind (``last["parts"]``' keys).
 PART_LABELS = {
@@ -104,7 +104,7 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         points,
         cells,
         out / "mesh",
-        title=f"{example}: mesh, level {level}, {cells.shape[0]} cells",
+        title=mesh_title(example, level, cells.shape[0], last["level"]),
         highlight=plots.boundary_groups(points, cells, segments),
         colors=("#1f77b4", "#2ca02c", "#d62728"),
         **zoom,
@@ -128,6 +128,15 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         **friction,
     )
     return written
+
+
+def mesh_title(example: str, level: int, n_cells: int, last_level: int) -> str:
+    """The mesh figure's title: its level, and when that is not the run's last one, which is
+    (the finest mesh is shown only up to ``plots.READABLE_CELLS`` cells)."""
+    head = f"{example}: mesh, level {level}, {n_cells} cells"
+    if level == last_level:
+        return head + " (last level)"
+    return head + f"\n(an earlier level, readable; the run ends at level {last_level})"
 
 
 def _joined(lines) -> np.ndarray | None:
