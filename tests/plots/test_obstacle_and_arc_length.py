@@ -132,3 +132,16 @@ def test_arc_lengths_on_a_closed_chain_start_at_its_first_edge():
     rows, s = arc_lengths(cs, points)["loop"]
     np.testing.assert_array_equal(rows, [0, 4, 1, 5, 2, 6, 3, 7])
     np.testing.assert_allclose(s, [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5])
+
+
+def test_a_gap_function_is_drawn_as_the_surface_x_plus_psi_n():
+    """Example 6.2's obstacle ψ(y) = -0.2 + 0.5 |y - 0.5| along the normal (1, 0) of the side
+    x = 1 is the V-shaped surface x = 1 + ψ(y), unscaled (once drawn as 1 + scale ψ)."""
+    from signorini.examples import get_example
+
+    a = last_arrays(get_example("example-6.2"), 800)
+    outline = a["obstacle"]["right"]
+    outline = outline[np.isfinite(outline[:, 0])]
+    assert outline[:, 1].min() == 0.0 and outline[:, 1].max() == 1.0
+    psi = -0.2 + 0.5 * np.abs(outline[:, 1] - 0.5)
+    np.testing.assert_allclose(outline[:, 0], 1.0 + psi, rtol=0, atol=1e-14)
