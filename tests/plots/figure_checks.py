@@ -106,6 +106,9 @@ def describe(fig: Figure) -> dict:
             ]
             for ax in fig.axes
         ],
+        "legend_boxes": [lg.get_window_extent(fig.canvas.get_renderer()) for lg in legends],
+        "data_to_display": [ax.transData.frozen() for ax in fig.axes],
+        "zorders_by_axes": [[ln.get_zorder() for ln in ax.get_lines()] for ax in fig.axes],
         "yticklabels": [[t.get_text() for t in ax.get_yticklabels()] for ax in fig.axes],
     }
 

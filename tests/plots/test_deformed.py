@@ -105,21 +105,25 @@ def test_displacement_scale(size, u_max, scale):
     assert drawn <= 0.25 and (u_max == 0 or drawn >= 0.02)  # visible, and not folding over
 
 
-def test_obstacle_from_the_gap_is_drawn_with_the_body_scale(tmp_path, captured):
+def test_obstacle_from_the_gap_is_drawn_at_true_scale(tmp_path, captured):
+    """The surface ``z + ψ(z) n_z`` of the small-deformation model, not scaled with the
+    displacement (which once bent a flat obstacle), and the title says which is scaled."""
     mesh = rectangle(nx=4, ny=4)
     p, c = mesh.points, mesh.cells
     u = np.column_stack([np.zeros(len(p)), -0.5 * (1.0 - p[:, 1])])  # |u| up to 0.5
     bottom = p[np.isclose(p[:, 1], 0.0)][::-1]  # in reverse order
-    gap = 0.5 + 0.1 * bottom[:, 0]
+    gap = 0.05 + 0.1 * bottom[:, 0]
     normal = np.tile([0.0, -1.0], (len(bottom), 1))
     plot_deformed(
         p, c, u, tmp_path / "d", contact_points=bottom, pressure=np.ones(5), gap=gap, normal=normal
     )
     (info,) = captured
-    assert info["titles"][0] == "deformed body, displacement \u00d70.2"
-    x, y = info["lines"]["obstacle (gap \u00d70.2)"]
+    assert " ".join(info["titles"][0].split()) == (
+        "deformed body, displacement \u00d70.2, obstacle at true scale"
+    )
+    x, y = info["lines"]["obstacle (true scale)"]
     np.testing.assert_allclose(x, bottom[::-1, 0])  # ordered along the boundary
-    np.testing.assert_allclose(y, -0.2 * gap[::-1])
+    np.testing.assert_allclose(y, -gap[::-1])
     with pytest.raises(ValueError, match="gap and normal"):
         plot_deformed(p, c, u, tmp_path / "x", contact_points=bottom, gap=gap)
     with pytest.raises(ValueError, match="scale must be"):
@@ -166,10 +170,15 @@ def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
             np.column_stack(friction["lines"][label]), drawn[codes == value]
         )
     np.testing.assert_array_equal(friction["lines"]["$p_{t,h}$"][1], p_t)
-    # the friction stress panel: its curve, then the stick and the slip nodes on it
+    # the friction stress panel: its curve on top, the stick and the slip nodes in a strip at
+    # the bottom of the axes (axes coordinates), where they hide no curve
     (x_pt, y_pt), (x_stick, y_stick), (x_slip, y_slip) = friction["lines_by_axes"][-1][1:4]
-    np.testing.assert_array_equal(y_stick, p_t[codes == 1])
+    np.testing.assert_array_equal(x_stick, bottom[codes == 1, 0])
+    np.testing.assert_array_equal(y_stick, 0.04)
     np.testing.assert_array_equal(x_slip, bottom[codes == 2, 0])
+    np.testing.assert_array_equal(y_slip, 0.09)
+    z_pressure, z_pt, z_stick, z_slip = friction["zorders_by_axes"][-1][:4]
+    assert min(z_pressure, z_pt) > max(z_stick, z_slip)
     assert friction["ylabel"][-1] == "contact stresses"
     assert frictionless["legend"] == ["reference"]
     assert list(frictionless["lines"]) == ["$p_h$"]
@@ -182,9 +191,9 @@ def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
         plot_deformed(p, c, u, tmp_path / "x", **kwargs, tangential_pressure=p_t[:3])
 
 
-def test_obstacle_from_gaps_is_left_out_where_the_drawn_gap_is_far(tmp_path, captured):
-    """A half-disc over a plane: the plane is drawn only near the contact zone, and the axes
-    are not stretched to where scale · ψ puts it far from the body."""
+def test_obstacle_from_gaps_is_left_out_where_the_gap_is_far(tmp_path, captured):
+    """A half-disc over a plane: the plane is drawn straight (y = 0, not the parabola
+    ``scale · ψ`` once made of it), only near the contact zone."""
     theta = np.linspace(np.pi, 2 * np.pi, 41)
     arc = np.column_stack([np.cos(theta), 1 + np.sin(theta)])
     points = np.vstack([[0.0, 1.0], arc])
@@ -199,5 +208,6 @@ def test_obstacle_from_gaps_is_left_out_where_the_drawn_gap_is_far(tmp_path, cap
     (label,) = [k for k in info["lines"] if k.startswith("obstacle")]
     x, y = info["lines"][label]
     shown = np.isfinite(y)
-    assert np.all(10 * gap[shown] <= 0.25 * 2.0) and not shown.all() and shown.any()
-    assert info["data_lim"][0].y0 > -0.6  # not down to 1 − 10 · 1 = −9
+    assert np.all(gap[shown] <= 0.25 * 2.0) and not shown.all() and shown.any()
+    np.testing.assert_array_equal(y[shown], 0.0)
+    assert info["data_lim"][0].y0 > -0.01  # not down to 1 − 10 · 1 = −9

@@ -51,13 +51,15 @@ def test_every_figure_of_the_examples_is_readable(tmp_path, captured, monkeypatc
     )
     # Example 6.1: |u| up to 0.88 on the unit square is drawn shrunk, and the title says so
     e1 = [i for i in captured if i["titles"][0].startswith("example-6.1: deformed")]
-    assert e1[0]["titles"][0] == "example-6.1: deformed body\ndisplacement \u00d70.1"
-    assert "obstacle (gap \u00d70.1)" in e1[0]["legend"]
+    assert e1[0]["titles"][0] == (
+        "example-6.1: deformed body\ndisplacement \u00d70.1, obstacle at true scale"
+    )
+    assert "obstacle (true scale)" in e1[0]["legend"]
     # Example 6.2 (|u| <= 0.2) at true scale, the inclined block (|u| <= 0.03 on 2) magnified
     titles = [i["titles"][0] for i in captured if "deformed body" in i["titles"][0]]
     assert titles[1:] == [
         "example-6.2: deformed body\ndisplacement at true scale",
-        "inclined_block: deformed body\ndisplacement \u00d75",
+        "inclined_block: deformed body\ndisplacement \u00d75, obstacle at true scale",
     ]
     # the mesh figures: a readable level, the three kinds of boundary marked
     meshes = [i for i in captured if ": mesh, level" in i["titles"][0]]
@@ -68,7 +70,7 @@ def test_every_figure_of_the_examples_is_readable(tmp_path, captured, monkeypatc
             r"Neumann $\Gamma_N$",
             r"contact $\Gamma_C$",
         ]
-        n_cells = int(info["titles"][0].rsplit(", ", 1)[1].split()[0])
+        n_cells = int(info["titles"][0].split(" cells")[0].rsplit(", ", 1)[1])
         assert n_cells <= READABLE_CELLS
     assert np.all([len(i["segments"]) == 3 for i in meshes])
     # where the contact zone ends inside Γ_C (6.2, the block), a zoom panel shows it
@@ -78,10 +80,13 @@ def test_every_figure_of_the_examples_is_readable(tmp_path, captured, monkeypatc
     history = np.genfromtxt(tmp_path / "e1" / "history.csv", delimiter=",", names=True)
     k = int(np.flatnonzero(history["n_cells"] <= 200)[-1])
     assert k < history.size - 1
-    assert (
-        meshes[0]["titles"][0]
-        == f"example-6.1: mesh, level {k}, {int(history['n_cells'][k])} cells"
+    # ... and its title says that it is not the last level, which the others are
+    last = int(history["level"][-1])
+    assert " ".join(meshes[0]["titles"][0].split()) == (
+        f"example-6.1: mesh, level {k}, {int(history['n_cells'][k])} cells (an earlier level, "
+        f"readable; the run ends at level {last})"
     )
+    assert all(" ".join(i["titles"][0].split()).endswith("(last level)") for i in meshes[1:])
     points, cells = read_level_mesh(tmp_path / "e1" / f"level_{k:03d}.vtu")
     contact = np.array(meshes[0]["segments"][r"contact $\Gamma_C$"])
     assert np.all(contact[:, :, 1] == 0.0)  # Γ_C is the bottom y = 0 ...

@@ -5,7 +5,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from signorini.examples.partial_slip import (
+    COEFFICIENT,
+    partial_slip,
+    partial_slip_metrics,
+    partial_slip_path,
+    partial_slip_pressure,
+)
+from signorini.loop import adaptive
 from signorini.plots import plot_pressure_comparison
+from signorini.plots.run_figures import pressure_figure
 
 from .figure_checks import check_written
 
@@ -34,6 +43,13 @@ def test_markers_in_order_beside_the_reference_line(tmp_path, captured):
     assert ps == pytest.approx([0.0, p0 * np.sqrt(0.75), p0, p0 * np.sqrt(0.75)])
     xr, pr = info["lines"]["Hertz"]
     assert np.array_equal(xr, x_ref) and pr.max() == pytest.approx(p0)
+    # the curve is drawn above the ~300 markers it is compared with, and the legend box lies
+    # clear of the peak (it sits under the axes)
+    z_hertz, z_markers = info["zorders_by_axes"][0][:2]
+    assert z_hertz > z_markers
+    peak = info["data_to_display"][0].transform((0.0, p0))
+    (box,) = info["legend_boxes"]
+    assert not box.contains(*peak) and box.y1 < info["data_to_display"][0].transform((0, 0))[1]
 
 
 def test_refuses_arrays_of_different_lengths(tmp_path):
@@ -41,3 +57,31 @@ def test_refuses_arrays_of_different_lengths(tmp_path):
         plot_pressure_comparison([0.0, 1.0], [1.0], [0.0], [1.0], tmp_path / "p")
     with pytest.raises(ValueError, match="reference"):
         plot_pressure_comparison([0.0], [1.0], [[0.0]], [[1.0]], tmp_path / "p")
+
+
+def test_partial_slip_zoom_shows_cattaneo_mindlin(tmp_path, captured):
+    """The contact zone of ``partial-slip`` zoomed to |x| <= 1.5 a (once the stick zone was
+    7 % of the axis), with Hertz's pressure and Cattaneo–Mindlin's friction stress for the
+    level's own forces: q(0) = F p0 (1 - c/a), q = F p on c < |x| < a."""
+    *_, last = adaptive(partial_slip(), max_ndof=1500, path=partial_slip_path()[:-1])
+    known = partial_slip_pressure(last.result)
+    metrics = partial_slip_metrics(last.result)
+    lo, hi = known.window
+    a = hi / 1.5
+    assert lo == -hi and a == pytest.approx(metrics["a"], rel=0.05)  # Hertz's a, the forces' a
+    xr, q = known.x_reference, known.tangential_reference
+    p0 = known.reference.max()
+    c_over_a = metrics["c_over_a_theory"]
+    assert known.tangential_label.endswith(f"$c/a$ = {c_over_a:.3f}")
+    middle = np.argmin(np.abs(xr))
+    assert abs(q[middle]) == pytest.approx(COEFFICIENT * p0 * (1 - c_over_a), rel=1e-9)
+    slip = (np.abs(xr) > c_over_a * a * 1.01) & (np.abs(xr) < a)
+    np.testing.assert_allclose(np.abs(q[slip]), COEFFICIENT * known.reference[slip], rtol=1e-12)
+    # the computed friction stress has the sign of the prediction
+    assert np.sign(np.sum(known.tangential)) == np.sign(q[middle])
+    pressure_figure("partial-slip", tmp_path, known)
+    (info,) = captured
+    assert info["legend"][:3] == ["Hertz, $a$ = " + f"{a:.4g}", "$p_h$", known.tangential_label]
+    assert {"stick", "slip"} <= set(info["legend"])
+    zorders = info["zorders_by_axes"][0]
+    assert min(zorders[0], zorders[2]) > max(zorders[1], zorders[3])  # lines above markers

@@ -7,7 +7,7 @@ import pytest
 from matplotlib.figure import Figure
 
 from signorini.plots import add_slope_triangle
-from signorini.plots.slopes import slope_label, triangle_vertices
+from signorini.plots.slopes import FIT_SCATTER, slope_label, steady_slope, triangle_vertices
 
 from .figure_checks import NDOF, legend_slope
 
@@ -66,3 +66,43 @@ def test_slope_label_states_the_fitted_slope_or_nothing():
     label = slope_label("q", NDOF, values, last=3)
     assert label.startswith("q, slope ") and legend_slope(label) == -0.8
     assert slope_label("q", NDOF[:1], values[:1], last=3) == "q"
+
+
+# --- a slope is printed only where it is a rate -------------------------------------------
+
+RUN = np.geomspace(100.0, 1e5, 12)  # an adaptive run's N_dof; the fit window is its finer half
+
+
+def test_steady_slope_of_a_power_law_is_its_exponent():
+    assert steady_slope(RUN, 3.0 * RUN**-1.0) == pytest.approx(-1.0, abs=1e-12)
+    assert steady_slope(RUN, RUN**-1.5, last=4) == pytest.approx(-1.5, abs=1e-12)
+    assert slope_label("x", RUN, RUN**-1.0, None) == "x, slope \u22121.00"
+
+
+def test_no_slope_for_a_term_at_round_off_on_a_level_of_the_window():
+    """hertz's eta_7: round-off (NaN once taken out) on five of the nine levels of the window;
+    the four others fit a rising line, once printed as "slope 1.09"."""
+    values = 1e-9 * RUN**1.1
+    values[[6, 8, 9, 10, 11]] = np.nan
+    assert steady_slope(RUN, values) is None
+    assert slope_label(r"$\eta_7$", RUN, values, None) == r"$\eta_7$ (no steady rate)"
+    # out of the window (the coarse half) a missing level does not matter
+    values = RUN**-1.0
+    values[1] = np.nan
+    assert steady_slope(RUN, values) == pytest.approx(-1.0, abs=1e-12)
+
+
+def test_no_slope_for_a_term_that_jumps_by_a_decade_inside_the_window():
+    values = RUN**-1.0
+    values[9:] *= 10.0  # one jump by a decade
+    assert steady_slope(RUN, values) is None
+    # scatter of 0.1 decade about a line is a rate (the scatter's root mean square is 0.1)
+    wiggle = 10.0 ** (0.1 * np.where(np.arange(RUN.size) % 2, 1.0, -1.0))
+    assert steady_slope(RUN, RUN**-1.0 * wiggle) == pytest.approx(-1.0, abs=0.1)
+    assert steady_slope(RUN, RUN**-1.0 * wiggle**2) is None  # 0.2 decade > FIT_SCATTER
+    assert FIT_SCATTER == 0.15
+
+
+def test_no_slope_for_a_term_zero_on_every_level():
+    assert steady_slope(RUN, np.zeros(RUN.size)) is None
+    assert slope_label("x", RUN, np.full(RUN.size, np.nan), None) == "x"

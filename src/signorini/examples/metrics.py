@@ -37,6 +37,16 @@ class PressureComparison:
         What the known pressure is (for a legend), e.g. ``"Hertz"``.
     title : str
         Title of the figure.
+    tangential : (m,) float array or None
+        With friction: the computed friction stress p_t,z at the nodes.
+    tangential_reference : (r,) float array or None
+        The known friction stress at ``x_reference`` (e.g. Cattaneo–Mindlin's).
+    tangential_label : str
+        What the known friction stress is (for a legend).
+    state : (m,) str array or None
+        ``"inactive"``, ``"stick"`` or ``"slip"`` per node.
+    window : (2,) float or None
+        The x range to show (a zoom on the contact zone).
     """
 
     x: np.ndarray
@@ -45,6 +55,11 @@ class PressureComparison:
     reference: np.ndarray
     label: str
     title: str = ""
+    tangential: np.ndarray | None = None
+    tangential_reference: np.ndarray | None = None
+    tangential_label: str = ""
+    state: np.ndarray | None = None
+    window: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)

@@ -26,13 +26,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..contact.solution import STICK, ContactResult
+from ..contact.solution import SLIP, STICK, ContactResult
 from ..fem.material import Material
 from ..mesh.builders import half_disc
 from ..mesh.curves import Circle
 from ..problem import Contact, ContactProblem, Coulomb, Dirichlet
 from ..problem.obstacles import HalfPlane
-from .metrics import Metrics
+from .hertz import hertz_solution
+from .metrics import Metrics, PressureComparison
 
 __all__ = [
     "PARTIAL_SLIP_METRICS",
@@ -142,6 +143,45 @@ def partial_slip_metrics(result: ContactResult) -> dict[str, float]:
     }
 
 
+def partial_slip_pressure(result: ContactResult) -> PressureComparison:
+    """The contact zone zoomed: the computed p_z and p_t,z, the stick and slip nodes, beside
+    Hertz's pressure p0 √(1 − x²/a²) and Cattaneo–Mindlin's friction stress
+    q(x) = F p0 (√(1 − x²/a²) − (c/a) √(1 − x²/c²) [|x| < c]) with the level's own forces
+    (P = Σ Λ_n, Q = Σ Λ_t, c = a √(1 − Q/(F P))); x from the force-weighted centre."""
+    lam_n = result.contact_force
+    total = float(lam_n.sum())
+    if not total > 0:
+        raise ValueError("partial-slip: the half-disc does not touch the plane (no contact force)")
+    problem = result.problem
+    coefficient = problem.conditions["arc"].friction.coefficient
+    radius = 0.5 * problem.mesh.part_length("top")
+    a, p0 = hertz_solution(total, radius, problem.material)
+    ratio = float(result.tangential_force.sum()) / (coefficient * total)
+    c = a * np.sqrt(max(1.0 - abs(ratio), 0.0))
+    points = result.space.node_points[result.contact.nodes]
+    x = points[:, 0] - float(lam_n @ points[:, 0]) / total
+    x_ref = np.linspace(-a, a, 801)
+    hertz_p = p0 * np.sqrt(np.maximum(1.0 - (x_ref / a) ** 2, 0.0))
+    inner = (c / a) * np.sqrt(np.maximum(1.0 - (x_ref / max(c, 1e-300)) ** 2, 0.0))
+    sign = np.sign(float(np.sum(result.tangential_pressure))) or 1.0
+    state = np.where(
+        result.state == STICK, "stick", np.where(result.state == SLIP, "slip", "inactive")
+    )
+    return PressureComparison(
+        x=x,
+        pressure=result.pressure,
+        x_reference=x_ref,
+        reference=hertz_p,
+        label=rf"Hertz, $a$ = {a:.4g}",
+        title=f"partial-slip: contact zone, {result.ndof} unknowns",
+        tangential=result.tangential_pressure,
+        tangential_reference=sign * coefficient * (hertz_p - p0 * inner),
+        tangential_label=rf"Cattaneo–Mindlin, $c/a$ = {c / a:.3f}",
+        state=state,
+        window=(-1.5 * a, 1.5 * a),
+    )
+
+
 #: The partial-slip example's columns of ``history.csv``.
 PARTIAL_SLIP_METRICS = Metrics(
     measure=partial_slip_metrics,
@@ -155,4 +195,5 @@ PARTIAL_SLIP_METRICS = Metrics(
         "q_over_fp": "Q/(F P), the pull against the force that makes the whole contact slip, "
         "no unit",
     },
+    pressure=partial_slip_pressure,
 )

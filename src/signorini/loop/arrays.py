@@ -4,16 +4,26 @@ they take arrays and part names, never the solver's objects, as :meth:`LevelReco
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
 
+from ..contact.contact_set import ContactSet
 from ..contact.solution import SLIP, STICK
 
 if TYPE_CHECKING:
     from . import Level
 
-__all__ = ["level_arrays"]
+__all__ = ["arc_lengths", "level_arrays", "obstacle_outline"]
+
+#: Points sampled along each contact edge where the obstacle's outline is drawn.
+OUTLINE_SAMPLES = 9
+#: The outline is left out where the obstacle is farther than this fraction of the body's size
+#: from the contact part (a shape far from most of a curved part, e.g. the plane under a disc).
+OUTLINE_REACH = 0.25
 
 
 def level_arrays(level: Level) -> dict[str, Any]:
@@ -27,7 +37,9 @@ def level_arrays(level: Level) -> dict[str, Any]:
         problem's initial mesh, and ``parts``, the names of its ``"dirichlet"``,
         ``"neumann"`` and ``"contact"`` parts; per constraint (k of them)
         ``contact_points (k, 2)``, ``active (k,)``, ``pressure (k,)`` p_z, ``gap (k,)`` ψ(z)
-        and ``normal (k, 2)`` n_z; with friction on some contact part also ``state (k,)`` as
+        and ``normal (k, 2)`` n_z; ``obstacle``, each contact part's obstacle outline near
+        it (:func:`obstacle_outline`); ``along``, each contact part's constraints and their arc
+        length (:func:`arc_lengths`); with friction on some contact part also ``state (k,)`` as
         the labels ``"inactive"``, ``"stick"``, ``"slip"``, ``contact_displacement (k, 2)``
         and ``tangential_pressure (k,)`` p_t,z.
     """
@@ -49,6 +61,8 @@ def level_arrays(level: Level) -> dict[str, Any]:
         "pressure": res.pressure,
         "gap": cs.gap,
         "normal": cs.normal,
+        "obstacle": obstacle_outline(cs, res.space.node_points, problem.conditions),
+        "along": arc_lengths(cs, res.space.node_points),
     }
     if cs.has_friction:
         arrays["state"] = np.where(
@@ -57,3 +71,105 @@ def level_arrays(level: Level) -> dict[str, Any]:
         arrays["contact_displacement"] = res.u[cs.nodes]
         arrays["tangential_pressure"] = res.tangential_pressure
     return arrays
+
+
+def _on_edges(ends: np.ndarray, m: int) -> np.ndarray:
+    """``(e, m, ...)`` values at ``m`` equispaced points of each edge, interpolated
+    quadratically from ``ends (e, 3, ...)`` at ``[start, end, midpoint]`` (the P2 edge)."""
+    t = np.linspace(0.0, 1.0, m)
+    basis = np.stack([2 * (t - 0.5) * (t - 1), 2 * t * (t - 0.5), 4 * t * (1 - t)], axis=1)
+    return np.einsum("mj,ej...->em...", basis, ends)
+
+
+def obstacle_outline(
+    cs: ContactSet, node_points: np.ndarray, conditions: Mapping[str, Any]
+) -> dict[str, np.ndarray]:
+    """Each contact part's obstacle near the part at true scale, as a polyline broken by NaN
+    rows.
+
+    Along each contact edge, :data:`OUTLINE_SAMPLES` points ``x`` of the (P2) edge are mapped
+    to the obstacle: against a shape (:mod:`signorini.problem.obstacles`, a user's
+    ``Obstacle`` subclass) to their closest point ``x + ψ(x) n(x)`` from its
+    ``gap_and_direction``, which lies on the shape's boundary; for a gap function given along
+    the body's normal the nodes' ``z + ψ(z) n_z``, interpolated quadratically along the edge
+    (the obstacle surface of the small-deformation model, docs/method.md). Points whose gap
+    exceeds :data:`OUTLINE_REACH` times the body's size are left out (NaN).
+
+    Parameters
+    ----------
+    cs : ContactSet
+        The contact data of the level.
+    node_points : (n_nodes, 2) float array
+        The P2 nodes.
+    conditions : mapping
+        The problem's conditions by part name (``Contact`` for the contact parts).
+
+    Returns
+    -------
+    dict
+        Part name -> ``(e * (OUTLINE_SAMPLES + 1), 2)`` float array, ``e`` the part's contact
+        edges: one run of points per edge, a NaN row after each.
+    """
+    m = OUTLINE_SAMPLES
+    size = float(np.ptp(node_points, axis=0).max()) if node_points.size else 0.0
+    outline = {}
+    for i, name in enumerate(cs.parts):  # a loop over the contact parts
+        sel = cs.edge_part == i
+        out = np.full((int(sel.sum()), m + 1, 2), np.nan)
+        obstacle = conditions[name].obstacle
+        if obstacle is not None:
+            x = _on_edges(node_points[cs.edge_nodes[sel]], m).reshape(-1, 2)
+            g, n = obstacle.gap_and_direction(x)
+            out[:, :m] = (x + g[:, None] * n).reshape(-1, m, 2)
+            psi = g.reshape(-1, m)
+        else:
+            ends = node_points[cs.edge_nodes[sel]]
+            ends = ends + cs.edge_gap[sel][..., None] * cs.edge_direction[sel]
+            out[:, :m] = _on_edges(ends, m)
+            psi = _on_edges(cs.edge_gap[sel], m)
+        out[:, :m][np.abs(psi) > OUTLINE_REACH * size] = np.nan
+        outline[name] = out.reshape(-1, 2)
+    return outline
+
+
+def arc_lengths(
+    cs: ContactSet, node_points: np.ndarray
+) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each contact part's constraints and their arc length along the part.
+
+    The part's edges (oriented counter-clockwise, ``cs.edge_nodes``) form chains; the arc
+    length of a vertex is its distance along the chain from the chain's first vertex
+    (shortest paths on the directed chain graph, each edge weighted by its length through its
+    midpoint), a midpoint's that of its edge's start plus the half-edge.
+
+    Returns
+    -------
+    dict
+        Part name -> ``(rows (j,), s (j,))``: the rows of the part's constraints (indices of
+        ``cs.nodes``; a corner node's row for this part) in increasing ``s``, and ``s``
+        (length units, from 0).
+    """
+    along = {}
+    for i, name in enumerate(cs.parts):  # a loop over the contact parts
+        sel = cs.edge_part == i
+        en, local = cs.edge_nodes[sel], cs.edge_local[sel]
+        if en.shape[0] == 0:
+            along[name] = (np.zeros(0, np.int64), np.zeros(0))
+            continue
+        x = node_points[en]
+        half = np.hypot(*(x[:, 2] - x[:, 0]).T), np.hypot(*(x[:, 1] - x[:, 2]).T)
+        vertices, ends = np.unique(en[:, :2], return_inverse=True)
+        ends = ends.reshape(-1, 2)
+        n_v = vertices.size
+        graph = coo_matrix((half[0] + half[1], (ends[:, 0], ends[:, 1])), shape=(n_v, n_v))
+        roots = np.setdiff1d(ends[:, 0], ends[:, 1])
+        if roots.size == 0:  # a closed part: from the first edge's start
+            roots = ends[:1, 0]
+        dist = dijkstra(graph.tocsr(), directed=True, indices=roots, min_only=True)
+        s = np.stack([dist[ends[:, 0]], dist[ends[:, 1]], dist[ends[:, 0]] + half[0]], axis=1)
+        rows, first = np.unique(local.ravel(), return_index=True)
+        s = s.ravel()[first][rows >= 0]
+        rows = rows[rows >= 0]
+        order = np.argsort(s, kind="stable")
+        along[name] = (rows[order], s[order])
+    return along

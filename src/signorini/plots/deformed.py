@@ -9,6 +9,7 @@ stress p_t is drawn with the pressure.
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +22,7 @@ from numpy.typing import ArrayLike
 
 from ..mesh.topology import boundary_edges
 from .contact_line import contact_coordinate
+from .contact_stress import draw_states, draw_stresses, part_widths
 from .mesh import line_width, mesh_arrays
 from .style import RC, STYLES, fit_title, new_figure, save_figure, trim_height
 
@@ -35,19 +37,12 @@ __all__ = [
 DRAWN_FRACTION = 0.1
 #: Displacements between these fractions of the body's size are drawn at true scale.
 TRUE_SCALE_RANGE = (0.02, 0.25)
-#: The obstacle drawn from gaps is left out where the drawn gap exceeds this fraction of the
+#: The obstacle drawn from gaps is left out where the gap exceeds this fraction of the
 #: body's size (a shape far from most of a curved contact part, e.g. the plane under a disc).
 OBSTACLE_REACH = 0.25
 
 #: The states a contact node may be in, as ``plot_deformed(state=...)`` names them.
 NODE_STATES = ("inactive", "stick", "slip")
-
-#: How the stick and slip nodes of a frictional contact and its friction stress are drawn.
-FRICTION_STYLES: dict[str, dict[str, str]] = {
-    "stick": {"color": "#1b9e77", "marker": "o", "label": "stick"},
-    "slip": {"color": "#e7298a", "marker": "D", "label": "slip"},
-    "tangential_pressure": {"color": "#d95f02", "marker": "s", "label": r"$p_{t,h}$"},
-}
 
 
 def displacement_scale(points: ArrayLike, displacement: ArrayLike) -> float:
@@ -148,7 +143,7 @@ def _draw_body(
             zorder=5,
         )
     if states is not None:
-        _draw_states(ax, *states)
+        draw_states(ax, *states)
     ax.set_aspect("equal")
     ax.autoscale_view()
     ax.set_xlabel(r"$x$")
@@ -160,66 +155,6 @@ def _draw_body(
     ax.legend(
         loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=below, ncols=2, frameon=False
     )
-
-
-def _draw_pressure(
-    ax: Any,
-    contact_points: np.ndarray,
-    pressure: np.ndarray,
-    tangential: np.ndarray | None,
-    state: np.ndarray | None,
-) -> None:
-    """The pressure (and the friction stress, its stick and slip nodes marked) against the
-    coordinate along the contact boundary."""
-    t, tlabel = contact_coordinate(contact_points)
-    order = np.argsort(t, kind="stable")
-    curves = [("pressure", pressure)]
-    if tangential is not None:
-        curves.append(("tangential_pressure", tangential))
-    for key, values in curves:
-        st = STYLES.get(key) or FRICTION_STYLES[key]
-        ax.plot(
-            t[order],
-            values[order],
-            color=st["color"],
-            marker=st["marker"] if t.size <= 80 and state is None else "",
-            markersize=2.5,
-            label=st["label"],
-        )
-    if state is not None:
-        marked = np.column_stack([t, curves[-1][1]])
-        _draw_states(ax, marked, state, legend=False)
-    ax.axhline(0.0, color="0.5", linewidth=0.6)
-    ax.grid(True, linestyle="-")
-    ax.set_xlabel(tlabel)
-    if tangential is None:
-        ax.set_ylabel(r"contact pressure $p_h$")
-    else:
-        ax.set_ylabel("contact stresses")
-        lo, hi = ax.get_ylim()
-        ax.set_ylim(lo, hi + 0.45 * (hi - lo))  # an empty band on top for the legend
-        ax.legend(loc="upper center", ncols=2)
-
-
-def _draw_states(ax: Any, at: np.ndarray, state: np.ndarray, legend: bool = True) -> None:
-    """Markers on the contact nodes that stick and that slip, at the points ``at (k, 2)``
-    (labelled for the legend, or not)."""
-    size = 3.0 if state.size <= 200 else 1.5
-    for key in ("stick", "slip"):
-        on = state == key
-        if not on.any():
-            continue
-        st = FRICTION_STYLES[key]
-        ax.plot(
-            at[on, 0],
-            at[on, 1],
-            linestyle="",
-            marker=st["marker"],
-            markersize=size,
-            color=st["color"],
-            label=st["label"] if legend else f"_{st['label']}",
-            zorder=6,
-        )
 
 
 def plot_deformed(
@@ -238,6 +173,7 @@ def plot_deformed(
     state: ArrayLike | None = None,
     contact_displacement: ArrayLike | None = None,
     tangential_pressure: ArrayLike | None = None,
+    along: Mapping[str, tuple[ArrayLike, ArrayLike]] | None = None,
 ) -> list[Path]:
     """The deformed body coloured by ``|u_h|``, and the contact pressure along ``Γ_C``.
 
@@ -270,17 +206,18 @@ def plot_deformed(
         Magnification of the displacement in the drawing; "auto":
         :func:`displacement_scale`.
     obstacle : (j, 2) float array, optional
-        Polyline of the obstacle in physical coordinates, drawn as given (true scale).
+        Polyline of the obstacle in physical coordinates (NaN rows break it), drawn as
+        given, at true scale (e.g. :func:`signorini.loop.arrays.obstacle_outline`).
     title : str, optional
         First line of the body's title (default "deformed body").
     show_mesh : bool, default True
         Draw the deformed triangulation with faint lines.
     gap : (k,) float array, optional
         The gap ``ψ`` at ``contact_points`` along ``normal`` (k, 2): the obstacle is then
-        drawn at ``contact_points + scale * gap * normal``, ordered along the boundary: with
-        the same scale as the body, so a body that does not penetrate the obstacle is not
-        drawn through it; left out where ``scale * |gap|`` exceeds :data:`OBSTACLE_REACH`
-        times the body's size. Not together with ``obstacle``.
+        drawn at ``contact_points + gap * normal``, ordered along the boundary, at true scale
+        (the obstacle's surface for a gap given along the body's normal, the closest points
+        of a shape); left out where ``|gap|`` exceeds :data:`OBSTACLE_REACH` times the
+        body's size. Not together with ``obstacle``.
     state : (k,) str array, optional
         Each contact node's state, one of :data:`NODE_STATES` (``"inactive"``, ``"stick"``,
         ``"slip"``): the stick and slip nodes are marked. Needs ``contact_displacement``.
@@ -288,6 +225,12 @@ def plot_deformed(
         The displacement of the contact nodes (where their states are marked).
     tangential_pressure : (k,) float array, optional
         The friction stress p_t at ``contact_points``, drawn with the pressure.
+    along : mapping, optional
+        Contact part name -> ``(rows, s)``: the rows of ``contact_points`` on the part and
+        their arc length along it (:func:`signorini.loop.arrays.arc_lengths`). The stresses
+        are then drawn per part against ``s``, the parts side by side
+        (:mod:`signorini.plots.contact_stress`); else against
+        :func:`~signorini.plots.contact_line.contact_coordinate`.
 
     Returns
     -------
@@ -331,32 +274,43 @@ def plot_deformed(
                 f"contact_points, got {g.shape} and {n.shape}"
             )
         order = np.argsort(contact_coordinate(cp)[0], kind="stable")
-        obs = (cp + scale * g[:, None] * n)[order]
-        far = scale * np.abs(g[order]) > OBSTACLE_REACH * float(np.ptp(p, axis=0).max())
+        obs = (cp + g[:, None] * n)[order]
+        far = np.abs(g[order]) > OBSTACLE_REACH * float(np.ptp(p, axis=0).max())
         obs[far] = np.nan  # a gap in the drawn line
         if far.all():
             obs = None
-        if scale != 1.0:
-            obstacle_label += f" (gap \u00d7{scale:g})"
     drawn = [p + scale * u] + ([] if obs is None else [obs])
     lo = np.min([np.nanmin(d, axis=0) for d in drawn], axis=0)
     hi = np.max([np.nanmax(d, axis=0) for d in drawn], axis=0)
     aspect = float((hi[1] - lo[1]) / max(hi[0] - lo[0], 1e-300))
     body = float(np.clip(2.2 * aspect, 0.8, 3.0))  # inches of the equal-aspect box
-    head = f"{title}\n{scale_text(scale)}" if title else f"deformed body, {scale_text(scale)}"
+    said = scale_text(scale)
+    if obs is not None and scale != 1.0:
+        said += ", obstacle at true scale"
+        obstacle_label += " (true scale)"
+    head = f"{title}\n{said}" if title else f"deformed body, {said}"
+    parts = _checked_along(along, cp) if pressure is not None else None
     with mpl.rc_context(RC):
         if pressure is None:
             fig = new_figure(height=body + 1.45)
             ax = fig.add_subplot()
         else:
             fig = new_figure(height=body + 1.45 + 1.7)
-            ax, axp = fig.subplots(2, 1, gridspec_kw={"height_ratios": [body + 1.0, 1.2]})
+            grid = fig.add_gridspec(
+                2,
+                1 if parts is None else len(parts),
+                height_ratios=[body + 1.0, 1.2],
+                width_ratios=None if parts is None else part_widths(parts),
+            )
+            ax = fig.add_subplot(grid[0, :])
+            axp = [fig.add_subplot(grid[1, 0])]
+            axp += [fig.add_subplot(grid[1, j], sharey=axp[0]) for j in range(1, grid.ncols)]
         if states is not None:
             states = (cp + scale * states[0], states[1])
         _draw_body(fig, ax, p, c, u, scale, obs, obstacle_label, show_mesh, states)
         ax.set_title(fit_title(head, fig))
         if pressure is not None:
-            _draw_pressure(axp, cp, pr, pt, None if states is None else states[1])
+            draw_stresses(axp, cp, pr, pt, None if states is None else states[1], parts)
         trim_height(fig)
         return save_figure(fig, path)
 
@@ -394,3 +348,28 @@ def _checked_states(
     if not np.isin(st, NODE_STATES).all():
         raise ValueError(f"state must hold the labels {', '.join(map(repr, NODE_STATES))}")
     return uc, st
+
+
+def _checked_along(
+    along: Mapping[str, tuple[ArrayLike, ArrayLike]] | None, cp: np.ndarray
+) -> dict[str, tuple[np.ndarray, np.ndarray]] | None:
+    """``along`` (part name -> rows of ``contact_points`` and their arc length) checked."""
+    if along is None:
+        return None
+    if not isinstance(along, Mapping) or not along:
+        raise ValueError("along must map contact part names to (rows, arc length)")
+    out = {}
+    for name, (rows, s) in along.items():
+        rows = np.asarray(rows, dtype=np.int64)
+        s = np.asarray(s, dtype=np.float64)
+        if rows.ndim != 1 or s.shape != rows.shape or not np.isfinite(s).all():
+            raise ValueError(
+                f"along[{name!r}] must be (rows, arc length), two 1-d arrays of one length "
+                f"with finite lengths, got shapes {rows.shape} and {s.shape}"
+            )
+        if rows.size and (rows.min() < 0 or rows.max() >= cp.shape[0]):
+            raise ValueError(
+                f"along[{name!r}]: rows must index contact_points (0 to {cp.shape[0] - 1})"
+            )
+        out[str(name)] = (rows, s)
+    return out

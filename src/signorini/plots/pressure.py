@@ -1,4 +1,6 @@
-"""A computed contact pressure beside a known one (e.g. Hertz's p0 √(1 − x²/a²))."""
+"""A computed contact pressure beside a known one (e.g. Hertz's p0 √(1 − x²/a²)); with
+friction also the friction stress beside a known one (e.g. Cattaneo–Mindlin's), the stick and
+slip nodes marked, zoomed on the contact zone."""
 
 from __future__ import annotations
 
@@ -9,9 +11,21 @@ import matplotlib as mpl
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .contact_stress import FRICTION_STYLES, draw_rug
 from .style import RC, STYLES, fit_title, new_figure, save_figure
 
 __all__ = ["plot_pressure_comparison"]
+
+#: Drawing order: the computed nodal values (markers) below the known curves (lines), so that
+#: ~300 markers do not hide the curve they are compared with.
+MARKER_ZORDER, REFERENCE_ZORDER = 2.0, 3.0
+
+
+def _pair(a: ArrayLike | None, b: ArrayLike | None, what: str) -> tuple[np.ndarray, ...]:
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    if a.ndim != 1 or a.shape != b.shape:
+        raise ValueError(f"{what} must be 1-d arrays of one length, got {a.shape}, {b.shape}")
+    return a, b
 
 
 def plot_pressure_comparison(
@@ -24,8 +38,16 @@ def plot_pressure_comparison(
     label: str = "reference",
     title: str = "",
     xlabel: str = r"$x$",
+    tangential: ArrayLike | None = None,
+    tangential_reference: ArrayLike | None = None,
+    tangential_label: str = "",
+    state: ArrayLike | None = None,
+    window: tuple[float, float] | None = None,
 ) -> list[Path]:
-    """The nodal pressure p_z against x, with the known pressure drawn as a line beside it.
+    """The nodal pressure p_z against x, with the known pressure drawn as a line above it.
+
+    The computed values are small hollow markers drawn below the known curves, the legend sits
+    under the axes (where it hides no data).
 
     Parameters
     ----------
@@ -39,6 +61,14 @@ def plot_pressure_comparison(
         ``<path>.png`` and ``<path>.pdf`` are written.
     label, title, xlabel : str
         Legend entry of the known pressure, title, x-axis label.
+    tangential : (m,) float array, optional
+        The friction stress p_t,z at the nodes, drawn as markers.
+    tangential_reference : (r,) float array, optional
+        The known friction stress at ``x_reference`` (legend entry ``tangential_label``).
+    state : (m,) str array, optional
+        ``"inactive"``, ``"stick"`` or ``"slip"`` per node: marked in a strip at the bottom.
+    window : (2,) float, optional
+        The x range shown (a zoom on the contact zone).
 
     Returns
     -------
@@ -48,37 +78,55 @@ def plot_pressure_comparison(
     Raises
     ------
     ValueError
-        If ``x`` and ``pressure`` (or ``x_reference`` and ``reference``) differ in shape or
-        are not 1-d.
+        If ``x`` and ``pressure`` (or ``x_reference`` and ``reference``, or the friction
+        arrays) differ in shape or are not 1-d.
     """
-    arrays = []
-    for a, b, what in ((x, pressure, "x and pressure"), (x_reference, reference, "reference")):
-        a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
-        if a.ndim != 1 or a.shape != b.shape:
-            raise ValueError(f"{what} must be 1-d arrays of one length, got {a.shape}, {b.shape}")
-        arrays += [a, b]
-    x, pressure, x_reference, reference = arrays
+    x, pressure = _pair(x, pressure, "x and pressure")
+    x_reference, reference = _pair(x_reference, reference, "reference")
+    pt = None if tangential is None else _pair(x, tangential, "x and tangential")[1]
+    qt = None
+    if tangential_reference is not None:
+        qt = _pair(x_reference, tangential_reference, "tangential reference")[1]
+    st = None if state is None else np.asarray(state)
+    if st is not None and st.shape != x.shape:
+        raise ValueError(f"state must have shape {x.shape}, got {st.shape}")
     keep = np.isfinite(x) & np.isfinite(pressure)
-    order = np.argsort(x[keep], kind="stable")
-    st = STYLES["pressure"]
+    order = np.flatnonzero(keep)[np.argsort(x[keep], kind="stable")]
+    style = STYLES["pressure"]
+    size = 2.5 if order.size <= 80 else 1.8
     with mpl.rc_context(RC):
-        fig = new_figure()
+        fig = new_figure(height=3.2 if pt is None else 3.6)
         ax = fig.add_subplot()
-        ax.plot(x_reference, reference, color="0.35", linewidth=1.0, label=label)
         ax.plot(
-            x[keep][order],
-            pressure[keep][order],
-            color=st["color"],
-            marker=st["marker"],
-            markersize=2.5,
-            linestyle="none",
-            label=st["label"],
-        )
-        ax.axhline(0.0, color="0.5", linewidth=0.6)
+            x_reference, reference, color="0.15", linewidth=1.3, label=label,
+            zorder=REFERENCE_ZORDER,
+        )  # fmt: skip
+        ax.plot(
+            x[order], pressure[order], color=style["color"], marker=style["marker"],
+            markersize=size, markerfacecolor="none", markeredgewidth=0.6, linestyle="none",
+            label=style["label"], zorder=MARKER_ZORDER,
+        )  # fmt: skip
+        if qt is not None:
+            ax.plot(
+                x_reference, qt, color="0.15", linewidth=1.3, linestyle="--",
+                label=tangential_label, zorder=REFERENCE_ZORDER,
+            )  # fmt: skip
+        if pt is not None:
+            ft = FRICTION_STYLES["tangential_pressure"]
+            ax.plot(
+                x[order], pt[order], color=ft["color"], marker=ft["marker"], markersize=size,
+                markerfacecolor="none", markeredgewidth=0.6, linestyle="none",
+                label=ft["label"], zorder=MARKER_ZORDER,
+            )  # fmt: skip
+        if st is not None:
+            draw_rug(ax, x[order], st[order], legend=True)
+        ax.axhline(0.0, color="0.5", linewidth=0.6, zorder=1)
         ax.grid(True, linestyle="-")
         ax.set_xlabel(xlabel)
-        ax.set_ylabel(r"contact pressure $p_h$")
-        ax.legend(loc="upper right", fontsize=6)
+        ax.set_ylabel(r"contact pressure $p_h$" if pt is None else "contact stresses")
+        if window is not None:
+            ax.set_xlim(*window)
+        fig.legend(loc="outside lower center", ncols=2, fontsize=6)
         if title:
             ax.set_title(fit_title(title, fig))
         return save_figure(fig, path)

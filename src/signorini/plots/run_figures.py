@@ -23,7 +23,7 @@ from ..output import read_history
 from .contact_line import free_boundary_ends
 from .mesh import boundary_groups
 
-__all__ = ["KnownPressure", "part_segments", "pressure_figure", "run_figures"]
+__all__ = ["KnownPressure", "mesh_title", "part_segments", "pressure_figure", "run_figures"]
 
 #: How the figure of the mesh labels the parts of each kind (``last["parts"]``' keys).
 PART_LABELS = {
@@ -51,8 +51,9 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
     The mesh figure shows the finest level of at most ``plots.READABLE_CELLS`` cells (read back
     from its ``level_NNN.vtu``; the last level when that file is missing or holds another
     mesh), with Γ_D, Γ_N and Γ_C marked. The deformed body is drawn with a stated displacement
-    scale, the obstacle at its gap with the same scale; with friction its stick and slip nodes
-    marked and the friction stress drawn with the pressure.
+    scale, the obstacle at true scale, the pressure per contact part against its arc length;
+    with friction its stick and slip nodes marked and the friction stress drawn with the
+    pressure.
 
     Parameters
     ----------
@@ -66,8 +67,10 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         (vertices first), ``initial`` (the problem's initial :class:`~signorini.mesh.Mesh`,
         whose parts refinement splits), ``parts`` (part names by kind: ``"dirichlet"``,
         ``"neumann"``, ``"contact"``), and per contact node ``contact_points (k, 2)``,
-        ``active (k,)``, ``pressure (k,)``, ``gap (k,)``, ``normal (k, 2)``; with friction
-        also ``state (k,)`` (labels, :data:`~signorini.plots.deformed.NODE_STATES`),
+        ``active (k,)``, ``pressure (k,)``, ``gap (k,)``, ``normal (k, 2)``, ``obstacle`` (part
+        name -> the obstacle's outline at true scale) and ``along`` (part name -> rows and
+        arc length); with friction also ``state (k,)`` (labels,
+        :data:`~signorini.plots.deformed.NODE_STATES`),
         ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)``.
     """
     written = list(plots.make_figures(out / "history.csv", out, example))
@@ -101,7 +104,7 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         points,
         cells,
         out / "mesh",
-        title=f"{example}: mesh, level {level}, {cells.shape[0]} cells",
+        title=mesh_title(example, level, cells.shape[0], last["level"]),
         highlight=plots.boundary_groups(points, cells, segments),
         colors=("#1f77b4", "#2ca02c", "#d62728"),
         **zoom,
@@ -119,12 +122,27 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         out / "deformed",
         contact_points=last["contact_points"],
         pressure=last["pressure"],
-        gap=last["gap"],
-        normal=last["normal"],
+        obstacle=_joined(last["obstacle"].values()),
+        along=last["along"],
         title=f"{example}: deformed body",
         **friction,
     )
     return written
+
+
+def mesh_title(example: str, level: int, n_cells: int, last_level: int) -> str:
+    """The mesh figure's title: its level, and when that is not the run's last one, which is
+    (the finest mesh is shown only up to ``plots.READABLE_CELLS`` cells)."""
+    head = f"{example}: mesh, level {level}, {n_cells} cells"
+    if level == last_level:
+        return head + " (last level)"
+    return head + f"\n(an earlier level, readable; the run ends at level {last_level})"
+
+
+def _joined(lines) -> np.ndarray | None:
+    """Polylines ``(j, 2)`` joined into one, a NaN row between them (None if there are none)."""
+    lines = [np.vstack([line, np.full((1, 2), np.nan)]) for line in lines if len(line)]
+    return np.vstack(lines) if lines else None
 
 
 def part_segments(initial: Mesh, part: str, points: np.ndarray, cells: np.ndarray) -> np.ndarray:
@@ -151,7 +169,9 @@ def part_segments(initial: Mesh, part: str, points: np.ndarray, cells: np.ndarra
 def pressure_figure(example: str, out: Path, known: KnownPressure) -> list[Path]:
     """The last level's pressure beside the known one (``<example>_pressure``; e.g. Hertz's
     for ``hertz``), as an example's metrics give it
-    (:attr:`Metrics.pressure <signorini.examples.Metrics.pressure>` of the last level)."""
+    (:attr:`Metrics.pressure <signorini.examples.Metrics.pressure>` of the last level); with
+    friction also the friction stress beside a known one, the stick and slip nodes marked,
+    zoomed on the contact zone (``partial-slip``: Cattaneo–Mindlin's)."""
     return plots.plot_pressure_comparison(
         known.x,
         known.pressure,
@@ -160,4 +180,9 @@ def pressure_figure(example: str, out: Path, known: KnownPressure) -> list[Path]
         out / f"{example}_pressure",
         label=known.label,
         title=known.title,
+        **{
+            key: getattr(known, key)
+            for key in ("tangential", "tangential_reference", "tangential_label", "state", "window")
+            if getattr(known, key, None) is not None
+        },
     )

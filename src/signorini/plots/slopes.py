@@ -23,6 +23,7 @@ __all__ = [
     "fit_start",
     "finer_half_slope",
     "slope_label",
+    "steady_slope",
     "triangle_vertices",
 ]
 
@@ -81,17 +82,76 @@ def fit_note(ndof_runs: Sequence[ArrayLike], last: int | None = None) -> str:
     return "slopes: least squares on the finer half of each run"
 
 
+#: The largest scatter of a curve about its fitted line, as the root mean square of the
+#: residuals of ``log10(values)`` (decades), for which its slope is printed.
+FIT_SCATTER = 0.15
+
+
+def fit_window(ndof: ArrayLike, last: int | None) -> np.ndarray:
+    """(n,) bool: the levels a slope is fitted over: the finer half of the run
+    (``N_dof >= fit_start(ndof)``, :func:`fit_start`) for ``last=None``, else the last
+    ``last`` levels."""
+    x = np.asarray(ndof, dtype=np.float64)
+    if last is None:
+        return x >= fit_start(x) * (1.0 - 1e-12)
+    window = np.zeros(x.shape, dtype=bool)
+    window[-last:] = True
+    return window
+
+
+def steady_slope(ndof: ArrayLike, values: ArrayLike, last: int | None = None) -> float | None:
+    """The fitted slope of a curve where it means a rate, else None.
+
+    The slope (least squares of ``log values`` against ``log N_dof`` over the levels of
+    :func:`fit_window`) is a rate only if the curve is positive and finite (above round-off:
+    the caller puts NaN where it is not) on *every* level of the window, and the fitted line
+    describes it: the root mean square of the residuals of ``log10(values)`` is at most
+    :data:`FIT_SCATTER` decades. A term that vanishes on some levels, or jumps by a decade
+    inside the window, has no rate: a slope fitted to it (e.g. "slope 1.09" for a term that is
+    round-off on five of nine levels) would read as divergence.
+
+    Parameters
+    ----------
+    ndof, values : (n,) array_like
+        ``N_dof`` and the curve's value on each level.
+    last : int or None
+        None: the finer half of the run; an int: the last ``last`` levels.
+
+    Returns
+    -------
+    float or None
+        The slope, or None when it is no rate (or fewer than two levels lie in the window).
+    """
+    x = np.asarray(ndof, dtype=np.float64)
+    y = np.asarray(values, dtype=np.float64)
+    if x.ndim != 1 or x.shape != y.shape:
+        raise ValueError(
+            f"ndof and values must be 1-d arrays of equal length, got shapes {x.shape} and "
+            f"{y.shape}"
+        )
+    window = fit_window(x, last)
+    xw, yw = x[window], y[window]
+    if xw.size < 2 or not (np.all(np.isfinite(yw) & (yw > 0)) and np.all(xw > 0)):
+        return None
+    lx, ly = np.log10(xw), np.log10(yw)
+    if np.ptp(lx) == 0.0:
+        return None
+    slope, intercept = np.polyfit(lx, ly, 1)
+    scatter = float(np.sqrt(np.mean((ly - (slope * lx + intercept)) ** 2)))
+    return float(slope) if scatter <= FIT_SCATTER else None
+
+
 def slope_label(label: str, ndof: np.ndarray, values: np.ndarray, last: int | None) -> str:
-    """``label`` followed by the fitted slope (two decimals), or ``label`` alone when there is
-    no slope: over the finer half of the run (:func:`finer_half_slope`) for ``last=None``,
-    else over the last ``last`` levels (:func:`~signorini.output.fitted_slope`)."""
-    try:
-        if last is None:
-            slope = finer_half_slope(ndof, values)
-        else:
-            slope = fitted_slope(ndof, values, last)
-    except ValueError:
-        return label
+    """``label`` followed by the fitted slope (two decimals) where it is a rate
+    (:func:`steady_slope`: over the finer half of the run for ``last=None``, else over the
+    last ``last`` levels), ``label (no steady rate)`` where it is not, and ``label`` alone
+    when fewer than two levels have a value."""
+    slope = steady_slope(ndof, values, last)
+    if slope is None:
+        y = np.asarray(values, dtype=np.float64)
+        return (
+            label if np.count_nonzero(np.isfinite(y) & (y > 0)) < 2 else f"{label} (no steady rate)"
+        )
     return f"{label}, slope {format_number(slope)}"
 
 
