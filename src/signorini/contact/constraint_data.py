@@ -16,6 +16,7 @@ from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
 
 __all__ = [
+    "check_dirichlet_admissible",
     "directions_and_gaps",
     "edge_weights",
     "friction_data",
@@ -159,3 +160,72 @@ def _integrator(space: P2Space, on_part: np.ndarray, edges: tuple, what: str, k:
         return np.bincount(loc[inside], weights=share.ravel()[inside], minlength=k)
 
     return integrate
+
+
+#: a Dirichlet value may exceed the gap at a node it shares with a contact part by round-off:
+#: this fraction of the larger of max|u_D| and max|ψ| there, plus
+#: :data:`DIRICHLET_POINT_TOL` times the extent of the mesh (round-off of a distance
+#: computed from coordinates)
+DIRICHLET_GAP_RTOL = 1e-9
+DIRICHLET_POINT_TOL = 1e-12
+
+
+def check_dirichlet_admissible(
+    problem: ContactProblem, space: P2Space, nodes: np.ndarray, constraint: tuple, parts: list
+) -> None:
+    """Refuse Dirichlet data that violate the contact constraint at a node of a contact part.
+
+    At a node on the closure of both Γ_D and Γ_C the displacement is prescribed, so the
+    constraint ``u(z)·n_z ≤ ψ(z)`` of the contact part holds only if ``u_D(z)·n_z ≤ ψ(z)``:
+    otherwise the admissible set K of the continuous problem is empty (no displacement with
+    these boundary values keeps the body out of the obstacle) and the discrete solutions
+    converge to nothing; the estimator's η7 sees the violation at that node on every level
+    (docs/method.md, *The continuous problem*).
+
+    Parameters
+    ----------
+    problem : ContactProblem
+    space : P2Space
+    nodes : (j,) int array
+        Dirichlet nodes on contact edges, one entry per (node, contact part).
+    constraint : tuple of (j, 2) and (j,) float arrays
+        The constraint direction n_z and the gap ψ(z) of each entry.
+    parts : list of str
+        The contact part of each entry.
+
+    Raises
+    ------
+    ProblemError
+        Naming the node's coordinates, the Dirichlet and the contact part, u_D·n and ψ.
+    """
+    if nodes.size == 0:
+        return
+    direction, gap = constraint
+    x = space.node_points[nodes]
+    value = np.zeros((nodes.size, 2))
+    owner = np.full(nodes.size, "", dtype=object)
+    for name in problem.dirichlet_parts:  # a node on two parts takes the later part's value
+        on = np.isin(nodes, space.part_nodes([name]))
+        if on.any():
+            what = f"the Dirichlet value of part {name!r}"
+            value[on] = evaluate_field(problem.conditions[name].field(), x[on], what)
+            owner[on] = name
+    normal_value = np.einsum("kc,kc->k", value, direction)
+    excess = normal_value - gap
+    pts = space.mesh.points
+    extent = float(np.abs(pts).max() + np.ptp(pts, axis=0).max())
+    scale = max(float(np.abs(value).max()), float(np.abs(gap).max()))
+    bad = np.flatnonzero(excess > DIRICHLET_GAP_RTOL * scale + DIRICHLET_POINT_TOL * extent)
+    if bad.size == 0:
+        return
+    i = bad[np.argmax(excess[bad])]
+    more = f" (and {bad.size - 1} more such node(s))" if bad.size > 1 else ""
+    raise ProblemError(
+        f"the node at ({x[i, 0]:.12g}, {x[i, 1]:.12g}) lies on Dirichlet part {owner[i]!r} and "
+        f"contact part {parts[i]!r}{more}: its prescribed displacement u_D = "
+        f"({value[i, 0]:.6g}, {value[i, 1]:.6g}) moves it by u_D·n = {normal_value[i]:.6g} "
+        f"along the constraint direction n = ({direction[i, 0]:.6g}, {direction[i, 1]:.6g}), "
+        f"beyond the gap ψ = {gap[i]:.6g} by {excess[i]:.6g}: the Dirichlet data violate the "
+        "contact constraint, so no admissible displacement exists. Make u_D·n ≤ ψ at the "
+        "parts' common nodes (e.g. move the obstacle or change u_D)"
+    )

@@ -31,7 +31,12 @@ from ..fem.space import P2Space
 from ..mesh.geometry import segment_normals
 from ..problem.fields import ProblemError
 from ..problem.problem import ContactProblem
-from .constraint_data import directions_and_gaps, edge_weights, friction_data
+from .constraint_data import (
+    check_dirichlet_admissible,
+    directions_and_gaps,
+    edge_weights,
+    friction_data,
+)
 
 __all__ = [
     "ContactSet",
@@ -271,7 +276,9 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     Raises
     ------
     ProblemError
-        If every contact node is a Dirichlet node, contact parts with the same direction at a
+        If every contact node is a Dirichlet node, a Dirichlet value violates the contact
+        constraint at a node shared with a contact part
+        (:func:`check_dirichlet_admissible`), contact parts with the same direction at a
         shared node have different gaps, two directions at a corner are nearly parallel, a
         node lies on more than two contact parts, or a gap function or obstacle does not give
         finite numbers.
@@ -298,6 +305,14 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     free = ~np.isin(cand_node, problem.dirichlet_nodes(space))
     if not free.any():
         raise ProblemError("every node of the contact boundary is a Dirichlet node")
+    held = np.flatnonzero(~free)
+    check_dirichlet_admissible(
+        problem,
+        space,
+        cand_node[held],
+        (direction.reshape(-1, 2)[first[held]], edge_gap.ravel()[first[held]]),
+        [parts[i] for i in ukey[held] % n_parts],
+    )
     kept = np.flatnonzero(free)
     row_of, starts = _rows(
         cand_node[kept],

@@ -1,0 +1,64 @@
+"""Contact data that no displacement can satisfy, refused before any level: a Dirichlet value
+that pushes a node shared with a contact part into the obstacle (u_D·n > ψ there)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from signorini.contact.solution import solve
+from signorini.fem.material import Material
+from signorini.loop import adaptive
+from signorini.mesh.builders import rectangle
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
+from signorini.problem.obstacles import HalfPlane
+
+MATERIAL = Material.from_young(10.0, 0.3)
+
+
+def _held_at_left(value, bottom: Contact) -> ContactProblem:
+    """The unit square: its left side moved by ``value``, its bottom on a contact part."""
+    return ContactProblem(
+        rectangle(nx=4, ny=4),
+        MATERIAL,
+        {
+            "left": Dirichlet(value),
+            "bottom": bottom,
+            "right": Neumann(),
+            "top": Neumann((0.0, -0.1)),
+        },
+    )
+
+
+@pytest.mark.parametrize(
+    "bottom",
+    [Contact(), Contact(obstacle=HalfPlane((0.0, 0.0), (0.0, 1.0)))],
+    ids=["gap", "shape"],
+)
+def test_dirichlet_value_into_the_obstacle_is_refused_before_any_level(bottom):
+    # the left side pushed down by 0.1 into a foundation at gap 0: at (0, 0), u_D·n = 0.1 > ψ
+    problem = _held_at_left((0.0, -0.1), bottom)
+    for run in (lambda: solve(problem), lambda: next(adaptive(problem))):
+        with pytest.raises(ProblemError) as info:
+            run()
+        msg = str(info.value)
+        for text in ("(0, 0)", "'left'", "'bottom'", "u_D·n = 0.1", "ψ = 0", "by 0.1"):
+            assert text in msg, msg
+
+
+def test_a_varying_dirichlet_value_names_the_violating_node():
+    # u_D(x) = (0, −0.2 + 0.2 y) is 0 at the top and −0.2 at the bottom; the gap is 0.05
+    problem = _held_at_left(
+        lambda x: np.column_stack([0.0 * x[:, 0], -0.2 + 0.2 * x[:, 1]]), Contact(gap=0.05)
+    )
+    with pytest.raises(ProblemError, match=r"\(0, 0\).*u_D·n = 0\.2 .*ψ = 0\.05 by 0\.15"):
+        solve(problem)
+
+
+@pytest.mark.parametrize("value", [(0.0, 0.1), (0.3, 0.0), (0.0, -0.05)])
+def test_admissible_dirichlet_values_at_the_shared_node_are_solved(value):
+    # lifted, moved along the foundation, or pushed down by exactly the gap 0.05
+    result = solve(_held_at_left(value, Contact(gap=0.05)))
+    un = -result.u[:, 1]  # u·n with n = (0, −1) on the bottom
+    bottom = np.isclose(result.space.node_points[:, 1], 0.0)
+    assert un[bottom].max() <= 0.05 * (1 + 1e-9)
