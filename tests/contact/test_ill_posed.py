@@ -62,3 +62,37 @@ def test_admissible_dirichlet_values_at_the_shared_node_are_solved(value):
     un = -result.u[:, 1]  # u·n with n = (0, −1) on the bottom
     bottom = np.isclose(result.space.node_points[:, 1], 0.0)
     assert un[bottom].max() <= 0.05 * (1 + 1e-9)
+
+
+def _on_foundation(bottom: Contact) -> ContactProblem:
+    """The unit square held at its top, its bottom on a contact part."""
+    return ContactProblem(
+        rectangle(nx=4, ny=4),
+        MATERIAL,
+        {"top": Dirichlet((0.0, 0.0)), "bottom": bottom, "left": Neumann(), "right": Neumann()},
+    )
+
+
+@pytest.mark.parametrize("depth", [0.4, 0.5, 2.0])
+@pytest.mark.parametrize("shape", [False, True], ids=["gap", "shape"])
+def test_an_obstacle_deep_inside_the_body_is_refused(depth, shape):
+    # the foundation's surface at y = depth inside the unit square (diagonal √2; the bound
+    # is 0.25 √2 = 0.354): the linearised constraint would pull the bottom up by `depth`
+    obstacle = HalfPlane((0.0, depth), (0.0, 1.0))
+    problem = _on_foundation(Contact(obstacle=obstacle) if shape else Contact(gap=-depth))
+    with pytest.raises(ProblemError) as info:
+        solve(problem)
+    msg = str(info.value)
+    assert f"contact part 'bottom' starts {depth:g} deep" in msg, msg
+    assert "size 1.41421" in msg and "0.25" in msg
+
+
+@pytest.mark.parametrize("depth", [0.0, 0.2, 0.35])
+def test_a_small_initial_overlap_is_solved(depth):
+    # up to a quarter of the diagonal (Example 6.2 of the paper starts 0.2 deep): the bottom is
+    # pushed out to the foundation's surface, u_y = depth on the bottom to round-off
+    result = solve(_on_foundation(Contact(gap=-depth)))
+    bottom = np.isclose(result.space.node_points[:, 1], 0.0)
+    assert np.abs(-result.u[bottom, 1] + depth).max() <= 1e-10 * max(depth, 1e-300) or (
+        depth == 0.0 and np.abs(result.u).max() == 0.0
+    )

@@ -16,7 +16,9 @@ from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
 
 __all__ = [
+    "DEEP_OVERLAP",
     "check_dirichlet_admissible",
+    "check_initial_overlap",
     "directions_and_gaps",
     "edge_weights",
     "friction_data",
@@ -171,7 +173,7 @@ DIRICHLET_POINT_TOL = 1e-12
 
 
 def check_dirichlet_admissible(
-    problem: ContactProblem, space: P2Space, nodes: np.ndarray, constraint: tuple, parts: list
+    problem: ContactProblem, space: P2Space, nodes: np.ndarray, constraint: tuple, parts: tuple
 ) -> None:
     """Refuse Dirichlet data that violate the contact constraint at a node of a contact part.
 
@@ -190,8 +192,8 @@ def check_dirichlet_admissible(
         Dirichlet nodes on contact edges, one entry per (node, contact part).
     constraint : tuple of (j, 2) and (j,) float arrays
         The constraint direction n_z and the gap ψ(z) of each entry.
-    parts : list of str
-        The contact part of each entry.
+    parts : tuple of (tuple of str, (j,) int array)
+        The contact parts' names and the part of each entry.
 
     Raises
     ------
@@ -222,10 +224,64 @@ def check_dirichlet_admissible(
     more = f" (and {bad.size - 1} more such node(s))" if bad.size > 1 else ""
     raise ProblemError(
         f"the node at ({x[i, 0]:.12g}, {x[i, 1]:.12g}) lies on Dirichlet part {owner[i]!r} and "
-        f"contact part {parts[i]!r}{more}: its prescribed displacement u_D = "
+        f"contact part {parts[0][parts[1][i]]!r}{more}: its prescribed displacement u_D = "
         f"({value[i, 0]:.6g}, {value[i, 1]:.6g}) moves it by u_D·n = {normal_value[i]:.6g} "
         f"along the constraint direction n = ({direction[i, 0]:.6g}, {direction[i, 1]:.6g}), "
         f"beyond the gap ψ = {gap[i]:.6g} by {excess[i]:.6g}: the Dirichlet data violate the "
         "contact constraint, so no admissible displacement exists. Make u_D·n ≤ ψ at the "
         "parts' common nodes (e.g. move the obstacle or change u_D)"
+    )
+
+
+#: the deepest initial penetration accepted, as a fraction of the body's size (the diagonal of
+#: its bounding box); docs/method.md, *Obstacles as shapes*, "Initial overlap"
+DEEP_OVERLAP = 0.25
+
+
+def check_initial_overlap(
+    mesh_points: np.ndarray, node_points: np.ndarray, gap: np.ndarray, parts: tuple
+) -> None:
+    """Refuse an obstacle that starts deeper inside the body than the linearised model covers.
+
+    A node with ``ψ(z) < 0`` starts inside the obstacle and must move by at least ``|ψ(z)|``.
+    The Dirichlet part holds the body within a distance ``d`` (the diagonal of its bounding
+    box), so the displacement gradient is at least ``|ψ(z)| / d`` somewhere; small-deformation
+    elasticity and the linearised constraint ``u·n_z ≤ ψ(z)`` are first-order models in that
+    gradient. Beyond ``|ψ(z)| > DEEP_OVERLAP · d`` (a gradient of 1/4, where the neglected
+    quadratic terms are an eighth of the linear ones) the solution is not a small-deformation
+    one: refused. The paper's Example 6.2 (``ψ = −0.2`` on the unit square, 0.14 of ``d``) is
+    accepted (docs/method.md, *Obstacles as shapes*).
+
+    Parameters
+    ----------
+    mesh_points : (n, 2) float array
+        The mesh's vertices.
+    node_points : (k, 2) float array
+        The constrained nodes.
+    gap : (k,) float array
+        ψ at those nodes.
+    parts : tuple of (tuple of str, (k,) int array)
+        The contact parts' names and the part of each node.
+
+    Raises
+    ------
+    ProblemError
+        Naming the part, the node, its depth and the body's size.
+    """
+    if gap.size == 0 or gap.min() >= 0.0:
+        return
+    size = float(np.hypot(*np.ptp(mesh_points, axis=0)))
+    deepest = int(np.argmin(gap))
+    depth = -float(gap[deepest])
+    if depth <= DEEP_OVERLAP * size:
+        return
+    x, name = node_points[deepest], parts[0][parts[1][deepest]]
+    raise ProblemError(
+        f"the obstacle of contact part {name!r} starts {depth:.6g} deep inside the "
+        f"body at ({x[0]:.12g}, {x[1]:.12g}) (ψ = {-depth:.6g}), more than {DEEP_OVERLAP} times "
+        f"the body's size {size:.6g} (its bounding box's diagonal): the linearised, "
+        "small-deformation contact model cannot represent an initial overlap that deep (it "
+        "would pull the body through the obstacle with strains of order one). Place the "
+        "obstacle at the body's surface (ψ ≈ 0) and move it in by steps of a load path, or "
+        "shift the obstacle out"
     )

@@ -33,6 +33,7 @@ from ..problem.fields import ProblemError
 from ..problem.problem import ContactProblem
 from .constraint_data import (
     check_dirichlet_admissible,
+    check_initial_overlap,
     directions_and_gaps,
     edge_weights,
     friction_data,
@@ -278,10 +279,11 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     ProblemError
         If every contact node is a Dirichlet node, a Dirichlet value violates the contact
         constraint at a node shared with a contact part
-        (:func:`check_dirichlet_admissible`), contact parts with the same direction at a
-        shared node have different gaps, two directions at a corner are nearly parallel, a
-        node lies on more than two contact parts, or a gap function or obstacle does not give
-        finite numbers.
+        (:func:`check_dirichlet_admissible`), an obstacle starts deeper inside the body than a
+        quarter of its size (:func:`check_initial_overlap`), contact parts with the same
+        direction at a shared node have different gaps, two directions at a corner are nearly
+        parallel, a node lies on more than two contact parts, or a gap function or obstacle
+        does not give finite numbers.
     """
     mesh = space.mesh
     parts = tuple(problem.contact_parts)
@@ -311,9 +313,15 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
         space,
         cand_node[held],
         (direction.reshape(-1, 2)[first[held]], edge_gap.ravel()[first[held]]),
-        [parts[i] for i in ukey[held] % n_parts],
+        (parts, ukey[held] % n_parts),
     )
     kept = np.flatnonzero(free)
+    check_initial_overlap(
+        mesh.points,
+        space.node_points[cand_node[kept]],
+        edge_gap.ravel()[first[kept]],
+        (parts, ukey[kept] % n_parts),
+    )
     row_of, starts = _rows(
         cand_node[kept],
         direction.reshape(-1, 2)[first[kept]],
