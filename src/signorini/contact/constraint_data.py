@@ -11,6 +11,7 @@ from ..algebra.laws import LawGroups
 from ..fem import iso, p2
 from ..fem.quadrature import gauss_legendre
 from ..fem.space import P2Space
+from ..mesh.validation import MeshError
 from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
@@ -39,15 +40,42 @@ def _body_normals(
         return np.broadcast_to(problem.contact_normals[name], nodes.shape + (2,)).copy()
     curve = mesh.curves[mesh.part_index(name)]
     if curve is not None and curve.has_normal:
-        n = curve.normal(space.node_points[nodes.ravel()]).reshape(nodes.shape + (2,))
-        sign = np.sign(np.einsum("ejc,ec->ej", n, chord))
-        return n * np.where(sign < 0, -1.0, 1.0)[..., None]
+        x = space.node_points[nodes.ravel()]
+        try:
+            n = curve.normal(x).reshape(nodes.shape + (2,))
+        except MeshError as err:
+            raise ProblemError(f"the curve of contact part {name!r}: {err}") from err
+        cos = np.einsum("ejc,ec->ej", n, chord)
+        _check_across(name, cos, x)
+        return n * np.where(cos < 0, -1.0, 1.0)[..., None]
     total = np.zeros((space.n_nodes, 2))
     np.add.at(total, nodes[:, :2].ravel(), np.repeat(chord, 2, axis=0))
     out = np.repeat(chord[:, None, :], 3, axis=1)
     mean = total[nodes[:, :2]]
     out[:, :2] = mean / np.hypot(mean[..., 0], mean[..., 1])[..., None]
     return out
+
+
+#: a curve's normal at a node of a contact edge may differ from the edge chord's normal by at
+#: most this angle (radians, 60°): the curve turns by about h / R over an edge, far less on
+#: any mesh that resolves it; a normal along the boundary (the tangent) is 90° off
+CURVE_NORMAL_ANGLE = np.pi / 3
+
+
+def _check_across(name: str, cos: np.ndarray, x: np.ndarray) -> None:
+    """Refuse a curve normal that runs along the boundary rather than across it: ``cos (e, 3)``
+    of its angle to the chord's normal at the nodes ``x (3 e, 2)`` of a part's edges."""
+    bad = np.flatnonzero(np.abs(cos).ravel() < np.cos(CURVE_NORMAL_ANGLE))
+    if bad.size:
+        i = bad[0]
+        angle = np.degrees(np.arccos(min(abs(float(cos.ravel()[i])), 1.0)))
+        raise ProblemError(
+            f"the curve of contact part {name!r} gives at the node ({x[i, 0]:.12g}, "
+            f"{x[i, 1]:.12g}) a normal {angle:.3g}° away from the normal of the boundary edge "
+            f"there (more than {np.degrees(CURVE_NORMAL_ANGLE):.0f}°; {bad.size} node(s)): it "
+            "runs along the boundary, not across it. ProjectedCurve(normal=...) must return "
+            "the curve's normal, not its tangent"
+        )
 
 
 def directions_and_gaps(
