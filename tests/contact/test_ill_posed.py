@@ -10,6 +10,7 @@ from signorini.contact.solution import solve
 from signorini.fem.material import Material
 from signorini.loop import adaptive
 from signorini.mesh.builders import rectangle
+from signorini.mesh.mesh import Mesh
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
 from signorini.problem.obstacles import HalfPlane
 
@@ -96,3 +97,50 @@ def test_a_small_initial_overlap_is_solved(depth):
     assert np.abs(-result.u[bottom, 1] + depth).max() <= 1e-10 * max(depth, 1e-300) or (
         depth == 0.0 and np.abs(result.u).max() == 0.0
     )
+
+
+def _pinched(tilt: float) -> ContactProblem:
+    """The block (0, 2) × (0, 1) held at its top; the bottom's left half "a" above a floor
+    (direction (0, −1)), its right half "b" under an obstacle at y ≥ 0.2 tilted by ``tilt``
+    (direction about (0, 1)): at (1, 0) the two directions are (nearly) opposite."""
+    tol = 1e-9
+    m = rectangle(0.0, 2.0, 0.0, 1.0, nx=4, ny=2)
+    on_bottom = lambda x: np.abs(x[:, 1]) < tol  # noqa: E731
+    mesh = Mesh.from_arrays(
+        m.points,
+        m.cells,
+        {
+            "a": lambda x: on_bottom(x) & (x[:, 0] <= 1 + tol),
+            "b": lambda x: on_bottom(x) & (x[:, 0] >= 1 - tol),
+            "top": lambda x: np.abs(x[:, 1] - 1) < tol,
+            "sides": lambda x: (np.abs(x[:, 0]) < tol) | (np.abs(x[:, 0] - 2) < tol),
+        },
+    )
+    above = HalfPlane((1.0, 0.2), (np.sin(tilt), -np.cos(tilt)))
+    return ContactProblem(
+        mesh,
+        MATERIAL,
+        {
+            "top": Dirichlet((0.0, -0.01)),
+            "sides": Neumann(),
+            "a": Contact(obstacle=HalfPlane((0.0, 0.0), (0.0, 1.0))),
+            "b": Contact(obstacle=above),
+        },
+    )
+
+
+@pytest.mark.parametrize("tilt", [0.0, 0.005])
+def test_opposite_directions_at_a_node_are_refused_naming_both_parts(tilt):
+    # before: numpy.linalg.LinAlgError "Singular matrix" from the corner frame (or, 0.005 rad
+    # from opposite, a frame with condition number ~1e5 squared)
+    with pytest.raises(ProblemError) as info:
+        solve(_pinched(tilt))
+    msg = str(info.value)
+    assert "node at (1, 0) lies on contact parts 'a' and 'b'" in msg, msg
+    assert "opposite" in msg, msg
+
+
+def test_a_corner_far_from_opposite_is_solved():
+    # tilted by 0.1 rad from opposite: a (sharp) corner, two constraints solved exactly
+    result = solve(_pinched(0.1))
+    assert result.report.kkt.max < 1e-10
