@@ -75,24 +75,45 @@ def _on_foundation(bottom: Contact) -> ContactProblem:
 
 
 @pytest.mark.parametrize("depth", [0.4, 0.5, 2.0])
-@pytest.mark.parametrize("shape", [False, True], ids=["gap", "shape"])
-def test_an_obstacle_deep_inside_the_body_is_refused(depth, shape):
+def test_an_obstacle_deep_inside_the_body_is_refused(depth):
     # the foundation's surface at y = depth inside the unit square (diagonal √2; the bound
     # is 0.25 √2 = 0.354): the linearised constraint would pull the bottom up by `depth`
-    obstacle = HalfPlane((0.0, depth), (0.0, 1.0))
-    problem = _on_foundation(Contact(obstacle=obstacle) if shape else Contact(gap=-depth))
+    problem = _on_foundation(Contact(obstacle=HalfPlane((0.0, depth), (0.0, 1.0))))
     with pytest.raises(ProblemError) as info:
         solve(problem)
     msg = str(info.value)
     assert f"contact part 'bottom' starts {depth:g} deep" in msg, msg
+    assert "move the body out by at most 0 " in msg, msg
     assert "size 1.41421" in msg and "0.25" in msg
 
 
-@pytest.mark.parametrize("depth", [0.0, 0.2, 0.35])
-def test_a_small_initial_overlap_is_solved(depth):
-    # up to a quarter of the diagonal (Example 6.2 of the paper starts 0.2 deep): the bottom is
-    # pushed out to the foundation's surface, u_y = depth on the bottom to round-off
-    result = solve(_on_foundation(Contact(gap=-depth)))
+def test_a_deep_overlap_that_the_dirichlet_data_move_out_of_is_solved():
+    # the same foundation 0.5 deep, the top moved up by 0.45: the body is lifted out of it,
+    # the bottom ends on the surface y = 0.5 with little strain
+    problem = ContactProblem(
+        rectangle(nx=4, ny=4),
+        MATERIAL,
+        {
+            "top": Dirichlet((0.0, 0.45)),
+            "bottom": Contact(obstacle=HalfPlane((0.0, 0.5), (0.0, 1.0))),
+            "left": Neumann(),
+            "right": Neumann(),
+        },
+    )
+    result = solve(problem)
+    bottom = np.isclose(result.space.node_points[:, 1], 0.0)
+    assert np.abs(result.u[bottom, 1] - 0.5).max() < 1e-12
+
+
+@pytest.mark.parametrize(
+    ("depth", "shape"), [(0.0, True), (0.2, True), (0.35, True), (0.2, False), (2.0, False)]
+)
+def test_a_small_initial_overlap_or_a_gap_function_is_solved(depth, shape):
+    # shapes up to a quarter of the diagonal (Example 6.2 of the paper starts 0.2 deep), gap
+    # functions at any depth (the linear model's own data): the bottom is pushed out to the
+    # foundation's surface, u_y = depth on the bottom to round-off
+    obstacle = HalfPlane((0.0, depth), (0.0, 1.0))
+    result = solve(_on_foundation(Contact(obstacle=obstacle) if shape else Contact(gap=-depth)))
     bottom = np.isclose(result.space.node_points[:, 1], 0.0)
     assert np.abs(-result.u[bottom, 1] + depth).max() <= 1e-10 * max(depth, 1e-300) or (
         depth == 0.0 and np.abs(result.u).max() == 0.0

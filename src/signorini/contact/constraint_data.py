@@ -232,14 +232,7 @@ def check_dirichlet_admissible(
         return
     direction, gap = constraint
     x = space.node_points[nodes]
-    value = np.zeros((nodes.size, 2))
-    owner = np.full(nodes.size, "", dtype=object)
-    for name in problem.dirichlet_parts:  # a node on two parts takes the later part's value
-        on = np.isin(nodes, space.part_nodes([name]))
-        if on.any():
-            what = f"the Dirichlet value of part {name!r}"
-            value[on] = evaluate_field(problem.conditions[name].field(), x[on], what)
-            owner[on] = name
+    value, owner = _dirichlet_values(problem, space, nodes)
     normal_value = np.einsum("kc,kc->k", value, direction)
     excess = normal_value - gap
     pts = space.mesh.points
@@ -261,55 +254,88 @@ def check_dirichlet_admissible(
     )
 
 
-#: the deepest initial penetration accepted, as a fraction of the body's size (the diagonal of
-#: its bounding box); docs/method.md, *Obstacles as shapes*, "Initial overlap"
+#: the deepest initial penetration accepted beyond what the Dirichlet data move the body, as
+#: a fraction of the body's size (the diagonal of its bounding box); docs/method.md,
+#: *Obstacles as shapes*, "Initial overlap"
 DEEP_OVERLAP = 0.25
 
 
-def check_initial_overlap(
-    mesh_points: np.ndarray, node_points: np.ndarray, gap: np.ndarray, parts: tuple
-) -> None:
-    """Refuse an obstacle that starts deeper inside the body than the linearised model covers.
+def _dirichlet_values(problem: ContactProblem, space: P2Space, nodes: np.ndarray):
+    """``u_D`` at the Dirichlet nodes ``nodes (j,)`` and the Dirichlet part of each (a node on
+    two parts takes the later part's value, as in the assembly)."""
+    x = space.node_points[nodes]
+    value = np.zeros((nodes.size, 2))
+    owner = np.full(nodes.size, "", dtype=object)
+    for name in problem.dirichlet_parts:
+        on = np.isin(nodes, space.part_nodes([name]))
+        if on.any():
+            what = f"the Dirichlet value of part {name!r}"
+            value[on] = evaluate_field(problem.conditions[name].field(), x[on], what)
+            owner[on] = name
+    return value, owner
 
-    A node with ``ψ(z) < 0`` starts inside the obstacle and must move by at least ``|ψ(z)|``.
-    The Dirichlet part holds the body within a distance ``d`` (the diagonal of its bounding
-    box), so the displacement gradient is at least ``|ψ(z)| / d`` somewhere; small-deformation
-    elasticity and the linearised constraint ``u·n_z ≤ ψ(z)`` are first-order models in that
-    gradient. Beyond ``|ψ(z)| > DEEP_OVERLAP · d`` (a gradient of 1/4, where the neglected
-    quadratic terms are an eighth of the linear ones) the solution is not a small-deformation
-    one: refused. The paper's Example 6.2 (``ψ = −0.2`` on the unit square, 0.14 of ``d``) is
-    accepted (docs/method.md, *Obstacles as shapes*).
+
+def check_initial_overlap(
+    problem: ContactProblem, space: P2Space, nodes: np.ndarray, constraint: tuple, parts: tuple
+) -> None:
+    """Refuse an obstacle shape that starts deeper inside the body than its linearisation
+    covers.
+
+    Only shapes (``Contact(obstacle=...)``) are checked: their constraint is linearised at the
+    point of the obstacle closest to the node, which for a node deep inside may lie on the far
+    side of the obstacle (the body is pulled through it). A gap function ``ψ`` states the
+    linear model's data directly and is taken as given at any size (a manufactured solution
+    may have a large one).
+    A node ``z`` with ``ψ(z) < 0`` starts inside the obstacle: ``u(z)·(−n_z) ≥ |ψ(z)|``. At a
+    Dirichlet node ``y`` the displacement is ``u_D(y)``, so ``u`` changes by at least
+    ``need = |ψ(z)| − max_y u_D(y)·(−n_z)`` between the two, within the body's size ``d`` (the
+    diagonal of its bounding box): the displacement gradient is at least ``need / d``
+    somewhere. Small-deformation elasticity and the linearised constraint are first-order
+    models in that gradient; beyond ``need > DEEP_OVERLAP · d`` (a gradient of 1/4, where the
+    neglected quadratic terms are an eighth of the linear ones) the solution is not a
+    small-deformation one: refused. An overlap that the Dirichlet data themselves move the
+    body out of (a translation) needs no strain and stays accepted; so does the paper's
+    Example 6.2 (``ψ = −0.2`` on the unit square, u_D = 0: 0.14 d). docs/method.md,
+    *Obstacles as shapes*.
 
     Parameters
     ----------
-    mesh_points : (n, 2) float array
-        The mesh's vertices.
-    node_points : (k, 2) float array
-        The constrained nodes.
-    gap : (k,) float array
-        ψ at those nodes.
+    problem : ContactProblem
+    space : P2Space
+    nodes : (k,) int array
+        The constrained nodes (not Dirichlet nodes), one entry per (node, contact part).
+    constraint : tuple of (k, 2) and (k,) float arrays
+        The direction n_z and the gap ψ(z) of each entry.
     parts : tuple of (tuple of str, (k,) int array)
-        The contact parts' names and the part of each node.
+        The contact parts' names and the part of each entry.
 
     Raises
     ------
     ProblemError
-        Naming the part, the node, its depth and the body's size.
+        Naming the part, the node, its depth, the Dirichlet data's share and the body's size.
     """
-    if gap.size == 0 or gap.min() >= 0.0:
+    direction, gap = constraint
+    pts = space.mesh.points
+    size = float(np.hypot(*np.ptp(pts, axis=0)))
+    shape = np.array([problem.conditions[p].obstacle is not None for p in parts[0]])
+    deep = np.flatnonzero((-gap > DEEP_OVERLAP * size) & shape[parts[1]])
+    if deep.size == 0:
         return
-    size = float(np.hypot(*np.ptp(mesh_points, axis=0)))
-    deepest = int(np.argmin(gap))
-    depth = -float(gap[deepest])
-    if depth <= DEEP_OVERLAP * size:
+    value, _ = _dirichlet_values(problem, space, problem.dirichlet_nodes(space))
+    moved = (value @ -direction[deep].T).max(axis=0)  # (deep,) max_y u_D(y)·(−n_z)
+    need = -gap[deep] - moved
+    worst = int(np.argmax(need))
+    if need[worst] <= DEEP_OVERLAP * size:
         return
-    x, name = node_points[deepest], parts[0][parts[1][deepest]]
+    i = deep[worst]
+    x, name = space.node_points[nodes[i]], parts[0][parts[1][i]]
     raise ProblemError(
-        f"the obstacle of contact part {name!r} starts {depth:.6g} deep inside the "
-        f"body at ({x[0]:.12g}, {x[1]:.12g}) (ψ = {-depth:.6g}), more than {DEEP_OVERLAP} times "
-        f"the body's size {size:.6g} (its bounding box's diagonal): the linearised, "
-        "small-deformation contact model cannot represent an initial overlap that deep (it "
-        "would pull the body through the obstacle with strains of order one). Place the "
-        "obstacle at the body's surface (ψ ≈ 0) and move it in by steps of a load path, or "
+        f"the obstacle of contact part {name!r} starts {-gap[i]:.6g} deep inside the body at "
+        f"({x[0]:.12g}, {x[1]:.12g}) (ψ = {gap[i]:.6g}; the Dirichlet data move the body out "
+        f"by at most {moved[worst]:.6g} along the constraint direction), more than "
+        f"{DEEP_OVERLAP} times the body's size {size:.6g} (its bounding box's diagonal): the "
+        "linearised, small-deformation contact model cannot represent an initial overlap that "
+        "deep (it would pull the body through the obstacle with strains of order one). Place "
+        "the obstacle at the body's surface (ψ ≈ 0) and move it in by steps of a load path, or "
         "shift the obstacle out"
     )

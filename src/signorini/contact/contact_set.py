@@ -345,9 +345,10 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     )
     kept = np.flatnonzero(free)
     check_initial_overlap(
-        mesh.points,
-        space.node_points[cand_node[kept]],
-        edge_gap.ravel()[first[kept]],
+        problem,
+        space,
+        cand_node[kept],
+        (direction.reshape(-1, 2)[first[kept]], edge_gap.ravel()[first[kept]]),
         (parts, ukey[kept] % n_parts),
     )
     row_of, starts = _rows(
