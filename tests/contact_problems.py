@@ -215,7 +215,7 @@ def independent_system(problem: ContactProblem, mesh: Mesh) -> System:
 
 
 def corner_problem(angle: float = 0.0, shapes: bool = False) -> ContactProblem:
-    """The unit square (rotated by ``angle``) pushed by its top into a rigid corner: a floor
+    """The unit square (rotated by ``angle``) pushed down by its top into a rigid corner: a floor
     under the bottom and a wall right of the right side, both at gap 0, with a body force."""
     c, s = np.cos(angle), np.sin(angle)
     R = np.array([[c, -s], [s, c]])
@@ -234,7 +234,7 @@ def corner_problem(angle: float = 0.0, shapes: bool = False) -> ContactProblem:
         wall = Contact(obstacle=HalfPlane(R @ [1.0, 0.0], R @ [-1.0, 0.0]))
     else:
         floor, wall = Contact(), Contact()
-    push = R @ [0.02, -0.03]
+    push = R @ [0.0, -0.03]
     force = R @ [0.5, -1.0]
     return ContactProblem(
         mesh,

@@ -141,9 +141,13 @@ def test_polygonal_part_takes_the_mean_of_its_edges_normals_at_a_vertex():
             "rest": lambda x: (np.abs(x[:, 1] - 1) < TOL) | (np.abs(x[:, 0]) < TOL),
         },
     )
-    pb = ContactProblem(
-        mesh, MATERIAL, {"rest": Dirichlet((0.02, -0.02)), "corner": Contact(gap=0.005)}
-    )
+
+    # the left and top sides sheared towards the corner part, fixed where they meet it (a
+    # uniform (0.02, −0.02) would push (0, 0) and (1, 1) into the obstacle: no solution)
+    def shear(x):
+        return 0.02 * np.column_stack([x[:, 1] * (1 - x[:, 0]), -x[:, 0] * (1 - x[:, 1])])
+
+    pb = ContactProblem(mesh, MATERIAL, {"rest": Dirichlet(shear), "corner": Contact(gap=0.005)})
     space = P2Space(mesh)
     cs = contact_set(pb, space)
     x = space.node_points[cs.nodes]

@@ -21,6 +21,25 @@ def test_degenerate_triangle() -> None:
         Mesh.from_arrays(p, [[0, 1, 3], [0, 1, 2]], ALL)
 
 
+@pytest.mark.parametrize("height", [1e-12, 0.0])
+def test_a_sliver_is_refused_naming_the_cell_its_vertices_and_aspect_ratio(height) -> None:
+    # aspect ratio = longest edge / smallest height = 1 / height, refused beyond 5e11
+    p = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, height], [0.0, 1.0]])
+    with pytest.raises(MeshError) as info:
+        Mesh.from_arrays(p, [[0, 1, 3], [0, 1, 2]], ALL)
+    msg = str(info.value)
+    assert "cell 1 = [0, 1, 2] with vertices (0, 0), (1, 0), (0.5, " in msg, msg
+    aspect = "1e+12" if height else "inf"
+    assert f"aspect ratio (longest edge / smallest height) {aspect}, beyond 5e+11" in msg, msg
+
+
+def test_a_thin_cell_below_the_bound_is_accepted() -> None:
+    # aspect 1e9 (the solve's accuracy on it is checked by its residuals, not here)
+    p = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, -1e-9], [0.0, 1.0]])
+    mesh = Mesh.from_arrays(p, [[0, 1, 3], [0, 2, 1]], ALL)
+    assert mesh.area[1] == pytest.approx(0.5e-9, rel=1e-6)
+
+
 def test_repeated_vertex_is_degenerate() -> None:
     with pytest.raises(MeshError, match="degenerate triangle.*repeated vertex"):
         Mesh.from_arrays(SQUARE_P, [[0, 1, 1], [0, 2, 3]], ALL)
@@ -125,7 +144,11 @@ def test_boundary_edges_without_part_constructor() -> None:
     m = Mesh.from_arrays(SQUARE_P, SQUARE_C, ALL)
     keep = np.any(np.sort(m.boundary, axis=1) != [2, 3], axis=1)
     assert keep.sum() == 3
-    with pytest.raises(MeshError, match=r"1 boundary edge\(s\) without a part, first \(2, 3\)"):
+    with pytest.raises(
+        MeshError,
+        match=r"1 boundary edge\(s\) without a part, first the edge from \(1, 1\) to \(0, 1\) "
+        r"\(vertices 2 and 3\)",
+    ):
         Mesh(SQUARE_P, SQUARE_C, m.boundary[keep], m.boundary_part[keep], ["all"])
 
 

@@ -9,9 +9,11 @@ import pytest
 from contact_problems import corner_problem
 
 from signorini.contact.contact_set import contact_set
+from signorini.contact.solution import solve
 from signorini.fem.material import Material
 from signorini.fem.space import P2Space
 from signorini.mesh.builders import rectangle
+from signorini.mesh.mesh import Mesh
 from signorini.problem import Contact, ContactProblem, Coulomb, Dirichlet, Neumann, Tresca
 from signorini.problem.fields import ProblemError
 
@@ -96,17 +98,43 @@ def test_negative_bound_function_names_the_part():
         contact_set(pb, P2Space(pb.mesh))
 
 
-def test_corner_constraints_are_frictionless():
-    base = corner_problem()
+@pytest.mark.parametrize("shapes", [False, True], ids=["gap", "shape"])
+@pytest.mark.parametrize("which", ["bottom", "right", "both"])
+def test_friction_at_a_corner_is_refused_when_the_problem_is_built(which, shapes):
+    # the rigid corner's vertex (1, 0) carries one constraint per part: no tangent is left for
+    # a friction law (before: refused only inside solve, after the assembly)
+    base = corner_problem(shapes=shapes)
     conditions = dict(base.conditions)
-    conditions["bottom"] = Contact(friction=Coulomb(0.5))
-    conditions["right"] = Contact(friction=Tresca(1.0))
-    pb = ContactProblem(base.mesh, base.material, conditions, body_force=base.body_force)
-    cs = contact_set(pb, P2Space(pb.mesh))
-    corner = cs.nodes == cs.nodes[cs.second][0]
-    law = cs.friction
-    assert law.laws == (Coulomb(0.5), Tresca(1.0))
-    assert (law.index[corner] == -1).all()
-    assert (law.index[~corner & (cs.part == 0)] == 0).all()
-    assert (law.index[~corner & (cs.part == 1)] == 1).all()
-    assert (law.weight[corner] == 0).all()
+    for part in ("bottom", "right") if which == "both" else (which,):
+        conditions[part] = Contact(obstacle=base.conditions[part].obstacle, friction=Coulomb(0.5))
+    with pytest.raises(ProblemError) as info:
+        ContactProblem(base.mesh, base.material, conditions, body_force=base.body_force)
+    msg = str(info.value)
+    assert "the vertex (1, 0) is a corner of contact parts 'bottom' and 'right'" in msg, msg
+    named = ["bottom", "right"] if which == "both" else [which]
+    assert f"and {named} have friction" in msg, msg
+
+
+def test_friction_where_two_parts_continue_each_other_is_accepted():
+    # the bottom split at x = 0.5 into two frictional parts on one floor: one direction at
+    # (0.5, 0), no corner; the solve equals that of the unsplit frictional bottom
+    base = corner_problem()
+    tol = 1e-12
+    split = Mesh.from_arrays(
+        base.mesh.points,
+        base.mesh.cells,
+        {
+            "left": lambda x: np.abs(x[:, 0]) < tol,
+            "top": lambda x: np.abs(x[:, 1] - 1) < tol,
+            "right": lambda x: np.abs(x[:, 0] - 1) < tol,
+            "a": lambda x: (np.abs(x[:, 1]) < tol) & (x[:, 0] <= 0.5 + tol),
+            "b": lambda x: (np.abs(x[:, 1]) < tol) & (x[:, 0] >= 0.5 - tol),
+        },
+    )
+    conditions = {k: v for k, v in base.conditions.items() if k != "bottom"}
+    conditions["right"] = Neumann()
+    two = dict(conditions, a=Contact(friction=Coulomb(0.5)), b=Contact(friction=Coulomb(0.5)))
+    one = dict(conditions, bottom=Contact(friction=Coulomb(0.5)))
+    split_result = solve(ContactProblem(split, base.material, two, body_force=base.body_force))
+    whole = solve(ContactProblem(base.mesh, base.material, one, body_force=base.body_force))
+    assert np.abs(split_result.u - whole.u).max() <= 1e-12 * np.abs(whole.u).max()

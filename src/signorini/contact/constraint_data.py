@@ -11,11 +11,15 @@ from ..algebra.laws import LawGroups
 from ..fem import iso, p2
 from ..fem.quadrature import gauss_legendre
 from ..fem.space import P2Space
+from ..mesh.validation import MeshError
 from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
 
 __all__ = [
+    "DEEP_OVERLAP",
+    "check_dirichlet_admissible",
+    "check_initial_overlap",
     "directions_and_gaps",
     "edge_weights",
     "friction_data",
@@ -36,15 +40,42 @@ def _body_normals(
         return np.broadcast_to(problem.contact_normals[name], nodes.shape + (2,)).copy()
     curve = mesh.curves[mesh.part_index(name)]
     if curve is not None and curve.has_normal:
-        n = curve.normal(space.node_points[nodes.ravel()]).reshape(nodes.shape + (2,))
-        sign = np.sign(np.einsum("ejc,ec->ej", n, chord))
-        return n * np.where(sign < 0, -1.0, 1.0)[..., None]
+        x = space.node_points[nodes.ravel()]
+        try:
+            n = curve.normal(x).reshape(nodes.shape + (2,))
+        except MeshError as err:
+            raise ProblemError(f"the curve of contact part {name!r}: {err}") from err
+        cos = np.einsum("ejc,ec->ej", n, chord)
+        _check_across(name, cos, x)
+        return n * np.where(cos < 0, -1.0, 1.0)[..., None]
     total = np.zeros((space.n_nodes, 2))
     np.add.at(total, nodes[:, :2].ravel(), np.repeat(chord, 2, axis=0))
     out = np.repeat(chord[:, None, :], 3, axis=1)
     mean = total[nodes[:, :2]]
     out[:, :2] = mean / np.hypot(mean[..., 0], mean[..., 1])[..., None]
     return out
+
+
+#: a curve's normal at a node of a contact edge may differ from the edge chord's normal by at
+#: most this angle (radians, 60°): the curve turns by about h / R over an edge, far less on
+#: any mesh that resolves it; a normal along the boundary (the tangent) is 90° off
+CURVE_NORMAL_ANGLE = np.pi / 3
+
+
+def _check_across(name: str, cos: np.ndarray, x: np.ndarray) -> None:
+    """Refuse a curve normal that runs along the boundary rather than across it: ``cos (e, 3)``
+    of its angle to the chord's normal at the nodes ``x (3 e, 2)`` of a part's edges."""
+    bad = np.flatnonzero(np.abs(cos).ravel() < np.cos(CURVE_NORMAL_ANGLE))
+    if bad.size:
+        i = bad[0]
+        angle = np.degrees(np.arccos(min(abs(float(cos.ravel()[i])), 1.0)))
+        raise ProblemError(
+            f"the curve of contact part {name!r} gives at the node ({x[i, 0]:.12g}, "
+            f"{x[i, 1]:.12g}) a normal {angle:.3g}° away from the normal of the boundary edge "
+            f"there (more than {np.degrees(CURVE_NORMAL_ANGLE):.0f}°; {bad.size} node(s)): it "
+            "runs along the boundary, not across it. ProjectedCurve(normal=...) must return "
+            "the curve's normal, not its tangent"
+        )
 
 
 def directions_and_gaps(
@@ -159,3 +190,152 @@ def _integrator(space: P2Space, on_part: np.ndarray, edges: tuple, what: str, k:
         return np.bincount(loc[inside], weights=share.ravel()[inside], minlength=k)
 
     return integrate
+
+
+#: a Dirichlet value may exceed the gap at a node it shares with a contact part by round-off:
+#: this fraction of the larger of max|u_D| and max|ψ| there, plus
+#: :data:`DIRICHLET_POINT_TOL` times the extent of the mesh (round-off of a distance
+#: computed from coordinates)
+DIRICHLET_GAP_RTOL = 1e-9
+DIRICHLET_POINT_TOL = 1e-12
+
+
+def check_dirichlet_admissible(
+    problem: ContactProblem, space: P2Space, nodes: np.ndarray, constraint: tuple, parts: tuple
+) -> None:
+    """Refuse Dirichlet data that violate the contact constraint at a node of a contact part.
+
+    At a node on the closure of both Γ_D and Γ_C the displacement is prescribed, so the
+    constraint ``u(z)·n_z ≤ ψ(z)`` of the contact part holds only if ``u_D(z)·n_z ≤ ψ(z)``:
+    otherwise the admissible set K of the continuous problem is empty (no displacement with
+    these boundary values keeps the body out of the obstacle) and the discrete solutions
+    converge to nothing; the estimator's η7 sees the violation at that node on every level
+    (docs/method.md, *The continuous problem*).
+
+    Parameters
+    ----------
+    problem : ContactProblem
+    space : P2Space
+    nodes : (j,) int array
+        Dirichlet nodes on contact edges, one entry per (node, contact part).
+    constraint : tuple of (j, 2) and (j,) float arrays
+        The constraint direction n_z and the gap ψ(z) of each entry.
+    parts : tuple of (tuple of str, (j,) int array)
+        The contact parts' names and the part of each entry.
+
+    Raises
+    ------
+    ProblemError
+        Naming the node's coordinates, the Dirichlet and the contact part, u_D·n and ψ.
+    """
+    if nodes.size == 0:
+        return
+    direction, gap = constraint
+    x = space.node_points[nodes]
+    value, owner = _dirichlet_values(problem, space, nodes)
+    normal_value = np.einsum("kc,kc->k", value, direction)
+    excess = normal_value - gap
+    pts = space.mesh.points
+    extent = float(np.abs(pts).max() + np.ptp(pts, axis=0).max())
+    scale = max(float(np.abs(value).max()), float(np.abs(gap).max()))
+    bad = np.flatnonzero(excess > DIRICHLET_GAP_RTOL * scale + DIRICHLET_POINT_TOL * extent)
+    if bad.size == 0:
+        return
+    i = bad[np.argmax(excess[bad])]
+    more = f" (and {bad.size - 1} more such node(s))" if bad.size > 1 else ""
+    raise ProblemError(
+        f"the node at ({x[i, 0]:.12g}, {x[i, 1]:.12g}) lies on Dirichlet part {owner[i]!r} and "
+        f"contact part {parts[0][parts[1][i]]!r}{more}: its prescribed displacement u_D = "
+        f"({value[i, 0]:.6g}, {value[i, 1]:.6g}) moves it by u_D·n = {normal_value[i]:.6g} "
+        f"along the constraint direction n = ({direction[i, 0]:.6g}, {direction[i, 1]:.6g}), "
+        f"beyond the gap ψ = {gap[i]:.6g} by {excess[i]:.6g}: the Dirichlet data violate the "
+        "contact constraint, so no admissible displacement exists. Make u_D·n ≤ ψ at the "
+        "parts' common nodes (e.g. move the obstacle or change u_D)"
+    )
+
+
+#: the deepest initial penetration accepted beyond what the Dirichlet data move the body, as
+#: a fraction of the body's size (the diagonal of its bounding box); docs/method.md,
+#: *Obstacles as shapes*, "Initial overlap"
+DEEP_OVERLAP = 0.25
+
+
+def _dirichlet_values(problem: ContactProblem, space: P2Space, nodes: np.ndarray):
+    """``u_D`` at the Dirichlet nodes ``nodes (j,)`` and the Dirichlet part of each (a node on
+    two parts takes the later part's value, as in the assembly)."""
+    x = space.node_points[nodes]
+    value = np.zeros((nodes.size, 2))
+    owner = np.full(nodes.size, "", dtype=object)
+    for name in problem.dirichlet_parts:
+        on = np.isin(nodes, space.part_nodes([name]))
+        if on.any():
+            what = f"the Dirichlet value of part {name!r}"
+            value[on] = evaluate_field(problem.conditions[name].field(), x[on], what)
+            owner[on] = name
+    return value, owner
+
+
+def check_initial_overlap(
+    problem: ContactProblem, space: P2Space, nodes: np.ndarray, constraint: tuple, parts: tuple
+) -> None:
+    """Refuse an obstacle shape that starts deeper inside the body than its linearisation
+    covers.
+
+    Only shapes (``Contact(obstacle=...)``) are checked: their constraint is linearised at the
+    point of the obstacle closest to the node, which for a node deep inside may lie on the far
+    side of the obstacle (the body is pulled through it). A gap function ``ψ`` states the
+    linear model's data directly and is taken as given at any size (a manufactured solution
+    may have a large one).
+    A node ``z`` with ``ψ(z) < 0`` starts inside the obstacle: ``u(z)·(−n_z) ≥ |ψ(z)|``. At a
+    Dirichlet node ``y`` the displacement is ``u_D(y)``, so ``u`` changes by at least
+    ``need = |ψ(z)| − max_y u_D(y)·(−n_z)`` between the two, within the body's size ``d`` (the
+    diagonal of its bounding box): the displacement gradient is at least ``need / d``
+    somewhere. Small-deformation elasticity and the linearised constraint are first-order
+    models in that gradient; beyond ``need > DEEP_OVERLAP · d`` (a gradient of 1/4, where the
+    neglected quadratic terms are an eighth of the linear ones) the solution is not a
+    small-deformation one: refused. An overlap that the Dirichlet data themselves move the
+    body out of (a translation) needs no strain and stays accepted; so does the paper's
+    Example 6.2 (``ψ = −0.2`` on the unit square, u_D = 0: 0.14 d). docs/method.md,
+    *Obstacles as shapes*.
+
+    Parameters
+    ----------
+    problem : ContactProblem
+    space : P2Space
+    nodes : (k,) int array
+        The constrained nodes (not Dirichlet nodes), one entry per (node, contact part).
+    constraint : tuple of (k, 2) and (k,) float arrays
+        The direction n_z and the gap ψ(z) of each entry.
+    parts : tuple of (tuple of str, (k,) int array)
+        The contact parts' names and the part of each entry.
+
+    Raises
+    ------
+    ProblemError
+        Naming the part, the node, its depth, the Dirichlet data's share and the body's size.
+    """
+    direction, gap = constraint
+    pts = space.mesh.points
+    size = float(np.hypot(*np.ptp(pts, axis=0)))
+    shape = np.array([problem.conditions[p].obstacle is not None for p in parts[0]])
+    deep = np.flatnonzero((-gap > DEEP_OVERLAP * size) & shape[parts[1]])
+    if deep.size == 0:
+        return
+    value, _ = _dirichlet_values(problem, space, problem.dirichlet_nodes(space))
+    moved = (value @ -direction[deep].T).max(axis=0)  # (deep,) max_y u_D(y)·(−n_z)
+    need = -gap[deep] - moved
+    worst = int(np.argmax(need))
+    if need[worst] <= DEEP_OVERLAP * size:
+        return
+    i = deep[worst]
+    x, name = space.node_points[nodes[i]], parts[0][parts[1][i]]
+    raise ProblemError(
+        f"the obstacle of contact part {name!r} starts {-gap[i]:.6g} deep inside the body at "
+        f"({x[0]:.12g}, {x[1]:.12g}) (ψ = {gap[i]:.6g}; the Dirichlet data move the body out "
+        f"by at most {moved[worst]:.6g} along the constraint direction), more than "
+        f"{DEEP_OVERLAP} times the body's size {size:.6g} (its bounding box's diagonal): the "
+        "linearised, small-deformation contact model cannot represent an initial overlap that "
+        "deep (it would pull the body through the obstacle with strains of order one). Place "
+        "the obstacle at the body's surface (ψ ≈ 0) and move it in by steps of a load path, or "
+        "shift the obstacle out"
+    )

@@ -31,7 +31,13 @@ from ..fem.space import P2Space
 from ..mesh.geometry import segment_normals
 from ..problem.fields import ProblemError
 from ..problem.problem import ContactProblem
-from .constraint_data import directions_and_gaps, edge_weights, friction_data
+from .constraint_data import (
+    check_dirichlet_admissible,
+    check_initial_overlap,
+    directions_and_gaps,
+    edge_weights,
+    friction_data,
+)
 
 __all__ = [
     "ContactSet",
@@ -51,6 +57,8 @@ SAME_DIRECTION = 1e-8
 #: a corner's two constraint directions must be at least this angle apart (radians): the
 #: corner frame's condition number grows like 1 / sin² of the angle
 MIN_CORNER_ANGLE = 1e-2
+#: two directions at a node closer than MIN_CORNER_ANGLE to opposite are refused as well
+MAX_CORNER_COS = float(np.cos(MIN_CORNER_ANGLE))
 
 
 @dataclass(frozen=True)
@@ -231,7 +239,7 @@ def _empty(parts: tuple[str, ...]) -> ContactSet:
 
 
 def _rows(
-    nodes: np.ndarray, direction: np.ndarray, gap: np.ndarray, points: np.ndarray
+    nodes: np.ndarray, direction: np.ndarray, gap: np.ndarray, points: np.ndarray, names: tuple
 ) -> tuple[np.ndarray, np.ndarray]:
     """Which constraint row each (node, part) candidate becomes, and whether it starts one.
 
@@ -251,6 +259,7 @@ def _rows(
         )
     corner = np.concatenate([[False], same_node]) & ~merge
     cos = np.einsum("kc,kc->k", direction[1:], direction[:-1])
+    _refuse_opposite(nodes, points, names, np.flatnonzero(corner[1:] & (cos < -MAX_CORNER_COS)))
     narrow = np.flatnonzero(corner[1:] & (np.arccos(np.clip(cos, -1, 1)) < MIN_CORNER_ANGLE))
     if narrow.size:
         raise ProblemError(
@@ -264,6 +273,31 @@ def _rows(
     return np.cumsum(starts) - 1, starts
 
 
+def _refuse_opposite(nodes: np.ndarray, points: np.ndarray, names: tuple, pair: np.ndarray):
+    """Refuse a node whose two contact parts' directions are (nearly) opposite.
+
+    Two opposite constraints ``u·n ≤ ψ_1`` and ``−u·n ≤ ψ_2`` bound the same displacement
+    component from both sides: a box, not a corner. The corner frame gives each of a node's
+    constraints its own DOF (``A_z = [n; m]`` must be invertible) and PDAS one bound per DOF,
+    so the pair cannot be represented; and it arises where the body's boundary folds back on
+    itself at the node (a slit, a cusp), or two obstacles pinch one point from both sides.
+    ``pair`` indexes the first of each such pair of candidates.
+    """
+    if pair.size == 0:
+        return
+    i = pair[0]
+    part_names, part = names
+    x = points[nodes[i]]
+    raise ProblemError(
+        f"the node at ({x[0]:.12g}, {x[1]:.12g}) lies on contact parts "
+        f"{part_names[part[i]]!r} and {part_names[part[i + 1]]!r}, whose constraint directions "
+        f"there are opposite (within {MIN_CORNER_ANGLE} rad; {pair.size} such node(s)): the "
+        "two constraints bound one displacement component from both sides, which a corner "
+        "node's two constraints cannot represent. Let the obstacles meet the body on one side "
+        "of the node, or make the node a Dirichlet node"
+    )
+
+
 def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     """Collect the constraints of ``space`` for ``problem`` (docs/method.md, *Discrete
     problem* and *Contact directions*).
@@ -271,10 +305,13 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     Raises
     ------
     ProblemError
-        If every contact node is a Dirichlet node, contact parts with the same direction at a
-        shared node have different gaps, two directions at a corner are nearly parallel, a
-        node lies on more than two contact parts, or a gap function or obstacle does not give
-        finite numbers.
+        If every contact node is a Dirichlet node, a Dirichlet value violates the contact
+        constraint at a node shared with a contact part
+        (:func:`check_dirichlet_admissible`), an obstacle starts deeper inside the body than a
+        quarter of its size (:func:`check_initial_overlap`), contact parts with the same
+        direction at a shared node have different gaps, two directions at a corner are nearly
+        parallel, a node lies on more than two contact parts, or a gap function or obstacle
+        does not give finite numbers.
     """
     mesh = space.mesh
     parts = tuple(problem.contact_parts)
@@ -298,12 +335,28 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     free = ~np.isin(cand_node, problem.dirichlet_nodes(space))
     if not free.any():
         raise ProblemError("every node of the contact boundary is a Dirichlet node")
+    held = np.flatnonzero(~free)
+    check_dirichlet_admissible(
+        problem,
+        space,
+        cand_node[held],
+        (direction.reshape(-1, 2)[first[held]], edge_gap.ravel()[first[held]]),
+        (parts, ukey[held] % n_parts),
+    )
     kept = np.flatnonzero(free)
+    check_initial_overlap(
+        problem,
+        space,
+        cand_node[kept],
+        (direction.reshape(-1, 2)[first[kept]], edge_gap.ravel()[first[kept]]),
+        (parts, ukey[kept] % n_parts),
+    )
     row_of, starts = _rows(
         cand_node[kept],
         direction.reshape(-1, 2)[first[kept]],
         edge_gap.ravel()[first[kept]],
         space.node_points,
+        (parts, ukey[kept] % n_parts),
     )
     cand_row = np.full(ukey.size, -1)
     cand_row[kept] = row_of

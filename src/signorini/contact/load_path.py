@@ -18,7 +18,7 @@ from ..mesh.mesh import Mesh
 from ..problem.problem import ContactProblem
 from .solution import ContactResult, solve
 
-__all__ = ["check_path", "solve_path"]
+__all__ = ["check_path", "mesh_difference", "solve_path"]
 
 log = logging.getLogger(__name__)
 
@@ -61,7 +61,8 @@ def solve_path(
     ------
     ValueError
         If ``problems`` is empty or holds something else than problems, or two steps have
-        different contact parts or initial meshes (naming the step).
+        different contact parts or initial meshes, including their boundary parts and curves
+        (naming the step and what differs).
     """
     problems = check_path(problems)
     mesh = problems[0].mesh if mesh is None else mesh
@@ -111,4 +112,63 @@ def check_path(problems: object) -> list[ContactProblem]:
                 f"problems[{i}] is posed on another mesh than problems[0] ({a.n_cells} and "
                 f"{b.n_cells} cells): the steps of a load path share one mesh"
             )
+        difference = None if a is b else mesh_difference(a, b)
+        if difference:
+            raise ValueError(
+                f"problems[{i}] is posed on the points and cells of problems[0] but {difference}"
+                ": the steps of a load path share one mesh, with its parts and curves (every "
+                "step is solved on the first step's mesh)"
+            )
     return steps
+
+
+#: two curves are the same on a part if their projections (and normals) of the part's edge
+#: midpoints agree to this fraction of the mesh's extent (largest coordinate plus diameter)
+SAME_CURVE_TOL = 1e-12
+
+
+def mesh_difference(a: Mesh, b: Mesh) -> str | None:
+    """What differs between two meshes with the same points and cells, or ``None``.
+
+    Compared: the part of every boundary edge (by name), the curve attached to every part
+    (by where it puts the part's edge midpoints: :meth:`~signorini.mesh.curves.Curve.project`
+    and, where given, :meth:`~signorini.mesh.curves.Curve.normal`), and the cell regions if the
+    meshes have them.
+    """
+
+    def labels(m: Mesh) -> np.ndarray:
+        names = np.array([*m.part_names, ""], dtype=object)
+        return names[m.edge_part]  # -1 (interior) -> ""
+
+    la, lb = labels(a), labels(b)
+    if set(a.part_names) != set(b.part_names):
+        return f"has the parts {sorted(a.part_names)}, problems[0] {sorted(b.part_names)}"
+    moved = np.flatnonzero(la != lb)
+    if moved.size:
+        e = moved[0]
+        x = a.points[a.edges[e]]
+        return (
+            f"labels {moved.size} boundary edge(s) with other parts (the edge "
+            f"({x[0, 0]:.12g}, {x[0, 1]:.12g})–({x[1, 0]:.12g}, {x[1, 1]:.12g}) is on part "
+            f"{la[e]!r}, on problems[0] {lb[e]!r})"
+        )
+    extent = float(np.abs(a.points).max() + np.ptp(a.points, axis=0).max())
+    for name in a.part_names:
+        ca, cb = a.curves[a.part_index(name)], b.curves[b.part_index(name)]
+        if ca is cb:
+            continue
+        if (ca is None) != (cb is None):
+            which = "has a curve" if ca is not None else "has no curve"
+            return f"{which} on part {name!r}, unlike problems[0]"
+        x = a.edge_midpoints[a.part_edges(name)]
+        same = np.abs(ca.project(x) - cb.project(x)).max() <= SAME_CURVE_TOL * extent
+        if same and (ca.has_normal or cb.has_normal):
+            same = ca.has_normal == cb.has_normal and np.allclose(
+                ca.normal(x), cb.normal(x), rtol=0.0, atol=SAME_CURVE_TOL
+            )
+        if not same:
+            return f"attaches another curve to part {name!r} ({ca!r}, problems[0] {cb!r})"
+    ra, rb = getattr(a, "regions", None), getattr(b, "regions", None)
+    if ra is not None and rb is not None and not np.array_equal(ra, rb):
+        return "has other cell regions"
+    return None

@@ -239,6 +239,7 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
     gap = cs.edge_normal_gap(result.u)  # u_h·n − ψ_h at [start, end, midpoint]
     density = _semi_contact_density(result) / unit
     x0, x1 = mesh.points[cs.edge_nodes[:, 0]], mesh.points[cs.edge_nodes[:, 1]]
+    eta7_shares = penetration(x0, x1, gap, scale=float(np.abs(result.u).max(initial=0.0)))
 
     # each integral once per cell or edge, through its own geometry (docs/method.md,
     # *Estimator*, "On curved boundaries")
@@ -266,7 +267,7 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
         "eta_4": on_edges(contact, J4),
         "eta_5": on_edges(contact, J5),
         "eta_6": spread_node_parts(contact, parts6, n_nodes, n_cells),
-        "eta_7": TermShares(None, boundary_cell_shares(contact, penetration(x0, x1, gap), n_cells)),
+        "eta_7": TermShares(None, boundary_cell_shares(contact, eta7_shares, n_cells)),
         "eta_8": spread_node_parts(
             contact, move_dirichlet_thirds(parts8, cs.edge_local), n_nodes, n_cells
         ),

@@ -382,7 +382,9 @@ def friction_work(
     return friction_work_thirds(slip, friction, bound, length, points)
 
 
-def penetration(x0: np.ndarray, x1: np.ndarray, gap: np.ndarray) -> np.ndarray:
+def penetration(
+    x0: np.ndarray, x1: np.ndarray, gap: np.ndarray, scale: float | None = None
+) -> np.ndarray:
     """Each contact edge's share of ``η7² = ‖(u_h·n − ψ_h)⁺‖²_{H^{1/2}(Γ_C)}``.
 
     Parameters
@@ -391,6 +393,9 @@ def penetration(x0: np.ndarray, x1: np.ndarray, gap: np.ndarray) -> np.ndarray:
         Start and end points of the contact edges.
     gap : (k, 3) float array
         ``u_h·n − ψ_h`` at ``[start, end, midpoint]``.
+    scale : float, optional
+        The displacement's size, ``max|u_h|``: where two contact parts meet, their gaps may
+        differ by its round-off (default: ``max|gap|`` only).
 
     Returns
     -------
@@ -403,5 +408,5 @@ def penetration(x0: np.ndarray, x1: np.ndarray, gap: np.ndarray) -> np.ndarray:
     1e9) the distances ``|x − y|`` of the quadrature points would otherwise lose 9 digits.
     """
     origin = x0.min(axis=0) if len(x0) else np.zeros(2)
-    _, share = hhalf_norm2_positive_part(x0 - origin, x1 - origin, gap, validate=False)
+    _, share = hhalf_norm2_positive_part(x0 - origin, x1 - origin, gap, validate=False, scale=scale)
     return share

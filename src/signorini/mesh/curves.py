@@ -158,7 +158,9 @@ class ProjectedCurve(Curve):
         The nearest point of the curve to each point (the package's convention for user
         functions, docs/method.md *User functions*).
     normal : callable ``normal(x (n, 2)) -> (n, 2)``, optional
-        Unit normals at points of the curve; without it :meth:`normal` raises.
+        Unit normals at points of the curve; without it :meth:`normal` raises. Checked where
+        they are used: unit length (:data:`UNIT_TOL`), and, on a contact part, across the
+        boundary (not along it) at each node.
 
     The halfway point of ``p`` and ``q`` is the projection of the chord midpoint
     ``(p + q) / 2``: the midpoint along the curve up to O(h³) for a smooth curve, not exactly.
@@ -200,9 +202,21 @@ class ProjectedCurve(Curve):
         return self._call("project", self._project, x)
 
     def normal(self, x: np.ndarray) -> np.ndarray:
+        """The user's normals at ``x``; ``MeshError`` naming a point where |n| ≠ 1."""
         if self._normal is None:
             raise MeshError("ProjectedCurve: no normal function was given")
-        return self._call("normal", self._normal, x)
+        n = self._call("normal", self._normal, x)
+        length = np.hypot(n[:, 0], n[:, 1])
+        bad = np.flatnonzero(np.abs(length - 1.0) > UNIT_TOL)
+        if bad.size:
+            i = bad[0]
+            raise MeshError(
+                f"ProjectedCurve: normal must return unit vectors; at the point "
+                f"({x[i, 0]:.12g}, {x[i, 1]:.12g}) it returned ({n[i, 0]:.6g}, {n[i, 1]:.6g}) of "
+                f"length {length[i]:.6g} ({bad.size} of {len(n)} points are off by more than "
+                f"{UNIT_TOL:g}); normalise it"
+            )
+        return n
 
     def halfway(self, p: np.ndarray, q: np.ndarray) -> np.ndarray:
         return self.project(0.5 * (_points(p) + _points(q)))
@@ -210,6 +224,10 @@ class ProjectedCurve(Curve):
     def __repr__(self) -> str:
         return f"ProjectedCurve({getattr(self._project, '__name__', 'project')})"
 
+
+#: a user normal (:class:`ProjectedCurve`) whose length differs from 1 by more than this is
+#: refused: a normal computed in floating point is a unit vector to about 1e-16
+UNIT_TOL = 1e-8
 
 #: Candidate (point, piece) pairs examined at once by :meth:`QuadraticBoundary.project`
 #: when it compares a point with every piece.

@@ -102,11 +102,28 @@ def as_cells(cells: np.ndarray, n_points: int, what: str = "cells") -> np.ndarra
     return c
 
 
-def degenerate_cells(points: np.ndarray, cells: np.ndarray, area: np.ndarray) -> np.ndarray:
-    """``(n_cells,)`` bool: cells whose area is round-off relative to their longest edge²."""
+#: the largest aspect ratio (longest edge / smallest height, ``h_max² / (2 |A|)``) of a cell
+#: that is not refused as degenerate. The area computed from float64 coordinates carries an
+#: error of about ``1e-16 h_max²``, so at this aspect ratio it has only 4 correct digits, and
+#: so have the cell's stiffness (∝ 1/|A|) and every quantity computed from it; beyond it
+#: the cell is numerically flat. Accuracy of the solve on cells below the bound is the
+#: solver's concern (its residuals say when it fails).
+MAX_ASPECT = 5e11
+
+
+def aspect_ratios(points: np.ndarray, cells: np.ndarray, area: np.ndarray) -> np.ndarray:
+    """``(n_cells,)`` each cell's longest edge over its smallest height, ``h_max² / (2|A|)``
+    (``inf`` for a zero area): 2/√3 for an equilateral triangle."""
     p = points[cells]
     h2 = ((p - np.roll(p, 1, axis=1)) ** 2).sum(-1).max(axis=1)
-    return np.abs(area) <= 1e-12 * h2
+    with np.errstate(divide="ignore"):
+        return h2 / (2.0 * np.abs(area))
+
+
+def degenerate_cells(points: np.ndarray, cells: np.ndarray, area: np.ndarray) -> np.ndarray:
+    """``(n_cells,)`` bool: cells whose aspect ratio exceeds :data:`MAX_ASPECT` (their area is
+    round-off relative to their longest edge²)."""
+    return aspect_ratios(points, cells, area) >= MAX_ASPECT
 
 
 def nondegenerate_area(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
@@ -117,9 +134,14 @@ def nondegenerate_area(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
     degenerate = degenerate_cells(points, cells, area)
     if degenerate.any():
         bad = np.flatnonzero(degenerate)
+        c = bad[0]
+        corners = ", ".join(f"({x:.12g}, {y:.12g})" for x, y in points[cells[c]])
+        aspect = aspect_ratios(points, cells[c : c + 1], area[c : c + 1])[0]
         raise MeshError(
-            f"degenerate triangle(s) {format_indices(bad)} (zero area or repeated vertex), "
-            f"e.g. cell {bad[0]} = {cells[bad[0]].tolist()}"
+            f"degenerate triangle(s) {format_indices(bad)} (zero area, repeated vertex or a "
+            f"sliver), e.g. cell {c} = {cells[c].tolist()} with vertices {corners}: aspect "
+            f"ratio (longest edge / smallest height) {aspect:.3g}, beyond {MAX_ASPECT:.0e}, "
+            "where its area is round-off of its coordinates"
         )
     return area
 
@@ -158,6 +180,15 @@ def _check_points(points: np.ndarray, cells: np.ndarray) -> None:
         )
 
 
+def _edge_text(points: np.ndarray, edge: np.ndarray) -> str:
+    """``the edge from (x, y) to (x, y) (vertices i and j)`` for a vertex pair ``edge``."""
+    a, b = points[edge[0]], points[edge[1]]
+    return (
+        f"the edge from ({a[0]:.12g}, {a[1]:.12g}) to ({b[0]:.12g}, {b[1]:.12g}) (vertices "
+        f"{edge[0]} and {edge[1]})"
+    )
+
+
 def _check_part_labels(mesh: Mesh) -> None:
     """Every boundary row has a valid part index, and every part owns an edge."""
     if mesh.boundary_part.shape != (len(mesh.boundary),):
@@ -167,7 +198,7 @@ def _check_part_labels(mesh: Mesh) -> None:
         first = mesh.boundary[np.flatnonzero(bad_part)[0]]
         raise MeshError(
             f"{int(bad_part.sum())} boundary edge(s) have no part, first "
-            f"({first[0]}, {first[1]}); label every boundary edge"
+            f"{_edge_text(mesh.points, first)}; label every boundary edge"
         )
     for index, name in enumerate(mesh.part_names):
         if not np.any(mesh.boundary_part == index):
@@ -188,10 +219,9 @@ def _check_boundary_labelled(mesh: Mesh, is_bnd: np.ndarray) -> None:
     labelled[be] = True
     missing = np.flatnonzero(is_bnd & ~labelled)
     if missing.size:
-        e = mesh.edges[missing[0]]
         raise MeshError(
             f"{missing.size} boundary edge(s) without a part, first "
-            f"({e[0]}, {e[1]}); label every boundary edge"
+            f"{_edge_text(mesh.points, mesh.edges[missing[0]])}; label every boundary edge"
         )
 
 

@@ -328,3 +328,40 @@ def test_polyline_against_brute_force():
     w = np.array([[0.4, -0.1, -0.5], [-0.1, 0.64, 0.36], [0.64, 0.3, 0.2]])
     ref = brute_force_seminorm(x0, x1, w)
     assert hhalf_seminorm2_positive_part(x0, x1, w)[0] == pytest.approx(ref, rel=1e-10)
+
+
+def _corner_edges():
+    # two edges meeting at a right angle at (1, 0): the floor and the wall of a corner
+    x0 = np.array([[0.0, 0.0], [1.0, 1.0]])
+    x1 = np.array([[1.0, 0.0], [1.0, 0.0]])
+    return x0, x1
+
+
+def test_round_off_jump_at_a_corner_is_measured_on_the_data_scale():
+    # a corner node closed to round-off on both contact parts: the two gaps u·n − ψ differ by
+    # 8.7e-19 there, where the penetration's own size is 1.7e-18 (the other nodes are open by
+    # 1e-3). Measured on v's own size the jump read as a discontinuity ("v jumps by …");
+    # on the data's size (max|w| by default, or the displacement's) it is round-off.
+    x0, x1 = _corner_edges()
+    w_small = np.array([[1.2e-18, 1.7e-18, 1.5e-18], [1e-18, 0.83e-18, 0.9e-18]])
+    # with an open edge elsewhere on Γ_C
+    far0, far1 = np.array([[5.0, 0.0]]), np.array([[6.0, 0.0]])
+    w = np.vstack([w_small, [-1e-3, -1e-3, -1e-3]])
+    total, share = hhalf_norm2_positive_part(np.vstack([x0, far0]), np.vstack([x1, far1]), w)
+    assert 0.0 < total < 1e-34 and share[2] == 0.0
+    # data all of round-off size (every node closed): the caller's scale (max|u_h|) decides
+    with pytest.raises(ValueError, match="v jumps by"):
+        hhalf_norm2_positive_part(x0, x1, w_small, validate=False)
+    total, _ = hhalf_norm2_positive_part(x0, x1, w_small, validate=False, scale=1e-2)
+    assert 0.0 < total < 1e-34
+    total_checked, _ = hhalf_norm2_positive_part(x0, x1, w_small, scale=1e-2)
+    assert total_checked == total
+
+
+def test_a_true_jump_at_a_corner_is_still_refused():
+    x0, x1 = _corner_edges()
+    w = np.array([[0.0, 1.0, 0.5], [0.0, 0.5, 0.25]])
+    with pytest.raises(ValueError, match="discontinuous"):
+        hhalf_norm2_positive_part(x0, x1, w, scale=1.0)
+    with pytest.raises(ValueError, match="v jumps by"):
+        hhalf_norm2_positive_part(x0, x1, w, validate=False, scale=1.0)

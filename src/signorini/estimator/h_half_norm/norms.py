@@ -78,7 +78,9 @@ def _seminorm_shares(pc: PositivePartPieces) -> np.ndarray:
     return np.bincount(pc.edge, weights=share, minlength=k)
 
 
-def l2_norm2_positive_part(x0, x1, w, *, validate: bool = True) -> tuple[float, np.ndarray]:
+def l2_norm2_positive_part(
+    x0, x1, w, *, validate: bool = True, scale: float | None = None
+) -> tuple[float, np.ndarray]:
     """``||max(w, 0)||^2_{L^2(Γ_C)}`` and its per-edge shares.
 
     Parameters
@@ -89,6 +91,8 @@ def l2_norm2_positive_part(x0, x1, w, *, validate: bool = True) -> tuple[float, 
         Quadratic on each edge, values at ``[start, end, midpoint]``.
     validate : bool
         Check the input (see :func:`hhalf_norm2_positive_part`).
+    scale : float, optional
+        The size of the data ``w`` (see :func:`hhalf_norm2_positive_part`).
 
     Returns
     -------
@@ -97,12 +101,14 @@ def l2_norm2_positive_part(x0, x1, w, *, validate: bool = True) -> tuple[float, 
     eta2_edge : ndarray of float64, shape (k,)
         Share of each edge; sums to ``total``.
     """
-    pc = positive_part_pieces(x0, x1, w, validate=validate)
+    pc = positive_part_pieces(x0, x1, w, validate=validate, scale=scale)
     eta2 = np.bincount(pc.edge, weights=_l2_shares(pc), minlength=pc.n_edges)
     return float(eta2.sum()), eta2.astype(np.float64)
 
 
-def hhalf_seminorm2_positive_part(x0, x1, w, *, validate: bool = True) -> tuple[float, np.ndarray]:
+def hhalf_seminorm2_positive_part(
+    x0, x1, w, *, validate: bool = True, scale: float | None = None
+) -> tuple[float, np.ndarray]:
     """``∫_{Γ_C}∫_{Γ_C} (v(x) - v(y))^2 / |x - y|^2``, ``v = max(w, 0)``, and per-edge shares.
 
     Parameters
@@ -113,6 +119,8 @@ def hhalf_seminorm2_positive_part(x0, x1, w, *, validate: bool = True) -> tuple[
         Quadratic on each edge, values at ``[start, end, midpoint]``.
     validate : bool
         Check the input (see :func:`hhalf_norm2_positive_part`).
+    scale : float, optional
+        The size of the data ``w`` (see :func:`hhalf_norm2_positive_part`).
 
     Returns
     -------
@@ -121,11 +129,13 @@ def hhalf_seminorm2_positive_part(x0, x1, w, *, validate: bool = True) -> tuple[
     eta2_edge : ndarray of float64, shape (k,)
         Share of each edge (see the module notes); sums to ``total``.
     """
-    eta2 = _seminorm_shares(positive_part_pieces(x0, x1, w, validate=validate))
+    eta2 = _seminorm_shares(positive_part_pieces(x0, x1, w, validate=validate, scale=scale))
     return float(eta2.sum()), eta2
 
 
-def hhalf_norm2_positive_part(x0, x1, w, *, validate: bool = True) -> tuple[float, np.ndarray]:
+def hhalf_norm2_positive_part(
+    x0, x1, w, *, validate: bool = True, scale: float | None = None
+) -> tuple[float, np.ndarray]:
     """η7² = ``||max(w, 0)||^2_{H^{1/2}(Γ_C)}`` and its split over the edges of Γ_C.
 
     The norm is ``||v||^2_{L^2} + ∫∫ (v(x) - v(y))^2 / |x - y|^2 ds_x ds_y``
@@ -143,6 +153,12 @@ def hhalf_norm2_positive_part(x0, x1, w, *, validate: bool = True) -> tuple[floa
         Check shapes, finiteness, edge lengths and the continuity of ``max(w, 0)`` at
         shared end points. The estimator passes ``False``: its arrays come from a valid
         contact set (docs/method.md, *Estimator*).
+    scale : float, optional
+        The size of the data ``w`` is computed from (the estimator passes the largest
+        displacement and gap). Where edges meet, ``max(w, 0)`` may differ by round-off of the
+        data, ``CONTINUITY_RTOL · scale``, and is taken as continuous; a larger jump is
+        an error. Default ``max|w|``: with ``w`` itself of the size of round-off (a contact
+        zone closed to round-off), its own round-off would read as a jump.
 
     Returns
     -------
@@ -159,7 +175,7 @@ def hhalf_norm2_positive_part(x0, x1, w, *, validate: bool = True) -> tuple[floa
         ``max(w, 0)`` at a shared end point. Always: on edges that cross or overlap where
         ``v > 0`` (found by the quadrature itself).
     """
-    pc = positive_part_pieces(x0, x1, w, validate=validate)
+    pc = positive_part_pieces(x0, x1, w, validate=validate, scale=scale)
     eta2 = _seminorm_shares(pc)
     eta2 = eta2 + np.bincount(pc.edge, weights=_l2_shares(pc), minlength=pc.n_edges)
     return float(eta2.sum()), eta2

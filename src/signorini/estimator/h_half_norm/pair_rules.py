@@ -170,8 +170,9 @@ def _duffy_pair_kernel(pc, p, up, p_end, q, uq, q_end) -> np.ndarray:
     if np.any(jump > parameters.CONTINUITY_RTOL * pc.v_scale):
         # shared end points were checked on input: this is a point where edges cross
         raise ValueError(
-            f"H^1/2 quadrature: v jumps by {jump.max():.3e} where two edges meet away "
-            "from a shared end point; the edges of Γ_C probably overlap or cross each other"
+            f"H^1/2 quadrature: v jumps by {jump.max():.3e} (the data's size is "
+            f"{pc.v_scale:.3e}) where two edges meet away from a shared end point; the edges "
+            "of Γ_C probably overlap or cross each other"
         )
     cos = np.einsum("ij,ij->i", dp, dq)
     order = duffy_angular_order(a, b, cos)

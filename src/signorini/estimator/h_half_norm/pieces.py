@@ -53,6 +53,10 @@ class PositivePartPieces:
         End points of the maximal straight runs of ``Γ_C \\ S`` (where v = 0).
     tol : float
         Distance below which two points are taken as the same point.
+    scale : float
+        The size of the data ``w`` comes from (default ``max|w|``; the estimator passes the
+        displacement's and the gap's): a jump of ``v`` at a point where edges meet below
+        ``CONTINUITY_RTOL · scale`` is round-off, not a discontinuity.
     """
 
     n_edges: int
@@ -66,6 +70,7 @@ class PositivePartPieces:
     run_start: np.ndarray
     run_end: np.ndarray
     tol: float
+    scale: float = 0.0
 
     @property
     def n_pieces(self) -> int:
@@ -79,12 +84,13 @@ class PositivePartPieces:
 
     @property
     def v_scale(self) -> float:
-        """Largest value of v at the ends and midpoints of the pieces (0.0 if S is empty)."""
+        """The scale of ``v`` for continuity checks: :attr:`scale`, or the largest value of v
+        at the ends and midpoints of the pieces if that is larger (0.0 if S is empty)."""
         if self.n_pieces == 0:
             return 0.0
         c0, c1, c2 = self.coef.T
         ends = np.abs(np.concatenate([c0, c0 + c1 + c2, c0 + 0.5 * c1 + 0.25 * c2]))
-        return float(ends.max())
+        return max(float(ends.max()), self.scale)
 
 
 # --------------------------------------------------------------------------- validation
@@ -267,17 +273,19 @@ def _zero_set_runs(x0, x1, pid, rest, zedge, zs, z_lo, z_hi) -> tuple[np.ndarray
     )
 
 
-def _no_pieces(k: int, tol: float) -> PositivePartPieces:
+def _no_pieces(k: int, tol: float, scale: float) -> PositivePartPieces:
     """``S`` empty: nothing to integrate (the zero runs are not needed either)."""
     empty2 = np.zeros((0, 2))
     empty3 = np.zeros((0, 3))
     none = np.zeros(0, dtype=np.int64)
     return PositivePartPieces(
-        k, none, empty2, empty2, empty2, np.zeros(0), empty3, empty3, empty2, empty2, tol
+        k, none, empty2, empty2, empty2, np.zeros(0), empty3, empty3, empty2, empty2, tol, scale
     )
 
 
-def positive_part_pieces(x0, x1, w, *, validate: bool = True) -> PositivePartPieces:
+def positive_part_pieces(
+    x0, x1, w, *, validate: bool = True, scale: float | None = None
+) -> PositivePartPieces:
     """Cut Γ_C at the roots of ``w``: pieces of ``{w > 0}`` and straight zero runs.
 
     Parameters
@@ -291,6 +299,10 @@ def positive_part_pieces(x0, x1, w, *, validate: bool = True) -> PositivePartPie
     validate : bool
         Check the input (:func:`check_edge_data` and the continuity of ``max(w, 0)``);
         callers whose arrays come from a valid mesh pass ``False``.
+    scale : float, optional
+        The size of the data ``w`` is computed from (for ``w = u_h·n − ψ_h``: the largest
+        displacement and gap); ``v`` may jump by round-off, ``CONTINUITY_RTOL · scale``, where
+        edges meet. Default ``max|w|``; a larger ``scale`` only widens that allowance.
 
     Returns
     -------
@@ -311,15 +323,17 @@ def positive_part_pieces(x0, x1, w, *, validate: bool = True) -> PositivePartPie
     extent = np.abs(coords).max() + np.ptp(coords, axis=0).max() if k else 1.0
     tol = float(parameters.POINT_TOL * extent)
     pid = _point_ids(coords)
+    own = float(np.abs(w).max()) if k else 0.0
+    scale = own if scale is None else max(own, float(scale))
     if validate:
         ends = np.maximum(np.concatenate([w[:, 0], w[:, 1]]), 0.0)
-        _check_continuity(pid, ends, k, float(np.abs(w).max()) if k else 0.0)
+        _check_continuity(pid, ends, k, scale)
 
     abc = monomial_coefficients(w)
     cand = maximum_on_unit_interval(w, abc) > 0.0  # edges where v > 0 somewhere
     cand_idx = np.flatnonzero(cand)
     if cand_idx.size == 0:
-        return _no_pieces(k, tol)
+        return _no_pieces(k, tol, scale)
 
     elen = np.hypot(*(x1 - x0).T)
     snap = np.maximum(parameters.ROOT_SNAP, 4.0 * tol / elen[cand_idx])
@@ -351,4 +365,5 @@ def positive_part_pieces(x0, x1, w, *, validate: bool = True) -> PositivePartPie
         run_start=run_start,
         run_end=run_end,
         tol=tol,
+        scale=scale,
     )
