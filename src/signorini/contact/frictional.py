@@ -31,7 +31,7 @@ from ..problem.fields import ProblemError
 from .contact_set import ContactSet
 from .node_frames import to_frames
 from .ordering import ordered_solver
-from .system import Assembled
+from .system import Assembled, obstacle_displacement
 
 __all__ = [
     "Solved",
@@ -203,7 +203,9 @@ def solve_frictional(
     max_iter : int
     previous : ContactResult, optional
         The previous load step (checked by :func:`check_previous`): the law acts on the slip
-        from its tangential displacements (:func:`slip_reference`); without ``u0`` its states
+        from its tangential displacements (:func:`slip_reference`) relative to its obstacles,
+        moved by this step's obstacle motion (``assembled.obstacle_motion``;
+        docs/method.md, *Obstacle motion*); without ``u0`` its states
         (laws of the same classes node by node) or its displacement (else) are the warm start.
     active0 : (k,) bool array, optional
         The nodes in contact in ``u0`` (the frictionless warm-start rule of ``solve``).
@@ -214,9 +216,13 @@ def solve_frictional(
     check_friction_set(cs)
     law = cs.friction
     warm = {}
-    reference = np.zeros(cs.size)
+    # slip relative to the obstacle: its prescribed displacement counts (docs/method.md,
+    # *Obstacle motion*)
+    tangent = cs.tangent[:, 0]
+    reference = np.einsum("kc,kc->k", assembled.obstacle_motion, tangent)
     if previous is not None:
-        reference = slip_reference(previous, cs)
+        moved = obstacle_displacement(previous.problem, previous.contact)
+        reference += slip_reference(previous, cs) - np.einsum("kc,kc->k", moved, tangent)
         if u0 is None and same_law_kinds(previous.contact.friction, law):
             warm = {"state0": previous.state, "direction0": previous.direction}
         elif u0 is None:

@@ -132,7 +132,7 @@ class ContactResult:
         The tangential displacement of no slip per constraint, which the friction law's slip
         ``u(z)·t_z − tangential_reference`` is measured from: the previous load step's
         ``u(z)·t_z`` (docs/method.md, *Load paths*), 0 for a single step and without
-        friction.
+        friction; with a moved obstacle, relative to it (docs/method.md, *Obstacle motion*).
 
     Derived: ``ndof``, ``density`` s_z, ``pressure`` p_z, ``total_contact_force``,
     ``classes``, :meth:`contact_profile` (the contact quantities of a part in boundary
