@@ -11,7 +11,16 @@ from signorini.examples.hertz_half import hertz_quarter, hertz_quarter_metrics
 from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle
 from signorini.output import fitted_slope
-from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError, Roller
+from signorini.problem import (
+    Contact,
+    ContactProblem,
+    Coulomb,
+    Dirichlet,
+    HalfPlane,
+    Neumann,
+    ProblemError,
+    Roller,
+)
 
 #: P per unit thickness on the whole cylinder: a / R ≈ 0.1 with E = 1, ν = 0.3
 FORCE = 0.0084
@@ -58,7 +67,7 @@ def test_no_load_along_the_free_motion_is_refused():
         "bottom": Contact(gap=0.0),
     }
     problem = ContactProblem(mesh, Material.from_young(1.0, 0.3), conditions)
-    with pytest.raises(ProblemError, match=r"no component along .*along \(0\.0, 1\.0\)"):
+    with pytest.raises(ProblemError, match=r"does not press the body.*along \(0\.0, 1\.0\)"):
         solve(problem)
 
 
@@ -82,3 +91,33 @@ def test_motion_that_no_contact_holds_is_refused_at_build_time():
     p = ContactProblem(mesh, material, {**free, "left": Roller(), "bottom": Roller()})
     assert p.rigid_motions.shape == (0, 3)
     assert np.isfinite(solve(p).u).all()
+
+
+def test_semi_coercive_body_with_friction_carries_its_weight():
+    # u_x held along the top holds the horizontal translation; the vertical translation and
+    # the rotation about a point of the top are held by the frictional foundation the block
+    # rests on under its own weight
+    mesh = rectangle(0.0, 2.0, 0.0, 1.0, 8, 4)
+    conditions = {
+        "top": Dirichlet((0.0, None)),
+        "left": Neumann(),
+        "right": Neumann(),
+        "bottom": Contact(obstacle=HalfPlane((0.0, 0.0), (0.0, 1.0)), friction=Coulomb(0.3)),
+    }
+    weight = 0.05
+    problem = ContactProblem(
+        mesh, Material.from_young(1.0, 0.3), conditions, body_force=lambda x: (0.0, -weight)
+    )
+    assert problem.rigid_motions.shape == (2, 3)
+    result = solve(problem)
+    assert result.total_contact_force == pytest.approx(2.0 * weight, rel=1e-10)
+    # symmetric about x = 1: the friction forces cancel
+    assert abs(result.tangential_force.sum()) <= 1e-10 * result.total_contact_force
+
+
+def test_friction_at_a_node_a_roller_holds_tangentially_is_refused():
+    problem = hertz_quarter(force=FORCE, h_bottom=0.1)
+    arc = Contact(obstacle=HalfPlane((0.0, 0.0), (0.0, 1.0)), friction=Coulomb(0.3))
+    problem = ContactProblem(problem.mesh, problem.material, {**problem.conditions, "arc": arc})
+    with pytest.raises(ProblemError, match=r"'arc' has friction at the node \(0\.0, 0\.0\)"):
+        solve(problem)

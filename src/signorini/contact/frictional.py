@@ -208,7 +208,8 @@ def solve_frictional(
         docs/method.md, *Obstacle motion*); without ``u0`` its states
         (laws of the same classes node by node) or its displacement (else) are the warm start.
     active0 : (k,) bool array, optional
-        The nodes in contact in ``u0`` (the frictionless warm-start rule of ``solve``).
+        The nodes in contact in ``u0`` (the frictionless warm-start rule of ``solve``);
+        without ``u0`` and ``previous``, the first active set (those nodes stick).
     warm_rtol : float
         The relative size below which a tangential displacement of ``u0`` counts as zero.
     """
@@ -234,6 +235,11 @@ def solve_frictional(
         warm = {"state0": state0, "direction0": direction0}
     elif u0 is not None:
         warm = {"x0": to_frames(u0.ravel(), cs.frame_nodes, cs.frames)}
+    elif active0 is not None and not warm:
+        # a first active set without a displacement (a semi-coercive body: docs/method.md,
+        # *Force control*): those nodes stick, the others are out of contact
+        state0 = np.where(active0, STICK, INACTIVE).astype(np.int64)
+        warm = {"state0": state0, "direction0": np.zeros(cs.size, dtype=np.int64)}
     nodes = cs.nodes
     problem = check_friction(
         K, F, 2 * nodes, 2 * nodes + 1, cs.gap, assembled.dirichlet, assembled.dirichlet_values,

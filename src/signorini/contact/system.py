@@ -177,7 +177,8 @@ def _dirichlet_dofs(
     ------
     ProblemError
         If a component held at a constrained node is not one free frame DOF (a roller that
-        holds the contact direction, or part of it), naming the node and both parts.
+        holds the contact direction, or part of it), or the node has friction, naming the
+        node and the contact part.
     """
     held = problem.held_components(space)
     values = np.zeros((space.n_nodes, 2))
@@ -208,6 +209,17 @@ def _dirichlet_dofs(
                 "there is not perpendicular to the held component: the two conditions "
                 "conflict (end the roller before the contact part, or make the contact "
                 "direction at the shared node perpendicular to it)"
+            )
+        rows = cs.local(nodes)
+        if cs.has_friction and (cs.friction.index[rows] >= 0).any():
+            k = int(np.flatnonzero(cs.friction.index[rows] >= 0)[0])
+            raise ProblemError(
+                f"contact part {cs.parts[cs.part[rows[k]]]!r} has friction at the node "
+                f"{tuple(np.round(space.node_points[nodes[k]], 12).tolist())}, whose "
+                "tangential displacement a Dirichlet or Roller part holds: the friction law "
+                "has no slip to act on there. Give the contact part no friction, or end the "
+                "roller before it (a symmetry plane through a frictional contact: model the "
+                "whole body)"
             )
         held[nodes] = False
         held[nodes, j] = True
