@@ -220,10 +220,12 @@ def solve_frictional(
     # slip relative to the obstacle: its prescribed displacement counts (docs/method.md,
     # *Obstacle motion*)
     tangent = cs.tangent[:, 0]
-    reference = np.einsum("kc,kc->k", assembled.obstacle_motion, tangent)
+    reference = np.einsum("kc,kc->k", assembled.obstacle_motion, tangent) + 0.0
     if previous is not None:
         moved = obstacle_displacement(previous.problem, previous.contact)
-        reference += slip_reference(previous, cs) - np.einsum("kc,kc->k", moved, tangent)
+        reference += slip_reference(previous, cs)
+        if moved.any():
+            reference -= np.einsum("kc,kc->k", moved, tangent)
         if u0 is None and same_law_kinds(previous.contact.friction, law):
             warm = {"state0": previous.state, "direction0": previous.direction}
         elif u0 is None:
