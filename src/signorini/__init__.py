@@ -28,6 +28,7 @@ from .problem import (
     ExactSolution,
     Neumann,
     ProblemError,
+    Roller,
     Tresca,
 )
 from .problem.obstacles import Disc, HalfPlane, Obstacle, Polyline, SignedDistance
@@ -61,6 +62,7 @@ __all__ = [
     "Polyline",
     "ProblemError",
     "ProjectedCurve",
+    "Roller",
     "SignedDistance",
     "Tresca",
     "adaptive",

@@ -104,7 +104,7 @@ def test_no_dirichlet_part():
 
 
 def test_condition_of_wrong_type():
-    with pytest.raises(ProblemError, match="must be Dirichlet, Neumann or Contact"):
+    with pytest.raises(ProblemError, match="must be Dirichlet, Roller, Neumann or Contact"):
         ContactProblem(
             _square(),
             MATERIAL,

@@ -261,16 +261,19 @@ DEEP_OVERLAP = 0.25
 
 
 def _dirichlet_values(problem: ContactProblem, space: P2Space, nodes: np.ndarray):
-    """``u_D`` at the Dirichlet nodes ``nodes (j,)`` and the Dirichlet part of each (a node on
-    two parts takes the later part's value, as in the assembly)."""
+    """``u_D`` at the Dirichlet nodes ``nodes (j,)`` (held in both components, from one part
+    or two) and the Dirichlet part of each (a node on two parts takes the later part's value
+    in each component that part holds, as in the assembly)."""
     x = space.node_points[nodes]
     value = np.zeros((nodes.size, 2))
     owner = np.full(nodes.size, "", dtype=object)
-    for name in problem.dirichlet_parts:
-        on = np.isin(nodes, space.part_nodes([name]))
-        if on.any():
+    for name, cond in problem.held.items():  # Dirichlet and Roller parts, as Dirichlet
+        on = np.flatnonzero(np.isin(nodes, space.part_nodes([name])))
+        if on.size:
             what = f"the Dirichlet value of part {name!r}"
-            value[on] = evaluate_field(problem.conditions[name].field(), x[on], what)
+            comp = np.flatnonzero(cond.components)
+            v = evaluate_field(cond.field(), x[on], what)
+            value[on[:, None], comp[None, :]] = v[:, comp]
             owner[on] = name
     return value, owner
 

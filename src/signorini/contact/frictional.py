@@ -31,7 +31,7 @@ from ..problem.fields import ProblemError
 from .contact_set import ContactSet
 from .node_frames import to_frames
 from .ordering import ordered_solver
-from .system import Assembled
+from .system import Assembled, obstacle_displacement
 
 __all__ = [
     "Solved",
@@ -203,10 +203,13 @@ def solve_frictional(
     max_iter : int
     previous : ContactResult, optional
         The previous load step (checked by :func:`check_previous`): the law acts on the slip
-        from its tangential displacements (:func:`slip_reference`); without ``u0`` its states
+        from its tangential displacements (:func:`slip_reference`) relative to its obstacles,
+        moved by this step's obstacle motion (``assembled.obstacle_motion``;
+        docs/method.md, *Obstacle motion*); without ``u0`` its states
         (laws of the same classes node by node) or its displacement (else) are the warm start.
     active0 : (k,) bool array, optional
-        The nodes in contact in ``u0`` (the frictionless warm-start rule of ``solve``).
+        The nodes in contact in ``u0`` (the frictionless warm-start rule of ``solve``);
+        without ``u0`` and ``previous``, the first active set (those nodes stick).
     warm_rtol : float
         The relative size below which a tangential displacement of ``u0`` counts as zero.
     """
@@ -214,9 +217,15 @@ def solve_frictional(
     check_friction_set(cs)
     law = cs.friction
     warm = {}
-    reference = np.zeros(cs.size)
+    # slip relative to the obstacle: its prescribed displacement counts (docs/method.md,
+    # *Obstacle motion*)
+    tangent = cs.tangent[:, 0]
+    reference = np.einsum("kc,kc->k", assembled.obstacle_motion, tangent) + 0.0
     if previous is not None:
-        reference = slip_reference(previous, cs)
+        moved = obstacle_displacement(previous.problem, previous.contact)
+        reference += slip_reference(previous, cs)
+        if moved.any():
+            reference -= np.einsum("kc,kc->k", moved, tangent)
         if u0 is None and same_law_kinds(previous.contact.friction, law):
             warm = {"state0": previous.state, "direction0": previous.direction}
         elif u0 is None:
@@ -228,6 +237,11 @@ def solve_frictional(
         warm = {"state0": state0, "direction0": direction0}
     elif u0 is not None:
         warm = {"x0": to_frames(u0.ravel(), cs.frame_nodes, cs.frames)}
+    elif active0 is not None and not warm:
+        # a first active set without a displacement (a semi-coercive body: docs/method.md,
+        # *Force control*): those nodes stick, the others are out of contact
+        state0 = np.where(active0, STICK, INACTIVE).astype(np.int64)
+        warm = {"state0": state0, "direction0": np.zeros(cs.size, dtype=np.int64)}
     nodes = cs.nodes
     problem = check_friction(
         K, F, 2 * nodes, 2 * nodes + 1, cs.gap, assembled.dirichlet, assembled.dirichlet_values,

@@ -3,7 +3,10 @@
 Coulomb friction is path-dependent: the state after a load path is not the static solution
 of its last load. Each step is solved with the previous step's result (``solve(...,
 previous=...)``), so that the friction law acts on the slip increment of the step and the
-iteration starts from the previous states (docs/method.md, *Load paths*).
+iteration starts from the previous states (docs/method.md, *Load paths*). A rigid obstacle
+moved along the path (``shape.moved(d)`` in each step's problem) counts in the slip: the law
+acts on the tangential displacement relative to the obstacle (docs/method.md, *Obstacle
+motion*).
 """
 
 from __future__ import annotations

@@ -25,8 +25,9 @@ from ..fem.postprocess import nodal_stress
 from ..fem.space import P2Space
 from ..mesh.mesh import Mesh
 from ..problem.fields import evaluate_field
-from ..problem.problem import ContactProblem, free_ndof
+from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
+from .force_control import check_load_carried, initial_active_set
 from .frictional import Solved, check_previous, solve_frictional
 from .nested import NESTED_MIN_NDOF, coarse_mesh, transfer_active
 from .node_frames import to_cartesian
@@ -132,7 +133,7 @@ class ContactResult:
         The tangential displacement of no slip per constraint, which the friction law's slip
         ``u(z)·t_z − tangential_reference`` is measured from: the previous load step's
         ``u(z)·t_z`` (docs/method.md, *Load paths*), 0 for a single step and without
-        friction.
+        friction; with a moved obstacle, relative to it (docs/method.md, *Obstacle motion*).
 
     Derived: ``ndof``, ``density`` s_z, ``pressure`` p_z, ``total_contact_force``,
     ``classes``, :meth:`contact_profile` (the contact quantities of a part in boundary
@@ -159,8 +160,8 @@ class ContactResult:
 
     @property
     def ndof(self) -> int:
-        """Free scalar unknowns (the paper's Ndof: :func:`~signorini.problem.problem.free_ndof`)."""
-        return free_ndof(self.space, self.dirichlet_nodes)
+        """Free scalar unknowns, the paper's Ndof (:meth:`ContactProblem.free_ndof`)."""
+        return self.problem.free_ndof(self.space)
 
     @property
     def density(self) -> np.ndarray:
@@ -285,6 +286,8 @@ def solve(
     if assembled is None:
         assembled = assemble(problem, mesh)
     space, cs = assembled.space, assembled.contact
+    if problem.rigid_motions.size:
+        check_load_carried(problem, assembled)
     if previous is not None:
         check_previous(previous, space, cs)
         if u0 is None and not cs.has_friction:
@@ -310,10 +313,14 @@ def solve(
         and mesh is not problem.mesh
         and cs.size > 0
         and not cs.has_friction
-        and free_ndof(space, problem.dirichlet_nodes(space)) >= NESTED_MIN_NDOF
+        and problem.free_ndof(space) >= NESTED_MIN_NDOF
     ):
         active0 = _nested_active_set(problem, assembled, solver, max_iter, fallback)
         timings["nested"] = time.perf_counter() - t0
+    if active0 is None and problem.rigid_motions.size:
+        # semi-coercive: the empty active set leaves the free rigid motions singular; start
+        # from the first points of contact (docs/method.md, *Force control*)
+        active0 = initial_active_set(problem, assembled)
     solved = _solve_system(
         assembled, (K, F), u0=u0, active0=active0, previous=previous,
         options=PDASOptions(max_iter=max_iter, fallback=fallback), solver=solver,
@@ -336,7 +343,7 @@ def solve(
         contact_force=solved.normal_force if unit == 1.0 else solved.normal_force * unit,
         active=solved.state != INACTIVE,
         report=report,
-        dirichlet_nodes=assembled.dirichlet[::2] // 2,
+        dirichlet_nodes=assembled.dirichlet_nodes,
         tangential_force=solved.tangential_force * unit,
         state=solved.state,
         direction=solved.direction,

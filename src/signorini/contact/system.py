@@ -15,13 +15,13 @@ from ..fem.loads import assemble_body_force, assemble_edge_load
 from ..fem.space import P2Space
 from ..fem.stiffness import assemble_stiffness
 from ..mesh.mesh import Mesh
-from ..problem.conditions import Dirichlet, Neumann
+from ..problem.conditions import Neumann
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, contact_set
 from .node_frames import rotate_frames
 
-__all__ = ["Assembled", "assemble", "LOAD_DEGREE"]
+__all__ = ["Assembled", "assemble", "obstacle_displacement", "LOAD_DEGREE"]
 
 #: quadrature degree for loads with smooth data
 LOAD_DEGREE = 8
@@ -47,13 +47,20 @@ class Assembled:
         Dirichlet DOFs are fixed), rotated in place at the constrained nodes.
     F : (n_dofs,) float array
         The load ``L(ψ_i)``: body force and Neumann tractions, rotated like K.
-    dirichlet : (2 n_D,) int array
-        Both DOFs of every Dirichlet node, node after node (sorted by node).
-    dirichlet_values : (2 n_D,) float array
-        The prescribed displacements of those DOFs (Cartesian: Dirichlet nodes are never
-        rotated).
+    dirichlet : (n_held,) int array
+        The held DOFs (sorted): both DOFs of every Dirichlet node, one DOF of a node on a
+        roller or a one-component Dirichlet part (docs/method.md, *Rollers and components*).
+    dirichlet_values : (n_held,) float array
+        The prescribed displacements of those DOFs: Cartesian, except the frame DOF held at
+        a constrained node on a roller (its tangential component).
     seconds : float
         Wall-clock time of the assembly.
+    dirichlet_nodes : (n_D,) int array
+        The nodes whose both DOFs are held.
+    obstacle_motion : (k, 2) float array
+        The prescribed rigid displacement of the obstacle of each constraint's part
+        (:meth:`~signorini.problem.obstacle_base.Obstacle.moved`; 0 for a gap function or
+        an obstacle in place): the friction law's slip is relative to it.
     """
 
     space: P2Space
@@ -63,6 +70,8 @@ class Assembled:
     dirichlet: np.ndarray
     dirichlet_values: np.ndarray
     seconds: float
+    dirichlet_nodes: np.ndarray
+    obstacle_motion: np.ndarray
 
 
 def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
@@ -109,17 +118,97 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
 
         for rows, geometry in space.boundary_edges(edges):
             F += assemble_edge_load(geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE)
-    # Dirichlet values (a node on two Dirichlet parts takes the later part's value)
-    d_nodes = problem.dirichlet_nodes(space)
-    d_values = np.empty((d_nodes.size, 2))
-    for name in problem.dirichlet_parts:
-        cond: Dirichlet = problem.conditions[name]
-        nodes = space.part_nodes([name])
-        d_values[np.searchsorted(d_nodes, nodes)] = evaluate_field(
-            cond.field(), space.node_points[nodes], f"the Dirichlet value of part {name!r}"
-        )
-    dirichlet = np.column_stack([2 * d_nodes, 2 * d_nodes + 1]).ravel()
-
     cs = contact_set(problem, space)
     K, F = rotate_frames(K, F, cs.frame_nodes, cs.frames, copy=False, validate=False)
-    return Assembled(space, cs, K, F, dirichlet, d_values.ravel(), time.perf_counter() - t0)
+    dirichlet, d_values = _dirichlet_dofs(problem, space, cs)
+    return Assembled(
+        space,
+        cs,
+        K,
+        F,
+        dirichlet,
+        d_values,
+        time.perf_counter() - t0,
+        problem.dirichlet_nodes(space),
+        obstacle_displacement(problem, cs),
+    )
+
+
+def obstacle_displacement(problem: ContactProblem, cs: ContactSet) -> np.ndarray:
+    """``(k, 2)`` the prescribed displacement of the obstacle of each constraint of ``cs``
+    (docs/method.md, *Obstacle motion*): ``Obstacle.displacement`` of its part's obstacle,
+    0 for a part with a gap function."""
+    by_part = np.zeros((len(cs.parts), 2))
+    for i, name in enumerate(cs.parts):  # a loop over contact parts
+        obstacle = problem.conditions[name].obstacle
+        if obstacle is not None:
+            by_part[i] = obstacle.displacement
+    return by_part[cs.part] if cs.size else np.zeros((0, 2))
+
+
+def _dirichlet_dofs(
+    problem: ContactProblem, space: P2Space, cs: ContactSet
+) -> tuple[np.ndarray, np.ndarray]:
+    """The held DOFs (sorted) and their values (docs/method.md, *Rollers and components*).
+
+    A node on two Dirichlet parts takes the later part's value in each component that part
+    holds. At a constrained node (in its contact frame ``u = Q y``) a held Cartesian
+    component ``u_c = Q[c] y`` must be one frame DOF: ``Q[c, j] = 0`` for the other ``j``
+    (a roller along the contact direction's tangent, as where a symmetry axis meets a
+    symmetric contact arc), and not a constrained one; that frame DOF is held at
+    ``u_c / Q[c, j]``.
+
+    Raises
+    ------
+    ProblemError
+        If a component held at a constrained node is not one free frame DOF (a roller that
+        holds the contact direction, or part of it), or the node has friction, naming the
+        node and the contact part.
+    """
+    held = problem.held_components(space)
+    values = np.zeros((space.n_nodes, 2))
+    for name, cond in problem.held.items():
+        nodes = space.part_nodes([name])
+        v = evaluate_field(
+            cond.field(), space.node_points[nodes], f"the Dirichlet value of part {name!r}"
+        )
+        comp = np.asarray(cond.components)
+        values[nodes[:, None], np.flatnonzero(comp)[None, :]] = v[:, comp]
+    where = cs.local(np.arange(space.n_nodes))
+    partial = held.any(axis=1) & ~held.all(axis=1) & (where >= 0)
+    if partial.any():
+        nodes = np.flatnonzero(partial)
+        Q = cs.frames[np.searchsorted(cs.frame_nodes, nodes)]  # (m, 2, 2): u = Q y
+        comp = held[nodes, 1].astype(np.int64)  # the one held component
+        row = Q[np.arange(nodes.size), comp]  # (m, 2): u_c = row · y
+        j = np.argmax(np.abs(row), axis=1)
+        other = np.abs(row[np.arange(nodes.size), 1 - j])
+        bad = (other > 1e-9 * np.abs(row).max(axis=1)) | np.isin(2 * nodes + j, cs.constrained_dofs)
+        bad = np.flatnonzero(bad)
+        if bad.size:
+            z = nodes[bad[0]]
+            raise ProblemError(
+                f"the node at {tuple(np.round(space.node_points[z], 12).tolist())} is held in "
+                f"u_{'xy'[comp[bad[0]]]} by a Dirichlet or Roller part and lies on contact "
+                f"part {cs.parts[cs.part[cs.local(np.array([z]))[0]]]!r}, whose direction "
+                "there is not perpendicular to the held component: the two conditions "
+                "conflict (end the roller before the contact part, or make the contact "
+                "direction at the shared node perpendicular to it)"
+            )
+        rows = cs.local(nodes)
+        if cs.has_friction and (cs.friction.index[rows] >= 0).any():
+            k = int(np.flatnonzero(cs.friction.index[rows] >= 0)[0])
+            raise ProblemError(
+                f"contact part {cs.parts[cs.part[rows[k]]]!r} has friction at the node "
+                f"{tuple(np.round(space.node_points[nodes[k]], 12).tolist())}, whose "
+                "tangential displacement a Dirichlet or Roller part holds: the friction law "
+                "has no slip to act on there. Give the contact part no friction, or end the "
+                "roller before it (a symmetry plane through a frictional contact: model the "
+                "whole body)"
+            )
+        held[nodes] = False
+        held[nodes, j] = True
+        values[nodes, j] = values[nodes, comp] / row[np.arange(nodes.size), j]
+        values[nodes, 1 - j] = 0.0
+    dofs = np.flatnonzero(held.ravel())
+    return dofs, values.ravel()[dofs]

@@ -3,7 +3,7 @@ obstacles as shapes (``obstacles``: the base :class:`Obstacle` a shape subclasse
 built-in shapes), the problem itself (``problem``), and the one place where user functions
 are evaluated and checked (``fields``)."""
 
-from .conditions import Contact, Dirichlet, ExactSolution, Neumann
+from .conditions import Contact, Dirichlet, ExactSolution, Neumann, Roller
 from .fields import ProblemError
 from .friction import Coulomb, Tresca
 from .obstacles import Disc, HalfPlane, Obstacle, Polyline, SignedDistance
@@ -21,6 +21,7 @@ __all__ = [
     "Obstacle",
     "Polyline",
     "ProblemError",
+    "Roller",
     "SignedDistance",
     "SlenderBodyWarning",
     "Tresca",

@@ -39,9 +39,13 @@ from .fields import (
 from .friction import LAW_MEMBERS, Friction
 from .obstacles import Obstacle
 
-__all__ = ["Condition", "Contact", "Dirichlet", "ExactSolution", "Neumann"]
+__all__ = ["Condition", "Contact", "Dirichlet", "ExactSolution", "Neumann", "Roller"]
 
 _DIRICHLET = "two finite numbers (u_x, u_y) or a function u_D(x) of points x (n, 2)"
+_COMPONENT = (
+    "two finite numbers (u_x, u_y), one of them possibly None (that component free), or a "
+    "function u_D(x) of points x (n, 2)"
+)
 _TRACTION = (
     "two finite numbers (g_x, g_y) or a function g(x) or g(x, normal) of points x (n, 2) "
     "and outward unit normals normal (n, 2)"
@@ -52,32 +56,91 @@ _NORMAL = "None or two finite numbers, not both zero"
 
 @dataclass(frozen=True)
 class Dirichlet:
-    """Prescribed displacement ``u = u_D`` on a boundary part.
+    """Prescribed displacement ``u = u_D`` on a boundary part, or one component of it.
 
     Parameters
     ----------
-    value : two floats, or callable, default (0, 0)
+    value : two floats (one may be None), or callable, default (0, 0)
         The displacement ``(u_x, u_y)`` on the whole part, or a function ``u_D(x)`` of the
         points ``x``, a float array of shape ``(n, 2)``, returning ``(n, 2)`` (or one
         ``(2,)`` vector for all points). Length units (docs/method.md, *User functions*).
+        A component given as ``None`` is free: ``Dirichlet((0.0, None))`` holds ``u_x = 0``
+        and leaves ``u_y`` and the traction ``σ_yx n_x + σ_yy n_y`` free (zero), as
+        FEniCS's ``DirichletBC(V.sub(0), 0, ...)`` does (docs/method.md, *Rollers and
+        components*). For the normal component of a straight part see :class:`Roller`.
 
     Raises
     ------
     ProblemError
-        If ``value`` is neither two finite numbers nor a function of one argument ``x``.
+        If ``value`` is neither two finite numbers (one of them possibly ``None``, not both)
+        nor a function of one argument ``x``.
     """
 
-    value: VectorField | tuple[float, float] = (0.0, 0.0)
+    value: VectorField | tuple[float | None, float | None] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
         if callable(self.value):
             check_function(self.value, "Dirichlet(value=...)", _DIRICHLET)
+            return
+        value = self.value
+        if isinstance(value, tuple | list) and len(value) == 2 and any(v is None for v in value):
+            given = [v for v in value if v is not None]
+            if not given:
+                raise ProblemError(
+                    f"Dirichlet(value=...) must be {_COMPONENT}; got {value!r} (a part with "
+                    "no component held needs Neumann((0, 0)))"
+                )
+            try:
+                check_numbers(given, 1, "Dirichlet(value=...)", _DIRICHLET)
+            except ProblemError:
+                raise ProblemError(
+                    f"Dirichlet(value=...) must be {_COMPONENT}; got {value!r}"
+                ) from None
         else:
-            check_numbers(self.value, 2, "Dirichlet(value=...)", _DIRICHLET)
+            check_numbers(value, 2, "Dirichlet(value=...)", _DIRICHLET)
+
+    @property
+    def components(self) -> tuple[bool, bool]:
+        """Which of ``(u_x, u_y)`` the condition holds."""
+        if callable(self.value):
+            return (True, True)
+        held = tuple(v is not None for v in self.value)
+        return held  # type: ignore[return-value]
 
     def field(self) -> VectorField:
-        """``u_D`` as a function of ``x (n, 2)``."""
-        return self.value if callable(self.value) else constant_field(self.value)
+        """``u_D`` as a function of ``x (n, 2)`` (a free component reads 0)."""
+        if callable(self.value):
+            return self.value
+        return constant_field(tuple(0.0 if v is None else v for v in self.value))
+
+
+@dataclass(frozen=True)
+class Roller:
+    """A roller (symmetry) condition on a straight part: ``u·n = value``, ``σ_t = 0``.
+
+    The normal component of the displacement is prescribed and the body slides freely along
+    the part (no tangential traction): the symmetry plane of a half-model, or deal.II's
+    "no normal flux" constraint. ``n`` is the part's outward unit normal, so ``value > 0``
+    moves the part outwards. The part must be straight. On a part along an axis the roller
+    holds one Cartesian component (``Roller()`` on ``x = 0`` is ``Dirichlet((0.0, None))``);
+    on an oblique straight part it is refused for now (docs/method.md, *Rollers and
+    components*).
+
+    Parameters
+    ----------
+    value : float, default 0
+        The normal displacement ``u·n`` (length units).
+
+    Raises
+    ------
+    ProblemError
+        If ``value`` is not a finite number.
+    """
+
+    value: float = 0.0
+
+    def __post_init__(self) -> None:
+        check_numbers(self.value, 1, "Roller(value=...)", "a finite number")
 
 
 @dataclass(frozen=True)
@@ -251,4 +314,4 @@ class ExactSolution:
         )
 
 
-Condition = Dirichlet | Neumann | Contact
+Condition = Dirichlet | Roller | Neumann | Contact

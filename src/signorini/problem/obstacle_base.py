@@ -16,6 +16,7 @@ import numpy as np
 
 __all__ = [
     "TIE",
+    "MovedObstacle",
     "Obstacle",
     "checked_point",
     "checked_positive",
@@ -112,3 +113,53 @@ class Obstacle(ABC):
     def _gap_and_direction(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``psi (n,)`` and ``n (n, 2)`` as :meth:`gap_and_direction` returns them, at the
         checked points ``x (n, 2)`` (finite float64)."""
+
+    @property
+    def displacement(self) -> np.ndarray:
+        """``(2,)`` the prescribed rigid displacement of the obstacle from where it was given
+        (zero; :meth:`moved` sets it). The friction law measures slip relative to it
+        (docs/method.md, *Obstacle motion*)."""
+        return np.zeros(2)
+
+    def moved(self, displacement) -> MovedObstacle:
+        """This obstacle translated rigidly by ``displacement (2,)`` (length units), e.g. one
+        load step of a path: ``Disc(c, r).moved((0.1 * t, -0.02))``.
+
+        The gap and direction are those of the moved shape; a friction law on the contact
+        part measures the slip relative to the obstacle, so that dragging the obstacle and
+        moving the body the other way are the same (docs/method.md, *Obstacle motion*).
+        Moving a moved obstacle adds the displacements.
+        """
+        return MovedObstacle(self, displacement)
+
+
+class MovedObstacle(Obstacle):
+    """An obstacle translated rigidly by a prescribed displacement (:meth:`Obstacle.moved`).
+
+    Parameters
+    ----------
+    shape : Obstacle
+        The obstacle where it was given.
+    displacement : (2,) float array
+        Its rigid displacement from there.
+    """
+
+    def __init__(self, shape: Obstacle, displacement):
+        if not isinstance(shape, Obstacle):
+            raise ValueError(f"MovedObstacle: shape must be an Obstacle, got {shape!r}")
+        d = checked_point(displacement, "Obstacle.moved", "displacement")
+        if isinstance(shape, MovedObstacle):
+            shape, d = shape.shape, shape.displacement + d
+        self.shape = shape
+        self._displacement = d
+        self._displacement.flags.writeable = False
+
+    @property
+    def displacement(self) -> np.ndarray:
+        return self._displacement
+
+    def __repr__(self) -> str:
+        return f"{self.shape!r}.moved({self._displacement.tolist()})"
+
+    def _gap_and_direction(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self.shape.gap_and_direction(x - self._displacement)

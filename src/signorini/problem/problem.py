@@ -28,8 +28,9 @@ from ..fem.space import P2Space
 from ..mesh.curves import Line
 from ..mesh.geometry import segment_normals
 from ..mesh.mesh import Mesh
-from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann
+from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann, Roller
 from .fields import ProblemError, VectorField, check_function
+from .rigid import free_rigid_motions
 
 __all__ = ["ContactProblem", "SlenderBodyWarning", "free_ndof"]
 
@@ -72,10 +73,19 @@ class ContactProblem:
     ------
     ProblemError
         Before any work, if a part has no condition or a condition names no part, a condition
-        or the body force is of the wrong kind, a component of the body has no Dirichlet part
-        (the message names each such component), or a contact part with a given normal is not
-        straight along it, or a node where two contact parts meet at an angle lies on a
-        frictional part (:func:`_check_corner_friction`).
+        or the body force is of the wrong kind, a component of a body with Dirichlet parts has
+        none (the message names each such component), a rigid motion is held neither by the
+        Dirichlet and Roller parts nor by the contact parts (the message names it), a
+        contact part with a given normal is not straight along it, or a node where two
+        contact parts meet at an angle lies on a frictional part
+        (:func:`_check_corner_friction`).
+
+    Notes
+    -----
+    A body whose rigid motions are held only partly by Dirichlet and Roller parts, the rest
+    by its contact parts (semi-coercive: a body under force control), is accepted;
+    :attr:`rigid_motions` holds those motions, and the solver checks that the load presses
+    the body onto its contacts along them (docs/method.md, *Force control*).
     """
 
     mesh: Mesh
@@ -85,6 +95,8 @@ class ContactProblem:
     exact: ExactSolution | None = None
     name: str = "problem"
     contact_normals: dict[str, np.ndarray] = field(init=False, repr=False)
+    held: dict[str, Dirichlet] = field(init=False, repr=False)
+    rigid_motions: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         mesh = self.mesh
@@ -112,9 +124,9 @@ class ContactProblem:
                 "Dirichlet(...), Neumann(...) or Contact(...)"
             )
         for name, cond in self.conditions.items():
-            if not isinstance(cond, Dirichlet | Neumann | Contact):
+            if not isinstance(cond, Dirichlet | Roller | Neumann | Contact):
                 raise ProblemError(
-                    f"the condition of part {name!r} must be Dirichlet, Neumann or "
+                    f"the condition of part {name!r} must be Dirichlet, Roller, Neumann or "
                     f"Contact, got {type(cond).__name__}"
                 )
         if self.body_force is not None:
@@ -125,11 +137,18 @@ class ContactProblem:
             )
         if self.exact is not None and not isinstance(self.exact, ExactSolution):
             raise ProblemError(f"exact must be an ExactSolution, got {type(self.exact).__name__}")
-        if not self.dirichlet_parts:
+        if not self.dirichlet_parts and not self.contact_parts:
             raise ProblemError(
                 "the problem needs a Dirichlet part (meas Γ_D > 0) to rule out rigid body motions"
             )
-        _check_components(mesh, self.dirichlet_parts, self.contact_parts)
+        object.__setattr__(
+            self, "held", {name: self._held_condition(name) for name in self.dirichlet_parts}
+        )
+        if self.dirichlet_parts:
+            _check_components(mesh, self.dirichlet_parts, self.contact_parts)
+        object.__setattr__(
+            self, "rigid_motions", free_rigid_motions(mesh, self.held, self.contact_parts)
+        )
         _warn_if_slender(mesh)
         normals = {name: self._segment_normal(name) for name in self.contact_parts}
         normals = {name: n for name, n in normals.items() if n is not None}
@@ -138,7 +157,8 @@ class ContactProblem:
 
     @property
     def dirichlet_parts(self) -> list[str]:
-        return [n for n, c in self.conditions.items() if isinstance(c, Dirichlet)]
+        """The parts with a Dirichlet or Roller condition (all or some components held)."""
+        return [n for n, c in self.conditions.items() if isinstance(c, Dirichlet | Roller)]
 
     @property
     def neumann_parts(self) -> list[str]:
@@ -149,13 +169,51 @@ class ContactProblem:
         return [n for n, c in self.conditions.items() if isinstance(c, Contact)]
 
     def dirichlet_nodes(self, space: P2Space) -> np.ndarray:
-        """Sorted P2 nodes of ``space`` on the closure of Γ_D: both their DOFs are prescribed."""
-        return space.part_nodes(self.dirichlet_parts)
+        """Sorted P2 nodes of ``space`` whose both DOFs are prescribed: on the closure of a
+        part holding both components, or of two parts holding one each (a roller's corner)."""
+        return np.flatnonzero(self.held_components(space).all(axis=1))
 
-    def free_ndof(self, mesh: Mesh) -> int:
-        """Free scalar unknowns on ``mesh``, the paper's Ndof (:func:`free_ndof`)."""
-        space = P2Space(mesh)
-        return free_ndof(space, self.dirichlet_nodes(space))
+    def held_components(self, space: P2Space) -> np.ndarray:
+        """``(n_nodes, 2)`` bool: which components of ``u`` the Dirichlet and Roller parts
+        hold at each P2 node of ``space`` (docs/method.md, *Rollers and components*)."""
+        held = np.zeros((space.n_nodes, 2), dtype=bool)
+        for name, cond in self.held.items():
+            held[space.part_nodes([name])] |= np.asarray(cond.components)
+        return held
+
+    def _held_condition(self, name: str) -> Dirichlet:
+        """The condition of Dirichlet or Roller part ``name`` as a :class:`Dirichlet`: a
+        roller on a straight part along an axis holds the one Cartesian component along its
+        normal."""
+        cond = self.conditions[name]
+        if isinstance(cond, Dirichlet):
+            return cond
+        mesh = self.mesh
+        ab = mesh.oriented_boundary(mesh.part_edges(name))
+        _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+        mean = n.mean(axis=0)
+        mean /= np.linalg.norm(mean)
+        curve = mesh.curves[mesh.part_index(name)]
+        if np.abs(n - mean).max() > 1e-8 or not (curve is None or isinstance(curve, Line)):
+            raise ProblemError(
+                f"Roller on part {name!r}: the part is not straight (its edges' outward "
+                "normals differ); a roller holds the normal component of a straight part"
+            )
+        axis = int(np.argmax(np.abs(mean)))
+        if abs(mean[1 - axis]) > 1e-12:
+            raise ProblemError(
+                f"Roller on part {name!r}: its normal {tuple(np.round(mean, 12))} is not "
+                "along an axis; a roller on an oblique part is not supported (rotate the "
+                "model so that the part is along x or y)"
+            )
+        value = float(np.sign(mean[axis]) * cond.value)
+        return Dirichlet((value, None) if axis == 0 else (None, value))
+
+    def free_ndof(self, mesh: Mesh | P2Space) -> int:
+        """Free scalar unknowns on ``mesh`` (or its space), the paper's Ndof: all DOFs minus
+        the held ones (:func:`free_ndof` without rollers; a roller holds one DOF a node)."""
+        space = mesh if isinstance(mesh, P2Space) else P2Space(mesh)
+        return space.n_dofs - int(self.held_components(space).sum())
 
     def _segment_normal(self, name: str) -> np.ndarray | None:
         """Outward unit normal of a straight contact part with a gap function, checked against

@@ -1,0 +1,115 @@
+"""The rigid motions of a body that its Dirichlet and Roller parts leave free, and whether
+its contact parts can hold them (docs/method.md, *Force control*).
+
+A plane rigid motion is ``r(x) = (a − c (y − y_c) / L, b + c (x − x_c) / L)``: coefficients
+``(a, b, c)`` in a basis scaled by the body's centre ``(x_c, y_c)`` and size ``L`` so that the
+three columns are alike. A held component ``u_c`` at a vertex is a linear condition on
+``(a, b, c)``; the null space of all of them is the free motions. Frictionless contact acts
+along the contact directions only, so a free motion tangential to every contact edge (zero
+``r(x_e)·n_e`` at every contact edge's midpoint ``x_e``) is held by nothing.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..mesh.geometry import segment_normals
+from ..mesh.mesh import Mesh
+from .fields import ProblemError
+
+__all__ = ["describe_motion", "free_rigid_motions", "motion_field"]
+
+#: a singular value below this times the largest is zero (the conditions are O(1) numbers)
+RANK_RTOL = 1e-9
+
+
+def _frame(mesh: Mesh) -> tuple[np.ndarray, float]:
+    centre = 0.5 * (mesh.points.min(axis=0) + mesh.points.max(axis=0))
+    size = float(np.ptp(mesh.points, axis=0).max())
+    return centre, size
+
+
+def motion_field(mesh: Mesh, motions: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The rigid motions ``motions (k, 3)`` of :func:`free_rigid_motions` at the points
+    ``x (n, 2)``: ``(k, n, 2)``."""
+    centre, size = _frame(mesh)
+    d = (x - centre) / size
+    a, b, c = (motions[:, i, None] for i in range(3))
+    return np.stack([a - c * d[None, :, 1], b + c * d[None, :, 0]], axis=-1)
+
+
+def describe_motion(mesh: Mesh, motion: np.ndarray) -> str:
+    """A rigid motion in words: ``translation along (0, 1)`` or ``rotation about (x, y)``."""
+    centre, size = _frame(mesh)
+    a, b, c = np.asarray(motion, dtype=np.float64) / np.abs(motion).max()
+    if abs(c) <= 1e-8:
+        d = np.array([a, b]) / np.hypot(a, b)
+        d = d if (d[np.argmax(np.abs(d))] > 0) else -d
+        return f"translation along {tuple(np.round(d, 6).tolist())}"
+    p = centre + size * np.array([-b, a]) / c
+    return f"rotation about {tuple(np.round(p, 6).tolist())}"
+
+
+def _null_space(rows: np.ndarray, k: int) -> np.ndarray:
+    """Orthonormal basis ``(m, k)`` of the null space of ``rows (n, k)``."""
+    if rows.shape[0] == 0:
+        return np.eye(k)
+    _, s, vt = np.linalg.svd(rows, full_matrices=True)
+    rank = int((s > RANK_RTOL * s.max()).sum()) if s.size and s.max() > 0 else 0
+    return vt[rank:]
+
+
+def free_rigid_motions(
+    mesh: Mesh, held: Mapping[str, object], contact_parts: list[str]
+) -> np.ndarray:
+    """The rigid motions ``(k, 3)`` (orthonormal coefficients, ``k ≤ 3``) that the held
+    components of ``held`` (part name → :class:`~.conditions.Dirichlet`) leave free.
+
+    Raises
+    ------
+    ProblemError
+        If a free motion is tangential to every contact part (or there is none): nothing
+        holds it. The message names the motion.
+    """
+    centre, size = _frame(mesh)
+    rows = []
+    for name, cond in held.items():  # a loop over parts
+        v = np.unique(mesh.edges[mesh.part_edges(name)])
+        d = (mesh.points[v] - centre) / size
+        one, zero = np.ones(v.size), np.zeros(v.size)
+        by_component = (
+            np.column_stack([one, zero, -d[:, 1]]),
+            np.column_stack([zero, one, d[:, 0]]),
+        )
+        rows += [by_component[c] for c in range(2) if cond.components[c]]
+    free = _null_space(np.concatenate(rows) if rows else np.zeros((0, 3)), 3)
+    if free.shape[0] == 0:
+        return free
+    normals, mids = [], []
+    for name in contact_parts:  # a loop over parts
+        ab = mesh.oriented_boundary(mesh.part_edges(name))
+        _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+        normals.append(n)
+        mids.append(0.5 * (mesh.points[ab[:, 0]] + mesh.points[ab[:, 1]]))
+    if normals:
+        r = motion_field(mesh, free, np.concatenate(mids))  # (k, n_e, 2)
+        along = np.einsum("kec,ec->ek", r, np.concatenate(normals))
+        loose = _null_space(along, free.shape[0]) @ free
+    else:
+        loose = free
+    if loose.shape[0]:
+        motions = "; ".join(describe_motion(mesh, m) for m in loose)
+        held_by = (
+            f"the contact parts {contact_parts} act only along their normals, to which it is "
+            "tangential"
+            if contact_parts
+            else "there is no contact part"
+        )
+        raise ProblemError(
+            f"the problem needs a Dirichlet part (meas Γ_D > 0), a Roller or a contact part "
+            f"to hold the rigid motion {motions}: the Dirichlet and Roller parts "
+            f"{list(held)} leave it free and {held_by} (docs/method.md, *Force control*)"
+        )
+    return free
