@@ -214,7 +214,7 @@ class ContactResult:
         def gradient(x: np.ndarray) -> np.ndarray:
             return evaluate_field(exact.gradient, x, "the exact gradient", shape=(2, 2))
 
-        cells, material = self.space.mapping, self.problem.material
+        cells, material = self.space.mapping, self.problem.material_on(self.space.mesh)
         energy = energy_error2(cells, u_cell, gradient, material, degree=degree)
         h1 = h1_seminorm_error2(cells, u_cell, gradient, degree=degree)
         return {"error_energy": float(np.sqrt(energy.sum())), "error_h1": float(np.sqrt(h1.sum()))}

@@ -13,13 +13,16 @@ import numpy as np
 from ..mesh.geometry import segment_normals
 from . import p2
 from .mapping import CellMap
-from .material import Material, stress
+from .material import CellMaterials, Material, _per_cell, on_cells, stress
 
 __all__ = ["cell_stress", "div_stress", "edge_traction", "stress_divergence", "traction"]
 
 
 def cell_stress(
-    vertices: CellMap | np.ndarray, u_cell: np.ndarray, material: Material, xi: np.ndarray
+    vertices: CellMap | np.ndarray,
+    u_cell: np.ndarray,
+    material: Material | CellMaterials,
+    xi: np.ndarray,
 ) -> np.ndarray:
     """Stress ``sigma(u_h)`` at reference points of each cell.
 
@@ -43,7 +46,7 @@ def cell_stress(
 
         def group_stress(g):
             points = xi if xi.ndim == 2 else xi[g.cells]
-            return stress(material, g.field_gradients(u[g.cells], points))
+            return stress(on_cells(material, g.cells), g.field_gradients(u[g.cells], points))
 
         return vertices.per_cell(group_stress)
     return stress(material, p2.field_gradients(vertices, u_cell, xi))
@@ -52,7 +55,7 @@ def cell_stress(
 def traction(
     vertices: CellMap | np.ndarray,
     u_cell: np.ndarray,
-    material: Material,
+    material: Material | CellMaterials,
     xi: np.ndarray,
     normal: np.ndarray,
 ) -> np.ndarray:
@@ -84,7 +87,7 @@ def traction(
 def edge_traction(
     vertices: np.ndarray,
     u_cell: np.ndarray,
-    material: Material,
+    material: Material | CellMaterials,
     local_edge: np.ndarray,
     t: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -120,7 +123,9 @@ def edge_traction(
     return traction(v, u_cell, material, xi, normal), normal
 
 
-def div_stress(vertices: np.ndarray, u_cell: np.ndarray, material: Material) -> np.ndarray:
+def div_stress(
+    vertices: np.ndarray, u_cell: np.ndarray, material: Material | CellMaterials
+) -> np.ndarray:
     """``div sigma(u_h)`` on each cell (constant for P2 on straight triangles).
 
     ``(div sigma)_i = mu Laplace u_i + (lam + mu) d_i div u``, from the constant
@@ -140,11 +145,13 @@ def div_stress(vertices: np.ndarray, u_cell: np.ndarray, material: Material) -> 
     return stress_divergence(p2.field_hessian(vertices, u_cell), material)
 
 
-def stress_divergence(hess: np.ndarray, material: Material) -> np.ndarray:
+def stress_divergence(hess: np.ndarray, material: Material | CellMaterials) -> np.ndarray:
     """``div sigma(u)`` ``(..., 2)`` from the Hessian ``(..., 2, 2, 2)`` of ``u``,
     ``hess[..., i, j, k] = d^2 u_i / d x_j d x_k`` (e.g. through a cell's map,
     :meth:`signorini.fem.mapping.IsoparametricCells.field_hessians`):
-    ``mu Laplace u_i + (lam + mu) d_i div u``."""
+    ``mu Laplace u_i + (lam + mu) d_i div u`` (``lam_eff`` in plane stress; a
+    :class:`~signorini.fem.material.CellMaterials` of the leading axis' cells)."""
     lap = hess[..., 0, 0] + hess[..., 1, 1]
     grad_div = hess[..., 0, 0, :] + hess[..., 1, 1, :]
-    return material.mu * lap + (material.lam + material.mu) * grad_div
+    mu = _per_cell(material.mu, lap.ndim)
+    return mu * lap + (_per_cell(material.lam_eff, lap.ndim) + mu) * grad_div

@@ -23,7 +23,8 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     u·n_z = ψ is imposed), ``contact_class`` (0 none, 1 semi, 2 full, −1 off Γ_C) and
     ``contact_state`` (0 inactive, 1 stick, 2 slip, −1 off Γ_C; a frictionless node in contact
     slips). At a corner node with two constraints the scalars are the larger of the two, the
-    tangential pressure and the traction their sums. Cell data: ``eta2`` (element indicators)
+    tangential pressure and the traction their sums. Cell data: ``region`` (the cell's region,
+    an index into ``mesh.region_names``), ``eta2`` (element indicators)
     and ``eta2_k`` per contribution when an estimate is given.
 
     Parameters
@@ -56,7 +57,7 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     np.add.at(tangential, cs.nodes, p_t)
     t = cs.tangent[:, 0]
     np.add.at(traction[:, :2], cs.nodes, -result.pressure[:, None] * cs.normal - p_t[:, None] * t)
-    cell_data = {}
+    cell_data = {"region": [space.mesh.cell_region.astype(np.int32)]}  # into mesh.region_names
     if estimate is not None:
         cell_data["eta2"] = [estimate.eta2]
         for k in range(estimate.eta2_cell.shape[0]):
