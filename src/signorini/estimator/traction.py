@@ -55,7 +55,9 @@ class CellStress:
         self.sigma_vertex, self.unit = sigma_vertex, unit
 
     @classmethod
-    def of(cls, space, u: np.ndarray, material: Material | CellMaterials, unit: float = 1.0) -> CellStress:
+    def of(
+        cls, space, u: np.ndarray, material: Material | CellMaterials, unit: float = 1.0
+    ) -> CellStress:
         """σ(u_h) of the nodal values ``u (n_nodes, 2)`` of a :class:`~signorini.fem.space.
         P2Space`, in the stress unit ``unit``."""
         u_cell = space.cell_values(u)
