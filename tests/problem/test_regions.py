@@ -133,3 +133,16 @@ def test_coated_block_on_an_obstacle_converges_adaptively_at_the_optimal_rate():
     ndof, eta = np.array(levels).T
     assert ndof[-1] > 8000
     assert -1.2 < fitted_slope(ndof, eta, 6) < -0.9
+
+
+def test_vtu_has_the_cells_region(tmp_path):
+    import meshio
+
+    from signorini.output.vtu import write_vtu
+
+    problem, _ = layered_block(nx=2, ny=2)
+    result = solve(problem)
+    path = write_vtu(tmp_path / "layers.vtu", result)
+    region = meshio.read(path).cell_data["region"][0]
+    np.testing.assert_array_equal(region, problem.mesh.cell_region)
+    assert problem.mesh.region_names == ("base", "coating")
