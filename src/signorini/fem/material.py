@@ -16,6 +16,7 @@ last-axis-is-derivative: ``grad_u[..., i, j] = d u_i / d x_j``.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -197,7 +198,7 @@ class CellMaterials:
         Index into ``materials`` of each cell.
     """
 
-    def __init__(self, materials, index: np.ndarray) -> None:
+    def __init__(self, materials: Sequence[Material], index: np.ndarray) -> None:
         self.materials = tuple(materials)
         self.index = np.asarray(index, dtype=np.int64)
         table = np.array([[m.lam, m.lam_eff, m.mu] for m in self.materials]).reshape(-1, 3)
@@ -210,6 +211,9 @@ class CellMaterials:
     def restrict(self, cells: np.ndarray | slice) -> CellMaterials:
         """The materials of the cells ``cells`` (indices, a mask or a slice), in that order."""
         return CellMaterials(self.materials, self.index[cells])
+
+    def __repr__(self) -> str:
+        return f"CellMaterials({list(self.materials)!r}, n_cells={len(self)})"
 
 
 def on_cells(
