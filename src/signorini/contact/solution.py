@@ -195,7 +195,7 @@ class ContactResult:
     def nodal_stress(self) -> np.ndarray:
         """``(n_nodes, 3, 3)`` σ(u_h) at the P2 nodes, each the mean of its cells' values, σ_zz
         from the material (:func:`signorini.fem.postprocess.nodal_stress`)."""
-        return nodal_stress(self.space, self.u, self.problem.material)
+        return nodal_stress(self.space, self.u, self.problem.material_on(self.mesh))
 
     @cached_property
     def classes(self) -> np.ndarray:
@@ -222,7 +222,7 @@ class ContactResult:
         def gradient(x: np.ndarray) -> np.ndarray:
             return evaluate_field(exact.gradient, x, "the exact gradient", shape=(2, 2))
 
-        cells, material = self.space.mapping, self.problem.material
+        cells, material = self.space.mapping, self.problem.material_on(self.space.mesh)
         energy = energy_error2(cells, u_cell, gradient, material, degree=degree)
         h1 = h1_seminorm_error2(cells, u_cell, gradient, degree=degree)
         return {"error_energy": float(np.sqrt(energy.sum())), "error_h1": float(np.sqrt(h1.sum()))}

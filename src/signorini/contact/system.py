@@ -87,13 +87,13 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     # the space of a validated mesh and problem: no need to re-check the arrays
     with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported just below
         K = assemble_stiffness(
-            space.mapping, space.cell_dofs, n_dofs, problem.material, validate=False
+            space.mapping, space.cell_dofs, n_dofs, problem.material_on(mesh), validate=False
         )
     if not np.isfinite(K.data).all():
-        m = problem.material
+        m = problem.material_on(mesh)
         raise ProblemError(
-            f"material: the stiffness matrix overflows float64 (lam = {m.lam:.3g}, "
-            f"mu = {m.mu:.3g}); state E in larger units (e.g. GPa instead of Pa)"
+            f"material: the stiffness matrix overflows float64 (lam = {np.max(m.lam):.3g}, "
+            f"mu = {np.max(m.mu):.3g}); state E in larger units (e.g. GPa instead of Pa)"
         )
     F = np.zeros(n_dofs)
     if problem.body_force is not None:

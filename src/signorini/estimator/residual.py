@@ -53,6 +53,7 @@ from ..contact.contact_set import SEMI_CONTACT
 from ..contact.solution import ContactResult
 from ..fem.iso import curved_edges
 from ..fem.mapping import CellMap, edge_groups
+from ..fem.material import CellMaterials, Material, on_cells
 from ..fem.postprocess import stress_divergence
 from ..fem.quadrature import line_rule, triangle_rule
 from ..fem.space import P2Space
@@ -223,7 +224,7 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
     # unit σ₀ (a power of 4, 1 for ordinary stresses): exact, and no square overflows;
     # Estimate puts σ₀ back (docs/method.md, *Estimator*, "Units")
     u_cell = space.cell_values(result.u)
-    material = problem.material
+    material = problem.material_on(mesh)  # each cell's own where regions differ
     sigma = vertex_stress(cells, u_cell, material)
     unit = stress_unit(float(np.abs(sigma).max(initial=0.0)))
     stresses = CellStress(cells, mesh.points, mesh.cells, u_cell, material, sigma / unit, unit)
@@ -243,7 +244,7 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
 
     # each integral once per cell or edge, through its own geometry (docs/method.md,
     # *Estimator*, "On curved boundaries")
-    R = _interior_residual(problem, cells, u_cell, unit)
+    R = _interior_residual(problem, material, cells, u_cell, unit)
     J3 = _neumann_integrals(problem, mesh, stresses, t_n, w_n, unit)
     J4, J5 = contact_stress(
         stresses, mesh, contact, cs.edge_normal, cs.edge_direction, t, w, pressure, p_t
@@ -321,18 +322,24 @@ def geometry(space: P2Space) -> tuple[CellMap, np.ndarray]:
 
 
 def _interior_residual(
-    problem: ContactProblem, cells: CellMap, u_cell: np.ndarray, unit: float
+    problem: ContactProblem,
+    material: Material | CellMaterials,
+    cells: CellMap,
+    u_cell: np.ndarray,
+    unit: float,
 ) -> np.ndarray:
     """η1's ``‖f + div σ(u_h)‖²_T`` ``(n_cells,)``: div σ(u_h) from the Hessian of u_h through
     each cell's map (constant on affine cells), f at the points of the degree-``CELL_DEGREE``
-    rule (called once, at the points of the maps), both in the stress unit."""
+    rule (called once, at the points of the maps), both in the stress unit; each cell with its
+    own material."""
     xi, w = triangle_rule(CELL_DEGREE)
     f = None
     if problem.body_force is not None:
         f = evaluate_field(problem.body_force, cells.points(xi), "body_force") / unit
 
     def residual(g) -> np.ndarray:
-        div = stress_divergence(g.field_hessians(u_cell[g.cells], xi), problem.material) / unit
+        hess = g.field_hessians(u_cell[g.cells], xi)
+        div = stress_divergence(hess, on_cells(material, g.cells)) / unit
         return interior_residual(
             0.5 * g.jacobians(xi)[1], div, None if f is None else f[g.cells], w
         )

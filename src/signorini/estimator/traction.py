@@ -10,18 +10,22 @@ from collections.abc import Iterator
 import numpy as np
 
 from ..fem.mapping import AffineCells, CellMap, Cells, Edges
-from ..fem.material import Material, stress
+from ..fem.material import CellMaterials, Material, on_cells, stress
 from ..fem.p2 import REFERENCE_NODES, edge_basis, edge_reference_points
 from ..mesh.geometry import segment_normals
 
 __all__ = ["CellStress", "direction_field", "edge_traction", "vertex_stress"]
 
 
-def vertex_stress(cells: CellMap, u_cell: np.ndarray, material: Material) -> np.ndarray:
+def vertex_stress(
+    cells: CellMap, u_cell: np.ndarray, material: Material | CellMaterials
+) -> np.ndarray:
     """σ(u_h) ``(n_cells, 3, 2, 2)`` of each cell at its vertices, through its map, from the
     interleaved coefficients ``u_cell (n_cells, 12)``."""
     vertices = REFERENCE_NODES[:3]
-    return cells.per_cell(lambda g: stress(material, g.field_gradients(u_cell[g.cells], vertices)))
+    return cells.per_cell(
+        lambda g: stress(on_cells(material, g.cells), g.field_gradients(u_cell[g.cells], vertices))
+    )
 
 
 class CellStress:
@@ -37,7 +41,8 @@ class CellStress:
     cells : CellMap
     points, cell_vertices : mesh arrays ``(n_points, 2)``, ``(n_cells, 3)``
     u_cell : (n_cells, 12) float array
-    material : Material
+    material : Material or CellMaterials
+        One material, or each cell's (σ(u_h) of a cell with its own material).
     sigma_vertex : (n_cells, 3, 2, 2) float array
         :func:`vertex_stress`, already divided by ``unit``.
     unit : float
@@ -50,7 +55,9 @@ class CellStress:
         self.sigma_vertex, self.unit = sigma_vertex, unit
 
     @classmethod
-    def of(cls, space, u: np.ndarray, material: Material, unit: float = 1.0) -> CellStress:
+    def of(
+        cls, space, u: np.ndarray, material: Material | CellMaterials, unit: float = 1.0
+    ) -> CellStress:
         """σ(u_h) of the nodal values ``u (n_nodes, 2)`` of a :class:`~signorini.fem.space.
         P2Space`, in the stress unit ``unit``."""
         u_cell = space.cell_values(u)
@@ -65,7 +72,7 @@ class CellStress:
             return edge_traction(self.sigma_vertex, self.points, self.cell_vertices, cell, k, t)
         edges = group.local_edges(slot, k) if edges is None else edges
         grad = group.rows(slot).field_gradients(self.u_cell[cell], edge_reference_points(k, t))
-        sig = stress(self.material, grad) / self.unit
+        sig = stress(on_cells(self.material, cell), grad) / self.unit
         return np.einsum("eqij,eqj->eqi", sig, edges.normals(t))
 
     def on_edges(

@@ -13,7 +13,7 @@ import numpy as np
 from ..mesh.geometry import segment_normals
 from . import iso, p2
 from .mapping import CellMap
-from .material import Material, stress
+from .material import CellMaterials, Material, _per_cell, on_cells, stress, stress_zz
 
 __all__ = [
     "cell_stress",
@@ -26,7 +26,10 @@ __all__ = [
 
 
 def cell_stress(
-    vertices: CellMap | np.ndarray, u_cell: np.ndarray, material: Material, xi: np.ndarray
+    vertices: CellMap | np.ndarray,
+    u_cell: np.ndarray,
+    material: Material | CellMaterials,
+    xi: np.ndarray,
 ) -> np.ndarray:
     """Stress ``sigma(u_h)`` at reference points of each cell.
 
@@ -50,7 +53,7 @@ def cell_stress(
 
         def group_stress(g):
             points = xi if xi.ndim == 2 else xi[g.cells]
-            return stress(material, g.field_gradients(u[g.cells], points))
+            return stress(on_cells(material, g.cells), g.field_gradients(u[g.cells], points))
 
         return vertices.per_cell(group_stress)
     return stress(material, p2.field_gradients(vertices, u_cell, xi))
@@ -59,7 +62,7 @@ def cell_stress(
 def traction(
     vertices: CellMap | np.ndarray,
     u_cell: np.ndarray,
-    material: Material,
+    material: Material | CellMaterials,
     xi: np.ndarray,
     normal: np.ndarray,
 ) -> np.ndarray:
@@ -91,7 +94,7 @@ def traction(
 def edge_traction(
     vertices: np.ndarray,
     u_cell: np.ndarray,
-    material: Material,
+    material: Material | CellMaterials,
     local_edge: np.ndarray,
     t: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -127,7 +130,9 @@ def edge_traction(
     return traction(v, u_cell, material, xi, normal), normal
 
 
-def div_stress(vertices: np.ndarray, u_cell: np.ndarray, material: Material) -> np.ndarray:
+def div_stress(
+    vertices: np.ndarray, u_cell: np.ndarray, material: Material | CellMaterials
+) -> np.ndarray:
     """``div sigma(u_h)`` on each cell (constant for P2 on straight triangles).
 
     ``(div sigma)_i = mu Laplace u_i + (lam + mu) d_i div u``, from the constant
@@ -147,53 +152,51 @@ def div_stress(vertices: np.ndarray, u_cell: np.ndarray, material: Material) -> 
     return stress_divergence(p2.field_hessian(vertices, u_cell), material)
 
 
-def stress_divergence(hess: np.ndarray, material: Material) -> np.ndarray:
+def stress_divergence(hess: np.ndarray, material: Material | CellMaterials) -> np.ndarray:
     """``div sigma(u)`` ``(..., 2)`` from the Hessian ``(..., 2, 2, 2)`` of ``u``,
     ``hess[..., i, j, k] = d^2 u_i / d x_j d x_k`` (e.g. through a cell's map,
     :meth:`signorini.fem.mapping.IsoparametricCells.field_hessians`):
-    ``mu Laplace u_i + (lam + mu) d_i div u``."""
+    ``mu Laplace u_i + (lam + mu) d_i div u`` (``lam_eff`` in plane stress; a
+    :class:`~signorini.fem.material.CellMaterials` of the leading axis' cells)."""
     lap = hess[..., 0, 0] + hess[..., 1, 1]
     grad_div = hess[..., 0, 0, :] + hess[..., 1, 1, :]
-    return material.mu * lap + (material.lam + material.mu) * grad_div
+    mu = _per_cell(material.mu, lap.ndim)
+    return mu * lap + (_per_cell(material.lam_eff, lap.ndim) + mu) * grad_div
 
 
-def nodal_stress(space, u: np.ndarray, material) -> np.ndarray:
+def nodal_stress(space, u: np.ndarray, material: Material | CellMaterials) -> np.ndarray:
     """The stress of the P2 displacement ``u (n_nodes, 2)`` of ``space`` at its nodes, averaged
     over the cells sharing each node.
 
     Each cell gives σ(u_h) at its six nodes (the gradient of its P2 displacement on its own
-    map, curved cells included); a node's value is the mean of the values of its cells. On
-    a linear-elastic field with continuous σ of degree ≤ 1 (a patch test) this is exact.
+    map, curved cells included, with the cell's own material); a node's value is the mean of
+    the values of its cells. On a linear-elastic field with continuous σ of degree ≤ 1 (a
+    patch test) this is exact; at a node on an interface between two materials it is the
+    mean of the two sides' values (σ jumps there).
+
+    Parameters
+    ----------
+    space : P2Space
+    u : (n_nodes, 2) float array
+    material : Material or CellMaterials
+        One material, or one per cell of ``space.mesh``.
 
     Returns
     -------
     (n_nodes, 3, 3) float array
-        σ with σ_zz from the material (plane strain: ``λ (σ_xx + σ_yy) / (2 (λ + μ))``).
+        σ with σ_zz from the material (:func:`~signorini.fem.material.stress_zz`: λ tr ε in
+        plane strain, 0 in plane stress).
     """
     nodes = space.cell_nodes  # (m, 6)
     m = nodes.shape[0]
     u_cell = u[nodes].reshape(m, 12)
     grad, _ = iso.field_derivatives(space.node_points[nodes], u_cell, p2.REFERENCE_NODES)
-    sig = stress(material, grad).reshape(-1, 4)  # (m * 6, [xx, xy, yx, yy])
+    sig = np.zeros((m, 6, 3, 3))
+    sig[..., :2, :2] = stress(material, grad)
+    sig[..., 2, 2] = stress_zz(material, grad)
     count = np.bincount(nodes.ravel(), minlength=space.n_nodes).astype(np.float64)
-    mean = (
-        np.column_stack(
-            [
-                np.bincount(nodes.ravel(), weights=sig[:, j], minlength=space.n_nodes)
-                for j in range(4)
-            ]
-        )
-        / np.maximum(count, 1.0)[:, None]
+    flat = sig.reshape(m * 6, 9)
+    mean = np.column_stack(
+        [np.bincount(nodes.ravel(), weights=flat[:, j], minlength=space.n_nodes) for j in range(9)]
     )
-    out = np.zeros((space.n_nodes, 3, 3))
-    out[:, :2, :2] = mean.reshape(-1, 2, 2)
-    out[:, 2, 2] = _sigma_zz(material, out[:, 0, 0], out[:, 1, 1])
-    return out
-
-
-def _sigma_zz(material, sxx: np.ndarray, syy: np.ndarray) -> np.ndarray:
-    """σ_zz of the material: 0 in plane stress, ``λ (σ_xx + σ_yy) / (2 (λ + μ))`` (= λ tr ε)
-    in plane strain."""
-    if getattr(material, "plane", "strain") == "stress":
-        return np.zeros_like(sxx)
-    return material.lam * (sxx + syy) / (2.0 * (material.lam + material.mu))
+    return (mean / np.maximum(count, 1.0)[:, None]).reshape(-1, 3, 3)

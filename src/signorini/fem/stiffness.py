@@ -26,7 +26,7 @@ import scipy.sparse as sp
 
 from . import p2
 from .mapping import AffineCells, CellMap, Cells
-from .material import Material
+from .material import CellMaterials, Material, on_cells
 from .quadrature import triangle_rule
 
 __all__ = ["assemble_stiffness", "element_blocks", "element_stiffness"]
@@ -103,7 +103,7 @@ def _geometric_factors(J: np.ndarray, det: np.ndarray) -> np.ndarray:
 
 def element_blocks(
     cells: Cells,
-    material: Material,
+    material: Material | CellMaterials,
     degree: int | None = None,
     dof_order: bool = False,
     out: np.ndarray | None = None,
@@ -121,14 +121,23 @@ def element_blocks(
     ``(cof J grad phi_a) . C (cof J grad phi_b)``, exact on affine cells (degree 2); on the
     quadratic maps of isoparametric cells (degree 4) the rational remainder is far below the
     discretisation error (Ciarlet-Raviart: degree 2k - 2 suffices for the optimal rate).
-    ``out (m, 144)``, if given, receives the result.
+    ``out (m, 144)``, if given, receives the result. With a :class:`CellMaterials` of the
+    group's cells, one GEMM per material on its rows.
     """
     degree = 2 * cells.order if degree is None else degree
     xi, _ = triangle_rule(degree)
     J, det = cells.jacobians(xi)  # (m, p, 2, 2), p = 1 (constant) or q
     m, n_p = det.shape
     fac = _geometric_factors(J.reshape(-1, 2, 2), det.reshape(-1)).reshape(m, -1)
-    basis = _stiffness_basis(material.lam, material.mu, dof_order, degree, n_p > 1)
+    if isinstance(material, CellMaterials):
+        out = np.empty((m, 144)) if out is None else out
+        for k, mat in enumerate(material.materials):  # a loop over materials, not cells
+            rows = np.flatnonzero(material.index == k)
+            if rows.size:
+                basis = _stiffness_basis(mat.lam_eff, mat.mu, dof_order, degree, n_p > 1)
+                out[rows] = fac[rows] @ basis
+        return out
+    basis = _stiffness_basis(material.lam_eff, material.mu, dof_order, degree, n_p > 1)
     return np.matmul(fac, basis, out=out)
 
 
@@ -223,7 +232,7 @@ def _checked_input(
         raise ValueError(f"n_dofs must be a non-negative integer, got {n_dofs!r}")
     if n % 2:
         raise ValueError(f"n_dofs must be even (two components per node), got {n}")
-    if not isinstance(material, Material):
+    if not isinstance(material, Material | CellMaterials):
         raise ValueError(f"material must be a Material, got {type(material).__name__}")
     v = np.asarray(vertices, dtype=np.float64)
     if v.ndim != 3 or v.shape[1:] != (3, 2):
@@ -262,7 +271,7 @@ def assemble_stiffness(
     cells: CellMap | np.ndarray,
     cell_dofs: np.ndarray,
     n_dofs: int,
-    material: Material,
+    material: Material | CellMaterials,
     *,
     validate: bool = True,
 ) -> sp.csr_matrix:
@@ -278,7 +287,8 @@ def assemble_stiffness(
         Interleaved global DOFs (``2 * node + component``).
     n_dofs : int
         Number of global DOFs (even: two per node).
-    material : Material
+    material : Material or CellMaterials
+        One material, or one per cell (:class:`~signorini.fem.material.CellMaterials`).
     validate : bool, optional
         Check the arrays (shapes, finite counter-clockwise cells, interleaved DOFs in
         range). The assembly of a :class:`~signorini.fem.space.P2Space`, whose arrays are
@@ -311,12 +321,12 @@ def assemble_stiffness(
     if mapping is None:
         mapping = CellMap(cells)
     if len(mapping.groups) == 1:
-        blocks = element_blocks(mapping.groups[0], material)
+        blocks = element_blocks(mapping.groups[0], on_cells(material, mapping.groups[0].cells))
     else:  # group after group into one array (no scatter), the cells' nodes in that order
         blocks = np.empty((mapping.n_cells, 144))
         start = 0
         for g in mapping.groups:
-            element_blocks(g, material, out=blocks[start : start + len(g)])
+            element_blocks(g, on_cells(material, g.cells), out=blocks[start : start + len(g)])
             start += len(g)
         nodes = nodes[np.concatenate([g.cells for g in mapping.groups])]
     return _assemble_node_blocks(nodes, n // 2, blocks.reshape(-1, 6, 6, 2, 2))

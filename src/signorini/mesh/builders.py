@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .mesh import Mesh, MeshError
+from .regions import RegionSpec
 
 __all__ = ["rectangle"]
 
@@ -19,6 +20,8 @@ def rectangle(
     nx: int = 4,
     ny: int = 4,
     pattern: str = "unionjack",
+    *,
+    regions: RegionSpec | None = None,
 ) -> Mesh:
     """Structured triangulation of the rectangle ``[x0, x1] × [y0, y1]``.
 
@@ -33,6 +36,10 @@ def rectangle(
         rectangle's centre lines when ``nx`` and ``ny`` are even; ``"right"`` / ``"left"``
         use one diagonal direction; ``"crossed"`` splits each square into four triangles
         through its centre.
+    regions : mapping region name -> selector, or array, optional
+        The cells' regions, e.g. ``{"coating": lambda x: x[:, 1] > 0.9, "base": lambda x:
+        x[:, 1] < 0.9}`` with selectors of the cell centroids ``x (n, 2)``, as for
+        :meth:`Mesh.from_arrays`; one region ``"body"`` by default.
     """
     if not (np.isfinite([x0, x1, y0, y1]).all() and x1 > x0 and y1 > y0):
         raise MeshError(f"rectangle needs x0 < x1 and y0 < y1, got [{x0}, {x1}] x [{y0}, {y1}]")
@@ -77,7 +84,7 @@ def rectangle(
         "top": lambda x: np.abs(x[:, 1] - y1) < tol,
         "left": lambda x: np.abs(x[:, 0] - x0) < tol,
     }
-    return Mesh.from_arrays(points, cells, parts)
+    return Mesh.from_arrays(points, cells, parts, regions=regions)
 
 
 def half_disc(

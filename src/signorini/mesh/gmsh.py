@@ -12,6 +12,7 @@ import numpy as np
 
 from .curves import QuadraticBoundary
 from .mesh import Mesh, MeshError
+from .regions import DEFAULT_REGION
 from .topology import edge_keys
 
 __all__ = ["read_mesh"]
@@ -35,7 +36,9 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
     ``line3``) tagged with physical groups make the boundary parts, named after the groups
     (``gmsh:physical`` / field data; a physical group without a name is called
     ``"part<tag>"``). Physical tag 0 is Gmsh's mark for an element in *no* physical group
-    (written when all elements are saved): such lines name no part. The mesh must lie in a
+    (written when all elements are saved): such lines name no part. Triangles in physical
+    surface groups carry those groups as cell regions (:attr:`Mesh.region_names`, e.g. one
+    material each). The mesh must lie in a
     plane ``z = const``. Cells are oriented counter-clockwise (see
     :meth:`Mesh.from_arrays`) and each cell's longest edge becomes its refinement edge.
 
@@ -138,11 +141,28 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
         if missing:
             raise MeshError(f"{path} has no boundary group(s) {missing}; it has {sorted(groups)}")
         groups = {p: groups[p] for p in parts}
+    regions = _surface_regions(m, tri, tags)
     try:
-        mesh = Mesh.from_arrays(points, cells, {k: np.concatenate(v) for k, v in groups.items()})
+        boundary = {k: np.concatenate(v) for k, v in groups.items()}
+        mesh = Mesh.from_arrays(points, cells, boundary, regions=regions)
         return _with_quadratic_boundaries(mesh, _given_midpoints(m, renumber))
     except MeshError as exc:
         raise MeshError(f"{path}: {exc}") from None
+
+
+def _surface_regions(m: object, tri: list, tags: list | None) -> np.ndarray | None:
+    """The cell regions of the triangles ``tri`` (their blocks, in order): the names of their
+    physical surface groups (``"region<tag>"`` for an unnamed one, ``"body"`` for triangles
+    in none); ``None`` (one region) if no triangle is in a physical group."""
+    if tags is None:
+        return None
+    surface = np.concatenate([np.asarray(tags[i]).reshape(-1) for i, _ in tri]).astype(int)
+    if not surface.any():
+        return None
+    names = {int(v[0]): k for k, v in (m.field_data or {}).items() if len(v) > 1 and v[1] == 2}
+    tag, index = np.unique(surface, return_inverse=True)
+    label = [DEFAULT_REGION if t == 0 else names.get(int(t), f"region{int(t)}") for t in tag]
+    return np.asarray(label, dtype=object)[index.reshape(-1)].astype(str)
 
 
 def _given_midpoints(m: object, renumber: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

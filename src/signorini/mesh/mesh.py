@@ -13,6 +13,8 @@ Conventions (fixed for the whole package)
 - The boundary is split into named *parts* (``part_names``); every boundary edge carries the
   index of its part in ``boundary_part``. What a part means (Dirichlet, Neumann, contact) is the
   business of :mod:`signorini.problem`, not of the mesh. Parts survive refinement.
+- Cells carry a *region* (``region_names``, ``cell_region``: e.g. one per material,
+  :mod:`signorini.mesh.regions`); a child cell takes its parent's region.
 
 A :class:`Mesh` is immutable; derived topology is computed once and cached. Building one from
 user arrays runs the checks of :mod:`signorini.mesh.validation`.
@@ -33,6 +35,7 @@ import numpy as np
 from .curves import Curve
 from .geometry import signed_area
 from .parts import check_parts, part_indices
+from .regions import DEFAULT_REGION, RegionSpec, region_labels
 from .topology import boundary_edges, edge_keys, edge_topology, longest_edge_first
 from .validation import (
     MeshError,
@@ -74,6 +77,11 @@ class Mesh:
     curves : sequence of Curve or None, optional
         The curve each part carries (``None`` for a part without one), one per part name;
         attach curves with :meth:`with_curve`, which checks them.
+    cell_region : (n_cells,) int array, optional
+        Index into ``region_names`` of each cell; by default every cell is in one region,
+        ``"body"``.
+    region_names : sequence of str, optional
+        The names of the cell regions (e.g. Gmsh physical surfaces), one per region index.
 
     Attributes
     ----------
@@ -101,6 +109,8 @@ class Mesh:
         *,
         validate: bool = True,
         curves: tuple[Curve | None, ...] | list[Curve | None] | None = None,
+        cell_region: np.ndarray | None = None,
+        region_names: tuple[str, ...] | list[str] | None = None,
     ) -> None:
         if validate:  # argument kinds first: a clear error instead of NumPy's
             points = as_points(points)
@@ -123,10 +133,29 @@ class Mesh:
                 f"curves needs one Curve or None per part ({len(self.part_names)}), got "
                 f"{self.curves!r}"
             )
-        for a in (self.points, self.cells, self.boundary, self.boundary_part):
+        self._set_regions(cell_region, region_names)
+        for a in (self.points, self.cells, self.boundary, self.boundary_part, self.cell_region):
             a.flags.writeable = False
         if validate:
             validate_mesh(self)
+
+    def _set_regions(
+        self, cell_region: np.ndarray | None, region_names: tuple[str, ...] | list[str] | None
+    ) -> None:
+        n = self.cells.shape[0]
+        if cell_region is None:
+            cell_region = np.zeros(n, dtype=np.int64)
+        names = (DEFAULT_REGION,) if region_names is None else tuple(str(r) for r in region_names)
+        region = np.ascontiguousarray(cell_region, dtype=np.int64).reshape(-1)
+        if region.shape != (n,) or (n and (region.min() < 0 or region.max() >= len(names))):
+            raise MeshError(
+                f"cell_region must give each of the {n} cells an index into region_names "
+                f"{list(names)}, got shape {region.shape}"
+                + (f" and values in [{region.min()}, {region.max()}]" if region.size else "")
+            )
+        if len(set(names)) != len(names):
+            raise MeshError(f"region_names must be distinct, got {list(names)}")
+        self.cell_region, self.region_names = region, names
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -135,6 +164,8 @@ class Mesh:
         points: np.ndarray,
         cells: np.ndarray,
         parts: Mapping[str, np.ndarray | Callable[[np.ndarray], np.ndarray]],
+        *,
+        regions: RegionSpec | None = None,
     ) -> Mesh:
         """Build a mesh from user arrays, putting each cell's longest edge first.
 
@@ -156,6 +187,11 @@ class Mesh:
 
             Selectors claim only the edges no list names; a boundary edge claimed by two
             parts is an error.
+        regions : array or mapping, optional
+            The cells' regions (e.g. one per material): an ``(n_cells,)`` array of int or str
+            labels, or a mapping region name -> selector ``f(x) -> (n,) bool`` of the cell
+            centroids ``x (n, 2)`` claiming every cell once
+            (:func:`~signorini.mesh.regions.region_labels`). By default one region, ``"body"``.
 
         Raises
         ------
@@ -180,7 +216,10 @@ class Mesh:
         cells = longest_edge_first(points, cells)
         bnd = boundary_edges(cells)
         part_of = part_indices(points, bnd, parts, names)
-        mesh = cls(points, cells, bnd, part_of, names)
+        region, region_names = region_labels(regions, points[cells].mean(axis=1))
+        mesh = cls(
+            points, cells, bnd, part_of, names, cell_region=region, region_names=region_names
+        )
         if flipped.size:
             mesh.reoriented = _frozen(flipped)
         return mesh
@@ -238,6 +277,8 @@ class Mesh:
             self.part_names,
             validate=False,
             curves=curves,
+            cell_region=self.cell_region,
+            region_names=self.region_names,
         )
         mesh.reoriented = self.reoriented
         return mesh
@@ -378,6 +419,14 @@ class Mesh:
             cos = (u * v).sum(1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
             angles.append(np.arccos(np.clip(cos, -1.0, 1.0)))
         return float(np.min(angles))
+
+    def region_cells(self, name: str) -> np.ndarray:
+        """Indices of the cells of region ``name``."""
+        if name not in self.region_names:
+            raise MeshError(
+                f"the mesh has no cell region {name!r}; its regions are {list(self.region_names)}"
+            )
+        return np.flatnonzero(self.cell_region == self.region_names.index(name))
 
     def part_length(self, name: str) -> float:
         """Total length of boundary part ``name``."""

@@ -193,6 +193,8 @@ def _bisect(mesh: Mesh, marked_edges: np.ndarray) -> Refinement:
         mesh.part_names,
         validate=False,
         curves=mesh.curves,
+        cell_region=mesh.cell_region[parent],  # a child takes its parent's region
+        region_names=mesh.region_names,
     )
     return Refinement(refined, parent, edge_point)
 

@@ -364,6 +364,8 @@ class RunFolder:
                 boundary=mesh.boundary,
                 boundary_part=mesh.boundary_part,
                 part_names=np.array(mesh.part_names, dtype=str),
+                cell_region=mesh.cell_region,
+                region_names=np.array(mesh.region_names, dtype=str),
             )
             if u0 is not None:
                 arrays["u0"] = np.asarray(u0, dtype=np.float64)
@@ -427,6 +429,7 @@ class RunFolder:
                     data["boundary"],
                     data["boundary_part"],
                     [str(n) for n in data["part_names"]],
+                    **_regions(data),
                 )
                 u0 = np.array(data["u0"]) if "u0" in data else None
         except (OSError, ValueError, KeyError) as exc:
@@ -441,3 +444,13 @@ class RunFolder:
             return []
         text = file.read_text(encoding="utf-8")
         return list(csv.DictReader(io.StringIO(text)))
+
+
+def _regions(data) -> dict:
+    """The saved mesh's cell regions (none in a state saved before regions existed)."""
+    if "cell_region" not in data:
+        return {}
+    return {
+        "cell_region": data["cell_region"],
+        "region_names": [str(n) for n in data["region_names"]],
+    }

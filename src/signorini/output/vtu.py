@@ -45,8 +45,10 @@ POINT_FIELDS: dict[str, str] = {
     "contact_state": "0 inactive, 1 stick, 2 slip (a frictionless node in contact slips), −1 "
     "off Γ_C",
 }
-#: Cell data of a level's VTU file (with the estimate): name -> meaning.
+#: Cell data of a level's VTU file (the eta2 fields with an estimate): name -> meaning.
 CELL_FIELDS: dict[str, str] = {
+    "region": "the cell's material region, an index into the mesh's region names "
+    "(mesh.region_names; 0 where the mesh has one region)",
     "eta2": "the squared element indicator η_T² (the sum of the contributions)",
     "eta2_k": "the squared contribution η_k,T² of term k = 1, 2, … (docs/method.md, "
     "*Estimator*): one field per term",
@@ -105,9 +107,8 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     voigt = np.column_stack(
         [sig[:, 0, 0], sig[:, 1, 1], sig[:, 2, 2], sig[:, 0, 1], sig[:, 1, 2], sig[:, 0, 2]]
     )
-    # cell fields: one array per field, in the cells' order (further per-cell data such as a
-    # material region belong here, and in CELL_FIELDS)
-    cell_data: dict[str, list[np.ndarray]] = {}
+    # cell fields: one array per field, in the cells' order (each one in CELL_FIELDS)
+    cell_data = {"region": [space.mesh.cell_region.astype(np.int32)]}  # into mesh.region_names
     if estimate is not None:
         cell_data["eta2"] = [estimate.eta2]
         for k in range(estimate.eta2_cell.shape[0]):

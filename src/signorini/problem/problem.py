@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ..fem.material import Material
+from ..fem.material import CellMaterials, Material
 from ..fem.space import P2Space
 from ..mesh.curves import Line
 from ..mesh.geometry import segment_normals
@@ -59,7 +59,10 @@ class ContactProblem:
     mesh : Mesh
         The initial mesh; its boundary parts carry the conditions. Every component of the body
         (cells joined through shared edges) needs a Dirichlet part.
-    material : Material
+    material : Material or mapping region name -> Material
+        One material for the whole body, or one per cell region of the mesh
+        (:attr:`~signorini.mesh.Mesh.region_names`, e.g.
+        ``{"coating": Material.from_young(...), "base": ...}``); every region needs one.
     conditions : mapping part name -> Dirichlet | Neumann | Contact
         Every boundary part of the mesh must get exactly one condition.
     body_force : callable or None
@@ -89,7 +92,7 @@ class ContactProblem:
     """
 
     mesh: Mesh
-    material: Material
+    material: Material | Mapping[str, Material]
     conditions: Mapping[str, Condition]
     body_force: VectorField | None = None
     exact: ExactSolution | None = None
@@ -102,10 +105,7 @@ class ContactProblem:
         mesh = self.mesh
         if not isinstance(mesh, Mesh):
             raise ProblemError(f"mesh must be a signorini Mesh, got {type(mesh).__name__}")
-        if not isinstance(self.material, Material):
-            raise ProblemError(
-                "material must be a signorini Material (Material.from_young or Material.from_lame)"
-            )
+        _check_materials(self.material, mesh)
         if not isinstance(self.conditions, Mapping):
             raise ProblemError(
                 "conditions must be a mapping part name -> Dirichlet | Neumann | Contact, "
@@ -167,6 +167,18 @@ class ContactProblem:
     @property
     def contact_parts(self) -> list[str]:
         return [n for n, c in self.conditions.items() if isinstance(c, Contact)]
+
+    def material_on(self, mesh: Mesh) -> Material | CellMaterials:
+        """The material of each cell of ``mesh`` (the initial mesh or a refinement of it): the
+        one :class:`Material` where every region has the same, else a
+        :class:`~signorini.fem.material.CellMaterials` from the cells' regions."""
+        if isinstance(self.material, Material):
+            return self.material
+        given = {str(k): v for k, v in self.material.items()}
+        materials = [given[name] for name in mesh.region_names]
+        if all(m == materials[0] for m in materials):
+            return materials[0]
+        return CellMaterials(materials, mesh.cell_region)
 
     def dirichlet_nodes(self, space: P2Space) -> np.ndarray:
         """Sorted P2 nodes of ``space`` whose both DOFs are prescribed: on the closure of a
@@ -246,6 +258,40 @@ class ContactProblem:
                     f"is not its outward normal {tuple(np.round(mean, 12))}"
                 )
         return mean
+
+
+def _check_materials(material: object, mesh: Mesh) -> None:
+    """A :class:`Material`, or a mapping giving each cell region of ``mesh`` one.
+
+    Raises
+    ------
+    ProblemError
+        Naming the regions without a material, the names that are not regions, or a value
+        that is not a :class:`Material`.
+    """
+    kind = "a signorini Material (Material.from_young or Material.from_lame)"
+    if isinstance(material, Material):
+        return
+    if not isinstance(material, Mapping):
+        raise ProblemError(
+            f"material must be {kind}, or a mapping region name -> Material, got "
+            f"{type(material).__name__}"
+        )
+    given = {str(k): v for k, v in material.items()}
+    regions = list(mesh.region_names)
+    unknown = sorted(set(given) - set(regions))
+    missing = [r for r in regions if r not in given]
+    if unknown or missing:
+        raise ProblemError(
+            "material must give each cell region of the mesh one Material: "
+            + (f"region(s) {missing} have none" if missing else "")
+            + ("; " if missing and unknown else "")
+            + (f"{unknown} are not regions of the mesh" if unknown else "")
+            + f"; its regions are {regions}"
+        )
+    for name, m in given.items():
+        if not isinstance(m, Material):
+            raise ProblemError(f"the material of region {name!r} must be {kind}, got {m!r}")
 
 
 #: How many floating components an error message describes (the rest are counted).
