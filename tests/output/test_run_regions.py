@@ -13,6 +13,7 @@ def test_saved_state_keeps_the_cell_regions(tmp_path):
     mesh = rectangle(0, 1, 0, 1, nx=4, ny=4, regions=regions)
     folder, _ = RunFolder.create(tmp_path / "r", PROBLEM, {})
     folder.save_state(0, mesh, None, final=False)
+    folder.close()  # the folder is locked per open descriptor
     saved = RunFolder.open(tmp_path / "r")._read_state().mesh
     assert saved.region_names == ("base", "coating")
     np.testing.assert_array_equal(saved.cell_region, mesh.cell_region)
