@@ -6,6 +6,7 @@ from .curves import Circle, Curve, Line, ProjectedCurve, QuadraticBoundary
 from .gmsh import read_mesh
 from .mesh import Mesh, MeshError
 from .refine import Refinement, refine_nvb, refine_uniform
+from .regions import with_regions
 
 __all__ = [
     "Circle",
@@ -21,4 +22,5 @@ __all__ = [
     "rectangle",
     "refine_nvb",
     "refine_uniform",
+    "with_regions",
 ]

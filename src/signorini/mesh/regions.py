@@ -15,7 +15,7 @@ import numpy as np
 
 from .validation import MeshError
 
-__all__ = ["DEFAULT_REGION", "RegionSpec", "region_labels"]
+__all__ = ["DEFAULT_REGION", "RegionSpec", "region_labels", "with_regions"]
 
 #: The one region of a mesh built without regions.
 DEFAULT_REGION = "body"
@@ -106,3 +106,38 @@ def _from_selectors(
             f"{centroids[c].tolist()}); the selectors of {list(names)} must cover every cell"
         )
     return index, names
+
+
+def with_regions(mesh, regions: RegionSpec):
+    """A copy of ``mesh`` (the same points, cells, boundary parts and curves) whose cells carry
+    ``regions``, as :func:`region_labels` reads them (labels per cell, or selectors of the
+    cell centroids): regions for a mesh built without them, e.g. by
+    :func:`~signorini.mesh.builders.half_disc` or a builder of an example.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    regions : array_like or mapping
+
+    Returns
+    -------
+    Mesh
+
+    Raises
+    ------
+    MeshError
+        As :func:`region_labels`: a cell claimed by no selector or by two, labels of the wrong
+        size.
+    """
+    region, names = region_labels(regions, mesh.points[mesh.cells].mean(axis=1))
+    return type(mesh)(
+        mesh.points,
+        mesh.cells,
+        mesh.boundary,
+        mesh.boundary_part,
+        mesh.part_names,
+        validate=False,
+        curves=mesh.curves,
+        cell_region=region,
+        region_names=names,
+    )
