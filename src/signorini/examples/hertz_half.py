@@ -20,6 +20,7 @@ import numpy as np
 
 from ..contact.solution import ContactResult
 from ..fem.material import Material
+from ..mesh.builders import ring_cells
 from ..mesh.curves import Circle
 from ..mesh.mesh import Mesh
 from ..problem import Contact, ContactProblem, Dirichlet, Neumann, Roller
@@ -50,29 +51,10 @@ def quarter_disc(radius: float = 1.0, rings: int = 4, *, h_bottom: float | None 
     x = np.where(s == 0.5, 1.0, np.sin(np.pi * s))
     y = np.where(s == 0.5, 0.0, -np.cos(np.pi * s))
     points = radius * (np.column_stack([j * x, j * y]) / rings + [0.0, 1.0])
-    cells = []
-    for ring in range(1, rings + 1):  # a loop over quarter-rings (a few)
-        n_in, n_out = 2 * (ring - 1), 2 * ring
-        mid_in = (np.arange(n_in) + 0.5) / max(n_in, 1)
-        mid_out = (np.arange(n_out) + 0.5) / n_out
-        is_out = np.concatenate([np.zeros(n_in, bool), np.ones(n_out, bool)])
-        order = np.argsort(np.concatenate([mid_in, mid_out]), kind="stable")
-        is_out = is_out[order]
-        seen_out = np.cumsum(is_out) - is_out
-        seen_in = np.cumsum(~is_out) - ~is_out
-        a, b = first[ring - 1], first[ring]
-        inner = np.where(n_in > 0, a + seen_in, a)
-        cells.append(
-            np.where(
-                is_out[:, None],
-                np.column_stack([b + seen_out, b + seen_out + 1, inner]),
-                np.column_stack([a + seen_in, b + seen_out, a + seen_in + 1]),
-            )
-        )
     tol = 1e-9 * radius
     mesh = Mesh.from_arrays(
         points,
-        np.concatenate(cells),
+        ring_cells(first, 2),
         {
             "top": lambda x: np.abs(x[:, 1] - radius) < tol,
             "axis": lambda x: np.abs(x[:, 0]) < tol,

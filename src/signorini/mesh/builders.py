@@ -183,15 +183,30 @@ def _polar_half_disc(rings: int) -> tuple[np.ndarray, np.ndarray]:
     s = k / np.maximum(3 * j, 1) - 0.5
     y = np.where(np.abs(s) == 0.5, 0.0, -np.cos(np.pi * s))
     points = np.column_stack([j * np.sin(np.pi * s), j * y]) / rings
+    return points, ring_cells(first, 3)
+
+
+def ring_cells(first: np.ndarray, per_ring: int) -> np.ndarray:
+    """The cells of a polar mesh of rings about a centre (point 0): ring ``j = 1 …`` has
+    ``per_ring · j + 1`` points from index ``first[j]`` on (``first`` of length rings + 1).
+
+    The strip between rings ``j − 1`` and ``j`` gets one triangle per segment of either ring:
+    the segments taken in the order of their midpoint angles, each joined to the node of the
+    other ring reached so far (counter-clockwise for angles increasing with the index).
+
+    Returns
+    -------
+    (n_cells, 3) int array
+    """
     cells = []
-    for ring in range(1, rings + 1):  # a loop over half-rings (rings ≤ a few tens)
-        n_in, n_out = max(3 * (ring - 1), 0), 3 * ring
+    for ring in range(1, len(first)):  # a loop over rings (a few tens at most)
+        n_in, n_out = per_ring * (ring - 1), per_ring * ring
         mid_in = (np.arange(n_in) + 0.5) / max(n_in, 1)
         mid_out = (np.arange(n_out) + 0.5) / n_out
         is_out = np.concatenate([np.zeros(n_in, bool), np.ones(n_out, bool)])
         order = np.argsort(np.concatenate([mid_in, mid_out]), kind="stable")
         is_out = is_out[order]
-        # nodes of each half-ring reached before each segment
+        # nodes of each ring reached before each segment
         seen_out = np.cumsum(is_out) - is_out
         seen_in = np.cumsum(~is_out) - ~is_out
         a, b = first[ring - 1], first[ring]
@@ -203,4 +218,4 @@ def _polar_half_disc(rings: int) -> tuple[np.ndarray, np.ndarray]:
                 np.column_stack([a + seen_in, b + seen_out, a + seen_in + 1]),
             )
         )
-    return points, np.concatenate(cells)
+    return np.concatenate(cells)
