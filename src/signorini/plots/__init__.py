@@ -31,12 +31,13 @@ from .convergence import (
 )
 from .deformed import displacement_scale, plot_deformed
 from .mesh import READABLE_CELLS, boundary_groups, plot_mesh, read_level_mesh, readable_level
-from .pressure import plot_pressure_comparison
+from .pressure import FrictionCurves, plot_pressure_comparison
 from .report import make_figures
 from .slopes import add_slope_triangle, finer_half_slope
 from .style import STYLES
 
 __all__ = [
+    "FrictionCurves",
     "STYLES",
     "read_history",
     "fitted_slope",

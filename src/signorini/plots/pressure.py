@@ -5,6 +5,7 @@ slip nodes marked, zoomed on the contact zone."""
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib as mpl
@@ -14,11 +15,33 @@ from numpy.typing import ArrayLike
 from .contact_stress import FRICTION_STYLES, draw_rug
 from .style import RC, STYLES, fit_title, new_figure, save_figure
 
-__all__ = ["plot_pressure_comparison"]
+__all__ = ["FrictionCurves", "plot_pressure_comparison"]
 
 #: Drawing order: the computed nodal values (markers) below the known curves (lines), so that
 #: ~300 markers do not hide the curve they are compared with.
 MARKER_ZORDER, REFERENCE_ZORDER = 2.0, 3.0
+
+
+@dataclass(frozen=True)
+class FrictionCurves:
+    """The friction part of a pressure figure (plain arrays).
+
+    Attributes
+    ----------
+    tangential : (m,) float array
+        The friction stress p_t,z at the nodes ``x``, drawn as markers.
+    reference : (r,) float array, optional
+        The known friction stress at ``x_reference``, drawn as a dashed line.
+    label : str
+        Its legend entry.
+    state : (m,) str array, optional
+        ``"inactive"``, ``"stick"`` or ``"slip"`` per node: marked in a strip at the bottom.
+    """
+
+    tangential: ArrayLike
+    reference: ArrayLike | None = None
+    label: str = ""
+    state: ArrayLike | None = None
 
 
 def _pair(a: ArrayLike | None, b: ArrayLike | None, what: str) -> tuple[np.ndarray, ...]:
@@ -38,10 +61,7 @@ def plot_pressure_comparison(
     label: str = "reference",
     title: str = "",
     xlabel: str = r"$x$",
-    tangential: ArrayLike | None = None,
-    tangential_reference: ArrayLike | None = None,
-    tangential_label: str = "",
-    state: ArrayLike | None = None,
+    friction: FrictionCurves | None = None,
     window: tuple[float, float] | None = None,
 ) -> list[Path]:
     """The nodal pressure p_z against x, with the known pressure drawn as a line above it.
@@ -61,12 +81,9 @@ def plot_pressure_comparison(
         ``<path>.png`` and ``<path>.pdf`` are written.
     label, title, xlabel : str
         Legend entry of the known pressure, title, x-axis label.
-    tangential : (m,) float array, optional
-        The friction stress p_t,z at the nodes, drawn as markers.
-    tangential_reference : (r,) float array, optional
-        The known friction stress at ``x_reference`` (legend entry ``tangential_label``).
-    state : (m,) str array, optional
-        ``"inactive"``, ``"stick"`` or ``"slip"`` per node: marked in a strip at the bottom.
+    friction : FrictionCurves, optional
+        The friction stress at the nodes, a known one at ``x_reference`` and the nodes'
+        stick/slip states.
     window : (2,) float, optional
         The x range shown (a zoom on the contact zone).
 
@@ -83,11 +100,12 @@ def plot_pressure_comparison(
     """
     x, pressure = _pair(x, pressure, "x and pressure")
     x_reference, reference = _pair(x_reference, reference, "reference")
-    pt = None if tangential is None else _pair(x, tangential, "x and tangential")[1]
+    f = FrictionCurves(None) if friction is None else friction
+    pt = None if f.tangential is None else _pair(x, f.tangential, "x and tangential")[1]
     qt = None
-    if tangential_reference is not None:
-        qt = _pair(x_reference, tangential_reference, "tangential reference")[1]
-    st = None if state is None else np.asarray(state)
+    if f.reference is not None:
+        qt = _pair(x_reference, f.reference, "tangential reference")[1]
+    st = None if f.state is None else np.asarray(f.state)
     if st is not None and st.shape != x.shape:
         raise ValueError(f"state must have shape {x.shape}, got {st.shape}")
     keep = np.isfinite(x) & np.isfinite(pressure)
@@ -109,7 +127,7 @@ def plot_pressure_comparison(
         if qt is not None:
             ax.plot(
                 x_reference, qt, color="0.15", linewidth=1.3, linestyle="--",
-                label=tangential_label, zorder=REFERENCE_ZORDER,
+                label=f.label, zorder=REFERENCE_ZORDER,
             )  # fmt: skip
         if pt is not None:
             ft = FRICTION_STYLES["tangential_pressure"]

@@ -180,9 +180,10 @@ def pressure_figure(example: str, out: Path, known: KnownPressure) -> list[Path]
         out / f"{example}_pressure",
         label=known.label,
         title=known.title,
-        **{
-            key: getattr(known, key)
-            for key in ("tangential", "tangential_reference", "tangential_label", "state", "window")
-            if getattr(known, key, None) is not None
-        },
+        friction=None
+        if getattr(known, "tangential", None) is None
+        else plots.FrictionCurves(
+            known.tangential, known.tangential_reference, known.tangential_label, known.state
+        ),
+        window=getattr(known, "window", None),
     )
