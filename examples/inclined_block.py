@@ -91,8 +91,7 @@ def main() -> None:
         mesh.cells,
         result.u[: mesh.n_points],
         args.out / "deformed",
-        contact_points=x,
-        pressure=result.pressure,
+        plots.ContactDrawing(x, result.pressure),
         scale=5.0,
         title="deformed body and contact pressure",
     )

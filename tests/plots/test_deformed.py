@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from signorini.mesh.builders import rectangle
-from signorini.plots import plot_deformed
+from signorini.plots import ContactDrawing, plot_deformed
 from signorini.plots.contact_line import contact_coordinate, free_boundary_ends
 from signorini.plots.deformed import NODE_STATES, displacement_scale
 
@@ -21,7 +21,7 @@ def test_deformed_figure_with_pressure_and_obstacle(tmp_path, captured):
     right = p[np.isclose(p[:, 0], 1.0)]
     pressure = 1.0 - np.abs(right[:, 1] - 0.5)
     written = plot_deformed(
-        p, c, u_p2, tmp_path / "deformed", contact_points=right, pressure=pressure, scale=3.0
+        p, c, u_p2, tmp_path / "deformed", ContactDrawing(right, pressure), scale=3.0
     )
     check_written(written, tmp_path / "deformed")
     (info,) = captured
@@ -63,11 +63,9 @@ def test_deformed_figure_rejects_bad_arrays(tmp_path):
     with pytest.raises(ValueError, match="displacement"):
         plot_deformed(p, c, np.zeros((3, 2)), tmp_path / "x")
     with pytest.raises(ValueError, match="together"):
-        plot_deformed(p, c, np.zeros_like(p), tmp_path / "x", pressure=np.ones(3))
+        plot_deformed(p, c, np.zeros_like(p), tmp_path / "x", ContactDrawing(pressure=np.ones(3)))
     with pytest.raises(ValueError, match="pressure must have shape"):
-        plot_deformed(
-            p, c, np.zeros_like(p), tmp_path / "x", contact_points=p[:3], pressure=np.ones(4)
-        )
+        plot_deformed(p, c, np.zeros_like(p), tmp_path / "x", ContactDrawing(p[:3], np.ones(4)))
     assert not any(tmp_path.iterdir())
 
 
@@ -115,7 +113,7 @@ def test_obstacle_from_the_gap_is_drawn_at_true_scale(tmp_path, captured):
     gap = 0.05 + 0.1 * bottom[:, 0]
     normal = np.tile([0.0, -1.0], (len(bottom), 1))
     plot_deformed(
-        p, c, u, tmp_path / "d", contact_points=bottom, pressure=np.ones(5), gap=gap, normal=normal
+        p, c, u, tmp_path / "d", ContactDrawing(bottom, np.ones(5), gap=gap, normal=normal)
     )
     (info,) = captured
     assert " ".join(info["titles"][0].split()) == (
@@ -125,7 +123,7 @@ def test_obstacle_from_the_gap_is_drawn_at_true_scale(tmp_path, captured):
     np.testing.assert_allclose(x, bottom[::-1, 0])  # ordered along the boundary
     np.testing.assert_allclose(y, -gap[::-1])
     with pytest.raises(ValueError, match="gap and normal"):
-        plot_deformed(p, c, u, tmp_path / "x", contact_points=bottom, gap=gap)
+        plot_deformed(p, c, u, tmp_path / "x", ContactDrawing(bottom, gap=gap))
     with pytest.raises(ValueError, match="scale must be"):
         plot_deformed(p, c, u, tmp_path / "x", scale="big")
 
@@ -156,12 +154,15 @@ def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
     state = np.array(NODE_STATES)[codes]  # the labels "inactive", "stick", "slip"
     pressure = np.array([0, 0, 1, 2, 3, 2, 1, 0.5, 0.0])
     p_t = np.array([0, 0, 0.5, 0.4, 0.1, -0.2, 0.5, 0.25, 0.0])
-    kwargs = {"contact_points": bottom, "pressure": pressure, "scale": 5.0}
+
+    def contact(**friction):
+        return ContactDrawing(bottom, pressure, **friction)
+
     plot_deformed(
-        p, c, u, tmp_path / "f", **kwargs, state=state, contact_displacement=u_bottom,
-        tangential_pressure=p_t,
+        p, c, u, tmp_path / "f",
+        contact(state=state, contact_displacement=u_bottom, tangential_pressure=p_t), scale=5.0,
     )  # fmt: skip
-    plot_deformed(p, c, u, tmp_path / "n", **kwargs)
+    plot_deformed(p, c, u, tmp_path / "n", contact(), scale=5.0)
     friction, frictionless = captured
     assert friction["legend"] == ["reference", "stick", "slip", "$p_h$", "$p_{t,h}$"]
     drawn = bottom + 5.0 * u_bottom
@@ -184,11 +185,13 @@ def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
     assert list(frictionless["lines"]) == ["$p_h$"]
     assert frictionless["ylabel"][-1] == "contact pressure $p_h$"
     with pytest.raises(ValueError, match="state needs contact_points and contact_displacement"):
-        plot_deformed(p, c, u, tmp_path / "x", **kwargs, state=state)
+        plot_deformed(p, c, u, tmp_path / "x", contact(state=state), scale=5.0)
     with pytest.raises(ValueError, match="state must hold"):
-        plot_deformed(p, c, u, tmp_path / "x", **kwargs, state=codes, contact_displacement=u_bottom)
+        plot_deformed(
+            p, c, u, tmp_path / "x", contact(state=codes, contact_displacement=u_bottom), scale=5.0
+        )
     with pytest.raises(ValueError, match="tangential_pressure must have shape"):
-        plot_deformed(p, c, u, tmp_path / "x", **kwargs, tangential_pressure=p_t[:3])
+        plot_deformed(p, c, u, tmp_path / "x", contact(tangential_pressure=p_t[:3]), scale=5.0)
 
 
 def test_obstacle_from_gaps_is_left_out_where_the_gap_is_far(tmp_path, captured):
@@ -202,7 +205,7 @@ def test_obstacle_from_gaps_is_left_out_where_the_gap_is_far(tmp_path, captured)
     gap = arc[:, 1]  # the distance to the plane y = 0
     normal = np.tile([0.0, -1.0], (41, 1))
     plot_deformed(
-        points, cells, u, tmp_path / "d", contact_points=arc, gap=gap, normal=normal, scale=10.0
+        points, cells, u, tmp_path / "d", ContactDrawing(arc, gap=gap, normal=normal), scale=10.0
     )
     (info,) = captured
     (label,) = [k for k in info["lines"] if k.startswith("obstacle")]

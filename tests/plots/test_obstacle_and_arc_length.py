@@ -11,7 +11,7 @@ from signorini.examples import hertz, punch
 from signorini.loop import adaptive
 from signorini.loop.arrays import arc_lengths, level_arrays
 from signorini.plots.contact_stress import NARROWEST, part_widths
-from signorini.plots.deformed import plot_deformed
+from signorini.plots.deformed import ContactDrawing, plot_deformed
 from signorini.plots.run_figures import _joined
 
 
@@ -55,8 +55,8 @@ def test_hertz_plane_is_drawn_straight_and_the_arc_spans_pi_r(hertz_arrays, tmp_
     # the figure draws both as given
     plot_deformed(
         a["points"], a["cells"], a["displacement"][: len(a["points"])], tmp_path / "d",
-        contact_points=a["contact_points"], pressure=a["pressure"],
-        obstacle=_joined(a["obstacle"].values()), along=a["along"],
+        ContactDrawing(a["contact_points"], a["pressure"], along=a["along"]),
+        obstacle=_joined(a["obstacle"].values()),
     )  # fmt: skip
     (info,) = captured
     x_drawn, y_drawn = info["lines"]["obstacle (true scale)"]
@@ -97,8 +97,8 @@ def test_punch_outline_is_its_polyline_with_rounded_corners(punch_arrays, tmp_pa
     assert widths[1] / sum(widths) == pytest.approx(1 / 3, abs=0.02)
     plot_deformed(
         a["points"], a["cells"], a["displacement"][: len(a["points"])], tmp_path / "d",
-        contact_points=a["contact_points"], pressure=a["pressure"],
-        obstacle=_joined(a["obstacle"].values()), along=a["along"],
+        ContactDrawing(a["contact_points"], a["pressure"], along=a["along"]),
+        obstacle=_joined(a["obstacle"].values()),
     )  # fmt: skip
     (info,) = captured
     assert info["titles"][1:] == ["contact part 'top'", "contact part 'right'"]

@@ -29,7 +29,7 @@ from .convergence import (
     plot_error_and_estimator,
     plot_estimator,
 )
-from .deformed import displacement_scale, plot_deformed
+from .deformed import ContactDrawing, displacement_scale, plot_deformed
 from .mesh import READABLE_CELLS, boundary_groups, plot_mesh, read_level_mesh, readable_level
 from .pressure import FrictionCurves, plot_pressure_comparison
 from .report import make_figures
@@ -37,6 +37,7 @@ from .slopes import add_slope_triangle, finer_half_slope
 from .style import STYLES
 
 __all__ = [
+    "ContactDrawing",
     "FrictionCurves",
     "STYLES",
     "read_history",

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -27,6 +28,7 @@ from .mesh import line_width, mesh_arrays
 from .style import RC, STYLES, fit_title, new_figure, save_figure, trim_height
 
 __all__ = [
+    "ContactDrawing",
     "plot_deformed",
     "displacement_scale",
     "scale_text",
@@ -41,7 +43,7 @@ TRUE_SCALE_RANGE = (0.02, 0.25)
 #: body's size (a shape far from most of a curved contact part, e.g. the plane under a disc).
 OBSTACLE_REACH = 0.25
 
-#: The states a contact node may be in, as ``plot_deformed(state=...)`` names them.
+#: The states a contact node may be in, as ``ContactDrawing(state=...)`` names them.
 NODE_STATES = ("inactive", "stick", "slip")
 
 
@@ -157,23 +159,32 @@ def _draw_body(
     )
 
 
+@dataclass(frozen=True)
+class ContactDrawing:
+    """What :func:`plot_deformed` draws of the contact boundary (plain arrays; every field is
+    described under :func:`plot_deformed`'s ``contact``)."""
+
+    contact_points: ArrayLike | None = None
+    pressure: ArrayLike | None = None
+    gap: ArrayLike | None = None
+    normal: ArrayLike | None = None
+    state: ArrayLike | None = None
+    contact_displacement: ArrayLike | None = None
+    tangential_pressure: ArrayLike | None = None
+    along: Mapping[str, tuple[ArrayLike, ArrayLike]] | None = None
+
+
 def plot_deformed(
     points: ArrayLike,
     cells: ArrayLike,
     displacement: ArrayLike,
     path: str | os.PathLike,
-    contact_points: ArrayLike | None = None,
-    pressure: ArrayLike | None = None,
+    contact: ContactDrawing | None = None,
+    *,
     scale: float | str = "auto",
     obstacle: ArrayLike | None = None,
     title: str | None = None,
     show_mesh: bool = True,
-    gap: ArrayLike | None = None,
-    normal: ArrayLike | None = None,
-    state: ArrayLike | None = None,
-    contact_displacement: ArrayLike | None = None,
-    tangential_pressure: ArrayLike | None = None,
-    along: Mapping[str, tuple[ArrayLike, ArrayLike]] | None = None,
 ) -> list[Path]:
     """The deformed body coloured by ``|u_h|``, and the contact pressure along ``Γ_C``.
 
@@ -197,21 +208,14 @@ def plot_deformed(
         displacement (vertices first) can be passed as is.
     path : str or os.PathLike
         Output path without extension.
+    contact : ContactDrawing, optional
+        The contact boundary's arrays; its fields, each optional:
+
     contact_points : (k, 2) float array, optional
         Reference coordinates of the contact nodes (needed with ``pressure``, ``gap``).
     pressure : (k,) float array, optional
         Contact pressure at ``contact_points`` (e.g. ``p_z`` of docs/method.md, *Discrete
         problem*).
-    scale : float or "auto", default "auto"
-        Magnification of the displacement in the drawing; "auto":
-        :func:`displacement_scale`.
-    obstacle : (j, 2) float array, optional
-        Polyline of the obstacle in physical coordinates (NaN rows break it), drawn as
-        given, at true scale (e.g. :func:`signorini.loop.arrays.obstacle_outline`).
-    title : str, optional
-        First line of the body's title (default "deformed body").
-    show_mesh : bool, default True
-        Draw the deformed triangulation with faint lines.
     gap : (k,) float array, optional
         The gap ``ψ`` at ``contact_points`` along ``normal`` (k, 2): the obstacle is then
         drawn at ``contact_points + gap * normal``, ordered along the boundary, at true scale
@@ -232,11 +236,25 @@ def plot_deformed(
         (:mod:`signorini.plots.contact_stress`); else against
         :func:`~signorini.plots.contact_line.contact_coordinate`.
 
+    scale : float or "auto", default "auto"
+        Magnification of the displacement in the drawing; "auto":
+        :func:`displacement_scale`.
+    obstacle : (j, 2) float array, optional
+        Polyline of the obstacle in physical coordinates (NaN rows break it), drawn as
+        given, at true scale (e.g. :func:`signorini.loop.arrays.obstacle_outline`).
+    title : str, optional
+        First line of the body's title (default "deformed body").
+    show_mesh : bool, default True
+        Draw the deformed triangulation with faint lines.
     Returns
     -------
     list of pathlib.Path
         The PNG and PDF files written.
     """
+    cd = ContactDrawing() if contact is None else contact
+    contact_points, pressure, gap, normal = cd.contact_points, cd.pressure, cd.gap, cd.normal
+    state, contact_displacement = cd.state, cd.contact_displacement
+    tangential_pressure, along = cd.tangential_pressure, cd.along
     p, c = mesh_arrays(points, cells)
     u = _vertex_displacement(displacement, p.shape[0])
     if isinstance(scale, str):

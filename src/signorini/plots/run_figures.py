@@ -120,12 +120,11 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         last["cells"],
         last["displacement"][: last["points"].shape[0]],
         out / "deformed",
-        contact_points=last["contact_points"],
-        pressure=last["pressure"],
+        plots.ContactDrawing(
+            last["contact_points"], last["pressure"], along=last["along"], **friction
+        ),
         obstacle=_joined(last["obstacle"].values()),
-        along=last["along"],
         title=f"{example}: deformed body",
-        **friction,
     )
     return written
 
