@@ -18,7 +18,14 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["TEMP_SUFFIX", "atomic_write", "remove_temporaries", "replacing"]
+__all__ = [
+    "TEMP_SUFFIX",
+    "atomic_write",
+    "describe_names",
+    "folder_listing",
+    "remove_temporaries",
+    "replacing",
+]
 
 #: Ending of every temporary file the atomic writers create.
 TEMP_SUFFIX = ".signorini-tmp"
@@ -97,3 +104,14 @@ def remove_temporaries(folder: str | os.PathLike) -> list[Path]:
             shutil.rmtree(entry.path, ignore_errors=True)  # a same-name write's folder
             removed.append(Path(entry.path))
     return removed
+
+
+def folder_listing(folder: Path) -> list[str]:
+    """The names in ``folder``, sorted (none if it is not a folder)."""
+    return sorted(os.listdir(folder)) if folder.is_dir() else []
+
+
+def describe_names(names: list[str]) -> str:
+    """The first four of ``names`` and how many more, for a message."""
+    shown = ", ".join(names[:4])
+    return shown + (f" and {len(names) - 4} more" if len(names) > 4 else "")

@@ -54,7 +54,7 @@ except ImportError:  # pragma: no cover - Windows
 import numpy as np
 
 from ..mesh.mesh import Mesh
-from .files import atomic_write, remove_temporaries, replacing
+from .files import atomic_write, describe_names, folder_listing, remove_temporaries, replacing
 
 __all__ = [
     "MANIFEST",
@@ -143,15 +143,6 @@ class ResumeState:
     history_rows: list[dict]
 
 
-def _listing(folder: Path) -> list[str]:
-    return sorted(os.listdir(folder)) if folder.is_dir() else []
-
-
-def _describe(names: list[str]) -> str:
-    shown = ", ".join(names[:4])
-    return shown + (f" and {len(names) - 4} more" if len(names) > 4 else "")
-
-
 class RunFolder:
     """The output folder of one run and its manifest.
 
@@ -212,14 +203,14 @@ class RunFolder:
         lock = cls._claim(path, "output folder")
         try:
             removed = remove_temporaries(path) + remove_temporaries(path / UNIFORM)
-            present = _listing(path)
+            present = folder_listing(path)
             if present and not overwrite:
                 old = cls._read_manifest(path)
                 what = (
                     f"it holds a run of {old.get('problem', {}).get('name', '?')} "
                     f"({cls._status_of(old)})"
                     if old
-                    else f"it holds {len(present)} file(s): {_describe(present)}"
+                    else f"it holds {len(present)} file(s): {describe_names(present)}"
                 )
                 raise RunFolderError(
                     f"output folder {path} is not empty: {what}. Give --overwrite to remove "
@@ -321,7 +312,7 @@ class RunFolder:
                 f"{STATE} says level {state.level} finished; start again with --overwrite"
             )
         state.history_rows = rows[: state.level + 1]
-        for name in _listing(path):
+        for name in folder_listing(path):
             m = re.fullmatch(r"level_(\d{3,})\.vtu", name)
             if m and int(m.group(1)) > state.level:
                 (path / name).unlink()
@@ -403,7 +394,7 @@ class RunFolder:
         removed = []
         for sub in ("", UNIFORM):
             folder = path / sub if sub else path
-            for name in _listing(folder):
+            for name in folder_listing(folder):
                 rel = f"{sub}/{name}" if sub else name
                 target = folder / name
                 if not target.is_file():
