@@ -7,6 +7,7 @@ from signorini.fem.material import CellMaterials, Material, on_cells, stress
 from signorini.fem.postprocess import cell_stress
 from signorini.fem.space import P2Space
 from signorini.fem.stiffness import assemble_stiffness
+from signorini.mesh import with_regions
 from signorini.mesh.builders import half_disc
 from signorini.mesh.mesh import Mesh
 
@@ -17,18 +18,8 @@ VOID = Material(lam=0.0, mu=1e-300)
 
 def two_region_half_disc() -> Mesh:
     """The curved half-disc, its cells below y = 0.4 (on the arc, isoparametric) stiff."""
-    mesh = half_disc(rings=4)
-    lower = (mesh.points[mesh.cells].mean(axis=1)[:, 1] < 0.4).astype(int)
-    return Mesh(
-        mesh.points,
-        mesh.cells,
-        mesh.boundary,
-        mesh.boundary_part,
-        mesh.part_names,
-        validate=False,
-        curves=mesh.curves,
-        cell_region=lower,
-        region_names=("upper", "lower"),
+    return with_regions(
+        half_disc(rings=4), {"upper": lambda x: x[:, 1] >= 0.4, "lower": lambda x: x[:, 1] < 0.4}
     )
 
 

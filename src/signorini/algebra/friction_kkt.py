@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .kkt import contact_scale, force_scale
+from .kkt import contact_scale, force_scale, normal_law_columns
 from .laws import LawGroups, check_laws
 from .qp import BoundQP, _index_array, check_qp, check_vector
 from .sparse import as_csr
@@ -214,11 +214,7 @@ class FrictionKKT:
         :meth:`~.kkt.KKTResiduals.columns` and ``kkt_tangential_bound``,
         ``kkt_tangential_complementarity``."""
         return {
-            "kkt_primal": self.primal,
-            "kkt_dual": self.dual,
-            "kkt_complementarity": self.complementarity,
-            "kkt_stationarity": self.stationarity,
-            "kkt_dirichlet": self.dirichlet,
+            **normal_law_columns(self),
             "kkt_tangential_bound": self.tangential_bound,
             "kkt_tangential_complementarity": self.tangential_complementarity,
         }

@@ -87,13 +87,20 @@ class KKTResiduals:
     def columns(self) -> dict[str, float]:
         """The five relative residuals as history columns: ``kkt_primal``, ``kkt_dual``,
         ``kkt_complementarity``, ``kkt_stationarity``, ``kkt_dirichlet``."""
-        return {
-            "kkt_primal": self.primal,
-            "kkt_dual": self.dual,
-            "kkt_complementarity": self.complementarity,
-            "kkt_stationarity": self.stationarity,
-            "kkt_dirichlet": self.dirichlet,
-        }
+        return normal_law_columns(self)
+
+
+def normal_law_columns(kkt) -> dict[str, float]:
+    """The history columns of the normal law's residuals of ``kkt`` (a
+    :class:`KKTResiduals` or a :class:`~.friction_kkt.FrictionKKT`): ``kkt_primal``,
+    ``kkt_dual``, ``kkt_complementarity``, ``kkt_stationarity``, ``kkt_dirichlet``."""
+    return {
+        "kkt_primal": kkt.primal,
+        "kkt_dual": kkt.dual,
+        "kkt_complementarity": kkt.complementarity,
+        "kkt_stationarity": kkt.stationarity,
+        "kkt_dirichlet": kkt.dirichlet,
+    }
 
 
 def kkt_residuals(
