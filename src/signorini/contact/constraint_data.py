@@ -5,6 +5,9 @@ the contact edges' nodes, the weights m_z, w_z per edge, and the friction data
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..algebra.laws import LawGroups
@@ -15,6 +18,9 @@ from ..mesh.validation import MeshError
 from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
+
+if TYPE_CHECKING:
+    from .mortar import MortarCoupling
 
 __all__ = [
     "DEEP_OVERLAP",
@@ -79,10 +85,16 @@ def _check_across(name: str, cos: np.ndarray, x: np.ndarray) -> None:
 
 
 def directions_and_gaps(
-    problem: ContactProblem, space: P2Space, cs_edges: tuple, chord: np.ndarray
+    problem: ContactProblem,
+    space: P2Space,
+    cs_edges: tuple,
+    chord: np.ndarray,
+    couplings: Mapping[str, MortarCoupling],
 ) -> tuple[np.ndarray, np.ndarray]:
     """n_z and ψ(z) at the nodes ``[start, end, midpoint]`` of the contact edges, part by part
-    (each part has its own obstacle), shapes ``(n_ce, 3, 2)`` and ``(n_ce, 3)``."""
+    (each part has its own obstacle), shapes ``(n_ce, 3, 2)`` and ``(n_ce, 3)``; on the slave
+    part of a contact pair the mortar direction and weighted gap ``g̃_z / D_zz`` of its
+    coupling (docs/method.md, *Two bodies*)."""
     parts, edge_part, edge_nodes = cs_edges
     direction = np.empty(edge_nodes.shape + (2,))
     gap = np.empty(edge_nodes.shape)
@@ -91,7 +103,12 @@ def directions_and_gaps(
         cond: Contact = problem.conditions[name]
         nodes, inverse = np.unique(edge_nodes[sel], return_inverse=True)
         x = space.node_points[nodes]
-        if cond.obstacle is not None:
+        if name in couplings:
+            c = couplings[name]
+            loc = np.searchsorted(c.slave_nodes, nodes)
+            psi = c.weighted_gap[loc] / c.D[loc]
+            direction[sel] = c.normal[loc][inverse].reshape(-1, 3, 2)
+        elif cond.obstacle is not None:
             try:
                 psi, n = cond.obstacle.gap_and_direction(x)
             except ValueError as err:

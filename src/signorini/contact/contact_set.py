@@ -38,6 +38,8 @@ from .constraint_data import (
     edge_weights,
     friction_data,
 )
+from .mortar import mortar_coupling
+from .two_body import PairTransfer, pair_transfer
 
 __all__ = [
     "ContactSet",
@@ -116,6 +118,10 @@ class ContactSet:
         of each constraint (``-1``: frictionless; a corner's constraints are frictionless)
         and its nodal weight (Tresca: ``s_z = ∫ s ψ_z ds`` over the constraint's part, force
         per unit thickness; Coulomb: its coefficient F); docs/method.md, *Friction*.
+    transfer : PairTransfer or None
+        With contact pairs between two bodies, the mortar transfer of
+        :mod:`~signorini.contact.two_body`: the constraints bound the relative displacement
+        ``ũ = u − T_d u`` (:meth:`relative`); ``None`` without pairs (``ũ = u``).
 
     Derived: ``tangent`` (the tangent space of each constraint as a basis beside its
     normal), ``edge_tangent``, ``frames``, ``has_friction``.
@@ -138,6 +144,7 @@ class ContactSet:
     edge_normal: np.ndarray
     edge_local: np.ndarray
     friction: LawGroups
+    transfer: PairTransfer | None = None
 
     @property
     def size(self) -> int:
@@ -189,13 +196,23 @@ class ContactSet:
         constrained."""
         return _locate(self.frame_nodes, np.asarray(nodes), np.flatnonzero(~self.second))
 
+    def relative(self, u: np.ndarray) -> np.ndarray:
+        """The displacement ``ũ = u − T_d u`` the constraints bound, for nodal values
+        ``u (n_nodes, 2)``: ``u`` itself without contact pairs (docs/method.md, *Two
+        bodies*)."""
+        u = np.asarray(u)
+        if self.transfer is None:
+            return u
+        return u - (self.transfer.dofs @ u.ravel()).reshape(u.shape)
+
     def normal_displacement(self, u: np.ndarray) -> np.ndarray:
-        """``u(z)·n_z`` per constraint, for nodal values ``u (n_nodes, 2)``."""
-        return np.einsum("kc,kc->k", u[self.nodes], self.normal)
+        """``ũ(z)·n_z`` per constraint, for nodal values ``u (n_nodes, 2)``
+        (:meth:`relative`)."""
+        return np.einsum("kc,kc->k", self.relative(u)[self.nodes], self.normal)
 
     def edge_normal_gap(self, u: np.ndarray) -> np.ndarray:
-        """``u·n_z − ψ`` at ``[start, end, midpoint]`` of each contact edge, ``(n_ce, 3)``."""
-        un = np.einsum("ejc,ejc->ej", u[self.edge_nodes], self.edge_direction)
+        """``ũ·n_z − ψ`` at ``[start, end, midpoint]`` of each contact edge, ``(n_ce, 3)``."""
+        un = np.einsum("ejc,ejc->ej", self.relative(u)[self.edge_nodes], self.edge_direction)
         return un - self.edge_gap
 
 
@@ -325,7 +342,10 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     for i, name in enumerate(parts):  # straight parts: exactly their normal
         if name in problem.contact_normals:
             chord[edge_part == i] = problem.contact_normals[name]
-    direction, edge_gap = directions_and_gaps(problem, space, (parts, edge_part, edge_nodes), chord)
+    couplings = {s: mortar_coupling(space, s, m) for s, m in problem.pairs.items()}
+    direction, edge_gap = directions_and_gaps(
+        problem, space, (parts, edge_part, edge_nodes), chord, couplings
+    )
 
     # candidates: one per (node, part), Dirichlet nodes left out
     n_parts = len(parts)
@@ -371,11 +391,14 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     loc = edge_local.ravel()
     inside = loc >= 0
     k = nodes.size
+    part = ukey[lead] % n_parts
+    normal = direction.reshape(-1, 2)[first[lead]]
+    friction = friction_data(problem, space, edge_part, edge_nodes, edge_local, part, second)
     return ContactSet(
         nodes=nodes,
-        normal=direction.reshape(-1, 2)[first[lead]],
+        normal=normal,
         gap=edge_gap.ravel()[first[lead]],
-        part=ukey[lead] % n_parts,
+        part=part,
         second=second,
         hat_integral=np.bincount(loc[inside], weights=hat.ravel()[inside], minlength=k),
         basis_integral=np.bincount(loc[inside], weights=basis.ravel()[inside], minlength=k),
@@ -388,8 +411,13 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
         edge_direction=direction,
         edge_normal=chord,
         edge_local=edge_local,
-        friction=friction_data(
-            problem, space, edge_part, edge_nodes, edge_local, ukey[lead] % n_parts, second
+        friction=friction,
+        transfer=pair_transfer(
+            space,
+            couplings,
+            (nodes, part, second, normal, friction.index >= 0),
+            parts,
+            tuple(problem.pairs[s] for s in couplings),
         ),
     )
 

@@ -148,7 +148,7 @@ def check_previous(previous: object, space: P2Space, cs: ContactSet) -> None:
 def slip_reference(previous: object, cs: ContactSet) -> np.ndarray:
     """``(k,)`` the tangential displacement of no slip per constraint: the previous step's
     ``u(z)·t_z`` in this step's frames (the DOF ``2z + 1`` of :func:`to_frames`)."""
-    x = to_frames(previous.u.ravel(), cs.frame_nodes, cs.frames)
+    x = to_frames(cs.relative(previous.u).ravel(), cs.frame_nodes, cs.frames)
     return x[2 * cs.nodes + 1]
 
 
@@ -230,6 +230,8 @@ def solve_frictional(
             warm = {"state0": previous.state, "direction0": previous.direction}
         elif u0 is None:
             u0 = previous.u
+    if u0 is not None:  # the unknowns bound by the constraints (docs/method.md, *Two bodies*)
+        u0 = cs.relative(u0)
     if u0 is not None and active0 is not None:
         state0, direction0 = states_from_displacement(u0, cs, reference, active0, warm_rtol)
         # no friction force out of contact where the law acts only in contact: no direction

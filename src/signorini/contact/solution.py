@@ -34,6 +34,7 @@ from .node_frames import to_cartesian
 from .ordering import ordered_solver
 from .profile import ContactProfile, contact_profile
 from .system import Assembled, assemble
+from .two_body import master_traction, physical
 
 __all__ = [
     "ContactProfile",
@@ -178,6 +179,22 @@ class ContactResult:
     def tangential_pressure(self) -> np.ndarray:
         """Consistent nodal friction stress ``p_t,z = Λ_t,z / w_z``."""
         return self.tangential_force / self.contact.basis_integral
+
+    @cached_property
+    def master_side(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """With contact pairs, the master parts' P2 nodes ``(m,)``, the consistent traction
+        the slaves exert there ``(m, 2)`` and the transferred pressure ``(m,)``
+        (:func:`~signorini.contact.two_body.master_traction`; docs/method.md, *Two
+        bodies*); empty arrays without pairs."""
+        cs = self.contact
+        if cs.transfer is None:
+            return np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros(0)
+        f = -(
+            self.contact_force[:, None] * cs.normal
+            + self.tangential_force[:, None] * cs.tangent[:, 0]
+        )
+        force = np.column_stack([f, self.contact_force])
+        return master_traction(self.space, cs.transfer, cs.nodes, force)
 
     @property
     def total_contact_force(self) -> float:
@@ -338,7 +355,7 @@ def solve(
     return ContactResult(
         problem=problem,
         space=space,
-        u=to_cartesian(solved.x, cs.frame_nodes, cs.frames).reshape(-1, 2),
+        u=physical(to_cartesian(solved.x, cs.frame_nodes, cs.frames).reshape(-1, 2), cs.transfer),
         contact=cs,
         contact_force=solved.normal_force if unit == 1.0 else solved.normal_force * unit,
         active=solved.state != INACTIVE,

@@ -20,6 +20,7 @@ from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, contact_set
 from .node_frames import rotate_frames
+from .two_body import two_body_system
 
 __all__ = ["Assembled", "assemble", "obstacle_displacement", "LOAD_DEGREE"]
 
@@ -44,7 +45,8 @@ class Assembled:
         The constrained nodes, their normals, gaps and weights.
     K : (n_dofs, n_dofs) scipy.sparse CSR matrix
         The stiffness matrix ``a(ψ_j, ψ_i)`` (symmetric positive semi-definite before the
-        Dirichlet DOFs are fixed), rotated in place at the constrained nodes.
+        Dirichlet DOFs are fixed), rotated in place at the constrained nodes; with contact
+        pairs, in the basis of the relative displacement (``(I + T)ᵀ K (I + T)``).
     F : (n_dofs,) float array
         The load ``L(ψ_i)``: body force and Neumann tractions, rotated like K.
     dirichlet : (n_held,) int array
@@ -79,7 +81,9 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
 
     The two DOFs of every constrained node are transformed into its frame (normal and
     tangential components; a corner's two constraint directions) so that each constraint
-    ``u(z)·n_z ≤ ψ(z)`` becomes a bound on one unknown.
+    ``u(z)·n_z ≤ ψ(z)`` becomes a bound on one unknown. With contact pairs between bodies
+    the unknowns are first the relative displacement ``ũ = u − T u``
+    (:mod:`~signorini.contact.two_body`; docs/method.md, *Two bodies*).
     """
     t0 = time.perf_counter()
     space = P2Space(mesh)
@@ -119,6 +123,8 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
         for rows, geometry in space.boundary_edges(edges):
             F += assemble_edge_load(geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE)
     cs = contact_set(problem, space)
+    if cs.transfer is not None:  # contact pairs: the relative displacement's basis
+        K, F = two_body_system(K, F, cs.transfer.dofs)
     K, F = rotate_frames(K, F, cs.frame_nodes, cs.frames, copy=False, validate=False)
     dirichlet, d_values = _dirichlet_dofs(problem, space, cs)
     return Assembled(

@@ -6,7 +6,9 @@ curved geometry.
 - :mod:`.punch`: a rigid punch with rounded corners pressed into a block held against a wall;
 - :mod:`.friction`: Example 6.2 with Tresca or Coulomb friction on its contact part;
 - :mod:`.partial_slip`: the Hertz half-disc pressed on a plane with Coulomb friction, then
-  pulled sideways (Cattaneo–Mindlin), a load path of two steps.
+  pulled sideways (Cattaneo–Mindlin), a load path of two steps;
+- :mod:`.two_bodies`: contact between two elastic bodies: two cylinders (Hertz), two
+  mirror-image half-discs, two blocks with non-matching meshes (the contact patch test).
 
 :data:`EXAMPLES` holds one :class:`Example` record per built-in example, by the name the
 command line takes (``signorini run hertz``): its problem, and where it has them its
@@ -26,6 +28,7 @@ from .metrics import Metrics, PressureComparison
 from .paper import example_6_1, example_6_2
 from .partial_slip import PARTIAL_SLIP_METRICS, partial_slip, partial_slip_path
 from .punch import punch
+from .two_bodies import CYLINDERS_METRICS, hertz_pair, stacked_blocks, two_cylinders
 
 __all__ = [
     "EXAMPLES",
@@ -43,6 +46,9 @@ __all__ = [
     "partial_slip",
     "partial_slip_path",
     "punch",
+    "hertz_pair",
+    "stacked_blocks",
+    "two_cylinders",
 ]
 
 
@@ -91,6 +97,9 @@ EXAMPLES: dict[str, Example] = {
         Example("hertz", hertz, metrics=HERTZ_METRICS),
         Example("punch", punch),
         Example("partial-slip", partial_slip, PARTIAL_SLIP_METRICS, partial_slip_path),
+        Example("two-cylinders", two_cylinders, metrics=CYLINDERS_METRICS),
+        Example("stacked-blocks", stacked_blocks),
+        Example("hertz-pair", hertz_pair),
     )
 }
 

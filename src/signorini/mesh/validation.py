@@ -34,6 +34,7 @@ __all__ = [
     "nondegenerate_area",
     "format_indices",
     "validate_mesh",
+    "winding_numbers",
 ]
 
 #: Relative tolerance for a boundary point lying inside a boundary edge (a hanging node).
@@ -335,7 +336,7 @@ def _check_boundary_crossings(points: np.ndarray, segments: np.ndarray) -> None:
             )
 
 
-def _winding_numbers(points: np.ndarray, segments: np.ndarray, at: np.ndarray) -> np.ndarray:
+def winding_numbers(points: np.ndarray, segments: np.ndarray, at: np.ndarray) -> np.ndarray:
     """Winding numbers ``(m,)`` of the closed chain of oriented ``segments`` around the points
     ``at (m, 2)`` (signed crossings of the ray to +x)."""
     a, b = points[segments[:, 0]], points[segments[:, 1]]
@@ -384,7 +385,7 @@ def _check_no_overlap(mesh: Mesh, is_bnd: np.ndarray) -> None:
     test = np.union1d(first, pinch)
     cell = mesh.edge2cell[bnd[test], 0]
     centroid = points[mesh.cells[cell]].mean(axis=1)
-    covered = _winding_numbers(points, segments, centroid)
+    covered = winding_numbers(points, segments, centroid)
     if np.any(covered != 1):
         k = np.flatnonzero(covered != 1)[0]
         area = float(np.abs(mesh.area).sum())

@@ -228,6 +228,12 @@ class Contact:
         The friction law on the part (:mod:`signorini.problem.friction`, or any object of the
         protocol :class:`signorini.algebra.laws.FrictionLaw`); ``None`` for frictionless
         contact.
+    master : str or None
+        Contact with a second deformable body: the boundary part of the other body (the
+        master; this part is the slave) that this part may touch (docs/method.md, *Two
+        bodies*). The constraint is the dual mortar one, the gap and the direction come from
+        the two surfaces; the master part takes no condition of its own. Not with ``gap``,
+        ``normal`` or ``obstacle``.
 
     Raises
     ------
@@ -242,9 +248,30 @@ class Contact:
     normal: tuple[float, float] | None = None
     obstacle: Obstacle | None = None
     friction: Friction | None = None
+    master: str | None = None
 
     def __post_init__(self) -> None:
         friction = self.friction
+        if self.master is not None:
+            if not isinstance(self.master, str) or not self.master:
+                raise ProblemError(
+                    "Contact(master=...) must be the name of the other body's boundary part, "
+                    f"got {self.master!r}"
+                )
+            given = [
+                f"{key}=..."
+                for key, v in (
+                    ("gap", self.gap),
+                    ("normal", self.normal),
+                    ("obstacle", self.obstacle),
+                )
+                if v is not None and (callable(v) or key != "gap" or np.any(np.asarray(v, float)))
+            ]
+            if given:
+                raise ProblemError(
+                    f"Contact(master={self.master!r}) takes its gap and direction from the two "
+                    f"surfaces; do not give {', '.join(given)} with it"
+                )
         if friction is not None and not all(hasattr(friction, a) for a in LAW_MEMBERS):
             raise ProblemError(
                 "Contact(friction=...) must be None, Tresca(bound) or Coulomb(coefficient) "

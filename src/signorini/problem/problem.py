@@ -31,6 +31,7 @@ from ..mesh.mesh import Mesh
 from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann, Roller
 from .corners import check_corner_friction
 from .fields import ProblemError, VectorField, check_function
+from .pairs import contact_pairs
 from .rigid import free_rigid_motions
 
 __all__ = ["ContactProblem", "SlenderBodyWarning", "free_ndof"]
@@ -101,6 +102,7 @@ class ContactProblem:
     contact_normals: dict[str, np.ndarray] = field(init=False, repr=False)
     held: dict[str, Dirichlet] = field(init=False, repr=False)
     rigid_motions: np.ndarray = field(init=False, repr=False)
+    pairs: dict[str, str] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         mesh = self.mesh
@@ -118,7 +120,9 @@ class ContactProblem:
                 f"conditions name boundary parts the mesh does not have: "
                 f"{unknown}; its parts are {list(mesh.part_names)}"
             )
-        missing = [p for p in mesh.part_names if p not in self.conditions]
+        object.__setattr__(self, "pairs", contact_pairs(mesh, self.conditions))
+        masters = set(self.pairs.values())
+        missing = [p for p in mesh.part_names if p not in self.conditions and p not in masters]
         if missing:
             raise ProblemError(
                 f"boundary part(s) {missing} have no condition; give each part "
@@ -148,7 +152,11 @@ class ContactProblem:
         if self.dirichlet_parts:
             _check_components(mesh, self.dirichlet_parts, self.contact_parts)
         object.__setattr__(
-            self, "rigid_motions", free_rigid_motions(mesh, self.held, self.contact_parts)
+            self,
+            "rigid_motions",
+            free_rigid_motions(
+                mesh, self.held, [p for p in self.contact_parts if p not in self.pairs]
+            ),
         )
         _warn_if_slender(mesh)
         normals = {name: self._segment_normal(name) for name in self.contact_parts}
@@ -234,7 +242,7 @@ class ContactProblem:
         (their directions are per node: docs/method.md, *Contact directions*)."""
         mesh = self.mesh
         given = self.conditions[name].normal
-        if self.conditions[name].obstacle is not None:
+        if self.conditions[name].obstacle is not None or name in self.pairs:
             return None
         ab = mesh.oriented_boundary(mesh.part_edges(name))
         _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])

@@ -1,0 +1,205 @@
+"""The change of basis that makes the dual mortar constraint of two bodies nodal
+(docs/method.md, *Two bodies*; Wohlmuth–Krause).
+
+A constrained slave node ``j`` of a contact pair bounds its weighted gap,
+``n_j·(D_jj u_j − Σ_k M_jk u_k) ≤ g̃_j``. With ``T_jk = M_jk / D_jj`` (zero outside the
+constrained slave rows and the master columns) and the relative displacement
+``ũ_j = u_j − P_j Σ_k T_jk u_k`` that is ``ũ_j·n_j ≤ g̃_j / D_jj``: a bound on one unknown
+in the node's frame, as for a rigid obstacle. ``P_j`` is the identity where the node has a
+friction law (its tangential unknown is then the relative slip the law acts on) and the
+projection ``n_j n_jᵀ`` where it has none (its tangential unknown stays the slave's own
+displacement, so a roller may hold it as at a rigid obstacle). The DOF transfer
+``T_d = [P_j T_jk]`` has ``T_d² = 0`` (no master node is a slave node), so ``u = (I + T_d) ũ``
+has the inverse ``ũ = (I − T_d) u``, and ``K̃ = (I + T_d)ᵀ K (I + T_d)``,
+``F̃ = (I + T_d)ᵀ F`` stay symmetric positive definite: the active-set solver, its warm
+starts, bordered updates and orderings, friction laws and every linear-solver backend take
+them as they take one body's system.
+
+The multiplier of constraint ``j`` is the slave's nodal contact force ``Λ_j`` along
+``n_j`` (and the friction force along ``t_j``); the master's nodal forces are
+``−T_dᵀ f`` of the slave's ``f``, so the two bodies' resultants are equal and opposite
+wherever ``Σ_k M_jk = D_jj``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..fem.space import P2Space
+from ..problem.fields import ProblemError
+from .constraint_data import edge_weights
+from .mortar import MortarCoupling
+
+__all__ = [
+    "PairTransfer",
+    "master_forces",
+    "master_traction",
+    "mortar_transfer",
+    "pair_transfer",
+    "physical",
+    "two_body_system",
+]
+
+
+def mortar_transfer(
+    n_nodes: int, rows: np.ndarray, T: sp.csr_matrix, projection: np.ndarray
+) -> sp.csr_matrix:
+    """The DOF transfer ``T_d (2 n_nodes, 2 n_nodes)`` on interleaved DOFs (``2 node +
+    component``) of the node transfer rows ``T (r, n_nodes)`` of the constrained slave nodes
+    ``rows (r,)``, each with its ``projection (r, 2, 2)`` ``P_j``: block ``(j, k)`` is
+    ``P_j T_jk``."""
+    coo = sp.coo_matrix(T)
+    block = coo.data[:, None, None] * projection[coo.row]  # (nnz, 2, 2)
+    r = 2 * np.asarray(rows)[coo.row][:, None, None] + np.arange(2)[None, :, None]
+    c = 2 * coo.col[:, None, None] + np.arange(2)[None, None, :]
+    r, c = np.broadcast_arrays(r, c)
+    return sp.csr_matrix((block.ravel(), (r.ravel(), c.ravel())), shape=(2 * n_nodes, 2 * n_nodes))
+
+
+def two_body_system(
+    K: sp.csr_matrix, F: np.ndarray, Td: sp.csr_matrix
+) -> tuple[sp.csr_matrix, np.ndarray]:
+    """``K̃ = (I + T_d)ᵀ K (I + T_d)`` and ``F̃ = (I + T_d)ᵀ F`` (Cartesian DOFs), with sorted
+    indices and full 2 × 2 node blocks, as :func:`~.node_frames.rotate_frames` needs."""
+    KT = K @ Td
+    return _full_blocks((K + KT + KT.T + Td.T @ KT).tocoo()), F + Td.T @ F
+
+
+def _full_blocks(A: sp.coo_matrix) -> sp.csr_matrix:
+    """``A`` in CSR with every 2 × 2 node block it touches stored whole (explicit zeros
+    where a projected transfer ``n nᵀ`` left an entry out), indices sorted."""
+    n = A.shape[0]
+    keys = A.row.astype(np.int64) * n + A.col
+    order = np.argsort(keys)
+    keys, values = keys[order], A.data[order]
+    blocks = np.unique((A.row // 2).astype(np.int64) * (n // 2) + A.col // 2)
+    bi, bj = np.divmod(blocks, n // 2)
+    rows = (2 * bi[:, None] + [0, 0, 1, 1]).ravel()
+    cols = (2 * bj[:, None] + [0, 1, 0, 1]).ravel()
+    want = np.sort(rows * n + cols)
+    rows, cols = np.divmod(want, n)
+    pos = np.minimum(np.searchsorted(keys, want), max(keys.size - 1, 0))
+    data = np.where(keys[pos] == want, values[pos], 0.0) if keys.size else np.zeros(want.size)
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))])
+    out = sp.csr_matrix((data, cols, indptr), shape=A.shape)  # rows, then columns, sorted
+    out.has_sorted_indices = True
+    return out
+
+
+def physical(u_relative: np.ndarray, transfer: PairTransfer | None) -> np.ndarray:
+    """``u = ũ + T_d ũ`` of nodal values ``(n_nodes, 2)``."""
+    if transfer is None:
+        return u_relative
+    return u_relative + (transfer.dofs @ u_relative.ravel()).reshape(-1, 2)
+
+
+def master_forces(
+    Td: sp.csr_matrix, nodes: np.ndarray, force: np.ndarray, n_nodes: int
+) -> np.ndarray:
+    """``(n_nodes, 2)`` the nodal contact forces the slave constraints ``nodes (k,)`` with
+    forces ``force (k, 2)`` (``Λ_j n_j``, plus any friction force) exert on the master:
+    ``−T_dᵀ f``."""
+    f = np.zeros((n_nodes, 2))
+    np.add.at(f, nodes, force)
+    return -(Td.T @ f.ravel()).reshape(-1, 2)
+
+
+@dataclass(frozen=True)
+class PairTransfer:
+    """The mortar transfer of a problem's contact pairs.
+
+    Attributes
+    ----------
+    nodes : (n_nodes, n_nodes) scipy.sparse CSR matrix
+        ``T_jk = M_jk / D_jj`` on the constrained slave rows and the master columns.
+    dofs : (n_dofs, n_dofs) scipy.sparse CSR matrix
+        ``T_d``, blocks ``P_j T_jk`` on interleaved DOFs.
+    masters : tuple of str
+        The master parts, pair after pair.
+    """
+
+    nodes: sp.csr_matrix
+    dofs: sp.csr_matrix
+    masters: tuple[str, ...]
+
+
+def master_traction(
+    space: P2Space, transfer: PairTransfer, nodes: np.ndarray, force: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The master side of the pairs: the P2 nodes of the master parts ``(m,)``, the
+    consistent traction the slaves exert there ``(m, 2)`` (nodal force of
+    :func:`master_forces` over ``w_k = ∫_{Γ_m} φ_k ds``), and the transferred pressure
+    ``(m,)`` ``Σ_j T_jk Λ_j / w_k``; ``nodes (k,)`` and ``force (k, 3)`` the slave
+    constraints' nodes and their ``(f_x, f_y, Λ)`` (the force on the slave and the normal
+    contact force)."""
+    edges = np.concatenate([space.mesh.part_edges(m) for m in transfer.masters])
+    edge_nodes = space.edge_nodes(edges)
+    w = np.bincount(
+        edge_nodes.ravel(), weights=edge_weights(space, edges, edge_nodes)[1].ravel(),
+        minlength=space.n_nodes,
+    )  # fmt: skip
+    on = np.unique(edge_nodes)
+    f = master_forces(transfer.dofs, nodes, force[:, :2], space.n_nodes)[on]
+    lam = np.zeros(space.n_nodes)
+    np.add.at(lam, nodes, force[:, 2])
+    return on, f / w[on, None], (transfer.nodes.T @ lam)[on] / w[on]
+
+
+def pair_transfer(
+    space: P2Space,
+    couplings: Mapping[str, MortarCoupling],
+    rows: tuple,
+    parts: tuple,
+    masters: tuple[str, ...],
+) -> PairTransfer | None:
+    """The transfer of the contact pairs ``couplings {slave part: coupling}`` for the
+    constraint rows ``rows = (nodes, part, second, normal, frictional)`` of a contact set
+    with ``parts``, ``masters`` the master parts; ``None`` without pairs.
+
+    Raises
+    ------
+    ProblemError
+        If a constrained slave node is a corner (it lies on a second contact part), or a node
+        is on the master side of one constraint and is itself constrained as a slave.
+    """
+    if not couplings:
+        return None
+    nodes, part, second, normal, frictional = rows
+    Td = sp.csr_matrix((space.n_dofs, space.n_dofs))
+    Tn = sp.csr_matrix((space.n_nodes, space.n_nodes))
+    for name, c in couplings.items():  # a loop over contact pairs
+        mine = np.flatnonzero(part == parts.index(name))
+        corner = np.isin(nodes[mine], nodes[second]) | second[mine]
+        if corner.any():
+            z = nodes[mine][np.flatnonzero(corner)[0]]
+            raise ProblemError(
+                f"the node at {_point(space, z)} of contact part {name!r}, the slave of a "
+                "pair, lies on a second contact part: a slave node carries one constraint "
+                "(end the other part before it)"
+            )
+        loc = np.searchsorted(c.slave_nodes, nodes[mine])
+        n = normal[mine]
+        projection = np.where(
+            frictional[mine, None, None], np.eye(2), n[:, :, None] * n[:, None, :]
+        )
+        T = sp.diags(1.0 / c.D[loc]) @ c.M[loc]
+        Td = Td + mortar_transfer(space.n_nodes, nodes[mine], T, projection)
+        Tn = Tn + sp.csr_matrix(
+            (np.ones(mine.size), (nodes[mine], np.arange(mine.size))),
+            shape=(space.n_nodes, mine.size),
+        ) @ sp.csr_matrix(T)
+    both = np.intersect1d(np.unique(Tn.indices), nodes)
+    if both.size:
+        raise ProblemError(
+            f"the node at {_point(space, both[0])} is constrained as a slave node and lies on "
+            "the master side of a contact pair: give the two pairs' parts no common node"
+        )
+    return PairTransfer(Tn.tocsr(), Td.tocsr(), masters)
+
+
+def _point(space: P2Space, z: int) -> tuple:
+    return tuple(np.round(space.node_points[z], 12).tolist())

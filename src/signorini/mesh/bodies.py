@@ -1,0 +1,130 @@
+"""Several bodies in one mesh: the disjoint union of separately meshed bodies
+(docs/method.md, *Two bodies*).
+
+Each body keeps its own points, cells, boundary parts, curves and regions; in the union a
+part ``top`` of body ``upper`` is named ``"upper.top"`` and a region ``coat`` of it
+``"upper.coat"`` (a body meshed without regions is the one region ``"upper"``). The bodies'
+meshes need not match where they touch: their points may coincide there or not, and no cell
+of one may lie inside the other. Refinement, the P2 space, assembly and the estimator treat
+the union as one mesh whose components are the bodies.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from .mesh import Mesh
+from .regions import DEFAULT_REGION
+from .validation import MeshError, winding_numbers
+
+__all__ = ["BODY_SEPARATOR", "body_of_cells", "union"]
+
+#: joins a body's name and its part's or region's name in the union
+BODY_SEPARATOR = "."
+
+
+def union(bodies: Mapping[str, Mesh]) -> Mesh:
+    """One mesh of the bodies ``{name: mesh}``, in the mapping's order.
+
+    Parameters
+    ----------
+    bodies : mapping body name -> Mesh
+        Two or more bodies, each a valid mesh (built by :meth:`Mesh.from_arrays`, a
+        builder or :func:`~signorini.mesh.gmsh.read_mesh`); names without
+        :data:`BODY_SEPARATOR`.
+
+    Returns
+    -------
+    Mesh
+        Points and cells of the bodies one after the other; parts ``"body.part"``, regions
+        ``"body"`` (``"body.region"`` for a body with several), every part's curve kept.
+
+    Raises
+    ------
+    MeshError
+        If ``bodies`` is not a mapping of at least two names to meshes, a name is empty or
+        holds the separator, or a cell of one body lies inside another body (they overlap
+        instead of touching; the message names both bodies and the cell's centroid).
+    """
+    if not isinstance(bodies, Mapping) or len(bodies) < 2:
+        raise MeshError(
+            "union(bodies=...) takes a mapping of two or more body names to meshes, got "
+            f"{type(bodies).__name__}"
+            + (f" of {len(bodies)}" if isinstance(bodies, Mapping) else "")
+        )
+    for name, mesh in bodies.items():
+        if not isinstance(name, str) or not name or BODY_SEPARATOR in name:
+            raise MeshError(
+                f"union: body names must be non-empty strings without {BODY_SEPARATOR!r}, "
+                f"got {name!r}"
+            )
+        if not isinstance(mesh, Mesh):
+            raise MeshError(
+                f"union: body {name!r} must be a signorini Mesh, got {type(mesh).__name__}"
+            )
+    meshes = list(bodies.values())
+    names = list(bodies)
+    _check_apart(names, meshes)
+    offset = np.cumsum([0] + [m.n_points for m in meshes])
+    part_names, region_names = [], []
+    boundary_part, cell_region, curves = [], [], []
+    for name, mesh in bodies.items():
+        boundary_part.append(mesh.boundary_part + len(part_names))
+        part_names += [f"{name}{BODY_SEPARATOR}{p}" for p in mesh.part_names]
+        curves += list(mesh.curves)
+        cell_region.append(mesh.cell_region + len(region_names))
+        if mesh.region_names == (DEFAULT_REGION,):
+            region_names.append(name)
+        else:
+            region_names += [f"{name}{BODY_SEPARATOR}{r}" for r in mesh.region_names]
+    return Mesh(
+        np.concatenate([m.points for m in meshes]),
+        np.concatenate([m.cells + offset[b] for b, m in enumerate(meshes)]),
+        np.concatenate([m.boundary + offset[b] for b, m in enumerate(meshes)]),
+        np.concatenate(boundary_part),
+        part_names,
+        validate=False,  # each body is valid; touching points may coincide across bodies
+        curves=curves,
+        cell_region=np.concatenate(cell_region),
+        region_names=region_names,
+    )
+
+
+def _check_apart(names: list[str], meshes: list[Mesh]) -> None:
+    """No cell centroid of one body lies inside another (winding number of its boundary)."""
+    for a, mesh in enumerate(meshes):  # a loop over bodies
+        segments = mesh.oriented_boundary(np.flatnonzero(mesh.edge2cell[:, 1] < 0))
+        for b, other in enumerate(meshes):
+            if a == b:
+                continue
+            centroid = other.points[other.cells].mean(axis=1)
+            inside = np.flatnonzero(winding_numbers(mesh.points, segments, centroid) != 0)
+            if inside.size:
+                x = centroid[inside[0]]
+                raise MeshError(
+                    f"union: body {names[b]!r} overlaps body {names[a]!r}: the centroid "
+                    f"({x[0]:.6g}, {x[1]:.6g}) of its cell {inside[0]} ({inside.size} cell(s) "
+                    "in all) lies inside the other body. Bodies in contact touch along their "
+                    "boundaries; move them apart"
+                )
+
+
+def body_of_cells(mesh: Mesh) -> np.ndarray:
+    """The body ``(n_cells,)`` of each cell: the connected components of the cells joined
+    through shared edges, numbered in the order of their first cell (for a union, or a
+    refinement of one, the bodies in the union's order when each body is connected)."""
+    e2c = mesh.edge2cell
+    inner = e2c[:, 1] >= 0
+    n = mesh.n_cells
+    graph = sp.coo_matrix(
+        (np.ones(int(inner.sum()), dtype=np.int8), (e2c[inner, 0], e2c[inner, 1])), shape=(n, n)
+    )
+    _, label = connected_components(graph, directed=False)
+    _, first, inverse = np.unique(label, return_index=True, return_inverse=True)
+    rank = np.empty(first.size, dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(first.size)
+    return rank[inverse]

@@ -1,0 +1,236 @@
+"""Contact between two elastic bodies (docs/method.md, *Two bodies*): the contact patch test,
+an independent dual solve of the mortar-constrained QP, the symmetric pair against the
+one-body Hertz problem, equal and opposite resultants, rotation invariance, the estimator,
+and bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg as sl
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.optimize import nnls
+from scipy.spatial import cKDTree
+
+from signorini.contact import solve
+from signorini.contact.mortar import mortar_coupling
+from signorini.estimator import estimate
+from signorini.examples.hertz import hertz
+from signorini.examples.two_bodies import hertz_pair, stacked_blocks, two_cylinders
+from signorini.fem.space import P2Space
+from signorini.fem.stiffness import assemble_stiffness
+from signorini.mesh.bodies import body_of_cells, union
+from signorini.mesh.builders import rectangle
+from signorini.mesh.validation import MeshError
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
+
+
+def exact_pressure(problem: ContactProblem, depth: float = 0.01) -> float:
+    """σ_yy = −p in both blocks of :func:`stacked_blocks`: δ = p Σ (1 − ν²) / E (height 1
+    each, plane strain, free lateral expansion)."""
+    m = problem.material
+    return depth / sum((1 - m[b].poisson ** 2) / m[b].young for b in ("upper", "lower"))
+
+
+@pytest.mark.parametrize("edges", [(5, 7), (7, 5), (4, 4), (3, 8)])
+def test_contact_patch_test(edges):
+    """Uniform compression through a non-matching interface is reproduced: uniform pressure
+    on both sides equal to the exact p, the affine displacement at every node, η at
+    round-off."""
+    problem = stacked_blocks(edges)
+    r = solve(problem)
+    p = exact_pressure(problem)
+    nodes, traction, master_pressure = r.master_side
+    print(f"{edges}: slave p in [{r.pressure.min():.15g}, {r.pressure.max():.15g}], exact {p:.15g}")
+    assert np.abs(r.pressure / p - 1).max() < 1e-11
+    assert np.abs(master_pressure / p - 1).max() < 1e-11
+    assert np.abs(traction - [0.0, -p]).max() < 1e-11 * p
+    assert r.active.all()
+    # the exact displacement, block by block: u_y = −ε (y-top) and u_x = ν' ε x style
+    body = np.zeros(r.space.n_nodes, dtype=np.int64)
+    body[r.space.cell_nodes.ravel()] = np.repeat(body_of_cells(r.mesh), 6)
+    m = problem.material
+    x = r.space.node_points
+    for b, name in enumerate(("upper", "lower")):
+        E, nu = m[name].young, m[name].poisson
+        eyy = -p * (1 - nu**2) / E
+        exx = p * nu * (1 + nu) / E
+        on = body == b
+        uy_exact = np.where(b == 0, eyy * (x[on, 1] - 2.0) - 0.01, eyy * x[on, 1])
+        assert np.abs(r.u[on, 1] - uy_exact).max() < 1e-12
+        assert np.abs(r.u[on, 0] - exx * x[on, 0]).max() < 1e-12
+    assert estimate(r).eta < 1e-11 * p
+
+
+def test_resultants_equal_and_opposite():
+    """The forces the slave receives and the master receives sum to zero, component by
+    component, and the slave's resultant is the load the Dirichlet parts carry."""
+    r = solve(two_cylinders(rings=4))
+    cs = r.contact
+    slave = -(r.contact_force[:, None] * cs.normal).sum(axis=0)
+    nodes, traction, _ = r.master_side
+    from signorini.contact.two_body import master_forces
+
+    master = master_forces(cs.transfer.dofs, cs.nodes, -r.contact_force[:, None] * cs.normal,
+                           r.space.n_nodes).sum(axis=0)  # fmt: skip
+    print(f"slave {slave}, master {master}")
+    assert slave[1] > 0
+    assert np.abs(slave + master).max() < 1e-13 * np.abs(slave).max()
+
+
+def _cartesian_qp(problem: ContactProblem):
+    """The two-body QP assembled here from the fem layer and the mortar coupling alone:
+    ``min ½ uᵀ K u`` with the held DOFs, subject to ``n_j·(D_jj u_j − Σ_k M_jk u_k) ≤ g̃_j``."""
+    mesh = problem.mesh
+    space = P2Space(mesh)
+    K = assemble_stiffness(space.mapping, space.cell_dofs, space.n_dofs, problem.material_on(mesh))
+    held = problem.held_components(space).ravel()
+    values = np.zeros(space.n_dofs)
+    for name, cond in problem.held.items():
+        nodes = space.part_nodes([name])
+        for c in range(2):
+            if cond.components[c]:
+                values[2 * nodes + c] = cond.field()(space.node_points[nodes])[:, c]
+    rows, gaps = [], []
+    dirichlet_nodes = problem.dirichlet_nodes(space)
+    for slave, master in problem.pairs.items():
+        c = mortar_coupling(space, slave, master)
+        keep = ~np.isin(c.slave_nodes, dirichlet_nodes)
+        M = sp.lil_matrix((keep.sum(), space.n_nodes))
+        M[:, :] = c.M[keep]
+        j = c.slave_nodes[keep]
+        n = c.normal[keep]
+        B = sp.lil_matrix((j.size, space.n_dofs))
+        for comp in range(2):  # B_j = n_j ⊗ (D_jj e_j − M_j)
+            block = -sp.csr_matrix(M).multiply(n[:, [comp]])
+            B[:, comp::2] = block
+        B = sp.csr_matrix(B)
+        B = B + sp.csr_matrix(
+            (np.concatenate([c.D[keep] * n[:, 0], c.D[keep] * n[:, 1]]),
+             (np.tile(np.arange(j.size), 2), np.concatenate([2 * j, 2 * j + 1]))),
+            shape=B.shape,
+        )  # fmt: skip
+        rows.append(B)
+        gaps.append(c.weighted_gap[keep])
+    return space, K.tocsc(), held, values, sp.vstack(rows).tocsr(), np.concatenate(gaps)
+
+
+@pytest.mark.parametrize("make", [lambda: stacked_blocks((3, 4)), lambda: two_cylinders(rings=4)])
+def test_agrees_with_dual_nnls(make):
+    """The mortar-constrained QP solved independently (Cartesian, no change of basis, dual
+    NNLS) gives the same displacement, the same contact forces and active set."""
+    problem = make()
+    r = solve(problem)
+    space, K, held, values, B, g = _cartesian_qp(problem)
+    free = np.flatnonzero(~held)
+    Kff = K[free][:, free].tocsc()
+    b = -(K[free][:, np.flatnonzero(held)] @ values[held])
+    Bf = B[:, free]
+    g = g - B[:, np.flatnonzero(held)] @ values[held]
+    lu = spla.splu(Kff)
+    KiBt = lu.solve(Bf.T.toarray())
+    Kib = lu.solve(b)
+    L = np.linalg.cholesky(Bf @ KiBt)
+    lam, _ = nnls(L.T, sl.solve_triangular(L, Bf @ Kib - g, lower=True), maxiter=50 * g.size)
+    u = values.copy()
+    u[free] = Kib - KiBt @ lam
+    du = np.abs(u - r.u.ravel()).max() / np.abs(r.u).max()
+    # the multiplier λ_j of the weighted constraint is the pressure: Λ_j = D_jj λ_j = w_j p_j
+    dl = np.abs(lam - r.pressure).max() / np.abs(lam).max()
+    print(f"{problem.name}: {free.size} unknowns, {g.size} constraints: du {du:.1e}, dΛ {dl:.1e}")
+    assert du < 1e-10 and dl < 1e-9
+    assert np.array_equal(lam > 1e-12 * lam.max(), r.active)
+
+
+def _upper_nodes(result) -> np.ndarray:
+    body = np.zeros(result.space.n_nodes, dtype=bool)
+    cells = body_of_cells(result.mesh) == 0
+    body[result.space.cell_nodes[cells].ravel()] = True
+    return np.flatnonzero(body)
+
+
+@pytest.mark.parametrize("h_bottom", [None, 0.05])
+def test_symmetric_pair_equals_one_body_hertz(h_bottom):
+    """Two mirror-image half-discs pressed together by δ equal, node by node, the one-body
+    Hertz problem pressed by δ/2 against the plane: displacements, contact forces and active
+    sets to round-off (the averaged normal is the symmetry plane's)."""
+    pair = solve(hertz_pair(depth=0.015, h_bottom=h_bottom))
+    one = solve(hertz(depth=0.0075, h_bottom=h_bottom))
+    upper = _upper_nodes(pair)
+    dist, idx = cKDTree(pair.space.node_points[upper]).query(one.space.node_points)
+    assert dist.max() < 1e-14
+    du = np.abs(pair.u[upper][idx] - one.u).max() / np.abs(one.u).max()
+    # constraints: the one-body problem constrains the whole arc, the pair |x| < R/2
+    z1 = one.space.node_points[one.contact.nodes]
+    z2 = pair.space.node_points[pair.contact.nodes]
+    d, j = cKDTree(z1).query(z2)
+    assert d.max() < 1e-14
+    dl = np.abs(pair.contact_force - one.contact_force[j]).max() / one.contact_force.max()
+    print(f"h_bottom {h_bottom}: max |Δu|/max|u| = {du:.1e}, max |ΔΛ|/max Λ = {dl:.1e}")
+    assert du < 1e-12 and dl < 1e-11
+    assert np.array_equal(pair.active, one.active[j])
+    assert one.active.sum() == pair.active.sum()
+
+
+def test_rotation_invariance():
+    """The two-cylinder problem rotated by 0.7 rad gives the rotated solution."""
+    angle = 0.7
+    R = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    a = solve(two_cylinders(rings=4))
+    b = solve(two_cylinders(rings=4, angle=angle))
+    assert np.abs(b.space.node_points - a.space.node_points @ R.T).max() < 1e-13
+    du = np.abs(b.u - a.u @ R.T).max() / np.abs(a.u).max()
+    dl = np.abs(b.contact_force - a.contact_force).max() / a.contact_force.max()
+    print(f"rotated by {angle} rad: |Δu| {du:.1e}, |ΔΛ| {dl:.1e}")
+    assert du < 1e-11 and dl < 1e-10
+    assert np.array_equal(a.active, b.active)
+
+
+# ------------------------------------------------------------------------------- bad input
+def two_blocks(conditions: dict) -> ContactProblem:
+    mesh = union({"a": rectangle(0, 1, 1, 2, 2, 2), "b": rectangle(0, 1, 0, 1, 3, 3)})
+    base = {p: Neumann() for p in mesh.part_names}
+    base.update({"a.top": Dirichlet((0.0, -0.01)), "b.bottom": Dirichlet((0.0, 0.0))})
+    base.update(conditions)
+    return ContactProblem(mesh=mesh, material=_material(), conditions=base)
+
+
+def _material():
+    from signorini.fem.material import Material
+
+    return Material.from_young(1.0, 0.3)
+
+
+def test_pair_refusals():
+    with pytest.raises(ProblemError, match="'b.nowhere' is not a boundary part"):
+        two_blocks({"a.bottom": Contact(master="b.nowhere")})
+    with pytest.raises(ProblemError, match="names itself as its master"):
+        two_blocks({"a.bottom": Contact(master="a.bottom")})
+    with pytest.raises(ProblemError, match="takes no condition of its own"):
+        two_blocks({"a.bottom": Contact(master="b.top")})  # b.top keeps its Neumann
+    with pytest.raises(ProblemError, match="do not give gap"):
+        Contact(master="b.top", gap=0.1)
+    with pytest.raises(ProblemError, match="do not give obstacle"):
+        from signorini.problem.obstacles import HalfPlane
+
+        Contact(master="b.top", obstacle=HalfPlane((0, 0), (0, 1)))
+
+
+def test_union_refusals():
+    a = rectangle(0, 1, 0, 1, 2, 2)
+    with pytest.raises(MeshError, match="overlaps body"):
+        union({"a": a, "b": rectangle(0.5, 1.5, 0.5, 1.5, 2, 2)})
+    with pytest.raises(MeshError, match="two or more"):
+        union({"a": a})
+    with pytest.raises(MeshError, match="without '.'"):
+        union({"a.b": a, "c": rectangle(0, 1, 1, 2, 2, 2)})
+
+
+def test_union_names_and_bodies():
+    m = union({"upper": rectangle(0, 1, 1, 2, 2, 2), "lower": rectangle(0, 1, 0, 1, 3, 3)})
+    assert m.part_names[:4] == ("upper.bottom", "upper.right", "upper.top", "upper.left")
+    assert m.region_names == ("upper", "lower")
+    body = body_of_cells(m)
+    assert np.array_equal(np.bincount(body), [8, 18])
+    assert np.array_equal(body, m.cell_region)
