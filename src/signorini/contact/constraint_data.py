@@ -29,6 +29,7 @@ __all__ = [
     "directions_and_gaps",
     "edge_weights",
     "friction_data",
+    "part_normals",
 ]
 
 
@@ -41,9 +42,18 @@ def _body_normals(
     edge's normal at a midpoint and the normalised mean of the part's two edges' normals at a
     vertex
     (docs/method.md, *Contact directions*)."""
-    mesh = space.mesh
     if name in problem.contact_normals:
         return np.broadcast_to(problem.contact_normals[name], nodes.shape + (2,)).copy()
+    return part_normals(space, name, nodes, chord)
+
+
+def part_normals(space: P2Space, name: str, nodes: np.ndarray, chord: np.ndarray) -> np.ndarray:
+    """The outward unit normal of boundary part ``name`` at the nodes ``[start, end,
+    midpoint]`` of its edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``:
+    the curve's normal on a part with a curve that has one, else the edge's normal at a
+    midpoint and the normalised mean of the part's two edges' normals at a vertex
+    (docs/method.md, *Contact directions*)."""
+    mesh = space.mesh
     curve = mesh.curves[mesh.part_index(name)]
     if curve is not None and curve.has_normal:
         x = space.node_points[nodes.ravel()]

@@ -1,0 +1,368 @@
+"""The dual mortar coupling of two bodies (:mod:`signorini.contact.mortar`): exact on flat
+interfaces, the symmetry plane's normal on mirrored arcs, an independent brute-force mortar
+matrix on curved non-matching arcs, rotation invariance, the weighted gap's convergence, and
+the refusals (docs/method.md, *Two bodies: the dual mortar coupling*)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import quad, quad_vec
+from scipy.optimize import brentq
+from scipy.spatial import cKDTree
+
+from signorini.contact.mortar import mortar_coupling
+from signorini.fem.space import P2Space
+from signorini.mesh.builders import half_disc, rectangle
+from signorini.mesh.curves import Circle
+from signorini.mesh.mesh import Mesh
+from signorini.mesh.refine import refine_nvb
+from signorini.problem.fields import ProblemError
+
+# --------------------------------------------------------------------------- meshes
+
+
+def union(**bodies: Mesh) -> Mesh:
+    """One mesh of the given bodies (disjoint components), parts named ``body.part``."""
+    pts, cells, bnd, bp, names, curves = [], [], [], [], [], []
+    off = 0
+    for key, m in bodies.items():
+        pts.append(m.points)
+        cells.append(m.cells + off)
+        bnd.append(m.boundary + off)
+        bp.append(m.boundary_part + len(names))
+        names += [f"{key}.{p}" for p in m.part_names]
+        curves += list(m.curves)
+        off += m.n_points
+    return Mesh(
+        np.vstack(pts),
+        np.vstack(cells),
+        np.vstack(bnd),
+        np.concatenate(bp),
+        names,
+        validate=False,  # touching bodies share point coordinates
+        curves=curves,
+    )
+
+
+def split_part(mesh: Mesh, part: str, new: str, select) -> Mesh:
+    """``mesh`` with the edges of ``part`` whose midpoints ``select`` moved to part ``new``
+    (carrying the same curve)."""
+    i = mesh.part_index(part)
+    mid = mesh.edge_midpoints[mesh.boundary_edge]
+    bp = mesh.boundary_part.copy()
+    bp[(bp == i) & select(mid)] = len(mesh.part_names)
+    return Mesh(
+        mesh.points,
+        mesh.cells,
+        mesh.boundary,
+        bp,
+        mesh.part_names + (new,),
+        validate=False,
+        curves=mesh.curves + (mesh.curves[i],),
+    )
+
+
+def moved(mesh: Mesh, Q: np.ndarray, shift=(0.0, 0.0)) -> Mesh:
+    """``mesh`` mapped by ``x -> Q x + shift`` (``Q`` orthogonal; a reflection reverses the
+    cells to keep them counter-clockwise), circles mapped along."""
+    reflect = np.linalg.det(Q) < 0
+    cells = mesh.cells[:, [1, 0, 2]] if reflect else mesh.cells
+    curves = tuple(
+        None if c is None else Circle(Q @ c.center + shift, c.radius) for c in mesh.curves
+    )
+    return Mesh(
+        mesh.points @ Q.T + shift,
+        cells,
+        mesh.boundary,
+        mesh.boundary_part,
+        mesh.part_names,
+        validate=False,
+        curves=curves,
+    )
+
+
+MIRROR = np.diag([1.0, -1.0])
+
+
+def rotation(angle: float) -> np.ndarray:
+    return np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+
+
+def blocks(n_upper: int, n_lower: int, gap: float = 0.0, width=(0.0, 1.0)) -> P2Space:
+    """An upper block ``[0, 1] × [gap, gap + 0.5]`` on a lower one ``width × [−0.5, 0]``,
+    ``n_upper`` and ``n_lower`` edges along the interface."""
+    lower = rectangle(width[0], width[1], -0.5, 0.0, n_lower, 2)
+    upper = rectangle(0.0, 1.0, gap, gap + 0.5, n_upper, 2)
+    return P2Space(union(up=upper, low=lower))
+
+
+def cap(radius: float, rings: int, half_width: float) -> Mesh:
+    """``half_disc(radius, rings)`` with the arc's edges within ``|x| < half_width`` as part
+    ``contact``."""
+    return split_part(
+        half_disc(radius, rings), "arc", "contact", lambda x: np.abs(x[:, 0]) < half_width
+    )
+
+
+def mirrored_arcs(rings: int = 4) -> P2Space:
+    top = cap(1.0, rings, 0.5)
+    return P2Space(union(up=top, low=moved(top, MIRROR)))
+
+
+def cylinders(Q: np.ndarray | None = None) -> P2Space:
+    """Cylinders of radii 1 (above, slave cap |x| < 0.45: 4 edges) and 2 (below, master cap
+    |x| < 0.9: 4 edges) 0.02 apart at x = 0, non-matching; both mapped by ``Q``."""
+    Q = np.eye(2) if Q is None else Q
+    upper = moved(cap(1.0, 4, 0.45), np.eye(2), (0.0, 0.02))
+    lower = moved(cap(2.0, 5, 0.9), MIRROR)
+    return P2Space(union(up=moved(upper, Q), low=moved(lower, Q)))
+
+
+def partner(space: P2Space, c, points: np.ndarray) -> np.ndarray:
+    """The master node at each of ``points``."""
+    master = np.unique(space.edge_nodes(space.mesh.part_edges(c.master)))
+    dist, k = cKDTree(space.node_points[master]).query(points)
+    assert dist.max() < 1e-14
+    return master[k]
+
+
+# --------------------------------------------------------------------------- flat
+
+
+def test_matching_flat_interface_M_is_D_and_the_gap_is_the_offset():
+    space = blocks(5, 5, gap=0.03)
+    c = mortar_coupling(space, "up.bottom", "low.top")
+    xs = space.node_points[c.slave_nodes]
+    assert c.slave_nodes.size == 11
+    np.testing.assert_allclose(c.normal, [[0.0, -1.0]] * 11, atol=1e-15)
+    k = partner(space, c, xs - [0.0, 0.03])
+    M = c.M.toarray()
+    np.testing.assert_allclose(M[np.arange(11), k], c.D, rtol=1e-14)
+    M[np.arange(11), k] = 0.0
+    assert np.abs(M).max() < 1e-15
+    # D = ∫φ_j: h/6 at the ends, h/3 at inner vertices, 2h/3 at midpoints (h = 1/5)
+    assert c.D.sum() == pytest.approx(1.0, rel=1e-14)
+    np.testing.assert_allclose(np.sort(c.D)[[0, -1]], [1 / 30, 2 / 15], rtol=1e-14)
+    np.testing.assert_allclose(c.weighted_gap, 0.03 * c.D, rtol=1e-13)
+    np.testing.assert_allclose(c.coverage, 1.0, atol=1e-14)
+
+
+@pytest.mark.parametrize("n_upper, n_lower", [(5, 7), (7, 5)])
+def test_non_matching_flat_interface_reproduces_affine_fields(n_upper, n_lower):
+    """Σ_k M_jk f(x_k) = D_jj f(x_j) for affine f along the interface (the contact patch
+    test) and for quadratic f (both traces are P2); M·1 = D (coverage 1)."""
+    space = blocks(n_upper, n_lower)
+    c = mortar_coupling(space, "up.bottom", "low.top")
+    x = space.node_points
+    xs = x[c.slave_nodes]
+    np.testing.assert_allclose(c.coverage, 1.0, atol=1e-14)
+    for f in (lambda p: np.ones(len(p)), lambda p: 3.0 - 2.5 * p[:, 0] + 7.0 * p[:, 1]):
+        np.testing.assert_allclose(c.M @ f(x), c.D * f(xs), rtol=0, atol=1e-15)
+    # quadratics along the interface too (both traces are P2), not a cubic
+    np.testing.assert_allclose(c.M @ x[:, 0] ** 2, c.D * xs[:, 0] ** 2, rtol=0, atol=1e-15)
+    assert np.abs(c.M @ x[:, 0] ** 3 - c.D * xs[:, 0] ** 3).max() > 1e-6
+    assert np.abs(c.weighted_gap).max() < 1e-16
+
+
+def test_partly_covered_nodes_and_the_constrained_ones():
+    """A master [0.3, 1.5] under a slave [0, 1]: coverage 1 for the nodes whose ψ lies over
+    it (x ≥ 0.5: ψ_j lives on the edges at x_j, and the edge [0.2, 0.4] is cut), not for the
+    others; refused unless those nodes are unconstrained."""
+    space = blocks(5, 6, width=(0.3, 1.5))
+    with pytest.raises(ProblemError, match=r"too short.*node at \(0\.[0-4]\d*, 0\).*swap"):
+        mortar_coupling(space, "up.bottom", "low.top")
+    nodes = np.unique(space.edge_nodes(space.mesh.part_edges("up.bottom")))
+    full = space.node_points[nodes, 0] > 0.45
+    c = mortar_coupling(space, "up.bottom", "low.top", constrained=nodes[full])
+    xs = space.node_points[c.slave_nodes]
+    np.testing.assert_allclose(c.coverage[full], 1.0, atol=1e-14)
+    assert np.abs(c.coverage[~full] - 1).min() > 0.1
+    # the cut edge [0.2, 0.4] over [0.3, 0.4]: its midpoint's row sums ∫_{0.3}^{0.4} ψ_mid
+    h = 0.2
+    t = np.linspace(0, 1, 2001)
+    phi = np.stack([(1 - t) * (1 - 2 * t), t * (2 * t - 1), 4 * t * (1 - t)])
+    mass = h * np.array([[4, -1, 2], [-1, 4, 2], [2, 2, 16]]) / 30
+    A = np.diag(h * np.array([1 / 6, 1 / 6, 2 / 3])) @ np.linalg.inv(mass)
+    psi_mid = A[2] @ phi
+    half = t >= 0.5
+    expected = h * np.trapezoid(psi_mid[half], t[half])
+    j = np.flatnonzero(np.isclose(xs[:, 0], 0.3))[0]
+    assert c.coverage[j] * c.D[j] == pytest.approx(expected, rel=1e-6)
+
+
+# --------------------------------------------------------------------------- curved
+
+
+def test_mirrored_arcs_give_the_symmetry_plane():
+    """Matching mirrored half-discs: n_j = (0, −1) to round-off, M = D on the mirror nodes,
+    g̃_j = D_jj · 2 y_j (twice the one-body gap to the plane y = 0)."""
+    space = mirrored_arcs()
+    c = mortar_coupling(space, "up.contact", "low.contact")
+    xs = space.node_points[c.slave_nodes]
+    assert np.abs(c.normal - [0.0, -1.0]).max() < 2e-16
+    k = partner(space, c, xs * [1.0, -1.0])
+    M = c.M.toarray()
+    np.testing.assert_allclose(M[np.arange(len(k)), k], c.D, rtol=1e-14)
+    M[np.arange(len(k)), k] = 0.0
+    assert np.abs(M).max() < 1e-15
+    np.testing.assert_allclose(c.weighted_gap, 2 * xs[:, 1] * c.D, rtol=1e-13, atol=1e-17)
+    np.testing.assert_allclose(c.coverage, 1.0, atol=1e-14)
+    # the curved D: ∫ φ_j along the quadratic edges sums to the arc's (quadratic) length
+    assert c.D.sum() == pytest.approx(np.pi / 3, rel=1e-5)
+
+
+def shape(t: float) -> np.ndarray:
+    """The P2 edge basis ``[start, end, midpoint]`` at ``t``."""
+    return np.array([(1 - t) * (1 - 2 * t), t * (2 * t - 1), 4 * t * (1 - t)])
+
+
+def _dual(X: np.ndarray) -> tuple:
+    """Independent dual basis of a quadratic edge ``X (3, 2)``: adaptive quadrature."""
+
+    def speed(t):
+        d = (4 * t - 3) * X[0] + (4 * t - 1) * X[1] + (4 - 8 * t) * X[2]
+        return np.hypot(*d)
+
+    mass = quad_vec(lambda t: np.outer(shape(t), shape(t)) * speed(t), 0, 1, epsabs=1e-16)[0]
+    A = np.diag(mass.sum(1)) @ np.linalg.inv(mass)
+    return A, speed
+
+
+def brute_force_mortar(space: P2Space, c) -> np.ndarray:
+    """``M`` by a plain loop over (slave edge, master edge): the segment ends by root finding
+    on the slave edge, ``π(ξ)`` by root finding per point inside adaptive quadrature."""
+    xp = space.node_points
+    s_nodes = space.edge_nodes(space.mesh.part_edges(c.slave))
+    m_nodes = space.edge_nodes(space.mesh.part_edges(c.master))
+    row = {n: i for i, n in enumerate(c.slave_nodes)}
+    out = np.zeros((c.slave_nodes.size, space.n_nodes))
+    for sn in s_nodes:
+        X = xp[sn]
+        N = c.normal[[row[n] for n in sn]]
+        A, speed = _dual(X)
+
+        def xs(t, X=X):
+            return shape(t) @ X
+
+        def ns(t, N=N):
+            return shape(t) @ N
+
+        for mn in m_nodes:
+            Y = xp[mn]
+
+            def cross(t, y):
+                d, n = xs(t) - y, ns(t)
+                return d[0] * n[1] - d[1] * n[0]
+
+            def eta(t, Y=Y):
+                def g(e):
+                    d, n = shape(e) @ Y - xs(t), ns(t)
+                    return d[0] * n[1] - d[1] * n[0]
+
+                if g(-3.0) * g(4.0) > 0:
+                    return np.nan  # the line misses this master edge's neighbourhood
+                return brentq(g, -3.0, 4.0, xtol=1e-15, rtol=1e-15)
+
+            cuts = [0.0, 1.0]
+            for y in Y[:2]:
+                if cross(0.0, y) * cross(1.0, y) < 0:
+                    cuts.append(brentq(cross, 0.0, 1.0, args=(y,), xtol=1e-15, rtol=1e-15))
+            cuts = np.sort(cuts)
+            for lo, hi in zip(cuts[:-1], cuts[1:], strict=True):
+                e_mid = eta(0.5 * (lo + hi))
+                if not 0 <= e_mid <= 1:
+                    continue
+
+                def integrand(t, A=A, speed=speed):
+                    return np.outer(A @ shape(t), shape(eta(t))) * speed(t)
+
+                local = quad_vec(integrand, lo, hi, epsabs=1e-17, epsrel=1e-14)[0]
+                out[np.ix_([row[n] for n in sn], mn)] += local
+    return out
+
+
+def test_curved_non_matching_arcs_against_brute_force():
+    space = cylinders()
+    c = mortar_coupling(space, "up.contact", "low.contact")
+    reference = brute_force_mortar(space, c)
+    assert (np.abs(reference) > 1e-14).sum() == 39  # the rows of 9 slave nodes
+    assert np.abs(c.M.toarray() - reference).max() < 1e-12 * c.D.max()
+    np.testing.assert_allclose(c.coverage, 1.0, atol=1e-13)
+    # the normal bisects the two circles' normals: at x_j it lies between n_s and −n_m
+    xs = space.node_points[c.slave_nodes]
+    assert np.abs(c.normal[np.argmin(np.hypot(*xs.T))] - [0, -1]).max() < 1e-15
+
+
+def test_rotation_invariance():
+    c0 = mortar_coupling(cylinders(), "up.contact", "low.contact")
+    Q = rotation(0.7)
+    space = cylinders(Q)
+    c1 = mortar_coupling(space, "up.contact", "low.contact")
+    np.testing.assert_array_equal(c0.slave_nodes, c1.slave_nodes)
+    np.testing.assert_allclose(c1.D, c0.D, rtol=1e-13)
+    assert abs(c1.M - c0.M).max() < 1e-13 * c0.D.max()
+    np.testing.assert_allclose(c1.weighted_gap, c0.weighted_gap, atol=1e-14 * c0.D.max())
+    np.testing.assert_allclose(c1.normal, c0.normal @ Q.T, atol=1e-14)
+
+
+def test_weighted_gap_converges_to_the_gap_at_the_node():
+    """A cylinder of radius 1 at height 0.05 over a flat block: g̃_j / D_jj at the coarse
+    vertices against the distance along n_j to y = 0, on uniformly refined meshes."""
+    top = moved(cap(1.0, 4, 0.45), np.eye(2), (0.0, 0.05))
+    mesh = union(up=top, low=rectangle(-1.0, 1.0, -0.5, 0.0, 6, 2))
+    coarse = np.unique(mesh.boundary[mesh.boundary_part == mesh.part_index("up.contact")])
+    errors = []
+    for _ in range(3):
+        space = P2Space(mesh)
+        c = mortar_coupling(space, "up.contact", "low.top")
+        row = np.searchsorted(c.slave_nodes, coarse)
+        x, n = space.node_points[coarse], c.normal[row]
+        true = x[:, 1] / -n[:, 1]
+        errors.append(np.abs(c.weighted_gap[row] / c.D[row] - true).max())
+        for _ in range(2):
+            mesh = refine_nvb(mesh, np.ones(mesh.n_cells, dtype=bool)).mesh
+    rates = np.log2(np.array(errors[:-1]) / errors[1:])
+    assert errors[0] < 1e-3 and rates.min() > 1.8, (errors, rates)
+
+
+# --------------------------------------------------------------------------- refusals
+
+
+def test_parts_of_one_body_are_refused():
+    space = P2Space(union(a=rectangle(0, 1, 0, 1, 2, 2), b=rectangle(0, 1, 2, 3, 2, 2)))
+    with pytest.raises(ProblemError, match=r"'a\.top'.*'a\.bottom'.*one body"):
+        mortar_coupling(space, "a.top", "a.bottom")
+    with pytest.raises(ProblemError, match=r"'a\.bottom'.*'a\.left'.*lies on both parts"):
+        mortar_coupling(space, "a.bottom", "a.left")
+    with pytest.raises(ProblemError, match="two different parts"):
+        mortar_coupling(space, "a.top", "a.top")
+    with pytest.raises(ProblemError, match=r"no boundary part 'a\.lid'"):
+        mortar_coupling(space, "a.lid", "b.bottom")
+
+
+def test_no_overlap_is_refused():
+    lower = rectangle(0.0, 1.0, -0.5, 0.0, 3, 2)
+    upper = rectangle(3.0, 4.0, 0.0, 0.5, 3, 2)
+    space = P2Space(union(up=upper, low=lower))
+    with pytest.raises(ProblemError, match=r"'up\.bottom'.*'low\.top'.*do not overlap"):
+        mortar_coupling(space, "up.bottom", "low.top")
+
+
+def test_deep_initial_overlap_is_refused():
+    space = blocks(5, 7, gap=-0.45)
+    with pytest.raises(ProblemError, match=r"overlap by 0\.45 .*small-deformation"):
+        mortar_coupling(space, "up.bottom", "low.top")
+    c = mortar_coupling(blocks(5, 7, gap=-0.2), "up.bottom", "low.top")
+    np.testing.assert_allclose(c.weighted_gap / c.D, -0.2, rtol=1e-13)
+
+
+def test_quad_reference_is_sound():
+    """The brute force's pieces: the dual basis is biorthogonal on a curved edge."""
+    X = np.array([[0.0, 0.0], [1.0, 0.2], [0.5, 0.2]])
+    A, speed = _dual(X)
+    for a in range(3):
+        for b in range(3):
+            v = quad(lambda t, a=a, b=b: (A[a] @ shape(t)) * shape(t)[b] * speed(t), 0, 1)[0]
+            w = quad(lambda t, a=a: shape(t)[a] * speed(t), 0, 1)[0]
+            assert v == pytest.approx(w if a == b else 0.0, abs=1e-13)
