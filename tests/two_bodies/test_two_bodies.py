@@ -79,7 +79,7 @@ def test_resultants_equal_and_opposite():
     assert np.abs(slave + master).max() < 1e-13 * np.abs(slave).max()
 
 
-def _cartesian_qp(problem: ContactProblem):
+def _cartesian_qp(problem: ContactProblem, tangential: bool = False):
     """The two-body QP assembled here from the fem layer and the mortar coupling alone:
     ``min ½ uᵀ K u`` with the held DOFs, subject to ``n_j·(D_jj u_j − Σ_k M_jk u_k) ≤ g̃_j``."""
     mesh = problem.mesh
@@ -113,6 +113,18 @@ def _cartesian_qp(problem: ContactProblem):
         )  # fmt: skip
         rows.append(B)
         gaps.append(c.weighted_gap[keep])
+        if tangential:  # t_j ⊗ (D_jj e_j − M_j), t = (−n_y, n_x)
+            t = np.column_stack([-n[:, 1], n[:, 0]])
+            Bt = sp.lil_matrix((j.size, space.n_dofs))
+            for comp in range(2):
+                Bt[:, comp::2] = -sp.csr_matrix(M).multiply(t[:, [comp]])
+            Bt = sp.csr_matrix(Bt) + sp.csr_matrix(
+                (np.concatenate([c.D[keep] * t[:, 0], c.D[keep] * t[:, 1]]),
+                 (np.tile(np.arange(j.size), 2), np.concatenate([2 * j, 2 * j + 1]))),
+                shape=(j.size, space.n_dofs),
+            )  # fmt: skip
+            rows.append(Bt)
+            gaps.append(np.zeros(j.size))
     return space, K.tocsc(), held, values, sp.vstack(rows).tocsr(), np.concatenate(gaps)
 
 
@@ -193,6 +205,7 @@ def two_blocks(conditions: dict) -> ContactProblem:
     base = {p: Neumann() for p in mesh.part_names}
     base.update({"a.top": Dirichlet((0.0, -0.01)), "b.bottom": Dirichlet((0.0, 0.0))})
     base.update(conditions)
+    base = {k: v for k, v in base.items() if v is not None}
     return ContactProblem(mesh=mesh, material=_material(), conditions=base)
 
 
@@ -234,3 +247,98 @@ def test_union_names_and_bodies():
     body = body_of_cells(m)
     assert np.array_equal(np.bincount(body), [8, 18])
     assert np.array_equal(body, m.cell_region)
+
+
+def test_body_held_only_by_its_pair_is_refused():
+    """The upper block on a roller only (its vertical motion held by nothing but the pair)
+    is refused before any work, naming the body's parts."""
+    with pytest.raises(ProblemError, match=r"held by its own Dirichlet and Roller parts in 2"):
+        two_blocks({"a.top": Neumann((0.0, -1.0)), "a.left": Dirichlet((0.0, None)),
+                    "a.bottom": Contact(master="b.top"), "b.top": None})  # fmt: skip
+
+
+def sheared_blocks(friction) -> ContactProblem:
+    """Two blocks (3 and 4 edges along the interface), the upper top moved by (0.004, −0.01),
+    the lower bottom held, the other sides free: pressed and sheared."""
+    mesh = union({"a": rectangle(0, 1, 1, 2, 3, 3), "b": rectangle(0, 1, 0, 1, 4, 4)})
+    conditions = {p: Neumann() for p in mesh.part_names}
+    del conditions["b.top"]
+    conditions.update({
+        "a.top": Dirichlet((0.004, -0.01)),
+        "b.bottom": Dirichlet((0.0, 0.0)),
+        "a.bottom": Contact(master="b.top", friction=friction),
+    })  # fmt: skip
+    return ContactProblem(mesh=mesh, material=_material(), conditions=conditions)
+
+
+def test_tresca_pair_equals_the_minimiser_of_its_convex_energy():
+    """Tresca friction on a pair: the solution is the minimiser of the convex energy with
+    the weighted relative slip, computed here by its dual over a box (BVLS), with stick and
+    slip nodes both present."""
+    from scipy.optimize import lsq_linear
+
+    from signorini.contact.solution import SLIP, STICK
+    from signorini.problem import Tresca
+
+    bound = 0.07 * solve(sheared_blocks(None)).pressure.max()
+    problem = sheared_blocks(Tresca(bound))
+    r = solve(problem)
+    assert (r.state == STICK).any() and (r.state == SLIP).any()
+    space, K, held, values, B, g = _cartesian_qp(problem, tangential=True)
+    k = r.contact.size
+    free = np.flatnonzero(~held)
+    Kff = K[free][:, free].toarray()
+    rhs = -(K[free][:, np.flatnonzero(held)] @ values[held])
+    Bf = B[:, free].toarray()
+    chol = sl.cho_factor(Kff)
+    H = Bf @ sl.cho_solve(chol, Bf.T)
+    c = Bf @ sl.cho_solve(chol, rhs) - (g - B[:, np.flatnonzero(held)] @ values[held])
+    L = np.linalg.cholesky(H)
+    s_t = r.contact.friction.weight / r.contact.basis_integral  # |Λ_t| ≤ s_z, Λ = D λ
+    lower = np.concatenate([np.zeros(k), -s_t])
+    upper = np.concatenate([np.full(k, np.inf), s_t])
+    lam = lsq_linear(L.T, sl.solve_triangular(L, c, lower=True), bounds=(lower, upper),
+                     method="bvls", tol=1e-15).x  # fmt: skip
+    u = values.copy()
+    u[free] = sl.cho_solve(chol, rhs - Bf.T @ lam)
+    du = np.abs(u - r.u.ravel()).max() / np.abs(r.u).max()
+    dn = np.abs(lam[:k] - r.pressure).max() / r.pressure.max()
+    dt = np.abs(lam[k:] - r.tangential_pressure).max() / r.pressure.max()
+    print(f"Tresca pair: |Δu| {du:.1e}, Δp {dn:.1e}, Δp_t {dt:.1e}")
+    assert du < 1e-8 and dn < 1e-8 and dt < 1e-8
+    assert r.report.kkt.max < 1e-11
+
+
+@pytest.mark.slow
+def test_partial_slip_of_identical_cylinders_against_cattaneo_mindlin():
+    """Two identical cylinders (elastically similar: the normal and tangential problems
+    uncouple exactly) pressed, then sheared at constant press with Coulomb friction F = 0.5:
+    the stick zone's half-width c against Cattaneo–Mindlin, c/a = √(1 − Q/(F P)), within
+    0.005 on a mesh refined along the contact zone (h ≤ 0.004, a ≈ 0.078)."""
+    from signorini.contact import solve_path
+    from signorini.examples.partial_slip import partial_slip_metrics
+    from signorini.mesh.refine import refine_nvb
+    from signorini.problem import Coulomb
+
+    path = [
+        two_cylinders(
+            (1.0, 1.0), (1.0, 1.0), depth=0.02, friction=Coulomb(0.5), shear=s, h_bottom=0.02
+        )  # fmt: skip
+        for s in (0.0, 0.012)
+    ]
+    mesh = path[0].mesh
+    for _ in range(12):  # a loop over refinement rounds
+        x = mesh.points[mesh.cells].mean(axis=1)
+        near = (np.abs(x[:, 0]) < 0.085) & (np.abs(x[:, 1]) < 0.01) & (mesh.h > 0.004)
+        if not near.any():
+            break
+        mesh = refine_nvb(mesh, np.flatnonzero(near)).mesh
+    r = solve_path(path, mesh=mesh)[-1]
+    m = partial_slip_metrics(r)
+    print(
+        f"{r.ndof} unknowns: c/a = {m['c_over_a']:.4f}, Cattaneo–Mindlin "
+        f"{m['c_over_a_theory']:.4f} (Q/(F P) = {m['q_over_fp']:.4f}), a = {m['a']:.5f}"
+    )
+    assert 0.6 < m["q_over_fp"] < 0.8
+    assert abs(m["c_over_a"] - m["c_over_a_theory"]) < 0.005
+    assert r.report.kkt.max < 1e-10

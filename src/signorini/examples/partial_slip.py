@@ -121,7 +121,11 @@ def partial_slip_metrics(result: ContactResult) -> dict[str, float]:
     total = float(lam_n.sum())
     if not total > 0:
         return dict.fromkeys(keys, float("nan"))
-    coefficient = result.problem.conditions["arc"].friction.coefficient
+    coefficient = next(
+        c.friction.coefficient
+        for c in result.problem.conditions.values()
+        if isinstance(c, Contact) and c.friction is not None
+    )
     x = result.space.node_points[result.contact.nodes, 0]
     centre = float(lam_n @ x) / total
     a = 2.0 * np.sqrt(float(lam_n @ (x - centre) ** 2) / total)

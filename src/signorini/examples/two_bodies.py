@@ -136,6 +136,7 @@ def two_cylinders(
     rings: int = 4,
     h_bottom: float | None = None,
     friction: object = None,
+    shear: float = 0.0,
     angle: float = 0.0,
 ) -> ContactProblem:
     """Two cylinders (half-discs) of radii R1 (``"upper"``, centre ``(0, R1)``) and R2
@@ -143,14 +144,17 @@ def two_cylinders(
     Poisson's ratio ν, pressed together by moving their flat sides by ``(0, ∓δ/2)``.
 
     The part of each arc with ``|x| < R1 / 2`` is the contact part (``"upper.contact"`` the
-    slave, ``"lower.contact"`` the master, wider by the radii's ratio); the rest of the arcs
+    slave; ``"lower.contact"``, with ``|x| < 3 R1 / 4``, the master); the rest of the arcs
     is traction-free. Defaults: a / R ≈ 0.1 with the effective radius R = R1 R2 / (R1 + R2).
-    ``angle`` rotates the whole problem about the origin (radians, counter-clockwise).
+    ``friction`` is the law on the pair (``None``: frictionless); ``shear`` moves the flat
+    sides apart along x as well, by ``±shear/2`` (the second step of a load path, after the
+    press). ``angle`` rotates the whole problem about the origin (radians,
+    counter-clockwise).
     """
     r1, r2 = radii
     upper = _split_arc(half_disc(r1, rings, h_bottom=h_bottom), (0.0, r1), r1, r1 / 2)
     lower = half_disc(r2, rings, h_bottom=None if h_bottom is None else h_bottom * r2 / r1)
-    lower = _split_arc(mirrored(lower), (0.0, -r2), r2, r1)
+    lower = _split_arc(mirrored(lower), (0.0, -r2), r2, 0.75 * r1)
     c, s = np.cos(angle), np.sin(angle)
     rotation = np.array([[c, -s], [s, c]])
     return ContactProblem(
@@ -160,8 +164,8 @@ def two_cylinders(
             "lower": Material.from_young(young[1], poisson),
         },
         conditions={
-            "upper.top": Dirichlet(tuple(rotation @ [0.0, -depth / 2])),
-            "lower.top": Dirichlet(tuple(rotation @ [0.0, depth / 2])),
+            "upper.top": Dirichlet(tuple(rotation @ [shear / 2, -depth / 2])),
+            "lower.top": Dirichlet(tuple(rotation @ [-shear / 2, depth / 2])),
             "upper.arc": Neumann(),
             "lower.arc": Neumann(),
             "upper.contact": Contact(master="lower.contact", friction=friction),

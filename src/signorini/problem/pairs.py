@@ -5,11 +5,17 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+import numpy as np
+
+from ..mesh.bodies import body_of_cells
 from ..mesh.mesh import Mesh
 from .conditions import Contact
 from .fields import ProblemError
 
-__all__ = ["contact_pairs"]
+__all__ = ["check_bodies_held", "contact_pairs"]
+
+#: a singular value below this times the largest is zero (the conditions are O(1) numbers)
+RANK_RTOL = 1e-9
 
 
 def contact_pairs(mesh: Mesh, conditions: Mapping[str, object]) -> dict[str, str]:
@@ -54,3 +60,46 @@ def contact_pairs(mesh: Mesh, conditions: Mapping[str, object]) -> dict[str, str
             )
         seen[master] = slave
     return pairs
+
+
+def check_bodies_held(mesh: Mesh, held: Mapping[str, object], pairs: Mapping[str, str]) -> None:
+    """Each body with a part in a contact pair must have its rigid motions held by its own
+    Dirichlet and Roller parts (a body held only through a pair, under force control, is not
+    supported; docs/method.md, *Two bodies*).
+
+    Raises
+    ------
+    ProblemError
+        Naming the body (by its parts) and how many rigid motions its own parts leave free.
+    """
+    if not pairs:
+        return
+    body = body_of_cells(mesh)
+    edge_body = np.full(mesh.n_edges, -1)
+    edge_body[mesh.edge_part >= 0] = body[mesh.edge2cell[mesh.edge_part >= 0, 0]]
+    paired = np.concatenate([mesh.part_edges(p) for p in (*pairs, *pairs.values())])
+    for b in np.unique(edge_body[paired]):  # a loop over bodies
+        lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
+        centre, size = 0.5 * (lo + hi), float(np.max(hi - lo))
+        rows = []
+        for name, cond in held.items():  # a loop over parts
+            e = mesh.part_edges(name)
+            v = np.unique(mesh.edges[e[edge_body[e] == b]])
+            d = (mesh.points[v] - centre) / size
+            one, zero = np.ones(v.size), np.zeros(v.size)
+            by_component = (
+                np.column_stack([one, zero, -d[:, 1]]),
+                np.column_stack([zero, one, d[:, 0]]),
+            )
+            rows += [by_component[c] for c in range(2) if cond.components[c]]
+        A = np.concatenate(rows) if rows else np.zeros((0, 3))
+        s = np.linalg.svd(A, compute_uv=False) if A.size else np.zeros(0)
+        rank = int((s > RANK_RTOL * s.max()).sum()) if s.size and s.max() > 0 else 0
+        if rank < 3:
+            parts = [p for p in mesh.part_names if (edge_body[mesh.part_edges(p)] == b).any()]
+            raise ProblemError(
+                f"the body with the parts {parts} is held by its own Dirichlet and Roller "
+                f"parts in {rank} of its 3 rigid motions; a body in a contact pair must be "
+                "held by its own parts (a body held only through its contact with another, "
+                "under force control, is not supported yet): add a Dirichlet or Roller part"
+            )

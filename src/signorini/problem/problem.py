@@ -31,7 +31,7 @@ from ..mesh.mesh import Mesh
 from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann, Roller
 from .corners import check_corner_friction
 from .fields import ProblemError, VectorField, check_function
-from .pairs import contact_pairs
+from .pairs import check_bodies_held, contact_pairs
 from .rigid import free_rigid_motions
 
 __all__ = ["ContactProblem", "SlenderBodyWarning", "free_ndof"]
@@ -151,6 +151,7 @@ class ContactProblem:
         )
         if self.dirichlet_parts:
             _check_components(mesh, self.dirichlet_parts, self.contact_parts)
+        check_bodies_held(mesh, self.held, self.pairs)
         object.__setattr__(
             self,
             "rigid_motions",
