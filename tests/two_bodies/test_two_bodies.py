@@ -342,3 +342,37 @@ def test_partial_slip_of_identical_cylinders_against_cattaneo_mindlin():
     assert 0.6 < m["q_over_fp"] < 0.8
     assert abs(m["c_over_a"] - m["c_over_a_theory"]) < 0.005
     assert r.report.kkt.max < 1e-10
+
+
+@pytest.mark.slow
+def test_two_cylinders_adaptive_against_hertz():
+    """Dissimilar cylinders (R1 = 1, R2 = 2, E1 = 1, E2 = 3): adaptively to 20 000 unknowns
+    a and p0 are within 1 % of Hertz at the computed load (a/R ≈ 0.1), η decreases at a
+    slope ≤ −0.9 in Ndof, the KKT residuals stay at round-off, and each body's finest cells
+    sit at the ends of the contact zone."""
+    from signorini.examples.two_bodies import cylinders_metrics
+    from signorini.loop import adaptive
+
+    levels = list(adaptive(two_cylinders(), max_ndof=20_000))
+    ndof = np.array([level.result.ndof for level in levels])
+    eta = np.array([level.estimate.eta for level in levels])
+    last = levels[-1].result
+    m = cylinders_metrics(last)
+    late = ndof >= 1000
+    slope = np.polyfit(np.log(ndof[late]), np.log(eta[late]), 1)[0]
+    print(f"{ndof[-1]} unknowns: a = {m['a']:.5f} ({m['a_rel_error']:+.2e}), "
+          f"p0 {m['p0_rel_error']:+.2e}, η slope {slope:.3f}")  # fmt: skip
+    assert abs(m["a_rel_error"]) < 0.01 and abs(m["p0_rel_error"]) < 0.01
+    assert 0.09 < m["a"] / (2 / 3) < 0.11
+    assert slope <= -0.9
+    assert max(level.result.report.kkt.max for level in levels) < 1e-10
+    mesh = last.mesh
+    body = body_of_cells(mesh)
+    x = mesh.points[mesh.cells].mean(axis=1)
+    for b in (0, 1):
+        cells = np.flatnonzero(body == b)
+        finest = cells[np.argsort(mesh.h[cells])[:10]]
+        ends = np.abs(np.abs(x[finest, 0]) - m["a"])
+        print(f"body {b}: the 10 finest cells (h ≤ {mesh.h[finest].max():.2e}) at |x| − a "
+              f"within {ends.max():.2e}")  # fmt: skip
+        assert ends.max() < 0.25 * m["a"]

@@ -144,7 +144,7 @@ def two_cylinders(
     Poisson's ratio ν, pressed together by moving their flat sides by ``(0, ∓δ/2)``.
 
     The part of each arc with ``|x| < R1 / 2`` is the contact part (``"upper.contact"`` the
-    slave; ``"lower.contact"``, with ``|x| < 3 R1 / 4``, the master); the rest of the arcs
+    slave; ``"lower.contact"``, with ``|x| < min(R1, 0.9 R2)``, the master); the rest of the arcs
     is traction-free. Defaults: a / R ≈ 0.1 with the effective radius R = R1 R2 / (R1 + R2).
     ``friction`` is the law on the pair (``None``: frictionless); ``shear`` moves the flat
     sides apart along x as well, by ``±shear/2`` (the second step of a load path, after the
@@ -154,7 +154,7 @@ def two_cylinders(
     r1, r2 = radii
     upper = _split_arc(half_disc(r1, rings, h_bottom=h_bottom), (0.0, r1), r1, r1 / 2)
     lower = half_disc(r2, rings, h_bottom=None if h_bottom is None else h_bottom * r2 / r1)
-    lower = _split_arc(mirrored(lower), (0.0, -r2), r2, 0.75 * r1)
+    lower = _split_arc(mirrored(lower), (0.0, -r2), r2, min(r1, 0.9 * r2))
     c, s = np.cos(angle), np.sin(angle)
     rotation = np.array([[c, -s], [s, c]])
     return ContactProblem(
