@@ -376,3 +376,79 @@ def test_two_cylinders_adaptive_against_hertz():
         print(f"body {b}: the 10 finest cells (h ≤ {mesh.h[finest].max():.2e}) at |x| − a "
               f"within {ends.max():.2e}")  # fmt: skip
         assert ends.max() < 0.25 * m["a"]
+
+
+def manufactured_blocks(edges: tuple[int, int]) -> ContactProblem:
+    """Two blocks of one material in contact all along y = 1 with the smooth solution
+    ``u = (A sin(πx) (y − 1)², −B y + C cos(πx) (y − 1)²)``: its shear stress vanishes on
+    y = 1 (frictionless), its normal displacement and σ_yy = −(λ + 2μ) B are continuous
+    there (contact everywhere, pressure (λ + 2μ) B > 0); body force −div σ(u), the exact
+    displacement on the top and bottom, the exact traction on the sides (so that the contact
+    zone's ends are constrained nodes, not Dirichlet ones)."""
+    from signorini.fem.material import Material
+    from signorini.problem import ExactSolution
+
+    A, B, C = 0.02, 0.01, 0.015
+    material = Material.from_young(1.0, 0.3)
+    lam, mu = material.lam, material.mu
+
+    def u(x):
+        s, c, d = np.sin(np.pi * x[:, 0]), np.cos(np.pi * x[:, 0]), x[:, 1] - 1.0
+        return np.column_stack([A * s * d**2, -B * x[:, 1] + C * c * d**2])
+
+    def grad(x):
+        s, c, d = np.sin(np.pi * x[:, 0]), np.cos(np.pi * x[:, 0]), x[:, 1] - 1.0
+        g = np.empty((len(x), 2, 2))
+        g[:, 0, 0], g[:, 0, 1] = A * np.pi * c * d**2, 2 * A * s * d
+        g[:, 1, 0], g[:, 1, 1] = -C * np.pi * s * d**2, -B + 2 * C * c * d
+        return g
+
+    def force(x):
+        s, c, d = np.sin(np.pi * x[:, 0]), np.cos(np.pi * x[:, 0]), x[:, 1] - 1.0
+        pi2 = np.pi**2
+        # second derivatives of u
+        uxx, uxy, uyy = -A * pi2 * s * d**2, 2 * A * np.pi * c * d, 2 * A * s
+        vxx, vxy, vyy = -C * pi2 * c * d**2, -2 * C * np.pi * s * d, 2 * C * c
+        div_x = (lam + 2 * mu) * uxx + mu * uyy + (lam + mu) * vxy
+        div_y = (lam + 2 * mu) * vyy + mu * vxx + (lam + mu) * uxy
+        return -np.column_stack([div_x, div_y])
+
+    mesh = union({"a": rectangle(0, 1, 1, 2, edges[0], edges[0]),
+                  "b": rectangle(0, 1, 0, 1, edges[1], edges[1])})  # fmt: skip
+
+    def traction(x, normal):
+        g = grad(x)
+        eps = 0.5 * (g + g.transpose(0, 2, 1))
+        sigma = lam * np.trace(eps, axis1=1, axis2=2)[:, None, None] * np.eye(2) + 2 * mu * eps
+        return np.einsum("nij,nj->ni", sigma, normal)
+
+    conditions = {p: Neumann(traction) for p in mesh.part_names}
+    conditions.update({"a.top": Dirichlet(u), "b.bottom": Dirichlet(u)})
+    conditions["a.bottom"] = Contact(master="b.top")
+    del conditions["b.top"]
+    return ContactProblem(mesh=mesh, material=material, conditions=conditions,
+                          body_force=force, exact=ExactSolution(u, grad))  # fmt: skip
+
+
+@pytest.mark.parametrize("edges", [(4, 3), (3, 4)])
+def test_efficiency_on_a_manufactured_two_body_solution(edges):
+    """Uniform refinement of the manufactured two-block problem (the slave finer, then
+    coarser): the energy error decreases at the P2 rate (slope −1 in Ndof), every interface
+    node is in contact, and the efficiency index η / ‖e‖ stays bounded (printed: 21 to 27)."""
+    from signorini.mesh.refine import refine_uniform
+
+    problem = manufactured_blocks(edges)
+    mesh, rows = problem.mesh, []
+    for _ in range(4):  # a loop over uniform refinements
+        r = solve(problem, mesh)
+        error = r.errors()["error_energy"]
+        rows.append((r.ndof, error, estimate(r).eta))
+        assert r.active.all()
+        mesh = refine_uniform(mesh).mesh
+    ndof, error, eta = (np.array(c) for c in zip(*rows, strict=True))
+    slope = np.polyfit(np.log(ndof[1:]), np.log(error[1:]), 1)[0]
+    efficiency = eta / error
+    print(f"{edges}: energy error slope {slope:.3f}; efficiency η/‖e‖ {np.round(efficiency, 2)}")
+    assert -1.05 < slope < -0.95
+    assert 10.0 < efficiency.min() and efficiency.max() < 40.0
+    assert efficiency.max() / efficiency.min() < 1.3

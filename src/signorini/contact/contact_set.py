@@ -210,9 +210,18 @@ class ContactSet:
         (:meth:`relative`)."""
         return np.einsum("kc,kc->k", self.relative(u)[self.nodes], self.normal)
 
+    def edge_relative(self, u: np.ndarray) -> np.ndarray:
+        """The relative displacement ``u − T u`` at ``[start, end, midpoint]`` of each contact
+        edge ``(n_ce, 3, 2)``, Dirichlet end points of a pair's slave included (``u``
+        itself without pairs)."""
+        u = np.asarray(u)
+        if self.transfer is not None:
+            u = u - (self.transfer.every_slave @ u.ravel()).reshape(u.shape)
+        return u[self.edge_nodes]
+
     def edge_normal_gap(self, u: np.ndarray) -> np.ndarray:
         """``ũ·n_z − ψ`` at ``[start, end, midpoint]`` of each contact edge, ``(n_ce, 3)``."""
-        un = np.einsum("ejc,ejc->ej", self.relative(u)[self.edge_nodes], self.edge_direction)
+        un = np.einsum("ejc,ejc->ej", self.edge_relative(u), self.edge_direction)
         return un - self.edge_gap
 
 

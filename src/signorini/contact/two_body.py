@@ -117,14 +117,20 @@ class PairTransfer:
     nodes : (n_nodes, n_nodes) scipy.sparse CSR matrix
         ``T_jk = M_jk / D_jj`` on the constrained slave rows and the master columns.
     dofs : (n_dofs, n_dofs) scipy.sparse CSR matrix
-        ``T_d``, blocks ``P_j T_jk`` on interleaved DOFs.
+        ``T_d``, blocks ``P_j T_jk`` on interleaved DOFs: the change of basis.
     masters : tuple of str
         The master parts, pair after pair.
+    every_slave : (n_dofs, n_dofs) scipy.sparse CSR matrix
+        Blocks ``T_jk I`` at every slave node, Dirichlet nodes included: the relative
+        displacement ``u − T u`` along the whole slave part, which the estimator reads
+        (:meth:`~.contact_set.ContactSet.edge_normal_gap`); at a constrained node its normal
+        component is the basis unknown's.
     """
 
     nodes: sp.csr_matrix
     dofs: sp.csr_matrix
     masters: tuple[str, ...]
+    every_slave: sp.csr_matrix
 
 
 def master_traction(
@@ -198,7 +204,13 @@ def pair_transfer(
             f"the node at {_point(space, both[0])} is constrained as a slave node and lies on "
             "the master side of a contact pair: give the two pairs' parts no common node"
         )
-    return PairTransfer(Tn.tocsr(), Td.tocsr(), masters)
+    every = sp.csr_matrix((space.n_dofs, space.n_dofs))
+    for c in couplings.values():  # a loop over contact pairs
+        T = sp.diags(1.0 / c.D) @ c.M
+        every = every + mortar_transfer(
+            space.n_nodes, c.slave_nodes, T, np.broadcast_to(np.eye(2), (c.D.size, 2, 2))
+        )
+    return PairTransfer(Tn.tocsr(), Td.tocsr(), masters, every.tocsr())
 
 
 def _point(space: P2Space, z: int) -> tuple:

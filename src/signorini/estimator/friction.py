@@ -13,8 +13,7 @@ nodal values at ``[start, end, midpoint]``:
   so ``b_z = s_z / w_z``; Coulomb ``F Λ_z``, so ``b_z = F p_z``): ``|p_t,z| ≤ b_z`` is the
   solver's nodal law ``|Λ_t,z| ≤ s_z`` divided by ``w_z``; 0 on frictionless parts;
 - ``u_t(z) = ũ_h(z)·t_z``, ``t_z`` the constraint's tangent (``ContactSet.edge_tangent``),
-  ``ũ_h`` the displacement the constraints bound (``ContactSet.relative``: relative to the
-  master with two bodies).
+  ``ũ_h`` relative to the master with two bodies (``ContactSet.edge_relative``).
 
 At a Dirichlet end point of Γ_C the stresses are 0 and ``u_t = u_D·t``; its third of the edge
 is given to the edge's midpoint (Dirichlet nodes carry no term).
@@ -53,7 +52,7 @@ def friction_edges(result: ContactResult, unit: float = 1.0) -> FrictionEdges | 
     inside = loc >= 0
     row = np.maximum(loc, 0)
     tangent = cs.edge_tangent[..., 0, :]
-    slip = np.einsum("ejc,ejc->ej", cs.relative(result.u)[cs.edge_nodes], tangent)
+    slip = np.einsum("ejc,ejc->ej", cs.edge_relative(result.u), tangent)
     return FrictionEdges(
         friction=np.where(inside, result.tangential_pressure[row], 0.0) / unit,
         bound=np.where(inside, bound[row], 0.0) / unit,
