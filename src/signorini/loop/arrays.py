@@ -39,7 +39,8 @@ def level_arrays(level: Level) -> dict[str, Any]:
         ``contact_points (k, 2)``, ``active (k,)``, ``pressure (k,)`` p_z, ``gap (k,)`` ψ(z)
         and ``normal (k, 2)`` n_z; ``obstacle``, each contact part's obstacle outline near
         it (:func:`obstacle_outline`); ``along``, each contact part's constraints and their arc
-        length (:func:`arc_lengths`); with friction on some contact part also ``state (k,)`` as
+        length (:func:`arc_lengths`); ``pairs``, the contact pairs between bodies
+        (slave part -> master part; docs/method.md, *Two bodies*); with friction on some contact part also ``state (k,)`` as
         the labels ``"inactive"``, ``"stick"``, ``"slip"``, ``contact_displacement (k, 2)``
         and ``tangential_pressure (k,)`` p_t,z.
     """
@@ -63,12 +64,13 @@ def level_arrays(level: Level) -> dict[str, Any]:
         "normal": cs.normal,
         "obstacle": obstacle_outline(cs, res.space.node_points, problem.conditions),
         "along": arc_lengths(cs, res.space.node_points),
+        "pairs": dict(problem.pairs),
     }
     if cs.has_friction:
         arrays["state"] = np.where(
             res.state == STICK, "stick", np.where(res.state == SLIP, "slip", "inactive")
         )
-        arrays["contact_displacement"] = res.u[cs.nodes]
+        arrays["contact_displacement"] = cs.relative(res.u)[cs.nodes]  # relative, two bodies
         arrays["tangential_pressure"] = res.tangential_pressure
     return arrays
 
@@ -114,6 +116,8 @@ def obstacle_outline(
     size = float(np.ptp(node_points, axis=0).max()) if node_points.size else 0.0
     outline = {}
     for i, name in enumerate(cs.parts):  # a loop over the contact parts
+        if getattr(conditions[name], "master", None) is not None:
+            continue  # the other body is drawn itself
         sel = cs.edge_part == i
         out = np.full((int(sel.sum()), m + 1, 2), np.nan)
         obstacle = conditions[name].obstacle

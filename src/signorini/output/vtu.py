@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..mesh.bodies import body_of_cells
 from .files import atomic_write, replacing
 
 __all__ = [
@@ -34,12 +35,14 @@ POINT_FIELDS: dict[str, str] = {
     "= λ(σ_xx + σ_yy)/(2(λ + μ)) in plane strain, 0 in plane stress",
     "von_mises": "von Mises stress sqrt(((σ_xx−σ_yy)² + (σ_yy−σ_zz)² + (σ_zz−σ_xx)²)/2 + "
     "3σ_xy²) of the nodal stress, σ_zz included",
-    "pressure": "on Γ_C the consistent nodal pressure p_z = Λ_z / w_z (0 elsewhere)",
+    "pressure": "on Γ_C the consistent nodal pressure p_z = Λ_z / w_z (0 elsewhere); on the "
+    "master part of a contact pair between two bodies the transferred pressure "
+    "Σ_j T_jk Λ_j / w_k (docs/method.md, *Two bodies*)",
     "contact_force": "on Γ_C the nodal contact force Λ_z (force per unit thickness; 0 elsewhere)",
     "tangential_pressure": "on Γ_C the consistent friction stress p_t,z = Λ_t,z / w_z along "
     "t_z = (−n_y, n_x); 0 without friction",
     "contact_traction": "on Γ_C the obstacle's traction on the body, −p_z n_z − p_t,z t_z "
-    "(3 components)",
+    "(3 components); on a pair's master the slave's consistent traction on it",
     "active": "1 where u·n_z = ψ is imposed (the node is in contact), else 0",
     "contact_class": "0 no contact, 1 semi, 2 full contact (the estimator's classes), −1 off Γ_C",
     "contact_state": "0 inactive, 1 stick, 2 slip (a frictionless node in contact slips), −1 "
@@ -49,6 +52,8 @@ POINT_FIELDS: dict[str, str] = {
 CELL_FIELDS: dict[str, str] = {
     "region": "the cell's material region, an index into the mesh's region names "
     "(mesh.region_names; 0 where the mesh has one region)",
+    "body": "with several bodies (a union mesh), the cell's body: 0, 1, … in the union's "
+    "order (not written for one body)",
     "eta2": "the squared element indicator η_T² (the sum of the contributions)",
     "eta2_k": "the squared contribution η_k,T² of term k = 1, 2, … (docs/method.md, "
     "*Estimator*): one field per term",
@@ -102,6 +107,9 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     np.add.at(tangential, cs.nodes, p_t)
     t = cs.tangent[:, 0]
     np.add.at(traction[:, :2], cs.nodes, -result.pressure[:, None] * cs.normal - p_t[:, None] * t)
+    masters, master_traction, master_pressure = result.master_side  # empty for one body
+    pressure[masters] = master_pressure
+    traction[masters, :2] = master_traction
     sig = result.nodal_stress  # (n_nodes, 3, 3): ContactResult.nodal_stress
     # VTK's symmetric tensor order: xx, yy, zz, xy, yz, xz
     voigt = np.column_stack(
@@ -109,6 +117,9 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     )
     # cell fields: one array per field, in the cells' order (each one in CELL_FIELDS)
     cell_data = {"region": [space.mesh.cell_region.astype(np.int32)]}  # into mesh.region_names
+    body = body_of_cells(space.mesh)
+    if body.max(initial=0) > 0:
+        cell_data["body"] = [body.astype(np.int32)]
     if estimate is not None:
         cell_data["eta2"] = [estimate.eta2]
         for k in range(estimate.eta2_cell.shape[0]):

@@ -124,7 +124,9 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
             last["contact_points"], last["pressure"], along=last["along"], **friction
         ),
         obstacle=_joined(last["obstacle"].values()),
-        title=f"{example}: deformed body",
+        title=f"{example}: deformed bod{'ies' if last.get('pairs') else 'y'}",
+        # bodies in contact pressed together overlap in a magnified drawing
+        scale=1.0 if last.get("pairs") else "auto",
     )
     return written
 
