@@ -214,6 +214,9 @@ def test_get_example():
         "hertz",
         "punch",
         "partial-slip",
+        "two-cylinders",
+        "stacked-blocks",
+        "hertz-pair",
     }
     for name in EXAMPLES:
         assert get_example(name).name == name

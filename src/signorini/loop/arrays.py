@@ -40,9 +40,9 @@ def level_arrays(level: Level) -> dict[str, Any]:
         and ``normal (k, 2)`` n_z; ``obstacle``, each contact part's obstacle outline near
         it (:func:`obstacle_outline`); ``along``, each contact part's constraints and their arc
         length (:func:`arc_lengths`); ``pairs``, the contact pairs between bodies
-        (slave part -> master part; docs/method.md, *Two bodies*); with friction on some contact part also ``state (k,)`` as
-        the labels ``"inactive"``, ``"stick"``, ``"slip"``, ``contact_displacement (k, 2)``
-        and ``tangential_pressure (k,)`` p_t,z.
+        (slave part -> master part; docs/method.md, *Two bodies*); with friction on some
+        contact part also ``state (k,)`` as the labels ``"inactive"``, ``"stick"``,
+        ``"slip"``, ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)`` p_t,z.
     """
     res = level.result
     mesh, problem, cs = res.mesh, res.problem, res.contact
