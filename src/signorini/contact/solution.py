@@ -338,7 +338,7 @@ def solve(
     return ContactResult(
         problem=problem,
         space=space,
-        u=to_cartesian(solved.x, cs.frame_nodes, cs.frames).reshape(-1, 2),
+        u=to_cartesian(solved.x, assembled.frame_nodes, assembled.frames).reshape(-1, 2),
         contact=cs,
         contact_force=solved.normal_force if unit == 1.0 else solved.normal_force * unit,
         active=solved.state != INACTIVE,
