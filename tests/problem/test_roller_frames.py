@@ -19,6 +19,7 @@ from signorini.output import fitted_slope
 from signorini.problem import (
     Contact,
     ContactProblem,
+    Coulomb,
     Dirichlet,
     ExactSolution,
     HalfPlane,
@@ -50,7 +51,9 @@ def _rotated(problem: ContactProblem) -> ContactProblem:
             cond = Neumann(tuple(ROT @ np.asarray(cond.traction, dtype=float)))
         elif isinstance(cond, Contact):
             plane = cond.obstacle
-            cond = Contact(obstacle=HalfPlane(ROT @ plane.point, ROT @ plane.normal))
+            cond = Contact(
+                obstacle=HalfPlane(ROT @ plane.point, ROT @ plane.normal), friction=cond.friction
+            )
         conditions[name] = cond
     return ContactProblem(_rotated_mesh(problem.mesh), problem.material, conditions)
 
@@ -60,6 +63,10 @@ def _assert_rotated(plain, turned):
     scale = np.abs(plain.u).max()
     assert np.abs(turned.space.node_points - plain.space.node_points @ ROT.T).max() < 1e-14
     assert np.abs(turned.u - plain.u @ ROT.T).max() <= 1e-12 * scale
+    # the rollers' forces: along an axis (a Cartesian DOF) and oblique (a frame DOF)
+    assert np.array_equal(turned.roller_nodes, plain.roller_nodes)
+    force = np.abs(plain.roller_force).max()
+    assert np.abs(turned.roller_force - plain.roller_force).max() <= 1e-11 * max(force, 1e-300)
     if plain.contact.size:
         assert np.array_equal(turned.contact.nodes, plain.contact.nodes)
         assert np.array_equal(turned.active, plain.active)
@@ -119,6 +126,43 @@ def test_rotated_block_on_rollers():
     assert a.ndof == b.ndof == plain.free_ndof(mesh)
 
 
+def test_rotated_block_on_a_frictional_foundation_with_a_roller():
+    # Coulomb friction at the foundation, a roller on the upper part of the left side (off
+    # the contact), pushed down and sideways on the top: semismooth Newton in the frames
+    unit = rectangle(0.0, 2.0, 0.0, 1.0, 8, 4)
+    mesh = Mesh.from_arrays(
+        unit.points,
+        unit.cells,
+        {
+            "bottom": lambda x: x[:, 1] < 1e-12,
+            "top": lambda x: x[:, 1] > 1.0 - 1e-12,
+            "roller": lambda x: (x[:, 0] < 1e-12) & (x[:, 1] > 0.5),
+            "free": lambda x: (
+                (x[:, 1] >= 1e-12)
+                & (x[:, 1] <= 1.0 - 1e-12)
+                & ((x[:, 0] > 1e-12) | (x[:, 1] < 0.5))
+            ),
+        },
+    )
+    conditions = {
+        "bottom": Contact(obstacle=HalfPlane((0.0, 0.0), (0.0, 1.0)), friction=Coulomb(0.3)),
+        "top": Neumann((-0.03, -0.1)),
+        "roller": Roller(),
+        "free": Neumann(),
+    }
+    plain = ContactProblem(mesh, Material.from_young(1.0, 0.3), conditions)
+    turned = _rotated(plain)
+    a, b = solve(plain), solve(turned)
+    _assert_rotated(a, b)
+    assert np.array_equal(a.state, b.state) and len(set(a.state.tolist())) >= 2
+    scale = np.abs(a.tangential_force).max()
+    assert scale > 0
+    assert np.abs(b.tangential_force - a.tangential_force).max() <= 1e-10 * scale
+    # equilibrium along x: the roller and the friction carry the push on the top
+    # (the roller acts with −Λ n = Λ e_x, the foundation with −Λ_t t, t = e_x)
+    assert a.roller_force.sum() - a.tangential_force.sum() == pytest.approx(0.06, rel=1e-9)
+
+
 def _trapezoid(n: int) -> Mesh:
     """The trapezoid with the oblique left side from (1, 0) to (1.4, 1), the right side from
     (2.5, 0) to (2.2, 1): a mapped structured mesh, parts named as the rectangle's."""
@@ -163,10 +207,25 @@ def test_oblique_roller_reproduces_an_affine_solution(bottom):
     }
     exact = ExactSolution(u, lambda x: np.broadcast_to(eps, (len(x), 2, 2)))
     problem = ContactProblem(mesh, material, conditions, exact=exact)
-    assert problem.rollers.keys() == ({"left"} if bottom == "dirichlet" else {"left"})
+    assert problem.rollers.keys() == {"left"}  # a roller along an axis holds u_y
     result = solve(problem)
     scale = np.abs(result.u).max()
     assert np.abs(result.u - u(result.space.node_points)).max() <= 1e-12 * scale
+    # the rollers' nodal forces are the uniform stress's: Λ_z = −σ_nn ∫ ψ_z ds over the part
+    space = result.space
+    expected = np.zeros(space.n_nodes)
+    for name in [p for p, c in conditions.items() if isinstance(c, Roller)]:
+        edges = mesh.part_edges(name)
+        nodes = space.edge_nodes(edges)
+        length = mesh.edge_length[edges]
+        ab = mesh.points[nodes[0, :2]]
+        normal = np.array([ab[1, 1] - ab[0, 1], ab[0, 0] - ab[1, 0]]) / length[0]
+        weights = np.column_stack([length / 6, length / 6, 2 * length / 3])
+        np.add.at(expected, nodes.ravel(), -(normal @ sigma @ normal) * weights.ravel())
+    assert result.roller_nodes.size == (6 if bottom == "dirichlet" else 12)
+    assert not np.isin(result.roller_nodes, result.dirichlet_nodes).any()
+    lam_z = result.roller_force
+    assert np.abs(lam_z - expected[result.roller_nodes]).max() <= 1e-12 * np.abs(lam_z).max()
     assert result.errors()["error_energy"] <= 1e-12 * np.sqrt(np.abs(sigma).max() * scale)
 
 

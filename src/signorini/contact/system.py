@@ -15,14 +15,23 @@ from ..fem.loads import assemble_body_force, assemble_edge_load
 from ..fem.space import P2Space
 from ..fem.stiffness import assemble_stiffness
 from ..mesh.mesh import Mesh
-from ..problem.conditions import Neumann
+from ..problem.conditions import Neumann, Roller
 from ..problem.fields import ProblemError, evaluate_field
+from ..problem.normals import straight_normal
 from ..problem.problem import ContactProblem
 from ..problem.rollers import HeldNodes, held_nodes
 from .contact_set import ContactSet, contact_set
 from .node_frames import frame_matrices, rotate_frames
 
-__all__ = ["Assembled", "assemble", "obstacle_displacement", "LOAD_DEGREE"]
+__all__ = [
+    "Assembled",
+    "RollerDofs",
+    "assemble",
+    "obstacle_displacement",
+    "roller_dofs",
+    "system_frames",
+    "LOAD_DEGREE",
+]
 
 #: quadrature degree for loads with smooth data
 LOAD_DEGREE = 8
@@ -69,6 +78,9 @@ class Assembled:
         Their frames ``Q_z``: ``contact.frames`` at a constrained node, ``[n t]`` at a
         roller node (``y_0 = u·n`` held). Every reader of the solution in Cartesian
         components goes through them (:func:`~.node_frames.to_cartesian`).
+    rollers : RollerDofs
+        The held DOF of each roller node off the contact boundary and its roller's normal
+        there, to recover the roller's force (:func:`roller_dofs`).
     """
 
     space: P2Space
@@ -82,6 +94,7 @@ class Assembled:
     obstacle_motion: np.ndarray
     frame_nodes: np.ndarray
     frames: np.ndarray
+    rollers: RollerDofs
 
 
 def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
@@ -145,6 +158,69 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
         obstacle_displacement(problem, cs),
         frame_nodes,
         frames,
+        roller_dofs(problem, space, held, cs),
+    )
+
+
+@dataclass(frozen=True)
+class RollerDofs:
+    """The roller nodes of a space whose one held DOF is along the roller's normal: every
+    node of a roller part that is neither a Dirichlet node nor a constrained node.
+
+    Attributes
+    ----------
+    nodes : (r,) int array
+        The nodes (sorted).
+    dofs : (r,) int array
+        The held DOF of each in the system's frames: ``2z`` (``y_0 = u·n``) at a roller
+        node in a frame, ``2z + c`` at a node of a roller along an axis.
+    sign : (r,) float array
+        ``u·n = sign · y[dofs]`` (±1: the outward normal of an axis roller may point along
+        −x or −y).
+    normal : (r, 2) float array
+        The roller's outward unit normal at each node.
+    """
+
+    nodes: np.ndarray
+    dofs: np.ndarray
+    sign: np.ndarray
+    normal: np.ndarray
+
+    def force(self, K: sp.csr_matrix, F: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``(r,)`` the nodal force of the roller on the body along ``−n``,
+        ``Λ_z = L(ψ_z n_z) − a(u_h, ψ_z n_z)`` (the contact force's formula, (3.17)):
+        positive where the roller pushes the body, for the frame system ``K y = F``."""
+        return self.sign * (F[self.dofs] - K[self.dofs] @ y)
+
+
+def roller_dofs(
+    problem: ContactProblem, space: P2Space, held: HeldNodes, cs: ContactSet
+) -> RollerDofs:
+    """The :class:`RollerDofs` of ``problem`` on ``space``: the roller nodes in frames
+    (``held.roller_nodes`` off the contact boundary) and the nodes of rollers along an axis
+    that hold one Cartesian component there."""
+    off = cs.local(held.roller_nodes) < 0
+    nodes, dofs = [held.roller_nodes[off]], [2 * held.roller_nodes[off]]
+    sign, normal = [np.ones(int(off.sum()))], [held.roller_normal[off]]
+    partial = held.components.sum(axis=1) == 1
+    for name in problem.held:  # a loop over parts
+        if not isinstance(problem.conditions[name], Roller):
+            continue
+        z = space.part_nodes([name])
+        z = z[partial[z] & (cs.local(z) < 0)]
+        n = straight_normal(space.mesh, name)
+        c = int(np.argmax(np.abs(n)))
+        nodes.append(z)
+        dofs.append(2 * z + c)
+        sign.append(np.full(z.size, np.sign(n[c])))
+        normal.append(np.broadcast_to(np.eye(2)[c] * np.sign(n[c]), (z.size, 2)))
+    nodes = np.concatenate(nodes)
+    first = np.unique(nodes, return_index=True)[1]  # a node on two axis rollers: once
+    return RollerDofs(
+        nodes[first],
+        np.concatenate(dofs)[first],
+        np.concatenate(sign)[first],
+        np.concatenate(normal)[first],
     )
 
 
