@@ -82,7 +82,9 @@ class ContactProblem:
         or the body force is of the wrong kind, a component of a body with Dirichlet parts has
         none (the message names each such component), a rigid motion is held neither by the
         Dirichlet and Roller parts nor by the contact parts (the message names it), a
-        contact part with a given normal is not straight along it, or a node where two
+        contact part with a given normal is not straight along it, a roller part has a
+        corner where its normal is undefined (:func:`~.rollers.check_roller_part`), or a
+        node where two
         contact parts meet at an angle lies on a frictional part
         (:func:`~.corners.check_corner_friction`).
 
