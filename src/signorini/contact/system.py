@@ -1,6 +1,7 @@
 """The algebraic contact problem of one mesh (paper, Section 3): stiffness, load, Dirichlet
 data and the constrained nodes, with the contact nodes rotated into (normal, tangential)
-frames.
+frames and the nodes of oblique and curved rollers into ``[n t]`` frames (docs/method.md,
+*Rollers and components*).
 """
 
 from __future__ import annotations
@@ -62,7 +63,8 @@ class Assembled:
         roller or a one-component Dirichlet part (docs/method.md, *Rollers and components*).
     dirichlet_values : (n_held,) float array
         The prescribed displacements of those DOFs: Cartesian, except the frame DOF held at
-        a constrained node on a roller (its tangential component).
+        a roller node (``u·n``) and at a constrained node on a roller (its tangential
+        component).
     seconds : float
         Wall-clock time of the assembly.
     dirichlet_nodes : (n_D,) int array
