@@ -342,6 +342,24 @@ def test_roller_refusals_on_oblique_and_curved_parts():
     )
     with pytest.raises(ProblemError, match=r"'corner'.*turns by 90°.*\(0, 0\).*Split the part"):
         ContactProblem(corner, material, {"corner": Roller(), "free": Neumann((0.1, 0.1))})
+    # a polygonal arc (no curve) turning by 1.1 / 4 rad per vertex is accepted: its vertices
+    # hold u·n with the mean of their two edges' normals
+    sector = _sector(2)
+    polygon = Mesh(sector.points, sector.cells, sector.boundary, sector.boundary_part,
+                   sector.part_names)  # fmt: skip
+    conditions = {"inner": Roller(), "outer": Neumann(lambda x, normal: -0.1 * normal)}
+    pushed = {**conditions, "start": Roller(), "end": Neumann(lambda x, normal: -0.1 * normal)}
+    result = solve(ContactProblem(polygon, material, pushed))  # slides along the arc
+    x = polygon.points
+    arc = np.flatnonzero(np.abs(np.hypot(*x.T) - 1.0) < 1e-12)
+    arc = arc[np.argsort(np.arctan2(x[arc, 1], x[arc, 0]))]
+    inner = arc[1:-1]  # the ends are corners held both ways
+    assert inner.size == 3 and np.isin(inner, result.roller_nodes).all()
+    prev, after = x[inner] - x[arc[:-2]], x[arc[2:]] - x[inner]
+    tangent = prev / np.hypot(*prev.T)[:, None] + after / np.hypot(*after.T)[:, None]
+    n = tangent @ np.array([[0.0, 1.0], [-1.0, 0.0]])  # (−τ_y, τ_x): the mean normal's line
+    assert np.abs(np.einsum("kc,kc->k", result.u[inner], n)).max() <= 1e-15
+    assert np.abs(result.u[inner]).max() > 1e-2
     # the roller on the rotated axis meets the unrotated plane's contact at an angle
     turned = _rotated(hertz_quarter(rings=3))
     conditions = {**turned.conditions, "arc": Contact(obstacle=HalfPlane((0, 0), (0, 1)))}
