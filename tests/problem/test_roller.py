@@ -110,8 +110,20 @@ def test_roller_refusals():
         rotated.boundary_part,
         rotated.part_names,
     )
-    with pytest.raises(ProblemError, match="'left'.*not along an axis"):
-        ContactProblem(rotated, material, {**free, "left": Roller()})
+    # a roller on an oblique part holds u·n in a node frame (tests/problem/
+    # test_roller_frames.py): the rotated model gives the rotated solution
+    free = {**free, "top": Neumann((0.2, -0.1)), "bottom": Dirichlet((0.01, 0.0))}
+    turn = np.array([[0.8, 0.6], [-0.6, 0.8]])
+    loads = {
+        "top": Neumann(tuple(np.array([0.2, -0.1]) @ turn)),
+        "bottom": Dirichlet(tuple(np.array([0.01, 0.0]) @ turn)),
+    }
+    r = solve(ContactProblem(rotated, material, {**free, **loads, "left": Roller(0.02)}))
+    plain = solve(ContactProblem(mesh, material, {**free, "left": Roller(0.02)}))
+    assert np.abs(r.u - plain.u @ turn).max() <= 1e-13 * np.abs(plain.u).max()
+    left = r.space.part_nodes(["left"])
+    left = left[~np.isin(left, r.dirichlet_nodes)]
+    assert np.abs(r.u[left] @ (np.array([-1.0, 0.0]) @ turn) - 0.02).max() <= 1e-15
     assert ContactProblem(mesh, material, {**free, "left": Roller()}).dirichlet_parts == [
         "bottom",
         "left",

@@ -14,10 +14,11 @@ from ..algebra.laws import LawGroups
 from ..fem import iso, p2
 from ..fem.quadrature import gauss_legendre
 from ..fem.space import P2Space
-from ..mesh.validation import MeshError
 from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
+from ..problem.normals import node_normals
 from ..problem.problem import ContactProblem
+from ..problem.rollers import held_nodes
 
 if TYPE_CHECKING:
     from .mortar import MortarCoupling
@@ -36,62 +37,24 @@ __all__ = [
 def _body_normals(
     problem: ContactProblem, space: P2Space, name: str, nodes: np.ndarray, chord: np.ndarray
 ) -> np.ndarray:
-    """The body's outward unit normal at the nodes ``[start, end, midpoint]`` of one part's
-    edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``: the part's normal
-    on a straight part, the curve's normal on a part with a curve that has one, else the
-    edge's normal at a midpoint and the normalised mean of the part's two edges' normals at a
-    vertex
-    (docs/method.md, *Contact directions*)."""
-    if name in problem.contact_normals:
-        return np.broadcast_to(problem.contact_normals[name], nodes.shape + (2,)).copy()
-    return part_normals(space, name, nodes, chord)
+    """The body's outward unit normal at the nodes ``[start, end, midpoint]`` of one contact
+    part's edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``
+    (:func:`signorini.problem.normals.node_normals`; docs/method.md, *Contact directions*)."""
+    return node_normals(
+        space.mesh,
+        name,
+        nodes,
+        space.node_points[nodes],
+        chord,
+        straight=problem.contact_normals.get(name),
+    )
 
 
 def part_normals(space: P2Space, name: str, nodes: np.ndarray, chord: np.ndarray) -> np.ndarray:
     """The outward unit normal of boundary part ``name`` at the nodes ``[start, end,
-    midpoint]`` of its edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``:
-    the curve's normal on a part with a curve that has one, else the edge's normal at a
-    midpoint and the normalised mean of the part's two edges' normals at a vertex
-    (docs/method.md, *Contact directions*)."""
-    mesh = space.mesh
-    curve = mesh.curves[mesh.part_index(name)]
-    if curve is not None and curve.has_normal:
-        x = space.node_points[nodes.ravel()]
-        try:
-            n = curve.normal(x).reshape(nodes.shape + (2,))
-        except MeshError as err:
-            raise ProblemError(f"the curve of contact part {name!r}: {err}") from err
-        cos = np.einsum("ejc,ec->ej", n, chord)
-        _check_across(name, cos, x)
-        return n * np.where(cos < 0, -1.0, 1.0)[..., None]
-    total = np.zeros((space.n_nodes, 2))
-    np.add.at(total, nodes[:, :2].ravel(), np.repeat(chord, 2, axis=0))
-    out = np.repeat(chord[:, None, :], 3, axis=1)
-    mean = total[nodes[:, :2]]
-    out[:, :2] = mean / np.hypot(mean[..., 0], mean[..., 1])[..., None]
-    return out
-
-
-#: a curve's normal at a node of a contact edge may differ from the edge chord's normal by at
-#: most this angle (radians, 60°): the curve turns by about h / R over an edge, far less on
-#: any mesh that resolves it; a normal along the boundary (the tangent) is 90° off
-CURVE_NORMAL_ANGLE = np.pi / 3
-
-
-def _check_across(name: str, cos: np.ndarray, x: np.ndarray) -> None:
-    """Refuse a curve normal that runs along the boundary rather than across it: ``cos (e, 3)``
-    of its angle to the chord's normal at the nodes ``x (3 e, 2)`` of a part's edges."""
-    bad = np.flatnonzero(np.abs(cos).ravel() < np.cos(CURVE_NORMAL_ANGLE))
-    if bad.size:
-        i = bad[0]
-        angle = np.degrees(np.arccos(min(abs(float(cos.ravel()[i])), 1.0)))
-        raise ProblemError(
-            f"the curve of contact part {name!r} gives at the node ({x[i, 0]:.12g}, "
-            f"{x[i, 1]:.12g}) a normal {angle:.3g}° away from the normal of the boundary edge "
-            f"there (more than {np.degrees(CURVE_NORMAL_ANGLE):.0f}°; {bad.size} node(s)): it "
-            "runs along the boundary, not across it. ProjectedCurve(normal=...) must return "
-            "the curve's normal, not its tangent"
-        )
+    midpoint]`` of its edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``,
+    from the geometry alone (:func:`signorini.problem.normals.node_normals`)."""
+    return node_normals(space.mesh, name, nodes, space.node_points[nodes], chord)
 
 
 def directions_and_gaps(
@@ -296,19 +259,12 @@ DEEP_OVERLAP = 0.25
 
 def _dirichlet_values(problem: ContactProblem, space: P2Space, nodes: np.ndarray):
     """``u_D`` at the Dirichlet nodes ``nodes (j,)`` (held in both components, from one part
-    or two) and the Dirichlet part of each (a node on two parts takes the later part's value
-    in each component that part holds, as in the assembly)."""
-    x = space.node_points[nodes]
-    value = np.zeros((nodes.size, 2))
+    or two, a roller's among them: :func:`~signorini.problem.rollers.held_nodes`) and the
+    Dirichlet or Roller part of each (the later one at a node on two)."""
+    value = held_nodes(problem, space).values[nodes]
     owner = np.full(nodes.size, "", dtype=object)
-    for name, cond in problem.held.items():  # Dirichlet and Roller parts, as Dirichlet
-        on = np.flatnonzero(np.isin(nodes, space.part_nodes([name])))
-        if on.size:
-            what = f"the Dirichlet value of part {name!r}"
-            comp = np.flatnonzero(cond.components)
-            v = evaluate_field(cond.field(), x[on], what)
-            value[on[:, None], comp[None, :]] = v[:, comp]
-            owner[on] = name
+    for name in problem.dirichlet_parts:  # a loop over parts
+        owner[np.isin(nodes, space.part_nodes([name]))] = name
     return value, owner
 
 

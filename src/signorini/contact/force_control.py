@@ -51,7 +51,8 @@ def check_load_carried(problem, assembled: Assembled) -> None:
     space, cs = assembled.space, assembled.contact
     motions = problem.rigid_motions
     r = motion_field(space.mesh, motions, space.node_points)  # (k, n_nodes, 2)
-    y = np.stack([to_frames(ri.ravel(), cs.frame_nodes, cs.frames) for ri in r])  # k ≤ 3
+    nodes, frames = assembled.frame_nodes, assembled.frames
+    y = np.stack([to_frames(ri.ravel(), nodes, frames) for ri in r])  # k ≤ 3
     work = y @ assembled.F  # (k,)
     scale = np.abs(y) @ np.abs(assembled.F)  # (k,)
     along = np.einsum("knc,nc->kn", r[:, cs.nodes], cs.normal)  # (k, n_constraints)

@@ -238,7 +238,7 @@ def solve_frictional(
         direction0[(state0 == INACTIVE) & ~law.everywhere] = 0
         warm = {"state0": state0, "direction0": direction0}
     elif u0 is not None:
-        warm = {"x0": to_frames(u0.ravel(), cs.frame_nodes, cs.frames)}
+        warm = {"x0": to_frames(u0.ravel(), assembled.frame_nodes, assembled.frames)}
     elif active0 is not None and not warm:
         # a first active set without a displacement (a semi-coercive body: docs/method.md,
         # *Force control*): those nodes stick, the others are out of contact

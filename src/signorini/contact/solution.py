@@ -120,6 +120,13 @@ class ContactResult:
         The P2 nodes on the closure of Γ_D (both components prescribed).
     timings : dict
         Seconds spent in ``assemble`` and ``solve``.
+    roller_nodes : (r,) int array
+        The nodes of roller parts held along their normal only (not Dirichlet nodes, not
+        constrained nodes; docs/method.md, *Rollers and components*).
+    roller_force : (r,) float array
+        The roller's nodal force on the body along ``−n_z`` at each,
+        ``Λ_z = L(ψ_z n_z) − a(u_h, ψ_z n_z)`` as for a contact force (3.17): positive where
+        the roller pushes the body; the roller acts on the body with ``−Λ_z n_z``.
     tangential_force : (k,) float array
         Nodal friction forces Λ_t,z (along the constraint's tangent ``contact.tangent``,
         ``t = (−n_y, n_x)``; the obstacle acts on the body with ``−Λ_t t``); 0 without
@@ -154,6 +161,8 @@ class ContactResult:
     direction: np.ndarray
     tangential_reference: np.ndarray
     timings: dict = field(default_factory=dict)
+    roller_nodes: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    roller_force: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def mesh(self) -> Mesh:
@@ -355,7 +364,10 @@ def solve(
     return ContactResult(
         problem=problem,
         space=space,
-        u=physical(to_cartesian(solved.x, cs.frame_nodes, cs.frames).reshape(-1, 2), cs.transfer),
+        u=physical(
+            to_cartesian(solved.x, assembled.frame_nodes, assembled.frames).reshape(-1, 2),
+            cs.transfer,
+        ),
         contact=cs,
         contact_force=solved.normal_force if unit == 1.0 else solved.normal_force * unit,
         active=solved.state != INACTIVE,
@@ -366,6 +378,8 @@ def solve(
         direction=solved.direction,
         tangential_reference=solved.reference,
         timings=timings,
+        roller_nodes=assembled.rollers.nodes,
+        roller_force=assembled.rollers.force(assembled.K, assembled.F, solved.x),
     )
 
 

@@ -1,6 +1,7 @@
 """The algebraic contact problem of one mesh (paper, Section 3): stiffness, load, Dirichlet
 data and the constrained nodes, with the contact nodes rotated into (normal, tangential)
-frames.
+frames and the nodes of oblique and curved rollers into ``[n t]`` frames (docs/method.md,
+*Rollers and components*).
 """
 
 from __future__ import annotations
@@ -15,14 +16,24 @@ from ..fem.loads import assemble_body_force, assemble_edge_load
 from ..fem.space import P2Space
 from ..fem.stiffness import assemble_stiffness
 from ..mesh.mesh import Mesh
-from ..problem.conditions import Neumann
+from ..problem.conditions import Neumann, Roller
 from ..problem.fields import ProblemError, evaluate_field
+from ..problem.normals import straight_normal
 from ..problem.problem import ContactProblem
+from ..problem.rollers import HeldNodes, held_nodes
 from .contact_set import ContactSet, contact_set
-from .node_frames import rotate_frames
+from .node_frames import frame_matrices, rotate_frames
 from .two_body import two_body_system
 
-__all__ = ["Assembled", "assemble", "obstacle_displacement", "LOAD_DEGREE"]
+__all__ = [
+    "Assembled",
+    "RollerDofs",
+    "assemble",
+    "obstacle_displacement",
+    "roller_dofs",
+    "system_frames",
+    "LOAD_DEGREE",
+]
 
 #: quadrature degree for loads with smooth data
 LOAD_DEGREE = 8
@@ -54,7 +65,8 @@ class Assembled:
         roller or a one-component Dirichlet part (docs/method.md, *Rollers and components*).
     dirichlet_values : (n_held,) float array
         The prescribed displacements of those DOFs: Cartesian, except the frame DOF held at
-        a constrained node on a roller (its tangential component).
+        a roller node (``u·n``) and at a constrained node on a roller (its tangential
+        component).
     seconds : float
         Wall-clock time of the assembly.
     dirichlet_nodes : (n_D,) int array
@@ -63,6 +75,16 @@ class Assembled:
         The prescribed rigid displacement of the obstacle of each constraint's part
         (:meth:`~signorini.problem.obstacle_base.Obstacle.moved`; 0 for a gap function or
         an obstacle in place): the friction law's slip is relative to it.
+    frame_nodes : (m,) int array
+        The nodes whose DOFs are in a frame ``u = Q_z y`` (sorted): the constrained nodes
+        and the roller nodes (:func:`system_frames`).
+    frames : (m, 2, 2) float array
+        Their frames ``Q_z``: ``contact.frames`` at a constrained node, ``[n t]`` at a
+        roller node (``y_0 = u·n`` held). Every reader of the solution in Cartesian
+        components goes through them (:func:`~.node_frames.to_cartesian`).
+    rollers : RollerDofs
+        The held DOF of each roller node off the contact boundary and its roller's normal
+        there, to recover the roller's force (:func:`roller_dofs`).
     """
 
     space: P2Space
@@ -74,6 +96,9 @@ class Assembled:
     seconds: float
     dirichlet_nodes: np.ndarray
     obstacle_motion: np.ndarray
+    frame_nodes: np.ndarray
+    frames: np.ndarray
+    rollers: RollerDofs
 
 
 def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
@@ -125,8 +150,10 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
     cs = contact_set(problem, space)
     if cs.transfer is not None:  # contact pairs: the relative displacement's basis
         K, F = two_body_system(K, F, cs.transfer.dofs)
-    K, F = rotate_frames(K, F, cs.frame_nodes, cs.frames, copy=False, validate=False)
-    dirichlet, d_values = _dirichlet_dofs(problem, space, cs)
+    held = held_nodes(problem, space)
+    frame_nodes, frames = system_frames(cs, held)
+    K, F = rotate_frames(K, F, frame_nodes, frames, copy=False, validate=False)
+    dirichlet, d_values = _dirichlet_dofs(held, space, cs)
     return Assembled(
         space,
         cs,
@@ -135,9 +162,90 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
         dirichlet,
         d_values,
         time.perf_counter() - t0,
-        problem.dirichlet_nodes(space),
+        np.flatnonzero(held.components.all(axis=1)),
         obstacle_displacement(problem, cs),
+        frame_nodes,
+        frames,
+        roller_dofs(problem, space, held, cs),
     )
+
+
+@dataclass(frozen=True)
+class RollerDofs:
+    """The roller nodes of a space whose one held DOF is along the roller's normal: every
+    node of a roller part that is neither a Dirichlet node nor a constrained node.
+
+    Attributes
+    ----------
+    nodes : (r,) int array
+        The nodes (sorted).
+    dofs : (r,) int array
+        The held DOF of each in the system's frames: ``2z`` (``y_0 = u·n``) at a roller
+        node in a frame, ``2z + c`` at a node of a roller along an axis.
+    sign : (r,) float array
+        ``u·n = sign · y[dofs]`` (±1: the outward normal of an axis roller may point along
+        −x or −y).
+    normal : (r, 2) float array
+        The roller's outward unit normal at each node.
+    """
+
+    nodes: np.ndarray
+    dofs: np.ndarray
+    sign: np.ndarray
+    normal: np.ndarray
+
+    def force(self, K: sp.csr_matrix, F: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``(r,)`` the nodal force of the roller on the body along ``−n``,
+        ``Λ_z = L(ψ_z n_z) − a(u_h, ψ_z n_z)`` (the contact force's formula, (3.17)):
+        positive where the roller pushes the body, for the frame system ``K y = F``."""
+        return self.sign * (F[self.dofs] - K[self.dofs] @ y)
+
+
+def roller_dofs(
+    problem: ContactProblem, space: P2Space, held: HeldNodes, cs: ContactSet
+) -> RollerDofs:
+    """The :class:`RollerDofs` of ``problem`` on ``space``: the roller nodes in frames
+    (``held.roller_nodes`` off the contact boundary) and the nodes of rollers along an axis
+    that hold one Cartesian component there."""
+    off = cs.local(held.roller_nodes) < 0
+    nodes, dofs = [held.roller_nodes[off]], [2 * held.roller_nodes[off]]
+    sign, normal = [np.ones(int(off.sum()))], [held.roller_normal[off]]
+    partial = held.components.sum(axis=1) == 1
+    for name in problem.held:  # a loop over parts
+        if not isinstance(problem.conditions[name], Roller):
+            continue
+        z = space.part_nodes([name])
+        z = z[partial[z] & (cs.local(z) < 0)]
+        n = straight_normal(space.mesh, name)
+        c = int(np.argmax(np.abs(n)))
+        nodes.append(z)
+        dofs.append(2 * z + c)
+        sign.append(np.full(z.size, np.sign(n[c])))
+        normal.append(np.broadcast_to(np.eye(2)[c] * np.sign(n[c]), (z.size, 2)))
+    nodes = np.concatenate(nodes)
+    first = np.unique(nodes, return_index=True)[1]  # a node on two axis rollers: once
+    return RollerDofs(
+        nodes[first],
+        np.concatenate(dofs)[first],
+        np.concatenate(sign)[first],
+        np.concatenate(normal)[first],
+    )
+
+
+def system_frames(cs: ContactSet, held: HeldNodes) -> tuple[np.ndarray, np.ndarray]:
+    """The nodes of a space whose DOFs are in a frame ``u = Q_z y`` (sorted) and their
+    frames ``(m, 2, 2)``: the constrained nodes with ``cs.frames``, and the roller nodes off
+    the contact boundary with ``[n t]``, ``t = (−n_y, n_x)``, so that ``y_0 = u·n`` is the
+    held DOF (docs/method.md, *Rollers and components*). A roller node on a contact part
+    keeps its contact frame (:func:`_dirichlet_dofs` checks that the roller holds a free
+    DOF of it)."""
+    off = cs.local(held.roller_nodes) < 0
+    nodes = np.concatenate([cs.frame_nodes, held.roller_nodes[off]])
+    if nodes.size == cs.frame_nodes.size:
+        return cs.frame_nodes, cs.frames
+    frames = np.concatenate([cs.frames, frame_matrices(held.roller_normal[off])])
+    order = np.argsort(nodes)
+    return nodes[order], frames[order]
 
 
 def obstacle_displacement(problem: ContactProblem, cs: ContactSet) -> np.ndarray:
@@ -153,68 +261,83 @@ def obstacle_displacement(problem: ContactProblem, cs: ContactSet) -> np.ndarray
 
 
 def _dirichlet_dofs(
-    problem: ContactProblem, space: P2Space, cs: ContactSet
+    held: HeldNodes, space: P2Space, cs: ContactSet
 ) -> tuple[np.ndarray, np.ndarray]:
     """The held DOFs (sorted) and their values (docs/method.md, *Rollers and components*).
 
-    A node on two Dirichlet parts takes the later part's value in each component that part
-    holds. At a constrained node (in its contact frame ``u = Q y``) a held Cartesian
-    component ``u_c = Q[c] y`` must be one frame DOF: ``Q[c, j] = 0`` for the other ``j``
-    (a roller along the contact direction's tangent, as where a symmetry axis meets a
-    symmetric contact arc), and not a constrained one; that frame DOF is held at
-    ``u_c / Q[c, j]``.
+    A node held along one direction ``d`` (a Cartesian component ``e_c``, or a roller's
+    normal) off the contact boundary holds ``u_c``, or the DOF ``y_0 = u·n`` of its roller
+    frame. At a constrained node (in its contact frame ``u = Q y``) the held ``d·u =
+    (Qᵀd)·y`` must be one frame DOF: ``(Qᵀd)_i = 0`` for the other ``i`` (a roller along
+    the contact direction's tangent, as where a symmetry axis meets a symmetric contact
+    arc), and not a constrained one; that frame DOF is held at ``value / (Qᵀd)_j``.
 
     Raises
     ------
     ProblemError
-        If a component held at a constrained node is not one free frame DOF (a roller that
+        If a direction held at a constrained node is not one free frame DOF (a roller that
         holds the contact direction, or part of it), or the node has friction, naming the
         node and the contact part.
     """
-    held = problem.held_components(space)
-    values = np.zeros((space.n_nodes, 2))
-    for name, cond in problem.held.items():
-        nodes = space.part_nodes([name])
-        v = evaluate_field(
-            cond.field(), space.node_points[nodes], f"the Dirichlet value of part {name!r}"
-        )
-        comp = np.asarray(cond.components)
-        values[nodes[:, None], np.flatnonzero(comp)[None, :]] = v[:, comp]
-    where = cs.local(np.arange(space.n_nodes))
-    partial = held.any(axis=1) & ~held.all(axis=1) & (where >= 0)
-    if partial.any():
-        nodes = np.flatnonzero(partial)
+    comp = held.components.copy()
+    values = held.values.copy()
+    partial = comp.any(axis=1) & ~comp.all(axis=1)
+    on_contact = np.flatnonzero(partial & (cs.local(np.arange(space.n_nodes)) >= 0))
+    c = comp[on_contact, 1].astype(np.int64)  # the one held component
+    rollers = held.roller_nodes
+    at_contact = cs.local(rollers) >= 0
+    # roller nodes off the contact boundary: the frame's first DOF, u·n
+    comp[rollers[~at_contact], 0] = True
+    values[rollers[~at_contact], 0] = held.roller_value[~at_contact]
+    nodes = np.concatenate([on_contact, rollers[at_contact]])
+    if nodes.size:
+        direction = np.concatenate([np.eye(2)[c], held.roller_normal[at_contact]])
+        value = np.concatenate([values[on_contact, c], held.roller_value[at_contact]])
+        name = [f"u_{'xy'[i]}" for i in c] + [
+            f"u·n along n = {tuple(np.round(n, 6).tolist())}" for n in direction[c.size :]
+        ]
+        j = _check_held_at_contact(space, cs, nodes, direction, name)
         Q = cs.frames[np.searchsorted(cs.frame_nodes, nodes)]  # (m, 2, 2): u = Q y
-        comp = held[nodes, 1].astype(np.int64)  # the one held component
-        row = Q[np.arange(nodes.size), comp]  # (m, 2): u_c = row · y
-        j = np.argmax(np.abs(row), axis=1)
-        other = np.abs(row[np.arange(nodes.size), 1 - j])
-        bad = (other > 1e-9 * np.abs(row).max(axis=1)) | np.isin(2 * nodes + j, cs.constrained_dofs)
-        bad = np.flatnonzero(bad)
-        if bad.size:
-            z = nodes[bad[0]]
-            raise ProblemError(
-                f"the node at {tuple(np.round(space.node_points[z], 12).tolist())} is held in "
-                f"u_{'xy'[comp[bad[0]]]} by a Dirichlet or Roller part and lies on contact "
-                f"part {cs.parts[cs.part[cs.local(np.array([z]))[0]]]!r}, whose direction "
-                "there is not perpendicular to the held component: the two conditions "
-                "conflict (end the roller before the contact part, or make the contact "
-                "direction at the shared node perpendicular to it)"
-            )
-        rows = cs.local(nodes)
-        if cs.has_friction and (cs.friction.index[rows] >= 0).any():
-            k = int(np.flatnonzero(cs.friction.index[rows] >= 0)[0])
-            raise ProblemError(
-                f"contact part {cs.parts[cs.part[rows[k]]]!r} has friction at the node "
-                f"{tuple(np.round(space.node_points[nodes[k]], 12).tolist())}, whose "
-                "tangential displacement a Dirichlet or Roller part holds: the friction law "
-                "has no slip to act on there. Give the contact part no friction, or end the "
-                "roller before it (a symmetry plane through a frictional contact: model the "
-                "whole body)"
-            )
-        held[nodes] = False
-        held[nodes, j] = True
-        values[nodes, j] = values[nodes, comp] / row[np.arange(nodes.size), j]
+        row = np.einsum("mci,mc->mi", Q, direction)  # (m, 2): d·u = row · y
+        comp[nodes] = False
+        comp[nodes, j] = True
+        values[nodes, j] = value / row[np.arange(nodes.size), j]
         values[nodes, 1 - j] = 0.0
-    dofs = np.flatnonzero(held.ravel())
+    dofs = np.flatnonzero(comp.ravel())
     return dofs, values.ravel()[dofs]
+
+
+def _check_held_at_contact(
+    space: P2Space, cs: ContactSet, nodes: np.ndarray, direction: np.ndarray, name: list
+) -> np.ndarray:
+    """The frame DOF ``j`` each constrained node ``nodes`` holds along ``direction (m, 2)``
+    (named ``name``); refuses a direction that is not one free frame DOF, or friction at
+    the node (see :func:`_dirichlet_dofs`)."""
+    Q = cs.frames[np.searchsorted(cs.frame_nodes, nodes)]
+    row = np.einsum("mci,mc->mi", Q, direction)
+    j = np.argmax(np.abs(row), axis=1)
+    other = np.abs(row[np.arange(nodes.size), 1 - j])
+    bad = (other > 1e-9 * np.abs(row).max(axis=1)) | np.isin(2 * nodes + j, cs.constrained_dofs)
+    bad = np.flatnonzero(bad)
+    if bad.size:
+        z = nodes[bad[0]]
+        raise ProblemError(
+            f"the node at {tuple(np.round(space.node_points[z], 12).tolist())} is held in "
+            f"{name[bad[0]]} by a Dirichlet or Roller part and lies on contact "
+            f"part {cs.parts[cs.part[cs.local(np.array([z]))[0]]]!r}, whose direction "
+            "there is not perpendicular to the held component: the two conditions "
+            "conflict (end the roller before the contact part, or make the contact "
+            "direction at the shared node perpendicular to it)"
+        )
+    rows = cs.local(nodes)
+    if cs.has_friction and (cs.friction.index[rows] >= 0).any():
+        k = int(np.flatnonzero(cs.friction.index[rows] >= 0)[0])
+        raise ProblemError(
+            f"contact part {cs.parts[cs.part[rows[k]]]!r} has friction at the node "
+            f"{tuple(np.round(space.node_points[nodes[k]], 12).tolist())}, whose "
+            "tangential displacement a Dirichlet or Roller part holds: the friction law "
+            "has no slip to act on there. Give the contact part no friction, or end the "
+            "roller before it (a symmetry plane through a frictional contact: model the "
+            "whole body)"
+        )
+    return j

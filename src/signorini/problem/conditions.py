@@ -67,7 +67,7 @@ class Dirichlet:
         A component given as ``None`` is free: ``Dirichlet((0.0, None))`` holds ``u_x = 0``
         and leaves ``u_y`` and the traction ``σ_yx n_x + σ_yy n_y`` free (zero), as
         FEniCS's ``DirichletBC(V.sub(0), 0, ...)`` does (docs/method.md, *Rollers and
-        components*). For the normal component of a straight part see :class:`Roller`.
+        components*). For the normal component of a part see :class:`Roller`.
 
     Raises
     ------
@@ -116,15 +116,20 @@ class Dirichlet:
 
 @dataclass(frozen=True)
 class Roller:
-    """A roller (symmetry) condition on a straight part: ``u·n = value``, ``σ_t = 0``.
+    """A roller (symmetry) condition: ``u(z)·n_z = value`` at each node, ``σ_t = 0``.
 
     The normal component of the displacement is prescribed and the body slides freely along
-    the part (no tangential traction): the symmetry plane of a half-model, or deal.II's
-    "no normal flux" constraint. ``n`` is the part's outward unit normal, so ``value > 0``
-    moves the part outwards. The part must be straight. On a part along an axis the roller
+    the part (no tangential traction): the symmetry plane of a half-model, deal.II's "no
+    normal flux" constraint, a body in a frictionless socket. ``n_z`` is the outward unit
+    normal at the node, so ``value > 0`` moves the part outwards: the part's normal on a
+    straight part, the exact normal of the part's curve where the mesh carries one, else the
+    normalised mean of the part's edges' normals at a vertex
+    (:func:`signorini.problem.normals.node_normals`). On a part along an axis the roller
     holds one Cartesian component (``Roller()`` on ``x = 0`` is ``Dirichlet((0.0, None))``);
-    on an oblique straight part it is refused for now (docs/method.md, *Rollers and
-    components*).
+    elsewhere the node's DOFs are solved in the frame ``[n_z t_z]`` (docs/method.md,
+    *Rollers and components*). A part with a corner (turning by more than 30° at a vertex
+    where no curve gives the normal) is refused by
+    :class:`~signorini.problem.problem.ContactProblem`: split it into two rollers.
 
     Parameters
     ----------

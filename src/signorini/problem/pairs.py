@@ -62,10 +62,17 @@ def contact_pairs(mesh: Mesh, conditions: Mapping[str, object]) -> dict[str, str
     return pairs
 
 
-def check_bodies_held(mesh: Mesh, held: Mapping[str, object], pairs: Mapping[str, str]) -> None:
+def check_bodies_held(
+    mesh: Mesh,
+    held: Mapping[str, object],
+    pairs: Mapping[str, str],
+    rollers: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
+) -> None:
     """Each body with a part in a contact pair must have its rigid motions held by its own
     Dirichlet and Roller parts (a body held only through a pair, under force control, is not
-    supported; docs/method.md, *Two bodies*).
+    supported; docs/method.md, *Two bodies*). ``held``: the parts holding Cartesian
+    components; ``rollers``: the oblique and curved roller parts, each part's vertices and
+    normals there.
 
     Raises
     ------
@@ -92,6 +99,12 @@ def check_bodies_held(mesh: Mesh, held: Mapping[str, object], pairs: Mapping[str
                 np.column_stack([zero, one, d[:, 0]]),
             )
             rows += [by_component[c] for c in range(2) if cond.components[c]]
+        for name, (x, n) in (rollers or {}).items():  # a loop over parts
+            if edge_body[mesh.part_edges(name)[0]] == b:
+                d = (x - centre) / size  # r·n = a n_x + b n_y + c (d_x n_y − d_y n_x)
+                rows.append(
+                    np.column_stack([n[:, 0], n[:, 1], d[:, 0] * n[:, 1] - d[:, 1] * n[:, 0]])
+                )
         A = np.concatenate(rows) if rows else np.zeros((0, 3))
         s = np.linalg.svd(A, compute_uv=False) if A.size else np.zeros(0)
         rank = int((s > RANK_RTOL * s.max()).sum()) if s.size and s.max() > 0 else 0

@@ -31,8 +31,10 @@ from ..mesh.mesh import Mesh
 from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann, Roller
 from .corners import check_corner_friction
 from .fields import ProblemError, VectorField, check_function
+from .normals import straight_normal
 from .pairs import check_bodies_held, contact_pairs
 from .rigid import free_rigid_motions
+from .rollers import check_roller_part, held_nodes, roller_normals
 
 __all__ = ["ContactProblem", "SlenderBodyWarning", "free_ndof"]
 
@@ -81,7 +83,9 @@ class ContactProblem:
         or the body force is of the wrong kind, a component of a body with Dirichlet parts has
         none (the message names each such component), a rigid motion is held neither by the
         Dirichlet and Roller parts nor by the contact parts (the message names it), a
-        contact part with a given normal is not straight along it, or a node where two
+        contact part with a given normal is not straight along it, a roller part has a
+        corner where its normal is undefined (:func:`~.rollers.check_roller_part`), or a
+        node where two
         contact parts meet at an angle lies on a frictional part
         (:func:`~.corners.check_corner_friction`).
 
@@ -101,6 +105,7 @@ class ContactProblem:
     name: str = "problem"
     contact_normals: dict[str, np.ndarray] = field(init=False, repr=False)
     held: dict[str, Dirichlet] = field(init=False, repr=False)
+    rollers: dict[str, Roller] = field(init=False, repr=False)
     rigid_motions: np.ndarray = field(init=False, repr=False)
     pairs: dict[str, str] = field(init=False, repr=False)
 
@@ -146,17 +151,22 @@ class ContactProblem:
             raise ProblemError(
                 "the problem needs a Dirichlet part (meas Γ_D > 0) to rule out rigid body motions"
             )
+        held = {name: self._held_condition(name) for name in self.dirichlet_parts}
+        object.__setattr__(self, "held", {k: v for k, v in held.items() if v is not None})
         object.__setattr__(
-            self, "held", {name: self._held_condition(name) for name in self.dirichlet_parts}
+            self, "rollers", {k: self.conditions[k] for k, v in held.items() if v is None}
         )
         if self.dirichlet_parts:
             _check_components(mesh, self.dirichlet_parts, self.contact_parts)
-        check_bodies_held(mesh, self.held, self.pairs)
+        check_bodies_held(mesh, self.held, self.pairs, self._roller_vertices())
         object.__setattr__(
             self,
             "rigid_motions",
             free_rigid_motions(
-                mesh, self.held, [p for p in self.contact_parts if p not in self.pairs]
+                mesh,
+                self.held,
+                [p for p in self.contact_parts if p not in self.pairs],
+                self._roller_vertices(),
             ),
         )
         _warn_if_slender(mesh)
@@ -196,46 +206,45 @@ class ContactProblem:
         return np.flatnonzero(self.held_components(space).all(axis=1))
 
     def held_components(self, space: P2Space) -> np.ndarray:
-        """``(n_nodes, 2)`` bool: which components of ``u`` the Dirichlet and Roller parts
-        hold at each P2 node of ``space`` (docs/method.md, *Rollers and components*)."""
-        held = np.zeros((space.n_nodes, 2), dtype=bool)
-        for name, cond in self.held.items():
-            held[space.part_nodes([name])] |= np.asarray(cond.components)
-        return held
+        """``(n_nodes, 2)`` bool: which Cartesian components of ``u`` the Dirichlet and
+        Roller parts hold at each P2 node of ``space``: both at a node held along two
+        independent directions; neither at a node an oblique or curved roller alone holds
+        (its normal component: :func:`~.rollers.held_nodes`; docs/method.md, *Rollers and
+        components*)."""
+        return held_nodes(self, space, values=False).components
 
-    def _held_condition(self, name: str) -> Dirichlet:
+    def _held_condition(self, name: str) -> Dirichlet | None:
         """The condition of Dirichlet or Roller part ``name`` as a :class:`Dirichlet`: a
         roller on a straight part along an axis holds the one Cartesian component along its
-        normal."""
+        normal; ``None`` for a roller on an oblique straight or a curved part (its normal
+        component is held in node frames: :mod:`.rollers`)."""
         cond = self.conditions[name]
         if isinstance(cond, Dirichlet):
             return cond
-        mesh = self.mesh
-        ab = mesh.oriented_boundary(mesh.part_edges(name))
-        _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
-        mean = n.mean(axis=0)
-        mean /= np.linalg.norm(mean)
-        curve = mesh.curves[mesh.part_index(name)]
-        if np.abs(n - mean).max() > 1e-8 or not (curve is None or isinstance(curve, Line)):
-            raise ProblemError(
-                f"Roller on part {name!r}: the part is not straight (its edges' outward "
-                "normals differ); a roller holds the normal component of a straight part"
-            )
+        mean = straight_normal(self.mesh, name)
+        if mean is None:
+            check_roller_part(self.mesh, name)
+            return None
         axis = int(np.argmax(np.abs(mean)))
         if abs(mean[1 - axis]) > 1e-12:
-            raise ProblemError(
-                f"Roller on part {name!r}: its normal {tuple(np.round(mean, 12))} is not "
-                "along an axis; a roller on an oblique part is not supported (rotate the "
-                "model so that the part is along x or y)"
-            )
+            return None
         value = float(np.sign(mean[axis]) * cond.value)
         return Dirichlet((value, None) if axis == 0 else (None, value))
+
+    def _roller_vertices(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """The vertices of each oblique or curved roller part and its normals there."""
+        out = {}
+        for name in self.rollers:  # a loop over parts
+            nodes, normals = roller_normals(self.mesh, name)
+            v, first = np.unique(nodes[:, :2].ravel(), return_index=True)
+            out[name] = (self.mesh.points[v], normals[:, :2].reshape(-1, 2)[first])
+        return out
 
     def free_ndof(self, mesh: Mesh | P2Space) -> int:
         """Free scalar unknowns on ``mesh`` (or its space), the paper's Ndof: all DOFs minus
         the held ones (:func:`free_ndof` without rollers; a roller holds one DOF a node)."""
         space = mesh if isinstance(mesh, P2Space) else P2Space(mesh)
-        return space.n_dofs - int(self.held_components(space).sum())
+        return space.n_dofs - held_nodes(self, space, values=False).n_held
 
     def _segment_normal(self, name: str) -> np.ndarray | None:
         """Outward unit normal of a straight contact part with a gap function, checked against

@@ -62,10 +62,17 @@ def _null_space(rows: np.ndarray, k: int) -> np.ndarray:
 
 
 def free_rigid_motions(
-    mesh: Mesh, held: Mapping[str, object], contact_parts: list[str]
+    mesh: Mesh,
+    held: Mapping[str, object],
+    contact_parts: list[str],
+    rollers: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
 ) -> np.ndarray:
     """The rigid motions ``(k, 3)`` (orthonormal coefficients, ``k ≤ 3``) that the held
-    components of ``held`` (part name → :class:`~.conditions.Dirichlet`) leave free.
+    components of ``held`` (part name → :class:`~.conditions.Dirichlet`) and the normal
+    components held by ``rollers`` (part name → its vertices ``(m, 2)`` and the normals
+    ``n (m, 2)`` there: ``r·n = 0``) leave free. A roller on an oblique straight part holds
+    the translation along its normal; on a circular arc it leaves the rotation about the
+    centre free.
 
     Raises
     ------
@@ -84,6 +91,9 @@ def free_rigid_motions(
             np.column_stack([zero, one, d[:, 0]]),
         )
         rows += [by_component[c] for c in range(2) if cond.components[c]]
+    for x, n in (rollers or {}).values():  # a loop over parts
+        d = (x - centre) / size
+        rows.append(np.column_stack([n[:, 0], n[:, 1], d[:, 0] * n[:, 1] - d[:, 1] * n[:, 0]]))
     free = _null_space(np.concatenate(rows) if rows else np.zeros((0, 3)), 3)
     if free.shape[0] == 0:
         return free
@@ -110,6 +120,7 @@ def free_rigid_motions(
         raise ProblemError(
             f"the problem needs a Dirichlet part (meas Γ_D > 0), a Roller or a contact part "
             f"to hold the rigid motion {motions}: the Dirichlet and Roller parts "
-            f"{list(held)} leave it free and {held_by} (docs/method.md, *Force control*)"
+            f"{list(held) + list(rollers or {})} leave it free and {held_by} (docs/method.md, "
+            "*Force control*)"
         )
     return free
