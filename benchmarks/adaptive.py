@@ -25,6 +25,13 @@ same: one complete direct (Cholesky) solve of the level's stiffness matrix.
     python benchmarks/adaptive.py --max-ndof 200000
     python benchmarks/adaptive.py --friction coulomb
     python benchmarks/adaptive.py --max-ndof 6000000   # to 5.4 million unknowns, 14 GiB
+
+With ``--problem two-cylinders`` the run is the two-body Hertz problem
+(:func:`signorini.examples.two_bodies.two_cylinders`, mortar contact between two elastic
+bodies); its floor factorizes the two-body matrix (the relative displacement's basis,
+docs/method.md, *Two bodies*).
+
+    python benchmarks/adaptive.py --problem two-cylinders
 """
 
 from __future__ import annotations
@@ -40,7 +47,7 @@ import numpy as np
 from signorini import adaptive, example_6_2
 from signorini.algebra import SOLVERS, eliminate_symmetric, make_solver, solver_factory
 from signorini.contact import assemble
-from signorini.examples import example_6_2_coulomb, example_6_2_tresca
+from signorini.examples import example_6_2_coulomb, example_6_2_tresca, two_cylinders
 from signorini.output import HistoryWriter, write_vtu
 from signorini.runtime import retain_freed_memory
 
@@ -114,6 +121,12 @@ def main() -> None:
         default="none",
         help="Example 6.2 with Coulomb (F = 0.3) or Tresca (s = 30) friction on Γ_C",
     )
+    parser.add_argument(
+        "--problem",
+        choices=("example-6.2", "two-cylinders"),
+        default="example-6.2",
+        help="Example 6.2 (with --friction) or the two-cylinder problem of two elastic bodies",
+    )
     args = parser.parse_args()
     retain_freed_memory()
     out = args.out or Path(tempfile.mkdtemp(prefix="signorini-bench-"))
@@ -123,6 +136,10 @@ def main() -> None:
         "coulomb": example_6_2_coulomb,
         "tresca": example_6_2_tresca,
     }[args.friction]()
+    if args.problem == "two-cylinders":
+        if args.friction != "none":
+            parser.error("--friction applies to example-6.2 only")
+        problem = two_cylinders()
     friction = args.friction != "none"
 
     cols = (

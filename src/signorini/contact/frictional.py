@@ -251,7 +251,10 @@ def solve_frictional(
     )  # fmt: skip
     options = FrictionOptions(max_iter=max_iter)
     # symmetric laws only (Tresca): symmetric systems (Cholesky); else non-symmetric ones (LU)
-    with ordered_solver(assembled.space, solver, symmetric=problem.symmetric) as linear:
+    coupling = None if cs.transfer is None else cs.transfer.nodes
+    with ordered_solver(
+        assembled.space, solver, symmetric=problem.symmetric, coupling=coupling
+    ) as linear:
         res = solve_friction(problem, options=options, solver=linear, **warm)
     state = res.state.astype(np.int64)
     # a frictionless node in contact slides freely: its friction force (0) is at its bound

@@ -41,17 +41,35 @@ def vertex_graph(mesh: Mesh) -> sp.csr_matrix:
     return sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
 
 
-def dof_ordering(space: P2Space) -> np.ndarray:
+def _with_coupling(graph: sp.csr_matrix, mesh: Mesh, coupling: sp.spmatrix) -> sp.csr_matrix:
+    """``graph`` with an edge between the vertices of every pair of P2 nodes that
+    ``coupling`` (``n_nodes × n_nodes``, e.g. a mortar transfer) joins; an edge midpoint
+    node stands for its edge's first vertex."""
+    c = sp.coo_matrix(coupling)
+    vertex = np.concatenate([np.arange(mesh.n_points), mesh.edges[:, 0]])
+    rows, cols = vertex[c.row], vertex[c.col]
+    extra = sp.csr_matrix(
+        (np.ones(2 * rows.size), (np.concatenate([rows, cols]), np.concatenate([cols, rows]))),
+        shape=graph.shape,
+    )
+    return (graph + extra).tocsr()
+
+
+def dof_ordering(space: P2Space, coupling: sp.spmatrix | None = None) -> np.ndarray:
     """A nested dissection ordering of the space's DOFs: METIS on the vertex graph
-    (:func:`~signorini.algebra.pardiso.metis_ordering`), extended to the edge nodes by
-    :meth:`~signorini.fem.space.P2Space.dof_order`.
+    (:func:`~signorini.algebra.pardiso.metis_ordering`), with the node pairs ``coupling``
+    joins (a contact pair's mortar transfer, docs/method.md, *Two bodies*), extended to the
+    edge nodes by :meth:`~signorini.fem.space.P2Space.dof_order`.
 
     Raises
     ------
     signorini.algebra.BackendUnavailableError
         If MKL (which provides METIS here) cannot be loaded.
     """
-    return space.dof_order(metis_ordering(vertex_graph(space.mesh)))
+    graph = vertex_graph(space.mesh)
+    if coupling is not None:
+        graph = _with_coupling(graph, space.mesh, coupling)
+    return space.dof_order(metis_ordering(graph))
 
 
 def ordered_solver(
@@ -60,6 +78,7 @@ def ordered_solver(
     *,
     symmetric: bool = True,
     check_symmetry: bool = True,
+    coupling: sp.spmatrix | None = None,
 ) -> AbstractContextManager[SPDSolver]:
     """The solver of ``space``'s systems, as a context manager.
 
@@ -73,6 +92,9 @@ def ordered_solver(
         as it is and not closed: its owner closes it.
     symmetric, check_symmetry : bool
         What the factory is asked for (:class:`~signorini.algebra.SolverRequest`).
+    coupling : (n_nodes, n_nodes) sparse matrix, optional
+        Node pairs the system joins beyond the mesh's edges (a contact pair's mortar
+        transfer), for the ordering.
     """
     if isinstance(solver, SPDSolver):
         return nullcontext(solver)
@@ -80,5 +102,5 @@ def ordered_solver(
         solver,
         symmetric=symmetric,
         check_symmetry=check_symmetry,
-        ordering=lambda: dof_ordering(space),
+        ordering=lambda: dof_ordering(space, coupling),
     )

@@ -404,7 +404,8 @@ def _solve_system(
             previous=previous, active0=active0, warm_rtol=WARM_START_RTOL,
         )  # fmt: skip
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
-    with ordered_solver(assembled.space, solver, check_symmetry=False) as linear:
+    coupling = None if cs.transfer is None else cs.transfer.nodes
+    with ordered_solver(assembled.space, solver, check_symmetry=False, coupling=coupling) as linear:
         res = solve_pdas(
             K,
             F,

@@ -66,7 +66,40 @@ def two_body_system(
     """``K̃ = (I + T_d)ᵀ K (I + T_d)`` and ``F̃ = (I + T_d)ᵀ F`` (Cartesian DOFs), with sorted
     indices and full 2 × 2 node blocks, as :func:`~.node_frames.rotate_frames` needs."""
     KT = K @ Td
-    return _full_blocks((K + KT + KT.T + Td.T @ KT).tocoo()), F + Td.T @ F
+    correction = _full_blocks((KT + KT.T + Td.T @ KT).tocoo())  # rows near the interface
+    return _add_rows(K.tocsr(), correction), F + Td.T @ F
+
+
+def _add_rows(K: sp.csr_matrix, C: sp.csr_matrix) -> sp.csr_matrix:
+    """``K + C`` for a ``C`` with few non-empty rows, keeping every entry either stores
+    (explicit zeros too), indices sorted: only the rows ``C`` touches are merged, the others
+    copied as they are (one pass over ``K``)."""
+    K.sort_indices()
+    n = K.shape[0]
+    touched = np.unique(np.repeat(np.arange(n), np.diff(C.indptr)))
+    Ks, Cs = K[touched].tocoo(), C[touched].tocoo()
+    M = sp.coo_matrix(
+        (np.concatenate([Ks.data, Cs.data]),
+         (np.concatenate([Ks.row, Cs.row]), np.concatenate([Ks.col, Cs.col]))),
+        shape=(touched.size, K.shape[1]),
+    ).tocsr()  # fmt: skip  # duplicates summed, explicit zeros kept, sorted
+    lengths = np.diff(K.indptr)
+    lengths[touched] = np.diff(M.indptr)
+    indptr = np.concatenate([[0], np.cumsum(lengths)])
+    data = np.empty(indptr[-1])
+    indices = np.empty(indptr[-1], dtype=K.indices.dtype)
+    row = np.repeat(np.arange(n), np.diff(K.indptr))
+    keep = np.ones(n, dtype=bool)
+    keep[touched] = False
+    kept = keep[row]
+    pos = indptr[row[kept]] + (np.arange(K.nnz) - K.indptr[row])[kept]
+    data[pos], indices[pos] = K.data[kept], K.indices[kept]
+    mrow = np.repeat(np.arange(touched.size), np.diff(M.indptr))
+    pos = indptr[touched[mrow]] + np.arange(M.nnz) - M.indptr[mrow]
+    data[pos], indices[pos] = M.data, M.indices
+    out = sp.csr_matrix((data, indices, indptr), shape=K.shape)
+    out.has_sorted_indices = True
+    return out
 
 
 def _full_blocks(A: sp.coo_matrix) -> sp.csr_matrix:
