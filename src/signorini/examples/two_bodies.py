@@ -31,6 +31,7 @@ __all__ = [
     "cylinders_metrics",
     "hertz_pair",
     "mirrored",
+    "split_arc",
     "stacked_blocks",
     "two_cylinders",
 ]
@@ -71,9 +72,10 @@ def _rotated(mesh: Mesh, rotation: np.ndarray) -> Mesh:
     )
 
 
-def _split_arc(mesh: Mesh, center: tuple, radius: float, width: float) -> Mesh:
+def split_arc(mesh: Mesh, center: tuple, radius: float, width: float) -> Mesh:
     """The half-disc ``mesh`` (parts top, arc) with its arc split into ``"contact"``
-    (``|x| < width``) and ``"arc"`` (the rest), both on their circle."""
+    (``|x| < width``) and ``"arc"`` (the rest), both on the circle of ``center`` and
+    ``radius``."""
     on_arc = mesh.boundary_part == mesh.part_index("arc")
     mid = mesh.points[mesh.boundary].mean(axis=1)
     part = np.where(on_arc & (np.abs(mid[:, 0]) < width), len(mesh.part_names), mesh.boundary_part)
@@ -111,8 +113,8 @@ def hertz_pair(
     upper body's solution is that of ``hertz(depth=δ/2)`` on the same mesh (docs/method.md,
     *Two bodies*)."""
     body = half_disc(radius, rings, h_bottom=h_bottom)
-    upper = _split_arc(body, (0.0, radius), radius, radius / 2)
-    lower = _split_arc(mirrored(body), (0.0, -radius), radius, radius / 2)
+    upper = split_arc(body, (0.0, radius), radius, radius / 2)
+    lower = split_arc(mirrored(body), (0.0, -radius), radius, radius / 2)
     return ContactProblem(
         mesh=union({"upper": upper, "lower": lower}),
         material=Material.from_young(young, poisson),
@@ -152,9 +154,9 @@ def two_cylinders(
     counter-clockwise).
     """
     r1, r2 = radii
-    upper = _split_arc(half_disc(r1, rings, h_bottom=h_bottom), (0.0, r1), r1, r1 / 2)
+    upper = split_arc(half_disc(r1, rings, h_bottom=h_bottom), (0.0, r1), r1, r1 / 2)
     lower = half_disc(r2, rings, h_bottom=None if h_bottom is None else h_bottom * r2 / r1)
-    lower = _split_arc(mirrored(lower), (0.0, -r2), r2, min(r1, 0.9 * r2))
+    lower = split_arc(mirrored(lower), (0.0, -r2), r2, min(r1, 0.9 * r2))
     c, s = np.cos(angle), np.sin(angle)
     rotation = np.array([[c, -s], [s, c]])
     return ContactProblem(
