@@ -962,3 +962,25 @@ def test_the_deformed_figure_of_a_frictional_result_marks_stick_and_slip(tmp_pat
     assert np.abs(with_friction.tangential_pressure).max() > 0
     assert without.state is None and without.contact_displacement is None
     assert without.tangential_pressure is None
+
+
+def test_resume_of_two_touching_bodies_gives_the_uninterrupted_run(tmp_path, capsys, monkeypatch):
+    """The two-cylinder run (two bodies whose points coincide where they touch) resumes
+    from its state file: the union's bodies are checked one by one, and the history and the
+    VTU files (with the body field) equal the uninterrupted run's."""
+    full, part = tmp_path / "full", tmp_path / "part"
+    args = ["run", "two-cylinders", "--max-ndof", "2000", "--no-figures"]
+    assert main([*args, "--out", str(full), "--quiet"]) == 0
+    interrupt_after_level(monkeypatch, 4)
+    assert main([*args, "--out", str(part)]) == 130
+    monkeypatch.undo()
+    capsys.readouterr()
+    assert main(["run", "two-cylinders", "--resume", str(part), "--quiet", "--no-figures"]) == 0
+    a, b = (history_without_timings(f / "history.csv") for f in (full, part))
+    assert len(a) > 6
+    assert_same_history(a, b)
+    last = sorted(p.name for p in full.glob("level_*.vtu"))[-1]
+    assert_same_vtu(full / last, part / last)
+    import meshio
+
+    assert set(np.unique(meshio.read(part / last).cell_data["body"][0])) == {0, 1}

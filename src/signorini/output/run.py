@@ -53,6 +53,7 @@ except ImportError:  # pragma: no cover - Windows
 
 import numpy as np
 
+from ..mesh.bodies import body_of_cells, validated_bodies
 from ..mesh.mesh import Mesh
 from .files import atomic_write, describe_names, folder_listing, remove_temporaries, replacing
 
@@ -357,6 +358,7 @@ class RunFolder:
                 part_names=np.array(mesh.part_names, dtype=str),
                 cell_region=mesh.cell_region,
                 region_names=np.array(mesh.region_names, dtype=str),
+                bodies=np.array(int(body_of_cells(mesh).max(initial=0)) + 1),
             )
             if u0 is not None:
                 arrays["u0"] = np.asarray(u0, dtype=np.float64)
@@ -414,14 +416,10 @@ class RunFolder:
         try:
             with np.load(file) as data:
                 level, final = int(data["level"]), bool(data["final"])
-                mesh = Mesh(
-                    data["points"],
-                    data["cells"],
-                    data["boundary"],
-                    data["boundary_part"],
-                    [str(n) for n in data["part_names"]],
-                    **_regions(data),
-                )
+                options = _mesh_options(data)
+                arrays = (data[k] for k in ("points", "cells", "boundary", "boundary_part"))
+                mesh = Mesh(*arrays, [str(n) for n in data["part_names"]], **options)
+                mesh = mesh if options["validate"] else validated_bodies(mesh)
                 u0 = np.array(data["u0"]) if "u0" in data else None
         except (OSError, ValueError, KeyError) as exc:
             raise RunFolderError(
@@ -437,11 +435,12 @@ class RunFolder:
         return list(csv.DictReader(io.StringIO(text)))
 
 
-def _regions(data) -> dict:
-    """The saved mesh's cell regions (none in a state saved before regions existed)."""
-    if "cell_region" not in data:
-        return {}
-    return {
-        "cell_region": data["cell_region"],
-        "region_names": [str(n) for n in data["region_names"]],
-    }
+def _mesh_options(data) -> dict:
+    """The saved mesh's cell regions (none in a state saved before regions existed), and
+    whether it is checked as one mesh (not as the union of several bodies, whose points may
+    coincide where they touch: :func:`~signorini.mesh.bodies.validated_bodies`)."""
+    options = {"validate": "bodies" not in data or int(data["bodies"]) == 1}
+    if "cell_region" in data:
+        options["cell_region"] = data["cell_region"]
+        options["region_names"] = [str(n) for n in data["region_names"]]
+    return options
