@@ -212,6 +212,55 @@ def test_mirrored_arcs_give_the_symmetry_plane():
     assert c.D.sum() == pytest.approx(np.pi / 3, rel=1e-5)
 
 
+def test_one_sided_directions_on_mirrored_arcs():
+    """On mirrored unit circles the slave's normal n_s(x_j) is tilted from the symmetry
+    plane's normal by the polar angle of x_j, the master's −n_m(π_j) by the polar angle of π_j
+    the other way (π_j on the line x_j + t n_j), the averaged one not at all."""
+    space = mirrored_arcs()
+    out = {}
+    for direction in ("averaged", "slave", "master"):
+        # one-sided: the lines from the ends leave the master (left unconstrained here)
+        free = [] if direction != "averaged" else None
+        c = mortar_coupling(
+            space, "up.contact", "low.contact", constrained=free, direction=direction
+        )
+        out[direction] = c, np.arctan2(c.normal[:, 0], -c.normal[:, 1])
+    c, tilt = out["averaged"]
+    xs = space.node_points[c.slave_nodes]
+    assert np.abs(tilt).max() < 2e-16
+    np.testing.assert_allclose(out["slave"][1], np.arcsin(xs[:, 0]), atol=1e-15)
+    c, tilt = out["master"]
+    hit = np.isfinite(c.master_point[:, 0])
+    assert hit.all()
+    np.testing.assert_allclose(tilt[hit], -np.arcsin(c.master_point[hit, 0]), atol=1e-14)
+    along = _cross(c.master_point[hit] - xs[hit], c.normal[hit])
+    assert np.abs(along).max() < 1e-15
+    assert np.abs(out["slave"][1]).max() == pytest.approx(np.pi / 6)
+    with pytest.raises(ProblemError, match=r"direction must be one of"):
+        mortar_coupling(space, "up.contact", "low.contact", direction="normal")
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def test_translation_far_from_the_origin():
+    """Blocks moved by (1000, −2000): D, M and the coverage keep their digits (the edge maps
+    are written relative to the edge's start)."""
+    c0 = mortar_coupling(blocks(50, 70, gap=0.01), "up.bottom", "low.top")
+    space = P2Space(
+        union(
+            up=moved(rectangle(0.0, 1.0, 0.01, 0.51, 50, 2), np.eye(2), (1e3, -2e3)),
+            low=moved(rectangle(0.0, 1.0, -0.5, 0.0, 70, 2), np.eye(2), (1e3, -2e3)),
+        )
+    )
+    c1 = mortar_coupling(space, "up.bottom", "low.top")
+    np.testing.assert_allclose(c1.coverage, 1.0, atol=1e-13)
+    np.testing.assert_allclose(c1.D, c0.D, rtol=1e-10)
+    assert abs(c1.M - c0.M).max() < 1e-10 * c0.D.max()
+    np.testing.assert_allclose(c1.weighted_gap / c1.D, 0.01, rtol=1e-8)
+
+
 def shape(t: float) -> np.ndarray:
     """The P2 edge basis ``[start, end, midpoint]`` at ``t``."""
     return np.array([(1 - t) * (1 - 2 * t), t * (2 * t - 1), 4 * t * (1 - t)])

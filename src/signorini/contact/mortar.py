@@ -36,7 +36,7 @@ from ..problem.fields import ProblemError
 from .constraint_data import part_normals
 from .mortar_checks import check_coupling, check_pair, pair_size
 
-__all__ = ["MortarCoupling", "mortar_coupling"]
+__all__ = ["DIRECTIONS", "MortarCoupling", "mortar_coupling"]
 
 #: Gauss points per segment (slave edge ∩ projected master edge) when both edges are
 #: straight: on a flat interface the integrand ψ_j (φ_k ∘ π) is a polynomial of degree 4 in
@@ -234,7 +234,7 @@ def _angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.arctan2(_cross(a, b), np.einsum("si,si->s", a, b))
 
 
-def _averaged_normals(slave: _Side, master: _Side, pairs: tuple, x: np.ndarray, ns: np.ndarray):
+def _averaged_normals(master: _Side, pairs: tuple, x: np.ndarray, ns: np.ndarray, mix: tuple):
     """The fixed point ``n_j = normalize(n_s(x_j) − n_m(π_j))`` at the slave nodes ``x (s,
     2)`` with outward normals ``ns (s, 2)``, the node's index ``pairs[2] (e, 3)``; π_j the
     nearest point where ``x_j + t n_j`` meets a candidate master edge.
@@ -243,12 +243,15 @@ def _averaged_normals(slave: _Side, master: _Side, pairs: tuple, x: np.ndarray, 
     the angle of ``n_s − n_m(π(θ))`` (the plain iteration contracts only by about gap ×
     curvature per step), from the master's normal at its nearest node; the last step is a
     plain one, so the result is ``normalize(n_s − n_m(π_j))`` itself. Returns ``n (s, 2)``,
-    ``π (s, 2)`` (NaN where the line misses the master) and ``n_s · n_m (s,)``."""
+    ``π (s, 2)`` (NaN where the line misses the master) and ``n_s · n_m (s,)``.
+    ``mix = (a, b)`` weighs the two normals, ``normalize(a n_s − b n_m)``: ``(1, 1)`` the
+    averaged normal, ``(1, 0)`` the slave's, ``(0, 1)`` the master's (for comparisons)."""
     e, f, index = pairs
+    a, b = mix
     key = np.unique(np.column_stack([index[e].ravel(), np.repeat(f, 3)]), axis=0)
     j, f = key[:, 0], key[:, 1]
     _, k = cKDTree(master.points.reshape(-1, 2)).query(x)
-    theta = _angle(ns, _unit(ns - master.normals.reshape(-1, 2)[k]))
+    theta = _angle(ns, _unit(a * ns - b * master.normals.reshape(-1, 2)[k]))
     previous = None
     for _ in range(NORMAL_STEPS):
         c, s = np.cos(theta), np.sin(theta)
@@ -256,7 +259,7 @@ def _averaged_normals(slave: _Side, master: _Side, pairs: tuple, x: np.ndarray, 
         hit, best, eta, xm, off = _nearest_hits(master, j, f, x, n)
         nm = _unit(_on_edge(master.normals[f[best]], eta)[0])
         new = n.copy()
-        new[hit] = _unit(ns[hit] - nm)
+        new[hit] = _unit(a * ns[hit] - b * nm)
         residual = _angle(ns, new) - theta
         if np.abs(residual).max(initial=0.0) <= 1e-15:
             break
@@ -349,8 +352,18 @@ def _mortar_entries(slave: _Side, master: _Side, seg: tuple, N: np.ndarray, coef
     return out, faces
 
 
+#: the constraint directions :func:`mortar_coupling` offers, as weights ``(a, b)`` of
+#: ``normalize(a n_s − b n_m)``
+DIRECTIONS = {"averaged": (1.0, 1.0), "slave": (1.0, 0.0), "master": (0.0, 1.0)}
+
+
 def mortar_coupling(
-    space: P2Space, slave: str, master: str, *, constrained: np.ndarray | None = None
+    space: P2Space,
+    slave: str,
+    master: str,
+    *,
+    constrained: np.ndarray | None = None,
+    direction: str = "averaged",
 ) -> MortarCoupling:
     """The dual mortar coupling of the contact pair ``slave`` → ``master``.
 
@@ -364,6 +377,11 @@ def mortar_coupling(
         The slave nodes that carry a constraint (e.g. all but the Dirichlet nodes); each must
         lie wholly over the master (coverage 1) and not start deeper inside it than the
         small-deformation model covers. Default: every slave node.
+    direction : {"averaged", "slave", "master"}
+        The constraint direction n_j: ``normalize(n_s − n_m(π_j))`` (the default; the
+        symmetry plane's normal on a mirror-symmetric pair), the slave's outward normal
+        ``n_s(x_j)``, or the reverse of the master's ``−n_m(π_j)`` (one-sided normals, for
+        comparison: they put a spurious shear on a symmetric pair, docs/method.md).
 
     Returns
     -------
@@ -379,6 +397,10 @@ def mortar_coupling(
         deeper than ``DEEP_OVERLAP`` times the bodies' size.
     """
     pair = f"contact pair (slave {slave!r}, master {master!r})"
+    if direction not in DIRECTIONS:
+        raise ProblemError(
+            f"{pair}: direction must be one of {list(DIRECTIONS)}, got {direction!r}"
+        )
     bodies = check_pair(space, slave, master, pair)
     s_side, m_side = _side(space, slave), _side(space, master)
     slave_nodes, index = np.unique(s_side.nodes, return_inverse=True)
@@ -387,7 +409,7 @@ def mortar_coupling(
     ns = np.zeros_like(x)
     ns[index.ravel()] = s_side.normals.reshape(-1, 2)
     e, f = _candidate_pairs(s_side, m_side)
-    normal, point, facing = _averaged_normals(s_side, m_side, (e, f, index), x, ns)
+    normal, point, facing = _averaged_normals(m_side, (e, f, index), x, ns, DIRECTIONS[direction])
     weight, coef = _dual_basis(s_side)
     D = np.bincount(index.ravel(), weights=weight.ravel(), minlength=slave_nodes.size)
     N = normal[index]
