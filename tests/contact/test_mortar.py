@@ -232,7 +232,9 @@ def test_one_sided_directions_on_mirrored_arcs():
     c, tilt = out["master"]
     hit = np.isfinite(c.master_point[:, 0])
     assert hit.all()
-    np.testing.assert_allclose(tilt[hit], -np.arcsin(c.master_point[hit, 0]), atol=1e-14)
+    # n_m between nodes is the P2 interpolant of the nodal (circle) normals: O(h³) off
+    error = np.abs(tilt[hit] + np.arcsin(c.master_point[hit, 0]))
+    assert 1e-7 < error.max() < 5e-6
     along = _cross(c.master_point[hit] - xs[hit], c.normal[hit])
     assert np.abs(along).max() < 1e-15
     assert np.abs(out["slave"][1]).max() == pytest.approx(np.pi / 6)
