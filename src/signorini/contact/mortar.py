@@ -51,8 +51,11 @@ CURVED_POINTS = 10
 SNAP = 64
 #: Gauss points of the slave edges' local mass matrices (exact on straight edges)
 MASS_POINTS = 10
-#: Newton steps of the projections (quadratic convergence; a straight master needs one)
+#: Newton steps of the projections (quadratic convergence; a straight master needs one),
+#: stopped once every step in the edge parameter is at most ``NEWTON_TOL``: the error after
+#: it is of its square, below round-off
 NEWTON_STEPS = 30
+NEWTON_TOL = 1e-10
 #: fixed-point steps of the averaged normal (it contracts by about gap × curvature per step)
 NORMAL_STEPS = 200
 
@@ -165,7 +168,7 @@ def _master_parameter(X: np.ndarray, x: np.ndarray, n: np.ndarray) -> tuple[np.n
         dg = _cross(dxm, n)
         step = np.divide(g, dg, out=np.zeros_like(g), where=dg != 0)
         eta = np.clip(eta - step, -1.0, 2.0)
-        if np.all(np.abs(step) <= 1e-15):
+        if np.all(np.abs(step) <= NEWTON_TOL):
             break
     xm, _ = _on_edge(X, eta)
     return eta, np.abs(_cross(xm - x, n)) <= 1e-12 * scale
@@ -185,7 +188,7 @@ def _slave_parameter(X: np.ndarray, N: np.ndarray, y: np.ndarray) -> np.ndarray:
         df = _cross(dxs, n) + _cross(xs - y, dn)
         step = np.divide(f, df, out=np.zeros_like(f), where=df != 0)
         xi = np.clip(xi - step, -1.0, 2.0)
-        if np.all(np.abs(step) <= 1e-15):
+        if np.all(np.abs(step) <= NEWTON_TOL):
             break
     return xi
 
@@ -195,20 +198,23 @@ def _slave_parameter(X: np.ndarray, N: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 def _candidate_pairs(slave: _Side, master: _Side) -> tuple[np.ndarray, np.ndarray]:
     """Slave and master edges ``(e, f)`` that may face each other: the master edge's centre
-    within ``r_e + R_f + 2 d_e`` of the slave edge's, ``r`` the edges' radii about their
+    within ``3 r_e + r_f + 2 d_e`` of the slave edge's, ``r`` the edges' radii about their
     centres and ``d_e`` the largest distance from a node of e to the nearest master node. A
-    master point reached along a direction within 60° of the master's normal
-    (:data:`FACING`) lies within ``2 d`` of the node."""
+    master point reached from a point of e (within ``d_e + r_e`` of the master) along a
+    direction within 60° of the master's normal (:data:`FACING`) lies within twice that."""
     cs, cm = slave.points.mean(axis=1), master.points.mean(axis=1)
     rs = np.hypot(*(slave.points - cs[:, None]).transpose(2, 0, 1)).max(axis=1)
     rm = np.hypot(*(master.points - cm[:, None]).transpose(2, 0, 1)).max(axis=1)
     d, _ = cKDTree(master.points.reshape(-1, 2)).query(slave.points.reshape(-1, 2))
-    radius = rs + rm.max() + 2 * d.reshape(-1, 3).max(axis=1)
+    radius = 3 * rs + 2 * d.reshape(-1, 3).max(axis=1)  # a point of e: within d + rs
     radius = radius * (1 + 1e-9) + 1e-12 * float(np.abs(cs).max())
     tree = cKDTree(cm)
-    counts = tree.query_ball_point(cs, radius, return_length=True)
-    f = np.fromiter(chain.from_iterable(tree.query_ball_point(cs, radius)), np.int64, counts.sum())
-    return np.repeat(np.arange(len(cs)), counts), f
+    reach = radius + rm.max()
+    counts = tree.query_ball_point(cs, reach, return_length=True)
+    f = np.fromiter(chain.from_iterable(tree.query_ball_point(cs, reach)), np.int64, counts.sum())
+    e = np.repeat(np.arange(len(cs)), counts)
+    near = np.hypot(*(cm[f] - cs[e]).T) <= radius[e] + rm[f] * (1 + 1e-9)
+    return e[near], f[near]
 
 
 def _nearest_hits(master: _Side, j: np.ndarray, f: np.ndarray, x: np.ndarray, n: np.ndarray):
