@@ -109,7 +109,16 @@ def cap(radius: float, rings: int, half_width: float) -> Mesh:
 
 
 def mirrored_arcs(rings: int = 4) -> P2Space:
+    """The half-disc of radius 1 and its mirror image in y = 0, touching at the origin:
+    parts ``contact`` (|x| < 1/2) and ``arc`` (the rest of the arc)."""
     top = cap(1.0, rings, 0.5)
+    return P2Space(union(up=top, low=moved(top, MIRROR)))
+
+
+def mirrored_half_discs(rings: int) -> P2Space:
+    """The same with the whole arc as one part ``arc`` (its ends meet their mirror images'
+    ends, where the two normals coincide)."""
+    top = half_disc(1.0, rings)
     return P2Space(union(up=top, low=moved(top, MIRROR)))
 
 
@@ -197,22 +206,31 @@ def test_partly_covered_nodes_and_the_constrained_ones():
 # --------------------------------------------------------------------------- curved
 
 
-def test_mirrored_arcs_give_the_symmetry_plane():
+@pytest.mark.parametrize(
+    "space, part, length",
+    [(mirrored_arcs(), "contact", np.pi / 3), (mirrored_half_discs(4), "arc", np.pi)]
+    + [(mirrored_half_discs(8), "arc", np.pi)],
+    ids=["cap", "half-disc", "half-disc-fine"],
+)
+def test_mirrored_arcs_give_the_symmetry_plane(space, part, length):
     """Matching mirrored half-discs: n_j = (0, −1) to round-off, M = D on the mirror nodes,
-    g̃_j = D_jj · 2 y_j (twice the one-body gap to the plane y = 0)."""
-    space = mirrored_arcs()
-    c = mortar_coupling(space, "up.contact", "low.contact")
+    g̃_j = D_jj · 2 y_j (twice the one-body gap to the plane y = 0); on the whole arc too,
+    up to its ends (where n_s − n_m vanishes and the direction is the bisector's limit)."""
+    c = mortar_coupling(space, f"up.{part}", f"low.{part}")
     xs = space.node_points[c.slave_nodes]
     assert np.abs(c.normal - [0.0, -1.0]).max() < 2e-16
     k = partner(space, c, xs * [1.0, -1.0])
     M = c.M.toarray()
-    np.testing.assert_allclose(M[np.arange(len(k)), k], c.D, rtol=1e-14)
+    error = np.abs(M[np.arange(len(k)), k] / c.D - 1)
+    # on the last edges of a half-disc the direction grazes both arcs: π loses digits there
+    grazing = np.abs(xs[:, 0]) > np.sin(np.radians(80))
+    assert error[~grazing].max() < 1e-13 and error.max() < 1e-11
     M[np.arange(len(k)), k] = 0.0
-    assert np.abs(M).max() < 1e-15
-    np.testing.assert_allclose(c.weighted_gap, 2 * xs[:, 1] * c.D, rtol=1e-13, atol=1e-17)
+    assert np.abs(M).max() < 1e-12 * c.D.max()
+    np.testing.assert_allclose(c.weighted_gap, 2 * xs[:, 1] * c.D, rtol=1e-13, atol=1e-14)
     np.testing.assert_allclose(c.coverage, 1.0, atol=1e-14)
     # the curved D: ∫ φ_j along the quadratic edges sums to the arc's (quadratic) length
-    assert c.D.sum() == pytest.approx(np.pi / 3, rel=1e-5)
+    assert c.D.sum() == pytest.approx(length, rel=1e-4)
 
 
 def test_one_sided_directions_on_mirrored_arcs():
