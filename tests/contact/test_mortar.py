@@ -177,6 +177,34 @@ def test_non_matching_flat_interface_reproduces_affine_fields(n_upper, n_lower):
     assert np.abs(c.weighted_gap).max() < 1e-16
 
 
+def jiggled(mesh: Mesh, rng: np.random.Generator, y: float) -> Mesh:
+    """``mesh`` with the inner vertices on the line ``y`` moved along it by up to 0.3 of the
+    spacing (so the interface's edges have random lengths)."""
+    points = mesh.points.copy()
+    on = np.flatnonzero(np.isclose(points[:, 1], y) & (points[:, 0] > 1e-9))
+    on = on[points[on, 0] < 1 - 1e-9]
+    h = 1.0 / (on.size + 1)
+    points[on, 0] += rng.uniform(-0.3, 0.3, on.size) * h
+    return Mesh(points, mesh.cells, mesh.boundary, mesh.boundary_part, mesh.part_names)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_random_non_matching_flat_interfaces(seed):
+    """Interfaces with random edge lengths (6 and 9 edges): M·1 = D and M reproduces affine
+    and quadratic fields along the interface, to round-off."""
+    rng = np.random.default_rng(seed)
+    upper = jiggled(rectangle(0.0, 1.0, 0.0, 0.5, 6, 2), rng, 0.0)
+    lower = jiggled(rectangle(0.0, 1.0, -0.5, 0.0, 9, 2), rng, 0.0)
+    space = P2Space(union(up=upper, low=lower))
+    c = mortar_coupling(space, "up.bottom", "low.top")
+    x = space.node_points
+    xs = x[c.slave_nodes]
+    np.testing.assert_allclose(c.coverage, 1.0, atol=1e-14)
+    for f in (x[:, 0], x[:, 0] ** 2 - 0.3 * x[:, 0]):
+        np.testing.assert_allclose(c.M @ f, c.D * f[c.slave_nodes], rtol=0, atol=1e-15)
+    assert c.M.nnz > 3 * xs.shape[0]  # non-matching: rows couple several master nodes
+
+
 def test_partly_covered_nodes_and_the_constrained_ones():
     """A master [0.3, 1.5] under a slave [0, 1]: coverage 1 for the nodes whose ψ lies over
     it (x ≥ 0.5: ψ_j lives on the edges at x_j, and the edge [0.2, 0.4] is cut), not for the
