@@ -441,6 +441,17 @@ def test_parts_of_one_body_are_refused():
         mortar_coupling(space, "a.lid", "b.bottom")
 
 
+def test_a_part_over_two_bodies_is_refused():
+    mesh = union(a=rectangle(0, 1, 0, 1, 2, 2), b=rectangle(0, 1, 2, 3, 2, 2))
+    part = mesh.boundary_part.copy()
+    part[part == mesh.part_index("b.bottom")] = mesh.part_index("a.top")  # one part, 2 bodies
+    mesh = Mesh(mesh.points, mesh.cells, mesh.boundary, part, mesh.part_names, validate=False)
+    with pytest.raises(ProblemError, match=r"slave part 'a\.top' runs over 2 bodies"):
+        mortar_coupling(P2Space(mesh), "a.top", "b.top")
+    with pytest.raises(ProblemError, match=r"the master must be a boundary part's name"):
+        mortar_coupling(P2Space(mesh), "a.top", 3)
+
+
 def test_no_overlap_is_refused():
     lower = rectangle(0.0, 1.0, -0.5, 0.0, 3, 2)
     upper = rectangle(3.0, 4.0, 0.0, 0.5, 3, 2)
