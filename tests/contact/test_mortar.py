@@ -435,6 +435,10 @@ def test_parts_of_one_body_are_refused():
         mortar_coupling(space, "a.top", "a.bottom")
     with pytest.raises(ProblemError, match=r"'a\.bottom'.*'a\.left'.*lies on both parts"):
         mortar_coupling(space, "a.bottom", "a.left")
+    with pytest.raises(ProblemError, match=r"constrained must be a 1-D array of node indices"):
+        mortar_coupling(space, "a.top", "b.bottom", constrained=[0.5, 1.5])
+    with pytest.raises(ProblemError, match=r"constrained holds node indices outside \[0, "):
+        mortar_coupling(space, "a.top", "b.bottom", constrained=[-1, 3])
     with pytest.raises(ProblemError, match="two different parts"):
         mortar_coupling(space, "a.top", "a.top")
     with pytest.raises(ProblemError, match=r"no boundary part 'a\.lid'"):

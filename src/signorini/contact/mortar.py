@@ -140,6 +140,24 @@ def _mortar_entries(slave: Side, master: Side, seg: tuple, N: np.ndarray, coef: 
     return out, faces
 
 
+def _node_list(nodes: object, n_nodes: int, pair: str) -> np.ndarray:
+    """``nodes`` as a 1-D int64 array of node indices, or a ProblemError naming the fault."""
+    array = np.asarray(nodes)
+    if array.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    if array.ndim != 1 or not np.issubdtype(array.dtype, np.integer):
+        raise ProblemError(
+            f"{pair}: constrained must be a 1-D array of node indices (int), got an array of "
+            f"shape {array.shape} and dtype {array.dtype}"
+        )
+    if array.min() < 0 or array.max() >= n_nodes:
+        raise ProblemError(
+            f"{pair}: constrained holds node indices outside [0, {n_nodes}): "
+            f"{array.min()} ... {array.max()}"
+        )
+    return array.astype(np.int64)
+
+
 #: the constraint directions :func:`mortar_coupling` offers, as weights ``(a, b)`` of
 #: ``normalize(a n_s − b n_m)``
 DIRECTIONS = {"averaged": (1.0, 1.0), "slave": (1.0, 0.0), "master": (0.0, 1.0)}
@@ -162,9 +180,10 @@ def mortar_coupling(
     slave, master : str
         Boundary parts of two different bodies, sharing no node.
     constrained : (c,) int array, optional
-        The slave nodes that carry a constraint (e.g. all but the Dirichlet nodes); each must
-        lie wholly over the master (coverage 1) and not start deeper inside it than the
-        small-deformation model covers. Default: every slave node.
+        The nodes that carry a constraint (e.g. all but the Dirichlet nodes; nodes off the
+        slave part are ignored); each slave node among them must lie wholly over the master
+        (coverage 1) and not start deeper inside it than the small-deformation model covers.
+        Default: every slave node.
     direction : {"averaged", "slave", "master"}
         The constraint direction n_j: ``normalize(n_s − n_m(π_j))`` (the default; the
         symmetry plane's normal on a mirror-symmetric pair), the slave's outward normal
@@ -190,6 +209,8 @@ def mortar_coupling(
             f"{pair}: direction must be one of {list(DIRECTIONS)}, got {direction!r}"
         )
     bodies = check_pair(space, slave, master, pair)
+    if constrained is not None:
+        constrained = _node_list(constrained, space.n_nodes, pair)
     s_side, m_side = side(space, slave), side(space, master)
     slave_nodes, index = np.unique(s_side.nodes, return_inverse=True)
     index = index.reshape(-1, 3)
@@ -221,6 +242,6 @@ def mortar_coupling(
     coupling = MortarCoupling(slave, master, slave_nodes, normal, D, M, gap, coverage, point)
     mine = np.ones(slave_nodes.size, dtype=bool)
     if constrained is not None:
-        mine = np.isin(slave_nodes, np.asarray(constrained, dtype=np.int64))
+        mine = np.isin(slave_nodes, constrained)
     check_coupling(coupling, (mine, pair_size(space, bodies), x), pair)
     return coupling
