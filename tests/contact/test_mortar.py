@@ -246,12 +246,13 @@ def test_mirrored_arcs_give_the_symmetry_plane(space, part, length):
     up to its ends (where n_s − n_m vanishes and the direction is the bisector's limit)."""
     c = mortar_coupling(space, f"up.{part}", f"low.{part}")
     xs = space.node_points[c.slave_nodes]
-    assert np.abs(c.normal - [0.0, -1.0]).max() < 2e-16
+    # on the last edges of a half-disc the direction grazes both arcs: π loses digits there
+    grazing = np.abs(xs[:, 0]) > np.sin(np.radians(80))
+    tilt = np.abs(c.normal - [0.0, -1.0]).max(axis=1)
+    assert tilt[~grazing].max() < 2e-16 and tilt.max() < 1e-15
     k = partner(space, c, xs * [1.0, -1.0])
     M = c.M.toarray()
     error = np.abs(M[np.arange(len(k)), k] / c.D - 1)
-    # on the last edges of a half-disc the direction grazes both arcs: π loses digits there
-    grazing = np.abs(xs[:, 0]) > np.sin(np.radians(80))
     assert error[~grazing].max() < 1e-13 and error.max() < 1e-11
     M[np.arange(len(k)), k] = 0.0
     assert np.abs(M).max() < 1e-12 * c.D.max()

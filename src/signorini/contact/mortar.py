@@ -158,6 +158,18 @@ def _node_list(nodes: object, n_nodes: int, pair: str) -> np.ndarray:
     return array.astype(np.int64)
 
 
+def _couple(sides: tuple, pairs: tuple, nodes: tuple, mix: tuple, coef: np.ndarray):
+    """The directions, paired points, facing segments and their entries from the candidate
+    edge pairs: ``(normal, point, (e, f, lo, hi), entries)``."""
+    s_side, m_side = sides
+    index, x, ns = nodes
+    normal, point = directions(m_side, (*pairs, index), x, ns, mix)
+    N = normal[index]
+    seg = segments(s_side, m_side, pairs, N, point[index[:, :2]])
+    entries, faces = _mortar_entries(s_side, m_side, seg, N, coef)
+    return normal, point, tuple(a[faces] for a in seg), entries[faces]
+
+
 #: the constraint directions :func:`mortar_coupling` offers, as weights ``(a, b)`` of
 #: ``normalize(a n_s − b n_m)``
 DIRECTIONS = {"averaged": (1.0, 1.0), "slave": (1.0, 0.0), "master": (0.0, 1.0)}
@@ -217,14 +229,19 @@ def mortar_coupling(
     x = space.node_points[slave_nodes]
     ns = np.zeros_like(x)
     ns[index.ravel()] = s_side.normals.reshape(-1, 2)
-    e, f = candidate_pairs(s_side, m_side)
-    normal, point = directions(m_side, (e, f, index), x, ns, DIRECTIONS[direction])
     weight, coef = _dual_basis(s_side)
     D = np.bincount(index.ravel(), weights=weight.ravel(), minlength=slave_nodes.size)
-    N = normal[index]
-    seg = segments(s_side, m_side, (e, f), N, point[index[:, :2]])
-    entries, faces = _mortar_entries(s_side, m_side, seg, N, coef)
-    e, f = seg[0][faces], seg[1][faces]
+    mix = DIRECTIONS[direction]
+    pairs = candidate_pairs(s_side, m_side, mix)
+    normal, point, seg, entries = _couple((s_side, m_side), pairs, (index, x, ns), mix, coef)
+    covered = np.bincount(seg[0], weights=seg[3] - seg[2], minlength=len(index))
+    wide = np.flatnonzero((np.abs(covered - 1) > 1e-12) | np.isnan(point[index, 0]).any(axis=1))
+    if wide.size:  # search these slave edges' surroundings widely
+        more = candidate_pairs(s_side, m_side, mix, wide)
+        both = np.vstack([np.column_stack(pairs), np.column_stack(more)])
+        pairs = tuple(np.unique(both, axis=0).T)
+        normal, point, seg, entries = _couple((s_side, m_side), pairs, (index, x, ns), mix, coef)
+    e, f = seg[0], seg[1]
     if e.size == 0:
         raise ProblemError(
             f"{pair}: no part of the slave lies over the master along the normals (the parts "
@@ -233,7 +250,7 @@ def mortar_coupling(
     rows = np.broadcast_to(index[e][:, :, None], (e.size, 3, 3))
     cols = np.broadcast_to(m_side.nodes[f][:, None, :], (e.size, 3, 3))
     M = sp.coo_matrix(
-        (entries[faces].ravel(), (rows.ravel(), cols.ravel())),
+        (entries.ravel(), (rows.ravel(), cols.ravel())),
         shape=(slave_nodes.size, space.n_nodes),
     ).tocsr()
     mx = M @ space.node_points

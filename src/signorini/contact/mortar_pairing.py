@@ -39,7 +39,7 @@ SNAP = 64
 #: stopped once every step in the edge parameter is at most ``NEWTON_TOL``: the error after
 #: it is of its square, below round-off
 NEWTON_STEPS = 30
-NEWTON_TOL = 1e-10
+NEWTON_TOL = 1e-13
 
 
 @dataclass(frozen=True)
@@ -100,26 +100,46 @@ def unit(v: np.ndarray) -> np.ndarray:
     return v / np.hypot(v[..., 0], v[..., 1])[..., None]
 
 
+def newton(residual, t: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """Newton's method on each entry of ``t (p,)`` (changed in place and returned):
+    ``residual(t[live], live) -> (g, g')`` for the entries still iterating, each kept within
+    ``[lo, hi]``; an entry stops once its step is at most :data:`NEWTON_TOL` or it stays at
+    a bound (its root lies beyond)."""
+    live = np.arange(t.size)
+    for _ in range(NEWTON_STEPS):
+        g, dg = residual(t[live], live)
+        step = np.divide(g, dg, out=np.zeros_like(g), where=dg != 0)
+        old = t[live]
+        new = np.clip(old - step, lo, hi)
+        t[live] = new
+        stuck = (new == old) & ((new == lo) | (new == hi))
+        live = live[(np.abs(step) > NEWTON_TOL) & ~stuck]
+        if live.size == 0:
+            break
+    return t
+
+
 def master_parameter(X: np.ndarray, x: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, ...]:
     """η where the line ``x + t n`` meets the master edges ``X (p, 3, 2)`` (``x, n (p, 2)`` or
     ``(p, q, 2)``): Newton on ``(x_m(η) − x) × n = 0`` from the chord's intersection (exact
-    for a straight edge). Returns ``η`` and whether it converged."""
-    a, b = X[:, 0], X[:, 1]
-    if x.ndim == 3:
-        a, b = a[:, None], b[:, None]
-    eta = cross(x - a, n) / cross(b - a, n)
+    for a straight edge), kept within ``[−1, 2]``. Returns ``η`` and whether it converged."""
+    shape = x.shape[:-1]
+    rows = np.repeat(np.arange(len(X)), x[0, ..., 0].size)
+    x, n = x.reshape(-1, 2), n.reshape(-1, 2)
+    a, b = X[rows, 0], X[rows, 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        eta = cross(x - a, n) / cross(b - a, n)
     eta = np.clip(np.nan_to_num(eta, nan=0.5), -1.0, 2.0)
-    scale = np.hypot(*(b - a).T).T * np.hypot(n[..., 0], n[..., 1])
-    for _ in range(NEWTON_STEPS):
-        xm, dxm = on_edge(X, eta)
-        g = cross(xm - x, n)
-        dg = cross(dxm, n)
-        step = np.divide(g, dg, out=np.zeros_like(g), where=dg != 0)
-        eta = np.clip(eta - step, -1.0, 2.0)
-        if np.all(np.abs(step) <= NEWTON_TOL):
-            break
-    xm, _ = on_edge(X, eta)
-    return eta, np.abs(cross(xm - x, n)) <= 1e-12 * scale
+
+    def residual(t, live):
+        xm, dxm = on_edge(X[rows[live]], t)
+        return cross(xm - x[live], n[live]), cross(dxm, n[live])
+
+    eta = newton(residual, eta, -1.0, 2.0)
+    xm, _ = on_edge(X[rows], eta)
+    scale = np.hypot(*(b - a).T) * np.hypot(n[:, 0], n[:, 1])
+    ok = np.abs(cross(xm - x, n)) <= 1e-12 * scale
+    return eta.reshape(shape), ok.reshape(shape)
 
 
 def slave_parameter(X: np.ndarray, N: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -129,42 +149,64 @@ def slave_parameter(X: np.ndarray, N: np.ndarray, y: np.ndarray) -> np.ndarray:
     a, b = X[:, 0], X[:, 1]
     d = b - a
     xi = np.clip(np.einsum("pi,pi->p", y - a, d) / np.einsum("pi,pi->p", d, d), -1.0, 2.0)
-    for _ in range(NEWTON_STEPS):
-        xs, dxs = on_edge(X, xi)
-        n, dn = on_edge(N, xi)
-        f = cross(xs - y, n)
-        df = cross(dxs, n) + cross(xs - y, dn)
-        step = np.divide(f, df, out=np.zeros_like(f), where=df != 0)
-        xi = np.clip(xi - step, -1.0, 2.0)
-        if np.all(np.abs(step) <= NEWTON_TOL):
-            break
-    return xi
+
+    def residual(t, live):
+        xs, dxs = on_edge(X[live], t)
+        n, dn = on_edge(N[live], t)
+        return cross(xs - y[live], n), cross(dxs, n) + cross(xs - y[live], dn)
+
+    return newton(residual, xi, -1.0, 2.0)
 
 
 # --------------------------------------------------------------------------- pairing
 
 
-def candidate_pairs(slave: Side, master: Side) -> tuple[np.ndarray, np.ndarray]:
-    """Slave and master edges ``(e, f)`` that may face each other: the master edge's centre
-    within ``3 r_e + r_f + 2 d_e`` of the slave edge's, ``r`` the edges' radii about their
-    centres and ``d_e`` the largest distance from a node of e to the nearest master node. A
-    master point reached from a point of e (within ``d_e + r_e`` of the master) along a
-    direction within 60° of the master's normal lies within twice that (a heuristic
-    beyond: a node whose line meets no candidate is left uncovered, and refused if it is
-    constrained)."""
+def candidate_pairs(
+    slave: Side, master: Side, mix: tuple, wide: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Slave and master edges ``(e, f)`` that may face each other, by a k-d tree of the
+    master edges' centres: f is a candidate of e if its centre is within ``ρ_e + r_f`` of a
+    centre ``c_e`` (``r`` an edge's radius about its centre).
+
+    By default (*near*): each node x of e is sent along the direction estimated from the
+    master's normal ``n_q`` at its nearest master node q (:func:`direction`) to the master's
+    tangent line at q, at p; ``c_e`` is the mean of its nodes' p and ``ρ_e = r_e + max |p −
+    c_e| + 2 max |p − q|``: a few master edges per slave edge, whatever the gap. For the
+    slave edges ``wide`` (where the near search left a node unpaired or the edge not
+    covered, :func:`~signorini.contact.mortar.mortar_coupling`): ``c_e`` the edge's centre
+    and ``ρ_e = 3 r_e + 2 d_e``, ``d_e`` the largest distance from a node of e to the nearest
+    master node: a master point reached from a point of e (within ``d_e + r_e`` of the
+    master) along a direction within 60° of the master's normal lies within twice that."""
     cs, cm = slave.points.mean(axis=1), master.points.mean(axis=1)
     rs = np.hypot(*(slave.points - cs[:, None]).transpose(2, 0, 1)).max(axis=1)
     rm = np.hypot(*(master.points - cm[:, None]).transpose(2, 0, 1)).max(axis=1)
-    d, _ = cKDTree(master.points.reshape(-1, 2)).query(slave.points.reshape(-1, 2))
-    radius = 3 * rs + 2 * d.reshape(-1, 3).max(axis=1)  # a point of e: within d + rs
-    radius = radius * (1 + 1e-9) + 1e-12 * float(np.abs(cs).max())
+    x = slave.points.reshape(-1, 2)
+    d, k = cKDTree(master.points.reshape(-1, 2)).query(x)
+    if wide is None:
+        q, nq = master.points.reshape(-1, 2)[k], master.normals.reshape(-1, 2)[k]
+        n0 = direction(slave.normals.reshape(-1, 2), nq, q - x, mix)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.einsum("pi,pi->p", q - x, nq) / np.einsum("pi,pi->p", n0, nq)
+        p = (x + t[:, None] * n0).reshape(-1, 3, 2)
+        centre = p.mean(axis=1)
+        spread = np.hypot(*(p - centre[:, None]).transpose(2, 0, 1)).max(axis=1)
+        off = np.hypot(*(p.reshape(-1, 2) - q).T).reshape(-1, 3).max(axis=1)
+        radius = rs + spread + 2 * off
+        rows = np.flatnonzero(np.isfinite(radius))
+        centre = centre[rows]
+    else:
+        rows = np.asarray(wide, dtype=np.int64)
+        radius = 3 * rs + 2 * d.reshape(-1, 3).max(axis=1)  # a point of e: within d + rs
+        centre = cs[rows]
+    radius = radius[rows] * (1 + 1e-9) + 1e-12 * float(np.abs(cs).max())
     tree = cKDTree(cm)
     reach = radius + rm.max()
-    counts = tree.query_ball_point(cs, reach, return_length=True)
-    f = np.fromiter(chain.from_iterable(tree.query_ball_point(cs, reach)), np.int64, counts.sum())
-    e = np.repeat(np.arange(len(cs)), counts)
-    near = np.hypot(*(cm[f] - cs[e]).T) <= radius[e] + rm[f] * (1 + 1e-9)
-    return e[near], f[near]
+    counts = tree.query_ball_point(centre, reach, return_length=True)
+    found = chain.from_iterable(tree.query_ball_point(centre, reach))
+    f = np.fromiter(found, np.int64, counts.sum())
+    e = np.repeat(np.arange(rows.size), counts)
+    near = np.hypot(*(cm[f] - centre[e]).T) <= radius[e] + rm[f] * (1 + 1e-9)
+    return rows[e[near]], f[near]
 
 
 def direction(ns: np.ndarray, nm: np.ndarray, r: np.ndarray, mix: tuple) -> np.ndarray:
@@ -204,22 +246,24 @@ def paired_points(
     X, N = master.points[f], master.normals[f]
     A, B = X[:, 0], X[:, 1]
     d = direction(ns, unit(N[:, 2]), X[:, 2] - x, mix)
-    eta = np.clip(np.nan_to_num(cross(x - A, d) / cross(B - A, d), nan=0.5), -0.5, 1.5)
-    for _ in range(NEWTON_STEPS):
-        xm, dxm = on_edge(X, eta)
-        m, dm = on_edge(N, eta)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        eta = cross(x - A, d) / cross(B - A, d)
+    eta = np.clip(np.nan_to_num(eta, nan=0.5), -0.5, 1.5)
+    # d turns with n_m: fully for the master's normal, by half for the averaged one
+    share = mix[1] / (mix[0] + mix[1])
+
+    def residual(t, live):
+        xm, dxm = on_edge(X[live], t)
+        m, dm = on_edge(N[live], t)
         size = np.hypot(m[:, 0], m[:, 1])
         nm = m / size[:, None]
         turn = cross(nm, dm) / size  # d(angle of n_m)/dη
-        d = direction(ns, nm, xm - x, mix)
-        # d turns with n_m: fully for the master's normal, by half for the averaged one
-        dd = mix[1] / (mix[0] + mix[1]) * turn[:, None] * np.column_stack([-d[:, 1], d[:, 0]])
-        g = cross(xm - x, d)
-        dg = cross(dxm, d) + cross(xm - x, dd)
-        step = np.divide(g, dg, out=np.zeros_like(g), where=dg != 0)
-        eta = np.clip(eta - step, -0.5, 1.5)
-        if np.all(np.abs(step) <= NEWTON_TOL):
-            break
+        r = xm - x[live]
+        d = direction(ns[live], nm, r, mix)
+        dd = share * turn[:, None] * np.column_stack([-d[:, 1], d[:, 0]])
+        return cross(r, d), cross(dxm, d) + cross(r, dd)
+
+    eta = newton(residual, eta, -0.5, 1.5)
     xm, _ = on_edge(X, eta)
     d = direction(ns, unit(on_edge(N, eta)[0]), xm - x, mix)
     scale = np.hypot(*(B - A).T) + np.hypot(*(xm - x).T)
