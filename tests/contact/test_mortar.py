@@ -14,6 +14,7 @@ from scipy.integrate import quad, quad_vec
 from scipy.optimize import brentq
 from scipy.spatial import cKDTree
 
+from signorini.contact.constraint_data import edge_weights
 from signorini.contact.mortar import mortar_coupling
 from signorini.fem.space import P2Space
 from signorini.mesh.builders import half_disc, rectangle
@@ -260,6 +261,23 @@ def test_mirrored_arcs_give_the_symmetry_plane(space, part, length):
     np.testing.assert_allclose(c.coverage, 1.0, atol=1e-14)
     # the curved D: ∫ φ_j along the quadratic edges sums to the arc's (quadratic) length
     assert c.D.sum() == pytest.approx(length, rel=1e-4)
+
+
+@pytest.mark.parametrize("which", ["half-disc", "cylinders", "blocks"])
+def test_D_is_the_weight_of_the_consistent_pressure(which):
+    """D_jj = w_z = ∫φ_z ds as contact parts integrate it (constraint_data.edge_weights,
+    its own quadrature along the curved edges), to round-off."""
+    space, slave, master = {
+        "half-disc": (mirrored_half_discs(4), "up.arc", "low.arc"),
+        "cylinders": (cylinders(), "up.contact", "low.contact"),
+        "blocks": (blocks(5, 7), "up.bottom", "low.top"),
+    }[which]
+    c = mortar_coupling(space, slave, master)
+    edges = space.mesh.part_edges(slave)
+    nodes = space.edge_nodes(edges)
+    _, w = edge_weights(space, edges, nodes)
+    D = np.bincount(np.searchsorted(c.slave_nodes, nodes.ravel()), weights=w.ravel())
+    np.testing.assert_allclose(c.D, D, rtol=4e-15)
 
 
 def test_one_sided_directions_on_mirrored_arcs():
