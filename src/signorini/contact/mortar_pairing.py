@@ -281,7 +281,6 @@ def directions(master: Side, pairs: tuple, x: np.ndarray, ns: np.ndarray, mix: t
     the master's normal at its nearest node. Returns ``n (s, 2)``, ``π (s, 2)`` (NaN where
     none)."""
     e, f, index = pairs
-    a, b = mix
     key = np.unique(np.column_stack([index[e].ravel(), np.repeat(f, 3)]), axis=0)
     j, f = key[:, 0], key[:, 1]
     eta, ok = paired_points(master, f, x[j], ns[j], mix)
