@@ -5,12 +5,16 @@ the refusals (docs/method.md, *Two bodies: the dual mortar coupling*)."""
 
 from __future__ import annotations
 
+import importlib.util
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.integrate import quad, quad_vec
 from scipy.optimize import brentq
 from scipy.spatial import cKDTree
 
+from signorini.contact.constraint_data import edge_weights
 from signorini.contact.mortar import mortar_coupling
 from signorini.fem.space import P2Space
 from signorini.mesh.builders import half_disc, rectangle
@@ -106,7 +110,16 @@ def cap(radius: float, rings: int, half_width: float) -> Mesh:
 
 
 def mirrored_arcs(rings: int = 4) -> P2Space:
+    """The half-disc of radius 1 and its mirror image in y = 0, touching at the origin:
+    parts ``contact`` (|x| < 1/2) and ``arc`` (the rest of the arc)."""
     top = cap(1.0, rings, 0.5)
+    return P2Space(union(up=top, low=moved(top, MIRROR)))
+
+
+def mirrored_half_discs(rings: int) -> P2Space:
+    """The same with the whole arc as one part ``arc`` (its ends meet their mirror images'
+    ends, where the two normals coincide)."""
+    top = half_disc(1.0, rings)
     return P2Space(union(up=top, low=moved(top, MIRROR)))
 
 
@@ -165,6 +178,34 @@ def test_non_matching_flat_interface_reproduces_affine_fields(n_upper, n_lower):
     assert np.abs(c.weighted_gap).max() < 1e-16
 
 
+def jiggled(mesh: Mesh, rng: np.random.Generator, y: float) -> Mesh:
+    """``mesh`` with the inner vertices on the line ``y`` moved along it by up to 0.3 of the
+    spacing (so the interface's edges have random lengths)."""
+    points = mesh.points.copy()
+    on = np.flatnonzero(np.isclose(points[:, 1], y) & (points[:, 0] > 1e-9))
+    on = on[points[on, 0] < 1 - 1e-9]
+    h = 1.0 / (on.size + 1)
+    points[on, 0] += rng.uniform(-0.3, 0.3, on.size) * h
+    return Mesh(points, mesh.cells, mesh.boundary, mesh.boundary_part, mesh.part_names)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_random_non_matching_flat_interfaces(seed):
+    """Interfaces with random edge lengths (6 and 9 edges): M·1 = D and M reproduces affine
+    and quadratic fields along the interface, to round-off."""
+    rng = np.random.default_rng(seed)
+    upper = jiggled(rectangle(0.0, 1.0, 0.0, 0.5, 6, 2), rng, 0.0)
+    lower = jiggled(rectangle(0.0, 1.0, -0.5, 0.0, 9, 2), rng, 0.0)
+    space = P2Space(union(up=upper, low=lower))
+    c = mortar_coupling(space, "up.bottom", "low.top")
+    x = space.node_points
+    xs = x[c.slave_nodes]
+    np.testing.assert_allclose(c.coverage, 1.0, atol=1e-14)
+    for f in (x[:, 0], x[:, 0] ** 2 - 0.3 * x[:, 0]):
+        np.testing.assert_allclose(c.M @ f, c.D * f[c.slave_nodes], rtol=0, atol=1e-15)
+    assert c.M.nnz > 3 * xs.shape[0]  # non-matching: rows couple several master nodes
+
+
 def test_partly_covered_nodes_and_the_constrained_ones():
     """A master [0.3, 1.5] under a slave [0, 1]: coverage 1 for the nodes whose ψ lies over
     it (x ≥ 0.5: ψ_j lives on the edges at x_j, and the edge [0.2, 0.4] is cut), not for the
@@ -194,22 +235,100 @@ def test_partly_covered_nodes_and_the_constrained_ones():
 # --------------------------------------------------------------------------- curved
 
 
-def test_mirrored_arcs_give_the_symmetry_plane():
+@pytest.mark.parametrize(
+    "space, part, length",
+    [(mirrored_arcs(), "contact", np.pi / 3), (mirrored_half_discs(4), "arc", np.pi)]
+    + [(mirrored_half_discs(8), "arc", np.pi)],
+    ids=["cap", "half-disc", "half-disc-fine"],
+)
+def test_mirrored_arcs_give_the_symmetry_plane(space, part, length):
     """Matching mirrored half-discs: n_j = (0, −1) to round-off, M = D on the mirror nodes,
-    g̃_j = D_jj · 2 y_j (twice the one-body gap to the plane y = 0)."""
-    space = mirrored_arcs()
-    c = mortar_coupling(space, "up.contact", "low.contact")
+    g̃_j = D_jj · 2 y_j (twice the one-body gap to the plane y = 0); on the whole arc too,
+    up to its ends (where n_s − n_m vanishes and the direction is the bisector's limit)."""
+    c = mortar_coupling(space, f"up.{part}", f"low.{part}")
     xs = space.node_points[c.slave_nodes]
-    assert np.abs(c.normal - [0.0, -1.0]).max() < 2e-16
+    # on the last edges of a half-disc the direction grazes both arcs: π loses digits there
+    grazing = np.abs(xs[:, 0]) > np.sin(np.radians(80))
+    tilt = np.abs(c.normal - [0.0, -1.0]).max(axis=1)
+    assert tilt[~grazing].max() < 2e-16 and tilt.max() < 1e-15
     k = partner(space, c, xs * [1.0, -1.0])
     M = c.M.toarray()
-    np.testing.assert_allclose(M[np.arange(len(k)), k], c.D, rtol=1e-14)
+    error = np.abs(M[np.arange(len(k)), k] / c.D - 1)
+    assert error[~grazing].max() < 1e-13 and error.max() < 1e-11
     M[np.arange(len(k)), k] = 0.0
-    assert np.abs(M).max() < 1e-15
-    np.testing.assert_allclose(c.weighted_gap, 2 * xs[:, 1] * c.D, rtol=1e-13, atol=1e-17)
+    assert np.abs(M).max() < 1e-12 * c.D.max()
+    np.testing.assert_allclose(c.weighted_gap, 2 * xs[:, 1] * c.D, rtol=1e-13, atol=1e-14)
     np.testing.assert_allclose(c.coverage, 1.0, atol=1e-14)
     # the curved D: ∫ φ_j along the quadratic edges sums to the arc's (quadratic) length
-    assert c.D.sum() == pytest.approx(np.pi / 3, rel=1e-5)
+    assert c.D.sum() == pytest.approx(length, rel=1e-4)
+
+
+@pytest.mark.parametrize("which", ["half-disc", "cylinders", "blocks"])
+def test_D_is_the_weight_of_the_consistent_pressure(which):
+    """D_jj = w_z = ∫φ_z ds as contact parts integrate it (constraint_data.edge_weights,
+    its own quadrature along the curved edges), to round-off."""
+    space, slave, master = {
+        "half-disc": (mirrored_half_discs(4), "up.arc", "low.arc"),
+        "cylinders": (cylinders(), "up.contact", "low.contact"),
+        "blocks": (blocks(5, 7), "up.bottom", "low.top"),
+    }[which]
+    c = mortar_coupling(space, slave, master)
+    edges = space.mesh.part_edges(slave)
+    nodes = space.edge_nodes(edges)
+    _, w = edge_weights(space, edges, nodes)
+    D = np.bincount(np.searchsorted(c.slave_nodes, nodes.ravel()), weights=w.ravel())
+    np.testing.assert_allclose(c.D, D, rtol=4e-15)
+
+
+def test_one_sided_directions_on_mirrored_arcs():
+    """On mirrored unit circles the slave's normal n_s(x_j) is tilted from the symmetry
+    plane's normal by the polar angle of x_j, the master's −n_m(π_j) by the polar angle of π_j
+    the other way (π_j on the line x_j + t n_j), the averaged one not at all."""
+    space = mirrored_arcs()
+    out = {}
+    for direction in ("averaged", "slave", "master"):
+        # one-sided: the lines from the ends leave the master (left unconstrained here)
+        free = [] if direction != "averaged" else None
+        c = mortar_coupling(
+            space, "up.contact", "low.contact", constrained=free, direction=direction
+        )
+        out[direction] = c, np.arctan2(c.normal[:, 0], -c.normal[:, 1])
+    c, tilt = out["averaged"]
+    xs = space.node_points[c.slave_nodes]
+    assert np.abs(tilt).max() < 2e-16
+    np.testing.assert_allclose(out["slave"][1], np.arcsin(xs[:, 0]), atol=1e-15)
+    c, tilt = out["master"]
+    hit = np.isfinite(c.master_point[:, 0])
+    assert hit.all()
+    # n_m between nodes is the P2 interpolant of the nodal (circle) normals: O(h³) off
+    error = np.abs(tilt[hit] + np.arcsin(c.master_point[hit, 0]))
+    assert 1e-7 < error.max() < 5e-6
+    along = _cross(c.master_point[hit] - xs[hit], c.normal[hit])
+    assert np.abs(along).max() < 1e-15
+    assert np.abs(out["slave"][1]).max() == pytest.approx(np.pi / 6)
+    with pytest.raises(ProblemError, match=r"direction must be one of"):
+        mortar_coupling(space, "up.contact", "low.contact", direction="normal")
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def test_translation_far_from_the_origin():
+    """Blocks moved by (1000, −2000): D, M and the coverage keep their digits (the edge maps
+    are written relative to the edge's start)."""
+    c0 = mortar_coupling(blocks(50, 70, gap=0.01), "up.bottom", "low.top")
+    space = P2Space(
+        union(
+            up=moved(rectangle(0.0, 1.0, 0.01, 0.51, 50, 2), np.eye(2), (1e3, -2e3)),
+            low=moved(rectangle(0.0, 1.0, -0.5, 0.0, 70, 2), np.eye(2), (1e3, -2e3)),
+        )
+    )
+    c1 = mortar_coupling(space, "up.bottom", "low.top")
+    np.testing.assert_allclose(c1.coverage, 1.0, atol=1e-13)
+    np.testing.assert_allclose(c1.D, c0.D, rtol=1e-10)
+    assert abs(c1.M - c0.M).max() < 1e-10 * c0.D.max()
+    np.testing.assert_allclose(c1.weighted_gap / c1.D, 0.01, rtol=1e-8)
 
 
 def shape(t: float) -> np.ndarray:
@@ -323,7 +442,7 @@ def test_weighted_gap_converges_to_the_gap_at_the_node():
         for _ in range(2):
             mesh = refine_nvb(mesh, np.ones(mesh.n_cells, dtype=bool)).mesh
     rates = np.log2(np.array(errors[:-1]) / errors[1:])
-    assert errors[0] < 1e-3 and rates.min() > 1.8, (errors, rates)
+    assert errors[0] < 1e-4 and rates.min() > 2.8, (errors, rates)  # O(h³)
 
 
 # --------------------------------------------------------------------------- refusals
@@ -335,10 +454,25 @@ def test_parts_of_one_body_are_refused():
         mortar_coupling(space, "a.top", "a.bottom")
     with pytest.raises(ProblemError, match=r"'a\.bottom'.*'a\.left'.*lies on both parts"):
         mortar_coupling(space, "a.bottom", "a.left")
+    with pytest.raises(ProblemError, match=r"constrained must be a 1-D array of node indices"):
+        mortar_coupling(space, "a.top", "b.bottom", constrained=[0.5, 1.5])
+    with pytest.raises(ProblemError, match=r"constrained holds node indices outside \[0, "):
+        mortar_coupling(space, "a.top", "b.bottom", constrained=[-1, 3])
     with pytest.raises(ProblemError, match="two different parts"):
         mortar_coupling(space, "a.top", "a.top")
     with pytest.raises(ProblemError, match=r"no boundary part 'a\.lid'"):
         mortar_coupling(space, "a.lid", "b.bottom")
+
+
+def test_a_part_over_two_bodies_is_refused():
+    mesh = union(a=rectangle(0, 1, 0, 1, 2, 2), b=rectangle(0, 1, 2, 3, 2, 2))
+    part = mesh.boundary_part.copy()
+    part[part == mesh.part_index("b.bottom")] = mesh.part_index("a.top")  # one part, 2 bodies
+    mesh = Mesh(mesh.points, mesh.cells, mesh.boundary, part, mesh.part_names, validate=False)
+    with pytest.raises(ProblemError, match=r"slave part 'a\.top' runs over 2 bodies"):
+        mortar_coupling(P2Space(mesh), "a.top", "b.top")
+    with pytest.raises(ProblemError, match=r"the master must be a boundary part's name"):
+        mortar_coupling(P2Space(mesh), "a.top", 3)
 
 
 def test_no_overlap_is_refused():
@@ -366,3 +500,42 @@ def test_quad_reference_is_sound():
             v = quad(lambda t, a=a, b=b: (A[a] @ shape(t)) * shape(t)[b] * speed(t), 0, 1)[0]
             w = quad(lambda t, a=a: shape(t)[a] * speed(t), 0, 1)[0]
             assert v == pytest.approx(w if a == b else 0.0, abs=1e-13)
+
+
+# --------------------------------------------------------------------------- patch test
+
+
+def _benchmark(name: str = "mortar_patch"):
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize("n_upper, n_lower", [(5, 7), (7, 5)])
+@pytest.mark.parametrize("slave", ["up.bottom", "low.top"])
+def test_contact_patch_test_mortar_passes_node_to_segment_does_not(n_upper, n_lower, slave):
+    """Stacked blocks under uniform pressure, 5/7 interface edges, every contact node active
+    (benchmarks/mortar_patch.py): the mortar pressure is uniform to round-off, the
+    node-to-segment one misses by 5 % or 25 % (measured 5.3e-2 and 2.5e-1)."""
+    bench = _benchmark()
+    mortar = bench.pressure_deviation(n_upper, n_lower, slave, "mortar")
+    nts = bench.pressure_deviation(n_upper, n_lower, slave, "nts")
+    assert mortar < 1e-11
+    coarse_slave = (n_upper < n_lower) == (slave == "up.bottom")
+    assert nts == pytest.approx(0.254 if coarse_slave else 0.0527, rel=0.02)
+
+
+def test_mirrored_half_discs_equal_the_one_body_hertz_solution():
+    """Two mirrored half-discs pressed together (benchmarks/mortar_symmetry.py, a/R ≈ 0.1):
+    with the averaged normal the upper body's solution is the one-body Hertz one to round-off
+    (measured 7.8e-14 in u, 5.0e-12 in λ) and mirror-symmetric; with a one-sided normal it
+    is off by 1.5e-2 and not symmetric (the issue measured 1.5e-2 at a/R = 0.1)."""
+    result = _benchmark("mortar_symmetry").compare()
+    same = result["averaged"]
+    assert same["u"] < 1e-11 and same["lam"] < 1e-9 and same["mirror"] < 1e-12
+    assert same["active"] == 1.0
+    for direction in ("slave", "master"):
+        r = result[direction]
+        assert 1e-2 < r["u"] < 2e-2 and r["mirror"] > 2e-2, (direction, r)

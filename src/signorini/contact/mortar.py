@@ -11,7 +11,9 @@ docs/method.md, *Two bodies: the dual mortar coupling*.
 
 Arrays: an edge's nodes are ``[start, end, midpoint]`` (counter-clockwise around its cell) and
 its map ``x(t) = Σ_a x_a φ_a(t)``, ``t ∈ [0, 1]`` (quadratic on a curved part, affine
-otherwise, where the midpoint node is the chord's midpoint).
+otherwise, where the midpoint node is the chord's midpoint). The geometry (projections,
+directions, segments) is in :mod:`signorini.contact.mortar_pairing`, the refusals in
+:mod:`signorini.contact.mortar_checks`.
 
 References
 ----------
@@ -23,20 +25,26 @@ set strategy for non-linear multibody contact problems*, CMAME 194 (2005).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from itertools import chain
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.spatial import cKDTree
 
 from ..fem.quadrature import gauss_legendre
 from ..fem.space import P2Space
-from ..mesh.geometry import segment_normals
 from ..problem.fields import ProblemError
-from .constraint_data import part_normals
 from .mortar_checks import check_coupling, check_pair, pair_size
+from .mortar_pairing import (
+    Side,
+    candidate_pairs,
+    directions,
+    edge_basis,
+    master_parameter,
+    on_edge,
+    segments,
+    side,
+)
 
-__all__ = ["MortarCoupling", "mortar_coupling"]
+__all__ = ["DIRECTIONS", "MortarCoupling", "mortar_coupling"]
 
 #: Gauss points per segment (slave edge ∩ projected master edge) when both edges are
 #: straight: on a flat interface the integrand ψ_j (φ_k ∘ π) is a polynomial of degree 4 in
@@ -48,10 +56,6 @@ STRAIGHT_POINTS = 4
 CURVED_POINTS = 10
 #: Gauss points of the slave edges' local mass matrices (exact on straight edges)
 MASS_POINTS = 10
-#: Newton steps of the projections (quadratic convergence; a straight master needs one)
-NEWTON_STEPS = 30
-#: fixed-point steps of the averaged normal (it contracts by about gap × curvature per step)
-NORMAL_STEPS = 200
 
 
 @dataclass(frozen=True)
@@ -91,183 +95,16 @@ class MortarCoupling:
     master_point: np.ndarray
 
 
-@dataclass(frozen=True)
-class _Side:
-    """One part's edges: ``nodes (e, 3)`` global, ``points (e, 3, 2)``, outward nodal
-    ``normals (e, 3, 2)`` (:func:`~signorini.contact.constraint_data.part_normals`),
-    ``curved (e,)``."""
-
-    nodes: np.ndarray
-    points: np.ndarray
-    normals: np.ndarray
-    curved: np.ndarray
-
-
-def _side(space: P2Space, name: str) -> _Side:
-    mesh = space.mesh
-    edges = mesh.part_edges(name)
-    nodes = space.edge_nodes(edges)
-    points = space.node_points[nodes]
-    _, chord = segment_normals(points[:, 0], points[:, 1])
-    curve = mesh.curves[mesh.part_index(name)]
-    curved = np.full(edges.size, curve is not None, dtype=bool)
-    return _Side(nodes, points, part_normals(space, name, nodes, chord), curved)
-
-
-# --------------------------------------------------------------------------- edge kernels
-
-
-def _basis(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """P2 edge basis ``[start, end, midpoint]`` and its derivative at ``t (...)``: ``(..., 3)``
-    each."""
-    phi = np.stack([(1 - t) * (1 - 2 * t), t * (2 * t - 1), 4 * t * (1 - t)], axis=-1)
-    dphi = np.stack([4 * t - 3, 4 * t - 1, 4 - 8 * t], axis=-1)
-    return phi, dphi
-
-
-def _on_edge(X: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``Σ_a X_a φ_a(t)`` and its t-derivative for nodal values ``X (p, 3, 2)`` at ``t (p,)``
-    or ``(p, q)``: ``(p, 2)`` or ``(p, q, 2)`` each."""
-    phi, dphi = _basis(t)
-    if t.ndim == 1:
-        return np.einsum("pa,pai->pi", phi, X), np.einsum("pa,pai->pi", dphi, X)
-    return np.einsum("pqa,pai->pqi", phi, X), np.einsum("pqa,pai->pqi", dphi, X)
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.hypot(v[..., 0], v[..., 1])[..., None]
-
-
-def _master_parameter(X: np.ndarray, x: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, ...]:
-    """η where the line ``x + t n`` meets the master edges ``X (p, 3, 2)`` (``x, n (p, 2)`` or
-    ``(p, q, 2)``): Newton on ``(x_m(η) − x) × n = 0`` from the chord's intersection (exact
-    for a straight edge). Returns ``η`` and whether it converged."""
-    a, b = X[:, 0], X[:, 1]
-    if x.ndim == 3:
-        a, b = a[:, None], b[:, None]
-    eta = _cross(x - a, n) / _cross(b - a, n)
-    eta = np.clip(np.nan_to_num(eta, nan=0.5), -1.0, 2.0)
-    scale = np.hypot(*(b - a).T).T * np.hypot(n[..., 0], n[..., 1])
-    for _ in range(NEWTON_STEPS):
-        xm, dxm = _on_edge(X, eta)
-        g = _cross(xm - x, n)
-        dg = _cross(dxm, n)
-        step = np.divide(g, dg, out=np.zeros_like(g), where=dg != 0)
-        eta = np.clip(eta - step, -1.0, 2.0)
-        if np.all(np.abs(step) <= 1e-15):
-            break
-    xm, _ = _on_edge(X, eta)
-    return eta, np.abs(_cross(xm - x, n)) <= 1e-12 * scale
-
-
-def _slave_parameter(X: np.ndarray, N: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """ξ where the slave edge ``X (p, 3, 2)`` with the normal field ``n(ξ) = Σ N_a φ_a(ξ)``
-    projects onto the points ``y (p, 2)``: ``(x_s(ξ) − y) × n(ξ) = 0``, Newton from the
-    projection onto the chord, kept within ``[−1, 2]``."""
-    a, b = X[:, 0], X[:, 1]
-    d = b - a
-    xi = np.clip(np.einsum("pi,pi->p", y - a, d) / np.einsum("pi,pi->p", d, d), -1.0, 2.0)
-    for _ in range(NEWTON_STEPS):
-        xs, dxs = _on_edge(X, xi)
-        n, dn = _on_edge(N, xi)
-        f = _cross(xs - y, n)
-        df = _cross(dxs, n) + _cross(xs - y, dn)
-        step = np.divide(f, df, out=np.zeros_like(f), where=df != 0)
-        xi = np.clip(xi - step, -1.0, 2.0)
-        if np.all(np.abs(step) <= 1e-15):
-            break
-    return xi
-
-
-# --------------------------------------------------------------------------- pairing
-
-
-def _candidate_pairs(slave: _Side, master: _Side) -> tuple[np.ndarray, np.ndarray]:
-    """Slave and master edges ``(e, f)`` that may face each other: the master edge's centre
-    within ``r_e + R_f + 2 d_e`` of the slave edge's, ``r`` the edges' radii about their
-    centres and ``d_e`` the largest distance from a node of e to the nearest master node. A
-    master point reached along a direction within 60° of the master's normal
-    (:data:`FACING`) lies within ``2 d`` of the node."""
-    cs, cm = slave.points.mean(axis=1), master.points.mean(axis=1)
-    rs = np.hypot(*(slave.points - cs[:, None]).transpose(2, 0, 1)).max(axis=1)
-    rm = np.hypot(*(master.points - cm[:, None]).transpose(2, 0, 1)).max(axis=1)
-    d, _ = cKDTree(master.points.reshape(-1, 2)).query(slave.points.reshape(-1, 2))
-    radius = rs + rm.max() + 2 * d.reshape(-1, 3).max(axis=1)
-    radius = radius * (1 + 1e-9) + 1e-12 * float(np.abs(cs).max())
-    tree = cKDTree(cm)
-    counts = tree.query_ball_point(cs, radius, return_length=True)
-    f = np.fromiter(chain.from_iterable(tree.query_ball_point(cs, radius)), np.int64, counts.sum())
-    return np.repeat(np.arange(len(cs)), counts), f
-
-
-def _averaged_normals(slave: _Side, master: _Side, pairs: tuple, x: np.ndarray, ns: np.ndarray):
-    """The fixed point ``n_j = normalize(n_s(x_j) − n_m(π_j))`` at the slave nodes ``x (s,
-    2)`` with outward normals ``ns (s, 2)``, the node's index ``pairs[2] (e, 3)``; π_j the
-    nearest point where ``x_j + t n_j`` meets a candidate master edge. Returns ``n (s, 2)``,
-    ``π (s, 2)`` (NaN where the line misses the master) and ``n_s · n_m (s,)``."""
-    e, f, index = pairs
-    j = index[e].ravel()
-    f = np.repeat(f, 3)
-    key = np.unique(np.column_stack([j, f]), axis=0)
-    j, f = key[:, 0], key[:, 1]
-    # start from the master's normal at its nearest node
-    _, k = cKDTree(master.points.reshape(-1, 2)).query(x)
-    n = _unit(ns - master.normals.reshape(-1, 2)[k])
-    point = np.full_like(x, np.nan)
-    facing = np.full(len(x), -1.0)
-    for _ in range(NORMAL_STEPS):
-        eta, ok = _master_parameter(master.points[f], x[j], n[j])
-        # off the edge by: a node just beyond the master's end steers by its extension
-        off = np.maximum(np.maximum(-eta, eta - 1), 0.0)
-        ok &= off <= 0.5
-        xm, _ = _on_edge(master.points[f], eta)
-        t = np.einsum("pi,pi->p", xm - x[j], n[j])
-        order = np.lexsort((np.abs(t), off > 1e-12, j))
-        order = order[ok[order]]
-        hit, first = np.unique(j[order], return_index=True)
-        best = order[first]
-        nm = _unit(_on_edge(master.normals[f[best]], eta[best])[0])
-        new = n.copy()
-        new[hit] = _unit(ns[hit] - nm)
-        on = off[best] <= 1e-12
-        point[:] = np.nan
-        point[hit[on]] = xm[best[on]]
-        facing[:] = -1.0
-        facing[hit[on]] = np.einsum("pi,pi->p", ns[hit[on]], nm[on])
-        change = float(np.abs(new - n).max(initial=0.0))
-        n = new
-        if change <= 4e-16:
-            break
-    return n, point, facing
-
-
-def _segments(slave: _Side, master: _Side, e: np.ndarray, f: np.ndarray, N: np.ndarray):
-    """The pieces ``[lo, hi] ⊂ [0, 1]`` of slave edges ``e`` over master edges ``f``: the
-    master edge's ends projected onto the slave edge along ``n(ξ) = Σ N_a φ_a(ξ)`` (``N (e_s,
-    3, 2)`` the slave edges' nodal directions). Returns ``e, f, lo, hi`` of non-empty ones."""
-    X, Ne = slave.points[e], N[e]
-    xi0 = _slave_parameter(X, Ne, master.points[f, 0])
-    xi1 = _slave_parameter(X, Ne, master.points[f, 1])
-    lo = np.clip(np.minimum(xi0, xi1), 0.0, 1.0)
-    hi = np.clip(np.maximum(xi0, xi1), 0.0, 1.0)
-    keep = hi > lo
-    return e[keep], f[keep], lo[keep], hi[keep]
-
-
 # --------------------------------------------------------------------------- integrals
 
 
-def _dual_basis(slave: _Side) -> tuple[np.ndarray, np.ndarray]:
+def _dual_basis(slave: Side) -> tuple[np.ndarray, np.ndarray]:
     """Per slave edge the local mass ``M_e = ∫_e φ_a φ_b ds`` (along the quadratic edge), the
     weights ``D_e = ∫_e φ_a ds = Σ_b (M_e)_ab`` ``(e, 3)`` and the coefficients ``A_e = D_e
     M_e⁻¹`` ``(e, 3, 3)`` of the dual basis ``ψ_a = Σ_b (A_e)_ab φ_b``."""
     t, w = gauss_legendre(MASS_POINTS)
-    phi, _ = _basis(t)
-    _, dx = _on_edge(slave.points, np.broadcast_to(t, (len(slave.points), t.size)))
+    phi, _ = edge_basis(t)
+    _, dx = on_edge(slave.points, np.broadcast_to(t, (len(slave.points), t.size)))
     ws = w * np.hypot(dx[..., 0], dx[..., 1])  # (e, q)
     mass = np.einsum("eq,qa,qb->eab", ws, phi, phi)
     weight = mass.sum(axis=2)
@@ -276,11 +113,11 @@ def _dual_basis(slave: _Side) -> tuple[np.ndarray, np.ndarray]:
     return weight, coef
 
 
-def _mortar_entries(slave: _Side, master: _Side, seg: tuple, N: np.ndarray, coef: np.ndarray):
+def _mortar_entries(slave: Side, master: Side, seg: tuple, N: np.ndarray, coef: np.ndarray):
     """``(S, 3, 3)`` ``∫_seg ψ_a (φ_b ∘ π) ds`` of the segments ``seg = (e, f, lo, hi)``: a
     Gauss rule in ξ on ``[lo, hi]`` (:data:`STRAIGHT_POINTS` or :data:`CURVED_POINTS`), π(ξ)
-    on master edge f along ``n(ξ)`` (:func:`_master_parameter`). Also whether each segment
-    faces the master (``n(ξ) · n_m(π(ξ)) < 0`` at its middle Gauss point)."""
+    on master edge f along ``n(ξ)`` (:func:`.mortar_pairing.master_parameter`). Also
+    whether each segment faces the master (``n(ξ) · n_m(π(ξ)) < 0`` at its middle Gauss point)."""
     e, f, lo, hi = seg
     out = np.zeros((e.size, 3, 3))
     faces = np.zeros(e.size, dtype=bool)
@@ -292,19 +129,59 @@ def _mortar_entries(slave: _Side, master: _Side, seg: tuple, N: np.ndarray, coef
         t, w = gauss_legendre(points)
         length = hi[g] - lo[g]
         xi = lo[g, None] + length[:, None] * t  # (S, q)
-        xs, dxs = _on_edge(slave.points[e[g]], xi)
-        n, _ = _on_edge(N[e[g]], xi)
-        eta, _ = _master_parameter(master.points[f[g]], xs, n)
-        nm, _ = _on_edge(master.normals[f[g]], eta[:, points // 2])
+        xs, dxs = on_edge(slave.points[e[g]], xi)
+        n, _ = on_edge(N[e[g]], xi)
+        eta, _ = master_parameter(master.points[f[g]], xs, n)
+        nm, _ = on_edge(master.normals[f[g]], eta[:, points // 2])
         faces[g] = np.einsum("pi,pi->p", n[:, points // 2], nm) < 0
         ws = length[:, None] * w * np.hypot(dxs[..., 0], dxs[..., 1])
-        psi = np.einsum("sqb,sab->sqa", _basis(xi)[0], coef[e[g]])
-        out[g] = np.einsum("sq,sqa,sqb->sab", ws, psi, _basis(eta)[0])
+        psi = np.einsum("sqb,sab->sqa", edge_basis(xi)[0], coef[e[g]])
+        out[g] = np.einsum("sq,sqa,sqb->sab", ws, psi, edge_basis(eta)[0])
     return out, faces
 
 
+def _node_list(nodes: object, n_nodes: int, pair: str) -> np.ndarray:
+    """``nodes`` as a 1-D int64 array of node indices, or a ProblemError naming the fault."""
+    array = np.asarray(nodes)
+    if array.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    if array.ndim != 1 or not np.issubdtype(array.dtype, np.integer):
+        raise ProblemError(
+            f"{pair}: constrained must be a 1-D array of node indices (int), got an array of "
+            f"shape {array.shape} and dtype {array.dtype}"
+        )
+    if array.min() < 0 or array.max() >= n_nodes:
+        raise ProblemError(
+            f"{pair}: constrained holds node indices outside [0, {n_nodes}): "
+            f"{array.min()} ... {array.max()}"
+        )
+    return array.astype(np.int64)
+
+
+def _couple(sides: tuple, pairs: tuple, nodes: tuple, mix: tuple, coef: np.ndarray):
+    """The directions, paired points, facing segments and their entries from the candidate
+    edge pairs: ``(normal, point, (e, f, lo, hi), entries)``."""
+    s_side, m_side = sides
+    index, x, ns = nodes
+    normal, point = directions(m_side, (*pairs, index), x, ns, mix)
+    N = normal[index]
+    seg = segments(s_side, m_side, pairs, N, point[index[:, :2]])
+    entries, faces = _mortar_entries(s_side, m_side, seg, N, coef)
+    return normal, point, tuple(a[faces] for a in seg), entries[faces]
+
+
+#: the constraint directions :func:`mortar_coupling` offers, as weights ``(a, b)`` of
+#: ``normalize(a n_s − b n_m)``
+DIRECTIONS = {"averaged": (1.0, 1.0), "slave": (1.0, 0.0), "master": (0.0, 1.0)}
+
+
 def mortar_coupling(
-    space: P2Space, slave: str, master: str, *, constrained: np.ndarray | None = None
+    space: P2Space,
+    slave: str,
+    master: str,
+    *,
+    constrained: np.ndarray | None = None,
+    direction: str = "averaged",
 ) -> MortarCoupling:
     """The dual mortar coupling of the contact pair ``slave`` → ``master``.
 
@@ -315,9 +192,15 @@ def mortar_coupling(
     slave, master : str
         Boundary parts of two different bodies, sharing no node.
     constrained : (c,) int array, optional
-        The slave nodes that carry a constraint (e.g. all but the Dirichlet nodes); each must
-        lie wholly over the master (coverage 1) and not start deeper inside it than the
-        small-deformation model covers. Default: every slave node.
+        The nodes that carry a constraint (e.g. all but the Dirichlet nodes; nodes off the
+        slave part are ignored); each slave node among them must lie wholly over the master
+        (coverage 1) and not start deeper inside it than the small-deformation model covers.
+        Default: every slave node.
+    direction : {"averaged", "slave", "master"}
+        The constraint direction n_j: ``normalize(n_s − n_m(π_j))`` (the default; the
+        symmetry plane's normal on a mirror-symmetric pair), the slave's outward normal
+        ``n_s(x_j)``, or the reverse of the master's ``−n_m(π_j)`` (one-sided normals, for
+        comparison: they put a spurious shear on a symmetric pair, docs/method.md).
 
     Returns
     -------
@@ -328,26 +211,37 @@ def mortar_coupling(
     ProblemError
         Naming the parts: an unknown part, both names the same, a node on both parts, parts
         on one body (self-contact is not modelled) or a part across several bodies, no
-        overlap of the slave with the master, surfaces that do not face each other, a
-        constrained slave node not wholly over the master (naming it), an initial overlap
-        deeper than ``DEEP_OVERLAP`` times the bodies' size.
+        overlap of the slave with the master, a constrained slave node not wholly over the
+        master (naming it), an initial overlap deeper than ``DEEP_OVERLAP`` times the bodies'
+        size.
     """
     pair = f"contact pair (slave {slave!r}, master {master!r})"
+    if direction not in DIRECTIONS:
+        raise ProblemError(
+            f"{pair}: direction must be one of {list(DIRECTIONS)}, got {direction!r}"
+        )
     bodies = check_pair(space, slave, master, pair)
-    s_side, m_side = _side(space, slave), _side(space, master)
+    if constrained is not None:
+        constrained = _node_list(constrained, space.n_nodes, pair)
+    s_side, m_side = side(space, slave), side(space, master)
     slave_nodes, index = np.unique(s_side.nodes, return_inverse=True)
     index = index.reshape(-1, 3)
     x = space.node_points[slave_nodes]
     ns = np.zeros_like(x)
     ns[index.ravel()] = s_side.normals.reshape(-1, 2)
-    e, f = _candidate_pairs(s_side, m_side)
-    normal, point, facing = _averaged_normals(s_side, m_side, (e, f, index), x, ns)
     weight, coef = _dual_basis(s_side)
     D = np.bincount(index.ravel(), weights=weight.ravel(), minlength=slave_nodes.size)
-    N = normal[index]
-    seg = _segments(s_side, m_side, e, f, N)
-    entries, faces = _mortar_entries(s_side, m_side, seg, N, coef)
-    e, f = seg[0][faces], seg[1][faces]
+    mix = DIRECTIONS[direction]
+    pairs = candidate_pairs(s_side, m_side, mix)
+    normal, point, seg, entries = _couple((s_side, m_side), pairs, (index, x, ns), mix, coef)
+    covered = np.bincount(seg[0], weights=seg[3] - seg[2], minlength=len(index))
+    wide = np.flatnonzero((np.abs(covered - 1) > 1e-12) | np.isnan(point[index, 0]).any(axis=1))
+    if wide.size:  # search these slave edges' surroundings widely
+        more = candidate_pairs(s_side, m_side, mix, wide)
+        both = np.vstack([np.column_stack(pairs), np.column_stack(more)])
+        pairs = tuple(np.unique(both, axis=0).T)
+        normal, point, seg, entries = _couple((s_side, m_side), pairs, (index, x, ns), mix, coef)
+    e, f = seg[0], seg[1]
     if e.size == 0:
         raise ProblemError(
             f"{pair}: no part of the slave lies over the master along the normals (the parts "
@@ -356,7 +250,7 @@ def mortar_coupling(
     rows = np.broadcast_to(index[e][:, :, None], (e.size, 3, 3))
     cols = np.broadcast_to(m_side.nodes[f][:, None, :], (e.size, 3, 3))
     M = sp.coo_matrix(
-        (entries[faces].ravel(), (rows.ravel(), cols.ravel())),
+        (entries.ravel(), (rows.ravel(), cols.ravel())),
         shape=(slave_nodes.size, space.n_nodes),
     ).tocsr()
     mx = M @ space.node_points
@@ -365,6 +259,6 @@ def mortar_coupling(
     coupling = MortarCoupling(slave, master, slave_nodes, normal, D, M, gap, coverage, point)
     mine = np.ones(slave_nodes.size, dtype=bool)
     if constrained is not None:
-        mine = np.isin(slave_nodes, np.asarray(constrained, dtype=np.int64))
-    check_coupling(coupling, (facing, mine, pair_size(space, bodies), x), pair)
+        mine = np.isin(slave_nodes, constrained)
+    check_coupling(coupling, (mine, pair_size(space, bodies), x), pair)
     return coupling

@@ -1,7 +1,6 @@
 """The refusals of a mortar contact pair (:func:`signorini.contact.mortar.mortar_coupling`):
-parts that cannot be coupled, surfaces that do not face each other, a master too short for
-the slave, an initial overlap beyond the small-deformation model (docs/method.md, *Two bodies:
-the dual mortar coupling*, "Refusals")."""
+parts that cannot be coupled, a master too short for the slave, an initial overlap beyond
+the small-deformation model (docs/method.md, *Two bodies: the dual mortar coupling*)."""
 
 from __future__ import annotations
 
@@ -14,12 +13,8 @@ from ..mesh.validation import MeshError
 from ..problem.fields import ProblemError
 from .constraint_data import DEEP_OVERLAP
 
-__all__ = ["COVERAGE_TOL", "FACING", "check_coupling", "check_pair", "pair_size"]
+__all__ = ["COVERAGE_TOL", "check_coupling", "check_pair", "pair_size"]
 
-#: where a slave node is paired, its normal and the master's must be within 80° of facing
-#: each other, ``n_s · (−n_m) ≥ cos 80°``: the averaged normal is then within 40° of each
-#: (the candidate search of :mod:`~signorini.contact.mortar` needs 60°)
-FACING = float(np.cos(np.radians(80.0)))
 #: a constrained slave node's ψ_j must lie wholly over the master: ``|coverage − 1| ≤
 #: COVERAGE_TOL`` (ψ_j changes sign, so a partly covered node may have a coverage above 1)
 COVERAGE_TOL = 1e-12
@@ -85,21 +80,10 @@ def pair_size(space: P2Space, bodies: tuple) -> float:
 
 
 def check_coupling(c, data: tuple, pair: str) -> None:
-    """Refuse surfaces that do not face each other at a paired slave node, a constrained slave
-    node not wholly over the master, and an initial overlap beyond the small-deformation model
+    """Refuse a constrained slave node not wholly over the master, and an initial overlap
+    beyond the small-deformation model
     (docs/method.md, *Two bodies: the dual mortar coupling*)."""
-    facing, mine, size, x = data
-    bad = np.flatnonzero(mine & (facing > -FACING))
-    if bad.size:
-        i = bad[np.argmax(facing[bad])]
-        angle = np.degrees(np.arccos(np.clip(-facing[i], -1.0, 1.0)))
-        raise ProblemError(
-            f"{pair}: the parts do not face each other at the slave node ({x[i, 0]:.12g}, "
-            f"{x[i, 1]:.12g}) ({bad.size} node(s)): the master's normal where the node's line "
-            f"meets it is {180 - angle:.3g}° from the reverse of the slave's (at most "
-            f"{np.degrees(np.arccos(FACING)):.0f}°); shorten the slave part to where the "
-            "bodies face each other"
-        )
+    mine, size, x = data
     bad = np.flatnonzero(mine & (np.abs(c.coverage - 1) > COVERAGE_TOL))
     if bad.size:
         i = bad[np.argmax(np.abs(c.coverage[bad] - 1))]
