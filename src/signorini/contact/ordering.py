@@ -25,7 +25,7 @@ import scipy.sparse as sp
 from ..algebra.backends import make_solver
 from ..algebra.pardiso import metis_ordering
 from ..algebra.solvers import SolverFactory, SPDSolver
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
 
 __all__ = ["dof_ordering", "ordered_solver", "vertex_graph"]
@@ -41,7 +41,7 @@ def vertex_graph(mesh: Mesh) -> sp.csr_matrix:
     return sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
 
 
-def dof_ordering(space: P2Space) -> np.ndarray:
+def dof_ordering(space: LagrangeSpace) -> np.ndarray:
     """A nested dissection ordering of the space's DOFs: METIS on the vertex graph
     (:func:`~signorini.algebra.pardiso.metis_ordering`), extended to the edge nodes by
     :meth:`~signorini.fem.space.P2Space.dof_order`.
@@ -55,7 +55,7 @@ def dof_ordering(space: P2Space) -> np.ndarray:
 
 
 def ordered_solver(
-    space: P2Space,
+    space: LagrangeSpace,
     solver: SPDSolver | SolverFactory | None = None,
     *,
     symmetric: bool = True,
@@ -65,7 +65,7 @@ def ordered_solver(
 
     Parameters
     ----------
-    space : P2Space
+    space : LagrangeSpace
     solver : SPDSolver or SolverFactory, optional
         A factory (default :func:`~signorini.algebra.auto_solver`) makes a new solver,
         offered :func:`dof_ordering` (PARDISO takes it; SuperLU keeps its own minimum degree

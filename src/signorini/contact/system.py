@@ -11,8 +11,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..fem.element import Element
 from ..fem.loads import assemble_body_force, assemble_edge_load
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace, space_of
 from ..fem.stiffness import assemble_stiffness
 from ..mesh.mesh import Mesh
 from ..problem.conditions import Neumann
@@ -38,8 +39,9 @@ class Assembled:
 
     Attributes
     ----------
-    space : P2Space
-        The P2 space of the mesh (node numbering: vertices, then edge midpoints).
+    space : P2Space or P1Space
+        The space of the mesh (P2 node numbering: vertices, then edge midpoints; P1: the
+        vertices).
     contact : ContactSet
         The constrained nodes, their normals, gaps and weights.
     K : (n_dofs, n_dofs) scipy.sparse CSR matrix
@@ -63,7 +65,7 @@ class Assembled:
         an obstacle in place): the friction law's slip is relative to it.
     """
 
-    space: P2Space
+    space: LagrangeSpace
     contact: ContactSet
     K: sp.csr_matrix
     F: np.ndarray
@@ -74,20 +76,27 @@ class Assembled:
     obstacle_motion: np.ndarray
 
 
-def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
+def assemble(problem: ContactProblem, mesh: Mesh, *, element: str | Element = "P2") -> Assembled:
     """Stiffness, load and constraints of ``problem`` on ``mesh`` (paper, Section 3).
 
     The two DOFs of every constrained node are transformed into its frame (normal and
     tangential components; a corner's two constraint directions) so that each constraint
-    ``u(z)·n_z ≤ ψ(z)`` becomes a bound on one unknown.
+    ``u(z)·n_z ≤ ψ(z)`` becomes a bound on one unknown. ``element``: ``"P2"`` (the paper's,
+    default) or ``"P1"`` (docs/method.md, *P1 elements and their estimator*); a ValueError
+    names it otherwise.
     """
     t0 = time.perf_counter()
-    space = P2Space(mesh)
+    space = space_of(mesh, element)
     n_dofs = space.n_dofs
     # the space of a validated mesh and problem: no need to re-check the arrays
     with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported just below
         K = assemble_stiffness(
-            space.mapping, space.cell_dofs, n_dofs, problem.material_on(mesh), validate=False
+            space.mapping,
+            space.cell_dofs,
+            n_dofs,
+            problem.material_on(mesh),
+            validate=False,
+            element=space.element,
         )
     if not np.isfinite(K.data).all():
         m = problem.material_on(mesh)
@@ -103,6 +112,7 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
             n_dofs,
             lambda x: evaluate_field(problem.body_force, x, "body_force"),
             degree=LOAD_DEGREE,
+            element=space.element,
         )
     for name in problem.neumann_parts:
         cond: Neumann = problem.conditions[name]
@@ -110,14 +120,16 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
             continue
         edges = mesh.part_edges(name)
         nodes = space.edge_nodes(edges)
-        dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1, 6)
+        dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(len(nodes), -1)
         g = cond.field()
 
         def traction(x, n, g=g, name=name):
             return evaluate_field(g, x, f"the traction of Neumann part {name!r}", normal=n)
 
         for rows, geometry in space.boundary_edges(edges):
-            F += assemble_edge_load(geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE)
+            F += assemble_edge_load(
+                geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE, element=space.element
+            )
     cs = contact_set(problem, space)
     K, F = rotate_frames(K, F, cs.frame_nodes, cs.frames, copy=False, validate=False)
     dirichlet, d_values = _dirichlet_dofs(problem, space, cs)
@@ -147,7 +159,7 @@ def obstacle_displacement(problem: ContactProblem, cs: ContactSet) -> np.ndarray
 
 
 def _dirichlet_dofs(
-    problem: ContactProblem, space: P2Space, cs: ContactSet
+    problem: ContactProblem, space: LagrangeSpace, cs: ContactSet
 ) -> tuple[np.ndarray, np.ndarray]:
     """The held DOFs (sorted) and their values (docs/method.md, *Rollers and components*).
 

@@ -24,7 +24,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..fem.material import CellMaterials, Material
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace, P2Space
 from ..mesh.curves import Line
 from ..mesh.geometry import segment_normals
 from ..mesh.mesh import Mesh
@@ -222,10 +222,10 @@ class ContactProblem:
         value = float(np.sign(mean[axis]) * cond.value)
         return Dirichlet((value, None) if axis == 0 else (None, value))
 
-    def free_ndof(self, mesh: Mesh | P2Space) -> int:
+    def free_ndof(self, mesh: Mesh | LagrangeSpace) -> int:
         """Free scalar unknowns on ``mesh`` (or its space), the paper's Ndof: all DOFs minus
         the held ones (:func:`free_ndof` without rollers; a roller holds one DOF a node)."""
-        space = mesh if isinstance(mesh, P2Space) else P2Space(mesh)
+        space = mesh if isinstance(mesh, LagrangeSpace) else P2Space(mesh)
         return space.n_dofs - int(self.held_components(space).sum())
 
     def _segment_normal(self, name: str) -> np.ndarray | None:
