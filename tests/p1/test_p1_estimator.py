@@ -40,7 +40,12 @@ def test_p1_pieces_of_a_contact_edge_are_its_halves():
     # ∫_0^{1/2} (1 − 2t)(1 − t) dt = 5/24; on the end's half v < 0: nothing
     assert np.allclose(out, [[0.75, 0.75, 0.0], [5 / 24, 0.0, 0.0]], rtol=1e-14, atol=1e-15)
     work = friction_work_thirds(
-        np.array([[1.0, 1.0, 1.0]]), np.zeros((1, 3)), np.ones((1, 3)), np.array([1.0]), None, P1.node_parts
+        np.array([[1.0, 1.0, 1.0]]),
+        np.zeros((1, 3)),
+        np.ones((1, 3)),
+        np.array([1.0]),
+        None,
+        P1.node_parts,
     )
     assert np.allclose(work, [[0.5, 0.5, 0.0]], rtol=1e-14)
 

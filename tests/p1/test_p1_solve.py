@@ -11,9 +11,9 @@ from signorini.contact.solution import solve
 from signorini.contact.system import assemble
 from signorini.examples import example_6_1, example_6_2
 from signorini.fem.element import P1, P2, element_of
+from signorini.fem.mapping import AffineCells
 from signorini.fem.material import Material
 from signorini.fem.norms import energy_error2
-from signorini.fem.mapping import AffineCells
 from signorini.fem.space import P1Space, P2Space, space_of
 from signorini.fem.stiffness import element_blocks
 from signorini.mesh.builders import rectangle
