@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from signorini.cli import main
+from signorini.plots import read_level_mesh
 from tests.test_cli import (
     assert_same_history,
     assert_same_vtu,
@@ -51,6 +52,10 @@ def test_a_p1_run_records_its_element_and_resumes_with_it(tmp_path, capsys, monk
     assert names == sorted(p.name for p in part.glob("level_*.vtu"))
     for name in names[4:]:
         assert_same_vtu(full / name, part / name)
+    # the mesh figure of a long run reads a readable level's mesh back from its VTU file
+    points, cells = read_level_mesh(full / "level_002.vtu")
+    assert cells.shape == (int(rows[2]["n_cells"]), 3) and points.shape == (len(vtu.points), 2)
+    assert main(["figures", "example-6.2", str(full)]) == 0
 
 
 def test_an_unknown_element_flag_is_refused(capsys):

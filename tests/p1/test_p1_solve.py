@@ -154,6 +154,13 @@ def test_p1_contact_patch_test(angle):
     assert density_err < 1e-10
     assert abs(r.total_contact_force - 2 * p) < 1e-10 * p
     assert max(kkt.values()) < 1e-12
+    # the nodal stress (VTU) is the constant exact stress; the profile along Γ_C has p
+    sigma = u.stress(r.space.node_points, MATERIAL)
+    assert np.abs(r.nodal_stress[:, :2, :2] - sigma).max() < 1e-11 * p
+    profile = r.contact_profile("bottom")
+    assert np.array_equal(np.sort(profile.nodes), r.contact.nodes)  # every vertex, in order
+    assert np.allclose(profile.s[-1], 2.0, rtol=1e-12)
+    assert np.nanmax(np.abs(profile.pressure - p)) < 1e-10 * p
 
 
 @pytest.mark.parametrize("example", [example_6_1, example_6_2])
