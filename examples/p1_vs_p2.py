@@ -128,10 +128,83 @@ def table(runs: dict, key: str) -> list[str]:
     return lines
 
 
+def _reach(h: dict, key: str, target: float) -> str:
+    n, sec = first_reach(h[key], h["ndof"], target), first_reach(h[key], h["seconds"], target)
+    if np.isnan(n):
+        return f"more than {int(h['ndof'][-1])} unknowns (not reached)"
+    return f"{int(n)} unknowns ({sec:.1f} s)"
+
+
+def _fastest(runs: dict, key: str) -> str:
+    """The method that reaches each target first in seconds, for the targets some reach."""
+    out = []
+    for target in TARGETS:
+        times = {m: first_reach(h[key], h["seconds"], target) for m, h in runs.items()}
+        times = {m: t for m, t in times.items() if not np.isnan(t)}
+        if times:
+            m = min(times, key=times.get)
+            out.append(f"{100 * target:g} %: {label(*m)} ({times[m]:.1f} s)")
+    return ", ".join(out) or "none reached"
+
+
+def paragraphs(runs61: dict, runs62: dict, runs_h: dict) -> list[str]:
+    """The two paragraphs, their numbers taken from the runs."""
+    p1a, p2a, p1u, p2u = (("P1", False), ("P2", False), ("P1", True), ("P2", True))
+    e61 = {m: slope(h["ndof"], h["error"]) for m, h in runs61.items()}
+    eta62 = {m: slope(h["ndof"], h["eta"]) for m, h in runs62.items()}
+    # unknowns P1 adaptive would need for 0.1 % on 6.1, extrapolated along its own slope
+    h = runs61[p1a]
+    need = h["ndof"][-1] * (h["error"][-1] / 1e-3) ** (-1 / e61[p1a])
+    per_dof = {m: h["seconds"][-1] / h["ndof"].sum() for m, h in runs62.items()}
+    eff = {m: np.median(h["efficiency"]) for m, h in runs61.items()}
+    last = {
+        m: (100 * abs(h["a_error"][-1]), 100 * abs(h["p0_error"][-1])) for m, h in runs_h.items()
+    }
+    return [
+        "**Per unknown.** Where the solution is smooth (Example 6.1) the rate decides: the "
+        f"energy error falls as N_dof^{e61[p2u]:.2f} (P2) against N_dof^{e61[p1u]:.2f} (P1), "
+        "uniform or adaptive alike, so 0.1 % takes P2 adaptive "
+        f"{_reach(runs61[p2a], 'error', 1e-3)} while P1 adaptive, along its own "
+        f"slope, would need about {need:.1e} unknowns. Where contact makes the solution non-smooth "
+        "(Example 6.2, the ends of the contact zone) uniform refinement costs P2 its order: "
+        f"η falls as N_dof^{eta62[p2u]:.2f}, no faster than P1's N_dof^{eta62[p1u]:.2f}; "
+        f"adaptive refinement gives it back (N_dof^{eta62[p2a]:.2f}), while adaptive P1 stays "
+        f"at N_dof^{eta62[p1a]:.2f}, the best a linear element can do. This is the paper's "
+        "claim, measured: P2 pays off for contact only with adaptivity. The total contact "
+        "force converges faster than the energy error for every method; to 0.01 % of the "
+        f"reference it takes P2 adaptive {_reach(runs62[p2a], 'force_error', 1e-4)}, P1 "
+        f"adaptive {_reach(runs62[p1a], 'force_error', 1e-4)}, P2 uniform "
+        f"{_reach(runs62[p2u], 'force_error', 1e-4)} and P1 uniform "
+        f"{_reach(runs62[p1u], 'force_error', 1e-4)}.",
+        "",
+        "**Per second.** A P2 unknown costs about what a P1 unknown costs in this code "
+        f"(Example 6.2, the loop's seconds over the unknowns of all its levels: P1 adaptive "
+        f"{1e6 * per_dof[p1a]:.0f} µs, P2 adaptive {1e6 * per_dof[p2a]:.0f} µs per unknown), "
+        "so the time axis tells the story of the N_dof axis, with one correction: an "
+        "adaptive run (θ = 0.4) pays for many small levels, which a loose target does not "
+        "repay. The fastest to each target: Example 6.1 "
+        f"{_fastest(runs61, 'error')}; Example 6.2 {_fastest(runs62, 'force_error')}. "
+        "On Example 6.1 η stays a nearly constant multiple of the error for both elements "
+        "(efficiency index, median "
+        f"{eff[p1a]:.1f} for P1, {eff[p2a]:.1f} for P2 adaptive): P2's η overestimates "
+        "more, which costs nothing in marking but should be remembered when η is used as a "
+        "stopping tolerance. Hertz bounds all of this by its model: at the finest levels "
+        f"a is {last[p1a][0]:.2f} % (P1 adaptive) and {last[p2a][0]:.2f} % (P2 adaptive) "
+        f"off the Hertz formula, p0 {last[p1a][1]:.2f} % and {last[p2a][1]:.2f} %, where "
+        "the finite half-disc itself differs from Hertz's half-space (the converged model's "
+        "numbers above); against the converged discrete model P2 adaptive reaches 0.1 % in "
+        "a after "
+        f"{_reach(runs_h[p2a], 'a_model', 1e-3)}, P1 adaptive "
+        f"{_reach(runs_h[p1a], 'a_model', 1e-3)}. The peak pressure, a nodal maximum, "
+        "converges erratically for both (the node nearest the centre moves as the mesh "
+        "changes), and P1's arc is a polygon of chords; P2's is the circle.",
+    ]
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--max-ndof", type=int, default=60_000)
-    p.add_argument("--reference-ndof", type=int, default=400_000)
+    p.add_argument("--max-ndof", type=int, default=40_000)
+    p.add_argument("--reference-ndof", type=int, default=250_000)
     p.add_argument("--out", type=Path, default=Path("docs"))
     args = p.parse_args()
     out, figures = args.out, args.out / "figures"
@@ -166,9 +239,18 @@ def main() -> None:
            "η_h")  # fmt: skip
 
     # ---------------------------------------------------------------- Hertz
+    for level in adaptive(hertz(), max_ndof=args.reference_ndof):
+        hertz_ref = (level.record.ndof, hertz_metrics(level.result))
+    h_ndof, h_ref = hertz_ref
+
     def hertz_errors(result, eta):
         m = hertz_metrics(result)
-        return {"a_error": m["a_rel_error"], "p0_error": m["p0_rel_error"]}
+        return {
+            "a_error": m["a_rel_error"],
+            "p0_error": m["p0_rel_error"],
+            "a_model": m["a"] / h_ref["a"] - 1.0,
+            "p0_model": m["p0"] / h_ref["p0"] - 1.0,
+        }
 
     runs_h = {m: run(hertz(), *m, args.max_ndof, hertz_errors) for m in METHODS}
     figure(figures / "p1_vs_p2_hertz_a.png", runs_h, "a_error", "Hertz: half-width a",
@@ -237,9 +319,18 @@ def main() -> None:
         "",
         *table(runs_h, "p0_error"),
         "",
+        "The same against the converged discrete model instead of Hertz (P2 adaptive to "
+        f"{h_ndof} unknowns: a = {h_ref['a']:.8g}, p0 = {h_ref['p0']:.8g}, themselves "
+        f"{100 * h_ref['a_rel_error']:+.3f} % and {100 * h_ref['p0_rel_error']:+.3f} % off "
+        "Hertz), half-width a, then peak pressure p0:",
+        "",
+        *table(runs_h, "a_model"),
+        "",
+        *table(runs_h, "p0_model"),
+        "",
         "## What the figures say",
         "",
-        "PARAGRAPHS",
+        *paragraphs(runs61, runs62, runs_h),
         "",
     ]
     (out / "p1_vs_p2.md").write_text("\n".join(md))
