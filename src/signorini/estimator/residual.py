@@ -24,7 +24,9 @@ vertex or as their midpoint): the only edges where the P2 basis function ψ_p is
 γ̃_p is made of the thirds of the contact edges that belong to p (outer thirds to the end
 vertices, the middle third to the midpoint). On contact edges ψ is replaced by its P2
 interpolant, so that (u_h·n − ψ) is a quadratic on each edge (exact for gaps that are
-piecewise quadratic with kinks at nodes, as in Example 6.2).
+piecewise quadratic with kinks at nodes, as in Example 6.2). A P1 solution is estimated by the
+same terms on its P2 form, the pieces γ̃_p and the edge layout taken from its element
+(docs/method.md, *P1 elements and their estimator*).
 
 Each term is one function of :mod:`signorini.estimator.terms` (arrays in, integrals out):
 η1 ``interior_residual``, η2 ``stress_jump``, η3 ``neumann_residual``,

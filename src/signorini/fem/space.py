@@ -88,14 +88,11 @@ class LagrangeSpace:
         stresses, norms) read (:meth:`~signorini.fem.element.Element.cell_coefficients`)."""
         return self.element.cell_coefficients(self.cell_values(u))
 
-    @cached_property
+    @property
     def cell_map_nodes(self) -> np.ndarray:
-        """``(n_cells, 6, 2)`` the six P2 node points of each cell's map (its vertices and
-        edge midpoints; on a curved part's cells of a P2 space the midpoint on the curve)."""
-        if self.element.n_local == 6:
-            return self.node_points[self.cell_nodes]
-        v = self.vertices
-        return np.concatenate([v, 0.5 * (v + v[:, [1, 2, 0]])], axis=1)
+        """``(n_cells, 6, 2)`` the six P2 node points of each cell's map: its vertices and
+        edge midpoints (on a curved part's cells of a P2 space the midpoint on the curve)."""
+        return self.node_points[self.cell_nodes]
 
 
 class P2Space(LagrangeSpace):
@@ -337,6 +334,13 @@ class P1Space(LagrangeSpace):
     def curved_edges(self) -> np.ndarray:
         """No edge is a quadratic: every edge is its chord."""
         return np.zeros(0, dtype=np.int64)
+
+    @property
+    def cell_map_nodes(self) -> np.ndarray:
+        """``(n_cells, 6, 2)`` each cell's vertices and chord midpoints: the P2 node points of
+        its (affine) map."""
+        v = self.vertices
+        return np.concatenate([v, 0.5 * (v + v[:, [1, 2, 0]])], axis=1)
 
     def dof_order(self, vertex_order: np.ndarray) -> np.ndarray:
         """The order of the DOFs of an order of the vertices, the two DOFs of a node
