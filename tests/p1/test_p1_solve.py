@@ -16,6 +16,8 @@ from signorini.fem.material import Material
 from signorini.fem.norms import energy_error2
 from signorini.fem.space import P1Space, P2Space, space_of
 from signorini.fem.stiffness import element_blocks
+from signorini.loop import adaptive
+from signorini.loop.options import AdaptiveOptions, OptionError
 from signorini.mesh.builders import rectangle
 from signorini.mesh.refine import refine_nvb, refine_uniform
 from tests.contact.test_solution import nvb_mesh, rotated_mesh, square_sides
@@ -184,3 +186,16 @@ def test_an_unknown_element_is_refused_naming_the_argument():
         assemble(pb, pb.mesh, element="Q1")
     with pytest.raises(ValueError, match="element must be one of"):
         element_of("P3")
+    with pytest.raises(OptionError, match="element must be one of") as err:
+        AdaptiveOptions(element="P3")
+    assert err.value.field == "element"
+    with pytest.raises(OptionError, match="element must be one of"):
+        adaptive(pb, element="P3")  # refused at the call, before any work
+
+
+def test_the_element_option_is_recorded_and_read_back():
+    options = AdaptiveOptions(element="p1")
+    assert options.element == "P1" and options.to_record()["element"] == "P1"
+    assert AdaptiveOptions.from_record(options.to_record()).element == "P1"
+    old = {k: v for k, v in AdaptiveOptions().to_record().items() if k != "element"}
+    assert AdaptiveOptions.from_record(old).element == "P2"  # a manifest from before P1
