@@ -28,6 +28,7 @@ OPTION_FLAGS: dict[str, str] = {
     "eta5": "eta5_variant",
     "backend": "solver",
     "fallback": "fallback",
+    "element": "element",
 }
 #: The flags that decide a run's files (recorded with the options; default off).
 FILE_FLAGS = ("no_vtu", "compare_uniform")
@@ -105,6 +106,13 @@ def parser() -> argparse.ArgumentParser:
         action="store_true",
         help="where the active set iteration cycles, finish that level with the primal "
         "active set method instead of stopping",
+    )
+    run.add_argument(
+        "--element",
+        type=str.upper,
+        choices=("P1", "P2"),
+        help="finite element: P2, the paper's, or P1 with its residual estimator (any case; "
+        f"default {default.element})",
     )
     run.add_argument(
         "--out", type=Path, default=None, help="output folder (default results/<problem>)"

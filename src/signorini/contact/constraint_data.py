@@ -13,7 +13,7 @@ import numpy as np
 from ..algebra.laws import LawGroups
 from ..fem import iso, p2
 from ..fem.quadrature import gauss_legendre
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace
 from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.normals import node_normals
@@ -35,7 +35,7 @@ __all__ = [
 
 
 def _body_normals(
-    problem: ContactProblem, space: P2Space, name: str, nodes: np.ndarray, chord: np.ndarray
+    problem: ContactProblem, space: LagrangeSpace, name: str, nodes: np.ndarray, chord: np.ndarray
 ) -> np.ndarray:
     """The body's outward unit normal at the nodes ``[start, end, midpoint]`` of one contact
     part's edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``
@@ -50,7 +50,9 @@ def _body_normals(
     )
 
 
-def part_normals(space: P2Space, name: str, nodes: np.ndarray, chord: np.ndarray) -> np.ndarray:
+def part_normals(
+    space: LagrangeSpace, name: str, nodes: np.ndarray, chord: np.ndarray
+) -> np.ndarray:
     """The outward unit normal of boundary part ``name`` at the nodes ``[start, end,
     midpoint]`` of its edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``,
     from the geometry alone (:func:`signorini.problem.normals.node_normals`)."""
@@ -59,7 +61,7 @@ def part_normals(space: P2Space, name: str, nodes: np.ndarray, chord: np.ndarray
 
 def directions_and_gaps(
     problem: ContactProblem,
-    space: P2Space,
+    space: LagrangeSpace,
     cs_edges: tuple,
     chord: np.ndarray,
     couplings: Mapping[str, MortarCoupling],
@@ -86,23 +88,24 @@ def directions_and_gaps(
                 psi, n = cond.obstacle.gap_and_direction(x)
             except ValueError as err:
                 raise ProblemError(f"the obstacle of contact part {name!r}: {err}") from err
-            direction[sel] = n[inverse].reshape(-1, 3, 2)
+            direction[sel] = n[inverse].reshape(-1, edge_nodes.shape[1], 2)
         else:
             what = f"the gap function of contact part {name!r}"
             psi = evaluate_field(cond.gap_field(), x, what, shape=())
             direction[sel] = _body_normals(problem, space, name, edge_nodes[sel], chord[sel])
-        gap[sel] = psi[inverse].reshape(-1, 3)
+        gap[sel] = psi[inverse].reshape(-1, edge_nodes.shape[1])
     return direction, gap
 
 
-def edge_weights(space: P2Space, edges: np.ndarray, edge_nodes: np.ndarray):
-    """``∫ φ_z ds`` and ``∫ ψ_z ds`` of ``[start, end, midpoint]`` on each contact edge,
-    ``(n_ce, 3)`` each: closed forms on straight edges, a Gauss rule along the quadratic edge
-    on curved ones."""
+def edge_weights(space: LagrangeSpace, edges: np.ndarray, edge_nodes: np.ndarray):
+    """``∫ φ_z ds`` and ``∫ ψ_z ds`` of ``[start, end, midpoint]`` (P1: ``[start, end]``) on
+    each contact edge, ``(n_ce, 3)`` (``(n_ce, 2)``) each: closed forms on straight edges
+    (the element's shares of the length), a Gauss rule along the quadratic edge on curved
+    ones."""
     length = space.mesh.edge_length[edges]
-    hat = np.column_stack([length / 4, length / 4, length / 2])
-    basis = np.column_stack([length / 6, length / 6, 2 * length / 3])
-    curved = np.flatnonzero(np.isin(edges, iso.curved_edges(space.mesh)))
+    hat = np.outer(length, space.element.hat_share)
+    basis = np.outer(length, space.element.basis_share)
+    curved = np.flatnonzero(np.isin(edges, space.curved_edges))
     if curved.size:
         t, w = gauss_legendre(6)
         halves = np.concatenate([t / 2, 0.5 + t / 2])  # φ_z is linear on each half-edge
@@ -123,7 +126,7 @@ def edge_weights(space: P2Space, edges: np.ndarray, edge_nodes: np.ndarray):
 
 def friction_data(
     problem: ContactProblem,
-    space: P2Space,
+    space: LagrangeSpace,
     edge_part: np.ndarray,
     edge_nodes: np.ndarray,
     edge_local: np.ndarray,
@@ -159,7 +162,7 @@ def friction_data(
     return LawGroups(tuple(laws), index, weight)
 
 
-def _integrator(space: P2Space, on_part: np.ndarray, edges: tuple, what: str, k: int):
+def _integrator(space: LagrangeSpace, on_part: np.ndarray, edges: tuple, what: str, k: int):
     """``integrate(f)``: ``∫ f ψ_z ds`` over the edges ``on_part`` (of ``edges``, the contact
     edges' nodes and constraint rows) per constraint ``(k,)``,
     by a 4-point Gauss rule along the (quadratic) edges; ``f`` must be ``≥ 0``."""
@@ -169,12 +172,17 @@ def _integrator(space: P2Space, on_part: np.ndarray, edges: tuple, what: str, k:
 
     def integrate(field) -> np.ndarray:
         points = space.node_points[edge_nodes[sel]]
-        x, speed, _ = iso.edge_geometry(points[:, :2], points[:, 2], t)
+        if points.shape[1] == 2:  # P1: straight edges [start, end]
+            d = points[:, 1] - points[:, 0]
+            x = points[:, None, 0] + t[None, :, None] * d[:, None]
+            speed = np.broadcast_to(np.hypot(d[:, 0], d[:, 1])[:, None], x.shape[:2])
+        else:
+            x, speed, _ = iso.edge_geometry(points[:, :2], points[:, 2], t)
         s = evaluate_field(field, x.reshape(-1, 2), what, shape=())
         if (s < 0).any():
             raise ProblemError(f"{what} must be >= 0; it is {s.min():.6g} somewhere")
         # ∫ s ψ_j |x'(t)| dt on each edge, j = start, end, midpoint
-        share = (s.reshape(-1, t.size) * speed * w) @ p2.edge_basis(t)
+        share = (s.reshape(-1, t.size) * speed * w) @ space.element.edge_basis(t)
         loc = edge_local[sel].ravel()
         inside = loc >= 0
         return np.bincount(loc[inside], weights=share.ravel()[inside], minlength=k)
@@ -191,7 +199,11 @@ DIRICHLET_POINT_TOL = 1e-12
 
 
 def check_dirichlet_admissible(
-    problem: ContactProblem, space: P2Space, nodes: np.ndarray, constraint: tuple, parts: tuple
+    problem: ContactProblem,
+    space: LagrangeSpace,
+    nodes: np.ndarray,
+    constraint: tuple,
+    parts: tuple,
 ) -> None:
     """Refuse Dirichlet data that violate the contact constraint at a node of a contact part.
 
@@ -257,7 +269,7 @@ def check_dirichlet_admissible(
 DEEP_OVERLAP = 0.25
 
 
-def _dirichlet_values(problem: ContactProblem, space: P2Space, nodes: np.ndarray):
+def _dirichlet_values(problem: ContactProblem, space: LagrangeSpace, nodes: np.ndarray):
     """``u_D`` at the Dirichlet nodes ``nodes (j,)`` (held in both components, from one part
     or two, a roller's among them: :func:`~signorini.problem.rollers.held_nodes`) and the
     Dirichlet or Roller part of each (the later one at a node on two)."""
@@ -269,7 +281,11 @@ def _dirichlet_values(problem: ContactProblem, space: P2Space, nodes: np.ndarray
 
 
 def check_initial_overlap(
-    problem: ContactProblem, space: P2Space, nodes: np.ndarray, constraint: tuple, parts: tuple
+    problem: ContactProblem,
+    space: LagrangeSpace,
+    nodes: np.ndarray,
+    constraint: tuple,
+    parts: tuple,
 ) -> None:
     """Refuse an obstacle shape that starts deeper inside the body than its linearisation
     covers.

@@ -27,7 +27,7 @@ from functools import cached_property
 import numpy as np
 
 from ..algebra.laws import LawGroups
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace
 from ..mesh.geometry import segment_normals
 from ..problem.fields import ProblemError
 from ..problem.problem import ContactProblem
@@ -98,7 +98,8 @@ class ContactSet:
     edges : (n_ce,) int array
         Mesh edges of Γ_C, part after part.
     edge_nodes : (n_ce, 3) int array
-        Global nodes ``[start, end, midpoint]`` of each contact edge, start to end in the
+        Global nodes ``[start, end, midpoint]`` (P1: ``(n_ce, 2)``, ``[start, end]``; the
+        other per-edge-node arrays likewise) of each contact edge, start to end in the
         counter-clockwise direction of the boundary (Dirichlet nodes included).
     edge_part : (n_ce,) int array
         Index into ``parts`` of each contact edge.
@@ -324,7 +325,7 @@ def _refuse_opposite(nodes: np.ndarray, points: np.ndarray, names: tuple, pair: 
     )
 
 
-def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
+def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     """Collect the constraints of ``space`` for ``problem`` (docs/method.md, *Discrete
     problem* and *Contact directions*).
 
@@ -389,7 +390,7 @@ def contact_set(problem: ContactProblem, space: P2Space) -> ContactSet:
     )
     cand_row = np.full(ukey.size, -1)
     cand_row[kept] = row_of
-    edge_local = cand_row[cand_of].reshape(-1, 3)
+    edge_local = cand_row[cand_of].reshape(edge_nodes.shape)
     lead = kept[starts]
     nodes = cand_node[lead]
     if np.unique(nodes, return_counts=True)[1].max() > 2:
@@ -451,7 +452,9 @@ def node_classes(cs: ContactSet, in_contact: np.ndarray, edge_in_contact: np.nda
     loc = cs.edge_local.ravel()
     touching = loc >= 0
     broken = np.bincount(
-        loc[touching], weights=np.repeat(~edge_full, 3)[touching], minlength=cs.size
+        loc[touching],
+        weights=np.repeat(~edge_full, cs.edge_local.shape[1])[touching],
+        minlength=cs.size,
     )
     classes = np.full(cs.size, NO_CONTACT, dtype=np.int64)
     classes[in_contact] = SEMI_CONTACT

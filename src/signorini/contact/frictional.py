@@ -26,7 +26,7 @@ from ..algebra.friction_kkt import check_friction
 from ..algebra.laws import LawGroups
 from ..algebra.result import SolveReport
 from ..algebra.solvers import SolverFactory, SPDSolver
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace
 from ..problem.fields import ProblemError
 from .contact_set import ContactSet
 from .node_frames import to_frames
@@ -108,7 +108,7 @@ def same_law_kinds(a: LawGroups, b: LawGroups) -> bool:
     return bool(np.array_equal(kinds(a), kinds(b)))
 
 
-def check_previous(previous: object, space: P2Space, cs: ContactSet) -> None:
+def check_previous(previous: object, space: LagrangeSpace, cs: ContactSet) -> None:
     """Check that ``previous`` is the result of a load step in ``space`` with the contact
     nodes of ``cs`` (docs/method.md, *Load paths*).
 

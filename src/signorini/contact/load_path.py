@@ -33,6 +33,7 @@ def solve_path(
     solver: SPDSolver | SolverFactory | None = None,
     max_iter: int = 50,
     u0: np.ndarray | None = None,
+    element: str = "P2",
 ) -> list[ContactResult]:
     """Solve a prescribed load path: one problem per load step, each from the previous step.
 
@@ -53,6 +54,8 @@ def solve_path(
         Warm start of the first step on ``mesh`` (as for :func:`~signorini.contact.solve`;
         e.g. the first step of a coarser mesh prolongated); the later steps start from the
         previous step.
+    element : {"P2", "P1"}
+        The finite element of every step (:func:`~signorini.contact.solve`).
 
     Returns
     -------
@@ -74,7 +77,15 @@ def solve_path(
         previous = results[-1] if results else None
         start = u0 if previous is None else None
         results.append(
-            solve(problem, mesh, u0=start, previous=previous, solver=solver, max_iter=max_iter)
+            solve(
+                problem,
+                mesh,
+                u0=start,
+                previous=previous,
+                solver=solver,
+                max_iter=max_iter,
+                element=element,
+            )
         )
         log.info("load step %d of %d solved", i + 1, len(problems))
     return results

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
 from ..mesh.refine import refine_nvb
 from .contact_set import ContactSet
@@ -107,10 +107,10 @@ def coarse_mesh(initial: Mesh, fine: Mesh, contact_parts: list[str]) -> Mesh | N
 
 
 def transfer_active(
-    coarse_space: P2Space,
+    coarse_space: LagrangeSpace,
     coarse_contact: ContactSet,
     coarse_active: np.ndarray,
-    space: P2Space,
+    space: LagrangeSpace,
     contact: ContactSet,
 ) -> np.ndarray:
     """The fine mesh's initial active set: each constraint takes the state of the coarse

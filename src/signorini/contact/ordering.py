@@ -25,7 +25,7 @@ import scipy.sparse as sp
 from ..algebra.backends import make_solver
 from ..algebra.pardiso import metis_ordering
 from ..algebra.solvers import SolverFactory, SPDSolver
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
 
 __all__ = ["dof_ordering", "ordered_solver", "vertex_graph"]
@@ -55,7 +55,7 @@ def _with_coupling(graph: sp.csr_matrix, mesh: Mesh, coupling: sp.spmatrix) -> s
     return (graph + extra).tocsr()
 
 
-def dof_ordering(space: P2Space, coupling: sp.spmatrix | None = None) -> np.ndarray:
+def dof_ordering(space: LagrangeSpace, coupling: sp.spmatrix | None = None) -> np.ndarray:
     """A nested dissection ordering of the space's DOFs: METIS on the vertex graph
     (:func:`~signorini.algebra.pardiso.metis_ordering`), with the node pairs ``coupling``
     joins (a contact pair's mortar transfer, docs/method.md, *Two bodies*), extended to the
@@ -73,7 +73,7 @@ def dof_ordering(space: P2Space, coupling: sp.spmatrix | None = None) -> np.ndar
 
 
 def ordered_solver(
-    space: P2Space,
+    space: LagrangeSpace,
     solver: SPDSolver | SolverFactory | None = None,
     *,
     symmetric: bool = True,
@@ -84,7 +84,7 @@ def ordered_solver(
 
     Parameters
     ----------
-    space : P2Space
+    space : LagrangeSpace
     solver : SPDSolver or SolverFactory, optional
         A factory (default :func:`~signorini.algebra.auto_solver`) makes a new solver,
         offered :func:`dof_ordering` (PARDISO takes it; SuperLU keeps its own minimum degree

@@ -101,9 +101,12 @@ def contact_profile(result: ContactResult, part: str | None = None) -> ContactPr
     mine = np.flatnonzero(cs.edge_part == cs.parts.index(part))
     order, chain_end, chain = _walk(cs.edge_nodes[mine], result.space.node_points)
     edges = mine[order]
-    # per ordered edge: start, midpoint, and the end vertex where a chain ends
-    take = np.column_stack([np.ones(edges.size, bool), np.ones(edges.size, bool), chain_end])
-    column = np.broadcast_to(np.array([0, 2, 1]), take.shape)[take]
+    # per ordered edge: start, midpoint (P2; P1 edges have none), and the end vertex where a
+    # chain ends
+    inner = [np.ones(edges.size, bool)] * (cs.edge_nodes.shape[1] - 1)
+    take = np.column_stack([*inner, chain_end])
+    order_of = np.array([0, 2, 1]) if cs.edge_nodes.shape[1] == 3 else np.array([0, 1])
+    column = np.broadcast_to(order_of, take.shape)[take]
     row = np.broadcast_to(edges[:, None], take.shape)[take]
     nodes = cs.edge_nodes[row, column]
     points = result.space.node_points[nodes]

@@ -20,9 +20,10 @@ from ..algebra.friction import INACTIVE, SLIP, STICK
 from ..algebra.pdas import PDASOptions, solve_pdas
 from ..algebra.result import PDASConvergenceError, SolveReport
 from ..algebra.solvers import SolverFactory, SPDSolver
+from ..fem.element import Element
 from ..fem.norms import energy_error2, h1_seminorm_error2
 from ..fem.postprocess import nodal_stress
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
@@ -96,8 +97,8 @@ class ContactResult:
     ----------
     problem : ContactProblem
         The problem that was solved.
-    space : P2Space
-        The P2 space of the mesh (``space.mesh``; node numbering: vertices, then midpoints).
+    space : P2Space or P1Space
+        The space of the mesh (``space.mesh``; P2 node numbering: vertices, then midpoints).
     u : (n_nodes, 2) float array
         Nodal displacements u_h(z) (Cartesian) at every P2 node.
     contact : ContactSet
@@ -149,7 +150,7 @@ class ContactResult:
     """
 
     problem: ContactProblem
-    space: P2Space
+    space: LagrangeSpace
     u: np.ndarray
     contact: ContactSet
     contact_force: np.ndarray
@@ -243,7 +244,7 @@ class ContactResult:
         exact = self.problem.exact
         if exact is None:
             raise ValueError(f"{self.problem.name} has no exact solution")
-        u_cell = self.space.cell_values(self.u)
+        u_cell = self.space.field_coefficients(self.u)
 
         def gradient(x: np.ndarray) -> np.ndarray:
             return evaluate_field(exact.gradient, x, "the exact gradient", shape=(2, 2))
@@ -265,6 +266,7 @@ def solve(
     assembled: Assembled | None = None,
     previous: ContactResult | None = None,
     nested: bool = True,
+    element: str | Element = "P2",
 ) -> ContactResult:
     """Solve the discrete Signorini problem (3.2) on ``mesh`` by the primal-dual active set
     method (docs/method.md, *Solver*); with Tresca or Coulomb friction on a contact part, by
@@ -302,15 +304,19 @@ def solve(
         from the active set of a coarse solve (:mod:`signorini.contact.nested`;
         docs/method.md, *Solver*). The solution is the same; False starts from the empty
         active set.
+    element : {"P2", "P1"}
+        The finite element (docs/method.md, *P1 elements and their estimator*); ignored with
+        ``assembled``, whose space has one.
 
     Raises
     ------
     ValueError
-        For a malformed ``u0``, or a ``previous`` of another mesh or other contact parts.
+        For a malformed ``u0``, an unknown ``element``, or a ``previous`` of another mesh or
+        other contact parts.
     """
     mesh = problem.mesh if mesh is None else mesh
     if assembled is None:
-        assembled = assemble(problem, mesh)
+        assembled = assemble(problem, mesh, element=element)
     space, cs = assembled.space, assembled.contact
     if problem.rigid_motions.size:
         check_load_carried(problem, assembled)
@@ -437,7 +443,14 @@ def _nested_active_set(
     if coarse is None:
         return None
     try:
-        result = solve(problem, coarse, solver=solver, max_iter=max_iter, fallback=fallback)
+        result = solve(
+            problem,
+            coarse,
+            solver=solver,
+            max_iter=max_iter,
+            fallback=fallback,
+            element=space.element,
+        )
     except PDASConvergenceError:
         return None
     log.info(

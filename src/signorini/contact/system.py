@@ -12,8 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..fem.element import Element
 from ..fem.loads import assemble_body_force, assemble_edge_load
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace, space_of
 from ..fem.stiffness import assemble_stiffness
 from ..mesh.mesh import Mesh
 from ..problem.conditions import Neumann, Roller
@@ -50,8 +51,9 @@ class Assembled:
 
     Attributes
     ----------
-    space : P2Space
-        The P2 space of the mesh (node numbering: vertices, then edge midpoints).
+    space : P2Space or P1Space
+        The space of the mesh (P2 node numbering: vertices, then edge midpoints; P1: the
+        vertices).
     contact : ContactSet
         The constrained nodes, their normals, gaps and weights.
     K : (n_dofs, n_dofs) scipy.sparse CSR matrix
@@ -87,7 +89,7 @@ class Assembled:
         there, to recover the roller's force (:func:`roller_dofs`).
     """
 
-    space: P2Space
+    space: LagrangeSpace
     contact: ContactSet
     K: sp.csr_matrix
     F: np.ndarray
@@ -101,22 +103,34 @@ class Assembled:
     rollers: RollerDofs
 
 
-def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
+def assemble(problem: ContactProblem, mesh: Mesh, *, element: str | Element = "P2") -> Assembled:
     """Stiffness, load and constraints of ``problem`` on ``mesh`` (paper, Section 3).
 
     The two DOFs of every constrained node are transformed into its frame (normal and
     tangential components; a corner's two constraint directions) so that each constraint
     ``u(z)·n_z ≤ ψ(z)`` becomes a bound on one unknown. With contact pairs between bodies
     the unknowns are first the relative displacement ``ũ = u − T u``
-    (:mod:`~signorini.contact.two_body`; docs/method.md, *Two bodies*).
+    (:mod:`~signorini.contact.two_body`; docs/method.md, *Two bodies*). ``element``:
+    ``"P2"`` (the paper's, default) or ``"P1"`` (docs/method.md, *P1 elements and their
+    estimator*; not with contact pairs); a ValueError names it otherwise.
     """
     t0 = time.perf_counter()
-    space = P2Space(mesh)
+    space = space_of(mesh, element)
+    if problem.pairs and space.element.name != "P2":
+        raise ValueError(
+            f"element={space.element.name!r}: contact pairs between bodies (the dual mortar "
+            "coupling of docs/method.md, *Two bodies*) are built for P2 only"
+        )
     n_dofs = space.n_dofs
     # the space of a validated mesh and problem: no need to re-check the arrays
     with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported just below
         K = assemble_stiffness(
-            space.mapping, space.cell_dofs, n_dofs, problem.material_on(mesh), validate=False
+            space.mapping,
+            space.cell_dofs,
+            n_dofs,
+            problem.material_on(mesh),
+            validate=False,
+            element=space.element,
         )
     if not np.isfinite(K.data).all():
         m = problem.material_on(mesh)
@@ -132,6 +146,7 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
             n_dofs,
             lambda x: evaluate_field(problem.body_force, x, "body_force"),
             degree=LOAD_DEGREE,
+            element=space.element,
         )
     for name in problem.neumann_parts:
         cond: Neumann = problem.conditions[name]
@@ -139,14 +154,16 @@ def assemble(problem: ContactProblem, mesh: Mesh) -> Assembled:
             continue
         edges = mesh.part_edges(name)
         nodes = space.edge_nodes(edges)
-        dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1, 6)
+        dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(len(nodes), -1)
         g = cond.field()
 
         def traction(x, n, g=g, name=name):
             return evaluate_field(g, x, f"the traction of Neumann part {name!r}", normal=n)
 
         for rows, geometry in space.boundary_edges(edges):
-            F += assemble_edge_load(geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE)
+            F += assemble_edge_load(
+                geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE, element=space.element
+            )
     cs = contact_set(problem, space)
     if cs.transfer is not None:  # contact pairs: the relative displacement's basis
         K, F = two_body_system(K, F, cs.transfer.dofs)
@@ -202,7 +219,7 @@ class RollerDofs:
 
 
 def roller_dofs(
-    problem: ContactProblem, space: P2Space, held: HeldNodes, cs: ContactSet
+    problem: ContactProblem, space: LagrangeSpace, held: HeldNodes, cs: ContactSet
 ) -> RollerDofs:
     """The :class:`RollerDofs` of ``problem`` on ``space``: the roller nodes in frames
     (``held.roller_nodes`` off the contact boundary) and the nodes of rollers along an axis
@@ -261,7 +278,7 @@ def obstacle_displacement(problem: ContactProblem, cs: ContactSet) -> np.ndarray
 
 
 def _dirichlet_dofs(
-    held: HeldNodes, space: P2Space, cs: ContactSet
+    held: HeldNodes, space: LagrangeSpace, cs: ContactSet
 ) -> tuple[np.ndarray, np.ndarray]:
     """The held DOFs (sorted) and their values (docs/method.md, *Rollers and components*).
 
@@ -308,7 +325,7 @@ def _dirichlet_dofs(
 
 
 def _check_held_at_contact(
-    space: P2Space, cs: ContactSet, nodes: np.ndarray, direction: np.ndarray, name: list
+    space: LagrangeSpace, cs: ContactSet, nodes: np.ndarray, direction: np.ndarray, name: list
 ) -> np.ndarray:
     """The frame DOF ``j`` each constrained node ``nodes`` holds along ``direction (m, 2)``
     (named ``name``); refuses a direction that is not one free frame DOF, or friction at

@@ -63,10 +63,16 @@ def friction_edges(result: ContactResult, unit: float = 1.0) -> FrictionEdges | 
 def move_dirichlet_thirds(parts: np.ndarray, edge_local: np.ndarray) -> np.ndarray:
     """Per-node parts ``(n_ce, 3)`` with the part of a Dirichlet end point (``edge_local``
     ``-1``) added to the edge's midpoint, so that Dirichlet nodes carry none and the parts
-    still sum to the edge's integral."""
+    still sum to the edge's integral. With P1's ``edge_local (n_ce, 2)`` (no midpoint node)
+    it goes to the edge's other end."""
     out = parts.copy()
     for col in (0, 1):
         at = edge_local[:, col] < 0
-        out[at, 2] += out[at, col]
+        # P1 (two nodes an edge): to the edge's other end, unless that is a Dirichlet node too
+        other = 1 - col
+        to = 2 if edge_local.shape[1] == 3 else other
+        if to == other:
+            at &= edge_local[:, other] >= 0
+        out[at, to] += out[at, col]
         out[at, col] = 0.0
     return out

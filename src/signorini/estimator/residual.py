@@ -24,7 +24,9 @@ vertex or as their midpoint): the only edges where the P2 basis function ψ_p is
 γ̃_p is made of the thirds of the contact edges that belong to p (outer thirds to the end
 vertices, the middle third to the midpoint). On contact edges ψ is replaced by its P2
 interpolant, so that (u_h·n − ψ) is a quadratic on each edge (exact for gaps that are
-piecewise quadratic with kinks at nodes, as in Example 6.2).
+piecewise quadratic with kinks at nodes, as in Example 6.2). A P1 solution is estimated by the
+same terms on its P2 form, the pieces γ̃_p and the edge layout taken from its element
+(docs/method.md, *P1 elements and their estimator*).
 
 Each term is one function of :mod:`signorini.estimator.terms` (arrays in, integrals out):
 η1 ``interior_residual``, η2 ``stress_jump``, η3 ``neumann_residual``,
@@ -51,12 +53,11 @@ import scipy.sparse as sp
 
 from ..contact.contact_set import SEMI_CONTACT
 from ..contact.solution import ContactResult
-from ..fem.iso import curved_edges
 from ..fem.mapping import CellMap, edge_groups
 from ..fem.material import CellMaterials, Material, on_cells
 from ..fem.postprocess import stress_divergence
 from ..fem.quadrature import line_rule, triangle_rule
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .friction import friction_edges, move_dirichlet_thirds
@@ -217,6 +218,8 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
         raise ValueError(f"eta5_variant must be one of {ETA5_VARIANTS}, got {eta5_variant!r}")
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells
+    element = space.element  # P2, or P1 read as the P2 field it is (docs/method.md, *P1 ...*)
+    on_edge = element.edge_values  # nodal data of contact edges at [start, end, midpoint]
     h_p = _node_mesh_size(mesh.h, space.cell_nodes, result.dirichlet_nodes, n_nodes)
     cells, quadratic_edges = geometry(space)
 
@@ -224,24 +227,26 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
     # every stress-like input (σ(u_h), div σ(u_h), f, g, p_z, s_z) is divided by the stress
     # unit σ₀ (a power of 4, 1 for ordinary stresses): exact, and no square overflows;
     # Estimate puts σ₀ back (docs/method.md, *Estimator*, "Units")
-    u_cell = space.cell_values(result.u)
+    u_cell = space.field_coefficients(result.u)
     material = problem.material_on(mesh)  # each cell's own where regions differ
     sigma = vertex_stress(cells, u_cell, material)
     unit = stress_unit(float(np.abs(sigma).max(initial=0.0)))
     stresses = CellStress(cells, mesh.points, mesh.cells, u_cell, material, sigma / unit, unit)
     t, w = line_rule(EDGE_DEGREE)
-    inner = _edge_set(mesh, np.flatnonzero(mesh.edge2cell[:, 1] >= 0))
+    inner = _edge_set(space, np.flatnonzero(mesh.edge2cell[:, 1] >= 0))
     jump = _from_both_sides(mesh, stresses.traction, inner.index, t)
     t_n, w_n = line_rule(NEUMANN_DEGREE)
     # the masters of contact pairs are Neumann edges with the slave's traction (pairs.py)
     masters, J3_masters = master_integrals(result, stresses, t_n, w_n, unit)
-    neumann = _edge_set(mesh, np.concatenate([_part_edges(mesh, problem.neumann_parts), masters]))
+    neumann = _edge_set(space, np.concatenate([_part_edges(mesh, problem.neumann_parts), masters]))
     contact = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
-    pressure = _edge_pressure(result) / unit if eta5_variant == "consistent" else None
+    pressure = on_edge(_edge_pressure(result)) / unit if eta5_variant == "consistent" else None
     friction = friction_edges(result, unit)  # None without friction
+    if friction is not None:
+        friction = type(friction)(*(on_edge(v) for v in friction))
     p_t = None if friction is None else friction.friction
-    gap = cs.edge_normal_gap(result.u)  # u_h·n − ψ_h at [start, end, midpoint]
-    density = _semi_contact_density(result) / unit
+    gap = on_edge(cs.edge_normal_gap(result.u))  # u_h·n − ψ_h at [start, end, midpoint]
+    density = on_edge(_semi_contact_density(result)) / unit
     x0, x1 = mesh.points[cs.edge_nodes[:, 0]], mesh.points[cs.edge_nodes[:, 1]]
     eta7_shares = penetration(x0, x1, gap, scale=float(np.abs(result.u).max(initial=0.0)))
 
@@ -249,17 +254,17 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
     # *Estimator*, "On curved boundaries")
     R = _interior_residual(problem, material, cells, u_cell, unit)
     J3 = np.concatenate([_neumann_integrals(problem, mesh, stresses, t_n, w_n, unit), J3_masters])
-    J4, J5 = contact_stress(
-        stresses, mesh, contact, cs.edge_normal, cs.edge_direction, t, w, pressure, p_t
-    )
+    direction = on_edge(cs.edge_direction)
+    J4, J5 = contact_stress(stresses, mesh, contact, cs.edge_normal, direction, t, w, pressure, p_t)
     parts6 = np.zeros(gap.shape)
     parts8 = np.zeros(gap.shape)
     curved = np.isin(cs.edges, quadratic_edges)
     for rows, edges in edge_groups(space.node_points[cs.edge_nodes], curved):
-        parts6[rows] = complementarity(gap[rows], density[rows], edges)
+        parts6[rows] = complementarity(gap[rows], density[rows], edges, None, element.hat_pieces)
         if friction is not None:
             slip, bound = friction.slip[rows], friction.bound[rows]
-            parts8[rows] = friction_work(slip, p_t[rows], bound, edges)
+            parts8[rows] = friction_work(slip, p_t[rows], bound, edges, None, element.node_parts)
+    n_edge = element.n_edge  # the element's own edge nodes (P1: the two ends)
 
     def on_edges(edges: EdgeSet, J: np.ndarray) -> TermShares:
         return spread_edge_integrals(edges, J, h_p, n_cells)
@@ -270,10 +275,10 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
         "eta_3": on_edges(neumann, J3),
         "eta_4": on_edges(contact, J4),
         "eta_5": on_edges(contact, J5),
-        "eta_6": spread_node_parts(contact, parts6, n_nodes, n_cells),
+        "eta_6": spread_node_parts(contact, parts6[:, :n_edge], n_nodes, n_cells),
         "eta_7": TermShares(None, boundary_cell_shares(contact, eta7_shares, n_cells)),
         "eta_8": spread_node_parts(
-            contact, move_dirichlet_thirds(parts8, cs.edge_local), n_nodes, n_cells
+            contact, move_dirichlet_thirds(parts8, cs.edge_local)[:, :n_edge], n_nodes, n_cells
         ),
     }
     return Estimate(
@@ -317,11 +322,11 @@ def _node_mesh_size(
     return h_p
 
 
-def geometry(space: P2Space) -> tuple[CellMap, np.ndarray]:
+def geometry(space: LagrangeSpace) -> tuple[CellMap, np.ndarray]:
     """The cells' maps (:attr:`~signorini.fem.space.P2Space.mapping`) and the boundary edges
-    that are quadratics (those on parts carrying a curve other than a line): the geometry
-    every term integrates on."""
-    return space.mapping, curved_edges(space.mesh)
+    that are quadratics (those on parts carrying a curve other than a line; none in a P1
+    space): the geometry every term integrates on."""
+    return space.mapping, space.curved_edges
 
 
 def _interior_residual(
@@ -414,10 +419,11 @@ def _part_edges(mesh, names) -> np.ndarray:
     return np.concatenate([mesh.part_edges(p) for p in names] or [np.zeros(0, np.int64)])
 
 
-def _edge_set(mesh, e: np.ndarray) -> EdgeSet:
-    """Mesh edges ``e`` with their P2 nodes ``[vertex, vertex, midpoint]`` and cells."""
-    nodes = np.column_stack([mesh.edges[e], mesh.n_points + e])
-    return EdgeSet(e, nodes, mesh.edge2cell[e], mesh.edge_length[e])
+def _edge_set(space: LagrangeSpace, e: np.ndarray) -> EdgeSet:
+    """Mesh edges ``e`` with their nodes ``[vertex, vertex, midpoint]`` (P1: the two
+    vertices) and cells."""
+    mesh = space.mesh
+    return EdgeSet(e, space.mesh_edge_nodes(e), mesh.edge2cell[e], mesh.edge_length[e])
 
 
 def _from_both_sides(mesh, traction, e: np.ndarray, t: np.ndarray):

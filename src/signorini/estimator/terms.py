@@ -30,6 +30,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..fem.element import P2
 from ..fem.p2 import edge_basis
 from .h_half_norm import hhalf_norm2_positive_part
 from .thirds import friction_work_thirds, third_integrals
@@ -94,6 +95,7 @@ def spread_cell_integrals(R: np.ndarray, cell_nodes: np.ndarray, h_p: np.ndarray
     ----------
     R : (n_cells,) float array
     cell_nodes : (n_cells, 6) int array
+        (``(n_cells, 3)`` for P1)
     h_p : (n_nodes,) float array
         Node mesh sizes, zero at Dirichlet nodes.
 
@@ -102,7 +104,8 @@ def spread_cell_integrals(R: np.ndarray, cell_nodes: np.ndarray, h_p: np.ndarray
     TermShares
         ``node = h_p² Σ_{T ∋ p} R_T``, ``cell = R_T Σ_{p ∈ T} h_p²``.
     """
-    node = h_p**2 * np.bincount(cell_nodes.ravel(), weights=np.repeat(R, 6), minlength=h_p.size)
+    k = cell_nodes.shape[1]
+    node = h_p**2 * np.bincount(cell_nodes.ravel(), weights=np.repeat(R, k), minlength=h_p.size)
     return TermShares(node, R * (h_p[cell_nodes] ** 2).sum(axis=1))
 
 
@@ -325,7 +328,11 @@ def normal_stress(
 
 
 def complementarity(
-    gap: np.ndarray, density: np.ndarray, length: np.ndarray, points: np.ndarray | None = None
+    gap: np.ndarray,
+    density: np.ndarray,
+    length: np.ndarray,
+    points: np.ndarray | None = None,
+    pieces: tuple = P2.hat_pieces,
 ) -> np.ndarray:
     """``s_p d_p`` with ``d_p = ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p``, per contact edge node (η6).
 
@@ -340,13 +347,16 @@ def complementarity(
     points : (k, 3, 2) float array, optional
         Node points ``[start, end, midpoint]`` of quadratic edges: integrate along them
         (:func:`third_integrals`).
+    pieces : tuple, optional
+        The element's γ̃_p and hats (:attr:`~signorini.fem.element.Element.hat_pieces`):
+        P2's thirds (default), P1's halves.
 
     Returns
     -------
     (k, 3) float array
         Each node's part from this edge.
     """
-    return density * third_integrals(-gap, length, points)
+    return density * third_integrals(-gap, length, points, pieces)
 
 
 def friction_work(
@@ -355,6 +365,7 @@ def friction_work(
     bound: np.ndarray,
     length: np.ndarray,
     points: np.ndarray | None = None,
+    parts: tuple = P2.node_parts,
 ) -> np.ndarray:
     """``∫_{γ̃_p} (max(b_h, |p_t,h|) |u_t| − p_t,h u_t) ds`` per contact edge node (η8): the
     defect of the friction work ``p_t u_t = s |u_t|`` of the tangential law (docs/method.md,
@@ -379,7 +390,7 @@ def friction_work(
     (k, 3) float array
         The edge's integrals over the thirds of its start, end and midpoint nodes.
     """
-    return friction_work_thirds(slip, friction, bound, length, points)
+    return friction_work_thirds(slip, friction, bound, length, points, parts)
 
 
 def penetration(

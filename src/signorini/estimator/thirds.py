@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..fem.edge_trace import evaluate, monomial_coefficients, roots_in_unit_interval
+from ..fem.element import P2
 from ..fem.mapping import Edges, QuadraticEdges, StraightEdges
 from ..fem.quadrature import gauss_legendre
 
@@ -19,17 +20,16 @@ __all__ = ["CURVED_THIRD_POINTS", "friction_work_thirds", "third_integrals"]
 CURVED_THIRD_POINTS = 5
 
 #: sub-intervals of [0, 1] where a half-edge hat φ of Q^h (3.6) is linear:
-#: ``(lo, hi, column, (φ(0), φ'))`` with column 0, 1, 2 = start, end, midpoint
-_HAT_PIECES = (
-    (0.0, 1 / 3, 0, (1.0, -2.0)),
-    (2 / 3, 1.0, 1, (-1.0, 2.0)),
-    (1 / 3, 0.5, 2, (0.0, 2.0)),
-    (0.5, 2 / 3, 2, (2.0, -2.0)),
-)
+#: ``(lo, hi, column, (φ(0), φ'))`` with column 0, 1, 2 = start, end, midpoint (P2's pieces;
+#: an element states its own, :class:`~signorini.fem.element.Element`)
+_HAT_PIECES = P2.hat_pieces
 
 
 def third_integrals(
-    v: np.ndarray, length: np.ndarray, points: np.ndarray | None = None
+    v: np.ndarray,
+    length: np.ndarray,
+    points: np.ndarray | None = None,
+    pieces: tuple = _HAT_PIECES,
 ) -> np.ndarray:
     """∫ v⁺ φ_p over the thirds γ̃_p of each edge (docs/method.md, *Estimator*, paper (4.12)).
 
@@ -48,6 +48,9 @@ def third_integrals(
         (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
         Node points ``[start, end, midpoint]`` of quadratic edges ``x(t)``.
+    pieces : tuple, optional
+        The pieces γ̃_p and hats of the element (:attr:`~signorini.fem.element.Element.
+        hat_pieces`): P2's thirds (default) or P1's halves (column 2 then stays 0).
 
     Returns
     -------
@@ -61,7 +64,7 @@ def third_integrals(
     roots = roots_in_unit_interval(coef)  # (k, 2), NaN where none
     gt, gw = gauss_legendre(_points(edges))
     out = np.zeros(v.shape)
-    for lo, hi, col, (p0, p1) in _HAT_PIECES:
+    for lo, hi, col, (p0, p1) in pieces:
         r = np.where(np.isnan(roots), lo, np.clip(roots, lo, hi))
         bounds = np.sort(np.column_stack([np.full(len(v), lo), r, np.full(len(v), hi)]), axis=1)
         for j in range(3):
@@ -78,7 +81,7 @@ def third_integrals(
 
 
 #: the thirds of [0, 1] as ``(lo, hi, column)``, column 0, 1, 2 = start, end, midpoint
-_THIRDS = ((0.0, 1 / 3, 0), (2 / 3, 1.0, 1), (1 / 3, 2 / 3, 2))
+_THIRDS = P2.node_parts
 
 
 def friction_work_thirds(
@@ -87,8 +90,10 @@ def friction_work_thirds(
     bound: np.ndarray,
     length: np.ndarray,
     points: np.ndarray | None = None,
+    parts: tuple = _THIRDS,
 ) -> np.ndarray:
-    """``∫ (max(b, |p_t|) |u_t| − p_t u_t) ds`` over each third of each edge (η8).
+    """``∫ (max(b, |p_t|) |u_t| − p_t u_t) ds`` over each third of each edge (η8); over
+    each half with P1's ``parts`` (:attr:`~signorini.fem.element.Element.node_parts`).
 
     The three quadratics are given by their values at ``[start, end, midpoint]``. Each third
     is cut at the roots of ``u_t``, ``p_t − b`` and ``p_t + b``, so that on each piece the
@@ -123,7 +128,7 @@ def friction_work_thirds(
     roots = np.column_stack([roots_in_unit_interval(c) for c in (cu, cp - cb, cp + cb)])
     gt, gw = gauss_legendre(_points(edges))
     out = np.zeros(cu.shape)
-    for lo, hi, col in _THIRDS:
+    for lo, hi, col in parts:
         r = np.where(np.isnan(roots), lo, np.clip(roots, lo, hi))
         ends = np.sort(np.column_stack([np.full(len(cu), lo), r, np.full(len(cu), hi)]), axis=1)
         for j in range(ends.shape[1] - 1):

@@ -11,7 +11,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import p2
+from .element import P2, Element
 from .mapping import CellMap, Edges, QuadraticEdges, StraightEdges
 from .quadrature import line_rule, triangle_rule
 
@@ -24,6 +24,7 @@ def assemble_body_force(
     n_dofs: int,
     f: Callable[[np.ndarray], np.ndarray],
     degree: int = 6,
+    element: Element = P2,
 ) -> np.ndarray:
     """Load vector of a body force, ``F[2 z + c] = int_Omega f_c psi_z dx``.
 
@@ -42,6 +43,8 @@ def assemble_body_force(
     degree : int, optional
         Quadrature degree on each cell (exact for ``f`` polynomial of degree
         ``degree - 2`` on straight cells).
+    element : Element, optional
+        The element of the DOFs (P2, the default, or P1 with ``cell_dofs (m, 6)``).
 
     Returns
     -------
@@ -51,7 +54,7 @@ def assemble_body_force(
     xi, w = triangle_rule(degree)
     x = mapping.points(xi)
     fx = np.broadcast_to(np.asarray(f(x), dtype=np.float64), x.shape)
-    phi = p2.basis(xi)  # (q, 6)
+    phi = element.basis(xi)  # (q, n_local)
     local = mapping.per_cell(
         lambda g: np.einsum("qa,mqc,mq->mac", phi, fx[g.cells], g.measure(w, xi))
     )
@@ -64,6 +67,7 @@ def assemble_edge_load(
     n_dofs: int,
     g: Callable[[np.ndarray, np.ndarray], np.ndarray],
     degree: int = 6,
+    element: Element = P2,
 ) -> np.ndarray:
     """Load vector of boundary tractions, ``G[2 z + c] = int_{Gamma_N} g_c psi_z ds``.
 
@@ -85,6 +89,9 @@ def assemble_edge_load(
         Gauss-Legendre degree along each edge (exact for ``g`` polynomial of
         degree ``degree - 2`` on straight edges); the integral is
         ``int_0^1 g psi |x'(t)| dt``.
+    element : Element, optional
+        The element of the DOFs (P2, the default, or P1 with ``edge_dofs (k, 4)`` of
+        ``(start, end)`` on straight edges).
 
     Returns
     -------
@@ -96,5 +103,5 @@ def assemble_edge_load(
     x = edges.points(t)
     gx = np.broadcast_to(np.asarray(g(x, edges.normals(t)), dtype=np.float64), x.shape)
     ds = np.broadcast_to(edges.speeds(t) * w, x.shape[:2])
-    local = np.einsum("qa,kqc,kq->kac", p2.edge_basis(t), gx, ds)
+    local = np.einsum("qa,kqc,kq->kac", element.edge_basis(t), gx, ds)
     return np.bincount(np.ravel(edge_dofs), weights=local.ravel(), minlength=n_dofs)

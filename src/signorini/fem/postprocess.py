@@ -165,8 +165,8 @@ def stress_divergence(hess: np.ndarray, material: Material | CellMaterials) -> n
 
 
 def nodal_stress(space, u: np.ndarray, material: Material | CellMaterials) -> np.ndarray:
-    """The stress of the P2 displacement ``u (n_nodes, 2)`` of ``space`` at its nodes, averaged
-    over the cells sharing each node.
+    """The stress of the displacement ``u (n_nodes, 2)`` of ``space`` (P2 or P1) at its nodes,
+    averaged over the cells sharing each node.
 
     Each cell gives σ(u_h) at its six nodes (the gradient of its P2 displacement on its own
     map, curved cells included, with the cell's own material); a node's value is the mean of
@@ -187,15 +187,16 @@ def nodal_stress(space, u: np.ndarray, material: Material | CellMaterials) -> np
         σ with σ_zz from the material (:func:`~signorini.fem.material.stress_zz`: λ tr ε in
         plane strain, 0 in plane stress).
     """
-    nodes = space.cell_nodes  # (m, 6)
-    m = nodes.shape[0]
-    u_cell = u[nodes].reshape(m, 12)
-    grad, _ = iso.field_derivatives(space.node_points[nodes], u_cell, p2.REFERENCE_NODES)
-    sig = np.zeros((m, 6, 3, 3))
+    nodes = space.cell_nodes  # (m, n_local): 6 for P2, 3 for P1
+    m, k = nodes.shape
+    u_cell = space.field_coefficients(u)  # (m, 12): a P1 field as the P2 field it is
+    xi = space.element.reference_nodes
+    grad, _ = iso.field_derivatives(space.cell_map_nodes, u_cell, xi)
+    sig = np.zeros((m, k, 3, 3))
     sig[..., :2, :2] = stress(material, grad)
     sig[..., 2, 2] = stress_zz(material, grad)
     count = np.bincount(nodes.ravel(), minlength=space.n_nodes).astype(np.float64)
-    flat = sig.reshape(m * 6, 9)
+    flat = sig.reshape(m * k, 9)
     mean = np.column_stack(
         [np.bincount(nodes.ravel(), weights=flat[:, j], minlength=space.n_nodes) for j in range(9)]
     )

@@ -1,9 +1,12 @@
-"""The conforming P2 Lagrange space on a mesh: nodes, DOF maps, interpolation, prolongation.
+"""The conforming Lagrange spaces on a mesh, P2 (the paper's) and P1: nodes, DOF maps,
+interpolation, prolongation; :func:`space_of` chooses one by its element.
 
 Global P2 nodes are the mesh vertices (node index = point index) followed by the edge
 midpoints (node index = ``n_points + edge index``). Vector DOFs are interleaved:
 ``dof = 2 * node + component``. Local node order on a cell: its three vertices, then the
 midpoints of local edges 0, 1, 2 (the order of VTK's quadratic triangle / meshio ``triangle6``).
+Global P1 nodes are the mesh vertices; a P1 space is affine on every cell (a curved boundary
+part is approximated by its chords; docs/method.md, *P1 elements and their estimator*).
 """
 
 from __future__ import annotations
@@ -17,13 +20,82 @@ from ..mesh.mesh import Mesh
 from ..mesh.refine import Refinement
 from ..mesh.validation import MeshError
 from . import iso
+from .element import P1, P2, Element, element_of
 from .mapping import CellMap, QuadraticEdges, StraightEdges, edge_groups
 from .p2 import basis_barycentric
 
-__all__ = ["P2Space"]
+__all__ = ["LagrangeSpace", "P1Space", "P2Space", "space_of"]
 
 
-class P2Space:
+class LagrangeSpace:
+    """What every space shares: the mesh, the interleaved DOFs of its cells, the cells'
+    geometry, nodal interpolation; the subclasses number the nodes.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        A validated mesh; the space trusts it (built inside the package, not a user entry).
+    """
+
+    element: Element
+    n_nodes: int
+    cell_nodes: np.ndarray
+    node_points: np.ndarray
+    curved: tuple[np.ndarray, np.ndarray] | None
+
+    def __init__(self, mesh: Mesh) -> None:
+        self.mesh = mesh
+
+    @property
+    def n_dofs(self) -> int:
+        return 2 * self.n_nodes
+
+    @cached_property
+    def cell_dofs(self) -> np.ndarray:
+        """``(n_cells, 2 n_local)`` interleaved global DOFs (local DOF ``2 * node + component``)."""
+        n = self.cell_nodes
+        return np.stack([2 * n, 2 * n + 1], axis=-1).reshape(len(n), 2 * n.shape[1])
+
+    @cached_property
+    def mapping(self) -> CellMap:
+        """The cells' geometry (:mod:`signorini.fem.mapping`): affine cells, and the
+        isoparametric cells of :attr:`curved` with their quadratic maps."""
+        return CellMap(self.vertices, self.curved)
+
+    @cached_property
+    def vertices(self) -> np.ndarray:
+        """``(n_cells, 3, 2)`` vertex coordinates of each cell."""
+        return self.mesh.points[self.mesh.cells]
+
+    def interpolate(self, func: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+        """Nodal interpolant ``(n_nodes, 2)`` of a vector field ``func(x (n, 2)) -> (n, 2)``."""
+        values = np.asarray(func(self.node_points), dtype=np.float64)
+        if values.shape != (self.n_nodes, 2):
+            raise ValueError(
+                f"the function to interpolate must return shape ({self.n_nodes}, 2)"
+                f" for {self.n_nodes} points, got {values.shape}"
+            )
+        return values
+
+    def cell_values(self, u: np.ndarray) -> np.ndarray:
+        """Per-cell interleaved coefficients ``(n_cells, 2 n_local)`` of nodal values
+        ``(n_nodes, 2)``."""
+        return np.asarray(u).reshape(-1)[self.cell_dofs]
+
+    def field_coefficients(self, u: np.ndarray) -> np.ndarray:
+        """The P2 coefficients ``(n_cells, 12)`` of the field with nodal values ``u (n_nodes,
+        2)`` on each cell's map, what the field kernels (:mod:`signorini.fem.mapping`,
+        stresses, norms) read (:meth:`~signorini.fem.element.Element.cell_coefficients`)."""
+        return self.element.cell_coefficients(self.cell_values(u))
+
+    @property
+    def cell_map_nodes(self) -> np.ndarray:
+        """``(n_cells, 6, 2)`` the six P2 node points of each cell's map: its vertices and
+        edge midpoints (on a curved part's cells of a P2 space the midpoint on the curve)."""
+        return self.node_points[self.cell_nodes]
+
+
+class P2Space(LagrangeSpace):
     """Vector-valued continuous P2 finite elements on a :class:`~signorini.mesh.Mesh`.
 
     Parameters
@@ -32,27 +104,16 @@ class P2Space:
         A validated mesh; the space trusts it (built inside the package, not a user entry).
     """
 
-    def __init__(self, mesh: Mesh) -> None:
-        self.mesh = mesh
+    element = P2
 
     @property
     def n_nodes(self) -> int:
         return self.mesh.n_points + self.mesh.n_edges
 
-    @property
-    def n_dofs(self) -> int:
-        return 2 * self.n_nodes
-
     @cached_property
     def cell_nodes(self) -> np.ndarray:
         """``(n_cells, 6)`` global node of each local node."""
         return np.hstack([self.mesh.cells, self.mesh.n_points + self.mesh.cell2edge])
-
-    @cached_property
-    def cell_dofs(self) -> np.ndarray:
-        """``(n_cells, 12)`` interleaved global DOFs (local DOF ``2 * node + component``)."""
-        n = self.cell_nodes
-        return np.stack([2 * n, 2 * n + 1], axis=-1).reshape(len(n), 12)
 
     @cached_property
     def node_points(self) -> np.ndarray:
@@ -90,16 +151,11 @@ class P2Space:
             )
         return cells, nodes
 
-    @cached_property
-    def mapping(self) -> CellMap:
-        """The cells' geometry (:mod:`signorini.fem.mapping`): affine cells, and the
-        isoparametric cells of :attr:`curved` with their quadratic maps."""
-        return CellMap(self.vertices, self.curved)
-
-    @cached_property
-    def vertices(self) -> np.ndarray:
-        """``(n_cells, 3, 2)`` vertex coordinates of each cell."""
-        return self.mesh.points[self.mesh.cells]
+    @property
+    def curved_edges(self) -> np.ndarray:
+        """The boundary edges that are quadratics (on parts carrying a curve other than a
+        line; :func:`signorini.fem.iso.curved_edges`)."""
+        return iso.curved_edges(self.mesh)
 
     def dof_order(self, vertex_order: np.ndarray) -> np.ndarray:
         """The order of the DOFs that extends an order of the mesh's vertices
@@ -134,6 +190,11 @@ class P2Space:
         ab = self.mesh.oriented_boundary(edge_index)
         return np.column_stack([ab, self.mesh.n_points + edge_index])
 
+    def mesh_edge_nodes(self, edge_index: np.ndarray) -> np.ndarray:
+        """``(k, 3)`` nodes ``[vertex, vertex, midpoint]`` of any mesh edges (as stored)."""
+        edge_index = np.asarray(edge_index, dtype=np.int64)
+        return np.column_stack([self.mesh.edges[edge_index], self.mesh.n_points + edge_index])
+
     def boundary_edges(
         self, edge_index: np.ndarray
     ) -> Iterator[tuple[slice | np.ndarray, StraightEdges | QuadraticEdges]]:
@@ -142,27 +203,13 @@ class P2Space:
         other than a line, straight elsewhere; ``(rows, edges)`` per kind."""
         edge_index = np.asarray(edge_index, dtype=np.int64)
         points = self.node_points[self.edge_nodes(edge_index)]
-        return edge_groups(points, np.isin(edge_index, iso.curved_edges(self.mesh)))
+        return edge_groups(points, np.isin(edge_index, self.curved_edges))
 
     def part_nodes(self, names: Iterable[str]) -> np.ndarray:
         """Sorted nodes on the closure of the named boundary parts (vertices and midpoints)."""
         edges = np.concatenate([self.mesh.part_edges(n) for n in names] or [np.zeros(0, int)])
         nodes = np.concatenate([self.mesh.edges[edges].ravel(), self.mesh.n_points + edges])
         return np.unique(nodes)
-
-    def interpolate(self, func: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-        """Nodal interpolant ``(n_nodes, 2)`` of a vector field ``func(x (n, 2)) -> (n, 2)``."""
-        values = np.asarray(func(self.node_points), dtype=np.float64)
-        if values.shape != (self.n_nodes, 2):
-            raise ValueError(
-                f"the function to interpolate must return shape ({self.n_nodes}, 2)"
-                f" for {self.n_nodes} points, got {values.shape}"
-            )
-        return values
-
-    def cell_values(self, u: np.ndarray) -> np.ndarray:
-        """Per-cell interleaved coefficients ``(n_cells, 12)`` of nodal values ``(n_nodes, 2)``."""
-        return np.asarray(u).reshape(-1)[self.cell_dofs]
 
     def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
         """Exact interpolation of a P2 field of this space on the refined mesh.
@@ -253,3 +300,124 @@ def _reference_nodes(coarse: Mesh, refinement: Refinement, fine: P2Space) -> np.
     points[refinement.edge_point[split]] = coarse.edge_midpoints[split]
     e = refinement.mesh.edges
     return np.vstack([points, 0.5 * (points[e[:, 0]] + points[e[:, 1]])])
+
+
+class P1Space(LagrangeSpace):
+    """Vector-valued continuous P1 finite elements on a :class:`~signorini.mesh.Mesh`: one
+    node per vertex (node index = point index), affine on every cell (a curved boundary part
+    is approximated by its chords; docs/method.md, *P1 elements and their estimator*).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        A validated mesh; the space trusts it.
+    """
+
+    element = P1
+    curved = None
+
+    @property
+    def n_nodes(self) -> int:
+        return self.mesh.n_points
+
+    @property
+    def cell_nodes(self) -> np.ndarray:
+        """``(n_cells, 3)`` global node of each local node: the cell's vertices."""
+        return self.mesh.cells
+
+    @property
+    def node_points(self) -> np.ndarray:
+        """``(n_nodes, 2)`` the mesh's points."""
+        return self.mesh.points
+
+    @property
+    def curved_edges(self) -> np.ndarray:
+        """No edge is a quadratic: every edge is its chord."""
+        return np.zeros(0, dtype=np.int64)
+
+    @property
+    def cell_map_nodes(self) -> np.ndarray:
+        """``(n_cells, 6, 2)`` each cell's vertices and chord midpoints: the P2 node points of
+        its (affine) map."""
+        v = self.vertices
+        return np.concatenate([v, 0.5 * (v + v[:, [1, 2, 0]])], axis=1)
+
+    def dof_order(self, vertex_order: np.ndarray) -> np.ndarray:
+        """The order of the DOFs of an order of the vertices, the two DOFs of a node
+        together (as :meth:`P2Space.dof_order`)."""
+        nodes = np.asarray(vertex_order, dtype=np.int64)
+        return np.stack([2 * nodes, 2 * nodes + 1], axis=-1).ravel()
+
+    def edge_nodes(self, edge_index: np.ndarray) -> np.ndarray:
+        """``(k, 2)`` nodes ``[start, end]`` of boundary edges, counter-clockwise."""
+        return self.mesh.oriented_boundary(np.asarray(edge_index, dtype=np.int64))
+
+    def mesh_edge_nodes(self, edge_index: np.ndarray) -> np.ndarray:
+        """``(k, 2)`` the two vertices of any mesh edges (as stored)."""
+        return self.mesh.edges[np.asarray(edge_index, dtype=np.int64)]
+
+    def boundary_edges(
+        self, edge_index: np.ndarray
+    ) -> Iterator[tuple[slice | np.ndarray, StraightEdges | QuadraticEdges]]:
+        """The boundary edges as straight edges, counter-clockwise as :meth:`edge_nodes`."""
+        yield slice(None), StraightEdges(self.node_points[self.edge_nodes(edge_index)])
+
+    def part_nodes(self, names: Iterable[str]) -> np.ndarray:
+        """Sorted nodes (vertices) on the closure of the named boundary parts."""
+        edges = np.concatenate([self.mesh.part_edges(n) for n in names] or [np.zeros(0, int)])
+        return np.unique(self.mesh.edges[edges])
+
+    def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
+        """Exact interpolation of a P1 field of this space on the refined mesh: the old
+        vertices keep their values, a bisection's new vertex gets the mean of the bisected
+        edge's two (the field at the chord's midpoint).
+
+        Parameters
+        ----------
+        u : (n_nodes, 2) or (n_nodes,) array
+        refinement : Refinement
+            The refinement of ``self.mesh``.
+
+        Returns
+        -------
+        (n_nodes_new, 2) or (n_nodes_new,) array
+
+        Raises
+        ------
+        ValueError
+            If ``u`` does not have one row per node, or ``refinement`` is not a refinement
+            of this space's mesh.
+        """
+        u = np.asarray(u, dtype=np.float64)
+        if u.shape[0] != self.n_nodes:
+            raise ValueError(f"u has {u.shape[0]} nodes, the space has {self.n_nodes}")
+        n_old = self.mesh.n_points
+        edge_point = np.asarray(refinement.edge_point)
+        split = (
+            np.flatnonzero(edge_point >= 0) if edge_point.shape == (self.mesh.n_edges,) else None
+        )
+        if split is None or refinement.mesh.n_points != n_old + split.size:
+            raise ValueError(
+                "the refinement is not a refinement of this space's mesh (its bisected edges "
+                "or points do not match the mesh's)"
+            )
+        out = np.empty((refinement.mesh.n_points,) + u.shape[1:])
+        out[:n_old] = u
+        ends = self.mesh.edges[split]
+        out[edge_point[split]] = 0.5 * (u[ends[:, 0]] + u[ends[:, 1]])
+        return out
+
+
+def space_of(mesh: Mesh, element: str | Element = "P2") -> LagrangeSpace:
+    """The space of ``element`` (``"P2"``, the default, or ``"P1"``) on ``mesh``: the one
+    place where a caller's choice of element becomes a space.
+
+    Raises
+    ------
+    ValueError
+        If ``element`` is not one of :data:`~signorini.fem.element.ELEMENTS`.
+    """
+    return _SPACES[element_of(element).name](mesh)
+
+
+_SPACES = {"P1": P1Space, "P2": P2Space}

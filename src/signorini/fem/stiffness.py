@@ -1,4 +1,5 @@
-"""The P2 stiffness matrix of plane-strain elasticity, ``a(w, v) = int_Omega sigma(w) : eps(v)``.
+"""The stiffness matrix of plane-strain elasticity, ``a(w, v) = int_Omega sigma(w) : eps(v)``,
+for the P2 element (the paper's) or P1 (:mod:`signorini.fem.element`).
 
 Arrays are vectorized over cells: ``vertices (m, 3, 2)`` is ``points[cells]``
 (counter-clockwise), ``cell_dofs (m, 12)`` the interleaved global DOFs,
@@ -25,6 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import p2
+from .element import ELEMENTS, P2, Element
 from .mapping import AffineCells, CellMap, Cells
 from .material import CellMaterials, Material, on_cells
 from .quadrature import triangle_rule
@@ -51,22 +53,28 @@ _P_PAIRS = [
 
 @lru_cache(maxsize=32)
 def _stiffness_basis(
-    lam: float, mu: float, dof_order: bool, degree: int = 2, per_point: bool = False
+    lam: float,
+    mu: float,
+    dof_order: bool,
+    degree: int = 2,
+    per_point: bool = False,
+    element: str = "P2",
 ) -> np.ndarray:
     """Matrix (10, 144) mapping the 10 geometric factors to K, with ``R`` summed over the
     points of the degree-``degree`` rule; ``(q * 10, 144)``, one block per point, if
     ``per_point`` (for Jacobians that vary from point to point).
 
-    The 144 columns are in node-block layout (a, b, i, j), or in interleaved DOF
-    layout (a, i, b, j) if ``dof_order``.
+    The 144 columns (``(2 n)²`` for an element of ``n`` local nodes: 36 for P1) are in
+    node-block layout (a, b, i, j), or in interleaved DOF layout (a, i, b, j) if ``dof_order``.
     """
     xi, w = triangle_rule(degree)
-    g = p2.grad_basis(xi)
+    g = ELEMENTS[element].grad_basis(xi)
+    n = g.shape[1]
     if per_point:
         R = np.einsum("q,qak,qbl->qklab", w, g, g)  # (q, 2, 2, 6, 6)
     else:
         R = np.einsum("q,qak,qbl->klab", w, g, g)[None]  # (1, 2, 2, 6, 6)
-    full = np.zeros((R.shape[0], 2, 2, 2, 2, 6, 6, 2, 2))
+    full = np.zeros((R.shape[0], 2, 2, 2, 2, n, n, 2, 2))
     for i in range(2):
         for j in range(2):
             for k in range(2):
@@ -77,15 +85,15 @@ def _stiffness_basis(
                     if i == j:
                         full[:, i, j, k, l, :, :, 0, 0] += mu * r
                         full[:, i, j, k, l, :, :, 1, 1] += mu * r
-    out = np.empty((R.shape[0], len(_P_PAIRS), 144))
+    out = np.empty((R.shape[0], len(_P_PAIRS), 4 * n * n))
     for s, (p, q) in enumerate(_P_PAIRS):
         blk = (
             full[(slice(None),) + p]
             if p == q
             else full[(slice(None),) + p] + full[(slice(None),) + q]
         )
-        out[:, s] = (blk.transpose(0, 1, 3, 2, 4) if dof_order else blk).reshape(R.shape[0], 144)
-    out = out.reshape(-1, 144)
+        out[:, s] = (blk.transpose(0, 1, 3, 2, 4) if dof_order else blk).reshape(R.shape[0], -1)
+    out = out.reshape(-1, 4 * n * n)
     out.setflags(write=False)
     return out
 
@@ -107,10 +115,12 @@ def element_blocks(
     degree: int | None = None,
     dof_order: bool = False,
     out: np.ndarray | None = None,
+    element: Element = P2,
 ) -> np.ndarray:
     """Element stiffness of a group of cells (:mod:`signorini.fem.mapping`), shape
-    ``(m, 144)``: ``[c, a, b, i, j] = a(phi_b e_j, phi_a e_i)`` on cell ``c`` in node-block
-    layout, or ``(a, i, b, j)`` if ``dof_order``.
+    ``(m, 144)`` (``(m, 36)`` for P1): ``[c, a, b, i, j] = a(phi_b e_j, phi_a e_i)`` on cell
+    ``c`` in node-block layout, or ``(a, i, b, j)`` if ``dof_order``, for the basis of
+    ``element``.
 
     One integrand for every geometry: ``K = sum_q P(x_q) R_q`` with the 10 geometric factors
     ``P = det J * Jit (x) Jit`` at the points of the rule and ``R_q`` the reference gradients'
@@ -129,15 +139,16 @@ def element_blocks(
     J, det = cells.jacobians(xi)  # (m, p, 2, 2), p = 1 (constant) or q
     m, n_p = det.shape
     fac = _geometric_factors(J.reshape(-1, 2, 2), det.reshape(-1)).reshape(m, -1)
+    name = element.name
     if isinstance(material, CellMaterials):
-        out = np.empty((m, 144)) if out is None else out
+        out = np.empty((m, 4 * element.n_local**2)) if out is None else out
         for k, mat in enumerate(material.materials):  # a loop over materials, not cells
             rows = np.flatnonzero(material.index == k)
             if rows.size:
-                basis = _stiffness_basis(mat.lam_eff, mat.mu, dof_order, degree, n_p > 1)
+                basis = _stiffness_basis(mat.lam_eff, mat.mu, dof_order, degree, n_p > 1, name)
                 out[rows] = fac[rows] @ basis
         return out
-    basis = _stiffness_basis(material.lam_eff, material.mu, dof_order, degree, n_p > 1)
+    basis = _stiffness_basis(material.lam_eff, material.mu, dof_order, degree, n_p > 1, name)
     return np.matmul(fac, basis, out=out)
 
 
@@ -220,7 +231,7 @@ def _assemble_node_blocks(
 
 
 def _checked_input(
-    vertices: np.ndarray, cell_dofs: np.ndarray, n_dofs: int, material: Material
+    vertices: np.ndarray, cell_dofs: np.ndarray, n_dofs: int, material: Material, width: int = 12
 ) -> tuple[np.ndarray, int]:
     """Validate the raw arrays of :func:`assemble_stiffness`; return the cell nodes and
     ``n_dofs``."""
@@ -248,8 +259,8 @@ def _checked_input(
             f"(clockwise or degenerate; first: cell {bad[0]}, det = {det[bad[0]]:.3e})"
         )
     d = np.asarray(cell_dofs)
-    if d.ndim != 2 or d.shape[1] != 12:
-        raise ValueError(f"cell_dofs must have shape (n, 12), got {d.shape}")
+    if d.ndim != 2 or d.shape[1] != width:
+        raise ValueError(f"cell_dofs must have shape (n, {width}), got {d.shape}")
     if d.shape[0] != v.shape[0]:
         raise ValueError(f"cell_dofs has {d.shape[0]} rows but there are {v.shape[0]} cells")
     if d.size and not np.issubdtype(d.dtype, np.integer):
@@ -274,6 +285,7 @@ def assemble_stiffness(
     material: Material | CellMaterials,
     *,
     validate: bool = True,
+    element: Element = P2,
 ) -> sp.csr_matrix:
     """Global stiffness matrix of ``a(u, v) = int sigma(u) : eps(v)``.
 
@@ -284,7 +296,7 @@ def assemble_stiffness(
         the isoparametric ones along curved parts, each integrated by :func:`element_blocks`),
         or the vertices of straight cells, counter-clockwise.
     cell_dofs : array_like of int, shape (m, 12)
-        Interleaved global DOFs (``2 * node + component``).
+        Interleaved global DOFs (``2 * node + component``); ``(m, 6)`` for P1.
     n_dofs : int
         Number of global DOFs (even: two per node).
     material : Material or CellMaterials
@@ -293,6 +305,9 @@ def assemble_stiffness(
         Check the arrays (shapes, finite counter-clockwise cells, interleaved DOFs in
         range). The assembly of a :class:`~signorini.fem.space.P2Space`, whose arrays are
         right by construction, skips it.
+    element : Element, optional
+        The element of the DOFs (:data:`~signorini.fem.element.P2`, the default, or
+        :data:`~signorini.fem.element.P1`).
 
     Returns
     -------
@@ -314,19 +329,22 @@ def assemble_stiffness(
         vertices = mapping.groups[0].vertices if mapping is not None else cells
         if mapping is not None and len(mapping.groups) > 1:
             vertices = mapping.per_cell(lambda g: g.vertices)
-        nodes, n = _checked_input(vertices, cell_dofs, n_dofs, material)
+        nodes, n = _checked_input(vertices, cell_dofs, n_dofs, material, 2 * element.n_local)
     else:
         nodes = np.asarray(cell_dofs, dtype=np.int64)[:, 0::2] // 2
         n = int(n_dofs)
     if mapping is None:
         mapping = CellMap(cells)
     if len(mapping.groups) == 1:
-        blocks = element_blocks(mapping.groups[0], on_cells(material, mapping.groups[0].cells))
+        g = mapping.groups[0]
+        blocks = element_blocks(g, on_cells(material, g.cells), element=element)
     else:  # group after group into one array (no scatter), the cells' nodes in that order
-        blocks = np.empty((mapping.n_cells, 144))
+        blocks = np.empty((mapping.n_cells, 4 * element.n_local**2))
         start = 0
         for g in mapping.groups:
-            element_blocks(g, on_cells(material, g.cells), out=blocks[start : start + len(g)])
+            rows = blocks[start : start + len(g)]
+            element_blocks(g, on_cells(material, g.cells), out=rows, element=element)
             start += len(g)
         nodes = nodes[np.concatenate([g.cells for g in mapping.groups])]
-    return _assemble_node_blocks(nodes, n // 2, blocks.reshape(-1, 6, 6, 2, 2))
+    k = element.n_local
+    return _assemble_node_blocks(nodes, n // 2, blocks.reshape(-1, k, k, 2, 2))

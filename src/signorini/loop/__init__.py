@@ -23,6 +23,7 @@ from ..contact.load_path import check_path, solve_path
 from ..contact.solution import ContactResult, solve
 from ..estimator.marking import mark_doerfler
 from ..estimator.residual import Estimate, estimate
+from ..fem.space import space_of
 from ..mesh.mesh import Mesh
 from ..mesh.refine import refine_nvb, refine_uniform
 from ..problem.problem import ContactProblem
@@ -93,8 +94,9 @@ def adaptive(
     mesh : Mesh, optional
         Mesh of the first level (default: the problem's).
     u0 : (n_nodes, 2) float array, optional
-        Warm start of the first level's solve on ``mesh`` (P2 nodal displacements: vertices
-        first, then edge midpoints); its nodes in contact form the initial active set.
+        Warm start of the first level's solve on ``mesh`` (nodal displacements of the
+        element's space: for P2 vertices first, then edge midpoints; for P1 the vertices);
+        its nodes in contact form the initial active set.
         Default: a cold start.
     first_level : int
         Index of the first level (default 0). To continue a run from its level ``k``, pass
@@ -157,9 +159,10 @@ def adaptive(
             )
         path = check_path([*path, problem])[:-1]
     mesh = problem.mesh if mesh is None else mesh
-    if problem.free_ndof(mesh) > options.max_ndof:
+    if problem.free_ndof(space_of(mesh, options.element)) > options.max_ndof:
         raise ValueError(
-            f"the initial mesh already has {problem.free_ndof(mesh)} unknowns, "
+            f"the initial mesh already has {problem.free_ndof(space_of(mesh, options.element))} "
+            "unknowns, "
             f"more than max_ndof={options.max_ndof}"
         )
     return _levels(problem, mesh, u0, options, first_level, metrics, path or None)
@@ -191,13 +194,15 @@ def _levels(
     path: Sequence[ContactProblem] | None,
 ) -> Iterator[Level]:
     """The loop of :func:`adaptive`, on checked arguments."""
-    uniform, solver = options.uniform, options.solver
+    uniform, solver, element = options.uniform, options.solver, options.element
     for level in range(first_level, options.max_levels):
         if path:
-            steps = solve_path([*path, problem], mesh, solver=solver, u0=u0)
+            steps = solve_path([*path, problem], mesh, solver=solver, u0=u0, element=element)
             result, warm = steps[-1], steps[0]
         else:
-            result = warm = solve(problem, mesh, u0=u0, solver=solver, fallback=options.fallback)
+            result = warm = solve(
+                problem, mesh, u0=u0, solver=solver, fallback=options.fallback, element=element
+            )
             steps = [result]
         u0 = None
         t0 = time.perf_counter()
@@ -222,7 +227,7 @@ def _levels(
             t0 = time.perf_counter()
             refinement = refine_uniform(mesh) if uniform else refine_nvb(mesh, marked)
             next_mesh = refinement.mesh
-            last = problem.free_ndof(next_mesh) > options.max_ndof
+            last = problem.free_ndof(space_of(next_mesh, element)) > options.max_ndof
             if not last and options.warm_start:
                 u0 = warm.space.prolongate(warm.u, refinement)
             record.t_refine = time.perf_counter() - t0

@@ -13,6 +13,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from ..contact.contact_set import ContactSet
 from ..contact.solution import SLIP, STICK
+from ..fem.element import P1
 
 if TYPE_CHECKING:
     from . import Level
@@ -75,6 +76,13 @@ def level_arrays(level: Level) -> dict[str, Any]:
     return arrays
 
 
+def _p2_edge(values: np.ndarray) -> np.ndarray:
+    """Per-edge nodal data ``(e, 3, ...)`` at ``[start, end, midpoint]``; a P1 edge's ``(e, 2,
+    ...)`` with the mean of its ends at the midpoint (:meth:`~signorini.fem.element.Element.
+    edge_values`)."""
+    return values if values.shape[1] == 3 else P1.edge_values(values)
+
+
 def _on_edges(ends: np.ndarray, m: int) -> np.ndarray:
     """``(e, m, ...)`` values at ``m`` equispaced points of each edge, interpolated
     quadratically from ``ends (e, 3, ...)`` at ``[start, end, midpoint]`` (the P2 edge)."""
@@ -122,15 +130,15 @@ def obstacle_outline(
         out = np.full((int(sel.sum()), m + 1, 2), np.nan)
         obstacle = conditions[name].obstacle
         if obstacle is not None:
-            x = _on_edges(node_points[cs.edge_nodes[sel]], m).reshape(-1, 2)
+            x = _on_edges(_p2_edge(node_points[cs.edge_nodes[sel]]), m).reshape(-1, 2)
             g, n = obstacle.gap_and_direction(x)
             out[:, :m] = (x + g[:, None] * n).reshape(-1, m, 2)
             psi = g.reshape(-1, m)
         else:
             ends = node_points[cs.edge_nodes[sel]]
-            ends = ends + cs.edge_gap[sel][..., None] * cs.edge_direction[sel]
+            ends = _p2_edge(ends + cs.edge_gap[sel][..., None] * cs.edge_direction[sel])
             out[:, :m] = _on_edges(ends, m)
-            psi = _on_edges(cs.edge_gap[sel], m)
+            psi = _on_edges(_p2_edge(cs.edge_gap[sel]), m)
         out[:, :m][np.abs(psi) > OUTLINE_REACH * size] = np.nan
         outline[name] = out.reshape(-1, 2)
     return outline
@@ -160,7 +168,7 @@ def arc_lengths(
         if en.shape[0] == 0:
             along[name] = (np.zeros(0, np.int64), np.zeros(0))
             continue
-        x = node_points[en]
+        x = _p2_edge(node_points[en])
         half = np.hypot(*(x[:, 2] - x[:, 0]).T), np.hypot(*(x[:, 1] - x[:, 2]).T)
         vertices, ends = np.unique(en[:, :2], return_inverse=True)
         ends = ends.reshape(-1, 2)
@@ -171,6 +179,7 @@ def arc_lengths(
             roots = ends[:1, 0]
         dist = dijkstra(graph.tocsr(), directed=True, indices=roots, min_only=True)
         s = np.stack([dist[ends[:, 0]], dist[ends[:, 1]], dist[ends[:, 0]] + half[0]], axis=1)
+        s = s[:, : en.shape[1]]  # P1: no midpoint node
         rows, first = np.unique(local.ravel(), return_index=True)
         s = s.ravel()[first][rows >= 0]
         rows = rows[rows >= 0]

@@ -20,6 +20,7 @@ from ..algebra.backends import auto_solver, solver_factory, solver_name
 from ..algebra.solvers import SolverFactory, SPDSolver
 from ..estimator.marking import check_theta
 from ..estimator.residual import ETA5_VARIANTS
+from ..fem.element import element_of
 
 __all__ = ["AdaptiveOptions", "LEGACY_KEYS", "OptionError"]
 
@@ -73,6 +74,9 @@ class AdaptiveOptions:
         makes one per solve, default :func:`~signorini.algebra.auto_solver`; a solver object
         is used by every level and not closed. A run folder records it by its name in
         :data:`signorini.algebra.SOLVERS`.
+    element : {"P2", "P1"}
+        The finite element of every level (any case; stored upper-case): the paper's P2, or
+        P1 with its residual estimator (docs/method.md, *P1 elements and their estimator*).
 
     Raises
     ------
@@ -89,6 +93,7 @@ class AdaptiveOptions:
     warm_start: bool = True
     fallback: bool = False
     solver: SolverFactory | SPDSolver = auto_solver
+    element: str = "P2"
 
     def __post_init__(self) -> None:
         for name in ("uniform", "warm_start", "fallback"):
@@ -111,6 +116,10 @@ class AdaptiveOptions:
                 "eta5_variant",
                 f"eta5_variant must be one of {list(ETA5_VARIANTS)}, got {self.eta5_variant!r}",
             )
+        try:
+            self._set("element", element_of(self.element).name)
+        except ValueError as exc:
+            raise OptionError("element", str(exc)) from None
         solver = self.solver
         if not isinstance(solver, SPDSolver) and (isinstance(solver, str) or not callable(solver)):
             raise OptionError(

@@ -71,7 +71,8 @@ def von_mises(sig: np.ndarray) -> np.ndarray:
 
 
 def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
-    """Write a discrete solution as a quadratic-triangle VTU file.
+    """Write a discrete solution as a VTU file of quadratic triangles (P2; ``triangle`` cells
+    for P1, the element's :attr:`~signorini.fem.element.Element.vtk_cell`).
 
     The point fields are :data:`POINT_FIELDS`, the cell fields (with an estimate)
     :data:`CELL_FIELDS`. At a corner node with two constraints the contact scalars are the
@@ -126,7 +127,7 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
             cell_data[f"eta2_{k + 1}"] = [estimate.eta2_cell[k]]
     mesh = meshio.Mesh(
         points,
-        [("triangle6", space.cell_nodes)],
+        [(space.element.vtk_cell, space.cell_nodes)],
         point_data={
             "displacement": disp,
             "stress": voigt,
@@ -178,7 +179,8 @@ def write_fields(path: str | os.PathLike) -> Path:
         "# Fields of the level_NNN.vtu files",
         "",
         "Quadratic triangles (VTK_QUADRATIC_TRIANGLE: 3 vertices, then the midpoints of "
-        "v0-v1, v1-v2, v2-v0). `levels.pvd` collects the levels with the level index as "
+        "v0-v1, v1-v2, v2-v0); linear triangles (VTK_TRIANGLE) in a run with --element P1. "
+        "`levels.pvd` collects the levels with the level index as "
         "time, `levels_ndof.pvd` with N_dof as time. Units are those of the problem's data.",
         "",
         "## Point data",

@@ -62,15 +62,18 @@ def read_level_mesh(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     """Vertex ``points (n_points, 2)`` and ``cells (n_cells, 3)`` of a run's level VTU file.
 
     The file holds the P2 nodes (vertices first, then edge midpoints) and ``triangle6``
-    cells (3 vertices, then 3 midpoints), as :func:`~signorini.output.write_vtu` writes
-    them; the triangulation is the first three columns and the vertices they number.
+    cells (3 vertices, then 3 midpoints), or for a P1 run the vertices and ``triangle``
+    cells, as :func:`~signorini.output.write_vtu` writes them; the triangulation is the
+    first three columns and the vertices they number.
     """
     import meshio
 
     m = meshio.read(path)
-    blocks = [b.data for b in m.cells if b.type == "triangle6"]
+    blocks = [b.data for b in m.cells if b.type in ("triangle6", "triangle")]
     if len(blocks) != 1:
-        raise ValueError(f"{path} holds no single triangle6 block: not a level file of a run")
+        raise ValueError(
+            f"{path} holds no single triangle6 (or triangle) block: not a level file of a run"
+        )
     cells = np.asarray(blocks[0][:, :3], dtype=np.int64)
     n_points = int(cells.max()) + 1
     if np.unique(cells).size != n_points:

@@ -99,7 +99,7 @@ def node_normals(
         return n * np.where(cos < 0, -1.0, 1.0)[..., None]
     total = np.zeros((int(nodes[:, :2].max(initial=0)) + 1, 2))
     np.add.at(total, nodes[:, :2].ravel(), np.repeat(chord, 2, axis=0))
-    out = np.repeat(chord[:, None, :], 3, axis=1)
+    out = np.repeat(chord[:, None, :], nodes.shape[1], axis=1)
     mean = total[nodes[:, :2]]
     out[:, :2] = mean / np.hypot(mean[..., 0], mean[..., 1])[..., None]
     return out

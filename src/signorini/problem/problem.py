@@ -24,7 +24,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..fem.material import CellMaterials, Material
-from ..fem.space import P2Space
+from ..fem.space import LagrangeSpace, P2Space
 from ..mesh.curves import Line
 from ..mesh.geometry import segment_normals
 from ..mesh.mesh import Mesh
@@ -240,10 +240,10 @@ class ContactProblem:
             out[name] = (self.mesh.points[v], normals[:, :2].reshape(-1, 2)[first])
         return out
 
-    def free_ndof(self, mesh: Mesh | P2Space) -> int:
+    def free_ndof(self, mesh: Mesh | LagrangeSpace) -> int:
         """Free scalar unknowns on ``mesh`` (or its space), the paper's Ndof: all DOFs minus
         the held ones (:func:`free_ndof` without rollers; a roller holds one DOF a node)."""
-        space = mesh if isinstance(mesh, P2Space) else P2Space(mesh)
+        space = mesh if isinstance(mesh, LagrangeSpace) else P2Space(mesh)
         return space.n_dofs - held_nodes(self, space, values=False).n_held
 
     def _segment_normal(self, name: str) -> np.ndarray | None:
