@@ -31,6 +31,7 @@ from signorini.contact.mortar import mortar_coupling
 from signorini.fem.material import Material
 from signorini.fem.space import P2Space
 from signorini.fem.stiffness import assemble_stiffness
+from signorini.mesh.bodies import union as bodies_union
 from signorini.mesh.builders import half_disc
 from signorini.mesh.curves import Circle
 from signorini.mesh.mesh import Mesh
@@ -50,15 +51,8 @@ def mirrored(mesh: Mesh) -> Mesh:
 
 
 def union(upper: Mesh, lower: Mesh) -> Mesh:
-    """One mesh of two bodies, parts ``up.*`` and ``low.*``."""
-    names = [f"up.{p}" for p in upper.part_names] + [f"low.{p}" for p in lower.part_names]
-    return Mesh(
-        np.vstack([upper.points, lower.points]),
-        np.vstack([upper.cells, lower.cells + upper.n_points]),
-        np.vstack([upper.boundary, lower.boundary + upper.n_points]),
-        np.concatenate([upper.boundary_part, lower.boundary_part + len(upper.part_names)]),
-        names, validate=False, curves=upper.curves + lower.curves,
-    )  # fmt: skip
+    """One mesh of two bodies, parts ``up.*`` and ``low.*`` (``mesh.bodies.union``)."""
+    return bodies_union({"up": upper, "low": lower})
 
 
 def solve_pdas(K, f, B, g, free, fixed_values):

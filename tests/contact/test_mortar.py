@@ -17,6 +17,7 @@ from scipy.spatial import cKDTree
 from signorini.contact.constraint_data import edge_weights
 from signorini.contact.mortar import mortar_coupling
 from signorini.fem.space import P2Space
+from signorini.mesh.bodies import union as bodies_union
 from signorini.mesh.builders import half_disc, rectangle
 from signorini.mesh.curves import Circle
 from signorini.mesh.mesh import Mesh
@@ -27,26 +28,22 @@ from signorini.problem.fields import ProblemError
 
 
 def union(**bodies: Mesh) -> Mesh:
-    """One mesh of the given bodies (disjoint components), parts named ``body.part``."""
-    pts, cells, bnd, bp, names, curves = [], [], [], [], [], []
-    off = 0
-    for key, m in bodies.items():
-        pts.append(m.points)
-        cells.append(m.cells + off)
-        bnd.append(m.boundary + off)
-        bp.append(m.boundary_part + len(names))
-        names += [f"{key}.{p}" for p in m.part_names]
-        curves += list(m.curves)
-        off += m.n_points
+    """One mesh of the given bodies (:func:`signorini.mesh.bodies.union`)."""
+    return bodies_union(bodies)
+
+
+def overlapping(upper: Mesh, lower: Mesh) -> Mesh:
+    """The union of two bodies that overlap, which :func:`union` refuses (built unchecked,
+    parts ``up.*`` and ``low.*``): what mortar_coupling must refuse on its own."""
+    away = Mesh(lower.points - [0.0, 10.0], lower.cells, lower.boundary, lower.boundary_part,
+                lower.part_names, validate=False, curves=lower.curves)  # fmt: skip
+    joined = union(up=upper, low=away)
+    points = joined.points.copy()
+    points[upper.n_points :] = lower.points
     return Mesh(
-        np.vstack(pts),
-        np.vstack(cells),
-        np.vstack(bnd),
-        np.concatenate(bp),
-        names,
-        validate=False,  # touching bodies share point coordinates
-        curves=curves,
-    )
+        points, joined.cells, joined.boundary, joined.boundary_part, joined.part_names,
+        validate=False, curves=joined.curves,
+    )  # fmt: skip
 
 
 def split_part(mesh: Mesh, part: str, new: str, select) -> Mesh:
@@ -98,7 +95,7 @@ def blocks(n_upper: int, n_lower: int, gap: float = 0.0, width=(0.0, 1.0)) -> P2
     ``n_upper`` and ``n_lower`` edges along the interface."""
     lower = rectangle(width[0], width[1], -0.5, 0.0, n_lower, 2)
     upper = rectangle(0.0, 1.0, gap, gap + 0.5, n_upper, 2)
-    return P2Space(union(up=upper, low=lower))
+    return P2Space(union(up=upper, low=lower) if gap >= 0 else overlapping(upper, lower))
 
 
 def cap(radius: float, rings: int, half_width: float) -> Mesh:

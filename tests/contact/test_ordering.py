@@ -142,7 +142,7 @@ def test_solve_uses_the_ordering_and_agrees_with_pardisos_own(adaptive_mesh, mon
     monkeypatch.setattr(
         solution,
         "ordered_solver",
-        lambda space, solver, **options: make_solver(solver, **options),
+        lambda space, solver, coupling=None, **options: make_solver(solver, **options),
     )
     own = solve(problem, adaptive_mesh, solver=pardiso_solver, nested=False)
     assert ordered.report.iterations == own.report.iterations

@@ -352,7 +352,11 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     for i, name in enumerate(parts):  # straight parts: exactly their normal
         if name in problem.contact_normals:
             chord[edge_part == i] = problem.contact_normals[name]
-    couplings = {s: mortar_coupling(space, s, m) for s, m in problem.pairs.items()}
+    dirichlet = problem.dirichlet_nodes(space)
+    couplings = {  # the slave's Dirichlet nodes carry no constraint
+        s: mortar_coupling(space, s, m, constrained=np.setdiff1d(space.part_nodes([s]), dirichlet))
+        for s, m in problem.pairs.items()
+    }
     direction, edge_gap = directions_and_gaps(
         problem, space, (parts, edge_part, edge_nodes), chord, couplings
     )
@@ -362,7 +366,7 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     key = (edge_nodes * n_parts + edge_part[:, None]).ravel()
     ukey, first, cand_of = np.unique(key, return_index=True, return_inverse=True)
     cand_node = ukey // n_parts
-    free = ~np.isin(cand_node, problem.dirichlet_nodes(space))
+    free = ~np.isin(cand_node, dirichlet)
     if not free.any():
         raise ProblemError("every node of the contact boundary is a Dirichlet node")
     held = np.flatnonzero(~free)
