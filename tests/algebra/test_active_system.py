@@ -152,8 +152,8 @@ def test_near_singular_solve_is_reported(backend):
     assert err.backend == backend
     assert "no Dirichlet condition" in str(err)
     if isinstance(err, SingularSystemError):
-        assert re.search(r"estimated relative error of 1\.\de\+00", str(err))  # petsc: 1.2
-        assert err.residual > 1e-4
+        estimate = float(re.search(r"estimated relative error of (\S+) ", str(err)).group(1))
+        assert estimate > 0.5 and err.residual > 1e-4  # PARDISO: 1.0, MUMPS (petsc): 0.83
     # the held block alone is solved, its residual checked and far below the bound
     n1 = K1.shape[0]
     result = solve_pdas(
@@ -170,8 +170,7 @@ def test_an_ill_conditioned_solve_is_refined_and_warned_about():
     3e-16), and a second warning says so."""
     _, K, F, d = _block_on_a_spring(1e-12)
     solutions = []
-    # MUMPS (petsc) estimates its solve's error at 7.4e-3, under the warning's 1e-2
-    for backend in (name for name in BACKEND_LIST if name != "petsc"):
+    for backend in BACKEND_LIST:
         with pytest.warns(IllConditionedWarning) as record:
             result = solve_pdas(
                 K, F, np.zeros(0, dtype=int), np.zeros(0), d, 0.0, solver=SOLVERS[backend]

@@ -45,10 +45,8 @@ def test_near_incompressible_contact_forces_are_compressive(backend):
     it to 1e-5, the round-off of forces whose KKT residual is 1e-6 (the forces change with
     1 − 2ν by 1.1 per unit, 2e-7 here)."""
     reference = solve(pressed_square(0.4999999), solver=SOLVERS[backend])
-    # KKT 1e-6: no warning yet; MUMPS (petsc) reads 1.1e-6 to 1.5e-6 here and warns
-    bound = 2e-6 if backend == "petsc" else 1e-6
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore" if backend == "petsc" else "error")
+        warnings.simplefilter("error")  # KKT 1e-6: no warning yet
         result = solve(pressed_square(0.499999999), solver=SOLVERS[backend])
     force = result.contact_force
     assert force.min() >= 0.0
@@ -57,7 +55,7 @@ def test_near_incompressible_contact_forces_are_compressive(backend):
     assert abs(total - reference.total_contact_force) <= 1e-5 * total
     np.testing.assert_allclose(force, reference.contact_force, rtol=0, atol=1e-5 * total)
     # honest residuals: the forces have about 6 digits, and the history says so
-    assert 1e-8 < result.report.kkt.max <= bound
+    assert 1e-8 < result.report.kkt.max <= 1e-6
     assert result.report.kkt.dual < 1e-7
 
 
