@@ -188,7 +188,6 @@ class PetscSolver(SPDSolver):
         if self.factorization == "lu":
             factor.setMumpsIcntl(10, -REFINEMENT_STEPS)
         self._mat, self._ksp = mat, ksp
-        self._diag = rows == A.indices  # this rank's part is read at a failed Cholesky
         self._x, self._b = mat.createVecs()
         self._scatter, self._all = PETSc.Scatter.toAll(self._x)
 
@@ -220,7 +219,7 @@ class PetscSolver(SPDSolver):
         if self.factorization == "cholesky":
             negative = int(factor.getMumpsInfog(12))
             if negative:
-                equation = _nonpositive_diagonal(A, data, self._diag)
+                equation = _nonpositive_diagonal(A, data)
                 where = "" if equation is None else f"; diagonal entry {equation} is not positive"
                 raise FactorizationError(
                     f"the matrix is not positive definite: MUMPS met {negative} negative "
@@ -273,13 +272,13 @@ class PetscLUSolver(PetscSolver):
         super().__init__(A, check_symmetry=False, ordering=ordering)
 
 
-def _nonpositive_diagonal(A: sp.csr_matrix, data: np.ndarray, diag: np.ndarray) -> int | None:
-    """The first row whose diagonal entry (in ``data``) is not positive, or None: where a
-    Cholesky factorization that reached it would stop (MUMPS counts negative pivots but does
-    not say where)."""
-    rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))[diag]
-    bad = rows[data[diag] <= 0]
-    return int(bad.min()) if bad.size else None
+def _nonpositive_diagonal(A: sp.csr_matrix, data: np.ndarray) -> int | None:
+    """The first row whose diagonal entry (of ``A`` with the values ``data``) is not
+    positive, or None: where a Cholesky factorization that reached it would stop (MUMPS
+    counts negative pivots but does not say where)."""
+    diagonal = sp.csr_matrix((data, A.indices, A.indptr), shape=A.shape).diagonal()
+    bad = np.flatnonzero(diagonal <= 0)
+    return int(bad[0]) if bad.size else None
 
 
 def petsc_solver(request: SolverRequest) -> PetscSolver:
