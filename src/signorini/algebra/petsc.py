@@ -210,7 +210,8 @@ class PetscSolver(SPDSolver):
             ) from err
         factor = pc.getFactorMatrix()
         status = int(factor.getMumpsInfog(1))
-        if status < 0 or int(pc.getFailedReason()) != 0:
+        failed = getattr(pc, "getFailedReason", lambda: 0)()  # petsc4py >= 3.19
+        if status < 0 or int(failed) != 0:
             raise FactorizationError(
                 f"MUMPS could not factorize the matrix (INFOG(1) = {status}): it is singular",
                 backend=self.backend,
