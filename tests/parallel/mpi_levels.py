@@ -13,10 +13,14 @@ import sys
 import numpy as np
 
 from signorini.algebra import solver_factory
-from signorini.examples import example_6_2, example_6_2_coulomb
+from signorini.examples import example_6_2, example_6_2_coulomb, example_6_2_tresca
 from signorini.loop import Level, adaptive
 
-PROBLEMS = {"example-6.2": example_6_2, "example-6.2-coulomb": example_6_2_coulomb}
+PROBLEMS = {
+    "example-6.2": example_6_2,
+    "example-6.2-coulomb": example_6_2_coulomb,
+    "example-6.2-tresca": example_6_2_tresca,
+}
 
 
 def level_numbers(levels: list[Level]) -> dict[str, np.ndarray]:

@@ -70,7 +70,11 @@ def serial():
 
 @pytest.mark.parametrize(
     "name,levels,first_ndofs",
-    [("example-6.2", 20, [144, 152, 160, 180]), ("example-6.2-coulomb", 20, [144, 152])],
+    [
+        ("example-6.2", 20, [144, 152, 160, 180]),
+        ("example-6.2-coulomb", 20, [144, 152]),
+        ("example-6.2-tresca", 20, [144]),
+    ],
 )
 @pytest.mark.parametrize("ranks", [1, 2, 3])
 def test_every_level_is_the_serial_one(serial, tmp_path, name, levels, first_ndofs, ranks):
