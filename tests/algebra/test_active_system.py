@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -150,7 +152,8 @@ def test_near_singular_solve_is_reported(backend):
     assert err.backend == backend
     assert "no Dirichlet condition" in str(err)
     if isinstance(err, SingularSystemError):
-        assert "estimated relative error of 1.0e+00" in str(err) and err.residual > 1e-4
+        estimate = float(re.search(r"estimated relative error of (\S+) ", str(err)).group(1))
+        assert estimate > 0.5 and err.residual > 1e-4  # PARDISO: 1.0, MUMPS (petsc): 0.83
     # the held block alone is solved, its residual checked and far below the bound
     n1 = K1.shape[0]
     result = solve_pdas(

@@ -25,6 +25,13 @@ from signorini.algebra import (
     solver_name,
     superlu_solver,
 )
+from signorini.algebra.petsc import petsc_module
+
+try:  # the optional "petsc" backend (signorini[mpi]) is listed where it loads
+    petsc_module()
+    PETSC: tuple[str, ...] = ("petsc",)
+except BackendUnavailableError:
+    PETSC = ()
 
 
 @pytest.fixture
@@ -51,13 +58,13 @@ def test_auto_takes_pardiso_when_mkl_is_installed():
         warnings.simplefilter("error")  # no fallback warning either
         solver = make_solver()
     assert solver.backend == "pardiso" and solver.reuses_analysis
-    assert available_backends() == ("pardiso", "scipy")
+    assert available_backends() == ("pardiso", "scipy", *PETSC)
 
 
 def test_unknown_backend_lists_valid():
-    with pytest.raises(ValueError, match="unknown backend 'mumps'.*auto, pardiso, scipy"):
+    with pytest.raises(ValueError, match="unknown backend 'mumps'.*auto, pardiso, scipy, petsc"):
         solver_factory("mumps")
-    assert tuple(SOLVERS) == ("auto", "pardiso", "scipy")
+    assert tuple(SOLVERS) == ("auto", "pardiso", "scipy", "petsc")
 
 
 def test_the_registry_names_each_factory_once():
@@ -77,7 +84,7 @@ def test_auto_falls_back_to_superlu_with_one_warning(broken_pardiso):
         solver = make_solver(auto_solver)
     assert len(caught) == 1 and caught[0].filename == __file__  # points at the caller
     assert solver.backend == "scipy" and not solver.reuses_analysis
-    assert available_backends() == ("scipy",)
+    assert available_backends() == ("scipy", *PETSC)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # once per process: a second fallback is silent
         result = solve_pdas(sp.identity(3, format="csr"), np.ones(3), [0], 0.5)

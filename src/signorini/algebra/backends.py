@@ -12,6 +12,10 @@ backend by name (:func:`solver_name`).
     the reason where it cannot be used.
 ``"scipy"``
     :func:`~.superlu.superlu_solver`: SuperLU, always there, with no reuse of the analysis.
+``"petsc"``
+    :func:`~.petsc.petsc_solver`: MUMPS through PETSc (the optional extra ``signorini[mpi]``),
+    serial or under ``mpiexec`` (docs/parallel.md); raises
+    :class:`~.solvers.BackendUnavailableError` naming the extra where petsc4py is missing.
 ``"auto"``
     :func:`auto_solver`, the default everywhere: PARDISO when it loads and solves a small test
     system; otherwise SuperLU, and a :class:`SolverFallbackWarning` says why (once per reason
@@ -34,6 +38,7 @@ import scipy.sparse as sp
 
 from .mkl import mkl_version
 from .pardiso import pardiso_problem, pardiso_solver
+from .petsc import petsc_solver
 from .solvers import BackendUnavailableError, SolverFactory, SolverRequest, SPDSolver
 from .superlu import superlu_solver
 
@@ -79,6 +84,7 @@ SOLVERS: dict[str, SolverFactory] = {
     "auto": auto_solver,
     "pardiso": pardiso_solver,
     "scipy": superlu_solver,
+    "petsc": petsc_solver,
 }
 
 
@@ -191,12 +197,17 @@ def make_solver(
 
 def solver_library(solver: object = None) -> str:
     """The sparse solver library a run uses: MKL PARDISO with MKL's version when the run's
-    solver is ``pardiso`` or ``auto`` and MKL loads, else SciPy's SuperLU."""
+    solver is ``pardiso`` or ``auto`` and MKL loads, PETSc's version and ranks for ``petsc``,
+    else SciPy's SuperLU."""
     name = str(solver) if solver is not None else "auto"
     if name in ("auto", "pardiso"):
         version = mkl_version()
         if version is not None:
             return f"MKL PARDISO ({version})"
+    if name == "petsc":
+        from .petsc import petsc_library
+
+        return petsc_library()
     if name in ("auto", "pardiso", "scipy", "superlu"):
         return f"SuperLU (SciPy {scipy.__version__})"
     return f"{name} (SciPy {scipy.__version__} installed)"

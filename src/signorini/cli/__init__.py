@@ -39,6 +39,7 @@ from . import figures, run
 from .levels import Printer, Status
 from .parser import parser
 from .problems import ProblemFileError, load_problem
+from .ranks import end_ranks
 
 __all__ = ["EXIT_TERMINATED", "load_problem", "main"]
 
@@ -60,8 +61,14 @@ def main(argv: list[str] | None = None) -> int:
     Returns the exit status: 0 on success, 2 for an error (one message on stderr; for a
     problem file that raises, the traceback of its own frames), 130 when interrupted
     (Ctrl-C) and 143 when terminated (SIGTERM), with one line saying what finished and
-    where.
+    where. Under ``mpiexec`` with the ``petsc`` backend a failed or interrupted rank ends
+    the whole job (:func:`.ranks.end_ranks`).
     """
+    return end_ranks(_main(argv))
+
+
+def _main(argv: list[str] | None) -> int:
+    """:func:`main` on this process."""
     args = parser().parse_args(argv)
     retain_freed_memory()  # large meshes: reuse freed pages instead of faulting in new ones
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")

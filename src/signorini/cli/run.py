@@ -26,6 +26,7 @@ from .figures import compare_uniform, draw_figures
 from .identity import check_problem, name_the_problem, problem_data
 from .levels import Clock, Printer, Status, write_levels
 from .problems import RunProblem, label, load, problem_id, with_curves_of
+from .ranks import follow, launched_ranks
 from .settings import RunSettings, new_settings, resumed_settings
 
 __all__ = ["run"]
@@ -54,6 +55,8 @@ def run(args: argparse.Namespace, status: Status | None = None) -> int:
     status = Status(say=Printer(quiet=args.quiet)) if status is None else status
     say = status.say
     if args.resume is not None:
+        if launched_ranks() > 1:
+            raise ValueError("--resume runs on one process: continue the run without mpiexec")
         folder = _open_resumed(args)
         status.folder = folder
         if args.example is None:
@@ -69,6 +72,8 @@ def run(args: argparse.Namespace, status: Status | None = None) -> int:
         folder, settings, name = None, new_settings(args), args.example
     status.problem = name
     job = load(name)
+    if folder is None and follow(args, settings, job):  # a rank > 0 of an MPI run: no files
+        return 0
     state = None
     if folder is None:
         folder = _create_folder(args, name, settings, say)

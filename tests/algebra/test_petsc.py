@@ -1,0 +1,150 @@
+"""The PETSc + MUMPS backend (signorini.algebra.petsc) against PARDISO and SuperLU.
+
+Runs where petsc4py with MUMPS is importable (the extra ``signorini[mpi]``) and is skipped
+elsewhere, except where ``SIGNORINI_REQUIRE_PETSC=1`` (CI's MPI stage) turns the skip into a
+failure. The error of a missing petsc4py is tested everywhere.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from linalg_problems import block_spd
+
+from signorini.algebra import (
+    BackendUnavailableError,
+    FactorizationError,
+    available_backends,
+    make_solver,
+    solver_factory,
+)
+from signorini.algebra import petsc as petsc_backend
+from signorini.algebra.backends import solver_library
+from signorini.algebra.petsc import petsc_solver, row_block
+from signorini.examples import example_6_2, example_6_2_coulomb
+from signorini.loop import adaptive
+
+
+def petsc_problem() -> str | None:
+    try:
+        petsc_backend.petsc_module()
+    except BackendUnavailableError as err:
+        return str(err)
+    return None
+
+
+PROBLEM = petsc_problem()
+if PROBLEM is not None and os.environ.get("SIGNORINI_REQUIRE_PETSC") == "1":
+    raise RuntimeError(f"SIGNORINI_REQUIRE_PETSC=1 but the petsc backend is unusable: {PROBLEM}")
+needs_petsc = pytest.mark.skipif(PROBLEM is not None, reason=f"petsc backend: {PROBLEM}")
+REFERENCE = "pardiso" if "pardiso" in available_backends() else "scipy"
+
+
+def test_a_missing_petsc4py_names_the_extra(monkeypatch):
+    petsc_backend.petsc_module.cache_clear()
+    monkeypatch.setitem(sys.modules, "petsc4py", None)  # import petsc4py raises ImportError
+    monkeypatch.setitem(sys.modules, "dolfinx_solver", None)
+    try:
+        with pytest.raises(BackendUnavailableError, match=r"petsc4py.*signorini\[mpi\]"):
+            make_solver(solver_factory("petsc"))
+        assert solver_library("petsc").startswith("PETSc (not usable: the petsc backend needs")
+        assert "petsc" not in available_backends()
+    finally:
+        petsc_backend.petsc_module.cache_clear()
+
+
+@pytest.mark.parametrize("n", [1, 2, 7, 100])
+def test_row_blocks_cover_the_rows_once_in_order(n):
+    for size in (1, 2, 3, 8):
+        blocks = [row_block(n, rank, size) for rank in range(size)]
+        assert blocks[0][0] == 0 and blocks[-1][1] == n
+        assert all(a[1] == b[0] for a, b in zip(blocks, blocks[1:], strict=False))
+        lengths = [hi - lo for lo, hi in blocks]
+        assert max(lengths) - min(lengths) <= 1 and lengths == sorted(lengths, reverse=True)
+
+
+@needs_petsc
+def test_cholesky_agrees_with_superlu_and_keeps_its_analysis():
+    rng = np.random.default_rng(3)
+    A = block_spd(14, 11, rng)
+    b = rng.standard_normal((A.shape[0], 3))
+    solver = make_solver(petsc_solver, symmetric=True)
+    assert solver.backend == "petsc" and solver.reuses_analysis
+    solver.factorize(A)
+    x = solver.solve(b)
+    exact = spla.spsolve(A.tocsc(), b)
+    assert np.abs(x - exact).max() / np.abs(exact).max() < 1e-12
+    # a refactorization with stored entries masked out (the active set's step): same
+    # pattern, no new analysis, and the answer of the masked matrix
+    rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
+    held = rng.uniform(size=A.shape[0]) < 0.3  # decoupled from the rest: still SPD
+    keep = held[rows] == held[A.indices]
+    masked = sp.csr_matrix((A.data * keep, A.indices, A.indptr), shape=A.shape)
+    solver.refactorize(keep)
+    x = solver.solve(b[:, 0])
+    exact = spla.spsolve(masked.tocsc(), b[:, 0])
+    assert np.abs(x - exact).max() / np.abs(exact).max() < 1e-12
+    assert (solver.n_analyses, solver.n_factorizations, solver.n_solves) == (1, 2, 2)
+    solver.close()
+
+
+@needs_petsc
+def test_cholesky_refuses_an_indefinite_matrix_and_lu_solves_it():
+    A = block_spd(6, 5, np.random.default_rng(0)).tolil()
+    A[4, 4] = -A[4, 4]
+    A = A.tocsr()
+    with pytest.raises(FactorizationError, match="not positive definite: MUMPS met 1 negative"):
+        make_solver(petsc_solver, A)
+    b = np.ones(A.shape[0])
+    x = make_solver(petsc_solver, A, symmetric=False).solve(b)
+    assert np.abs(A @ x - b).max() < 1e-12 * np.abs(A).max() * np.abs(x).max()
+
+
+@needs_petsc
+def test_manifest_names_petsc_and_its_ranks():
+    assert solver_library("petsc").startswith("PETSc 3.") and "MUMPS (1 rank)" in solver_library(
+        "petsc"
+    )
+
+
+def same_levels(problem, levels: int, max_ndof: int = 10**6) -> list[tuple[int, float]]:
+    """Run the adaptive loop with the PETSc backend and the reference backend and check they
+    agree level by level: Ndof, active set, marked cells, η and u to round-off."""
+    runs = {
+        name: list(
+            adaptive(problem, max_levels=levels, max_ndof=max_ndof, solver=solver_factory(name))
+        )
+        for name in ("petsc", REFERENCE)
+    }
+    checked = []
+    for a, b in zip(runs["petsc"], runs[REFERENCE], strict=True):
+        assert a.record.backend == "petsc" and b.record.backend == REFERENCE
+        assert a.record.ndof == b.record.ndof
+        np.testing.assert_array_equal(a.result.active, b.result.active)
+        if b.marked is not None:
+            np.testing.assert_array_equal(a.marked, b.marked)
+        scale = np.abs(b.result.u).max()
+        assert np.abs(a.result.u - b.result.u).max() <= 1e-11 * scale
+        assert a.record.eta == pytest.approx(b.record.eta, rel=1e-11)
+        np.testing.assert_allclose(
+            a.estimate.eta_terms, b.estimate.eta_terms, rtol=1e-9, atol=1e-12 * b.record.eta
+        )
+        checked.append((a.record.ndof, a.record.eta))
+    return checked
+
+
+@needs_petsc
+def test_example_6_2_adaptive_is_the_reference_run():
+    checked = same_levels(example_6_2(), levels=8)
+    assert [n for n, _ in checked] == [144, 152, 160, 180, 204, 242, 292, 362]
+
+
+@needs_petsc
+def test_coulomb_friction_on_mumps_lu_is_the_reference_run():
+    checked = same_levels(example_6_2_coulomb(), levels=5)
+    assert len(checked) == 5 and checked[-1][0] > checked[0][0]
