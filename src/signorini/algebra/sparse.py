@@ -16,6 +16,8 @@ __all__ = [
     "csr_row_indices",
     "diagonal_positions",
     "list_indices",
+    "STIFFNESS_RANGE",
+    "stiffness_unit",
     "symmetry_defect",
     "upper_positions",
 ]
@@ -146,3 +148,20 @@ def symmetry_defect(A: sp.csr_matrix) -> float:
         return 0.0
     D = A - A.T
     return float(np.abs(D.data).max()) / scale if D.nnz else 0.0
+
+
+#: a stiffness matrix whose largest diagonal entry lies in this range is solved as it is;
+#: outside it (E beyond about 1e±77) K and F are divided by a power of 2 first
+STIFFNESS_RANGE = (2.0**-256, 2.0**256)
+
+
+def stiffness_unit(K) -> float:
+    """1 if ``max |diag K|`` lies in ``STIFFNESS_RANGE`` (or is 0), else the power of 2
+    not above it. Dividing K and F by it is exact, so u_h is the same; it keeps sums over
+    K (the active set rule's constant c = mean diag K, the force scales of the KKT check)
+    and the factorization's products away from overflow and underflow when E is extreme."""
+    d = float(np.abs(K.diagonal()).max(initial=0.0))
+    lo, hi = STIFFNESS_RANGE
+    if d == 0.0 or not np.isfinite(d) or lo <= d <= hi:
+        return 1.0
+    return float(np.ldexp(1.0, int(np.floor(np.log2(d)))))

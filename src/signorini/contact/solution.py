@@ -20,6 +20,7 @@ from ..algebra.friction import INACTIVE, SLIP, STICK
 from ..algebra.pdas import PDASOptions, solve_pdas
 from ..algebra.result import PDASConvergenceError, SolveReport
 from ..algebra.solvers import SolverFactory, SPDSolver
+from ..algebra.sparse import stiffness_unit
 from ..fem.element import Element
 from ..fem.norms import energy_error2, h1_seminorm_error2
 from ..fem.postprocess import nodal_stress
@@ -51,9 +52,6 @@ log = logging.getLogger(__name__)
 
 #: quadrature degree for errors against a smooth exact solution
 ERROR_DEGREE = 10
-#: a stiffness matrix whose largest diagonal entry lies in this range is solved as it is;
-#: outside it (E beyond about 1e±77) K and F are divided by a power of 2 first
-STIFFNESS_RANGE = (2.0**-256, 2.0**256)
 
 
 #: a Dirichlet end point of Γ_C touches the obstacle (for the node classes) where
@@ -71,18 +69,6 @@ def _round_off_scale(u: np.ndarray, gap: np.ndarray) -> np.ndarray:
     displacements and to the gap at the node itself, not to the gap far away (a distant
     obstacle must not make the test lenient), and invariant under scaling of the problem."""
     return np.maximum(np.abs(u).max(initial=0.0), np.abs(gap))
-
-
-def stiffness_unit(K) -> float:
-    """1 if ``max |diag K|`` lies in ``STIFFNESS_RANGE`` (or is 0), else the power of 2
-    not above it. Dividing K and F by it is exact, so u_h is the same; it keeps sums over
-    K (the active set rule's constant c = mean diag K, the force scales of the KKT check)
-    and the factorization's products away from overflow and underflow when E is extreme."""
-    d = float(np.abs(K.diagonal()).max(initial=0.0))
-    lo, hi = STIFFNESS_RANGE
-    if d == 0.0 or not np.isfinite(d) or lo <= d <= hi:
-        return 1.0
-    return float(np.ldexp(1.0, int(np.floor(np.log2(d)))))
 
 
 @dataclass

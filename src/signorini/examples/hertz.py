@@ -35,6 +35,7 @@ from .metrics import Metrics, PressureComparison
 __all__ = [
     "DEPTH",
     "HERTZ_METRICS",
+    "beside_hertz",
     "hertz",
     "hertz_contact",
     "hertz_metrics",
@@ -190,15 +191,26 @@ def hertz_pressure(result: ContactResult) -> PressureComparison:
     a, p0 = hertz_solution(zone["force"], zone["radius"], result.problem.material)
     profile = result.contact_profile("arc")
     x = (profile.points - zone["centre"]) @ zone["tangent"]
+    return beside_hertz(
+        x, profile.pressure, (a, p0), f"hertz: contact pressure, {result.ndof} unknowns"
+    )
+
+
+def beside_hertz(
+    x: np.ndarray, pressure: np.ndarray, hertz: tuple[float, float], title: str
+) -> PressureComparison:
+    """The pressures ``pressure`` at ``x`` (along the contact, from its centre) within 2a of
+    the centre, beside Hertz's ``p0 √(1 − x² / a²)`` of ``hertz = (a, p0)``."""
+    a, p0 = hertz
     near = np.abs(x) <= 2.0 * a
     x_ref = np.linspace(-a, a, 401)
     return PressureComparison(
         x=x[near],
-        pressure=profile.pressure[near],
+        pressure=pressure[near],
         x_reference=x_ref,
         reference=p0 * np.sqrt(np.maximum(1.0 - (x_ref / a) ** 2, 0.0)),
         label=rf"Hertz, $a$ = {a:.4g}, $p_0$ = {p0:.4g}",
-        title=f"hertz: contact pressure, {result.ndof} unknowns",
+        title=title,
     )
 
 

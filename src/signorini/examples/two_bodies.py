@@ -24,6 +24,7 @@ from ..mesh.builders import half_disc, rectangle
 from ..mesh.curves import Circle
 from ..mesh.mesh import Mesh
 from ..problem import Contact, ContactProblem, Dirichlet, Neumann
+from .hertz import beside_hertz
 from .metrics import Metrics, PressureComparison
 
 __all__ = [
@@ -245,18 +246,10 @@ def cylinders_pressure(result: ContactResult) -> PressureComparison:
     a = float(np.sqrt(4.0 * total * radius / (np.pi * e_star)))
     p0 = 2.0 * total / (np.pi * a)
     x = result.space.node_points[result.contact.nodes, 0]
-    x = x - force @ x / total
-    near = np.abs(x) <= 2.0 * a
-    order = np.argsort(x[near])
-    x_ref = np.linspace(-a, a, 401)
-    return PressureComparison(
-        x=x[near][order],
-        pressure=result.pressure[near][order],
-        x_reference=x_ref,
-        reference=p0 * np.sqrt(np.maximum(1.0 - (x_ref / a) ** 2, 0.0)),
-        label=rf"Hertz, $a$ = {a:.4g}, $p_0$ = {p0:.4g}",
-        title=f"two cylinders: contact pressure, {result.ndof} unknowns",
-    )
+    order = np.argsort(x)
+    x = x[order] - force @ x / total
+    title = f"two cylinders: contact pressure, {result.ndof} unknowns"
+    return beside_hertz(x, result.pressure[order], (a, p0), title)
 
 
 #: The two-cylinder example's columns of ``history.csv`` and its pressure figure.
