@@ -227,6 +227,10 @@ def test_oblique_roller_reproduces_an_affine_solution(bottom):
     lam_z = result.roller_force
     assert np.abs(lam_z - expected[result.roller_nodes]).max() <= 1e-12 * np.abs(lam_z).max()
     assert result.errors()["error_energy"] <= 1e-12 * np.sqrt(np.abs(sigma).max() * scale)
+    # the roller edges' free traction (η3) vanishes with the rest of η on the exact solution
+    from signorini.estimator import estimate
+
+    assert estimate(result).eta <= 1e-11 * np.abs(sigma).max()
 
 
 def _sector(n: int, a: float = 1.0, b: float = 2.0, angles=(0.3, 1.4)) -> Mesh:
@@ -387,3 +391,42 @@ def test_roller_refusals_on_oblique_and_curved_parts():
     _assert_rotated(ra, rb)
     shared = np.flatnonzero(np.abs(ra.space.node_points - [1.0, 0.0]).max(axis=1) < 1e-14)
     assert ra.u[shared, 1] == pytest.approx(-0.01, abs=1e-15)
+
+
+def test_the_estimator_measures_the_free_traction_on_rollers():
+    """Roller edges enter η3 with their tangential traction (which must vanish; zero on the
+    exact affine trapezoid solution, test above): on the Lamé sector, where it is not exact,
+    it falls at the P2 rate, and η with it keeps a bounded efficiency index."""
+    from signorini.estimator import estimate
+    from signorini.estimator.held import held_part_integrals
+    from signorini.estimator.residual import geometry
+    from signorini.estimator.traction import CellStress, vertex_stress
+    from signorini.fem.quadrature import line_rule
+
+    material = Material.from_young(1.0, 0.3)
+    p = 0.1
+    exact = _lame(material, 1.0, 2.0, p)
+    conditions = {
+        "inner": Roller(),
+        "outer": Neumann(lambda x, normal: -p * normal),
+        "start": Roller(),
+        "end": Roller(),
+    }
+    mesh, rows = _sector(2), []
+    for _ in range(4):  # a loop over uniform refinements
+        r = solve(ContactProblem(mesh, material, conditions, exact=exact))
+        cells, _ = geometry(r.space)
+        u_cell = r.space.field_coefficients(r.u)
+        sigma = vertex_stress(cells, u_cell, material)
+        stresses = CellStress(cells, mesh.points, mesh.cells, u_cell, material, sigma, 1.0)
+        t, w = line_rule(7)
+        edges, J = held_part_integrals(r, stresses, t, w)
+        rows.append((r.ndof, r.errors()["error_energy"], estimate(r).eta, np.sqrt(J.sum())))
+        mesh = refine_uniform(mesh).mesh
+    ndof, error, eta, roller = (np.array(c) for c in zip(*rows, strict=True))
+    assert edges.size == sum(mesh.part_edges(n).size for n in ("inner", "start", "end")) // 2
+    efficiency = eta / error
+    print(f"\nroller traction residual {roller}; η/‖e‖ {np.round(efficiency, 2)}")
+    assert (roller > 0).all() and fitted_slope(ndof, roller, last=3) < -0.9
+    assert fitted_slope(ndof, eta, last=3) < -0.9
+    assert efficiency.max() / efficiency.min() < 1.3

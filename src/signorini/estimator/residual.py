@@ -61,8 +61,8 @@ from ..fem.space import LagrangeSpace
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .friction import friction_edges, move_dirichlet_thirds
+from .held import further_traction_edges
 from .names import TERMS
-from .pairs import master_integrals
 from .terms import (
     EdgeSet,
     TermShares,
@@ -236,9 +236,9 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
     inner = _edge_set(space, np.flatnonzero(mesh.edge2cell[:, 1] >= 0))
     jump = _from_both_sides(mesh, stresses.traction, inner.index, t)
     t_n, w_n = line_rule(NEUMANN_DEGREE)
-    # the masters of contact pairs are Neumann edges with the slave's traction (pairs.py)
-    masters, J3_masters = master_integrals(result, stresses, t_n, w_n, unit)
-    neumann = _edge_set(space, np.concatenate([_part_edges(mesh, problem.neumann_parts), masters]))
+    # pairs' masters (the slave's traction) and rollers (their free traction) join η3: held.py
+    further, J3_further = further_traction_edges(result, stresses, t_n, w_n, unit)
+    neumann = _edge_set(space, np.concatenate([_part_edges(mesh, problem.neumann_parts), further]))
     contact = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
     pressure = on_edge(_edge_pressure(result)) / unit if eta5_variant == "consistent" else None
     friction = friction_edges(result, unit)  # None without friction
@@ -253,7 +253,7 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
     # each integral once per cell or edge, through its own geometry (docs/method.md,
     # *Estimator*, "On curved boundaries")
     R = _interior_residual(problem, material, cells, u_cell, unit)
-    J3 = np.concatenate([_neumann_integrals(problem, mesh, stresses, t_n, w_n, unit), J3_masters])
+    J3 = np.concatenate([_neumann_integrals(problem, mesh, stresses, t_n, w_n, unit), J3_further])
     direction = on_edge(cs.edge_direction)
     J4, J5 = contact_stress(stresses, mesh, contact, cs.edge_normal, direction, t, w, pressure, p_t)
     parts6 = np.zeros(gap.shape)
