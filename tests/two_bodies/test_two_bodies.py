@@ -452,3 +452,18 @@ def test_efficiency_on_a_manufactured_two_body_solution(edges):
     assert -1.05 < slope < -0.95
     assert 10.0 < efficiency.min() and efficiency.max() < 40.0
     assert efficiency.max() / efficiency.min() < 1.3
+
+
+def test_stacked_blocks_print_the_patch_tests_deviation(tmp_path):
+    """``signorini run stacked-blocks`` writes the slave's and the master's pressure
+    deviations per level: round-off."""
+    import csv
+
+    from signorini.cli import main
+
+    assert main(["run", "stacked-blocks", "--tol", "1e-10", "--out", str(tmp_path),
+                 "--quiet", "--no-figures"]) == 0  # fmt: skip
+    rows = list(csv.DictReader(open(tmp_path / "history.csv")))
+    assert len(rows) == 1  # η at round-off on the initial mesh
+    for column in ("slave_pressure_deviation", "master_pressure_deviation"):
+        assert float(rows[0][column]) < 1e-10

@@ -28,7 +28,7 @@ from .metrics import Metrics, PressureComparison
 from .paper import example_6_1, example_6_2
 from .partial_slip import PARTIAL_SLIP_METRICS, partial_slip, partial_slip_path
 from .punch import punch
-from .two_bodies import CYLINDERS_METRICS, hertz_pair, stacked_blocks, two_cylinders
+from .two_bodies import BLOCKS_METRICS, CYLINDERS_METRICS, hertz_pair, stacked_blocks, two_cylinders
 
 __all__ = [
     "EXAMPLES",
@@ -98,7 +98,7 @@ EXAMPLES: dict[str, Example] = {
         Example("punch", punch),
         Example("partial-slip", partial_slip, PARTIAL_SLIP_METRICS, partial_slip_path),
         Example("two-cylinders", two_cylinders, metrics=CYLINDERS_METRICS),
-        Example("stacked-blocks", stacked_blocks),
+        Example("stacked-blocks", stacked_blocks, metrics=BLOCKS_METRICS),
         Example("hertz-pair", hertz_pair),
     )
 }
