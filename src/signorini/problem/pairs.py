@@ -11,11 +11,9 @@ from ..mesh.bodies import body_of_cells
 from ..mesh.mesh import Mesh
 from .conditions import Contact
 from .fields import ProblemError
+from .rigid import motion_conditions, null_motions
 
 __all__ = ["check_bodies_held", "contact_pairs"]
-
-#: a singular value below this times the largest is zero (the conditions are O(1) numbers)
-RANK_RTOL = 1e-9
 
 
 def contact_pairs(mesh: Mesh, conditions: Mapping[str, object]) -> dict[str, str]:
@@ -86,28 +84,7 @@ def check_bodies_held(
     edge_body[mesh.edge_part >= 0] = body[mesh.edge2cell[mesh.edge_part >= 0, 0]]
     paired = np.concatenate([mesh.part_edges(p) for p in (*pairs, *pairs.values())])
     for b in np.unique(edge_body[paired]):  # a loop over bodies
-        lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
-        centre, size = 0.5 * (lo + hi), float(np.max(hi - lo))
-        rows = []
-        for name, cond in held.items():  # a loop over parts
-            e = mesh.part_edges(name)
-            v = np.unique(mesh.edges[e[edge_body[e] == b]])
-            d = (mesh.points[v] - centre) / size
-            one, zero = np.ones(v.size), np.zeros(v.size)
-            by_component = (
-                np.column_stack([one, zero, -d[:, 1]]),
-                np.column_stack([zero, one, d[:, 0]]),
-            )
-            rows += [by_component[c] for c in range(2) if cond.components[c]]
-        for name, (x, n) in (rollers or {}).items():  # a loop over parts
-            if edge_body[mesh.part_edges(name)[0]] == b:
-                d = (x - centre) / size  # r·n = a n_x + b n_y + c (d_x n_y − d_y n_x)
-                rows.append(
-                    np.column_stack([n[:, 0], n[:, 1], d[:, 0] * n[:, 1] - d[:, 1] * n[:, 0]])
-                )
-        A = np.concatenate(rows) if rows else np.zeros((0, 3))
-        s = np.linalg.svd(A, compute_uv=False) if A.size else np.zeros(0)
-        rank = int((s > RANK_RTOL * s.max()).sum()) if s.size and s.max() > 0 else 0
+        rank = 3 - null_motions(motion_conditions(mesh, held, rollers, edge_body == b)).shape[0]
         if rank < 3:
             parts = [p for p in mesh.part_names if (edge_body[mesh.part_edges(p)] == b).any()]
             raise ProblemError(

@@ -20,11 +20,10 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from ..fem.material import CellMaterials, Material
 from ..fem.space import LagrangeSpace, P2Space
+from ..mesh.bodies import body_of_cells
 from ..mesh.curves import Line
 from ..mesh.geometry import segment_normals
 from ..mesh.mesh import Mesh
@@ -357,12 +356,8 @@ def _check_components(mesh: Mesh, dirichlet_parts: list[str], contact_parts: lis
         boundary parts (the first few, and how many more).
     """
     e2c = mesh.edge2cell
-    inner = e2c[:, 1] >= 0
-    n = mesh.n_cells
-    graph = sp.coo_matrix(
-        (np.ones(int(inner.sum()), dtype=np.int8), (e2c[inner, 0], e2c[inner, 1])), shape=(n, n)
-    )
-    n_comp, label = connected_components(graph, directed=False)
+    label = body_of_cells(mesh)
+    n_comp = int(label.max(initial=0)) + 1
     if n_comp == 1:
         return
     held = np.zeros(n_comp, dtype=bool)

@@ -19,7 +19,13 @@ from ..mesh.geometry import segment_normals
 from ..mesh.mesh import Mesh
 from .fields import ProblemError
 
-__all__ = ["describe_motion", "free_rigid_motions", "motion_field"]
+__all__ = [
+    "describe_motion",
+    "free_rigid_motions",
+    "motion_conditions",
+    "motion_field",
+    "null_motions",
+]
 
 #: a singular value below this times the largest is zero (the conditions are O(1) numbers)
 RANK_RTOL = 1e-9
@@ -61,6 +67,42 @@ def _null_space(rows: np.ndarray, k: int) -> np.ndarray:
     return vt[rank:]
 
 
+def motion_conditions(
+    mesh: Mesh,
+    held: Mapping[str, object],
+    rollers: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
+    on_edges: np.ndarray | None = None,
+) -> np.ndarray:
+    """The linear conditions ``(n, 3)`` on a rigid motion's coefficients ``(a, b, c)`` that
+    the held components of ``held`` and the roller normals of ``rollers`` (as in
+    :func:`free_rigid_motions`) impose at their parts' vertices; with ``on_edges`` (a bool
+    mask of the mesh's edges) only the held parts' edges in it and the roller parts that
+    start in it (one body of a union)."""
+    centre, size = _frame(mesh)
+    rows = [np.zeros((0, 3))]
+    for name, cond in held.items():  # a loop over parts
+        e = mesh.part_edges(name)
+        v = np.unique(mesh.edges[e if on_edges is None else e[on_edges[e]]])
+        d = (mesh.points[v] - centre) / size
+        one, zero = np.ones(v.size), np.zeros(v.size)
+        by_component = (
+            np.column_stack([one, zero, -d[:, 1]]),
+            np.column_stack([zero, one, d[:, 0]]),
+        )
+        rows += [by_component[c] for c in range(2) if cond.components[c]]
+    for name, (x, n) in (rollers or {}).items():  # a loop over parts
+        if on_edges is None or on_edges[mesh.part_edges(name)[0]]:
+            d = (x - centre) / size  # r·n = a n_x + b n_y + c (d_x n_y − d_y n_x)
+            rows.append(np.column_stack([n[:, 0], n[:, 1], d[:, 0] * n[:, 1] - d[:, 1] * n[:, 0]]))
+    return np.concatenate(rows)
+
+
+def null_motions(conditions: np.ndarray) -> np.ndarray:
+    """The rigid motions ``(k, 3)`` (orthonormal coefficients) that ``conditions (n, 3)``
+    leave free."""
+    return _null_space(conditions, 3)
+
+
 def free_rigid_motions(
     mesh: Mesh,
     held: Mapping[str, object],
@@ -80,21 +122,7 @@ def free_rigid_motions(
         If a free motion is tangential to every contact part (or there is none): nothing
         holds it. The message names the motion.
     """
-    centre, size = _frame(mesh)
-    rows = []
-    for name, cond in held.items():  # a loop over parts
-        v = np.unique(mesh.edges[mesh.part_edges(name)])
-        d = (mesh.points[v] - centre) / size
-        one, zero = np.ones(v.size), np.zeros(v.size)
-        by_component = (
-            np.column_stack([one, zero, -d[:, 1]]),
-            np.column_stack([zero, one, d[:, 0]]),
-        )
-        rows += [by_component[c] for c in range(2) if cond.components[c]]
-    for x, n in (rollers or {}).values():  # a loop over parts
-        d = (x - centre) / size
-        rows.append(np.column_stack([n[:, 0], n[:, 1], d[:, 0] * n[:, 1] - d[:, 1] * n[:, 0]]))
-    free = _null_space(np.concatenate(rows) if rows else np.zeros((0, 3)), 3)
+    free = null_motions(motion_conditions(mesh, held, rollers))
     if free.shape[0] == 0:
         return free
     normals, mids = [], []
