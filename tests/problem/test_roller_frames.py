@@ -273,18 +273,24 @@ def _lame(material: Material, a: float, b: float, p: float) -> ExactSolution:
     return ExactSolution(u, grad)
 
 
+def _sector_conditions(p: float) -> dict:
+    """Rollers on the sector's inner arc and radial sides, the pressure ``p`` on its outer
+    arc."""
+    return {
+        "inner": Roller(),
+        "outer": Neumann(lambda x, normal: -p * normal),
+        "start": Roller(),
+        "end": Roller(),
+    }
+
+
 def test_rollers_on_a_sector_converge_to_lame_at_the_p2_rate():
     # rollers on the radial sides (oblique) and on the inner arc (the circle's normal), the
     # outer arc under pressure: the Lamé solution u_r = A r + B / r, u_θ = 0
     material = Material.from_young(1.0, 0.3)
     p = 0.1
     exact = _lame(material, 1.0, 2.0, p)
-    conditions = {
-        "inner": Roller(),
-        "outer": Neumann(lambda x, normal: -p * normal),
-        "start": Roller(),
-        "end": Roller(),
-    }
+    conditions = _sector_conditions(p)
     mesh = _sector(2)
     ndof, errors = [], []
     for _ in range(4):
@@ -406,12 +412,7 @@ def test_the_estimator_measures_the_free_traction_on_rollers():
     material = Material.from_young(1.0, 0.3)
     p = 0.1
     exact = _lame(material, 1.0, 2.0, p)
-    conditions = {
-        "inner": Roller(),
-        "outer": Neumann(lambda x, normal: -p * normal),
-        "start": Roller(),
-        "end": Roller(),
-    }
+    conditions = _sector_conditions(p)
     mesh, rows = _sector(2), []
     for _ in range(4):  # a loop over uniform refinements
         r = solve(ContactProblem(mesh, material, conditions, exact=exact))
