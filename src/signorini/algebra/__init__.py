@@ -11,6 +11,7 @@ semismooth Newton extension to Tresca and Coulomb friction.
 ``mkl``                how MKL's runtime library is found and loaded
 ``pardiso``            MKL PARDISO through ctypes (SPD, non-symmetric LU), its factory; METIS
 ``backends``           the backends by name (``SOLVERS``, ``"auto"``), ``make_solver``
+``ranks``              the processes sharing a run's matrices: their collectives (``SERIAL``)
 ``qp``                 the bound-constrained QP's data, checked at the public entry
 ``kkt``                KKT residuals of a point
 ``active_system``      one active set's linear system: refactorization or bordered update

@@ -295,3 +295,13 @@ def petsc_solver(request: SolverRequest) -> PetscSolver:
     if request.symmetric:
         return PetscSolver(check_symmetry=request.check_symmetry)
     return PetscLUSolver()
+
+
+def _world_ranks():
+    from .ranks import world_ranks
+
+    return world_ranks()
+
+
+#: The ranks the backend's matrices are split over (:func:`~.ranks.solver_ranks`).
+petsc_solver.ranks = _world_ranks  # type: ignore[attr-defined]

@@ -1,0 +1,126 @@
+"""Which rank owns which nodes and cells of a mesh, on a run of several MPI ranks
+(docs/parallel.md, *What is distributed*).
+
+The partition cuts the nested dissection ordering of the mesh's vertex graph (METIS, the
+ordering the solver is handed, :mod:`.ordering`) into ``size`` contiguous blocks of vertices:
+a nested dissection numbers each subdomain's vertices together, so a block is a compact piece
+of the mesh. An edge node (P2) goes with its edge's first vertex, a cell with its first
+vertex. The nodes that a contact pair's coupling joins (a slave node and the master nodes of
+its mortar row, docs/method.md, *Two bodies*) go to one rank together: the change of basis
+mixes their rows, and keeping them on one rank keeps every row of the system on one rank.
+
+Rank r assembles the rows of the DOFs of its nodes; for that it computes the element matrices
+of every cell with a node of its own (:attr:`Partition.row_cells`): its own cells and one
+layer of its neighbours' (the ghost cells).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components, reverse_cuthill_mckee
+
+from ..algebra.ranks import Ranks
+from ..algebra.solvers import BackendUnavailableError
+from ..fem.space import LagrangeSpace
+from .ordering import vertex_graph
+
+__all__ = ["Partition", "partition"]
+
+
+@dataclass(frozen=True)
+class Partition:
+    """The owner rank of every node and cell of one space, seen from one rank.
+
+    Attributes
+    ----------
+    rank, size : int
+        This rank and the number of ranks.
+    node_owner : (n_nodes,) int array
+        The rank that owns each node of the space (and the rows of its two DOFs).
+    cell_owner : (n_cells,) int array
+        The rank that owns each cell (its estimator terms).
+    space : LagrangeSpace
+    """
+
+    rank: int
+    size: int
+    node_owner: np.ndarray
+    cell_owner: np.ndarray
+    space: LagrangeSpace
+
+    @property
+    def owned_nodes(self) -> np.ndarray:
+        """``(n_nodes,)`` bool: this rank's nodes."""
+        return self.node_owner == self.rank
+
+    @property
+    def owned_dofs(self) -> np.ndarray:
+        """``(n_dofs,)`` bool: the DOFs of this rank's nodes (interleaved, ``2 node + k``)."""
+        return np.repeat(self.owned_nodes, 2)
+
+    @property
+    def owned_cells(self) -> np.ndarray:
+        """``(n_cells,)`` bool: this rank's cells."""
+        return self.cell_owner == self.rank
+
+    @property
+    def row_cells(self) -> np.ndarray:
+        """``(n_cells,)`` bool: the cells with a node of this rank's, whose element matrices
+        its rows need (its own cells and the ghost layer around them)."""
+        return self.owned_nodes[self.space.cell_nodes].any(axis=1)
+
+
+def partition(
+    space: LagrangeSpace, ranks: Ranks, coupling: sp.spmatrix | None = None
+) -> Partition:
+    """The partition of ``space``'s nodes and cells over ``ranks``.
+
+    Parameters
+    ----------
+    space : LagrangeSpace
+    ranks : Ranks
+    coupling : (n_nodes, n_nodes) sparse matrix, optional
+        Node pairs that must share a rank (a contact pair's mortar transfer).
+
+    Returns
+    -------
+    Partition
+        The same on every rank (computed from replicated data, deterministically).
+    """
+    mesh = space.mesh
+    order = _vertex_order(mesh)
+    vertex_owner = np.empty(mesh.n_points, dtype=np.int64)
+    vertex_owner[order] = np.arange(mesh.n_points) * ranks.size // max(mesh.n_points, 1)
+    node_owner = vertex_owner
+    if space.n_nodes > mesh.n_points:  # P2: then the edge midpoints
+        node_owner = np.concatenate([vertex_owner, vertex_owner[mesh.edges[:, 0]]])
+    if coupling is not None and ranks.size > 1:
+        node_owner = _joined(node_owner, coupling)
+    cell_owner = vertex_owner[mesh.cells[:, 0]]
+    return Partition(ranks.rank, ranks.size, node_owner, cell_owner, space)
+
+
+def _vertex_order(mesh) -> np.ndarray:
+    """METIS's nested dissection of the vertex graph; reverse Cuthill–McKee without MKL."""
+    graph = vertex_graph(mesh)
+    try:
+        from ..algebra.pardiso import metis_ordering
+
+        return np.asarray(metis_ordering(graph), dtype=np.int64)
+    except BackendUnavailableError:
+        return np.asarray(reverse_cuthill_mckee(graph, symmetric_mode=True), dtype=np.int64)
+
+
+def _joined(node_owner: np.ndarray, coupling: sp.spmatrix) -> np.ndarray:
+    """``node_owner`` with every group of nodes that ``coupling`` joins given the owner of
+    the group's first node."""
+    n = node_owner.size
+    c = sp.coo_matrix(coupling)
+    graph = sp.csr_matrix((np.ones(c.nnz), (c.row, c.col)), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    first = np.full(label.max() + 1, n, dtype=np.int64)
+    np.minimum.at(first, label, np.arange(n))
+    return node_owner[first[label]]
