@@ -73,9 +73,7 @@ class Partition:
         return self.owned_nodes[self.space.cell_nodes].any(axis=1)
 
 
-def partition(
-    space: LagrangeSpace, ranks: Ranks, coupling: sp.spmatrix | None = None
-) -> Partition:
+def partition(space: LagrangeSpace, ranks: Ranks, coupling: sp.spmatrix | None = None) -> Partition:
     """The partition of ``space``'s nodes and cells over ``ranks``.
 
     Parameters
