@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from .ranks import SERIAL, Ranks
 from .sparse import as_csr
 
 __all__ = ["BoundQP", "check_qp", "check_vector"]
@@ -40,6 +41,10 @@ class BoundQP:
         The fixed DOFs ``d``, distinct and disjoint from ``constrained``.
     dirichlet_values : (n_d,) float array
         ``x_D``, in the order of ``dirichlet``.
+    ranks : Ranks
+        The processes that share ``K`` by rows (:mod:`.ranks`): on a rank of several, ``K``
+        holds that rank's rows only and ``K`` is the sum over the ranks; :data:`~.ranks.SERIAL`
+        for a whole matrix.
     """
 
     K: sp.csr_matrix
@@ -48,6 +53,7 @@ class BoundQP:
     gap: np.ndarray
     dirichlet: np.ndarray
     dirichlet_values: np.ndarray
+    ranks: Ranks = SERIAL
 
     @property
     def n(self) -> int:
@@ -62,6 +68,8 @@ def check_qp(
     gap: object,
     dirichlet: object = None,
     dirichlet_values: object = None,
+    *,
+    ranks: Ranks = SERIAL,
 ) -> BoundQP:
     """Check and normalise the data of the bound-constrained QP.
 
@@ -74,6 +82,8 @@ def check_qp(
     dirichlet : (n_d,) int array or (n,) bool mask, optional
     dirichlet_values : float, (n_d,) or (n,) float array, optional
         Default 0.
+    ranks : Ranks
+        As :attr:`BoundQP.ranks`; default a whole matrix.
 
     Returns
     -------
@@ -106,7 +116,7 @@ def check_qp(
         if vals.shape == (n,) and d.size != n:
             vals = vals[d]
         xd = check_vector(vals, d.size, "dirichlet_values", allow_scalar=True)
-    return BoundQP(K, F, c, g, d, xd)
+    return BoundQP(K, F, c, g, d, xd, ranks)
 
 
 def check_vector(v: object, n: int, name: str, *, allow_scalar: bool = False) -> np.ndarray:
