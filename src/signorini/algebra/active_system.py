@@ -242,8 +242,10 @@ class ActiveSetSystem:
         K, F, c = qp.K, qp.F, qp.constrained
         self.K, self.F, self.c, self.g = K, F, c, qp.gap
         self.K_c = K[c]  # rows of the constrained DOFs, for the multiplier
+        self.ranks = qp.ranks  # every product with K is summed over them (:mod:`.ranks`)
         self.solver = solver
-        self.eliminator = SymmetricEliminator(K)
+        self.eliminator = SymmetricEliminator(K, qp.ranks)
+        self.diagonal = self.eliminator.diagonal(K)
         self.fixed = np.zeros(K.shape[0], dtype=bool)
         self.fixed[qp.dirichlet] = True
         self.values = np.zeros(K.shape[0])
@@ -277,7 +279,7 @@ class ActiveSetSystem:
         self.fixed[c] = active
         self.values[c] = np.where(active, self.g, 0.0)
         t0 = time.perf_counter()
-        b = self.eliminator.rhs(self.K, F, self.fixed, self.values)
+        b = self.eliminator.rhs(self.K, F, self.fixed, self.values, self.diagonal)
         self.time_elimination += time.perf_counter() - t0
         x = None
         if self.factored is not None and self.max_update > 0:
@@ -313,7 +315,7 @@ class ActiveSetSystem:
                 self.solver.backend,
             )
         x[self.fixed] = self.values[self.fixed]
-        return x, F[c] - self.K_c @ x
+        return x, F[c] - self.ranks.sum(self.K_c @ x)
 
     def _solve_updated(
         self, F: np.ndarray, b: np.ndarray, changed: np.ndarray
@@ -329,31 +331,31 @@ class ActiveSetSystem:
         fixed in both, on ``f`` and on ``R``.
         """
         fixed0, fixed1, values, K = self.factored, self.fixed, self.values, self.K
+        total = self.ranks.sum  # of the products with rows of K: each row is on one rank
         released = changed[fixed0[changed]]
         added = changed[fixed1[changed]]
         r, k = released.size, changed.size
-        t = F - K @ np.where(fixed0 & fixed1, values, 0.0)
+        t = F - total(K @ np.where(fixed0 & fixed1, values, 0.0))
         rows_R = K[released]  # rows R = columns R (K is symmetric)
         K_Rf = rows_R.multiply(~fixed0[None, :]).tocsr()  # only the columns free in the factor
         rhs = np.zeros((K.shape[0], k + 1), order="F")
         rhs[:, 0] = np.where(fixed0, 0.0, t)
-        rhs[:, 1 : r + 1] = K_Rf.T.toarray()
+        rhs[:, 1 : r + 1] = total(K_Rf.T.toarray())
         rhs[added, np.arange(r + 1, k + 1)] = 1.0
         Z = self.solver.solve(rhs)  # K_ff⁻¹ [g, B] in one call (zero on the fixed DOFs)
         z, W = Z[:, 0], Z[:, 1:]
-        schur = -np.vstack([K_Rf @ W, W[added]])
-        schur[:r, :r] += rows_R[:, released].toarray()
+        schur = -np.vstack([total(K_Rf @ W), W[added]])
+        schur[:r, :r] += total(rows_R[:, released].toarray())
         load = np.concatenate([t[released], values[added]])
         try:
-            y = np.linalg.solve(schur, load - np.concatenate([K_Rf @ z, z[added]]))
+            y = np.linalg.solve(schur, load - np.concatenate([total(K_Rf @ z), z[added]]))
         except np.linalg.LinAlgError:
             return None
         x = z - W @ y
         x[released] = y[:r]
         x[fixed1] = values[fixed1]
         # accepted at round-off: relative to the size of both sides of A x = b
-        diagonal = K.data[self.eliminator.diagonal_positions]
-        scale = max(np.abs(b).max(), np.abs(diagonal).max() * np.abs(x).max(), 1e-300)
+        scale = max(np.abs(b).max(), np.abs(self.diagonal).max() * np.abs(x).max(), 1e-300)
         if not self.residual(b, x) <= UPDATE_RTOL * scale:
             return None
         self.n_updates += 1
@@ -379,14 +381,14 @@ class ActiveSetSystem:
 
     def _residual_vector(self, b: np.ndarray, x: np.ndarray) -> np.ndarray:
         """``b - A x`` (:meth:`residual`)."""
-        diagonal = self.K.data[self.eliminator.diagonal_positions]
-        r = self.K @ np.where(self.fixed, 0.0, x)
-        r[self.fixed] = diagonal[self.fixed] * x[self.fixed]
+        r = self.qp.matvec(np.where(self.fixed, 0.0, x))
+        r[self.fixed] = self.diagonal[self.fixed] * x[self.fixed]
         return b - r
 
     def _norm(self) -> float:
         """``‖K‖∞``: an upper bound of ``‖A‖∞`` for every eliminated matrix (whose rows are
         rows of ``K`` with entries dropped); computed once, when a solve is refined."""
         if self._norm_K is None:
-            self._norm_K = float(abs_matvec(self.K, np.ones(self.K.shape[0])).max(initial=0.0))
+            rows = abs_matvec(self.K, np.ones(self.K.shape[0]))  # this rank's rows
+            self._norm_K = self.ranks.max(float(rows.max(initial=0.0)))
         return self._norm_K

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .ranks import SERIAL, Ranks, stored_values
 from .sparse import as_csr, csr_row_indices, diagonal_positions, list_indices
 
 __all__ = ["SymmetricEliminator", "eliminate_symmetric"]
@@ -28,14 +29,21 @@ class SymmetricEliminator:
     The row index of every stored entry and the positions of the diagonal are computed once in
     the constructor and reused by every :meth:`apply`.
 
+    On a run of several ranks that split ``A`` by rows (:mod:`.ranks`), each rank masks the
+    entries of its own rows (:meth:`keep_mask`), the products with ``A`` are summed over the
+    ranks and the diagonal entries of the fixed rows are read on the rank that stores them.
+
     Parameters
     ----------
     A : scipy sparse matrix, shape (n, n)
         Symmetric; converted to canonical CSR (sorted indices) if it is not.
+    ranks : Ranks
+        The ranks that share ``A`` by rows (default one process, a whole matrix).
     """
 
-    def __init__(self, A: sp.spmatrix) -> None:
+    def __init__(self, A: sp.spmatrix, ranks: Ranks = SERIAL) -> None:
         A = as_csr(A)
+        self.ranks = ranks
         self.shape = A.shape
         self.indptr = A.indptr
         self.indices = A.indices
@@ -117,8 +125,9 @@ class SymmetricEliminator:
         if not np.isfinite(values).all():
             raise ValueError("x_fixed has non-finite (NaN or inf) values")
         diag_pos = self.diagonal_positions[fixed]
-        if (diag_pos < 0).any():
-            missing = np.flatnonzero(fixed)[diag_pos < 0]
+        stored = self.ranks.sum((diag_pos >= 0).astype(np.int32))  # on one rank of several
+        if (stored == 0).any():
+            missing = np.flatnonzero(fixed)[stored == 0]
             raise ValueError(f"no stored diagonal entry in fixed rows {list_indices(missing)}")
 
         keep = self.keep_mask(fixed)
@@ -130,7 +139,7 @@ class SymmetricEliminator:
                 raise ValueError("out does not have the sparsity pattern of A")
             np.multiply(A.data, keep, out=out.data)
             A_elim = out
-        return A_elim, self._rhs(A, b, fixed, values, diag_pos)
+        return A_elim, self._rhs(A, b, fixed, values, self.diagonal(A, diag_pos))
 
     def keep_mask(self, fixed: np.ndarray) -> np.ndarray:
         """``(nnz,)`` bool: the stored entries that survive the elimination of ``fixed``
@@ -141,17 +150,31 @@ class SymmetricEliminator:
         keep |= self.is_diagonal
         return keep
 
+    def diagonal(self, A: sp.csr_matrix, positions: np.ndarray | None = None) -> np.ndarray:
+        """The diagonal entries of ``A`` (the constructor's pattern) at ``positions`` (some
+        of :attr:`diagonal_positions`; default all), on every rank."""
+        positions = self.diagonal_positions if positions is None else positions
+        return stored_values(A.data, positions, self.ranks)
+
     def rhs(
-        self, A: sp.csr_matrix, b: np.ndarray, fixed: np.ndarray, values: np.ndarray
+        self,
+        A: sp.csr_matrix,
+        b: np.ndarray,
+        fixed: np.ndarray,
+        values: np.ndarray,
+        diagonal: np.ndarray | None = None,
     ) -> np.ndarray:
         """Right-hand side of the eliminated system, for full-length ``values`` (read on
-        ``fixed`` only, zero elsewhere)."""
-        return self._rhs(A, b, fixed, values, self.diagonal_positions[fixed])
+        ``fixed`` only, zero elsewhere); ``diagonal``: ``A``'s (:meth:`diagonal`), if known."""
+        if diagonal is None:
+            fixed_diagonal = self.diagonal(A, self.diagonal_positions[fixed])
+        else:
+            fixed_diagonal = diagonal[fixed]
+        return self._rhs(A, b, fixed, values, fixed_diagonal)
 
-    @staticmethod
-    def _rhs(A, b, fixed, values, diag_pos) -> np.ndarray:
-        b_elim = b - A @ np.where(fixed, values, 0.0)
-        b_elim[fixed] = A.data[diag_pos] * values[fixed]
+    def _rhs(self, A, b, fixed, values, fixed_diagonal) -> np.ndarray:
+        b_elim = b - self.ranks.sum(A @ np.where(fixed, values, 0.0))
+        b_elim[fixed] = fixed_diagonal * values[fixed]
         return b_elim
 
 

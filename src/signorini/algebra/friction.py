@@ -242,7 +242,7 @@ def solve_friction(
 def _rule_constants(problem: FrictionProblem, c: float | None) -> tuple[float, float]:
     """``(c, d)``: the constant of the update rule (given, or :data:`C_FACTOR`
     ``d``) and the mean diagonal ``d`` of ``K`` over the normal DOFs (1 without nodes)."""
-    diagonal = problem.qp.K.diagonal()[problem.normal]
+    diagonal = problem.qp.diagonal()[problem.normal]
     d = float(diagonal.mean()) if diagonal.size else 1.0
     return (C_FACTOR * d, d) if c is None else (float(c), d)
 
@@ -263,7 +263,7 @@ def _initial_states(
         if x0 is None:  # no contact; where a law acts everywhere, stick where it can rub
             return none[0], law.can_rub & law.everywhere, none[2]
         x = check_vector(x0, problem.qp.n, "x0")
-        r = problem.qp.F - problem.qp.K @ x
+        r = problem.qp.F - problem.qp.matvec(x)
         return _update(problem, rule, x, r[problem.normal], r[problem.tangent], none)
     state = np.asarray(state0)
     if state.shape != (m,) or not np.isin(state, (INACTIVE, STICK, SLIP)).all():
@@ -406,7 +406,7 @@ def _step(iteration: int, previous: States, states: States) -> FrictionStep:
 def _multipliers(p: FrictionProblem, x: np.ndarray, states: States) -> tuple[np.ndarray, ...]:
     """``Λ_n`` (0 off contact) and ``Λ_t`` (its imposed value off stick), (m,) each."""
     active, stick, direction = states
-    r = p.qp.F - p.qp.K @ x
+    r = p.qp.F - p.qp.matvec(x)
     multiplier_n = np.where(active, r[p.normal], 0.0)
     imposed = direction * p.slip_bound(multiplier_n, active)
     return multiplier_n, np.where(stick, r[p.tangent], imposed)

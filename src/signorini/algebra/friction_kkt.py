@@ -19,13 +19,14 @@ argument;
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .kkt import contact_scale, force_scale, normal_law_columns
 from .laws import LawGroups, check_laws
 from .qp import BoundQP, _index_array, check_qp, check_vector
+from .ranks import Ranks
 from .sparse import as_csr
 
 __all__ = ["FrictionKKT", "FrictionProblem", "check_friction", "friction_kkt"]
@@ -72,6 +73,11 @@ class FrictionProblem:
     def slip_bound(self, normal_force: np.ndarray, in_contact: np.ndarray) -> np.ndarray:
         """The slip bound ``s (m,)`` of each node's law at ``Λ_n = normal_force``."""
         return self.friction.slip_bound(normal_force, in_contact)
+
+    def on_ranks(self, ranks: Ranks) -> FrictionProblem:
+        """The same problem with ``K`` split by rows over ``ranks`` (each rank's ``K`` holds
+        its own rows, the other rows empty; :meth:`.BoundQP.on_ranks` checks it)."""
+        return replace(self, qp=self.qp.on_ranks(ranks))
 
 
 def check_friction(
@@ -239,9 +245,9 @@ def friction_kkt(
     """
     qp = problem.qp
     K, F, n_dof, t_dof = qp.K, qp.F, problem.normal, problem.tangent
-    Kx = K @ x
+    Kx = qp.matvec(x)
     r = F - Kx
-    force = force_scale(K, F, x, Kx)
+    force = force_scale(K, F, x, Kx, ranks=qp.ranks)
     lam_n, lam_t = r[n_dof], r[t_dof]
     slack = x[n_dof] - problem.gap
     slide = x[t_dof] - problem.reference
@@ -253,7 +259,7 @@ def friction_kkt(
     )
     disp = disp if disp > 0 else 1.0
     total = float(np.maximum(lam_n, 0.0).sum())
-    fc = contact_scale(K, F, x, n_dof, total, force)
+    fc = contact_scale(K, F, x, n_dof, total, force, qp.ranks)
     s = problem.slip_bound(lam_n, lam_n > 0 if in_contact is None else in_contact)
     stick = np.abs(slide) / disp
     wrong_way = np.maximum(-lam_t * slide, 0.0) / (fc * disp)

@@ -27,6 +27,7 @@ import scipy.sparse as sp
 
 from .active_system import ActiveSetSystem, refine
 from .friction_kkt import FrictionProblem
+from .ranks import stored_values
 from .solvers import SPDSolver
 from .sparse import abs_matvec, csr_row_indices, diagonal_positions
 
@@ -156,14 +157,15 @@ class CoupledSystem:
         values[p.normal] = np.where(active, p.gap, 0.0)
         fixed[p.tangent] = stick
         values[p.tangent] = np.where(stick, p.reference, 0.0)
-        b = rhs - A @ np.where(fixed, values, 0.0)
-        b[fixed] = data[self.diagonal[fixed]] * values[fixed]
+        total = qp.ranks.sum  # of the products with A's rows: each row is on one rank
+        b = rhs - total(A @ np.where(fixed, values, 0.0))
+        b[fixed] = stored_values(data, self.diagonal[fixed], qp.ranks) * values[fixed]
         keep = ~(fixed[self.rows] | fixed[self.indices]) | self.is_diagonal
         A.data *= keep
         self.time_assembly += time.perf_counter() - t0
         self.solver.factorize(A)  # the pattern is compared, and analysed only the first time
         x = self.solver.solve(b)
-        norm = lambda: float(abs_matvec(A, np.ones(n)).max(initial=0.0))  # noqa: E731
-        x = refine(self.solver.solve, lambda y: b - A @ y, b, x, norm, self.solver.backend)
+        norm = lambda: qp.ranks.max(float(abs_matvec(A, np.ones(n)).max(initial=0.0)))  # noqa: E731
+        x = refine(self.solver.solve, lambda y: b - total(A @ y), b, x, norm, self.solver.backend)
         x[fixed] = values[fixed]
         return x

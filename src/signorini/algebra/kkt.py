@@ -18,6 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .qp import BoundQP, check_qp, check_vector
+from .ranks import SERIAL, Ranks
 from .sparse import abs_matvec
 
 __all__ = ["KKTResiduals", "contact_scale", "force_scale", "kkt_residuals", "round_off_scale"]
@@ -111,6 +112,8 @@ def kkt_residuals(
     gap: np.ndarray | float,
     dirichlet: np.ndarray | None = None,
     dirichlet_values: np.ndarray | float | None = None,
+    *,
+    ranks: Ranks = SERIAL,
 ) -> KKTResiduals:
     """Relative KKT residuals of ``x`` for ``min 1/2 x^T K x - F^T x``, ``x_c <= g``, ``x_d = x_D``.
 
@@ -128,12 +131,14 @@ def kkt_residuals(
     dirichlet : (n_d,) int array or (n,) bool mask, optional
     dirichlet_values : float, (n_d,) or (n,) float array, optional
         Default 0.
+    ranks : Ranks
+        The processes that split ``K`` by rows (:attr:`~.qp.BoundQP.ranks`); default one.
 
     Returns
     -------
     KKTResiduals
     """
-    qp = check_qp(K, F, constrained, gap, dirichlet, dirichlet_values)
+    qp = check_qp(K, F, constrained, gap, dirichlet, dirichlet_values, ranks=ranks)
     return qp_residuals(qp, check_vector(x, qp.n, "x"))
 
 
@@ -143,28 +148,36 @@ def force_scale(
     x: np.ndarray,
     Kx: np.ndarray | None = None,
     round_off: float | None = None,
+    ranks: Ranks = SERIAL,
 ) -> float:
     """The size of the forces at ``x``: ``max(max |F|, max |K x|)`` — loads, reactions and
     contact forces, not the entries of ``|K| |x|``, whose cancellation in ``K x`` is only
     round-off — against which the equilibrium residual is measured; :func:`round_off_scale`
     where the forces themselves are round-off (at most ``64 eps max |K| |x|``: a rigid
     motion, no load), and 1 where everything vanishes. ``Kx`` and ``round_off``: ``K @ x``
-    and :func:`round_off_scale`, if known."""
-    Kx = K @ x if Kx is None else Kx
+    and :func:`round_off_scale`, if known; ``ranks``: those that split ``K`` by rows."""
+    Kx = ranks.sum(K @ x) if Kx is None else Kx
     force = max(np.abs(F).max(initial=0.0), np.abs(Kx).max(initial=0.0))
-    round_off = round_off_scale(K, F, x) if round_off is None else round_off
+    round_off = round_off_scale(K, F, x, ranks) if round_off is None else round_off
     return float(force) if force > _ROUNDOFF * round_off else round_off
 
 
-def round_off_scale(K: sp.csr_matrix, F: np.ndarray, x: np.ndarray) -> float:
+def round_off_scale(K: sp.csr_matrix, F: np.ndarray, x: np.ndarray, ranks: Ranks = SERIAL) -> float:
     """``max(max |F|, max |K| |x|)`` (1 where both vanish): the round-off of ``F - K x`` is
-    about eps times it."""
-    scale = max(np.abs(F).max(initial=0.0), abs_matvec(K, x).max(initial=0.0))
+    about eps times it. ``ranks``: those that split ``K`` by rows."""
+    rows = ranks.max(float(abs_matvec(K, x).max(initial=0.0)))
+    scale = max(np.abs(F).max(initial=0.0), rows)
     return float(scale) if scale > 0 else 1.0
 
 
 def contact_scale(
-    K: sp.csr_matrix, F: np.ndarray, x: np.ndarray, rows: np.ndarray, total: float, force: float
+    K: sp.csr_matrix,
+    F: np.ndarray,
+    x: np.ndarray,
+    rows: np.ndarray,
+    total: float,
+    force: float,
+    ranks: Ranks = SERIAL,
 ) -> float:
     """The scale of the contact forces: their sum ``total``, or ``force`` when it is round-off,
     at most ``64 eps Σ (|K| |x| + |F|)`` over ``rows`` (the constrained DOFs).
@@ -179,10 +192,13 @@ def contact_scale(
         ``Σ Λ⁺``.
     force : float
         :func:`force_scale`.
+    ranks : Ranks
+        Those that split ``K`` by rows.
     """
     if rows.size == 0:
         return force
-    round_off = _ROUNDOFF * float((abs_matvec(K[rows], x) + np.abs(F[rows])).sum())
+    row_sums = ranks.sum(abs_matvec(K[rows], x))
+    round_off = _ROUNDOFF * float((row_sums + np.abs(F[rows])).sum())
     return total if total > round_off else force
 
 
@@ -200,9 +216,9 @@ def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
     """
     K, F, c, g = qp.K, qp.F, qp.constrained, qp.gap
     d, xd = qp.dirichlet, qp.dirichlet_values
-    Kx = K @ x
+    Kx = qp.matvec(x)
     r = F - Kx
-    round_off = round_off_scale(K, F, x)
+    round_off = round_off_scale(K, F, x, qp.ranks)
     force = force_scale(K, F, x, Kx, round_off)
     multiplier = r[c]
     slack = x[c] - g
@@ -214,7 +230,7 @@ def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
     )
     disp = disp if disp > 0 else 1.0
     contact_force = float(np.maximum(multiplier, 0.0).sum())
-    contact = contact_scale(K, F, x, c, contact_force, force)
+    contact = contact_scale(K, F, x, c, contact_force, force, qp.ranks)
     other = np.ones(x.size, dtype=bool)
     other[c] = False
     other[d] = False

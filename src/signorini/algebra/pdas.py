@@ -42,6 +42,7 @@ from .backends import make_solver
 from .kkt import qp_residuals
 from .primal import primal_active_set
 from .qp import BoundQP, check_qp, check_vector
+from .ranks import SERIAL, Ranks
 from .result import PDASConvergenceError, PDASResult, PDASStep
 from .solvers import IllConditionedWarning, SolverFactory, SPDSolver, solver_usage
 from .sparse import abs_matvec
@@ -121,6 +122,7 @@ def solve_pdas(
     active0: np.ndarray | None = None,
     options: PDASOptions | None = None,
     solver: SPDSolver | SolverFactory | None = None,
+    ranks: Ranks = SERIAL,
 ) -> PDASResult:
     r"""Solve ``min 1/2 x^T K x - F^T x`` subject to ``x_c <= g`` and ``x_d = x_D`` by PDAS.
 
@@ -155,6 +157,11 @@ def solve_pdas(
         when ``K`` has the pattern it was analysed for). A factory
         (:class:`~.solvers.SolverFactory`, default :func:`~.backends.auto_solver`) makes one
         for this call, released afterwards.
+    ranks : Ranks
+        The processes that split ``K`` by rows (:attr:`~.qp.BoundQP.ranks`; docs/parallel.md):
+        on each rank ``K`` holds that rank's rows, the others empty, and every other argument
+        is the same on every rank; the result is the same on every rank. Default one
+        process and a whole ``K``.
 
     Returns
     -------
@@ -175,7 +182,7 @@ def solve_pdas(
     steps below it (:func:`_initial_active_set`, :func:`_iterate`, :func:`_after_failure`).
     """
     t_start = time.perf_counter()
-    qp = check_qp(K, F, constrained, gap, dirichlet, dirichlet_values)
+    qp = check_qp(K, F, constrained, gap, dirichlet, dirichlet_values, ranks=ranks)
     options = PDASOptions() if options is None else options
     if not isinstance(options, PDASOptions):
         raise ValueError(f"options must be a PDASOptions, got {type(options).__name__}")
@@ -260,7 +267,7 @@ def _rule_constant(qp: BoundQP, c: float | None) -> float:
     the constrained DOFs (docs/method.md, *Solver*)."""
     if c is None:
         m = qp.constrained.size
-        c_scale = float(qp.K.diagonal()[qp.constrained].mean()) if m else 1.0
+        c_scale = float(qp.diagonal()[qp.constrained].mean()) if m else 1.0
     else:
         c_scale = float(c)
     if not np.isfinite(c_scale) or c_scale <= 0:
@@ -280,7 +287,7 @@ def _initial_active_set(qp: BoundQP, c_scale: float, x0: object, active0: object
     if x0 is not None:
         x_start = check_vector(x0, qp.n, "x0")
         c = qp.constrained
-        multiplier0 = qp.F[c] - qp.K[c] @ x_start if m else np.zeros(0)
+        multiplier0 = qp.F[c] - qp.ranks.sum(qp.K[c] @ x_start) if m else np.zeros(0)
         return multiplier0 + c_scale * (x_start[c] - qp.gap) > 0
     return np.zeros(m, dtype=bool)
 
@@ -354,7 +361,7 @@ def _bands(
     if not active.any():
         return np.full(active.size, inactive_band)
     contact = float(np.maximum(multiplier, 0.0).sum())
-    round_off = float(abs_matvec(system.K_c, x).max(initial=0.0))
+    round_off = system.ranks.max(float(abs_matvec(system.K_c, x).max(initial=0.0)))
     active_band = max(_ACTIVE_RTOL * max(force, contact), _FORCE_ROUNDOFF * round_off)
     return np.where(active, active_band, inactive_band)
 
@@ -405,5 +412,5 @@ def _after_failure(
         )
     logger.warning("%s; finishing with the primal active set method", message)
     qp = system.qp
-    force = max(np.abs(qp.F).max(initial=0.0), np.abs(qp.K @ x).max(initial=0.0), 1e-300)
+    force = max(np.abs(qp.F).max(initial=0.0), np.abs(qp.matvec(x)).max(initial=0.0), 1e-300)
     return primal_active_set(system, x, force, 10 * active.size + 50, history)

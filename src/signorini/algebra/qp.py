@@ -13,15 +13,15 @@ or raises a :class:`ValueError` naming the argument; everything after it trusts 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
 
 from .ranks import SERIAL, Ranks
-from .sparse import as_csr
+from .sparse import as_csr, list_indices
 
-__all__ = ["BoundQP", "check_qp", "check_vector"]
+__all__ = ["BoundQP", "check_qp", "check_rows", "check_vector"]
 
 
 @dataclass(frozen=True)
@@ -60,6 +60,21 @@ class BoundQP:
         """Number of unknowns."""
         return self.K.shape[0]
 
+    def matvec(self, x: np.ndarray) -> np.ndarray:
+        """``K x`` on every rank: each rank's rows times ``x``, summed over the ranks (with
+        one process ``K @ x`` itself)."""
+        return self.ranks.sum(self.K @ x)
+
+    def diagonal(self) -> np.ndarray:
+        """The diagonal of ``K`` on every rank (summed over the ranks), ``(n,)``."""
+        return self.ranks.sum(self.K.diagonal())
+
+    def on_ranks(self, ranks: Ranks) -> BoundQP:
+        """The same problem with ``K`` split by rows over ``ranks`` (:attr:`ranks`), checked
+        by :func:`check_rows`."""
+        check_rows(self.K, ranks)
+        return replace(self, ranks=ranks)
+
 
 def check_qp(
     K: object,
@@ -93,9 +108,11 @@ def check_qp(
     ------
     ValueError
         Naming the argument: wrong shape or type, non-finite values, indices out of range or
-        repeated, ``constrained`` meeting ``dirichlet``.
+        repeated, ``constrained`` meeting ``dirichlet``, rows of ``K`` not on exactly one of
+        several ``ranks``.
     """
     K = as_csr(K, "K")
+    check_rows(K, ranks)
     n = K.shape[0]
     F = check_vector(F, n, "F")
     c = _index_array(constrained, n, "constrained")
@@ -117,6 +134,29 @@ def check_qp(
             vals = vals[d]
         xd = check_vector(vals, d.size, "dirichlet_values", allow_scalar=True)
     return BoundQP(K, F, c, g, d, xd, ranks)
+
+
+def check_rows(K: sp.csr_matrix, ranks: Ranks) -> None:
+    """Check that every row of ``K`` (canonical CSR) is stored on exactly one of ``ranks``
+    when there are several (the split of :attr:`BoundQP.ranks`); nothing with one process.
+
+    Collective: every rank gets the same answer.
+
+    Raises
+    ------
+    ValueError
+        Naming the rows stored on no rank or on several.
+    """
+    if not ranks.distributed:
+        return
+    holders = ranks.sum((np.diff(K.indptr) > 0).astype(np.int32))
+    wrong = np.flatnonzero(holders != 1)
+    if wrong.size:
+        raise ValueError(
+            f"K must hold each row on exactly one of the {ranks.size} ranks (its other rows "
+            f"empty); rows {list_indices(wrong)} are stored on "
+            f"{', '.join(str(int(h)) for h in holders[wrong[:5]])} ranks"
+        )
 
 
 def check_vector(v: object, n: int, name: str, *, allow_scalar: bool = False) -> np.ndarray:

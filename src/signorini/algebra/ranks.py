@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["SERIAL", "Ranks", "solver_ranks", "world_ranks"]
+__all__ = ["SERIAL", "Ranks", "solver_ranks", "stored_values", "world_ranks"]
 
 
 class Ranks:
@@ -116,6 +116,29 @@ def world_ranks() -> Ranks:
             f"several ranks need mpi4py with PETSc's MPI ({err}): pip install 'signorini[mpi]'"
         ) from err
     return MPIRanks(comm)
+
+
+def stored_values(data: np.ndarray, positions: np.ndarray, ranks: Ranks) -> np.ndarray:
+    """Entries of a matrix split by rows over ``ranks``, on every rank: ``data[positions]``
+    with the positions ``-1`` (rows stored on another rank) read as 0, summed over the ranks.
+
+    Each row lives on one rank, so the sum is that rank's value exactly. With one process,
+    where every position is stored, it is ``data[positions]`` (no extra pass).
+
+    Parameters
+    ----------
+    data : (nnz,) float array
+        The matrix's stored values (``A.data``).
+    positions : (k,) int array
+        Positions in ``data`` (e.g. of diagonal entries), ``-1`` where this rank stores none.
+
+    Returns
+    -------
+    (k,) float array
+    """
+    if not ranks.distributed:
+        return data[positions]
+    return ranks.sum(np.where(positions >= 0, data[positions], 0.0))
 
 
 def solver_ranks(solver: object) -> Ranks:
