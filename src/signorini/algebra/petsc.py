@@ -33,7 +33,9 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from .ranks import SERIAL, Ranks
 from .solvers import BackendUnavailableError, FactorizationError, SolverRequest, SPDSolver
+from .sparse import diagonal_positions, list_indices
 
 __all__ = [
     "PetscLUSolver",
@@ -144,29 +146,116 @@ class PetscSolver(SPDSolver):
         comm = self._PETSc.COMM_WORLD
         self.comm_size = comm.getSize()
         self._rank = comm.getRank()
+        self._ranks: Ranks = SERIAL if self.comm_size == 1 else _world_ranks()
+        self.split = False
         self._mat = self._ksp = self._x = self._b = self._scatter = self._all = None
         super().__init__(A, check_symmetry=check_symmetry, ordering=ordering)
 
-    def _local(self, A: sp.csr_matrix, data: np.ndarray) -> tuple[np.ndarray, ...]:
-        """This process's rows of ``A`` (with values ``data``) as local CSR arrays."""
-        lo, hi = self._rows
-        first, last = A.indptr[lo], A.indptr[hi]
+    # -- the rows of each rank ---------------------------------------------------------------
+    def same_pattern(self, A: sp.csr_matrix) -> bool:
+        """Whether ``A`` has the pattern of the last analysis on every rank (collective: the
+        ranks analyse together or not at all)."""
+        same = super().same_pattern(A)
+        if self.comm_size == 1:
+            return same
+        return self._ranks.max(0.0 if same else 1.0) == 0.0
+
+    def _check_new_pattern(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
+        """Decide whether ``A`` is whole on every rank or split by rows over the ranks
+        (:attr:`split`), and check it (collective; every rank raises the same error)."""
+        n = A.shape[0]
+        owned = np.diff(A.indptr) > 0
+        counts = self._ranks.gather(np.array([np.count_nonzero(owned)]))
+        self.split = self.comm_size > 1 and n > 0 and not (counts == n).all()
+        if not self.split:
+            super()._check_new_pattern(A, rows)
+            return
+        if counts.sum() != n:
+            raise ValueError(
+                f"A must be whole on every rank or split by rows over the {self.comm_size} "
+                f"ranks, each row on one: the ranks store {counts.tolist()} non-empty rows of {n}"
+            )
+        here = np.flatnonzero(owned)
+        missing = np.sort(self._ranks.gather(here[diagonal_positions(A, rows)[here] < 0]))
+        if missing.size:
+            raise ValueError(
+                f"A must store every diagonal entry; rows {list_indices(missing)} have none"
+            )
+        self._symmetry_pending = self.check_symmetry  # on the values, at the factorization
+
+    def _numbering(self, A: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
+        """PETSc's numbering of the unknowns: ``order`` (its row ``k`` is ``A``'s row
+        ``order[k]``) and this rank's rows in it, ``order[lo:hi]``.
+
+        A whole matrix: contiguous blocks of rows (:func:`row_block`), in the order of the
+        requested ordering if there is one. A split one: the ranks' own (non-empty) rows in rank
+        order, each rank's in the order of the requested ordering, else increasing. Raises a
+        :class:`ValueError` if a row is on several ranks (collective).
+        """
+        n = A.shape[0]
+        perm = self._perm
+        if not self.split:
+            order = np.arange(n) if perm is None else perm
+            lo, hi = row_block(n, self._rank, self.comm_size)
+            return order, order[lo:hi]
+        own = np.flatnonzero(np.diff(A.indptr) > 0)
+        if perm is not None:
+            position = np.empty(n, dtype=np.int64)
+            position[perm] = np.arange(n)
+            own = own[np.argsort(position[own], kind="stable")]
+        order = self._ranks.gather(own)
+        seen = np.bincount(order, minlength=n)
+        if (seen != 1).any():
+            twice = np.flatnonzero(seen != 1)
+            raise ValueError(f"A's rows {list_indices(twice)} are stored on several ranks")
+        return order, own
+
+    def _local(self, A: sp.csr_matrix, own: np.ndarray, to_petsc: np.ndarray | None) -> None:
+        """This rank's rows ``own`` of ``A`` as PETSc's local CSR arrays (``self._csr``) and
+        the positions in ``A.data`` of their values (``self._src``; a slice ``(first, last)``
+        when ``own`` is a contiguous block in ``A``'s numbering, as in the whole-matrix case
+        without an ordering)."""
         int_type = self._PETSc.IntType
-        indptr = (A.indptr[lo : hi + 1] - first).astype(int_type)
-        return (
-            indptr,
-            A.indices[first:last].astype(int_type),
-            np.ascontiguousarray(data[first:last], dtype=np.float64),
-        )
+        if to_petsc is None:  # rows lo..hi of A as they are
+            lo, hi = (int(own[0]), int(own[-1]) + 1) if own.size else (0, 0)
+            first, last = A.indptr[lo], A.indptr[hi]
+            indptr = (A.indptr[lo : hi + 1] - first).astype(int_type)
+            self._csr = (indptr, A.indices[first:last].astype(int_type))
+            self._src, self._own = slice(first, last), slice(lo, hi)
+            return
+        starts = A.indptr[own]
+        lengths = A.indptr[own + 1] - starts
+        indptr = np.zeros(own.size + 1, dtype=np.int64)
+        np.cumsum(lengths, out=indptr[1:])
+        src = np.repeat(starts - indptr[:-1], lengths) + np.arange(indptr[-1])
+        columns = to_petsc[A.indices[src]]
+        by_row = np.lexsort((columns, np.repeat(np.arange(own.size), lengths)))
+        self._csr = (indptr.astype(int_type), columns[by_row].astype(int_type))
+        self._src, self._own = src[by_row], own
+
+    def _values(self, A: sp.csr_matrix, keep: np.ndarray | None) -> np.ndarray:
+        """The values of this rank's PETSc rows of ``A`` with the entries off ``keep``
+        zeroed."""
+        values = np.array(A.data[self._src], dtype=np.float64)
+        if keep is not None:
+            values *= keep[self._src]
+        return values
 
     def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
         PETSc = self._PETSc
         self._release()
         n = A.shape[0]
-        self._rows = row_block(n, self._rank, self.comm_size)
-        m = self._rows[1] - self._rows[0]
-        indptr, indices, values = self._local(A, np.zeros(A.nnz))
-        self._csr = (indptr, indices)
+        order, own = self._numbering(A)
+        identity = not self.split and self._perm is None
+        to_petsc = None
+        if not identity:
+            to_petsc = np.empty(n, dtype=np.int64)
+            to_petsc[order] = np.arange(n)
+        self._local(A, own, to_petsc)
+        self._order = None if identity else order
+        m = own.size
+        indptr, indices = self._csr
+        values = np.zeros(indices.size)
         mat = PETSc.Mat().createAIJ(
             size=((m, n), (m, n)), csr=(indptr, indices, values), comm=PETSc.COMM_WORLD
         )
@@ -193,11 +282,12 @@ class PetscSolver(SPDSolver):
 
     def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
         PETSc = self._PETSc
-        data = A.data if keep is None else A.data * keep
         indptr, indices = self._csr
-        _, _, values = self._local(A, data)
+        values = self._values(A, keep)
         self._mat.setValuesCSR(indptr, indices, values)
         self._mat.assemble()
+        if self.split and self._symmetry_pending:
+            self._check_symmetry(values)
         self._ksp.setOperators(self._mat)
         pc = self._ksp.getPC()
         try:
@@ -220,7 +310,7 @@ class PetscSolver(SPDSolver):
         if self.factorization == "cholesky":
             negative = int(factor.getMumpsInfog(12))
             if negative:
-                equation = _nonpositive_diagonal(A, data)
+                equation = self._nonpositive_diagonal(A, keep)
                 where = "" if equation is None else f"; diagonal entry {equation} is not positive"
                 raise FactorizationError(
                     f"the matrix is not positive definite: MUMPS met {negative} negative "
@@ -229,12 +319,32 @@ class PetscSolver(SPDSolver):
                     equation=equation,
                 )
 
+    def _check_symmetry(self, values: np.ndarray) -> None:
+        """Refuse a split matrix that is not symmetric to ``1e-12 max |A|`` (as the serial
+        check of :class:`~.solvers.SPDSolver`; PETSc compares it with its transpose)."""
+        self._symmetry_pending = False
+        scale = self._ranks.max(float(np.abs(values).max(initial=0.0)))
+        if not self._mat.isSymmetric(1e-12 * scale):
+            raise ValueError("A is not symmetric: max|A - A^T| > 1e-12 max|A|")
+
+    def _nonpositive_diagonal(self, A: sp.csr_matrix, keep: np.ndarray | None) -> int | None:
+        """The first row whose diagonal entry (of ``A`` with the entries off ``keep``
+        zeroed) is not positive, or None: where a Cholesky factorization that reached it
+        would stop (MUMPS counts negative pivots but does not say where)."""
+        data = A.data if keep is None else A.data * keep
+        diagonal = sp.csr_matrix((data, A.indices, A.indptr), shape=A.shape).diagonal()
+        if self.split:  # this rank's rows, then the first over the ranks
+            bad = self._ranks.gather(self._own[diagonal[self._own] <= 0])
+            return int(bad.min()) if bad.size else None
+        bad = np.flatnonzero(diagonal <= 0)
+        return int(bad[0]) if bad.size else None
+
     def _solve(self, b: np.ndarray) -> np.ndarray:
-        lo, hi = self._rows
+        own, order = self._own, self._order
         columns = b.reshape(b.shape[0], -1)
         x = np.empty_like(columns)
         for j in range(columns.shape[1]):  # a handful of right-hand sides
-            self._b.setArray(columns[lo:hi, j])
+            self._b.setArray(columns[own, j])  # this rank's entries, in PETSc's order
             self._ksp.solve(self._b, self._x)
             reason = int(self._ksp.getConvergedReason())
             if reason < 0:
@@ -243,7 +353,10 @@ class PetscSolver(SPDSolver):
                     backend=self.backend,
                 )
             self._scatter.scatter(self._x, self._all)
-            x[:, j] = self._all.getArray()
+            if order is None:
+                x[:, j] = self._all.getArray()
+            else:
+                x[order, j] = self._all.getArray()
         return x.reshape(b.shape)
 
     def _release(self) -> None:
@@ -271,15 +384,6 @@ class PetscLUSolver(PetscSolver):
 
     def __init__(self, A: sp.spmatrix | None = None, *, ordering: np.ndarray | None = None) -> None:
         super().__init__(A, check_symmetry=False, ordering=ordering)
-
-
-def _nonpositive_diagonal(A: sp.csr_matrix, data: np.ndarray) -> int | None:
-    """The first row whose diagonal entry (of ``A`` with the values ``data``) is not
-    positive, or None: where a Cholesky factorization that reached it would stop (MUMPS
-    counts negative pivots but does not say where)."""
-    diagonal = sp.csr_matrix((data, A.indices, A.indptr), shape=A.shape).diagonal()
-    bad = np.flatnonzero(diagonal <= 0)
-    return int(bad[0]) if bad.size else None
 
 
 def petsc_solver(request: SolverRequest) -> PetscSolver:
