@@ -58,7 +58,9 @@ def pdas_case(problem, refinements: int, **options) -> dict[str, np.ndarray]:
     serial = solve_pdas(a.K, a.F, *args, options=PDASOptions(**options), solver=REFERENCE)
     warm = {} if x0_scale is None else {"x0": x0_scale * serial.x}
     if warm:
-        serial = solve_pdas(a.K, a.F, *args, options=PDASOptions(**options), solver=REFERENCE, **warm)
+        serial = solve_pdas(
+            a.K, a.F, *args, options=PDASOptions(**options), solver=REFERENCE, **warm
+        )
     split = solve_pdas(
         K_own, a.F, *args, options=PDASOptions(**options), solver=solver_factory("petsc"),
         ranks=world_ranks(), **warm,
@@ -115,9 +117,7 @@ CASES = {
     "example-6.2": lambda: pdas_case(example_6_2(), 2),
     "example-6.2 refactorized": lambda: pdas_case(example_6_2(), 2, max_update=0),
     "example-6.2 warm": lambda: pdas_case(example_6_2(), 2, x0_scale=0.9),
-    "example-6.2 primal fallback": lambda: pdas_case(
-        example_6_2(), 2, max_iter=2, fallback=True
-    ),
+    "example-6.2 primal fallback": lambda: pdas_case(example_6_2(), 2, max_iter=2, fallback=True),
     "two-cylinders": lambda: pdas_case(two_cylinders(rings=4), 2),
     "example-6.2-coulomb": lambda: friction_case(example_6_2_coulomb(), 2),
     "example-6.2-tresca": lambda: friction_case(example_6_2_tresca(), 2),

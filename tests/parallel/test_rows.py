@@ -38,7 +38,8 @@ def runs(request, tmp_path_factory):
 
 
 def case(runs: dict, name: str) -> dict[str, np.ndarray]:
-    return {key.split("/", 1)[1]: value for key, value in runs.items() if key.startswith(name + "/")}
+    prefix = name + "/"
+    return {key[len(prefix) :]: value for key, value in runs.items() if key.startswith(prefix)}
 
 
 @pytest.mark.parametrize("name", PDAS + FRICTION)
