@@ -6,23 +6,41 @@ source or Debian build). Nothing here is imported unless the backend is asked fo
 default install stays PETSc-free.
 
 The matrix is a PETSc AIJ matrix on ``PETSC_COMM_WORLD`` (``seqaij`` on one process,
-``mpiaij`` on several) with the rows split in contiguous blocks as PETSc splits them
-(:func:`row_block`); every process passes the same scipy matrix and hands PETSc its own rows
-only. The solve is ``KSPPREONLY`` with a MUMPS factorization: Cholesky with the matrix flagged
+``mpiaij`` on several), and each process hands PETSc its own rows only. The scipy matrix each
+process passes is either
+
+- *whole*, the same on every process (a user's script): PETSc's rows are split in contiguous
+  blocks as PETSc splits them (:func:`row_block`);
+- or *split by rows* (:mod:`.ranks`; what ``assemble`` builds on a rank of several): each
+  process's matrix holds its own rows, the other rows empty, and the matrix is the sum of
+  the processes' copies. PETSc needs each process's rows contiguous, so its numbering is a
+  permutation of the unknowns (computed once per pattern): process 0's rows first, then
+  process 1's, … (:attr:`PetscSolver.split`).
+
+The backend tells them apart by counting the non-empty rows over the processes (at each new
+pattern, collectively): ``n`` on every process is whole, ``n`` in total is split, anything
+else is refused. Right-hand sides and solutions are replicated vectors in the caller's
+numbering: each process sets the entries of its own rows, and the solution is gathered on
+every process (:meth:`Scatter.toAll`) and mapped back: the loop above the solver stays
+replicated (docs/parallel.md).
+
+The solve is ``KSPPREONLY`` with a MUMPS factorization: Cholesky with the matrix flagged
 symmetric positive definite (MUMPS ``SYM = 1``) for a symmetric request, LU otherwise
 (Coulomb's non-symmetric systems). One PETSc matrix, its :class:`KSP` and its factor are kept
 per pattern: a refactorization only rewrites the values (:meth:`Mat.setValuesCSR` into the
 existing nonzero structure), so PETSc keeps MUMPS's symbolic analysis, as PARDISO's phase 11
-is kept (:mod:`.solvers`). The solution is gathered on every process
-(:meth:`Scatter.toAll`): the loop above the solver stays replicated (docs/parallel.md).
+is kept (:mod:`.solvers`). With an ordering (:attr:`~.solvers.SPDSolver.ordering`) PETSc's
+numbering follows it (within each process's rows, when split), and an LU on one process
+hands it to MUMPS (``ICNTL(7) = 1``): PETSc passes its natural ordering to MUMPS's LU as
+``PERM_IN``, but ignores any ordering for MUMPS's Cholesky.
 
 Each LU solve does :data:`REFINEMENT_STEPS` steps of iterative refinement inside MUMPS. A failed
 Cholesky factorization (negative pivots counted by MUMPS, ``INFOG(12)``) names the first
 non-positive diagonal entry as its equation, where there is one.
 
-MUMPS orders by METIS nested dissection (``ICNTL(7) = 5``) where PETSc has METIS, else by its
-own choice; the contact layer's ordering (:attr:`SolverRequest.ordering`) is not computed for
-it.
+MUMPS's Cholesky orders by METIS nested dissection (``ICNTL(7) = 5``) where PETSc has METIS,
+else by its own choice; the contact layer's ordering (:attr:`SolverRequest.ordering`, METIS on
+the vertex graph) is computed for an LU on one process only (:func:`petsc_solver`).
 """
 
 from __future__ import annotations
@@ -116,12 +134,16 @@ class PetscSolver(SPDSolver):
     check_symmetry : bool
         As in :class:`~.solvers.SPDSolver`.
     ordering : (n,) int array, optional
-        Accepted for the interface and checked; MUMPS orders by itself.
+        PETSc's numbering follows it (within each process's rows of a split matrix); an LU
+        on one process hands it to MUMPS, a Cholesky orders by METIS regardless.
 
     Attributes
     ----------
     factorization : str
         ``"cholesky"`` or ``"lu"``.
+    split : bool
+        Whether the last analysed matrix was split by rows over the processes (else whole
+        on every process).
     comm_size : int
         Processes of ``PETSC_COMM_WORLD`` sharing the matrix's rows.
 
@@ -269,10 +291,15 @@ class PetscSolver(SPDSolver):
         pc = ksp.getPC()
         pc.setType(self.factorization)
         pc.setFactorSolverType("mumps")
+        # PETSc's numbering follows the ordering; PETSc hands its natural ordering to MUMPS
+        # as PERM_IN (ICNTL(7) = 1) for an LU on one process (it ignores it for Cholesky)
+        natural = self.factorization == "lu" and self._perm is not None and self.comm_size == 1
+        if natural:
+            pc.setFactorOrdering("natural")
         ksp.setOperators(mat)
         pc.setFactorSetUpSolverType()
         factor = pc.getFactorMatrix()
-        if PETSc.Sys.hasExternalPackage("metis"):
+        if PETSc.Sys.hasExternalPackage("metis") and not natural:
             factor.setMumpsIcntl(7, 5)  # METIS nested dissection for the analysis
         if self.factorization == "lu":
             factor.setMumpsIcntl(10, -REFINEMENT_STEPS)
@@ -388,8 +415,9 @@ class PetscLUSolver(PetscSolver):
 
 def petsc_solver(request: SolverRequest) -> PetscSolver:
     """The PETSc backend's solver factory (:class:`~.solvers.SolverFactory`):
-    :class:`PetscSolver` (MUMPS Cholesky) for a symmetric request, :class:`PetscLUSolver`
-    otherwise. The request's ordering is not computed (MUMPS orders by itself).
+    :class:`PetscSolver` (MUMPS Cholesky, ordered by METIS on the matrix) for a symmetric
+    request, :class:`PetscLUSolver` otherwise, given the request's ordering on one process
+    (docs/parallel.md, *Measurements*: MUMPS's LU with it against its own METIS).
 
     Raises
     ------
@@ -398,7 +426,18 @@ def petsc_solver(request: SolverRequest) -> PetscSolver:
     """
     if request.symmetric:
         return PetscSolver(check_symmetry=request.check_symmetry)
-    return PetscLUSolver()
+    return PetscLUSolver(ordering=_lu_ordering(request))
+
+
+def _lu_ordering(request: SolverRequest) -> np.ndarray | None:
+    """The request's ordering where MUMPS can take it (an LU on one process), else None;
+    None also where it cannot be computed here (the vertex graph's METIS needs MKL)."""
+    if request.ordering is None or petsc_module().COMM_WORLD.getSize() > 1:
+        return None
+    try:
+        return request.ordering()
+    except BackendUnavailableError:
+        return None
 
 
 def _world_ranks():
