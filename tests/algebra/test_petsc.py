@@ -26,6 +26,7 @@ from signorini.algebra import (
 from signorini.algebra import petsc as petsc_backend
 from signorini.algebra.backends import solver_library
 from signorini.algebra.petsc import petsc_solver, row_block
+from signorini.algebra.solvers import SolverRequest
 from signorini.examples import example_6_2, example_6_2_coulomb
 from signorini.loop import adaptive
 
@@ -148,3 +149,27 @@ def test_example_6_2_adaptive_is_the_reference_run():
 def test_coulomb_friction_on_mumps_lu_is_the_reference_run():
     checked = same_levels(example_6_2_coulomb(), levels=5)
     assert len(checked) == 5 and checked[-1][0] > checked[0][0]
+
+
+@needs_petsc
+@pytest.mark.parametrize("symmetric", [True, False])
+def test_an_ordering_renumbers_petsc_and_reaches_mumps_lu(symmetric):
+    rng = np.random.default_rng(5)
+    A = block_spd(12, 9, rng)
+    if not symmetric:  # a Coulomb-like coupling: one row plus a multiple of its neighbour
+        A = (A + sp.diags(0.3 * A.diagonal()[:-1], 1)).tocsr()
+    b = rng.standard_normal(A.shape[0])
+    exact = spla.spsolve(A.tocsc(), b)
+    ordering = rng.permutation(A.shape[0])
+    request = SolverRequest(symmetric=symmetric, ordering=lambda: ordering)
+    solver = petsc_solver(request)
+    solver.factorize(A)
+    x = solver.solve(b)
+    assert np.abs(x - exact).max() <= 1e-12 * np.abs(exact).max()
+    # the factory computes the ordering for the LU only (PETSc drops it for MUMPS's Cholesky)
+    assert not solver.split
+    assert solver._order is None if symmetric else np.array_equal(solver._order, ordering)
+    # MUMPS's ordering used: 1 (given) for the LU, its METIS (5) for the Cholesky
+    used = int(solver._ksp.getPC().getFactorMatrix().getMumpsInfog(7))
+    assert used == (5 if symmetric else 1)
+    solver.close()

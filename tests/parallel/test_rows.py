@@ -21,7 +21,7 @@ import pytest
 from .test_mpi import mpiexec, pytestmark  # noqa: F401  (skips where MPI is missing)
 
 SCRIPT = Path(__file__).with_name("mpi_rows.py")
-PDAS = ["example-6.2", "example-6.2 refactorized", "example-6.2 warm",
+PDAS = ["example-6.2", "example-6.2 refactorized", "example-6.2 warm", "example-6.2 ordered",
         "example-6.2 primal fallback", "two-cylinders"]  # fmt: skip
 FRICTION = ["example-6.2-coulomb", "example-6.2-tresca"]
 
