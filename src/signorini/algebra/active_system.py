@@ -220,6 +220,10 @@ class ActiveSetSystem:
     changed DOFs (one solve with k + 1 right-hand sides) instead of a new factorization; the
     result is checked by its residual and the system refactorized if the check fails.
 
+    With ``qp.ranks`` of several processes ``K`` holds this rank's rows (:mod:`.ranks`): the
+    products with ``K`` and its rows are summed over the ranks, the diagonal read where it is
+    stored, ``‖K‖∞`` maximised over them; the answers are those of the whole matrix.
+
     Parameters
     ----------
     qp : BoundQP
@@ -231,6 +235,8 @@ class ActiveSetSystem:
 
     Attributes
     ----------
+    diagonal : (n,) float array
+        The diagonal of ``K`` (on every rank).
     time_elimination : float
         Seconds spent forming right-hand sides.
     n_updates : int
