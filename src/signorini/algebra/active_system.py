@@ -251,7 +251,8 @@ class ActiveSetSystem:
         self.ranks = qp.ranks  # every product with K is summed over them (:mod:`.ranks`)
         self.solver = solver
         self.eliminator = SymmetricEliminator(K, qp.ranks)
-        self.diagonal = self.eliminator.diagonal(K)
+        # read once (an empty K, refused by the solver, has no positions to read)
+        self.diagonal = self.eliminator.diagonal(K) if K.nnz else np.zeros(K.shape[0])
         self.fixed = np.zeros(K.shape[0], dtype=bool)
         self.fixed[qp.dirichlet] = True
         self.values = np.zeros(K.shape[0])

@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .ranks import SERIAL, Ranks
+
 __all__ = [
     "abs_matvec",
     "as_csr",
@@ -155,12 +157,13 @@ def symmetry_defect(A: sp.csr_matrix) -> float:
 STIFFNESS_RANGE = (2.0**-256, 2.0**256)
 
 
-def stiffness_unit(K) -> float:
+def stiffness_unit(K, ranks: Ranks = SERIAL) -> float:
     """1 if ``max |diag K|`` lies in ``STIFFNESS_RANGE`` (or is 0), else the power of 2
     not above it. Dividing K and F by it is exact, so u_h is the same; it keeps sums over
     K (the active set rule's constant c = mean diag K, the force scales of the KKT check)
-    and the factorization's products away from overflow and underflow when E is extreme."""
-    d = float(np.abs(K.diagonal()).max(initial=0.0))
+    and the factorization's products away from overflow and underflow when E is extreme.
+    ``ranks``: those that split ``K`` by rows (the same unit on every rank)."""
+    d = ranks.max(float(np.abs(K.diagonal()).max(initial=0.0)))
     lo, hi = STIFFNESS_RANGE
     if d == 0.0 or not np.isfinite(d) or lo <= d <= hi:
         return 1.0
