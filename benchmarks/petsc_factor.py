@@ -5,9 +5,17 @@ last level the stiffness matrix with the Dirichlet DOFs eliminated (what
 ``benchmarks/adaptive.py`` calls the floor) is factorized by each backend in turn,
 ``--repeat`` times, alternating so that both see the same load on a shared machine. Printed
 per backend: the best time of analysis + factorization, of a refactorization (same pattern,
-analysis kept) and of one solve, and the residual. Needs the extra ``signorini[mpi]``.
+analysis kept) and of one solve, and the residual; for MUMPS also its ordering (``INFOG(7)``:
+5 METIS, 1 given), its factor's entries (``INFOG(29)``) and flops (``RINFOG(3)``). Needs the
+extra ``signorini[mpi]``.
+
+Backends: ``pardiso``, ``petsc`` (MUMPS Cholesky, its METIS), ``petsc-lu`` (MUMPS LU, its
+METIS), ``petsc-lu-ordered`` (MUMPS LU given the loop's ordering,
+:func:`signorini.contact.ordering.dof_ordering`, as the petsc factory gives it to an LU on one
+process).
 
     python benchmarks/petsc_factor.py --max-ndof 1000000
+    python benchmarks/petsc_factor.py --max-ndof 300000 --backends petsc-lu,petsc-lu-ordered
 """
 
 from __future__ import annotations
@@ -20,11 +28,21 @@ from adaptive import reduced_system
 
 from signorini import adaptive, example_6_2
 from signorini.algebra import SOLVERS, make_solver
+from signorini.contact.ordering import dof_ordering
 
 
-def timed(backend: str, K, b) -> tuple[float, float, float, float]:
-    """(analysis + factorization, refactorization, solve) seconds and the relative residual."""
-    with make_solver(SOLVERS[backend], check_symmetry=False) as solver:
+def solver_of(backend: str, ordering):
+    if backend.startswith("petsc-lu"):
+        from signorini.algebra.petsc import PetscLUSolver
+
+        return PetscLUSolver(ordering=ordering() if backend.endswith("ordered") else None)
+    return make_solver(SOLVERS[backend], check_symmetry=False)
+
+
+def timed(backend: str, K, b, ordering) -> tuple[np.ndarray, str]:
+    """(analysis + factorization, refactorization, solve) seconds, the relative residual, and
+    MUMPS's ordering, factor entries and flops."""
+    with solver_of(backend, ordering) as solver:
         t0 = time.perf_counter()
         solver.factorize(K)
         t1 = time.perf_counter()
@@ -32,7 +50,15 @@ def timed(backend: str, K, b) -> tuple[float, float, float, float]:
         t2 = time.perf_counter()
         x = solver.solve(b)
         t3 = time.perf_counter()
-    return t1 - t0, t2 - t1, t3 - t2, float(np.abs(K @ x - b).max() / np.abs(b).max())
+        about = ""
+        if backend.startswith("petsc"):
+            f = solver._ksp.getPC().getFactorMatrix()
+            about = (
+                f"  INFOG(7) {f.getMumpsInfog(7)}  factor entries {f.getMumpsInfog(29)}"
+                f"  flops {f.getMumpsRinfog(3):.3e}"
+            )
+    residual = float(np.abs(K @ x - b).max() / np.abs(b).max())
+    return np.array([t1 - t0, t2 - t1, t3 - t2, residual]), about
 
 
 def main() -> None:
@@ -43,17 +69,19 @@ def main() -> None:
     args = parser.parse_args()
     problem = example_6_2()
     *_, last = adaptive(problem, max_ndof=args.max_ndof, max_levels=200)
-    K, b = reduced_system(problem, last.result.space.mesh)
+    space = last.result.space
+    K, b = reduced_system(problem, space.mesh)
     print(f"{K.shape[0]} unknowns, {K.nnz} stored entries")
     best: dict[str, np.ndarray] = {}
+    about: dict[str, str] = {}
     for _ in range(args.repeat):
         for backend in args.backends.split(","):
-            t = np.array(timed(backend, K, b))
+            t, about[backend] = timed(backend, K, b, lambda: dof_ordering(space))
             best[backend] = t if backend not in best else np.minimum(best[backend], t)
     for backend, (first, again, solve, residual) in best.items():
         print(
-            f"{backend:8s} analysis+factorization {first:6.2f} s  refactorization {again:6.2f} s"
-            f"  solve {solve:6.3f} s  residual {residual:.1e}"
+            f"{backend:16s} analysis+factorization {first:6.2f} s  refactorization {again:6.2f} s"
+            f"  solve {solve:6.3f} s  residual {residual:.1e}{about[backend]}"
         )
 
 
