@@ -212,7 +212,7 @@ class PetscSolver(SPDSolver):
         A whole matrix: contiguous blocks of rows (:func:`row_block`), in the order of the
         requested ordering if there is one. A split one: the ranks' own (non-empty) rows in rank
         order, each rank's in the order of the requested ordering, else increasing. Raises a
-        :class:`ValueError` if a row is on several ranks (collective).
+        :class:`ValueError` if a row is on no rank or on several (collective).
         """
         n = A.shape[0]
         perm = self._perm
@@ -228,8 +228,8 @@ class PetscSolver(SPDSolver):
         order = self._ranks.gather(own)
         seen = np.bincount(order, minlength=n)
         if (seen != 1).any():
-            twice = np.flatnonzero(seen != 1)
-            raise ValueError(f"A's rows {list_indices(twice)} are stored on several ranks")
+            wrong = np.flatnonzero(seen != 1)
+            raise ValueError(f"A's rows {list_indices(wrong)} are on no rank or on several")
         return order, own
 
     def _local(self, A: sp.csr_matrix, own: np.ndarray, to_petsc: np.ndarray | None) -> None:
