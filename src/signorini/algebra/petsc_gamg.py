@@ -26,7 +26,9 @@ block alone.
 
 **Inexact solves.** A solve stops at ``‖b − A x‖₂ ≤ rtol ‖b‖₂`` (the true residual:
 ``KSP_NORM_UNPRECONDITIONED``), or where the residual reaches the round-off of the product,
-``eps ‖A‖∞ ‖x‖₂`` (``x`` the previous solution). The active set methods read
+``eps ‖A‖∞ ‖x‖₂`` (``x`` the previous solution). A solve of the matrix and right-hand side
+of the last solve (the confirming solve of :mod:`.inexact`) starts from that solve's
+solution; every other from zero. The active set methods read
 :attr:`GamgSolver.rtol` and follow the inexact stopping rule of :mod:`.inexact`
 (docs/parallel.md, *Inexact active set iterations*). A solve that does not reach its
 tolerance in :attr:`GamgSolver.max_it` iterations, or meets an indefinite matrix, raises
@@ -135,6 +137,7 @@ class GamgSolver(SPDSolver):
         self._keep: np.ndarray | None = None
         self._data: np.ndarray | None = None
         self._norm = self._x_norm = 0.0
+        self._last: tuple[np.ndarray, np.ndarray] | None = None  # the last solve's b and x
         super().__init__(A, check_symmetry=check_symmetry, ordering=ordering)
 
     def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
@@ -202,6 +205,7 @@ class GamgSolver(SPDSolver):
             ) from err
         self._keep = None if keep is None else keep.copy()
         self._data = A.data
+        self._last = None  # a new matrix: no solution to start from
         self._norm = float(abs_matvec(A, np.ones(A.shape[0])).max(initial=0.0))
 
     def _set_near_nullspace(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
@@ -236,7 +240,13 @@ class GamgSolver(SPDSolver):
         self._ksp.setTolerances(rtol=self.rtol, atol=atol, max_it=self.max_it)
         for j in range(columns.shape[1]):  # a handful of right-hand sides
             self._b.setArray(np.ascontiguousarray(columns[lo:hi, j]))
-            self._x.set(0.0)
+            # the same system again (a confirming solve, .inexact): from its last solution
+            again = self._last is not None and np.array_equal(columns[:, j], self._last[0])
+            if again:
+                self._x.setArray(np.ascontiguousarray(self._last[1][lo:hi]))
+            else:
+                self._x.set(0.0)
+            self._ksp.setInitialGuessNonzero(again)
             self._ksp.solve(self._b, self._x)
             reason = int(self._ksp.getConvergedReason())
             its = int(self._ksp.getIterationNumber())
@@ -255,6 +265,7 @@ class GamgSolver(SPDSolver):
             self._scatter.scatter(self._x, self._all)
             x[:, j] = self._all.getArray()
             self._x_norm = float(np.linalg.norm(x[:, j]))
+            self._last = (columns[:, j].copy(), x[:, j].copy())
         return x.reshape(b.shape)
 
     def _release(self) -> None:
@@ -262,7 +273,7 @@ class GamgSolver(SPDSolver):
             if obj is not None:
                 obj.destroy()
         self._mat = self._ksp = self._x = self._b = self._scatter = self._all = None
-        self._keep = None
+        self._keep = self._last = None
 
     def close(self) -> None:
         self._release()
