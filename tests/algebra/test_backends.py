@@ -29,7 +29,7 @@ from signorini.algebra.petsc import petsc_module
 
 try:  # the optional "petsc" backend (signorini[mpi]) is listed where it loads
     petsc_module()
-    PETSC: tuple[str, ...] = ("petsc",)
+    PETSC: tuple[str, ...] = ("petsc", "petsc-gamg")
 except BackendUnavailableError:
     PETSC = ()
 
@@ -64,7 +64,7 @@ def test_auto_takes_pardiso_when_mkl_is_installed():
 def test_unknown_backend_lists_valid():
     with pytest.raises(ValueError, match="unknown backend 'mumps'.*auto, pardiso, scipy, petsc"):
         solver_factory("mumps")
-    assert tuple(SOLVERS) == ("auto", "pardiso", "scipy", "petsc")
+    assert tuple(SOLVERS) == ("auto", "pardiso", "scipy", "petsc", "petsc-gamg")
 
 
 def test_the_registry_names_each_factory_once():
