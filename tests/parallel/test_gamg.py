@@ -23,7 +23,7 @@ from signorini.algebra import SingularSystemError, SolverRequest, make_solver, s
 from signorini.algebra.inexact import KKT_RTOL
 
 from .gamg_levels import run
-from .test_mpi import PROBLEM, REFERENCE, mpiexec, split
+from .test_mpi import PROBLEM, REFERENCE, history, mpiexec, split
 
 SCRIPT = Path(__file__).with_name("gamg_levels.py")
 
@@ -84,6 +84,32 @@ def test_two_ranks_give_the_direct_levels(serial, tmp_path, name):
     got = dict(np.load(out))
     assert int(got["size"]) == 2 and set(got["backend"]) == {"petsc-gamg"}
     compare(got, serial[name])
+
+
+@pytest.mark.slow
+def test_the_command_line_on_two_ranks_writes_the_direct_run_once(tmp_path):
+    from signorini.cli import main
+
+    args = ["run", "example-6.2", "--max-levels", "6", "--no-figures", "--quiet"]
+    assert main([*args, "--backend", REFERENCE, "--out", str(tmp_path / "serial")]) == 0
+    if mpiexec() is None:
+        pytest.skip("no mpiexec")
+    command = [*mpiexec(), "-n", "2", sys.executable, "-m", "signorini.cli", *args]
+    out = tmp_path / "two"
+    done = subprocess.run(
+        [*command, "--backend", "petsc-gamg", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert "GAMG (CG) (2 ranks)" in (out / "signorini-run.json").read_text()
+    got, reference = history(out), history(tmp_path / "serial")
+    assert set(got["backend"].astype(str)) == {"petsc-gamg"}
+    np.testing.assert_array_equal(got["ndof"], reference["ndof"])
+    np.testing.assert_array_equal(got["n_active"], reference["n_active"])
+    np.testing.assert_allclose(got["eta"], reference["eta"], rtol=ETA_RTOL)
+    assert (got["pdas_iterations"] == reference["pdas_iterations"] + 1).all()
 
 
 def test_the_near_nullspace_cuts_the_iterations():
