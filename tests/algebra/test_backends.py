@@ -29,7 +29,7 @@ from signorini.algebra.petsc import petsc_module
 
 try:  # the optional "petsc" backend (signorini[mpi]) is listed where it loads
     petsc_module()
-    PETSC: tuple[str, ...] = ("petsc", "petsc-gamg")
+    PETSC: tuple[str, ...] = ("petsc",)
 except BackendUnavailableError:
     PETSC = ()
 
@@ -59,6 +59,8 @@ def test_auto_takes_pardiso_when_mkl_is_installed():
         solver = make_solver()
     assert solver.backend == "pardiso" and solver.reuses_analysis
     assert available_backends() == ("pardiso", "scipy", *PETSC)
+    gamg = ("petsc-gamg",) if PETSC else ()  # iterative: listed only when asked for
+    assert available_backends(iterative=True) == ("pardiso", "scipy", *PETSC, *gamg)
 
 
 def test_unknown_backend_lists_valid():

@@ -127,18 +127,22 @@ def solver_name(solver: object) -> str:
     )
 
 
-def available_backends() -> tuple[str, ...]:
+def available_backends(*, iterative: bool = False) -> tuple[str, ...]:
     """The registered backends (``"auto"`` aside) that make a solver on this machine, in the
-    order of :data:`SOLVERS` (``"scipy"`` is always there)."""
+    order of :data:`SOLVERS` (``"scipy"`` is always there): the direct ones, whose solves are
+    exact to round-off, and with ``iterative=True`` also those that solve to a tolerance
+    (:attr:`~.solvers.SPDSolver.rtol`, e.g. ``"petsc-gamg"``)."""
     names = []
     for name, factory in SOLVERS.items():
         if factory is auto_solver:
             continue
         try:
-            factory(SolverRequest()).close()
+            solver = factory(SolverRequest())
         except BackendUnavailableError:
             continue
-        names.append(name)
+        solver.close()
+        if iterative or solver.rtol is None:
+            names.append(name)
     return tuple(names)
 
 
