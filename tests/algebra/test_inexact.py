@@ -9,9 +9,17 @@ from functools import cache
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from contact_problems import pressed_block
+from linalg_problems import CYCLING_F, CYCLING_G, CYCLING_K, brute_force_qp
 
-from signorini.algebra import SingularSystemError, solve_pdas, superlu_solver
+from signorini.algebra import (
+    PDASConvergenceError,
+    PDASOptions,
+    SingularSystemError,
+    solve_pdas,
+    superlu_solver,
+)
 from signorini.algebra.friction import FrictionOptions, solve_friction
 from signorini.algebra.friction_kkt import check_friction
 from signorini.algebra.inexact import CONFIRM_RTOL, KKT_RTOL
@@ -100,3 +108,27 @@ def test_an_inexact_tresca_iteration_confirms_its_states():
     assert solver.used[-1] == CONFIRM_RTOL and set(solver.used[:-1]) == {LOOSE}
     assert result.kkt.max <= KKT_RTOL, result.kkt
     assert solver.rtol == LOOSE
+
+
+def test_a_cycle_of_loose_solves_is_retried_with_tight_ones_then_falls_back():
+    """The 4-unknown system on which PDAS cycles (tests/algebra/test_pdas.py): a cycle met
+    with loose solves may be their error, so the iteration goes on with tight solves; the
+    cycle is reported only when it repeats with those, and the fallback then finishes with
+    tight solves at the primal active set method's exact solution."""
+    K = sp.csr_matrix(CYCLING_K)
+    with pytest.raises(PDASConvergenceError, match="cycles") as exact:
+        solve_pdas(K, CYCLING_F, np.arange(4), CYCLING_G)
+    solver = InexactSolver()
+    with pytest.raises(PDASConvergenceError, match="cycles") as inexact:
+        solve_pdas(K, CYCLING_F, np.arange(4), CYCLING_G, solver=solver)
+    n = len(exact.value.history)
+    assert len(inexact.value.history) > n and solver.used[: n - 1] == [LOOSE] * (n - 1)
+    assert solver.used[-1] == CONFIRM_RTOL and solver.rtol == LOOSE
+    solver.used.clear()
+    result = solve_pdas(
+        K, CYCLING_F, np.arange(4), CYCLING_G, options=PDASOptions(fallback=True), solver=solver
+    )
+    x_ref, _, active_ref = brute_force_qp(CYCLING_K, CYCLING_F, np.arange(4), CYCLING_G)
+    assert result.method == "primal-active-set" and np.array_equal(result.active, active_ref)
+    assert np.abs(result.x - x_ref).max() < 1e-12 * np.abs(x_ref).max()
+    assert solver.used[-1] == CONFIRM_RTOL and result.kkt.max <= KKT_RTOL

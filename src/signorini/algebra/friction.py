@@ -319,6 +319,9 @@ def _iterate(
                 return x, states, history
             seen, previous = {key: it + 1}, states  # solve them again, tightly
             continue
+        if key in seen and not inexact.tight:  # a cycle of loose solves: go on tightly
+            inexact.tighten()
+            seen = {}
         if key in seen:
             message = (
                 f"the frictional active set iteration cycles: the states computed in iteration "

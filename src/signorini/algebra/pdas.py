@@ -330,6 +330,9 @@ def _iterate(
             seen, previous = {active.tobytes(): it + 1}, active  # solve it again, tightly
             continue
         key = new_active.tobytes()
+        if key in seen and not rule.tight:  # a cycle of loose solves: go on with tight ones
+            rule.tighten()
+            seen = {}
         if key in seen:
             message = (
                 f"PDAS cycles: the active set computed in iteration {it} "
