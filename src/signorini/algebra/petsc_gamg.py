@@ -173,6 +173,8 @@ class GamgSolver(SPDSolver):
         self._mat, self._ksp = mat, ksp
         self._x, self._b = mat.createVecs()
         self._scatter, self._all = PETSc.Scatter.toAll(self._x)
+        # ‖A‖∞ ≤ ‖K‖∞ for every eliminated matrix of the pattern: the round-off floor's
+        self._norm = float(abs_matvec(A, np.ones(n)).max(initial=0.0))
         self._modes = None
         if self.near_nullspace is not None:
             modes = np.asarray(self.near_nullspace(), dtype=np.float64)
@@ -206,7 +208,6 @@ class GamgSolver(SPDSolver):
         self._keep = None if keep is None else keep.copy()
         self._data = A.data
         self._last = None  # a new matrix: no solution to start from
-        self._norm = float(abs_matvec(A, np.ones(A.shape[0])).max(initial=0.0))
 
     def _set_near_nullspace(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
         """The rigid motions, zero on the eliminated DOFs (rows that keep only their
