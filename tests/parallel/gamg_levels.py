@@ -18,12 +18,18 @@ sys.path.insert(0, str(Path(__file__).parent))  # mpi_levels, when run as a scri
 from mpi_levels import level_numbers  # noqa: E402
 
 from signorini.algebra import solver_factory  # noqa: E402
-from signorini.examples import example_6_2, example_6_2_tresca, two_cylinders  # noqa: E402
+from signorini.examples import (  # noqa: E402
+    example_6_2,
+    example_6_2_coulomb,
+    example_6_2_tresca,
+    two_cylinders,
+)
 from signorini.loop import adaptive  # noqa: E402
 
 PROBLEMS = {
     "example-6.2": example_6_2,
     "example-6.2-tresca": example_6_2_tresca,
+    "example-6.2-coulomb": example_6_2_coulomb,
     "two-cylinders": two_cylinders,
 }
 

@@ -86,6 +86,20 @@ def test_two_ranks_give_the_direct_levels(serial, tmp_path, name):
     compare(got, serial[name])
 
 
+def test_coulomb_on_petsc_gamg_is_mumps_lu_exactly():
+    """Coulomb's non-symmetric systems go to MUMPS LU: the direct run's levels to round-off,
+    with the direct run's iterations (no confirming solve) and no CG solve at all."""
+    name = "example-6.2-coulomb"
+    reference = run(name, 8, REFERENCE)
+    got = run(name, 8, "petsc-gamg")
+    np.testing.assert_array_equal(got["ndof"], reference["ndof"])
+    np.testing.assert_array_equal(got["active"], reference["active"])
+    np.testing.assert_array_equal(got["marked"], reference["marked"])
+    np.testing.assert_array_equal(got["iterations"], reference["iterations"])
+    np.testing.assert_allclose(got["eta"], reference["eta"], rtol=1e-11)
+    assert got["cg"].size == 0
+
+
 @pytest.mark.slow
 def test_the_command_line_on_two_ranks_writes_the_direct_run_once(tmp_path):
     from signorini.cli import main
