@@ -8,12 +8,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from signorini.algebra import superlu_solver
 from signorini.algebra.sparse import abs_matvec
-from signorini.contact import assemble
+from signorini.contact import assemble, solve
 from signorini.contact.node_frames import to_cartesian
 from signorini.contact.rigid_modes import system_rigid_modes
 from signorini.contact.two_body import physical
-from signorini.examples import example_6_2, two_cylinders
+from signorini.examples import example_6_2, example_6_2_tresca, two_cylinders
 from signorini.mesh.bodies import body_of_cells
 
 
@@ -54,3 +55,20 @@ def test_the_assembled_matrix_annihilates_the_rigid_motions_of_each_body(make, b
     # normals turn along the arc, and their rows differ from the Cartesian motion
     turned = np.abs(cartesian[frame_dofs] - modes[frame_dofs]).max()
     assert turned == 0 if bodies == 1 else turned > 0.1
+
+
+@pytest.mark.parametrize("make", [two_cylinders, example_6_2_tresca])
+def test_the_contact_layer_offers_the_rigid_motions_to_the_factory(make):
+    """The request of the frictionless (two cylinders) and the frictional (Tresca) path
+    carries the rigid motions of the assembled system, computed when the backend asks."""
+    requests = []
+
+    def factory(request):
+        requests.append(request)
+        return superlu_solver(request)
+
+    problem = make()
+    solve(problem, solver=factory)
+    assert len(requests) == 1 and requests[0].symmetric
+    a = assemble(problem, problem.mesh)
+    np.testing.assert_array_equal(requests[0].rigid_modes(), system_rigid_modes(a))
