@@ -12,11 +12,20 @@ of u against the direct solution, and the seconds of GAMG's set-up and of the so
 meshes are strongly graded at the kink of the obstacle and at the ends of the contact zone:
 the hard case for an algebraic multigrid.
 
+With ``--loop`` it runs instead the whole adaptive loop twice, one run after the other in
+this process: on the ``"petsc"`` backend (MUMPS) and on ``"petsc-gamg"`` (CG + GAMG with the
+inexact active set rule, docs/parallel.md, *Inexact active set iterations*). Printed per
+level: unknowns, active set iterations of each, the CG iterations of each GAMG solve, the
+solve phase's seconds of each (``t_solve``: set-ups or factorizations and solves), the
+largest KKT residual of the GAMG run; at the end the loops' totals and their ratio. The runs
+must give the same unknowns and active sets on every level (checked).
+
 Needs the extra ``signorini[mpi]``; under ``mpiexec -n N`` the rows are split as by the
 ``petsc`` backend (every rank runs the loop). Measured figures: docs/parallel.md.
 
     python benchmarks/gamg.py                     # to just above 10⁶ unknowns
     python benchmarks/gamg.py --max-ndof 300000 --no-nullspace
+    python benchmarks/gamg.py --loop --max-ndof 300000
 """
 
 from __future__ import annotations
@@ -28,6 +37,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini import adaptive, example_6_2
+from signorini.algebra import solver_factory
 from signorini.algebra.petsc import petsc_module, row_block
 from signorini.contact import assemble
 
@@ -109,14 +119,69 @@ def solve_gamg(K, b, modes, rtol: float, nullspace: bool):
     return everywhere.getArray().copy(), iterations, t1 - t0, t2 - t1
 
 
+def loop_run(backend: str, max_ndof: int) -> tuple[list, list, float]:
+    """The adaptive loop of Example 6.2 on ``backend``: its levels, every solver it made,
+    and its total seconds (wall clock, and this process's CPU time)."""
+    made = []
+    factory = solver_factory(backend)
+
+    def recording(request):
+        solver = factory(request)
+        made.append(solver)
+        return solver
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    levels = list(adaptive(example_6_2(), max_ndof=max_ndof, max_levels=200, solver=recording))
+    return levels, made, (time.perf_counter() - t0, time.process_time() - c0)
+
+
+def compare_loops(max_ndof: int, say) -> None:
+    """``--loop``: MUMPS's and GAMG's adaptive loops, level by level (module docstring)."""
+    mumps, _, t_mumps = loop_run("petsc", max_ndof)
+    gamg, solvers, t_gamg = loop_run("petsc-gamg", max_ndof)
+    say(f"{'ndof':>8} {'pdas':>4} {'gamg':>4} {'CG iterations':<24} {'mumps s':>8} "
+        f"{'gamg s':>8} {'kkt':>8}")  # fmt: skip
+    cg = [s.iterations for s in solvers if hasattr(s, "iterations")]
+    every = []
+    for a, b in zip(mumps, gamg, strict=True):
+        if a.record.ndof != b.record.ndof or not np.array_equal(a.result.active, b.result.active):
+            raise SystemExit(f"the runs part at {a.record.ndof} unknowns")
+        its = cg.pop(0) if cg else []
+        while cg and len(its) < b.result.report.n_solves:  # a level's nested coarse solve
+            its = its + cg.pop(0)
+        every += its
+        say(
+            f"{a.record.ndof:>8} {a.record.pdas_iterations:>4} {b.record.pdas_iterations:>4} "
+            f"{' '.join(map(str, its)):<24} {a.record.t_solve:>8.2f} {b.record.t_solve:>8.2f} "
+            f"{b.result.report.kkt.max:>8.1e}",
+            flush=True,
+        )
+    t_solve = sum(level.record.t_solve for level in mumps), sum(lv.record.t_solve for lv in gamg)
+    (t_mumps, cpu_mumps), (t_gamg, cpu_gamg) = t_mumps, t_gamg
+    say(
+        f"loop CPU time (this process): MUMPS {cpu_mumps:.1f} s, GAMG {cpu_gamg:.1f} s (ratio "
+        f"{cpu_gamg / cpu_mumps:.2f})"
+    )
+    say(
+        f"loop total: MUMPS {t_mumps:.1f} s, GAMG {t_gamg:.1f} s (ratio {t_gamg / t_mumps:.2f}); "
+        f"solve phase: {t_solve[0]:.1f} s, {t_solve[1]:.1f} s (ratio "
+        f"{t_solve[1] / t_solve[0]:.2f}); CG iterations per solve: mean {np.mean(every):.1f}, "
+        f"max {max(every)}; largest KKT residual {max(lv.result.report.kkt.max for lv in gamg):.1e}"
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max-ndof", type=int, default=1_000_000)
     parser.add_argument("--rtol", type=float, default=1e-10)
     parser.add_argument("--no-nullspace", action="store_true", help="GAMG's default (constants)")
+    parser.add_argument("--loop", action="store_true", help="the whole loop: MUMPS against GAMG")
     args = parser.parse_args()
     rank = petsc_module().COMM_WORLD.getRank()
     say = print if rank == 0 else (lambda *a, **k: None)
+    if args.loop:
+        compare_loops(args.max_ndof, say)
+        return
     say(f"{'ndof':>9} {'free':>9} {'its':>5} {'rel.err':>9} {'setup s':>8} {'solve s':>8}")
     target = 17_000
     for level in adaptive(example_6_2(), max_ndof=args.max_ndof, max_levels=200):

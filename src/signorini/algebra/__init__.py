@@ -10,10 +10,12 @@ semismooth Newton extension to Tresca and Coulomb friction.
 ``superlu``            SuperLU backend (always available): SPD, LU for non-symmetric; factory
 ``mkl``                how MKL's runtime library is found and loaded
 ``pardiso``            MKL PARDISO through ctypes (SPD, non-symmetric LU), its factory; METIS
+``petsc_gamg``         CG + GAMG through PETSc, the rigid-body near-nullspace (``"petsc-gamg"``)
 ``backends``           the backends by name (``SOLVERS``, ``"auto"``), ``make_solver``
 ``ranks``              the processes sharing a run's matrices: their collectives (``SERIAL``)
 ``qp``                 the bound-constrained QP's data, checked at the public entry
 ``kkt``                KKT residuals of a point
+``inexact``            the inexact stopping rule of an iterative solver: loose, then tight
 ``active_system``      one active set's linear system: refactorization or bordered update
 ``primal``             the primal active set fallback
 ``result``             the report of both solvers, PDAS steps and result, the convergence errors

@@ -17,6 +17,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .elimination import SymmetricEliminator
+from .inexact import check_iterative
 from .qp import BoundQP
 from .solvers import (
     SINGULAR_CAUSES,
@@ -289,7 +290,8 @@ class ActiveSetSystem:
         b = self.eliminator.rhs(self.K, F, self.fixed, self.values, self.diagonal)
         self.time_elimination += time.perf_counter() - t0
         x = None
-        if self.factored is not None and self.max_update > 0:
+        exact = self.solver.rtol is None  # else no update: it trusts solves to round-off
+        if self.factored is not None and self.max_update > 0 and exact:
             changed = np.flatnonzero(self.fixed != self.factored)
             if 0 < changed.size <= self.max_update:
                 x = self._solve_updated(F, b, changed)
@@ -313,14 +315,19 @@ class ActiveSetSystem:
                 ) from err
             self.factored = self.fixed.copy()
             x = self.solver.solve(b)
-            x = refine(
-                self.solver.solve,
-                lambda y: self._residual_vector(b, y),
-                b,
-                x,
-                self._norm,
-                self.solver.backend,
-            )
+            if not exact:  # an iterative solve: checked against its tolerance (.inexact)
+                x = check_iterative(
+                    lambda y: self._residual_vector(b, y), b, x, self.solver, self._norm
+                )
+            else:
+                x = refine(
+                    self.solver.solve,
+                    lambda y: self._residual_vector(b, y),
+                    b,
+                    x,
+                    self._norm,
+                    self.solver.backend,
+                )
         x[self.fixed] = self.values[self.fixed]
         return x, F[c] - self.ranks.sum(self.K_c @ x)
 

@@ -16,6 +16,10 @@ backend by name (:func:`solver_name`).
     :func:`~.petsc.petsc_solver`: MUMPS through PETSc (the optional extra ``signorini[mpi]``),
     serial or under ``mpiexec`` (docs/parallel.md); raises
     :class:`~.solvers.BackendUnavailableError` naming the extra where petsc4py is missing.
+``"petsc-gamg"``
+    :func:`~.petsc_gamg.petsc_gamg_solver`: CG preconditioned by PETSc's GAMG with the
+    rigid-body near-nullspace (the extra ``signorini[mpi]``), an iterative solver with the
+    inexact active set stopping rule of :mod:`.inexact`; MUMPS LU for non-symmetric systems.
 ``"auto"``
     :func:`auto_solver`, the default everywhere: PARDISO when it loads and solves a small test
     system; otherwise SuperLU, and a :class:`SolverFallbackWarning` says why (once per reason
@@ -39,6 +43,7 @@ import scipy.sparse as sp
 from .mkl import mkl_version
 from .pardiso import pardiso_problem, pardiso_solver
 from .petsc import petsc_solver
+from .petsc_gamg import petsc_gamg_solver
 from .solvers import BackendUnavailableError, SolverFactory, SolverRequest, SPDSolver
 from .superlu import superlu_solver
 
@@ -85,6 +90,7 @@ SOLVERS: dict[str, SolverFactory] = {
     "pardiso": pardiso_solver,
     "scipy": superlu_solver,
     "petsc": petsc_solver,
+    "petsc-gamg": petsc_gamg_solver,
 }
 
 
@@ -121,18 +127,22 @@ def solver_name(solver: object) -> str:
     )
 
 
-def available_backends() -> tuple[str, ...]:
+def available_backends(*, iterative: bool = False) -> tuple[str, ...]:
     """The registered backends (``"auto"`` aside) that make a solver on this machine, in the
-    order of :data:`SOLVERS` (``"scipy"`` is always there)."""
+    order of :data:`SOLVERS` (``"scipy"`` is always there): the direct ones, whose solves are
+    exact to round-off, and with ``iterative=True`` also those that solve to a tolerance
+    (:attr:`~.solvers.SPDSolver.rtol`, e.g. ``"petsc-gamg"``)."""
     names = []
     for name, factory in SOLVERS.items():
         if factory is auto_solver:
             continue
         try:
-            factory(SolverRequest()).close()
+            solver = factory(SolverRequest())
         except BackendUnavailableError:
             continue
-        names.append(name)
+        solver.close()
+        if iterative or solver.rtol is None:
+            names.append(name)
     return tuple(names)
 
 
@@ -143,6 +153,7 @@ def make_solver(
     symmetric: bool = True,
     check_symmetry: bool = True,
     ordering: Callable[[], np.ndarray] | None = None,
+    rigid_modes: Callable[[], np.ndarray] | None = None,
 ) -> SPDSolver:
     """A new solver from a factory, for symmetric positive definite or general matrices.
 
@@ -159,6 +170,10 @@ def make_solver(
         A fill-reducing ordering offered to the factory, computed only if the backend uses
         it (PARDISO does, SuperLU does not). To impose an ordering on any backend, set
         :attr:`~.solvers.SPDSolver.ordering` on the solver instead.
+    rigid_modes : callable () -> (n, k) float array, optional
+        The rigid motions in the system's unknowns
+        (:attr:`~.solvers.SolverRequest.rigid_modes`), computed only if the backend uses
+        them (``"petsc-gamg"`` does).
 
     Returns
     -------
@@ -184,6 +199,7 @@ def make_solver(
         symmetric=bool(symmetric),
         check_symmetry=bool(check_symmetry),
         ordering=ordering,
+        rigid_modes=rigid_modes,
     )
     made = factory(request)
     if not isinstance(made, SPDSolver):
@@ -204,10 +220,11 @@ def solver_library(solver: object = None) -> str:
         version = mkl_version()
         if version is not None:
             return f"MKL PARDISO ({version})"
-    if name == "petsc":
+    if name in ("petsc", "petsc-gamg"):
         from .petsc import petsc_library
 
-        return petsc_library()
+        library = petsc_library()
+        return library if name == "petsc" else library.replace("MUMPS", "GAMG (CG)", 1)
     if name in ("auto", "pardiso", "scipy", "superlu"):
         return f"SuperLU (SciPy {scipy.__version__})"
     return f"{name} (SciPy {scipy.__version__} installed)"

@@ -60,6 +60,7 @@ from .friction_result import (
     FrictionStep,
 )
 from .friction_system import CoupledSystem, SymmetricSystem, friction_system
+from .inexact import InexactRule
 from .qp import check_vector
 from .solvers import SolverFactory, SPDSolver, solver_usage
 
@@ -187,7 +188,8 @@ def solve_friction(
     before = solver_usage(solver)
     try:
         system = friction_system(problem, solver)
-        x, states, history = _iterate(system, states, rule, options.max_iter)
+        with InexactRule(solver) as inexact:  # an iterative solver's stopping rule
+            x, states, history = _iterate(system, states, rule, options.max_iter, inexact)
     finally:
         used = {key: value - before[key] for key, value in solver_usage(solver).items()}
         backend_name = solver.backend
@@ -290,8 +292,11 @@ def _iterate(
     states: States,
     rule: tuple[float, float],
     max_iter: int,
+    inexact: InexactRule,
 ) -> tuple[np.ndarray, States, list[FrictionStep]]:
     """The active set loop from ``states``: the last iterate, its states and the history.
+    With an iterative solver, repeated states are confirmed by a tight solve first
+    (``inexact``, :mod:`.inexact`).
 
     Raises
     ------
@@ -310,7 +315,13 @@ def _iterate(
         new = _update(p, rule, x, lam_n, lam_t, states)
         key = _key(new)
         if key == _key(states):
-            return x, states, history
+            if inexact.stop():
+                return x, states, history
+            seen, previous = {key: it + 1}, states  # solve them again, tightly
+            continue
+        if key in seen and not inexact.tight:  # a cycle of loose solves: go on tightly
+            inexact.tighten()
+            seen = {}
         if key in seen:
             message = (
                 f"the frictional active set iteration cycles: the states computed in iteration "

@@ -39,6 +39,7 @@ import scipy.sparse as sp
 
 from .active_system import ActiveSetSystem
 from .backends import make_solver
+from .inexact import InexactRule
 from .kkt import qp_residuals
 from .primal import primal_active_set
 from .qp import BoundQP, check_qp, check_vector
@@ -196,15 +197,17 @@ def solve_pdas(
     try:
         system = ActiveSetSystem(qp, solver, max_update=options.max_update)
         history: list[PDASStep] = []
-        x, multiplier, active, failure = _iterate(
-            system, active, c_scale, options.max_iter, history
-        )
-        method = "pdas"
-        if failure is not None:
-            x, multiplier, active = _after_failure(
-                system, x, active, failure, options.fallback, history
+        with InexactRule(solver) as rule:  # an iterative solver's stopping rule (.inexact)
+            x, multiplier, active, failure = _iterate(
+                system, active, c_scale, options.max_iter, history, rule
             )
-            method = "primal-active-set"
+            method = "pdas"
+            if failure is not None:
+                rule.tighten()
+                x, multiplier, active = _after_failure(
+                    system, x, active, failure, options.fallback, history
+                )
+                method = "primal-active-set"
     finally:
         used = {key: value - before[key] for key, value in solver_usage(solver).items()}
         backend_name = solver.backend
@@ -298,8 +301,11 @@ def _iterate(
     c_scale: float,
     max_iter: int,
     history: list[PDASStep],
+    rule: InexactRule,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[str, str] | None]:
-    """The PDAS loop from ``active``, appending one step per solve to ``history``.
+    """The PDAS loop from ``active``, appending one step per solve to ``history``; with an
+    iterative solver a repeated active set is confirmed by a tight solve first (``rule``,
+    :mod:`.inexact`).
 
     Returns
     -------
@@ -326,8 +332,14 @@ def _iterate(
         bands = _bands(system, active, multiplier, force, c_scale, x)
         new_active = _update_active_set(active, value, bands)
         if np.array_equal(new_active, active):
-            return x, multiplier, active, None
+            if rule.stop():
+                return x, multiplier, active, None
+            seen, previous = {active.tobytes(): it + 1}, active  # solve it again, tightly
+            continue
         key = new_active.tobytes()
+        if key in seen and not rule.tight:  # a cycle of loose solves: go on with tight ones
+            rule.tighten()
+            seen = {}
         if key in seen:
             message = (
                 f"PDAS cycles: the active set computed in iteration {it} "

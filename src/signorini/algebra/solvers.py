@@ -138,10 +138,16 @@ class SPDSolver:
         number of right-hand sides).
     time_analysis, time_factorization, time_solve : float
         Seconds spent in each phase (wall clock).
+    rtol : float or None
+        An iterative solver's tolerance: its solves stop at ``‖b − A x‖₂ ≤ rtol ‖b‖₂``, and
+        the active set methods then follow the inexact stopping rule of :mod:`.inexact`
+        (they may change it for a confirming solve). None (every direct backend): exact to
+        round-off.
     """
 
     backend: str = ""
     reuses_analysis: bool = False
+    rtol: float | None = None
 
     def __init__(
         self,
@@ -338,11 +344,18 @@ class SolverRequest:
         when called: a factory whose backend orders better by itself, or cannot use a given
         ordering, does not call it (the contact layer's METIS ordering of the mesh's vertex
         graph, :func:`signorini.contact.ordering.dof_ordering`, needs MKL).
+    rigid_modes : callable () -> (n, k) float array, optional
+        The rigid motions of the bodies written in the system's unknowns (node frames, the
+        relative displacement of contact pairs): the near-nullspace of the matrix before
+        its Dirichlet DOFs are fixed, computed only when called (an algebraic multigrid
+        needs it, :mod:`.petsc_gamg`; the contact layer's
+        :func:`signorini.contact.rigid_modes.system_rigid_modes`).
     """
 
     symmetric: bool = True
     check_symmetry: bool = True
     ordering: Callable[[], np.ndarray] | None = None
+    rigid_modes: Callable[[], np.ndarray] | None = None
 
 
 class SolverFactory(Protocol):

@@ -37,15 +37,16 @@ def launched_ranks() -> int:
 
 
 def follow(args: argparse.Namespace, settings: RunSettings, job: RunProblem) -> bool:
-    """On a rank other than 0 of a several-rank ``petsc`` run: run the loops rank 0 runs,
-    without output, and return True; False everywhere else (the caller runs as usual).
+    """On a rank other than 0 of a several-rank ``petsc`` or ``petsc-gamg`` run: run the loops
+    rank 0 runs, without output, and return True; False everywhere else (the caller runs as
+    usual).
 
     Raises
     ------
     ValueError
         For ``--resume`` on several ranks (a resumed run's state is read by one process).
     """
-    if solver_name(settings.options.solver) != "petsc":
+    if solver_name(settings.options.solver) not in ("petsc", "petsc-gamg"):
         return False
     from ..algebra.petsc import petsc_module
 

@@ -31,6 +31,7 @@ from ..problem.fields import ProblemError
 from .contact_set import ContactSet
 from .node_frames import to_frames
 from .ordering import ordered_solver
+from .rigid_modes import system_rigid_modes
 from .system import Assembled, obstacle_displacement
 
 __all__ = [
@@ -253,8 +254,9 @@ def solve_frictional(
     # symmetric laws only (Tresca): symmetric systems (Cholesky); else non-symmetric ones (LU)
     coupling = None if cs.transfer is None else cs.transfer.nodes
     with ordered_solver(
-        assembled.space, solver, symmetric=problem.symmetric, coupling=coupling
-    ) as linear:
+        assembled.space, solver, symmetric=problem.symmetric, coupling=coupling,
+        rigid_modes=lambda: system_rigid_modes(assembled),
+    ) as linear:  # fmt: skip
         res = solve_friction(problem, options=options, solver=linear, **warm)
     state = res.state.astype(np.int64)
     # a frictionless node in contact slides freely: its friction force (0) is at its bound

@@ -17,6 +17,7 @@ object is used as it is.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from contextlib import AbstractContextManager, nullcontext
 
 import numpy as np
@@ -79,6 +80,7 @@ def ordered_solver(
     symmetric: bool = True,
     check_symmetry: bool = True,
     coupling: sp.spmatrix | None = None,
+    rigid_modes: Callable[[], np.ndarray] | None = None,
 ) -> AbstractContextManager[SPDSolver]:
     """The solver of ``space``'s systems, as a context manager.
 
@@ -95,6 +97,10 @@ def ordered_solver(
     coupling : (n_nodes, n_nodes) sparse matrix, optional
         Node pairs the system joins beyond the mesh's edges (a contact pair's mortar
         transfer), for the ordering.
+    rigid_modes : callable () -> (n, k) float array, optional
+        The rigid motions in the system's unknowns, offered to the factory
+        (:attr:`~signorini.algebra.SolverRequest.rigid_modes`; an algebraic multigrid's
+        near-nullspace, :func:`~.rigid_modes.system_rigid_modes`).
     """
     if isinstance(solver, SPDSolver):
         return nullcontext(solver)
@@ -103,4 +109,5 @@ def ordered_solver(
         symmetric=symmetric,
         check_symmetry=check_symmetry,
         ordering=lambda: dof_ordering(space, coupling),
+        rigid_modes=rigid_modes,
     )

@@ -35,6 +35,7 @@ from .nested import NESTED_MIN_NDOF, coarse_mesh, transfer_active
 from .node_frames import to_cartesian
 from .ordering import ordered_solver
 from .profile import ContactProfile, contact_profile
+from .rigid_modes import system_rigid_modes
 from .system import Assembled, assemble
 from .two_body import master_traction, physical
 
@@ -397,7 +398,10 @@ def _solve_system(
         )  # fmt: skip
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
     coupling = None if cs.transfer is None else cs.transfer.nodes
-    with ordered_solver(assembled.space, solver, check_symmetry=False, coupling=coupling) as linear:
+    with ordered_solver(
+        assembled.space, solver, check_symmetry=False, coupling=coupling,
+        rigid_modes=lambda: system_rigid_modes(assembled),
+    ) as linear:  # fmt: skip
         res = solve_pdas(
             K,
             F,

@@ -1,0 +1,61 @@
+"""The rigid motions of the bodies in the unknowns of an assembled system: the near-nullspace
+an algebraic multigrid builds its coarse spaces from (:mod:`signorini.algebra.petsc_gamg`).
+
+Each body (a connected component of the mesh, :func:`~signorini.mesh.bodies.body_of_cells`)
+moves rigidly by ``u(x) = a + ω (−(y − y_b), x − x_b)``, ``(x_b, y_b)`` its centroid: two
+translations and a rotation, three vectors per body, each zero off its body. The assembled
+stiffness matrix ``K`` annihilates them before the Dirichlet DOFs are fixed — in the
+system's unknowns ``y``, which are the Cartesian displacement written in node frames at the
+contact and roller nodes, ``u = Q y`` (:mod:`.node_frames`), and with contact pairs the
+relative displacement ``ũ = (I − T_d) u`` (:mod:`.two_body`). So a motion ``u`` of the
+bodies is ``y = Q⁻¹ (I − T_d) u`` there, and ``K y = 0`` holds to round-off (tested).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..mesh.bodies import body_of_cells
+from .node_frames import to_frames
+from .system import Assembled
+
+__all__ = ["system_rigid_modes"]
+
+
+def system_rigid_modes(assembled: Assembled) -> np.ndarray:
+    """The rigid motions of every body of ``assembled``'s mesh in its system's unknowns.
+
+    Parameters
+    ----------
+    assembled : Assembled
+
+    Returns
+    -------
+    (n_dofs, 3 n_bodies) float array
+        Columns ``3b, 3b + 1, 3b + 2``: body b's translations along x and y and its rotation
+        about its centroid, written as the system's unknowns (module docstring).
+    """
+    space = assembled.space
+    points = space.node_points
+    cell_body = body_of_cells(space.mesh)
+    body = np.zeros(space.n_nodes, dtype=np.int64)
+    body[space.cell_nodes.ravel()] = np.repeat(cell_body, space.cell_nodes.shape[1])
+    n_bodies = int(cell_body.max(initial=0)) + 1
+    count = np.bincount(body, minlength=n_bodies)
+    centre = (
+        np.stack(
+            [np.bincount(body, weights=points[:, k], minlength=n_bodies) for k in range(2)], axis=1
+        )
+        / np.maximum(count, 1)[:, None]
+    )
+    local = points - centre[body]
+    modes = np.zeros((space.n_dofs, 3 * n_bodies))
+    nodes = np.arange(space.n_nodes)
+    modes[2 * nodes, 3 * body] = 1.0
+    modes[2 * nodes + 1, 3 * body + 1] = 1.0
+    modes[2 * nodes, 3 * body + 2] = -local[:, 1]
+    modes[2 * nodes + 1, 3 * body + 2] = local[:, 0]
+    transfer = assembled.contact.transfer
+    if transfer is not None:  # the relative displacement of the contact pairs
+        modes = modes - transfer.dofs @ modes
+    return to_frames(modes, assembled.frame_nodes, assembled.frames)
