@@ -240,15 +240,9 @@ def estimate(
     # every stress-like input (σ(u_h), div σ(u_h), f, g, p_z, s_z) is divided by the stress
     # unit σ₀ (a power of 4, 1 for ordinary stresses): exact, and no square overflows;
     # Estimate puts σ₀ back (docs/method.md, *Estimator*, "Units")
-    u_cell = space.field_coefficients(result.u)
     material = problem.material_on(mesh)  # each cell's own where regions differ
-    stressed = None if own is None else own.stressed_cells(mesh.edge2cell, cs.edges)
-    sigma = vertex_stress(cells, u_cell, material, stressed)
-    unit = stress_unit(ranks.max(float(np.abs(sigma).max(initial=0.0))))
-    stresses = CellStress(
-        cells, mesh.points, mesh.cells, u_cell, material, sigma / unit, unit,
-        owned=None if own is None else own.cells,
-    )  # fmt: skip
+    stresses = _cell_stress(result, cells, material, own)
+    unit, u_cell = stresses.unit, stresses.u_cell
     t, w = line_rule(EDGE_DEGREE)
     inner = _edge_set(space, np.flatnonzero(mesh.edge2cell[:, 1] >= 0))
     t_n, w_n = line_rule(NEUMANN_DEGREE)
@@ -344,6 +338,29 @@ def geometry(space: LagrangeSpace) -> tuple[CellMap, np.ndarray]:
     that are quadratics (those on parts carrying a curve other than a line; none in a P1
     space): the geometry every term integrates on."""
     return space.mapping, space.curved_edges
+
+
+def _cell_stress(
+    result: ContactResult, cells: CellMap, material: Material | CellMaterials, own: OwnPart | None
+) -> CellStress:
+    """σ(u_h) of ``result`` in its stress unit (:func:`stress_unit` of max|σ(u_h)|) on every
+    cell; with ``own`` on the cells its rank's terms read (``OwnPart.stressed_cells``, the
+    other rows zero), the maximum taken over the ranks."""
+    space, mesh = result.space, result.mesh
+    if own is None:
+        u_cell = space.field_coefficients(result.u)
+        sigma = vertex_stress(cells, u_cell, material)
+        unit = stress_unit(float(np.abs(sigma).max(initial=0.0)))
+        return CellStress(cells, mesh.points, mesh.cells, u_cell, material, sigma / unit, unit)
+    stressed = own.stressed_cells(mesh.edge2cell, result.contact.edges)
+    u_cell = np.zeros((mesh.n_cells, 12))
+    values = np.asarray(result.u).reshape(-1)[space.cell_dofs[stressed]]  # as cell_values
+    u_cell[stressed] = space.element.cell_coefficients(values)
+    sigma = vertex_stress(cells, u_cell, material, stressed)
+    unit = stress_unit(own.ranks.max(float(np.abs(sigma[stressed]).max(initial=0.0))))
+    if unit != 1.0:
+        sigma[stressed] /= unit
+    return CellStress(cells, mesh.points, mesh.cells, u_cell, material, sigma, unit, own.cells)
 
 
 def _interior_residual(
