@@ -378,7 +378,7 @@ def _interior_residual(
     xi, w = triangle_rule(CELL_DEGREE)
     subset = None if own is None else np.flatnonzero(own.cells)
     f = None
-    if problem.body_force is not None:
+    if problem.body_force is not None and (subset is None or subset.size):
         if subset is None:
             points = cells.points(xi)
         else:
