@@ -22,7 +22,25 @@ from signorini.contact.partition import partition
 from signorini.estimator.residual import estimate
 from signorini.examples import example_6_1, example_6_2, example_6_2_coulomb, hertz, two_cylinders
 from signorini.examples.hertz_half import hertz_quarter
+from signorini.fem.material import Material
 from signorini.loop import adaptive
+from signorini.mesh import rectangle
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann
+
+
+def held_block() -> ContactProblem:
+    """A block pressed on a plane, its left side holding u_x only (one-component Dirichlet: η3
+    on the free component there)."""
+    return ContactProblem(
+        rectangle(0.0, 1.0, 0.0, 1.0, 4, 4),
+        Material.from_young(1.0, 0.3),
+        {
+            "top": Dirichlet((0.01, -0.02)),
+            "left": Dirichlet((0.0, None)),
+            "right": Neumann((0.0, 0.0)),
+            "bottom": Contact(gap=0.0, normal=(0.0, -1.0)),
+        },
+    )
 
 
 class StandIn(Ranks):
@@ -45,6 +63,7 @@ PROBLEMS = {  # the problem, its element, its levels: 130 to 760 cells
     "hertz": (hertz, "P2", 10),
     "hertz-quarter": (hertz_quarter, "P2", 10),
     "two-cylinders": (two_cylinders, "P2", 6),
+    "held-block": (held_block, "P2", 8),
 }
 
 
