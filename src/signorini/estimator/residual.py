@@ -51,34 +51,32 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..contact.contact_set import SEMI_CONTACT
+from ..algebra.ranks import SERIAL, Ranks
+from ..contact.partition import Partition
 from ..contact.solution import ContactResult
-from ..fem.mapping import CellMap, edge_groups
+from ..fem.mapping import CellMap
 from ..fem.material import CellMaterials, Material, on_cells
 from ..fem.postprocess import stress_divergence
 from ..fem.quadrature import line_rule, triangle_rule
 from ..fem.space import LagrangeSpace
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
-from .friction import friction_edges, move_dirichlet_thirds
+from .contact_edges import contact_node_parts, contact_stress, edge_pressure, semi_contact_density
+from .friction import friction_edges
 from .held import further_traction_edges
 from .names import TERMS
+from .owned import OwnPart, own_part, per_cell_of
 from .terms import (
     EdgeSet,
     TermShares,
     boundary_cell_shares,
-    complementarity,
-    direction_field,
-    friction_work,
     interior_residual,
     neumann_residual,
-    normal_stress,
     penetration,
     spread_cell_integrals,
     spread_edge_integrals,
     spread_node_parts,
     stress_jump,
-    tangential_stress,
 )
 from .traction import CellStress, vertex_stress
 
@@ -193,7 +191,13 @@ class Estimate:
         return out
 
 
-def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Estimate:
+def estimate(
+    result: ContactResult,
+    eta5_variant: str = ETA5_VARIANTS[0],
+    *,
+    ranks: Ranks = SERIAL,
+    partition: Partition | None = None,
+) -> Estimate:
     """Compute η_h and all its contributions for a discrete solution (paper, Section 5).
 
     Parameters
@@ -204,6 +208,13 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
         ``"paper"`` is η5 as printed (the full normal stress on Γ_C); ``"consistent"``
         balances it by the discrete pressure, ``σ_nn(u_h) + p_h`` (docs/method.md, *Estimator*).
         With friction η4 is ``‖σ_t(u_h) + p_t,h‖`` in both variants.
+    ranks : Ranks, optional
+        The processes of a run on several MPI ranks (:mod:`signorini.algebra.ranks`; default
+        one process): each integrates its own cells and edges, and the integrals are summed
+        over them (:mod:`signorini.estimator.owned`); every rank returns the serial estimate.
+    partition : Partition, optional
+        Which cells are this rank's (:func:`signorini.contact.partition.partition`, built
+        from ``result.space`` and ``ranks`` when not given).
 
     Returns
     -------
@@ -212,10 +223,12 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
     Raises
     ------
     ValueError
-        For an unknown ``eta5_variant``.
+        For an unknown ``eta5_variant``, or ``ranks`` or ``partition`` that do not fit
+        (:func:`~signorini.estimator.owned.own_part`).
     """
     if eta5_variant not in ETA5_VARIANTS:
         raise ValueError(f"eta5_variant must be one of {ETA5_VARIANTS}, got {eta5_variant!r}")
+    own = own_part(result, ranks, partition)  # None: one process, every cell and edge
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells
     element = space.element  # P2, or P1 read as the P2 field it is (docs/method.md, *P1 ...*)
@@ -227,59 +240,57 @@ def estimate(result: ContactResult, eta5_variant: str = ETA5_VARIANTS[0]) -> Est
     # every stress-like input (σ(u_h), div σ(u_h), f, g, p_z, s_z) is divided by the stress
     # unit σ₀ (a power of 4, 1 for ordinary stresses): exact, and no square overflows;
     # Estimate puts σ₀ back (docs/method.md, *Estimator*, "Units")
-    u_cell = space.field_coefficients(result.u)
     material = problem.material_on(mesh)  # each cell's own where regions differ
-    sigma = vertex_stress(cells, u_cell, material)
-    unit = stress_unit(float(np.abs(sigma).max(initial=0.0)))
-    stresses = CellStress(cells, mesh.points, mesh.cells, u_cell, material, sigma / unit, unit)
+    stresses = _cell_stress(result, cells, material, own)
+    unit, u_cell = stresses.unit, stresses.u_cell
     t, w = line_rule(EDGE_DEGREE)
     inner = _edge_set(space, np.flatnonzero(mesh.edge2cell[:, 1] >= 0))
-    jump = _from_both_sides(mesh, stresses.traction, inner.index, t)
     t_n, w_n = line_rule(NEUMANN_DEGREE)
     # pairs' masters (the slave's traction) and rollers (their free traction) join η3: held.py
     further, J3_further = further_traction_edges(result, stresses, t_n, w_n, unit)
     neumann = _edge_set(space, np.concatenate([_part_edges(mesh, problem.neumann_parts), further]))
     contact = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
-    pressure = on_edge(_edge_pressure(result)) / unit if eta5_variant == "consistent" else None
+    pressure = on_edge(edge_pressure(result)) / unit if eta5_variant == "consistent" else None
     friction = friction_edges(result, unit)  # None without friction
     if friction is not None:
         friction = type(friction)(*(on_edge(v) for v in friction))
     p_t = None if friction is None else friction.friction
     gap = on_edge(cs.edge_normal_gap(result.u))  # u_h·n − ψ_h at [start, end, midpoint]
-    density = on_edge(_semi_contact_density(result)) / unit
+    density = on_edge(semi_contact_density(result)) / unit
     x0, x1 = mesh.points[cs.edge_nodes[:, 0]], mesh.points[cs.edge_nodes[:, 1]]
     eta7_shares = penetration(x0, x1, gap, scale=float(np.abs(result.u).max(initial=0.0)))
 
     # each integral once per cell or edge, through its own geometry (docs/method.md,
-    # *Estimator*, "On curved boundaries")
-    R = _interior_residual(problem, material, cells, u_cell, unit)
+    # *Estimator*, "On curved boundaries"); on several ranks, the rank's own (owned.py)
+    R = _interior_residual(problem, material, cells, u_cell, unit, own)
+    J2 = _stress_jumps(mesh, stresses, inner, t, w, own)
     J3 = np.concatenate([_neumann_integrals(problem, mesh, stresses, t_n, w_n, unit), J3_further])
     direction = on_edge(cs.edge_direction)
-    J4, J5 = contact_stress(stresses, mesh, contact, cs.edge_normal, direction, t, w, pressure, p_t)
-    parts6 = np.zeros(gap.shape)
-    parts8 = np.zeros(gap.shape)
+    # the contact terms on every contact edge, on every rank (Γ_C's data is replicated)
+    every = stresses.everywhere
+    J4, J5 = contact_stress(every, mesh, contact, cs.edge_normal, direction, t, w, pressure, p_t)
     curved = np.isin(cs.edges, quadratic_edges)
-    for rows, edges in edge_groups(space.node_points[cs.edge_nodes], curved):
-        parts6[rows] = complementarity(gap[rows], density[rows], edges, None, element.hat_pieces)
-        if friction is not None:
-            slip, bound = friction.slip[rows], friction.bound[rows]
-            parts8[rows] = friction_work(slip, p_t[rows], bound, edges, None, element.node_parts)
-    n_edge = element.n_edge  # the element's own edge nodes (P1: the two ends)
+    parts6, parts8 = contact_node_parts(result, gap, density, friction, curved)
+    if own is not None:  # each integral from the one rank that owns it, summed over the ranks
+        mine = own.edges(contact.cells)
+        J4, J5, eta7_shares = (np.where(mine, a, 0.0) for a in (J4, J5, eta7_shares))
+        parts6, parts8 = (np.where(mine[:, None], a, 0.0) for a in (parts6, parts8))
+        R, J2, J3, J4, J5, parts6, parts8, eta7_shares = own.sum(
+            [R, J2, J3, J4, J5, parts6, parts8, eta7_shares]
+        )
 
     def on_edges(edges: EdgeSet, J: np.ndarray) -> TermShares:
         return spread_edge_integrals(edges, J, h_p, n_cells)
 
     shares = {
         "eta_1": spread_cell_integrals(R, space.cell_nodes, h_p),
-        "eta_2": on_edges(inner, stress_jump(*jump, w, inner.length)),
+        "eta_2": on_edges(inner, J2),
         "eta_3": on_edges(neumann, J3),
         "eta_4": on_edges(contact, J4),
         "eta_5": on_edges(contact, J5),
-        "eta_6": spread_node_parts(contact, parts6[:, :n_edge], n_nodes, n_cells),
+        "eta_6": spread_node_parts(contact, parts6, n_nodes, n_cells),
         "eta_7": TermShares(None, boundary_cell_shares(contact, eta7_shares, n_cells)),
-        "eta_8": spread_node_parts(
-            contact, move_dirichlet_thirds(parts8, cs.edge_local)[:, :n_edge], n_nodes, n_cells
-        ),
+        "eta_8": spread_node_parts(contact, parts8, n_nodes, n_cells),
     }
     return Estimate(
         eta2_cell=np.stack([shares[name].cell for name in TERMS]),
@@ -329,30 +340,79 @@ def geometry(space: LagrangeSpace) -> tuple[CellMap, np.ndarray]:
     return space.mapping, space.curved_edges
 
 
+def _cell_stress(
+    result: ContactResult, cells: CellMap, material: Material | CellMaterials, own: OwnPart | None
+) -> CellStress:
+    """σ(u_h) of ``result`` in its stress unit (:func:`stress_unit` of max|σ(u_h)|) on every
+    cell; with ``own`` on the cells its rank's terms read (``OwnPart.stressed_cells``, the
+    other rows zero), the maximum taken over the ranks."""
+    space, mesh = result.space, result.mesh
+    if own is None:
+        u_cell = space.field_coefficients(result.u)
+        sigma = vertex_stress(cells, u_cell, material)
+        unit = stress_unit(float(np.abs(sigma).max(initial=0.0)))
+        return CellStress(cells, mesh.points, mesh.cells, u_cell, material, sigma / unit, unit)
+    stressed = own.stressed_cells(mesh.edge2cell, result.contact.edges)
+    u_cell = np.zeros((mesh.n_cells, 12))
+    values = np.asarray(result.u).reshape(-1)[space.cell_dofs[stressed]]  # as cell_values
+    u_cell[stressed] = space.element.cell_coefficients(values)
+    sigma = vertex_stress(cells, u_cell, material, stressed)
+    unit = stress_unit(own.ranks.max(float(np.abs(sigma[stressed]).max(initial=0.0))))
+    if unit != 1.0:
+        sigma[stressed] /= unit
+    return CellStress(cells, mesh.points, mesh.cells, u_cell, material, sigma, unit, own.cells)
+
+
 def _interior_residual(
     problem: ContactProblem,
     material: Material | CellMaterials,
     cells: CellMap,
     u_cell: np.ndarray,
     unit: float,
+    own: OwnPart | None = None,
 ) -> np.ndarray:
     """η1's ``‖f + div σ(u_h)‖²_T`` ``(n_cells,)``: div σ(u_h) from the Hessian of u_h through
     each cell's map (constant on affine cells), f at the points of the degree-``CELL_DEGREE``
     rule (called once, at the points of the maps), both in the stress unit; each cell with its
-    own material."""
+    own material. With ``own``, on its cells only (zero on the others)."""
     xi, w = triangle_rule(CELL_DEGREE)
+    subset = None if own is None else np.flatnonzero(own.cells)
     f = None
-    if problem.body_force is not None:
-        f = evaluate_field(problem.body_force, cells.points(xi), "body_force") / unit
+    if problem.body_force is not None and (subset is None or subset.size):
+        if subset is None:
+            points = cells.points(xi)
+        else:
+            points = per_cell_of(cells, subset, lambda g, _: g.points(xi), (len(xi), 2))
+        f = evaluate_field(problem.body_force, points, "body_force") / unit
 
-    def residual(g) -> np.ndarray:
+    def residual(g, f_g) -> np.ndarray:
         hess = g.field_hessians(u_cell[g.cells], xi)
         div = stress_divergence(hess, on_cells(material, g.cells)) / unit
-        return interior_residual(
-            0.5 * g.jacobians(xi)[1], div, None if f is None else f[g.cells], w
-        )
+        return interior_residual(0.5 * g.jacobians(xi)[1], div, f_g, w)
 
-    return cells.per_cell(residual)
+    if subset is None:
+        return cells.per_cell(lambda g: residual(g, None if f is None else f[g.cells]))
+    R = np.zeros(cells.n_cells)
+    R[subset] = per_cell_of(
+        cells, subset, lambda g, rows: residual(g, None if f is None else f[rows])
+    )
+    return R
+
+
+def _stress_jumps(
+    mesh, stresses: CellStress, inner: EdgeSet, t: np.ndarray, w: np.ndarray, own: OwnPart | None
+) -> np.ndarray:
+    """η2's ``‖⟦σ(u_h)⟧‖²_e`` on the interior edges ``inner``; with ``own`` on its edges only
+    (zero on the others)."""
+    if own is None:
+        return stress_jump(
+            *_from_both_sides(mesh, stresses.traction, inner.index, t), w, inner.length
+        )
+    J = np.zeros(inner.index.size)
+    mine = np.flatnonzero(own.edges(inner.cells))
+    jump = _from_both_sides(mesh, stresses.traction, inner.index[mine], t)
+    J[mine] = stress_jump(*jump, w, inner.length[mine])
+    return J
 
 
 def _neumann_integrals(
@@ -375,45 +435,6 @@ def _neumann_integrals(
     return np.concatenate(out) if out else np.zeros(0)
 
 
-def contact_stress(
-    stresses: CellStress,
-    mesh,
-    edges: EdgeSet,
-    normal: np.ndarray,
-    direction: np.ndarray,
-    t: np.ndarray,
-    w: np.ndarray,
-    pressure: np.ndarray | None = None,
-    friction: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray]:
-    """η4's and η5's integrals ``(k,)`` on the contact ``edges`` from ``σ(u_h) n`` at the
-    points ``t`` (weights ``w``): split along the contact part's normal ``normal (k, 2)``
-    on straight edges where every nodal constraint direction ``direction (k, 3, 2)`` is that
-    normal (the paper's case), else along the direction field
-    (:func:`~signorini.estimator.terms.direction_field`; docs/method.md, *Estimator*, "On
-    curved boundaries"); with the nodal friction stresses ``friction (k, 3)`` η4 is
-    ``‖σ_t + p_t,h‖²``, with the nodal pressures ``pressure (k, 3)`` η5 is
-    ``‖σ_nn + p_h‖²``."""
-    J4, J5 = np.zeros(edges.index.size), np.zeros(edges.index.size)
-    e = edges.index
-    for rows, sn, geometry in stresses.on_edges(mesh.edge2cell[e, 0], mesh.edge_local[e, 0], t):
-        ds = geometry.speeds(t)
-        d, n = direction[rows], normal[rows]
-        index = np.arange(e.size)[rows]
-        same = np.zeros(len(d), dtype=bool)
-        if geometry.normals(t).shape[1] == 1:  # a straight edge: is every n_z its normal?
-            same = ~(d != n[:, None, :]).any(axis=(1, 2))
-        for sel in (np.flatnonzero(same), np.flatnonzero(~same)):
-            if sel.size == 0:
-                continue
-            split = n[sel] if same[sel[0]] else direction_field(d[sel], t)
-            p = None if pressure is None else pressure[index[sel]]
-            f = None if friction is None else friction[index[sel]]
-            J4[index[sel]] = tangential_stress(sn[sel], split, w, ds[sel], t, f)
-            J5[index[sel]] = normal_stress(sn[sel], split, t, w, ds[sel], p)
-    return J4, J5
-
-
 def _part_edges(mesh, names) -> np.ndarray:
     """Mesh edges of the named boundary parts, part after part."""
     return np.concatenate([mesh.part_edges(p) for p in names] or [np.zeros(0, np.int64)])
@@ -431,20 +452,3 @@ def _from_both_sides(mesh, traction, e: np.ndarray, t: np.ndarray):
     outward normal (the second cell runs the edge the other way)."""
     c, k = mesh.edge2cell[e], mesh.edge_local[e]
     return traction(c[:, 0], k[:, 0], t), traction(c[:, 1], k[:, 1], 1 - t)
-
-
-def _edge_pressure(result: ContactResult) -> np.ndarray:
-    """The nodal pressures ``p_z`` at ``[start, end, midpoint]`` of each contact edge
-    ``(n_ce, 3)``, 0 at Dirichlet end points."""
-    loc = result.contact.edge_local
-    return np.where(loc >= 0, result.pressure[np.maximum(loc, 0)], 0.0)
-
-
-def _semi_contact_density(result: ContactResult) -> np.ndarray:
-    """The density ``s_p`` (4.1) at ``[start, end, midpoint]`` of each contact edge where p is
-    a semi-contact node, else 0: ``(n_ce, 3)``. A negative Λ_p is round-off (the solver's
-    KKT check bounds it) and counts as 0: η6² = s_p d_p must not turn negative."""
-    loc = result.contact.edge_local
-    semi = result.classes == SEMI_CONTACT
-    use = (loc >= 0) & semi[np.maximum(loc, 0)]
-    return np.where(use, np.maximum(result.density[np.maximum(loc, 0)], 0.0), 0.0)

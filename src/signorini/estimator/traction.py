@@ -13,19 +13,30 @@ from ..fem.mapping import AffineCells, CellMap, Cells, Edges
 from ..fem.material import CellMaterials, Material, on_cells, stress
 from ..fem.p2 import REFERENCE_NODES, edge_basis, edge_reference_points
 from ..mesh.geometry import segment_normals
+from .owned import per_cell_of
 
 __all__ = ["CellStress", "direction_field", "edge_traction", "vertex_stress"]
 
 
 def vertex_stress(
-    cells: CellMap, u_cell: np.ndarray, material: Material | CellMaterials
+    cells: CellMap,
+    u_cell: np.ndarray,
+    material: Material | CellMaterials,
+    subset: np.ndarray | None = None,
 ) -> np.ndarray:
     """σ(u_h) ``(n_cells, 3, 2, 2)`` of each cell at its vertices, through its map, from the
-    interleaved coefficients ``u_cell (n_cells, 12)``."""
+    interleaved coefficients ``u_cell (n_cells, 12)``; with ``subset (m,)`` (cell numbers) of
+    those cells only, the other rows zero (a rank's cells and their neighbours, :mod:`.owned`)."""
     vertices = REFERENCE_NODES[:3]
-    return cells.per_cell(
-        lambda g: stress(on_cells(material, g.cells), g.field_gradients(u_cell[g.cells], vertices))
-    )
+
+    def of(g: Cells, rows=None) -> np.ndarray:
+        return stress(on_cells(material, g.cells), g.field_gradients(u_cell[g.cells], vertices))
+
+    if subset is None:
+        return cells.per_cell(of)
+    out = np.zeros((cells.n_cells, 3, 2, 2))
+    out[subset] = per_cell_of(cells, subset, of, (3, 2, 2))
+    return out
 
 
 class CellStress:
@@ -47,12 +58,17 @@ class CellStress:
         :func:`vertex_stress`, already divided by ``unit``.
     unit : float
         The stress unit σ₀.
+    owned : (n_cells,) bool array, optional
+        A rank's cells (:mod:`.owned`): :meth:`on_edges` then gives the edges of these
+        cells only. ``None`` (the default): every cell's.
     """
 
-    def __init__(self, cells, points, cell_vertices, u_cell, material, sigma_vertex, unit=1.0):
+    def __init__(
+        self, cells, points, cell_vertices, u_cell, material, sigma_vertex, unit=1.0, owned=None
+    ):
         self.cells, self.points, self.cell_vertices = cells, points, cell_vertices
         self.u_cell, self.material = u_cell, material
-        self.sigma_vertex, self.unit = sigma_vertex, unit
+        self.sigma_vertex, self.unit, self.owned = sigma_vertex, unit, owned
 
     @classmethod
     def of(
@@ -64,6 +80,16 @@ class CellStress:
         sigma = vertex_stress(space.mapping, u_cell, material) / unit
         mesh = space.mesh
         return cls(space.mapping, mesh.points, mesh.cells, u_cell, material, sigma, unit)
+
+    @property
+    def everywhere(self) -> CellStress:
+        """The same stresses, :meth:`on_edges` giving every edge (``owned`` dropped)."""
+        if self.owned is None:
+            return self
+        return CellStress(
+            self.cells, self.points, self.cell_vertices, self.u_cell, self.material,
+            self.sigma_vertex, self.unit,
+        )  # fmt: skip
 
     def _traction(self, group: Cells, slot, cell, k, t, edges: Edges | None) -> np.ndarray:
         """σ(u_h) n on local edges ``k`` of ``cell`` (rows ``slot`` of ``group``); ``edges``
@@ -80,7 +106,19 @@ class CellStress:
     ) -> Iterator[tuple[slice | np.ndarray, np.ndarray, Edges]]:
         """``σ(u_h) n`` along local edge ``k (e,)`` of each ``cell (e,)`` at parameters ``t
         (q,)`` (counter-clockwise around the cell), n the outward normal, group by group:
-        ``(rows, traction (r, q, 2), edges)`` with the edges' geometry."""
+        ``(rows, traction (r, q, 2), edges)`` with the edges' geometry. With ``owned``, only
+        the rows whose cell is owned (none at all if there is no such row)."""
+        if self.owned is not None:
+            mine = np.flatnonzero(self.owned[cell])
+            if mine.size == 0:
+                return
+            if mine.size < len(cell):
+                for rows, traction, edges in self._on_edges(cell[mine], k[mine], t):
+                    yield mine[rows], traction, edges
+                return
+        yield from self._on_edges(cell, k, t)
+
+    def _on_edges(self, cell, k, t):
         for rows, g, slot, edges in self.cells.local_edges(cell, k):
             yield rows, self._traction(g, slot, cell[rows], k[rows], t, edges), edges
 

@@ -19,7 +19,9 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from ..algebra.ranks import solver_ranks
 from ..contact.load_path import check_path, solve_path
+from ..contact.partition import partition
 from ..contact.solution import ContactResult, solve
 from ..estimator.marking import mark_doerfler
 from ..estimator.residual import Estimate, estimate
@@ -205,8 +207,9 @@ def _levels(
             )
             steps = [result]
         u0 = None
+        on_ranks = _estimator_ranks(result, solver)
         t0 = time.perf_counter()
-        est = estimate(result, eta5_variant=options.eta5_variant)
+        est = estimate(result, eta5_variant=options.eta5_variant, **on_ranks)
         t_est = time.perf_counter() - t0
         record = level_record(level, result, est)
         record.t_estimate = t_est
@@ -249,6 +252,16 @@ def _levels(
         # here while the next level is solved (whose factorization is the run's memory peak)
         del result, warm, steps, est, marked, refinement
         mesh = next_mesh
+
+
+def _estimator_ranks(result: ContactResult, solver: object) -> dict[str, object]:
+    """:func:`estimate`'s ``ranks`` and ``partition`` on a run of several MPI ranks (those of
+    the solver, :func:`~signorini.algebra.ranks.solver_ranks`; docs/parallel.md): each rank
+    integrates its own cells; nothing on one process."""
+    ranks = solver_ranks(solver)
+    if not ranks.distributed:
+        return {}
+    return {"ranks": ranks, "partition": partition(result.space, ranks)}
 
 
 def _add_path_counts(record: LevelRecord, steps: Sequence[ContactResult]) -> None:
