@@ -26,6 +26,7 @@ import numpy as np
 from .kkt import contact_scale, force_scale, normal_law_columns
 from .laws import LawGroups, check_laws
 from .qp import BoundQP, _index_array, check_qp, check_vector
+from .ranks import SERIAL, Ranks
 from .sparse import as_csr
 
 __all__ = ["FrictionKKT", "FrictionProblem", "check_friction", "friction_kkt"]
@@ -87,6 +88,7 @@ def check_friction(
     weight: object,
     law_index: object = None,
     reference: object = None,
+    ranks: Ranks = SERIAL,
 ) -> FrictionProblem:
     """Check and normalise the data of the frictional contact problem.
 
@@ -117,6 +119,9 @@ def check_friction(
     reference : float or (m,) float array, optional
         ``x_ref``: the tangential displacement of no slip (default 0; the previous load step's
         in a quasi-static path, so that the law acts on the slip increment).
+    ranks : Ranks, optional
+        The processes that share ``K`` by rows (:attr:`~.qp.BoundQP.ranks`); default a whole
+        matrix.
 
     Raises
     ------
@@ -148,7 +153,9 @@ def check_friction(
     )
     friction = check_laws(laws, law_index, weight, m)
     constrained = np.concatenate([normal, tangent])
-    qp = check_qp(K, F, constrained, np.concatenate([g, ref]), dirichlet, dirichlet_values)
+    qp = check_qp(
+        K, F, constrained, np.concatenate([g, ref]), dirichlet, dirichlet_values, ranks=ranks
+    )
     return FrictionProblem(qp, normal, tangent, g, ref, friction)
 
 

@@ -42,6 +42,7 @@ from .backends import make_solver
 from .kkt import qp_residuals
 from .primal import primal_active_set
 from .qp import BoundQP, check_qp, check_vector
+from .ranks import SERIAL, Ranks
 from .result import PDASConvergenceError, PDASResult, PDASStep
 from .solvers import IllConditionedWarning, SolverFactory, SPDSolver, solver_usage
 from .sparse import abs_matvec
@@ -121,6 +122,7 @@ def solve_pdas(
     active0: np.ndarray | None = None,
     options: PDASOptions | None = None,
     solver: SPDSolver | SolverFactory | None = None,
+    ranks: Ranks = SERIAL,
 ) -> PDASResult:
     r"""Solve ``min 1/2 x^T K x - F^T x`` subject to ``x_c <= g`` and ``x_d = x_D`` by PDAS.
 
@@ -155,6 +157,9 @@ def solve_pdas(
         when ``K`` has the pattern it was analysed for). A factory
         (:class:`~.solvers.SolverFactory`, default :func:`~.backends.auto_solver`) makes one
         for this call, released afterwards.
+    ranks : Ranks, optional
+        The processes that share ``K`` by rows (:attr:`~.qp.BoundQP.ranks`); default a whole
+        matrix.
 
     Returns
     -------
@@ -175,7 +180,7 @@ def solve_pdas(
     steps below it (:func:`_initial_active_set`, :func:`_iterate`, :func:`_after_failure`).
     """
     t_start = time.perf_counter()
-    qp = check_qp(K, F, constrained, gap, dirichlet, dirichlet_values)
+    qp = check_qp(K, F, constrained, gap, dirichlet, dirichlet_values, ranks=ranks)
     options = PDASOptions() if options is None else options
     if not isinstance(options, PDASOptions):
         raise ValueError(f"options must be a PDASOptions, got {type(options).__name__}")

@@ -4,10 +4,12 @@
 The partition cuts the nested dissection ordering of the mesh's vertex graph (METIS, the
 ordering the solver is handed, :mod:`.ordering`) into ``size`` contiguous blocks of vertices:
 a nested dissection numbers each subdomain's vertices together, so a block is a compact piece
-of the mesh. An edge node (P2) goes with its edge's first vertex, a cell with its first
-vertex. The nodes that a contact pair's coupling joins (a slave node and the master nodes of
-its mortar row, docs/method.md, *Two bodies*) go to one rank together: the change of basis
-mixes their rows, and keeping them on one rank keeps every row of the system on one rank.
+of the mesh. An edge node (P2) and a cell go to the lowest rank of their vertices: inside a
+block to the block's rank, on a cut to the first of the ranks that meet there (the cut holds
+O(√n) of them, so the ranks keep about equal shares of nodes and cells). The nodes that a
+contact pair's coupling joins (a slave node and the master nodes of its mortar row,
+docs/method.md, *Two bodies*) go to one rank together: the change of basis mixes their rows,
+and keeping them on one rank keeps every row of the system on one rank.
 
 Rank r assembles the rows of the DOFs of its nodes; for that it computes the element matrices
 of every cell with a node of its own (:attr:`Partition.row_cells`): its own cells and one
@@ -22,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, reverse_cuthill_mckee
 
-from ..algebra.ranks import Ranks
+from ..algebra.ranks import SERIAL, Ranks
 from ..algebra.solvers import BackendUnavailableError
 from ..fem.space import LagrangeSpace
 from .ordering import vertex_graph
@@ -43,6 +45,9 @@ class Partition:
     cell_owner : (n_cells,) int array
         The rank that owns each cell (its estimator terms).
     space : LagrangeSpace
+    ranks : Ranks
+        The ranks themselves, whose collectives sum what each computes from its rows
+        (:meth:`~signorini.algebra.ranks.Ranks.sum`).
     """
 
     rank: int
@@ -50,6 +55,7 @@ class Partition:
     node_owner: np.ndarray
     cell_owner: np.ndarray
     space: LagrangeSpace
+    ranks: Ranks = SERIAL
 
     @property
     def owned_nodes(self) -> np.ndarray:
@@ -71,6 +77,28 @@ class Partition:
         """``(n_cells,)`` bool: the cells with a node of this rank's, whose element matrices
         its rows need (its own cells and the ghost layer around them)."""
         return self.owned_nodes[self.space.cell_nodes].any(axis=1)
+
+    def check_ranks(self, ranks: Ranks) -> None:
+        """Refuse ``ranks`` other than this partition's (an assembly shared by rows handed to
+        a solver on other processes), naming both."""
+        if ranks.size != self.size or ranks.rank != self.rank:
+            raise ValueError(
+                f"assembled holds the stiffness rows of rank {self.rank} of {self.size}, but "
+                f"the solver runs as rank {ranks.rank} of {ranks.size}: assemble with the "
+                "solver's ranks (signorini.algebra.ranks.solver_ranks(solver))"
+            )
+
+    def own_rows(self, A: sp.csr_matrix) -> sp.csr_matrix:
+        """``A (n_dofs, n_dofs)`` CSR with the rows of the other ranks' DOFs emptied (no
+        stored entry), this rank's as they are."""
+        keep = self.owned_dofs
+        length = np.where(keep, np.diff(A.indptr), 0)
+        entries = np.repeat(keep, np.diff(A.indptr))
+        indptr = np.zeros(A.shape[0] + 1, dtype=A.indptr.dtype)
+        np.cumsum(length, out=indptr[1:])
+        out = sp.csr_matrix((A.data[entries], A.indices[entries], indptr), shape=A.shape)
+        out.has_sorted_indices = A.has_sorted_indices
+        return out
 
 
 def partition(space: LagrangeSpace, ranks: Ranks, coupling: sp.spmatrix | None = None) -> Partition:
@@ -94,11 +122,11 @@ def partition(space: LagrangeSpace, ranks: Ranks, coupling: sp.spmatrix | None =
     vertex_owner[order] = np.arange(mesh.n_points) * ranks.size // max(mesh.n_points, 1)
     node_owner = vertex_owner
     if space.n_nodes > mesh.n_points:  # P2: then the edge midpoints
-        node_owner = np.concatenate([vertex_owner, vertex_owner[mesh.edges[:, 0]]])
+        node_owner = np.concatenate([vertex_owner, vertex_owner[mesh.edges].min(axis=1)])
     if coupling is not None and ranks.size > 1:
         node_owner = _joined(node_owner, coupling)
-    cell_owner = vertex_owner[mesh.cells[:, 0]]
-    return Partition(ranks.rank, ranks.size, node_owner, cell_owner, space)
+    cell_owner = vertex_owner[mesh.cells].min(axis=1)
+    return Partition(ranks.rank, ranks.size, node_owner, cell_owner, space, ranks)
 
 
 def _vertex_order(mesh) -> np.ndarray:
