@@ -125,7 +125,7 @@ def partition(space: LagrangeSpace, ranks: Ranks, coupling: sp.spmatrix | None =
         node_owner = np.concatenate([vertex_owner, vertex_owner[mesh.edges].min(axis=1)])
     if coupling is not None and ranks.size > 1:
         node_owner = _joined(node_owner, coupling)
-    cell_owner = vertex_owner[mesh.cells].min(axis=1)
+    cell_owner = node_owner[mesh.cells].min(axis=1)  # a cell of a rank has a node of it
     return Partition(ranks.rank, ranks.size, node_owner, cell_owner, space, ranks)
 
 

@@ -412,6 +412,8 @@ def _row_blocks(
     for g in mapping.groups:
         index = np.arange(mapping.n_cells)[g.cells]  # the group's cells, in its order
         slot = np.flatnonzero(cells[index])
+        if slot.size == 0:
+            continue
         mat = on_cells(material, g.cells)
         kind = mat.index if isinstance(mat, CellMaterials) else np.zeros(len(g), np.int64)
         asked = np.bincount(kind[slot], minlength=kind.max(initial=0) + 1)
@@ -424,4 +426,6 @@ def _row_blocks(
         blocks = element_blocks(g.rows(slot), on_cells(mat, slot), element=element)
         out.append(blocks[: slot.size - lone.size])
         out_nodes.append(nodes[index[slot[: slot.size - lone.size]]])
+    if not out:
+        return np.empty((0, 4 * element.n_local**2)), nodes[:0]
     return np.concatenate(out), np.concatenate(out_nodes)
