@@ -219,6 +219,16 @@ def test_partition_gives_every_node_and_cell_one_owner_the_same_on_every_call(si
     assert not np.array_equal(free[c.row], free[c.col])
 
 
+def test_partition_refuses_ranks_that_disagree():
+    class Disagreeing(Rank):
+        def max(self, value):
+            return value + self.rank + 1.0  # as if another rank's checksum were larger
+
+    space = space_of(case("example-6.2")[1])
+    with pytest.raises(RuntimeError, match="the ranks computed different partitions"):
+        partition(space, Disagreeing(0, 2))
+
+
 def test_partition_balances_the_nodes():
     problem, mesh, _ = case("example-6.2")
     mesh = refine_uniform(refine_uniform(mesh).mesh).mesh

@@ -18,6 +18,7 @@ layer of its neighbours' (the ghost cells).
 
 from __future__ import annotations
 
+import zlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -114,7 +115,12 @@ def partition(space: LagrangeSpace, ranks: Ranks, coupling: sp.spmatrix | None =
     Returns
     -------
     Partition
-        The same on every rank (computed from replicated data, deterministically).
+        The same on every rank (computed from replicated data, deterministically; checked).
+
+    Raises
+    ------
+    RuntimeError
+        If the ranks computed different partitions.
     """
     mesh = space.mesh
     order = _vertex_order(mesh)
@@ -126,6 +132,13 @@ def partition(space: LagrangeSpace, ranks: Ranks, coupling: sp.spmatrix | None =
     if coupling is not None and ranks.size > 1:
         node_owner = _joined(node_owner, coupling)
     cell_owner = node_owner[mesh.cells].min(axis=1)  # a cell of a rank has a node of it
+    if ranks.size > 1:  # the ranks must agree on it, or a row would be on two ranks or none
+        check = float(zlib.crc32(node_owner.tobytes()))
+        if ranks.max(check) != -ranks.max(-check):
+            raise RuntimeError(
+                "the ranks computed different partitions of the same mesh (METIS gave "
+                "different orderings): run them with the same MKL and thread settings"
+            )
     return Partition(ranks.rank, ranks.size, node_owner, cell_owner, space, ranks)
 
 

@@ -195,8 +195,9 @@ def _assemble_node_blocks(
     blocks : ndarray of float64, shape (m, k, k, 2, 2), C-contiguous
         ``blocks[c, a, b, i, j]`` is added to entry ``(2 z_a + i, 2 z_b + j)``.
     rows : ndarray of bool, shape (n_nodes,), optional
-        The nodes whose two rows are kept; the blocks of the other rows are left out before
-        the conversion (their rows are empty), the kept ones in their order.
+        The nodes whose two rows are kept (the others are emptied after the conversion):
+        ``cell_nodes`` must then hold every cell with a kept node, in the order of the whole
+        assembly, so that each kept row is summed from the same terms in the same order.
 
     Returns
     -------
@@ -210,24 +211,23 @@ def _assemble_node_blocks(
     nodes = cell_nodes.astype(idx, copy=False)
     packed = np.ascontiguousarray(blocks, dtype=np.float64).reshape(-1, 2)
     packed = packed.view(np.complex128).reshape(-1)  # (c, a, b, i): b_i0 + 1j b_i1
-    if rows is None:
-        row = np.empty((m, k, k, 2), dtype=idx)
-        row[..., 0] = 2 * nodes[:, :, None]
-        row[..., 1] = row[..., 0] + 1
-        cols = np.broadcast_to(nodes[:, None, :, None], (m, k, k, 2)).reshape(-1)
-    else:  # the block rows (c, a) of kept nodes, in their order
-        kept = rows[cell_nodes]  # (m, k)
-        packed = packed.reshape(m, k, 2 * k)[kept].reshape(-1)
-        c = np.nonzero(kept)[0]
-        row = np.empty((c.size, k, 2), dtype=idx)
-        row[..., 0] = 2 * nodes[kept][:, None]
-        row[..., 1] = row[..., 0] + 1
-        cols = np.broadcast_to(nodes[c][:, :, None], (c.size, k, 2)).reshape(-1)
+    row = np.empty((m, k, k, 2), dtype=idx)
+    row[..., 0] = 2 * nodes[:, :, None]
+    row[..., 1] = row[..., 0] + 1
+    cols = np.broadcast_to(nodes[:, None, :, None], (m, k, k, 2)).reshape(-1)
     half = sp.csr_matrix((packed, (row.reshape(-1), cols)), shape=(n_dofs, n_nodes))
     del row, cols
     half.sum_duplicates()  # canonical: summed duplicates, sorted indices
     if not half.has_sorted_indices:
         half.sort_indices()
+    if rows is not None:  # the kept rows, each summed from all its cells' terms
+        length = np.diff(half.indptr)
+        keep = np.repeat(np.repeat(rows, 2), length)
+        indptr = np.zeros_like(half.indptr)
+        np.cumsum(np.where(np.repeat(rows, 2), length, 0), out=indptr[1:])
+        half = sp.csr_matrix(
+            (half.data[: half.nnz][keep], half.indices[keep], indptr), shape=half.shape
+        )
     indices = np.empty((half.nnz, 2), dtype=half.indices.dtype)
     np.multiply(half.indices, 2, out=indices[:, 0])
     np.add(indices[:, 0], 1, out=indices[:, 1])
@@ -408,24 +408,30 @@ def _row_blocks(
     materials by region, a material of a group) that has several cells but of which only one
     is asked for is computed with a second of its cells, whose block is dropped.
     """
-    out, out_nodes = [], []
+    work = []  # (group, its rows computed, their materials, how many are kept)
     for g in mapping.groups:
         index = np.arange(mapping.n_cells)[g.cells]  # the group's cells, in its order
         slot = np.flatnonzero(cells[index])
-        if slot.size == 0:
-            continue
         mat = on_cells(material, g.cells)
         kind = mat.index if isinstance(mat, CellMaterials) else np.zeros(len(g), np.int64)
         asked = np.bincount(kind[slot], minlength=kind.max(initial=0) + 1)
         lone = np.flatnonzero((asked == 1) & (np.bincount(kind) > 1))
+        kept = slot.size
         if lone.size:  # one more cell of each such kind (a loop over materials)
             taken = np.zeros(len(g), dtype=bool)
             taken[slot] = True
-            extra = [np.flatnonzero((kind == k) & ~taken)[0] for k in lone]
-            slot = np.concatenate([slot, extra])
-        blocks = element_blocks(g.rows(slot), on_cells(mat, slot), element=element)
-        out.append(blocks[: slot.size - lone.size])
-        out_nodes.append(nodes[index[slot[: slot.size - lone.size]]])
-    if not out:
-        return np.empty((0, 4 * element.n_local**2)), nodes[:0]
-    return np.concatenate(out), np.concatenate(out_nodes)
+            slot = np.concatenate([slot, [np.flatnonzero((kind == k) & ~taken)[0] for k in lone]])
+        if kept:
+            work.append((g.rows(slot), on_cells(mat, slot), kept, index[slot[:kept]]))
+    blocks = np.empty((sum(w[2] for w in work), 4 * element.n_local**2))
+    start = 0
+    for group, mat, kept, _ in work:  # into one array (no copy), as the whole assembly does
+        rows = blocks[start : start + kept]
+        if kept == len(group):
+            element_blocks(group, mat, out=rows, element=element)
+        else:  # with the extra cells of lone kinds
+            rows[:] = element_blocks(group, mat, element=element)[:kept]
+        start += kept
+    if len(work) == 1:
+        return blocks, nodes[work[0][3]]
+    return blocks, nodes[np.concatenate([w[3] for w in work])] if work else nodes[:0]
