@@ -43,7 +43,7 @@ def main() -> None:
     args = parser.parse_args()
     problem = example_6_2()
     *_, last = adaptive(problem, max_ndof=args.max_ndof, max_levels=200)
-    K, b = reduced_system(problem, last.result.space.mesh)
+    K, b, _ = reduced_system(problem, last.result.space.mesh)
     print(f"{K.shape[0]} unknowns, {K.nnz} stored entries")
     best: dict[str, np.ndarray] = {}
     for _ in range(args.repeat):

@@ -45,7 +45,7 @@ def dense_peak_gflops(n: int, repeat: int) -> float:
 def factorization_rate(problem, mesh, repeat: int) -> tuple[float, float, float]:
     """PARDISO's operation count of the level's factorization (Mflop), the fastest numerical
     factorization (seconds) and its rate (GFlop/s)."""
-    K, _ = reduced_system(problem, mesh)
+    K, _, _ = reduced_system(problem, mesh)
     with PardisoSolver(check_symmetry=False) as solver:
         solver.factorize(K)  # analysis and a first factorization
         best = np.inf
