@@ -5,8 +5,7 @@ into frames; the ranks' matrices sum to the serial one and F is the serial F.
 
 Serial tests: a stand-in :class:`~signorini.algebra.ranks.Ranks` plays rank r of N in turn
 (its collectives are not needed by the assembly, or are played in lockstep by
-:class:`Lockstep`). They need neither MPI nor MKL (the partition orders by reverse
-Cuthill–McKee without MKL) and run in the MPI stage as well.
+:class:`Lockstep`). They need neither MPI nor MKL and run in the MPI stage as well.
 """
 
 from __future__ import annotations

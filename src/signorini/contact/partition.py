@@ -1,15 +1,21 @@
 """Which rank owns which nodes and cells of a mesh, on a run of several MPI ranks
 (docs/parallel.md, *What is distributed*).
 
-The partition cuts the nested dissection ordering of the mesh's vertex graph (METIS, the
-ordering the solver is handed, :mod:`.ordering`) into ``size`` contiguous blocks of vertices:
-a nested dissection numbers each subdomain's vertices together, so a block is a compact piece
-of the mesh. An edge node (P2) and a cell go to the lowest rank of their vertices: inside a
-block to the block's rank, on a cut to the first of the ranks that meet there (the cut holds
-O(√n) of them, so the ranks keep about equal shares of nodes and cells). The nodes that a
-contact pair's coupling joins (a slave node and the master nodes of its mortar row,
-docs/method.md, *Two bodies*) go to one rank together: the change of basis mixes their rows,
-and keeping them on one rank keeps every row of the system on one rank.
+The partition cuts the reverse Cuthill–McKee ordering of the mesh's vertex graph into ``size``
+contiguous blocks of vertices: the ordering numbers the vertices level set after level set of
+a breadth-first search, so a block is a band of the mesh, cut from the next by one level set.
+Measured on Example 6.2's adaptive meshes (``python benchmarks/rows.py``, and the blocks of
+METIS's nested dissection ordering, :mod:`.ordering`, for comparison): at 10⁶ unknowns it
+takes 0.07 s against METIS's 1.5 s (more than the stiffness assembly of a rank), and the ranks
+together compute 1.004, 1.010 and 1.029 times the cells of the serial assembly on 2, 3 and 8
+ranks, against 1.003, 1.014 and 1.030 with METIS's blocks (on 32 ranks 1.119 against 1.081:
+thin bands; a k-way partitioner would serve many ranks better). It needs no MKL and is the
+same on every rank (SciPy's, single-threaded). An edge node (P2) and a cell go to the lowest
+rank of their vertices: inside a block to the block's rank, on a cut to the first of the ranks
+that meet there (the cut holds O(√n) of them, so the ranks keep about equal shares of nodes
+and cells). The nodes that a contact pair's coupling joins (a slave node and the master nodes
+of its mortar row, docs/method.md, *Two bodies*) go to one rank together: the change of basis
+mixes their rows, and keeping them on one rank keeps every row of the system on one rank.
 
 Rank r assembles the rows of the DOFs of its nodes; for that it computes the element matrices
 of every cell with a node of its own (:attr:`Partition.row_cells`): its own cells and one
@@ -26,7 +32,6 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, reverse_cuthill_mckee
 
 from ..algebra.ranks import SERIAL, Ranks
-from ..algebra.solvers import BackendUnavailableError
 from ..fem.space import LagrangeSpace
 from .ordering import vertex_graph
 
@@ -136,21 +141,16 @@ def partition(space: LagrangeSpace, ranks: Ranks, coupling: sp.spmatrix | None =
         check = float(zlib.crc32(node_owner.tobytes()))
         if ranks.max(check) != -ranks.max(-check):
             raise RuntimeError(
-                "the ranks computed different partitions of the same mesh (METIS gave "
-                "different orderings): run them with the same MKL and thread settings"
+                "the ranks computed different partitions of the same mesh: run them with the "
+                "same signorini, NumPy and SciPy"
             )
     return Partition(ranks.rank, ranks.size, node_owner, cell_owner, space, ranks)
 
 
 def _vertex_order(mesh) -> np.ndarray:
-    """METIS's nested dissection of the vertex graph; reverse Cuthill–McKee without MKL."""
-    graph = vertex_graph(mesh)
-    try:
-        from ..algebra.pardiso import metis_ordering
-
-        return np.asarray(metis_ordering(graph), dtype=np.int64)
-    except BackendUnavailableError:
-        return np.asarray(reverse_cuthill_mckee(graph, symmetric_mode=True), dtype=np.int64)
+    """The reverse Cuthill–McKee ordering of the vertex graph."""
+    order = reverse_cuthill_mckee(vertex_graph(mesh), symmetric_mode=True)
+    return np.asarray(order, dtype=np.int64)
 
 
 def _joined(node_owner: np.ndarray, coupling: sp.spmatrix) -> np.ndarray:
