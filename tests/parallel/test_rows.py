@@ -10,6 +10,12 @@ Serial tests: a stand-in :class:`~signorini.algebra.ranks.Ranks` plays rank r of
 
 from __future__ import annotations
 
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -327,3 +333,41 @@ def test_a_serial_solve_has_no_partition():
     result = solve(problem, mesh)
     assert result.partition is None
     assert abs(2 * result.total_contact_force - 0.0084) <= 1e-9 * 0.0084
+
+
+def mpi_launcher() -> tuple[list[str] | None, str | None]:
+    """``mpiexec`` (beside this Python, or on PATH; with Open MPI's flags for root and
+    oversubscription) and None, or None and why the MPI run cannot be made."""
+    try:
+        from signorini.algebra.petsc import petsc_module
+
+        petsc_module()
+    except Exception as err:  # BackendUnavailableError: no petsc4py here
+        return None, str(err)
+    here = Path(sys.executable).parent / "mpiexec"
+    found = str(here) if here.exists() else shutil.which("mpiexec")
+    if found is None:
+        return None, "no mpiexec found"
+    version = subprocess.run([found, "--version"], capture_output=True, text=True).stdout
+    if "Open MPI" in version or "OpenRTE" in version:
+        return [found, "--allow-run-as-root", "--oversubscribe"], None
+    return [found], None
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("size", [2, 3])
+def test_the_rows_of_mpi_ranks_are_the_serial_rows(size):
+    """The same checks with real ranks (``world_ranks``, MPI's collectives): each rank's rows
+    are the serial ones, and its products summed by MPI are the serial products."""
+    launcher, why = mpi_launcher()
+    if launcher is None:
+        if os.environ.get("SIGNORINI_REQUIRE_PETSC") == "1":
+            pytest.fail(f"SIGNORINI_REQUIRE_PETSC=1 but the MPI run cannot be made: {why}")
+        pytest.skip(f"MPI run: {why}")
+    script = Path(__file__).with_name("mpi_rows.py")
+    done = subprocess.run(
+        [*launcher, "-n", str(size), sys.executable, str(script)],
+        capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-3000:]
+    assert f"rows: {size} ranks same" in done.stdout
