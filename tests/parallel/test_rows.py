@@ -22,6 +22,7 @@ import scipy.sparse as sp
 
 from signorini import Contact, ContactProblem, HalfPlane, Material, Neumann, Roller
 from signorini.algebra.backends import SOLVERS
+from signorini.algebra.friction_kkt import FrictionProblem
 from signorini.algebra.ranks import SERIAL, Ranks
 from signorini.contact import solution
 from signorini.contact.partition import partition
@@ -296,7 +297,7 @@ class Stop(Exception):
 @pytest.mark.parametrize("name", ["regions", "two-cylinders-tresca"])
 def test_solve_takes_the_ranks_from_its_solver_and_hands_them_to_the_qp(name, monkeypatch):
     """``solve`` assembles the rows of the solver's rank and passes its ranks to the QP (to
-    ``solve_pdas``, or to ``check_friction`` with friction)."""
+    ``solve_pdas``, or to the frictional problem's ``on_ranks`` with friction)."""
     problem, mesh, element = case(name)
     ranks = Rank(1, 3)
     ranks.sum = lambda a: a  # the stiffness unit's diagonal: this rank's part is enough here
@@ -306,9 +307,13 @@ def test_solve_takes_the_ranks_from_its_solver_and_hands_them_to_the_qp(name, mo
         seen.update(K=K, ranks=ranks)
         raise Stop
 
-    target = "check_friction" if "tresca" in name else "solve_pdas"
-    module = solution.solve_frictional.__module__ if "tresca" in name else solution.__name__
-    monkeypatch.setattr(f"{module}.{target}", record)
+    def record_problem(problem, ranks):
+        record(problem.qp.K, ranks=ranks)
+
+    if "tresca" in name:
+        monkeypatch.setattr(FrictionProblem, "on_ranks", record_problem)
+    else:
+        monkeypatch.setattr(f"{solution.__name__}.solve_pdas", record)
 
     def factory(request):
         return SOLVERS["scipy"](request)
