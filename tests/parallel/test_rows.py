@@ -89,7 +89,7 @@ def test_a_whole_matrix_passed_as_split_and_a_skew_one_are_refused(runs):
 def test_the_split_matrix_on_cg_gamg_gives_the_serial_answer(runs, name):
     """Split and whole on CG + GAMG against SuperLU: the same active sets (states), one more
     iteration (the confirming solve), x and the multipliers within 1e-8 relative, the KKT
-    residuals below KKT_RTOL (measured on 2 and 3 ranks: within 3e-13, below 3e-13)."""
+    residuals below KKT_RTOL (measured on 2 and 3 ranks: within 3.2e-13, below 2.7e-13)."""
     got = case(runs, name)
     size = int(runs["size"])
     owned = got["owned_rows"]
