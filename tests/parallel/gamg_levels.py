@@ -52,7 +52,8 @@ def run(problem: str, levels: int, solver: str) -> dict[str, np.ndarray]:
 
 
 def recording(factory):
-    """``factory`` and the list of every solver it makes."""
+    """``factory`` and the list of every solver it makes; with the factory's ranks (the ranks
+    it splits matrices over, :func:`~signorini.algebra.ranks.solver_ranks`)."""
     made = []
 
     def make(request):
@@ -60,6 +61,8 @@ def recording(factory):
         made.append(solver)
         return solver
 
+    if hasattr(factory, "ranks"):
+        make.ranks = factory.ranks
     return make, made
 
 
