@@ -46,6 +46,17 @@ class PetscRows(SPDSolver):
     matrix at each factorization, sets right-hand sides from :meth:`_local_entries` and maps
     gathered solutions back with :meth:`_caller_order`.
 
+    Parameters
+    ----------
+    A : scipy sparse matrix, shape (n, n), optional
+        Factorized right away if given: whole on every process, or split by rows over them.
+    check_symmetry : bool
+        As in :class:`~.solvers.SPDSolver` (for a split matrix: on the values, at the first
+        factorization, by PETSc).
+    ordering : (n,) int array, optional
+        As in :class:`~.solvers.SPDSolver`; PETSc's numbering follows it where the backend
+        says so (:meth:`_row_ordering`).
+
     Attributes
     ----------
     split : bool
