@@ -88,7 +88,8 @@ def _join(items: list[str]) -> str:
 
 
 def _step_data(problem: ContactProblem, mesh, k: int) -> dict[str, np.ndarray]:
-    """The assembled data of load step ``k`` on ``mesh``."""
+    """The assembled data of load step ``k`` on ``mesh``: the whole matrix (on one process),
+    as rank 0 alone writes and checks them, on the first level's mesh, even on several."""
     system = assemble(problem, mesh)
     cs = system.contact
     probe = np.sin(1.0 + np.arange(system.K.shape[0]))  # no zero entry, no symmetry

@@ -249,7 +249,7 @@ def solve_frictional(
     problem = check_friction(
         K, F, 2 * nodes, 2 * nodes + 1, cs.gap, assembled.dirichlet, assembled.dirichlet_values,
         laws=law.laws, weight=law.weight, law_index=law.index, reference=reference,
-    )  # fmt: skip
+    ).on_ranks(assembled.ranks)  # fmt: skip
     options = FrictionOptions(max_iter=max_iter)
     # symmetric laws only (Tresca): symmetric systems (Cholesky); else non-symmetric ones (LU)
     coupling = None if cs.transfer is None else cs.transfer.nodes

@@ -14,15 +14,28 @@ converges to the same discrete solution from any active set.
 
 from __future__ import annotations
 
+import logging
+from collections.abc import Callable
+
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..algebra.result import PDASConvergenceError
 from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
 from ..mesh.refine import refine_nvb
 from .contact_set import ContactSet
 
-__all__ = ["GLOBAL_SHARE", "NESTED_MAX_SHARE", "NESTED_MIN_NDOF", "coarse_mesh", "transfer_active"]
+__all__ = [
+    "GLOBAL_SHARE",
+    "NESTED_MAX_SHARE",
+    "NESTED_MIN_NDOF",
+    "coarse_mesh",
+    "nested_active_set",
+    "transfer_active",
+]
+
+log = logging.getLogger(__name__)
 
 #: nested iteration is used on meshes with at least this many free unknowns (below it one
 #: cold PDAS is cheap and the coarse solve would not pay for itself)
@@ -132,3 +145,26 @@ def transfer_active(
     following = np.minimum(row + 1, coarse_contact.size - 1)
     corner = contact.second & coarse_contact.second[following] & (following > row)
     return coarse_active[np.where(corner, following, row)]
+
+
+def nested_active_set(
+    problem, space: LagrangeSpace, cs: ContactSet, solve_coarse: Callable[[Mesh], object]
+) -> np.ndarray | None:
+    """The initial active set of a cold solve of ``problem`` on ``space`` (contact set
+    ``cs``) from the solve ``solve_coarse(mesh)`` (a
+    :class:`~signorini.contact.ContactResult`) on the coarse mesh of :func:`coarse_mesh`,
+    or None where there is no coarse mesh or its PDAS fails (the fine PDAS then starts
+    empty)."""
+    coarse = coarse_mesh(problem.mesh, space.mesh, problem.contact_parts)
+    if coarse is None:
+        return None
+    try:
+        result = solve_coarse(coarse)
+    except PDASConvergenceError:
+        return None
+    log.info(
+        "nested iteration: coarse mesh of %d unknowns, %d PDAS iterations",
+        result.ndof,
+        result.report.iterations,
+    )
+    return transfer_active(result.space, result.contact, result.active, space, cs)

@@ -15,10 +15,12 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..algebra.friction import INACTIVE, SLIP, STICK
 from ..algebra.pdas import PDASOptions, solve_pdas
-from ..algebra.result import PDASConvergenceError, SolveReport
+from ..algebra.ranks import solver_ranks
+from ..algebra.result import SolveReport
 from ..algebra.solvers import SolverFactory, SPDSolver
 from ..algebra.sparse import stiffness_unit
 from ..fem.element import Element
@@ -31,9 +33,10 @@ from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
 from .force_control import check_load_carried, initial_active_set
 from .frictional import Solved, check_previous, solve_frictional
-from .nested import NESTED_MIN_NDOF, coarse_mesh, transfer_active
+from .nested import NESTED_MIN_NDOF, nested_active_set
 from .node_frames import to_cartesian
 from .ordering import ordered_solver
+from .partition import Partition
 from .profile import ContactProfile, contact_profile
 from .rigid_modes import system_rigid_modes
 from .system import Assembled, assemble
@@ -115,6 +118,10 @@ class ContactResult:
         The roller's nodal force on the body along ``−n_z`` at each,
         ``Λ_z = L(ψ_z n_z) − a(u_h, ψ_z n_z)`` as for a contact force (3.17): positive where
         the roller pushes the body; the roller acts on the body with ``−Λ_z n_z``.
+    partition : Partition or None
+        On a run of several MPI ranks, which rank owns which nodes and cells and the ranks
+        themselves (:attr:`~.system.Assembled.partition`); None on one process. Everything
+        else is the same on every rank.
     tangential_force : (k,) float array
         Nodal friction forces Λ_t,z (along the constraint's tangent ``contact.tangent``,
         ``t = (−n_y, n_x)``; the obstacle acts on the body with ``−Λ_t t``); 0 without
@@ -151,6 +158,7 @@ class ContactResult:
     timings: dict = field(default_factory=dict)
     roller_nodes: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     roller_force: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    partition: Partition | None = None
 
     @property
     def mesh(self) -> Mesh:
@@ -268,7 +276,10 @@ def solve(
         Warm start (e.g. the previous level's solution prolongated to ``mesh``): its nodes in
         contact form the initial active set.
     solver : SolverFactory or SPDSolver, optional
-        The linear solver. A factory (:class:`~signorini.algebra.SolverFactory`, default
+        The linear solver, and the processes it runs on
+        (:func:`~signorini.algebra.ranks.solver_ranks`: on several MPI ranks each assembles
+        the stiffness rows of its own nodes, :func:`~.system.assemble`). A factory
+        (:class:`~signorini.algebra.SolverFactory`, default
         :func:`~signorini.algebra.auto_solver`: PARDISO, else SuperLU; a backend by name:
         :data:`signorini.algebra.SOLVERS`) is called once per sequence of systems (the
         solve, and the coarse solve of nested iteration) and its solvers are closed. An
@@ -279,7 +290,8 @@ def solve(
     fallback : bool
         On PDAS failure, fall back to a convergent method instead of raising.
     assembled : Assembled, optional
-        Reuse an assembly of the same mesh.
+        Reuse an assembly of the same mesh: a whole matrix on every process, or a rank's
+        rows for the solver's ranks.
     previous : ContactResult, optional
         The previous step of a quasi-static load path on the same mesh with the same contact
         parts (docs/method.md, *Load paths*): the friction law acts on the slip from its
@@ -298,12 +310,16 @@ def solve(
     Raises
     ------
     ValueError
-        For a malformed ``u0``, an unknown ``element``, or a ``previous`` of another mesh or
-        other contact parts.
+        For a malformed ``u0``, an unknown ``element``, a ``previous`` of another mesh or
+        other contact parts, or an ``assembled`` shared by rows over other ranks than the
+        solver's.
     """
     mesh = problem.mesh if mesh is None else mesh
     if assembled is None:
-        assembled = assemble(problem, mesh, element=element)
+        assembled = assemble(problem, mesh, element=element, ranks=solver_ranks(solver))
+    elif assembled.partition is not None:
+        assembled.partition.check_ranks(solver_ranks(solver))
+    ranks = assembled.ranks
     space, cs = assembled.space, assembled.contact
     if problem.rigid_motions.size:
         check_load_carried(problem, assembled)
@@ -322,7 +338,8 @@ def solve(
         active0 = un - cs.gap >= -WARM_START_RTOL * _round_off_scale(u0, cs.gap)
     # K and F divided by a power of 2 when E is extreme (exact; 1 otherwise), so that no
     # product in the factorization overflows or underflows
-    unit = stiffness_unit(assembled.K)
+    diagonal = assembled.K if ranks.size == 1 else sp.diags(ranks.sum(assembled.K.diagonal()))
+    unit = stiffness_unit(diagonal)
     K, F = (assembled.K, assembled.F) if unit == 1.0 else (assembled.K / unit, assembled.F / unit)
     t0 = time.perf_counter()
     timings = {"assemble": assembled.seconds}
@@ -334,7 +351,13 @@ def solve(
         and not cs.has_friction
         and problem.free_ndof(space) >= NESTED_MIN_NDOF
     ):
-        active0 = _nested_active_set(problem, assembled, solver, max_iter, fallback)
+        active0 = nested_active_set(
+            problem, space, cs,
+            lambda coarse: solve(
+                problem, coarse, solver=solver, max_iter=max_iter, fallback=fallback,
+                element=space.element,
+            ),
+        )  # fmt: skip
         timings["nested"] = time.perf_counter() - t0
     if active0 is None and problem.rigid_motions.size:
         # semi-coercive: the empty active set leaves the free rigid motions singular; start
@@ -372,7 +395,8 @@ def solve(
         tangential_reference=solved.reference,
         timings=timings,
         roller_nodes=assembled.rollers.nodes,
-        roller_force=assembled.rollers.force(assembled.K, assembled.F, solved.x),
+        roller_force=assembled.rollers.force(assembled.K, assembled.F, solved.x, ranks),
+        partition=assembled.partition,
     )
 
 
@@ -412,40 +436,8 @@ def _solve_system(
             active0=active0,
             options=options,
             solver=linear,
+            ranks=assembled.ranks,
         )
     zero = np.zeros(cs.size)
     state = np.where(res.active, SLIP, INACTIVE)
     return Solved(res.x, res.multiplier, zero, state, zero.astype(np.int8), zero, res)
-
-
-def _nested_active_set(
-    problem: ContactProblem,
-    assembled: Assembled,
-    solver: SPDSolver | SolverFactory | None,
-    max_iter: int,
-    fallback: bool,
-) -> np.ndarray | None:
-    """The initial active set of a cold solve on ``assembled``'s mesh from a solve on the
-    coarse mesh of :func:`~.nested.coarse_mesh` (itself nested where it qualifies), or None
-    where there is no coarse mesh or its PDAS fails (the fine PDAS then starts empty)."""
-    space, cs = assembled.space, assembled.contact
-    coarse = coarse_mesh(problem.mesh, space.mesh, problem.contact_parts)
-    if coarse is None:
-        return None
-    try:
-        result = solve(
-            problem,
-            coarse,
-            solver=solver,
-            max_iter=max_iter,
-            fallback=fallback,
-            element=space.element,
-        )
-    except PDASConvergenceError:
-        return None
-    log.info(
-        "nested iteration: coarse mesh of %d unknowns, %d PDAS iterations",
-        result.ndof,
-        result.report.iterations,
-    )
-    return transfer_active(result.space, result.contact, result.active, space, cs)

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..algebra.ranks import SERIAL, Ranks
 from ..fem.element import Element
 from ..fem.loads import assemble_body_force, assemble_edge_load
 from ..fem.space import LagrangeSpace, space_of
@@ -24,7 +25,8 @@ from ..problem.problem import ContactProblem
 from ..problem.rollers import HeldNodes, held_nodes
 from .contact_set import ContactSet, contact_set
 from .node_frames import frame_matrices, rotate_frames
-from .two_body import two_body_system
+from .partition import Partition, partition
+from .two_body import rows_read, two_body_system
 
 __all__ = [
     "Assembled",
@@ -59,7 +61,10 @@ class Assembled:
     K : (n_dofs, n_dofs) scipy.sparse CSR matrix
         The stiffness matrix ``a(ψ_j, ψ_i)`` (symmetric positive semi-definite before the
         Dirichlet DOFs are fixed), rotated in place at the constrained nodes; with contact
-        pairs, in the basis of the relative displacement (``(I + T)ᵀ K (I + T)``).
+        pairs, in the basis of the relative displacement (``(I + T)ᵀ K (I + T)``). On a rank
+        of several (:attr:`partition`), the rows of this rank's DOFs only, each the serial
+        matrix's bit for bit, the others empty: the matrix is the sum over the ranks, and a
+        product ``K x`` is ``partition.ranks.sum(K @ x)``.
     F : (n_dofs,) float array
         The load ``L(ψ_i)``: body force and Neumann tractions, rotated like K.
     dirichlet : (n_held,) int array
@@ -87,6 +92,9 @@ class Assembled:
     rollers : RollerDofs
         The held DOF of each roller node off the contact boundary and its roller's normal
         there, to recover the roller's force (:func:`roller_dofs`).
+    partition : Partition or None
+        On a run of several MPI ranks, which rank owns which nodes and cells
+        (:func:`~.partition.partition`) and the ranks (``partition.ranks``); None on one.
     """
 
     space: LagrangeSpace
@@ -101,9 +109,22 @@ class Assembled:
     frame_nodes: np.ndarray
     frames: np.ndarray
     rollers: RollerDofs
+    partition: Partition | None = None
+
+    @property
+    def ranks(self) -> Ranks:
+        """The ranks that share :attr:`K` by rows (:data:`~signorini.algebra.ranks.SERIAL`
+        for a whole matrix)."""
+        return SERIAL if self.partition is None else self.partition.ranks
 
 
-def assemble(problem: ContactProblem, mesh: Mesh, *, element: str | Element = "P2") -> Assembled:
+def assemble(
+    problem: ContactProblem,
+    mesh: Mesh,
+    *,
+    element: str | Element = "P2",
+    ranks: Ranks = SERIAL,
+) -> Assembled:
     """Stiffness, load and constraints of ``problem`` on ``mesh`` (paper, Section 3).
 
     The two DOFs of every constrained node are transformed into its frame (normal and
@@ -113,8 +134,19 @@ def assemble(problem: ContactProblem, mesh: Mesh, *, element: str | Element = "P
     (:mod:`~signorini.contact.two_body`; docs/method.md, *Two bodies*). ``element``:
     ``"P2"`` (the paper's, default) or ``"P1"`` (docs/method.md, *P1 elements and their
     estimator*; not with contact pairs); a ValueError names it otherwise.
+
+    On ``ranks`` of several MPI processes (docs/parallel.md, *What is distributed*) the
+    nodes are partitioned (:func:`~.partition.partition`, a contact pair's slave and master
+    nodes on one rank) and this rank assembles the rows of its own DOFs only, from the cells
+    that touch them: its ``K`` is the serial one with the other ranks' rows emptied, bit for
+    bit, also after the change of basis of two bodies and the rotation into frames. F and
+    everything else are the same on every rank. On one process nothing changes.
     """
     t0 = time.perf_counter()
+    if not isinstance(ranks, Ranks):
+        raise ValueError(
+            f"ranks must be a signorini.algebra.ranks.Ranks, got {type(ranks).__name__}"
+        )
     space = space_of(mesh, element)
     if problem.pairs and space.element.name != "P2":
         raise ValueError(
@@ -122,6 +154,14 @@ def assemble(problem: ContactProblem, mesh: Mesh, *, element: str | Element = "P
             "coupling of docs/method.md, *Two bodies*) are built for P2 only"
         )
     n_dofs = space.n_dofs
+    cs = contact_set(problem, space)
+    part, rows = None, None
+    if ranks.size > 1:  # this rank's rows, and with contact pairs the rows they read
+        part = partition(space, ranks, None if cs.transfer is None else cs.transfer.nodes)
+        rows = part.owned_nodes
+        if cs.transfer is not None:
+            rows = rows_read(space.cell_nodes, cs.transfer.dofs, rows)
+        rows = np.repeat(rows, 2)
     # the space of a validated mesh and problem: no need to re-check the arrays
     with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported just below
         K = assemble_stiffness(
@@ -131,8 +171,12 @@ def assemble(problem: ContactProblem, mesh: Mesh, *, element: str | Element = "P
             problem.material_on(mesh),
             validate=False,
             element=space.element,
+            rows=rows,
         )
-    if not np.isfinite(K.data).all():
+    overflow = not np.isfinite(K.data).all()
+    if ranks.size > 1:  # every rank raises, or none
+        overflow = ranks.max(float(overflow)) > 0.0
+    if overflow:
         m = problem.material_on(mesh)
         raise ProblemError(
             f"material: the stiffness matrix overflows float64 (lam = {np.max(m.lam):.3g}, "
@@ -164,9 +208,10 @@ def assemble(problem: ContactProblem, mesh: Mesh, *, element: str | Element = "P
             F += assemble_edge_load(
                 geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE, element=space.element
             )
-    cs = contact_set(problem, space)
     if cs.transfer is not None:  # contact pairs: the relative displacement's basis
         K, F = two_body_system(K, F, cs.transfer.dofs)
+        if part is not None:
+            K = part.own_rows(K)
     held = held_nodes(problem, space)
     frame_nodes, frames = system_frames(cs, held)
     K, F = rotate_frames(K, F, frame_nodes, frames, copy=False, validate=False)
@@ -184,6 +229,7 @@ def assemble(problem: ContactProblem, mesh: Mesh, *, element: str | Element = "P
         frame_nodes,
         frames,
         roller_dofs(problem, space, held, cs),
+        part,
     )
 
 
@@ -211,11 +257,14 @@ class RollerDofs:
     sign: np.ndarray
     normal: np.ndarray
 
-    def force(self, K: sp.csr_matrix, F: np.ndarray, y: np.ndarray) -> np.ndarray:
+    def force(
+        self, K: sp.csr_matrix, F: np.ndarray, y: np.ndarray, ranks: Ranks = SERIAL
+    ) -> np.ndarray:
         """``(r,)`` the nodal force of the roller on the body along ``−n``,
         ``Λ_z = L(ψ_z n_z) − a(u_h, ψ_z n_z)`` (the contact force's formula, (3.17)):
-        positive where the roller pushes the body, for the frame system ``K y = F``."""
-        return self.sign * (F[self.dofs] - K[self.dofs] @ y)
+        positive where the roller pushes the body, for the frame system ``K y = F``
+        (``K`` shared by rows over ``ranks``: the product summed over them)."""
+        return self.sign * (F[self.dofs] - ranks.sum(K[self.dofs] @ y))
 
 
 def roller_dofs(

@@ -41,6 +41,7 @@ __all__ = [
     "mortar_transfer",
     "pair_transfer",
     "physical",
+    "rows_read",
     "two_body_system",
 ]
 
@@ -64,10 +65,29 @@ def two_body_system(
     K: sp.csr_matrix, F: np.ndarray, Td: sp.csr_matrix
 ) -> tuple[sp.csr_matrix, np.ndarray]:
     """``K̃ = (I + T_d)ᵀ K (I + T_d)`` and ``F̃ = (I + T_d)ᵀ F`` (Cartesian DOFs), with sorted
-    indices and full 2 × 2 node blocks, as :func:`~.node_frames.rotate_frames` needs."""
+    indices and full 2 × 2 node blocks, as :func:`~.node_frames.rotate_frames` needs.
+
+    Every product here is computed row by row, so a row of ``K̃`` is the same bit for bit
+    whenever the rows of ``K`` it reads are (:func:`rows_read`): on a rank of several, ``K``
+    holds those rows only, and the rows of ``K̃`` it needs are exact (the others are not:
+    :meth:`~.partition.Partition.own_rows` drops them)."""
     KT = K @ Td
     correction = _full_blocks((KT + KT.T + Td.T @ KT).tocoo())  # rows near the interface
     return _add_rows(K.tocsr(), correction), F + Td.T @ F
+
+
+def rows_read(cell_nodes: np.ndarray, Td: sp.csr_matrix, nodes: np.ndarray) -> np.ndarray:
+    """``(n_nodes,) bool``: the nodes whose rows of ``K`` the rows of ``nodes (n_nodes,)
+    bool`` of ``K̃ = (I + T_d)ᵀ K (I + T_d)`` read (:func:`two_body_system`), where
+    ``nodes`` holds each slave node of ``T_d`` together with its master nodes (a rank's
+    nodes, :func:`~.partition.partition`): ``nodes`` themselves, and every node that shares
+    a cell (``cell_nodes (n_cells, k)``) with a slave node among them, as the term
+    ``(K T_d)ᵀ`` of a master row reads the rows of the slave's neighbours."""
+    filled = np.diff(Td.indptr)
+    slaves = nodes & ((filled[0::2] + filled[1::2]) > 0)
+    read = nodes.copy()
+    read[cell_nodes[slaves[cell_nodes].any(axis=1)]] = True
+    return read
 
 
 def _add_rows(K: sp.csr_matrix, C: sp.csr_matrix) -> sp.csr_matrix:

@@ -176,7 +176,7 @@ def element_stiffness(vertices: np.ndarray, material: Material) -> np.ndarray:
 
 
 def _assemble_node_blocks(
-    cell_nodes: np.ndarray, n_nodes: int, blocks: np.ndarray
+    cell_nodes: np.ndarray, n_nodes: int, blocks: np.ndarray, rows: np.ndarray | None = None
 ) -> sp.csr_matrix:
     """Assemble per-cell 2x2 node blocks into a scalar CSR with node-block pattern.
 
@@ -194,6 +194,10 @@ def _assemble_node_blocks(
     n_nodes : int
     blocks : ndarray of float64, shape (m, k, k, 2, 2), C-contiguous
         ``blocks[c, a, b, i, j]`` is added to entry ``(2 z_a + i, 2 z_b + j)``.
+    rows : ndarray of bool, shape (n_nodes,), optional
+        The nodes whose two rows are kept (the others are emptied after the conversion):
+        ``cell_nodes`` must then hold every cell with a kept node, in the order of the whole
+        assembly, so that each kept row is summed from the same terms in the same order.
 
     Returns
     -------
@@ -207,15 +211,23 @@ def _assemble_node_blocks(
     nodes = cell_nodes.astype(idx, copy=False)
     packed = np.ascontiguousarray(blocks, dtype=np.float64).reshape(-1, 2)
     packed = packed.view(np.complex128).reshape(-1)  # (c, a, b, i): b_i0 + 1j b_i1
-    rows = np.empty((m, k, k, 2), dtype=idx)
-    rows[..., 0] = 2 * nodes[:, :, None]
-    rows[..., 1] = rows[..., 0] + 1
+    row = np.empty((m, k, k, 2), dtype=idx)
+    row[..., 0] = 2 * nodes[:, :, None]
+    row[..., 1] = row[..., 0] + 1
     cols = np.broadcast_to(nodes[:, None, :, None], (m, k, k, 2)).reshape(-1)
-    half = sp.csr_matrix((packed, (rows.reshape(-1), cols)), shape=(n_dofs, n_nodes))
-    del rows, cols
+    half = sp.csr_matrix((packed, (row.reshape(-1), cols)), shape=(n_dofs, n_nodes))
+    del row, cols
     half.sum_duplicates()  # canonical: summed duplicates, sorted indices
     if not half.has_sorted_indices:
         half.sort_indices()
+    if rows is not None:  # the kept rows, each summed from all its cells' terms
+        length = np.diff(half.indptr)
+        keep = np.repeat(np.repeat(rows, 2), length)
+        indptr = np.zeros_like(half.indptr)
+        np.cumsum(np.where(np.repeat(rows, 2), length, 0), out=indptr[1:])
+        half = sp.csr_matrix(
+            (half.data[: half.nnz][keep], half.indices[keep], indptr), shape=half.shape
+        )
     indices = np.empty((half.nnz, 2), dtype=half.indices.dtype)
     np.multiply(half.indices, 2, out=indices[:, 0])
     np.add(indices[:, 0], 1, out=indices[:, 1])
@@ -286,8 +298,9 @@ def assemble_stiffness(
     *,
     validate: bool = True,
     element: Element = P2,
+    rows: np.ndarray | None = None,
 ) -> sp.csr_matrix:
-    """Global stiffness matrix of ``a(u, v) = int sigma(u) : eps(v)``.
+    """Global stiffness matrix of ``a(u, v) = int sigma(u) : eps(v)``, or some of its rows.
 
     Parameters
     ----------
@@ -308,6 +321,12 @@ def assemble_stiffness(
     element : Element, optional
         The element of the DOFs (:data:`~signorini.fem.element.P2`, the default, or
         :data:`~signorini.fem.element.P1`).
+    rows : (n_dofs,) bool array, optional
+        The rows to assemble (both DOFs of a node together): the rows a rank of a run on
+        several MPI ranks owns (docs/parallel.md, *What is distributed*). Only the cells with
+        a node of these rows are integrated, and the other rows are left empty; the rows
+        assembled are bit for bit those of the whole matrix (the same cells, in the same
+        order, so that SciPy sums each entry's terms in the same order). Default: every row.
 
     Returns
     -------
@@ -315,14 +334,16 @@ def assemble_stiffness(
         Symmetric, both triangles stored, sorted indices, node-block pattern:
         each pair of nodes sharing a cell has its full 2x2 block stored
         (explicit zeros kept), so rows ``2 z`` and ``2 z + 1`` have identical
-        column patterns and columns ``2 w``, ``2 w + 1`` are adjacent.
+        column patterns and columns ``2 w``, ``2 w + 1`` are adjacent. With ``rows``, the
+        rows not asked for have no stored entry.
 
     Raises
     ------
     ValueError
         If ``validate``: on inconsistent shapes, out-of-range or non-interleaved DOFs, odd
-        ``n_dofs``, badly oriented or non-finite cells, or a material that is not a
-        :class:`Material`.
+        ``n_dofs``, badly oriented or non-finite cells, a material that is not a
+        :class:`Material`, or ``rows`` not an ``(n_dofs,)`` bool array that takes both DOFs
+        of a node or neither.
     """
     mapping = cells if isinstance(cells, CellMap) else None
     if validate:
@@ -330,11 +351,18 @@ def assemble_stiffness(
         if mapping is not None and len(mapping.groups) > 1:
             vertices = mapping.per_cell(lambda g: g.vertices)
         nodes, n = _checked_input(vertices, cell_dofs, n_dofs, material, 2 * element.n_local)
+        if rows is not None:
+            _check_rows(rows, n)
     else:
         nodes = np.asarray(cell_dofs, dtype=np.int64)[:, 0::2] // 2
         n = int(n_dofs)
     if mapping is None:
         mapping = CellMap(cells)
+    if rows is not None:
+        kept = np.asarray(rows, dtype=bool)[0::2]
+        blocks, nodes = _row_blocks(mapping, nodes, material, element, kept[nodes].any(axis=1))
+        k = element.n_local
+        return _assemble_node_blocks(nodes, n // 2, blocks.reshape(-1, k, k, 2, 2), kept)
     if len(mapping.groups) == 1:
         g = mapping.groups[0]
         blocks = element_blocks(g, on_cells(material, g.cells), element=element)
@@ -348,3 +376,62 @@ def assemble_stiffness(
         nodes = nodes[np.concatenate([g.cells for g in mapping.groups])]
     k = element.n_local
     return _assemble_node_blocks(nodes, n // 2, blocks.reshape(-1, k, k, 2, 2))
+
+
+def _check_rows(rows: object, n_dofs: int) -> None:
+    """Refuse ``rows`` unless it is an ``(n_dofs,)`` bool array with ``rows[2z] ==
+    rows[2z + 1]``."""
+    r = np.asarray(rows)
+    if r.dtype != np.bool_ or r.shape != (n_dofs,):
+        raise ValueError(f"rows must be a bool array of shape ({n_dofs},), got {r.dtype} {r.shape}")
+    split = np.flatnonzero(r[0::2] != r[1::2])
+    if split.size:
+        raise ValueError(
+            f"rows must take both DOFs of a node or neither; node {split[0]} has one "
+            f"({split.size} such nodes)"
+        )
+
+
+def _row_blocks(
+    mapping: CellMap,
+    nodes: np.ndarray,
+    material: Material | CellMaterials,
+    element: Element,
+    cells: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The element blocks ``(e, 4 k²)`` of the cells ``cells (n_cells,) bool`` and their
+    nodes ``(e, k)``, group after group in the order of the whole assembly.
+
+    Each block equals the whole assembly's bit for bit: the GEMM of :func:`element_blocks`
+    gives a row the same value whatever the other rows, except that NumPy multiplies a
+    single row by a matrix-vector product, rounded differently; so a group (or, with
+    materials by region, a material of a group) that has several cells but of which only one
+    is asked for is computed with a second of its cells, whose block is dropped.
+    """
+    work = []  # (group, its rows computed, their materials, how many are kept)
+    for g in mapping.groups:
+        index = np.arange(mapping.n_cells)[g.cells]  # the group's cells, in its order
+        slot = np.flatnonzero(cells[index])
+        mat = on_cells(material, g.cells)
+        kind = mat.index if isinstance(mat, CellMaterials) else np.zeros(len(g), np.int64)
+        asked = np.bincount(kind[slot], minlength=kind.max(initial=0) + 1)
+        lone = np.flatnonzero((asked == 1) & (np.bincount(kind) > 1))
+        kept = slot.size
+        if lone.size:  # one more cell of each such kind (a loop over materials)
+            taken = np.zeros(len(g), dtype=bool)
+            taken[slot] = True
+            slot = np.concatenate([slot, [np.flatnonzero((kind == k) & ~taken)[0] for k in lone]])
+        if kept:
+            work.append((g.rows(slot), on_cells(mat, slot), kept, index[slot[:kept]]))
+    blocks = np.empty((sum(w[2] for w in work), 4 * element.n_local**2))
+    start = 0
+    for group, mat, kept, _ in work:  # into one array (no copy), as the whole assembly does
+        rows = blocks[start : start + kept]
+        if kept == len(group):
+            element_blocks(group, mat, out=rows, element=element)
+        else:  # with the extra cells of lone kinds
+            rows[:] = element_blocks(group, mat, element=element)[:kept]
+        start += kept
+    if len(work) == 1:
+        return blocks, nodes[work[0][3]]
+    return blocks, nodes[np.concatenate([w[3] for w in work])] if work else nodes[:0]

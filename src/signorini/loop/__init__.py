@@ -257,11 +257,13 @@ def _levels(
 def _estimator_ranks(result: ContactResult, solver: object) -> dict[str, object]:
     """:func:`estimate`'s ``ranks`` and ``partition`` on a run of several MPI ranks (those of
     the solver, :func:`~signorini.algebra.ranks.solver_ranks`; docs/parallel.md): each rank
-    integrates its own cells; nothing on one process."""
+    integrates its own cells, of the partition its rows were assembled by; nothing on one
+    process."""
     ranks = solver_ranks(solver)
     if not ranks.distributed:
         return {}
-    return {"ranks": ranks, "partition": partition(result.space, ranks)}
+    own = result.partition if result.partition is not None else partition(result.space, ranks)
+    return {"ranks": ranks, "partition": own}
 
 
 def _add_path_counts(record: LevelRecord, steps: Sequence[ContactResult]) -> None:
