@@ -38,18 +38,22 @@ def run(problem: str, levels: int, solver: str) -> dict[str, np.ndarray]:
     """:func:`mpi_levels.level_numbers` of ``levels`` adaptive levels of ``problem`` on the
     backend ``solver``, with ``kkt`` (the largest relative KKT residual of each level),
     ``iterations`` (the active set iterations of each level) and ``cg`` (the CG iterations
-    of every solve of an iterative backend, in order)."""
+    of every solve of an iterative backend, in order), and ``split`` (for every CG + GAMG
+    solver that factorized, whether its matrix was split by rows over the ranks)."""
     factory, made = recording(solver_factory(solver))
     run = list(adaptive(PROBLEMS[problem](), max_levels=levels, max_ndof=10**7, solver=factory))
     numbers = level_numbers(run)
     numbers["kkt"] = np.array([level.result.report.kkt.max for level in run])
     numbers["iterations"] = np.array([level.result.report.iterations for level in run])
     numbers["cg"] = np.array([k for s in made for k in getattr(s, "iterations", [])], dtype=int)
+    gamg = [s for s in made if s.backend == "petsc-gamg" and s.n_analyses]
+    numbers["split"] = np.array([s.split for s in gamg], dtype=bool)
     return numbers
 
 
 def recording(factory):
-    """``factory`` and the list of every solver it makes."""
+    """``factory`` and the list of every solver it makes; with the factory's ranks (the ranks
+    it splits matrices over, :func:`~signorini.algebra.ranks.solver_ranks`)."""
     made = []
 
     def make(request):
@@ -57,6 +61,8 @@ def recording(factory):
         made.append(solver)
         return solver
 
+    if hasattr(factory, "ranks"):
+        make.ranks = factory.ranks
     return make, made
 
 

@@ -3,9 +3,11 @@
 Run under ``mpiexec -n N python tests/parallel/mpi_split_solve.py OUT.npz``. Every rank assembles
 each problem whole, keeps only the rows of its own nodes (:func:`signorini.contact.partition
 .partition`: the other rows empty, as ``assemble`` on a rank of several builds them) and solves
-with the ``"petsc"`` backend and ``ranks`` = all the ranks; the same problem is solved with
-the whole ``K`` and a serial backend (SuperLU) in each process as the reference. Rank 0 writes
-both results of every case; :mod:`test_split_solve` compares them.
+with the ``"petsc"`` backend (or, in the cases named ``… gamg``, with CG + GAMG and the
+system's rigid motions as near-nullspace) and ``ranks`` = all the ranks; the same problem is
+solved with the whole ``K`` and a serial backend (SuperLU) in each process as the reference,
+and in the GAMG cases with the whole ``K`` on every rank on CG + GAMG as well (the replicated
+path). Rank 0 writes the results of every case; :mod:`test_split_solve` compares them.
 """
 
 from __future__ import annotations
@@ -19,10 +21,12 @@ from signorini.algebra import FrictionOptions, PDASOptions, solve_friction, solv
 from signorini.algebra.backends import solver_factory
 from signorini.algebra.friction_kkt import check_friction
 from signorini.algebra.petsc import PetscSolver
+from signorini.algebra.petsc_gamg import GamgSolver
 from signorini.algebra.ranks import world_ranks
 from signorini.algebra.solvers import SolverRequest
 from signorini.contact.ordering import dof_ordering
 from signorini.contact.partition import partition
+from signorini.contact.rigid_modes import system_rigid_modes
 from signorini.contact.system import assemble
 from signorini.examples import example_6_2, example_6_2_coulomb, example_6_2_tresca
 from signorini.examples.two_bodies import two_cylinders
@@ -57,6 +61,8 @@ def pdas_case(problem, refinements: int, **options) -> dict[str, np.ndarray]:
     cs = a.contact
     x0_scale = options.pop("x0_scale", None)
     solver = solver_factory("petsc")
+    if options.pop("gamg", False):
+        return gamg_pdas_case(a, K_own, **options)
     if options.pop("ordered", False):  # PETSc's rows in this order within each rank
         solver = PetscSolver(ordering=dof_ordering(a.space), check_symmetry=True)
     args = (cs.constrained_dofs, cs.gap, a.dirichlet, a.dirichlet_values)
@@ -85,8 +91,50 @@ def pdas_case(problem, refinements: int, **options) -> dict[str, np.ndarray]:
     return out
 
 
-def friction_case(problem, refinements: int) -> dict[str, np.ndarray]:
-    """The frictional problem of ``problem`` (its first law's nodes), split and whole."""
+def gamg_solver(a) -> GamgSolver:
+    """CG + GAMG with the rigid motions of ``a`` (in the system's numbering)."""
+    return GamgSolver(near_nullspace=lambda: system_rigid_modes(a))
+
+
+def gamg_numbers(solver: GamgSolver) -> dict[str, np.ndarray]:
+    """Whether the solver's matrix was split, its CG iterations, and its near-nullspace's
+    vectors of the last factorization gathered into the caller's numbering."""
+    return {
+        "split": np.array(solver.split),
+        "cg": np.array(solver.iterations),
+        "modes": solver.near_nullspace_vectors(),
+    }
+
+
+def gamg_pdas_case(a, K_own: sp.csr_matrix, **options) -> dict[str, np.ndarray]:
+    """Frictionless PDAS on CG + GAMG with ``K`` split and whole, and on SuperLU."""
+    cs = a.contact
+    args = (cs.constrained_dofs, cs.gap, a.dirichlet, a.dirichlet_values)
+    serial = solve_pdas(a.K, a.F, *args, options=PDASOptions(**options), solver=REFERENCE)
+    out = {"owned_rows": np.array([np.count_nonzero(np.diff(K_own.indptr))])}
+    out["rigid_modes"] = system_rigid_modes(a)
+    split_solver, whole_solver = gamg_solver(a), gamg_solver(a)
+    split = solve_pdas(
+        K_own, a.F, *args, options=PDASOptions(**options), solver=split_solver, ranks=world_ranks()
+    )
+    whole = solve_pdas(a.K, a.F, *args, options=PDASOptions(**options), solver=whole_solver)
+    for name, res in (("serial", serial), ("split", split), ("whole", whole)):
+        out |= {
+            f"{name}_x": res.x,
+            f"{name}_multiplier": res.multiplier,
+            f"{name}_active": res.active,
+            f"{name}_counts": np.array([res.iterations]),
+            f"{name}_kkt": np.array(list(res.kkt.columns().values())),
+        }
+    for name, solver in (("split", split_solver), ("whole", whole_solver)):
+        out |= {f"{name}_{key}": value for key, value in gamg_numbers(solver).items()}
+        solver.close()
+    return out
+
+
+def friction_case(problem, refinements: int, gamg: bool = False) -> dict[str, np.ndarray]:
+    """The frictional problem of ``problem`` (its first law's nodes), split and whole; with
+    ``gamg`` (a Tresca problem) on CG + GAMG, split and whole, against SuperLU."""
     a, K_own = assembled(problem, refinements)
     cs = a.contact
     law = cs.friction
@@ -101,12 +149,30 @@ def friction_case(problem, refinements: int) -> dict[str, np.ndarray]:
 
     options = FrictionOptions()
     serial = solve_friction(problem_of(a.K), options=options, solver=REFERENCE)
+    out = {"owned_rows": np.array([np.count_nonzero(np.diff(K_own.indptr))])}
+    if gamg:
+        out["rigid_modes"] = system_rigid_modes(a)
+        split_solver, whole_solver = gamg_solver(a), gamg_solver(a)
+        on_ranks = problem_of(K_own).on_ranks(world_ranks())
+        split = solve_friction(on_ranks, options=options, solver=split_solver)
+        whole = solve_friction(problem_of(a.K), options=options, solver=whole_solver)
+        for name, res in (("serial", serial), ("split", split), ("whole", whole)):
+            out |= {
+                f"{name}_x": res.x,
+                f"{name}_multiplier": np.concatenate([res.multiplier_n, res.multiplier_t]),
+                f"{name}_active": np.concatenate([res.state, res.direction]),
+                f"{name}_counts": np.array([res.iterations]),
+                f"{name}_kkt": np.array(list(res.kkt.columns().values())),
+            }
+        for name, solver in (("split", split_solver), ("whole", whole_solver)):
+            out |= {f"{name}_{key}": value for key, value in gamg_numbers(solver).items()}
+            solver.close()
+        return out
     split = solve_friction(
         problem_of(K_own).on_ranks(world_ranks()),
         options=options,
         solver=solver_factory("petsc"),
     )
-    out = {"owned_rows": np.array([np.count_nonzero(np.diff(K_own.indptr))])}
     for name, res in (("serial", serial), ("split", split)):
         out |= {
             f"{name}_x": res.x,
@@ -127,6 +193,9 @@ CASES = {
     "two-cylinders": lambda: pdas_case(two_cylinders(rings=4), 2),
     "example-6.2-coulomb": lambda: friction_case(example_6_2_coulomb(), 2),
     "example-6.2-tresca": lambda: friction_case(example_6_2_tresca(), 2),
+    "example-6.2 gamg": lambda: pdas_case(example_6_2(), 2, gamg=True),
+    "two-cylinders gamg": lambda: pdas_case(two_cylinders(rings=4), 2, gamg=True),
+    "example-6.2-tresca gamg": lambda: friction_case(example_6_2_tresca(), 2, gamg=True),
 }
 
 

@@ -19,8 +19,15 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from signorini.algebra import SingularSystemError, SolverRequest, make_solver, solve_pdas
+from signorini.algebra import (
+    SingularSystemError,
+    SolverRequest,
+    make_solver,
+    solve_pdas,
+    solver_factory,
+)
 from signorini.algebra.inexact import KKT_RTOL
+from signorini.algebra.ranks import solver_ranks, world_ranks
 
 from .gamg_levels import run
 from .test_mpi import PROBLEM, REFERENCE, history, mpiexec, split
@@ -84,6 +91,9 @@ def test_two_ranks_give_the_direct_levels(serial, tmp_path, name):
     got = dict(np.load(out))
     assert int(got["size"]) == 2 and set(got["backend"]) == {"petsc-gamg"}
     compare(got, serial[name])
+    # every system of the run was split by rows over the ranks: the contact layer assembled
+    # each rank's own rows for the backend's ranks
+    assert got["split"].size >= RUNS[name] and got["split"].all()
 
 
 def test_coulomb_on_petsc_gamg_is_mumps_lu_exactly():
@@ -167,6 +177,8 @@ def test_the_factory_gives_mumps_lu_for_non_symmetric_systems_and_checks_its_inp
     spd = _gamg()(SolverRequest())
     assert isinstance(spd, GamgSolver) and spd.rtol == 1e-8 and spd.backend == "petsc-gamg"
     spd.close()
+    # the ranks it splits matrices over: PETSC_COMM_WORLD's, as the petsc backend's
+    assert solver_ranks(_gamg()) is world_ranks() is solver_ranks(solver_factory("petsc"))
     with pytest.raises(ValueError, match="rtol must be a number in"):
         GamgSolver(rtol=0.0)
     with pytest.raises(ValueError, match="max_it must be a positive integer"):

@@ -19,10 +19,11 @@ process passes is either
 
 The backend tells them apart by counting the non-empty rows over the processes (at each new
 pattern, collectively): ``n`` on every process is whole, ``n`` in total is split, anything
-else is refused. Right-hand sides and solutions are replicated vectors in the caller's
-numbering: each process sets the entries of its own rows, and the solution is gathered on
-every process (:meth:`Scatter.toAll`) and mapped back: the loop above the solver stays
-replicated (docs/parallel.md).
+else is refused (:class:`~.petsc_rows.PetscRows`, shared with :mod:`.petsc_gamg`).
+Right-hand sides and solutions are replicated vectors in the caller's numbering: each
+process sets the entries of its own rows, and the solution is gathered on every process
+(:meth:`Scatter.toAll`) and mapped back: the loop above the solver stays replicated
+(docs/parallel.md).
 
 The solve is ``KSPPREONLY`` with a MUMPS factorization: Cholesky with the matrix flagged
 symmetric positive definite (MUMPS ``SYM = 1``) for a symmetric request, LU otherwise
@@ -51,9 +52,8 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from .ranks import SERIAL, Ranks
-from .solvers import BackendUnavailableError, FactorizationError, SolverRequest, SPDSolver
-from .sparse import diagonal_positions, list_indices
+from .petsc_rows import PetscRows, _world_ranks, row_block
+from .solvers import BackendUnavailableError, FactorizationError, SolverRequest
 
 __all__ = [
     "PetscLUSolver",
@@ -115,16 +115,7 @@ def petsc_library() -> str:
     return f"PETSc {version} + MUMPS ({size} rank{'s' if size > 1 else ''})"
 
 
-def row_block(n: int, rank: int, size: int) -> tuple[int, int]:
-    """The rows ``[start, end)`` that process ``rank`` of ``size`` owns in an ``n``-row
-    matrix: contiguous blocks, the first ``n % size`` one row longer (PETSc's
-    ``PetscSplitOwnership``)."""
-    base, extra = divmod(n, size)
-    start = rank * base + min(rank, extra)
-    return start, start + base + (rank < extra)
-
-
-class PetscSolver(SPDSolver):
+class PetscSolver(PetscRows):
     """Sparse Cholesky (or LU) by MUMPS through PETSc, the analysis kept per pattern.
 
     Parameters
@@ -164,117 +155,14 @@ class PetscSolver(SPDSolver):
         check_symmetry: bool = True,
         ordering: np.ndarray | None = None,
     ) -> None:
-        self._PETSc = petsc_module()
-        comm = self._PETSc.COMM_WORLD
-        self.comm_size = comm.getSize()
-        self._rank = comm.getRank()
-        self._ranks: Ranks = SERIAL if self.comm_size == 1 else _world_ranks()
-        self.split = False
-        self._mat = self._ksp = self._x = self._b = self._scatter = self._all = None
+        self._ksp = self._x = self._b = self._scatter = self._all = None
         super().__init__(A, check_symmetry=check_symmetry, ordering=ordering)
-
-    # -- the rows of each rank ---------------------------------------------------------------
-    def same_pattern(self, A: sp.csr_matrix) -> bool:
-        """Whether ``A`` has the pattern of the last analysis on every rank (collective: the
-        ranks analyse together or not at all)."""
-        same = super().same_pattern(A)
-        if self.comm_size == 1:
-            return same
-        return self._ranks.max(0.0 if same else 1.0) == 0.0
-
-    def _check_new_pattern(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
-        """Decide whether ``A`` is whole on every rank or split by rows over the ranks
-        (:attr:`split`), and check it (collective; every rank raises the same error)."""
-        n = A.shape[0]
-        owned = np.diff(A.indptr) > 0
-        counts = self._ranks.gather(np.array([np.count_nonzero(owned)]))
-        self.split = self.comm_size > 1 and n > 0 and not (counts == n).all()
-        if not self.split:
-            super()._check_new_pattern(A, rows)
-            return
-        if counts.sum() != n:
-            raise ValueError(
-                f"A must be whole on every rank or split by rows over the {self.comm_size} "
-                f"ranks, each row on one: the ranks store {counts.tolist()} non-empty rows of {n}"
-            )
-        here = np.flatnonzero(owned)
-        missing = np.sort(self._ranks.gather(here[diagonal_positions(A, rows)[here] < 0]))
-        if missing.size:
-            raise ValueError(
-                f"A must store every diagonal entry; rows {list_indices(missing)} have none"
-            )
-        self._symmetry_pending = self.check_symmetry  # on the values, at the factorization
-
-    def _numbering(self, A: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
-        """PETSc's numbering of the unknowns: ``order`` (its row ``k`` is ``A``'s row
-        ``order[k]``) and this rank's rows in it, ``order[lo:hi]``.
-
-        A whole matrix: contiguous blocks of rows (:func:`row_block`), in the order of the
-        requested ordering if there is one. A split one: the ranks' own (non-empty) rows in rank
-        order, each rank's in the order of the requested ordering, else increasing. Raises a
-        :class:`ValueError` if a row is on no rank or on several (collective).
-        """
-        n = A.shape[0]
-        perm = self._perm
-        if not self.split:
-            order = np.arange(n) if perm is None else perm
-            lo, hi = row_block(n, self._rank, self.comm_size)
-            return order, order[lo:hi]
-        own = np.flatnonzero(np.diff(A.indptr) > 0)
-        if perm is not None:
-            position = np.empty(n, dtype=np.int64)
-            position[perm] = np.arange(n)
-            own = own[np.argsort(position[own], kind="stable")]
-        order = self._ranks.gather(own)
-        seen = np.bincount(order, minlength=n)
-        if (seen != 1).any():
-            wrong = np.flatnonzero(seen != 1)
-            raise ValueError(f"A's rows {list_indices(wrong)} are on no rank or on several")
-        return order, own
-
-    def _local(self, A: sp.csr_matrix, own: np.ndarray, to_petsc: np.ndarray | None) -> None:
-        """This rank's rows ``own`` of ``A`` as PETSc's local CSR arrays (``self._csr``) and
-        the positions in ``A.data`` of their values (``self._src``; a slice ``(first, last)``
-        when ``own`` is a contiguous block in ``A``'s numbering, as in the whole-matrix case
-        without an ordering)."""
-        int_type = self._PETSc.IntType
-        if to_petsc is None:  # rows lo..hi of A as they are
-            lo, hi = (int(own[0]), int(own[-1]) + 1) if own.size else (0, 0)
-            first, last = A.indptr[lo], A.indptr[hi]
-            indptr = (A.indptr[lo : hi + 1] - first).astype(int_type)
-            self._csr = (indptr, A.indices[first:last].astype(int_type))
-            self._src, self._own = slice(first, last), slice(lo, hi)
-            return
-        starts = A.indptr[own]
-        lengths = A.indptr[own + 1] - starts
-        indptr = np.zeros(own.size + 1, dtype=np.int64)
-        np.cumsum(lengths, out=indptr[1:])
-        src = np.repeat(starts - indptr[:-1], lengths) + np.arange(indptr[-1])
-        columns = to_petsc[A.indices[src]]
-        by_row = np.lexsort((columns, np.repeat(np.arange(own.size), lengths)))
-        self._csr = (indptr.astype(int_type), columns[by_row].astype(int_type))
-        self._src, self._own = src[by_row], own
-
-    def _values(self, A: sp.csr_matrix, keep: np.ndarray | None) -> np.ndarray:
-        """The values of this rank's PETSc rows of ``A`` with the entries off ``keep``
-        zeroed."""
-        values = np.array(A.data[self._src], dtype=np.float64)
-        if keep is not None:
-            values *= keep[self._src]
-        return values
 
     def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
         PETSc = self._PETSc
         self._release()
         n = A.shape[0]
-        order, own = self._numbering(A)
-        identity = not self.split and self._perm is None
-        to_petsc = None
-        if not identity:
-            to_petsc = np.empty(n, dtype=np.int64)
-            to_petsc[order] = np.arange(n)
-        self._local(A, own, to_petsc)
-        self._order = None if identity else order
+        own = self._rows(A)
         m = own.size
         indptr, indices = self._csr
         values = np.zeros(indices.size)
@@ -346,14 +234,6 @@ class PetscSolver(SPDSolver):
                     equation=equation,
                 )
 
-    def _check_symmetry(self, values: np.ndarray) -> None:
-        """Refuse a split matrix that is not symmetric to ``1e-12 max |A|`` (as the serial
-        check of :class:`~.solvers.SPDSolver`; PETSc compares it with its transpose)."""
-        self._symmetry_pending = False
-        scale = self._ranks.max(float(np.abs(values).max(initial=0.0)))
-        if not self._mat.isSymmetric(1e-12 * scale):
-            raise ValueError("A is not symmetric: max|A - A^T| > 1e-12 max|A|")
-
     def _nonpositive_diagonal(self, A: sp.csr_matrix, keep: np.ndarray | None) -> int | None:
         """The first row whose diagonal entry (of ``A`` with the entries off ``keep``
         zeroed) is not positive, or None: where a Cholesky factorization that reached it
@@ -367,11 +247,10 @@ class PetscSolver(SPDSolver):
         return int(bad[0]) if bad.size else None
 
     def _solve(self, b: np.ndarray) -> np.ndarray:
-        own, order = self._own, self._order
         columns = b.reshape(b.shape[0], -1)
         x = np.empty_like(columns)
         for j in range(columns.shape[1]):  # a handful of right-hand sides
-            self._b.setArray(columns[own, j])  # this rank's entries, in PETSc's order
+            self._b.setArray(self._local_entries(columns[:, j]))  # in PETSc's order
             self._ksp.solve(self._b, self._x)
             reason = int(self._ksp.getConvergedReason())
             if reason < 0:
@@ -380,10 +259,7 @@ class PetscSolver(SPDSolver):
                     backend=self.backend,
                 )
             self._scatter.scatter(self._x, self._all)
-            if order is None:
-                x[:, j] = self._all.getArray()
-            else:
-                x[order, j] = self._all.getArray()
+            self._caller_order(self._all.getArray(), x[:, j])
         return x.reshape(b.shape)
 
     def _release(self) -> None:
@@ -438,12 +314,6 @@ def _lu_ordering(request: SolverRequest) -> np.ndarray | None:
         return request.ordering()
     except BackendUnavailableError:
         return None
-
-
-def _world_ranks():
-    from .ranks import world_ranks
-
-    return world_ranks()
 
 
 #: The ranks the backend's matrices are split over (:func:`~.ranks.solver_ranks`).

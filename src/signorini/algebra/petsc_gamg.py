@@ -3,8 +3,16 @@
 An iterative solver for the symmetric positive definite systems of the active set methods
 (the frictionless and Tresca systems): PETSc's conjugate gradients (``KSPCG``) with the
 smoothed-aggregation algebraic multigrid ``PCGAMG``, on ``PETSC_COMM_WORLD`` (serial or under
-``mpiexec``, the rows split as by the ``"petsc"`` backend, :func:`~.petsc.row_block`). It
-needs the optional extra ``signorini[mpi]`` and is imported only when asked for.
+``mpiexec``). It needs the optional extra ``signorini[mpi]`` and is imported only when asked
+for.
+
+**The rows.** As the ``"petsc"`` backend (:mod:`.petsc_rows`), a process passes either the
+whole matrix (the same on every process: PETSc's rows are split in contiguous blocks of whole
+nodes) or its own rows of a matrix split by rows over the processes (the other rows empty:
+PETSc's numbering then puts each process's rows together, in increasing order within it).
+The factory's ``ranks`` (:func:`~.ranks.solver_ranks`) tells the contact layer to build the
+latter. Right-hand sides, solutions and the near-nullspace vectors are replicated arrays in
+the caller's numbering, renumbered to PETSc's and back.
 
 **The near-nullspace.** Smoothed aggregation builds its coarse spaces from the modes the
 matrix nearly annihilates; for elasticity these are the rigid motions of each body, two
@@ -14,7 +22,9 @@ roller nodes and, with two bodies, in the basis of the relative displacement
 contact layer computes them (:func:`signorini.contact.rigid_modes.system_rigid_modes`) and
 hands them over as :attr:`~.solvers.SolverRequest.rigid_modes`. Without them GAMG falls back
 to the constant vectors of each of the two components. The matrix has block size 2 (a node's
-two DOFs aggregate together).
+two DOFs aggregate together) where every process's rows are whole nodes: an even ``n``, and
+with a split matrix each process's rows pairs ``2i, 2i + 1`` (both DOFs of a node on one rank,
+as :func:`signorini.contact.partition.partition` makes them); else block size 1.
 
 **The eliminated DOFs.** The active set methods impose the Dirichlet and active DOFs by
 zeroing their rows and columns in place, the diagonal kept (:mod:`.elimination`): such a
@@ -48,7 +58,8 @@ from collections.abc import Callable
 import numpy as np
 import scipy.sparse as sp
 
-from .petsc import PetscLUSolver, petsc_module, row_block
+from .petsc import PetscLUSolver
+from .petsc_rows import PetscRows, _world_ranks, row_block
 from .solvers import FactorizationError, SingularSystemError, SolverRequest, SPDSolver
 from .sparse import abs_matvec
 
@@ -68,7 +79,7 @@ EPS = float(np.finfo(np.float64).eps)
 OPTIONS_PREFIX = "signorini_gamg_"
 
 
-class GamgSolver(SPDSolver):
+class GamgSolver(PetscRows):
     """CG + GAMG with the rigid-body near-nullspace, for SPD matrices with a fixed pattern.
 
     :meth:`factorize` sets GAMG up (its aggregation, prolongators and coarse matrices: the
@@ -79,7 +90,7 @@ class GamgSolver(SPDSolver):
     Parameters
     ----------
     A : scipy sparse matrix, shape (n, n), optional
-        Set up right away if given; every process passes the same matrix.
+        Set up right away if given; whole on every process, or split by rows over them.
     check_symmetry : bool
         As in :class:`~.solvers.SPDSolver`.
     ordering : (n,) int array, optional
@@ -98,6 +109,8 @@ class GamgSolver(SPDSolver):
         CG iterations of every solve (one entry per right-hand side), in order.
     comm_size : int
         Processes of ``PETSC_COMM_WORLD``.
+    split : bool
+        Whether the last analysed matrix was split by rows over the processes.
 
     Raises
     ------
@@ -124,10 +137,6 @@ class GamgSolver(SPDSolver):
             raise ValueError(f"rtol must be a number in (0, 1), got {rtol!r}")
         if isinstance(max_it, bool) or not isinstance(max_it, (int, np.integer)) or max_it < 1:
             raise ValueError(f"max_it must be a positive integer, got {max_it!r}")
-        self._PETSc = petsc_module()
-        comm = self._PETSc.COMM_WORLD
-        self.comm_size = comm.getSize()
-        self._rank = comm.getRank()
         self.near_nullspace = near_nullspace
         self.rtol = float(rtol)
         self.max_it = int(max_it)
@@ -140,24 +149,32 @@ class GamgSolver(SPDSolver):
         self._last: tuple[np.ndarray, np.ndarray] | None = None  # the last solve's b and x
         super().__init__(A, check_symmetry=check_symmetry, ordering=ordering)
 
+    def _whole_rows(self, n: int) -> tuple[int, int]:
+        """A whole matrix's rows of this process: :func:`~.petsc_rows.row_block` of the
+        ``n // 2`` nodes, in DOFs, for an even ``n`` (whole 2 × 2 node blocks, PETSc's block
+        size 2)."""
+        if n % 2:
+            return row_block(n, self._rank, self.comm_size)
+        lo, hi = row_block(n // 2, self._rank, self.comm_size)
+        return 2 * lo, 2 * hi
+
+    def _row_ordering(self) -> None:
+        """None: the rows stay in increasing order within each process (whole nodes; the
+        ordering is not used)."""
+        return None
+
     def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
         PETSc = self._PETSc
         self._release()
         n = A.shape[0]
+        own = self._rows(A)
+        m = own.size
         # whole nodes (2 × 2 blocks) on every process
-        block = _even_block if n % 2 == 0 else row_block
-        lo, hi = self._rows = block(n, self._rank, self.comm_size)
-        first, last = A.indptr[lo], A.indptr[hi]
-        int_type = PETSc.IntType
-        self._csr = (
-            (A.indptr[lo : hi + 1] - first).astype(int_type),
-            A.indices[first:last].astype(int_type),
-        )
-        self._slice = (first, last)
+        nodes = m % 2 == 0 and (self._order is None or _node_pairs(own))
         mat = PETSc.Mat().createAIJ(
-            size=((hi - lo, n), (hi - lo, n)),
-            bsize=2 if n % 2 == 0 else 1,
-            csr=(*self._csr, np.zeros(last - first)),
+            size=((m, n), (m, n)),
+            bsize=2 if n % 2 == 0 and self._everywhere(nodes) else 1,
+            csr=(*self._csr, np.zeros(self._csr[1].size)),
             comm=PETSc.COMM_WORLD,
         )
         mat.assemble()
@@ -174,7 +191,7 @@ class GamgSolver(SPDSolver):
         self._x, self._b = mat.createVecs()
         self._scatter, self._all = PETSc.Scatter.toAll(self._x)
         # ‖A‖∞ ≤ ‖K‖∞ for every eliminated matrix of the pattern: the round-off floor's
-        self._norm = float(abs_matvec(A, np.ones(n)).max(initial=0.0))
+        self._norm = self._ranks.max(float(abs_matvec(A, np.ones(n)).max(initial=0.0)))
         self._modes = None
         if self.near_nullspace is not None:
             modes = np.asarray(self.near_nullspace(), dtype=np.float64)
@@ -187,13 +204,14 @@ class GamgSolver(SPDSolver):
 
     def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
         PETSc = self._PETSc
-        if self._keep is not None and keep is not None and np.array_equal(keep, self._keep):
-            if A.data is self._data:
-                return  # the same matrix: GAMG's set-up stands
-        first, last = self._slice
-        data = A.data[first:last] if keep is None else A.data[first:last] * keep[first:last]
-        self._mat.setValuesCSR(*self._csr, np.ascontiguousarray(data, dtype=np.float64))
+        same = self._keep is not None and keep is not None and A.data is self._data
+        if self._everywhere(same and np.array_equal(keep, self._keep)):
+            return  # the same matrix: GAMG's set-up stands
+        values = self._values(A, keep)
+        self._mat.setValuesCSR(*self._csr, values)
         self._mat.assemble()
+        if self.split and self._symmetry_pending:
+            self._check_symmetry(values)
         if self._modes is not None:
             self._set_near_nullspace(A, keep)
         self._ksp.setOperators(self._mat)
@@ -216,14 +234,18 @@ class GamgSolver(SPDSolver):
         modes = self._modes
         if keep is not None:
             kept = np.diff(np.concatenate([[0], np.cumsum(keep)])[A.indptr])
-            modes = np.where((kept <= 1)[:, None], 0.0, modes)
+            eliminated = kept <= 1
+            if self.split:  # this rank's rows are read here, the others on theirs
+                eliminated = np.zeros(A.shape[0], dtype=bool)
+                eliminated[self._ranks.gather(self._own[kept[self._own] <= 1])] = True
+            modes = np.where(eliminated[:, None], 0.0, modes)
         q, r = np.linalg.qr(modes)
         q = q[:, np.abs(np.diag(r)) > 1e-12 * max(np.abs(np.diag(r)).max(initial=0.0), 1e-300)]
-        lo, hi = self._rows
+        local = self._local_entries(q)  # this rank's rows, in PETSc's order
         vectors = []
         for k in range(q.shape[1]):  # the rigid motions: six at most
             v = self._mat.createVecLeft()
-            v.setArray(np.ascontiguousarray(q[lo:hi, k]))
+            v.setArray(np.ascontiguousarray(local[:, k]))
             vectors.append(v)
         space = PETSc.NullSpace().create(vectors=vectors, comm=PETSc.COMM_WORLD)
         self._mat.setNearNullSpace(space)
@@ -231,8 +253,21 @@ class GamgSolver(SPDSolver):
         for v in vectors:
             v.destroy()
 
+    def near_nullspace_vectors(self) -> np.ndarray:
+        """The near-nullspace GAMG was last set up with, gathered on every process in the
+        caller's numbering: ``(n, k)``, orthonormal columns (``(n, 0)`` without one).
+        Collective."""
+        if not self._factorized:
+            raise RuntimeError("near_nullspace_vectors() called before a successful factorize()")
+        space = self._mat.getNearNullSpace()
+        vectors = space.getVecs() if space is not None else []
+        out = np.empty((self.n, len(vectors)))
+        for k, v in enumerate(vectors):
+            self._scatter.scatter(v, self._all)
+            self._caller_order(self._all.getArray(), out[:, k])
+        return out
+
     def _solve(self, b: np.ndarray) -> np.ndarray:
-        lo, hi = self._rows
         columns = b.reshape(b.shape[0], -1)
         x = np.empty_like(columns)
         # the round-off floor: a residual at eps ‖A‖∞ ‖x‖₂ (x the last solution) is as
@@ -240,11 +275,12 @@ class GamgSolver(SPDSolver):
         atol = EPS * self._norm * self._x_norm
         self._ksp.setTolerances(rtol=self.rtol, atol=atol, max_it=self.max_it)
         for j in range(columns.shape[1]):  # a handful of right-hand sides
-            self._b.setArray(np.ascontiguousarray(columns[lo:hi, j]))
+            self._b.setArray(self._local_entries(columns[:, j]))
             # the same system again (a confirming solve, .inexact): from its last solution
-            again = self._last is not None and np.array_equal(columns[:, j], self._last[0])
+            last = self._last
+            again = self._everywhere(last is not None and np.array_equal(columns[:, j], last[0]))
             if again:
-                self._x.setArray(np.ascontiguousarray(self._last[1][lo:hi]))
+                self._x.setArray(self._local_entries(last[1]))
             else:
                 self._x.set(0.0)
             self._ksp.setInitialGuessNonzero(again)
@@ -264,7 +300,7 @@ class GamgSolver(SPDSolver):
                     residual=float(relative),
                 )
             self._scatter.scatter(self._x, self._all)
-            x[:, j] = self._all.getArray()
+            self._caller_order(self._all.getArray(), x[:, j])
             self._x_norm = float(np.linalg.norm(x[:, j]))
             self._last = (columns[:, j].copy(), x[:, j].copy())
         return x.reshape(b.shape)
@@ -281,11 +317,9 @@ class GamgSolver(SPDSolver):
         super().close()
 
 
-def _even_block(n: int, rank: int, size: int) -> tuple[int, int]:
-    """:func:`~.petsc.row_block` of the ``n // 2`` nodes, in DOFs: every process owns whole
-    2 × 2 node blocks (PETSc's block size 2)."""
-    lo, hi = row_block(n // 2, rank, size)
-    return 2 * lo, 2 * hi
+def _node_pairs(own: np.ndarray) -> bool:
+    """Whether the rows ``own`` (in order) are whole nodes: pairs ``2i, 2i + 1``."""
+    return bool((own[0::2] % 2 == 0).all() and (own[1::2] == own[0::2] + 1).all())
 
 
 def petsc_gamg_solver(request: SolverRequest) -> SPDSolver:
@@ -305,3 +339,8 @@ def petsc_gamg_solver(request: SolverRequest) -> SPDSolver:
             near_nullspace=getattr(request, "rigid_modes", None),
         )
     return PetscLUSolver()
+
+
+#: The ranks the backend's matrices are split over (:func:`~.ranks.solver_ranks`): on several,
+#: the contact layer hands each rank its own rows.
+petsc_gamg_solver.ranks = _world_ranks  # type: ignore[attr-defined]
