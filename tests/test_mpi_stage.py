@@ -19,6 +19,9 @@ import pytest
 
 ROOT = Path(__file__).parents[1]
 MPI_PYTHON = os.environ.get("SIGNORINI_MPI_PYTHON")
+#: A file of ``tests/parallel`` that plays the ranks in one process and needs neither PETSc
+#: nor MPI: the serial stage runs it, the MPI stage need not run it again.
+SERIAL_ONLY = "tests/parallel/test_estimator_ranks.py"
 
 
 @pytest.mark.slow
@@ -31,7 +34,7 @@ def test_the_petsc_backend_and_the_mpi_runs_pass():
     env = {**os.environ, "SIGNORINI_REQUIRE_PETSC": "1", "MPLBACKEND": "Agg"}
     done = subprocess.run(
         [MPI_PYTHON, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/parallel",
-         "tests/algebra/test_petsc.py"],
+         "tests/algebra/test_petsc.py", f"--ignore={SERIAL_ONLY}"],
         cwd=ROOT, env=env, capture_output=True, text=True, timeout=1200,
     )  # fmt: skip
     summary = done.stdout.strip().splitlines()[-1] if done.stdout.strip() else ""

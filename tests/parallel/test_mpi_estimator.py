@@ -31,8 +31,9 @@ pytestmark = [
 
 @pytest.mark.parametrize(
     "name,levels,ranks",
-    [("example-6.2", 16, 1), ("example-6.2", 16, 2), ("example-6.2", 16, 3)]
-    + [("example-6.2-coulomb", 10, 2), ("example-6.2-coulomb", 10, 3)],
+    # -n 2 on Example 6.2 is in test_mpi.py's comparison of whole runs; here the serial path
+    # (-n 1), the most ranks (-n 3) and friction
+    [("example-6.2", 16, 1), ("example-6.2", 16, 3), ("example-6.2-coulomb", 10, 2)],
 )
 def test_every_ranks_estimate_is_the_serial_one(tmp_path, name, levels, ranks):
     out = tmp_path / "estimate.npz"
