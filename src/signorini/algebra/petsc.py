@@ -197,12 +197,7 @@ class PetscSolver(PetscRows):
 
     def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
         PETSc = self._PETSc
-        indptr, indices = self._csr
-        values = self._values(A, keep)
-        self._mat.setValuesCSR(indptr, indices, values)
-        self._mat.assemble()
-        if self.split and self._symmetry_pending:
-            self._check_symmetry(values)
+        self._write_values(A, keep)
         self._ksp.setOperators(self._mat)
         pc = self._ksp.getPC()
         try:

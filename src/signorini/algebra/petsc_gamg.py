@@ -207,11 +207,7 @@ class GamgSolver(PetscRows):
         same = self._keep is not None and keep is not None and A.data is self._data
         if self._everywhere(same and np.array_equal(keep, self._keep)):
             return  # the same matrix: GAMG's set-up stands
-        values = self._values(A, keep)
-        self._mat.setValuesCSR(*self._csr, values)
-        self._mat.assemble()
-        if self.split and self._symmetry_pending:
-            self._check_symmetry(values)
+        self._write_values(A, keep)
         if self._modes is not None:
             self._set_near_nullspace(A, keep)
         self._ksp.setOperators(self._mat)

@@ -210,6 +210,15 @@ class PetscRows(SPDSolver):
             values *= keep[self._src]
         return values
 
+    def _write_values(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
+        """Write ``A``'s values (the entries off ``keep`` zeroed) into the kept PETSc matrix
+        and assemble it; a split matrix's symmetry is checked at its first factorization."""
+        values = self._values(A, keep)
+        self._mat.setValuesCSR(*self._csr, values)
+        self._mat.assemble()
+        if self.split and self._symmetry_pending:
+            self._check_symmetry(values)
+
     def _local_entries(self, v: np.ndarray) -> np.ndarray:
         """This rank's entries of a replicated vector (or of the rows of an ``(n, k)``
         array) in the caller's numbering, in PETSc's order."""

@@ -29,6 +29,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..fem.element import P2
 from ..fem.p2 import edge_basis
@@ -43,6 +44,7 @@ __all__ = [
     "interior_residual",
     "stress_jump",
     "neumann_residual",
+    "node_mesh_size",
     "tangential_stress",
     "normal_stress",
     "complementarity",
@@ -421,3 +423,20 @@ def penetration(
     origin = x0.min(axis=0) if len(x0) else np.zeros(2)
     _, share = hhalf_norm2_positive_part(x0 - origin, x1 - origin, gap, validate=False, scale=scale)
     return share
+
+
+def node_mesh_size(
+    h: np.ndarray, cell_nodes: np.ndarray, dirichlet_nodes: np.ndarray, n_nodes: int
+) -> np.ndarray:
+    """``h_p = max_{T ∋ p} h_T`` ``(n_nodes,)``, zero at Dirichlet nodes (they carry no term)."""
+    # node by node over its cells: the node-cell incidence in CSC form, one maximum per column
+    # (np.maximum.at took 0.1 s at 1.2M unknowns on some meshes' h_T, this 0.03 s on all)
+    m, k = cell_nodes.shape
+    incidence = sp.csr_matrix(
+        (np.repeat(h, k), cell_nodes.ravel(), np.arange(0, m * k + 1, k)), shape=(m, n_nodes)
+    ).tocsc()
+    h_p = np.zeros(n_nodes)
+    has_cells = np.diff(incidence.indptr) > 0
+    h_p[has_cells] = np.maximum.reduceat(incidence.data, incidence.indptr[:-1][has_cells])
+    h_p[dirichlet_nodes] = 0.0
+    return h_p
