@@ -22,6 +22,10 @@ MPI_PYTHON = os.environ.get("SIGNORINI_MPI_PYTHON")
 #: A file of ``tests/parallel`` that plays the ranks in one process and needs neither PETSc
 #: nor MPI: the serial stage runs it, the MPI stage need not run it again.
 SERIAL_ONLY = "tests/parallel/test_estimator_ranks.py"
+#: One BLAS thread per process: up to three ranks share the machine's cores (oversubscribed
+#: on two), and their BLAS threads would compete for them (the stage took 62 s with them,
+#: 55 s without).
+ONE_THREAD = dict.fromkeys(("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"), "1")
 
 
 @pytest.mark.slow
@@ -31,7 +35,7 @@ SERIAL_ONLY = "tests/parallel/test_estimator_ranks.py"
     "pip install -e '.[fast,test,mpi]' and name its python there (docs/parallel.md)",
 )
 def test_the_petsc_backend_and_the_mpi_runs_pass():
-    env = {**os.environ, "SIGNORINI_REQUIRE_PETSC": "1", "MPLBACKEND": "Agg"}
+    env = {**os.environ, "SIGNORINI_REQUIRE_PETSC": "1", "MPLBACKEND": "Agg", **ONE_THREAD}
     done = subprocess.run(
         [MPI_PYTHON, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/parallel",
          "tests/algebra/test_petsc.py", f"--ignore={SERIAL_ONLY}"],

@@ -1,4 +1,4 @@
-"""``K`` split by rows over 2 and 3 ranks (each rank its own nodes' rows, the others empty):
+"""``K`` split by rows over 2 ranks (each rank its own nodes' rows, the others empty):
 PDAS, its bordered updates, its warm start and its primal fallback, Tresca and Coulomb
 friction and a two-body problem give the serial answer.
 
@@ -33,7 +33,9 @@ FRICTION = ["example-6.2-coulomb", "example-6.2-tresca"]
 GAMG = ["example-6.2 gamg", "two-cylinders gamg", "example-6.2-tresca gamg"]
 
 
-@pytest.fixture(scope="module", params=[2, 3])
+# Two ranks here; three ranks split K in test_mpi.py's whole adaptive runs (Example 6.2 and
+# Coulomb) and in test_rows.py's assembly
+@pytest.fixture(scope="module", params=[2])
 def runs(request, tmp_path_factory):
     out = tmp_path_factory.mktemp(f"rows{request.param}") / "rows.npz"
     command = [*mpiexec(), "-n", str(request.param), sys.executable, str(SCRIPT), str(out)]
