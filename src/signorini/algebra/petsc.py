@@ -196,18 +196,9 @@ class PetscSolver(PetscRows):
         self._scatter, self._all = PETSc.Scatter.toAll(self._x)
 
     def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
-        PETSc = self._PETSc
         self._write_values(A, keep)
-        self._ksp.setOperators(self._mat)
+        self._set_up("MUMPS could not factorize the matrix (PETSc error {ierr}): it is singular")
         pc = self._ksp.getPC()
-        try:
-            self._ksp.setUp()
-        except PETSc.Error as err:
-            raise FactorizationError(
-                f"MUMPS could not factorize the matrix (PETSc error {err.ierr}): it is singular",
-                backend=self.backend,
-                code=int(err.ierr),
-            ) from err
         factor = pc.getFactorMatrix()
         status = int(factor.getMumpsInfog(1))
         failed = getattr(pc, "getFailedReason", lambda: 0)()  # petsc4py >= 3.19

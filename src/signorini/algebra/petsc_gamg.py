@@ -60,7 +60,7 @@ import scipy.sparse as sp
 
 from .petsc import PetscLUSolver
 from .petsc_rows import PetscRows, _world_ranks, row_block
-from .solvers import FactorizationError, SingularSystemError, SolverRequest, SPDSolver
+from .solvers import SingularSystemError, SolverRequest, SPDSolver
 from .sparse import abs_matvec
 
 __all__ = ["GamgSolver", "RTOL", "petsc_gamg_solver"]
@@ -203,22 +203,13 @@ class GamgSolver(PetscRows):
         self._keep = None
 
     def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
-        PETSc = self._PETSc
         same = self._keep is not None and keep is not None and A.data is self._data
         if self._everywhere(same and np.array_equal(keep, self._keep)):
             return  # the same matrix: GAMG's set-up stands
         self._write_values(A, keep)
         if self._modes is not None:
             self._set_near_nullspace(A, keep)
-        self._ksp.setOperators(self._mat)
-        try:
-            self._ksp.setUp()
-        except PETSc.Error as err:
-            raise FactorizationError(
-                f"GAMG could not be set up for the matrix (PETSc error {err.ierr})",
-                backend=self.backend,
-                code=int(err.ierr),
-            ) from err
+        self._set_up("GAMG could not be set up for the matrix (PETSc error {ierr})")
         self._keep = None if keep is None else keep.copy()
         self._data = A.data
         self._last = None  # a new matrix: no solution to start from

@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .ranks import SERIAL, Ranks
-from .solvers import SPDSolver
+from .solvers import FactorizationError, SPDSolver
 from .sparse import diagonal_positions, list_indices
 
 __all__ = ["PetscRows", "row_block"]
@@ -218,6 +218,18 @@ class PetscRows(SPDSolver):
         self._mat.assemble()
         if self.split and self._symmetry_pending:
             self._check_symmetry(values)
+
+    def _set_up(self, failure: str) -> None:
+        """Hand the written matrix to the KSP and set it up (MUMPS's factorization, GAMG's
+        hierarchy); a PETSc error raises :class:`~.solvers.FactorizationError` with the
+        message ``failure`` formatted with its ``ierr``."""
+        self._ksp.setOperators(self._mat)
+        try:
+            self._ksp.setUp()
+        except self._PETSc.Error as err:
+            raise FactorizationError(
+                failure.format(ierr=err.ierr), backend=self.backend, code=int(err.ierr)
+            ) from err
 
     def _local_entries(self, v: np.ndarray) -> np.ndarray:
         """This rank's entries of a replicated vector (or of the rows of an ``(n, k)``
