@@ -71,12 +71,13 @@ class FakeLibc:
         return self.result
 
 
-def test_sets_the_mmap_and_trim_thresholds(monkeypatch):
+def test_sets_the_mmap_and_trim_thresholds_and_one_arena(monkeypatch):
     libc = FakeLibc()
     monkeypatch.setattr(runtime.ctypes, "CDLL", lambda name: libc)
     assert runtime.retain_freed_memory() is True
-    # M_MMAP_THRESHOLD = -3 to 1 GiB, M_TRIM_THRESHOLD = -1 to the largest int
-    assert libc.calls == [(-3, 1 << 30), (-1, (1 << 31) - 1)]
+    # M_MMAP_THRESHOLD = -3 to 1 GiB, M_TRIM_THRESHOLD = -1 to the largest int,
+    # M_ARENA_MAX = -8 to one
+    assert libc.calls == [(-3, 1 << 30), (-1, (1 << 31) - 1), (-8, 1)]
 
 
 def test_reports_failure(monkeypatch):
@@ -90,3 +91,37 @@ def test_reports_failure(monkeypatch):
     assert runtime.retain_freed_memory() is False
     monkeypatch.setattr(runtime.ctypes, "CDLL", lambda name: object())  # no mallopt
     assert runtime.retain_freed_memory() is False
+
+
+THREADED = """
+import json, sys, threading
+import numpy as np
+from signorini.runtime import retain_freed_memory
+
+def rss():
+    with open("/proc/self/statm") as fh:
+        return int(fh.read().split()[1]) * 4096
+
+retain_freed_memory()
+def work():
+    a = np.ones(2**23)  # 64 MiB, freed in this thread
+    del a
+thread = threading.Thread(target=work)
+thread.start(); thread.join()
+before = rss()
+a = np.ones(2**23)  # in the main thread: the memory the other thread freed
+print(json.dumps({"grown": rss() - before}))
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc and /proc only")
+def test_memory_a_thread_freed_is_reused_by_the_main_thread():
+    """One heap for every thread (``M_ARENA_MAX = 1``): what a background thread
+    (:mod:`signorini.algebra.beside`) freed serves the main thread's next allocation, so the
+    process does not keep both threads' peaks."""
+    out = subprocess.run(
+        [sys.executable, "-c", THREADED], capture_output=True, text=True, check=True
+    ).stdout
+    grown = json.loads(out)["grown"]
+    print(f"RSS grown by {grown / 2**20:.1f} MiB reallocating 64 MiB a thread freed")
+    assert grown < 8 * 2**20

@@ -144,3 +144,55 @@ def test_reported_operation_count_and_memory_of_a_dense_factorization():
     assert set(memory) == {"analysis_peak", "permanent", "factorization"}
     assert memory["factorization"] * 1024 >= 8 * n * (n + 1) // 2, memory
     assert memory["analysis_peak"] > 0 and memory["permanent"] > 0, memory
+
+
+@pytest.mark.skipif(not HAS_PARDISO, reason="PARDISO not available")
+def test_an_analysis_beside_the_caller_is_the_analysis_of_factorize():
+    """``analyze(A, beside=True)`` runs in the background while the caller writes ``A``'s
+    values; the factorization then uses the new values and the same analysis: the solution
+    is bit for bit that of a solver that analyses in ``factorize``, counted once."""
+    rng = np.random.default_rng(5)
+    K = block_spd(40, 40, rng)
+    b = rng.standard_normal(K.shape[0])
+    order = rng.permutation(K.shape[0] // 2)
+    ordering = np.stack([2 * order, 2 * order + 1], axis=1).ravel()
+    A = K.copy()
+    A.data[:] = 0.0  # the values are written only after the analysis started
+    with PardisoSolver(check_symmetry=False, ordering=ordering) as ahead:
+        ahead.analyze(A, beside=True)
+        A.data[:] = K.data
+        ahead.factorize(A)
+        x = ahead.solve(b)
+        assert (ahead.n_analyses, ahead.n_factorizations) == (1, 1)
+        assert ahead.time_analysis > 0.0
+        ahead.factorize(K)  # the same pattern: no second analysis
+        assert ahead.n_analyses == 1
+    with PardisoSolver(check_symmetry=False, ordering=ordering) as in_turn:
+        in_turn.factorize(K)
+        assert np.array_equal(x, in_turn.solve(b))
+
+
+@pytest.mark.skipif(not HAS_PARDISO, reason="PARDISO not available")
+def test_an_error_of_an_analysis_beside_is_raised_by_factorize():
+    K = sp.csr_matrix(np.array([[2.0, 1.0, 0.0], [1.0, 0.0, 1.0], [0.0, 1.0, 2.0]]))
+    K.eliminate_zeros()  # row 1 stores no diagonal entry
+    solver = PardisoSolver()
+    solver.analyze(K, beside=True)  # returns at once
+    with pytest.raises(ValueError, match="diagonal entry; rows 1 have none"):
+        solver.factorize(K)
+    solver.analyze(K, beside=True)
+    solver.close()  # waits, and says nothing of it: the error concerns no one now
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_an_analysis_that_reads_the_values_is_done_in_the_callers_thread(backend):
+    """LU with matching (and SuperLU) read the values in the analysis: ``beside`` is
+    ignored, and the analysis is done (and counted) before ``analyze`` returns (one beside
+    is counted when a factorization waits for it)."""
+    from signorini.algebra import SOLVERS, make_solver
+
+    K = block_spd(6, 6, np.random.default_rng(2))
+    with make_solver(SOLVERS[backend], symmetric=False) as solver:
+        assert solver.analysis_reads_values
+        solver.analyze(K, beside=True)
+        assert solver.n_analyses == 1

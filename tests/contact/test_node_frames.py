@@ -171,3 +171,28 @@ def test_singular_frame_is_refused():
     K = sp.identity(4, format="csr")
     with pytest.raises(ValueError, match=r"the frame normals\[0\] is singular"):
         rotate_frames(K, np.zeros(4), [0], [[[1.0, 1.0], [1.0, 1.0]]])
+
+
+@pytest.mark.parametrize("which", ["example-6.2", "two-cylinders"])
+def test_the_assemblys_rotation_reads_only_the_rows_near_the_frames(which):
+    """Without validation, on a whole matrix (its pattern symmetric, no row empty), the
+    columns of the frame nodes are looked for only in the rows those nodes couple with; the
+    rotated matrix is the one of the scan of every entry, bit for bit."""
+    from signorini import example_6_2
+    from signorini.contact import assemble
+    from signorini.contact.node_frames import rotate_frames
+    from signorini.examples import two_cylinders
+
+    problem = example_6_2() if which == "example-6.2" else two_cylinders()
+    a = assemble(problem, problem.mesh)
+    rng = np.random.default_rng(7)
+    nodes = np.union1d(a.frame_nodes, rng.choice(a.space.n_nodes, 40, replace=False))
+    normals = random_normals(rng, nodes.size)
+    F = np.arange(a.K.shape[0], dtype=float)
+    near, F_near = rotate_frames(a.K, F, nodes, normals, validate=False)
+    every, F_every = rotate_frames(a.K, F, nodes, normals, validate=True)
+    assert np.array_equal(near.data, every.data) and np.array_equal(F_near, F_every)
+    assert not np.array_equal(near.data, a.K.data)
+    Q = sp.csr_matrix(dense_Q(a.K.shape[0], nodes, normals))
+    reference = (Q.T @ a.K @ Q).toarray()
+    assert np.abs(near.toarray() - reference).max() <= 1e-12 * np.abs(reference).max()

@@ -15,10 +15,13 @@ from signorini.algebra import (
     available_backends,
     make_solver,
     pardiso_solver,
+    superlu_solver,
 )
+from signorini.algebra.backends import takes_ordering
 from signorini.algebra.pardiso import PardisoSolver, metis_ordering
 from signorini.contact import assemble
-from signorini.contact.ordering import dof_ordering, ordered_solver, vertex_graph
+from signorini.contact.ordering import Ordering, dof_ordering, ordered_solver, vertex_graph
+from signorini.examples import example_6_2_coulomb, example_6_2_tresca, two_cylinders
 from signorini.fem.space import P2Space
 from signorini.mesh.builders import rectangle
 
@@ -134,17 +137,12 @@ def test_solution_does_not_depend_on_the_ordering(backend):
 
 
 @needs_pardiso
-def test_solve_uses_the_ordering_and_agrees_with_pardisos_own(adaptive_mesh, monkeypatch):
+def test_solve_uses_the_ordering_and_agrees_with_pardisos_own(adaptive_mesh):
     problem = example_6_2()
     ordered = solve(problem, adaptive_mesh, solver=pardiso_solver, nested=False)
-    import signorini.contact.solution as solution
-
-    monkeypatch.setattr(
-        solution,
-        "ordered_solver",
-        lambda space, solver, coupling=None, **options: make_solver(solver, **options),
-    )
-    own = solve(problem, adaptive_mesh, solver=pardiso_solver, nested=False)
+    with PardisoSolver(check_symmetry=False) as linear:  # a solver object: no ordering set
+        own = solve(problem, adaptive_mesh, solver=linear, nested=False)
+        assert linear.ordering is None and linear.n_analyses == 1
     assert ordered.report.iterations == own.report.iterations
     assert np.abs(ordered.u - own.u).max() <= 1e-10 * np.abs(own.u).max()
     assert (
@@ -176,3 +174,50 @@ def test_vertex_graph_has_an_entry_per_edge_both_ways():
     mesh = rectangle(nx=3, ny=2)
     G = vertex_graph(mesh)
     assert G.nnz == 2 * mesh.n_edges and (G != G.T).nnz == 0 and G.diagonal().sum() == 0
+
+
+@needs_pardiso
+def test_an_ordering_started_in_the_background_is_the_ordering(adaptive_mesh):
+    """:class:`Ordering` with ``prefetch`` (METIS beside the caller, on one MKL thread) gives
+    :func:`dof_ordering` exactly, with and without a contact pair's coupling; it is computed
+    once."""
+    space = P2Space(adaptive_mesh)
+    ahead = Ordering(space, prefetch=True)
+    first = ahead()
+    assert np.array_equal(first, dof_ordering(space)) and ahead() is first
+    assert np.array_equal(Ordering(space)(), first)
+    pair = assemble(two_cylinders(), two_cylinders().mesh)
+    coupling = pair.contact.transfer.nodes
+    assert np.array_equal(
+        Ordering(pair.space, coupling, prefetch=True)(), dof_ordering(pair.space, coupling)
+    )
+    assert np.array_equal(pair.ordering(), dof_ordering(pair.space, coupling))
+
+
+@needs_pardiso
+@pytest.mark.parametrize("make", [example_6_2, example_6_2_tresca, example_6_2_coulomb])
+def test_solve_with_its_analysis_beside_the_assembly_is_the_solve_without(adaptive_mesh, make):
+    """``solve`` with the PARDISO factory orders the unknowns and analyses the matrix beside
+    the assembly (:class:`Ordering`, :meth:`SPDSolver.analyze`); with an assembly passed in,
+    it does both in turn. The solutions are the same bit for bit, with the same counts (one
+    analysis); Coulomb's LU systems (another pattern) are analysed by their own solver."""
+    problem = make()
+    u0 = solve(problem, adaptive_mesh, solver=pardiso_solver).u  # a warm start: no nested solve
+    beside = solve(problem, adaptive_mesh, u0=u0, solver=pardiso_solver)
+    in_turn = solve(
+        problem, adaptive_mesh, u0=u0, solver=pardiso_solver,
+        assembled=assemble(problem, adaptive_mesh),
+    )  # fmt: skip
+    assert np.array_equal(beside.u, in_turn.u)
+    assert np.array_equal(beside.contact_force, in_turn.contact_force)
+    for key in ("iterations", "n_solves", "n_factorizations", "n_analyses", "n_updates"):
+        assert getattr(beside.report, key) == getattr(in_turn.report, key), key
+    assert beside.report.n_analyses == 1
+
+
+def test_takes_ordering_names_the_factories_that_use_an_offered_ordering():
+    assert takes_ordering(pardiso_solver) is True
+    assert takes_ordering(superlu_solver) is False
+    assert takes_ordering(None) is HAS_PARDISO  # auto: PARDISO where it works
+    with make_solver(superlu_solver) as solver:
+        assert takes_ordering(solver) is False  # a solver object is used as it is

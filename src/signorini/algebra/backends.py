@@ -56,6 +56,7 @@ __all__ = [
     "solver_factory",
     "solver_library",
     "solver_name",
+    "takes_ordering",
 ]
 
 
@@ -82,6 +83,22 @@ def auto_solver(request: SolverRequest) -> SPDSolver:
         return pardiso_solver(request)
     _warn_fallback(problem)
     return superlu_solver(request)
+
+
+#: ``auto`` takes the ordering it is offered where it takes PARDISO (:func:`takes_ordering`)
+auto_solver.takes_ordering = lambda: pardiso_problem() is None  # type: ignore[attr-defined]
+
+
+def takes_ordering(solver: object) -> bool:
+    """Whether the factory ``solver`` (``None``: :func:`auto_solver`) gives the solvers it
+    makes the fill-reducing ordering it is offered (:attr:`~.solvers.SolverRequest.ordering`)
+    for a symmetric system, so that the contact layer may compute it ahead
+    (:class:`~signorini.contact.ordering.Ordering`): its attribute ``takes_ordering``, a bool
+    or a function of nothing; False for a solver object (used as it is) and for a factory
+    without the attribute (the ordering is then computed only if the factory asks)."""
+    factory = auto_solver if solver is None else solver
+    flag = getattr(factory, "takes_ordering", False)
+    return bool(flag() if callable(flag) else flag)
 
 
 #: The solver factories by the name the command line and a run folder's manifest use.

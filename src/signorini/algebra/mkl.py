@@ -14,12 +14,18 @@ import importlib.metadata
 import re
 import sys
 from collections.abc import Callable
-from functools import lru_cache
+from functools import cache, lru_cache
 from pathlib import Path
 
 from .solvers import BackendUnavailableError
 
-__all__ = ["mkl_runtime_candidates", "mkl_version", "pardiso_function"]
+__all__ = [
+    "mkl_runtime_candidates",
+    "mkl_threads_local",
+    "mkl_version",
+    "openmp_sleep_at_once",
+    "pardiso_function",
+]
 
 #: File names of MKL's single dynamic library on Linux, macOS and Windows.
 _MKL_RT = re.compile(r"(lib)?mkl_rt(\.\d+)*\.(so(\.\d+)*|dylib|dll)")
@@ -99,6 +105,59 @@ def pardiso_function() -> Callable[..., None]:
         f"MKL's runtime library mkl_rt could not be loaded ({detail}); install it with "
         "`pip install signorini[fast]` (or `pip install mkl`)"
     )
+
+
+def mkl_threads_local(n: int) -> int:
+    """Set the number of threads MKL uses in the calling thread (``mkl_set_num_threads_local``;
+    0 returns to the global setting); the previous local setting is returned (0 where MKL has
+    no such call).
+
+    Raises
+    ------
+    BackendUnavailableError
+        If MKL cannot be loaded.
+    """
+    func = _mkl_call("MKL_Set_Num_Threads_Local")
+    return 0 if func is None else int(func(int(n)))
+
+
+def openmp_sleep_at_once() -> bool:
+    """Let the OpenMP threads of the calling thread's team sleep as soon as a parallel region
+    ends (Intel OpenMP's ``kmp_set_blocktime(0)``; they wait 200 ms by default), so that
+    after a call of MKL in a thread of ours they do not take a core from the main thread's
+    work. False where the OpenMP runtime MKL loaded has no such call.
+
+    Raises
+    ------
+    BackendUnavailableError
+        If MKL cannot be loaded.
+    """
+    threads = _mkl_call("MKL_Get_Max_Threads")  # loads MKL's threading layer and its OpenMP
+    if threads is not None:
+        threads()
+    try:
+        func = ctypes.CDLL(None).kmp_set_blocktime
+    except (OSError, AttributeError):
+        return False
+    func.argtypes = [ctypes.c_int]
+    func.restype = None
+    func(0)
+    return True
+
+
+@cache
+def _mkl_call(name: str) -> Callable[..., int] | None:
+    """MKL's service function ``name`` (one int argument or none, an int result), or None if
+    its library does not export it."""
+    pardiso_function()  # loads MKL, or says why not
+    for path in mkl_runtime_candidates():
+        try:
+            func = getattr(ctypes.CDLL(path), name)
+        except (OSError, AttributeError):
+            continue
+        func.restype = ctypes.c_int
+        return func
+    return None
 
 
 def mkl_version() -> str | None:

@@ -86,6 +86,7 @@ class PardisoSolver(SPDSolver):
 
     backend = "pardiso"
     reuses_analysis = True
+    analysis_reads_values = False  # an SPD analysis: no scaling or matching
     _mtype = 2  # real symmetric positive definite
 
     def __init__(
@@ -201,8 +202,10 @@ class PardisoSolver(SPDSolver):
         self._call(11)
 
     def _load_upper(self, A: sp.csr_matrix, rows: np.ndarray | None = None) -> None:
-        """Release the handle and hold the upper triangle of ``A`` in PARDISO's 32-bit CSR
-        arrays, with its positions in ``A.data`` for later refactorizations."""
+        """Release the handle and hold the pattern of the upper triangle of ``A`` in
+        PARDISO's 32-bit CSR arrays, with its positions in ``A.data`` for the factorizations,
+        which gather the values (the analysis does not read them, and ``A.data`` may be
+        written meanwhile: :meth:`~.solvers.SPDSolver.analyze`)."""
         self._release()
         positions, indptr = upper_positions(A, rows)
         if positions.size >= 2**31 - 1:
@@ -210,7 +213,7 @@ class PardisoSolver(SPDSolver):
         self._upos = positions
         self._ia = indptr.astype(np.int32)
         self._ja = A.indices[positions].astype(np.int32)
-        self._a = A.data[positions]
+        self._a = np.zeros(positions.size)
         self._n_eq = A.shape[0]
 
     def computed_ordering(self, A: sp.csr_matrix) -> np.ndarray:
@@ -295,6 +298,7 @@ class PardisoLUSolver(PardisoSolver):
     """
 
     _mtype = 11  # real non-symmetric
+    analysis_reads_values = True  # scaling and weighted matching
 
     def __init__(
         self,
@@ -347,6 +351,10 @@ def pardiso_solver(request: SolverRequest) -> PardisoSolver:
     if request.ordering is not None:
         solver.ordering = request.ordering()
     return solver
+
+
+#: PARDISO takes the ordering it is offered (:func:`~.backends.takes_ordering`)
+pardiso_solver.takes_ordering = True  # type: ignore[attr-defined]
 
 
 def metis_ordering(graph: sp.spmatrix) -> np.ndarray:

@@ -19,12 +19,14 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from concurrent.futures import Future
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 import scipy.sparse as sp
 
+from . import beside as background
 from .sparse import as_csr, csr_row_indices, diagonal_positions, list_indices, symmetry_defect
 
 __all__ = [
@@ -138,6 +140,9 @@ class SPDSolver:
         number of right-hand sides).
     time_analysis, time_factorization, time_solve : float
         Seconds spent in each phase (wall clock).
+    analysis_reads_values : bool
+        Whether the symbolic analysis reads the matrix's values (scaling, matching); where it
+        does not, :meth:`analyze` may run beside the caller.
     rtol : float or None
         An iterative solver's tolerance: its solves stop at ``‖b − A x‖₂ ≤ rtol ‖b‖₂``, and
         the active set methods then follow the inexact stopping rule of :mod:`.inexact`
@@ -148,6 +153,7 @@ class SPDSolver:
     backend: str = ""
     reuses_analysis: bool = False
     rtol: float | None = None
+    analysis_reads_values: bool = True
 
     def __init__(
         self,
@@ -170,6 +176,7 @@ class SPDSolver:
         self._matrix: sp.csr_matrix | None = None  # the matrix of the last factorize()
         self._n = 0
         self._factorized = False
+        self._ahead: Future | None = None  # an analysis running beside the caller (analyze)
         if A is not None:
             self.factorize(A)
 
@@ -211,25 +218,61 @@ class SPDSolver:
             If the matrix is singular or not positive definite.
         """
         A = as_csr(A)
+        self._wait()
         if not self.same_pattern(A):
-            rows = csr_row_indices(A)
-            self._check_new_pattern(A, rows)
-            self._perm = checked_ordering(self.ordering, A.shape[0])
-            self._factorized = False
-            t0 = time.perf_counter()
-            self._analyze(A, rows)
-            self.time_analysis += time.perf_counter() - t0
-            del rows  # 4 bytes per stored entry, not needed by the factorization's peak
-            self.n_analyses += 1
-            self._n = A.shape[0]
-            self._indptr = A.indptr.copy()
-            self._indices = A.indices  # a reference: patterns are not modified in place
+            self._counted(self._analysis(A))
         if keep is not None:
             keep = np.asarray(keep)
             if keep.dtype != np.bool_ or keep.shape != (A.nnz,):
                 raise ValueError(f"keep must be a boolean mask of shape ({A.nnz},)")
         self._matrix = A
         self._numeric(keep)
+
+    def analyze(self, A: sp.spmatrix, *, beside: bool = False) -> None:
+        """The symbolic analysis of ``A``'s pattern now, ahead of :meth:`factorize`, which
+        reuses it for a matrix of that pattern (``A`` checked as there; its values are not
+        read where :attr:`analysis_reads_values` is False, and may be written until then).
+
+        With ``beside`` (and :attr:`analysis_reads_values` False) the analysis runs in a
+        background (:func:`~.beside.beside`), beside the caller's work; the next
+        :meth:`factorize` or :meth:`close` waits for it and raises its error, if any.
+        """
+        A = as_csr(A)
+        self._wait()
+        if self.same_pattern(A):
+            return
+        if beside and not self.analysis_reads_values:
+            self._ahead = background.beside(self._analysis, A)
+        else:
+            self._counted(self._analysis(A))
+
+    def _analysis(self, A: sp.csr_matrix) -> float:
+        """Check a new pattern, analyse it, and remember it; the seconds of the analysis."""
+        rows = csr_row_indices(A)
+        self._check_new_pattern(A, rows)
+        self._perm = checked_ordering(self.ordering, A.shape[0])
+        self._factorized = False
+        t0 = time.perf_counter()
+        self._analyze(A, rows)
+        seconds = time.perf_counter() - t0
+        del rows  # 4 bytes per stored entry, not needed by the factorization's peak
+        self._n = A.shape[0]
+        self._indptr = A.indptr.copy()
+        self._indices = A.indices  # a reference: patterns are not modified in place
+        return seconds
+
+    def _counted(self, seconds: float) -> None:
+        """Count an analysis of ``seconds``: when it is done, or when the factorization that
+        uses it waits for it (an analysis beside the caller belongs to the call that uses it,
+        for the counters a caller differences, :func:`solver_usage`)."""
+        self.n_analyses += 1
+        self.time_analysis += seconds
+
+    def _wait(self) -> None:
+        """Wait for an analysis started by :meth:`analyze` beside the caller, if any."""
+        ahead, self._ahead = self._ahead, None
+        if ahead is not None:
+            self._counted(ahead.result())
 
     def refactorize(self, keep: np.ndarray) -> None:
         """Factorize the matrix of the last :meth:`factorize` again, with another ``keep``.
@@ -297,6 +340,9 @@ class SPDSolver:
 
     def close(self) -> None:
         """Release the factorization (the object can factorize again afterwards)."""
+        ahead, self._ahead = self._ahead, None
+        if ahead is not None:  # wait for it; its error, if any, concerns no one now
+            ahead.exception()
         self._factorized = False
         self._indptr = self._indices = self._matrix = None
 

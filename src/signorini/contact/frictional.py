@@ -252,9 +252,8 @@ def solve_frictional(
     ).on_ranks(assembled.ranks)  # fmt: skip
     options = FrictionOptions(max_iter=max_iter)
     # symmetric laws only (Tresca): symmetric systems (Cholesky); else non-symmetric ones (LU)
-    coupling = None if cs.transfer is None else cs.transfer.nodes
     with ordered_solver(
-        assembled.space, solver, symmetric=problem.symmetric, coupling=coupling,
+        assembled.space, solver, symmetric=problem.symmetric, ordering=assembled.ordering,
         rigid_modes=lambda: system_rigid_modes(assembled),
     ) as linear:  # fmt: skip
         res = solve_friction(problem, options=options, solver=linear, **warm)

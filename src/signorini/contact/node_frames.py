@@ -163,6 +163,25 @@ def _row_pairs(indptr: np.ndarray, nodes: np.ndarray) -> tuple[np.ndarray, np.nd
     return pos0, pos0 + np.repeat(length, length), length
 
 
+def _column_entries(
+    K: sp.csr_matrix, which_node: np.ndarray, pos0: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The positions of the stored entries in column ``2z`` of each node ``z`` of
+    ``which_node`` (its index there, -1 elsewhere) and those indices, for a ``K`` with a
+    symmetric pattern: only the rows of the DOFs that rows ``2z`` (stored at ``pos0``) couple
+    with store such a column, so only they are read (a few rows near the constrained
+    boundary instead of every entry of ``K``); the positions come in increasing order, as a
+    scan of every entry gives them."""
+    rows = np.unique(K.indices[pos0])
+    start = K.indptr[rows]
+    length = K.indptr[rows + 1] - start
+    positions = np.repeat(start - (np.cumsum(length) - length), length) + np.arange(length.sum())
+    columns = K.indices[positions]
+    col_node = which_node[columns >> 1]
+    hit = (col_node >= 0) & (columns % 2 == 0)
+    return positions[hit], col_node[hit]
+
+
 def _check_node_blocks(
     K: sp.csr_matrix, nodes: np.ndarray, first: np.ndarray, n_column_entries: int
 ) -> None:
@@ -254,14 +273,18 @@ def rotate_frames(
     # Column rotation: in every row, column 2z is stored and followed by column 2z + 1.
     which_node = np.full(K.shape[0] // 2, -1, dtype=np.int64)
     which_node[nodes] = np.arange(nodes.size)
-    col_node = which_node[K.indices >> 1]
-    first = np.flatnonzero((col_node >= 0) & (K.indices % 2 == 0))
-    if validate:
-        _check_node_blocks(K, nodes, first, np.count_nonzero(col_node >= 0))
     # Row rotation: rows 2z and 2z + 1 store the same columns, paired entry by entry.
     pos0, pos1, length = _row_pairs(K.indptr, nodes)
+    if validate or not np.diff(K.indptr).all():  # any row may store a column 2z
+        col_node = which_node[K.indices >> 1]
+        first = np.flatnonzero((col_node >= 0) & (K.indices % 2 == 0))
+        if validate:
+            _check_node_blocks(K, nodes, first, np.count_nonzero(col_node >= 0))
+        col_node = col_node[first]
+    else:  # an assembled matrix, whole: its pattern is symmetric
+        first, col_node = _column_entries(K, which_node, pos0)
     data = K.data
-    _transform_pairs(first, first + 1, Q[col_node[first]], data)
+    _transform_pairs(first, first + 1, Q[col_node], data)
     _transform_pairs(pos0, pos1, np.repeat(Q, length, axis=0), data)
     _transform_pairs(2 * nodes, 2 * nodes + 1, Q, F_rot)
     return K, F_rot

@@ -13,23 +13,31 @@ operations; the complete solve 0.57 times PARDISO's own.
 :func:`~signorini.contact.solve` into the solver of one mesh's systems: a factory is asked
 for a new one, offered this ordering (computed only if the backend takes it); a solver
 object is used as it is.
+
+:class:`Ordering` computes the ordering once per system. :func:`~.system.assemble` starts it
+in a background thread (``prefetch_ordering``) when the solver will take it
+(:func:`~signorini.algebra.backends.takes_ordering`): METIS runs in PARDISO's analysis
+through ``ctypes``, which releases the interpreter, so it takes the second core while the
+stiffness matrix is assembled on the first (docs/method.md, *Ordering of the unknowns*).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import Future
 from contextlib import AbstractContextManager, nullcontext
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..algebra.backends import make_solver
+from ..algebra.beside import beside
 from ..algebra.pardiso import metis_ordering
 from ..algebra.solvers import SolverFactory, SPDSolver
 from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
 
-__all__ = ["dof_ordering", "ordered_solver", "vertex_graph"]
+__all__ = ["Ordering", "dof_ordering", "ordered_solver", "vertex_graph"]
 
 
 def vertex_graph(mesh: Mesh) -> sp.csr_matrix:
@@ -56,6 +64,13 @@ def _with_coupling(graph: sp.csr_matrix, mesh: Mesh, coupling: sp.spmatrix) -> s
     return (graph + extra).tocsr()
 
 
+def ordering_graph(mesh: Mesh, coupling: sp.spmatrix | None = None) -> sp.csr_matrix:
+    """The graph :func:`dof_ordering` orders: the mesh's vertex graph, joined along the node
+    pairs of ``coupling``."""
+    graph = vertex_graph(mesh)
+    return graph if coupling is None else _with_coupling(graph, mesh, coupling)
+
+
 def dof_ordering(space: LagrangeSpace, coupling: sp.spmatrix | None = None) -> np.ndarray:
     """A nested dissection ordering of the space's DOFs: METIS on the vertex graph
     (:func:`~signorini.algebra.pardiso.metis_ordering`), with the node pairs ``coupling``
@@ -67,10 +82,49 @@ def dof_ordering(space: LagrangeSpace, coupling: sp.spmatrix | None = None) -> n
     signorini.algebra.BackendUnavailableError
         If MKL (which provides METIS here) cannot be loaded.
     """
-    graph = vertex_graph(space.mesh)
-    if coupling is not None:
-        graph = _with_coupling(graph, space.mesh, coupling)
-    return space.dof_order(metis_ordering(graph))
+    return space.dof_order(metis_ordering(ordering_graph(space.mesh, coupling)))
+
+
+class Ordering:
+    """The ordering :func:`dof_ordering` of one system's unknowns, computed once: when it is
+    first asked for, or, with ``prefetch``, started at once in a background thread.
+
+    With ``prefetch`` the graph is built here, in the caller's thread, and only METIS (in
+    PARDISO's analysis, which releases the interpreter) runs in the background
+    (:func:`~signorini.algebra.beside.beside`) while the caller goes on (the stiffness
+    matrix's assembly, :func:`~.system.assemble`); the first call waits for it and extends
+    it to the DOFs. The result is the same either way, and an error of the background work
+    (e.g. MKL missing) is raised by that call.
+
+    Parameters
+    ----------
+    space : LagrangeSpace
+    coupling : (n_nodes, n_nodes) sparse matrix, optional
+        As in :func:`dof_ordering`.
+    prefetch : bool
+        Start METIS now, in the background.
+    """
+
+    def __init__(
+        self, space: LagrangeSpace, coupling: sp.spmatrix | None = None, *, prefetch: bool = False
+    ) -> None:
+        self._space, self._coupling = space, coupling
+        self._order: np.ndarray | None = None
+        self._metis: Future | None = None
+        if prefetch:
+            graph = ordering_graph(space.mesh, coupling)
+            self._metis = beside(metis_ordering, graph, one_thread=True)
+
+    def __call__(self) -> np.ndarray:
+        """``order[k]``: the DOF eliminated k-th."""
+        if self._order is None:
+            if self._metis is not None:
+                vertices = self._metis.result()
+            else:
+                vertices = metis_ordering(ordering_graph(self._space.mesh, self._coupling))
+            self._order = self._space.dof_order(vertices)
+            self._metis = self._coupling = None
+        return self._order
 
 
 def ordered_solver(
@@ -79,7 +133,7 @@ def ordered_solver(
     *,
     symmetric: bool = True,
     check_symmetry: bool = True,
-    coupling: sp.spmatrix | None = None,
+    ordering: Callable[[], np.ndarray] | None = None,
     rigid_modes: Callable[[], np.ndarray] | None = None,
 ) -> AbstractContextManager[SPDSolver]:
     """The solver of ``space``'s systems, as a context manager.
@@ -89,14 +143,15 @@ def ordered_solver(
     space : LagrangeSpace
     solver : SPDSolver or SolverFactory, optional
         A factory (default :func:`~signorini.algebra.auto_solver`) makes a new solver,
-        offered :func:`dof_ordering` (PARDISO takes it; SuperLU keeps its own minimum degree
+        offered ``ordering`` (PARDISO takes it; SuperLU keeps its own minimum degree
         ordering), and closed at the end of the ``with`` block. An :class:`SPDSolver` is used
         as it is and not closed: its owner closes it.
     symmetric, check_symmetry : bool
         What the factory is asked for (:class:`~signorini.algebra.SolverRequest`).
-    coupling : (n_nodes, n_nodes) sparse matrix, optional
-        Node pairs the system joins beyond the mesh's edges (a contact pair's mortar
-        transfer), for the ordering.
+    ordering : callable () -> (n,) int array, optional
+        The ordering offered: the system's :class:`Ordering` (the ``ordering`` of its
+        :class:`~.system.Assembled`, which knows a contact pair's coupling). Default:
+        :func:`dof_ordering` of ``space``.
     rigid_modes : callable () -> (n, k) float array, optional
         The rigid motions in the system's unknowns, offered to the factory
         (:attr:`~signorini.algebra.SolverRequest.rigid_modes`; an algebraic multigrid's
@@ -108,6 +163,6 @@ def ordered_solver(
         solver,
         symmetric=symmetric,
         check_symmetry=check_symmetry,
-        ordering=lambda: dof_ordering(space, coupling),
+        ordering=Ordering(space) if ordering is None else ordering,
         rigid_modes=rigid_modes,
     )

@@ -7,6 +7,7 @@ frames and the nodes of oblique and curved rollers into ``[n t]`` frames (docs/m
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +26,7 @@ from ..problem.problem import ContactProblem
 from ..problem.rollers import HeldNodes, held_nodes
 from .contact_set import ContactSet, contact_set
 from .node_frames import frame_matrices, rotate_frames
+from .ordering import Ordering
 from .partition import Partition, partition
 from .two_body import rows_read, two_body_system
 
@@ -95,6 +97,11 @@ class Assembled:
     partition : Partition or None
         On a run of several MPI ranks, which rank owns which nodes and cells
         (:func:`~.partition.partition`) and the ranks (``partition.ranks``); None on one.
+    ordering : Ordering or None
+        The fill-reducing ordering of the unknowns offered to the solver
+        (:func:`~.ordering.dof_ordering`, with a contact pair's coupling), computed once;
+        started in the background during the assembly with ``prefetch_ordering``. None for
+        an Assembled built by hand: the solver is then offered the space's.
     """
 
     space: LagrangeSpace
@@ -110,6 +117,7 @@ class Assembled:
     frames: np.ndarray
     rollers: RollerDofs
     partition: Partition | None = None
+    ordering: Ordering | None = None
 
     @property
     def ranks(self) -> Ranks:
@@ -124,6 +132,8 @@ def assemble(
     *,
     element: str | Element = "P2",
     ranks: Ranks = SERIAL,
+    prefetch_ordering: bool = False,
+    on_pattern: Callable[[sp.csr_matrix, ContactSet, Ordering], None] | None = None,
 ) -> Assembled:
     """Stiffness, load and constraints of ``problem`` on ``mesh`` (paper, Section 3).
 
@@ -141,6 +151,15 @@ def assemble(
     that touch them: its ``K`` is the serial one with the other ranks' rows emptied, bit for
     bit, also after the change of basis of two bodies and the rotation into frames. F and
     everything else are the same on every rank. On one process nothing changes.
+
+    With ``prefetch_ordering`` (on one process; :func:`~.solution.solve` asks for it when its
+    solver takes an ordering, :func:`~signorini.algebra.backends.takes_ordering`) the
+    fill-reducing ordering of the unknowns (:attr:`Assembled.ordering`) is started in a
+    background thread before the stiffness matrix is assembled, and runs beside it.
+    ``on_pattern(K, contact, ordering)`` is called as soon as ``K``'s pattern is final (its
+    values are not: the rotation into frames writes them afterwards, in place):
+    :func:`~.solution.solve` starts the linear solver's symbolic analysis there, beside the
+    rest of the assembly (docs/method.md, *Ordering of the unknowns*).
     """
     t0 = time.perf_counter()
     if not isinstance(ranks, Ranks):
@@ -155,6 +174,11 @@ def assemble(
         )
     n_dofs = space.n_dofs
     cs = contact_set(problem, space)
+    ordering = Ordering(
+        space,
+        None if cs.transfer is None else cs.transfer.nodes,
+        prefetch=prefetch_ordering and ranks.size == 1,
+    )
     part, rows = None, None
     if ranks.size > 1:  # this rank's rows, and with contact pairs the rows they read
         part = partition(space, ranks, None if cs.transfer is None else cs.transfer.nodes)
@@ -212,6 +236,8 @@ def assemble(
         K, F = two_body_system(K, F, cs.transfer.dofs)
         if part is not None:
             K = part.own_rows(K)
+    if on_pattern is not None:
+        on_pattern(K, cs, ordering)
     held = held_nodes(problem, space)
     frame_nodes, frames = system_frames(cs, held)
     K, F = rotate_frames(K, F, frame_nodes, frames, copy=False, validate=False)
@@ -230,6 +256,7 @@ def assemble(
         frames,
         roller_dofs(problem, space, held, cs),
         part,
+        ordering,
     )
 
 

@@ -92,8 +92,9 @@ def rows_read(cell_nodes: np.ndarray, Td: sp.csr_matrix, nodes: np.ndarray) -> n
 
 def _add_rows(K: sp.csr_matrix, C: sp.csr_matrix) -> sp.csr_matrix:
     """``K + C`` for a ``C`` with few non-empty rows, keeping every entry either stores
-    (explicit zeros too), indices sorted: only the rows ``C`` touches are merged, the others
-    copied as they are (one pass over ``K``)."""
+    (explicit zeros too), indices sorted: only the rows ``C`` touches are merged; the
+    others are moved as they are, by one deletion and one insertion of those rows' entries
+    (two passes over ``K``'s arrays, no index array of its size)."""
     K.sort_indices()
     n = K.shape[0]
     touched = np.unique(np.repeat(np.arange(n), np.diff(C.indptr)))
@@ -103,20 +104,16 @@ def _add_rows(K: sp.csr_matrix, C: sp.csr_matrix) -> sp.csr_matrix:
          (np.concatenate([Ks.row, Cs.row]), np.concatenate([Ks.col, Cs.col]))),
         shape=(touched.size, K.shape[1]),
     ).tocsr()  # fmt: skip  # duplicates summed, explicit zeros kept, sorted
+    start = K.indptr[touched]
+    length = K.indptr[touched + 1] - start
+    at = start - (np.cumsum(length) - length)  # each touched row's place in K without them
+    entries = np.repeat(at, length) + np.arange(length.sum())  # theirs in K
+    merged = np.repeat(at, np.diff(M.indptr))
+    data = np.insert(np.delete(K.data, entries), merged, M.data)
+    indices = np.insert(np.delete(K.indices, entries), merged, M.indices)
     lengths = np.diff(K.indptr)
     lengths[touched] = np.diff(M.indptr)
     indptr = np.concatenate([[0], np.cumsum(lengths)])
-    data = np.empty(indptr[-1])
-    indices = np.empty(indptr[-1], dtype=K.indices.dtype)
-    row = np.repeat(np.arange(n), np.diff(K.indptr))
-    keep = np.ones(n, dtype=bool)
-    keep[touched] = False
-    kept = keep[row]
-    pos = indptr[row[kept]] + (np.arange(K.nnz) - K.indptr[row])[kept]
-    data[pos], indices[pos] = K.data[kept], K.indices[kept]
-    mrow = np.repeat(np.arange(touched.size), np.diff(M.indptr))
-    pos = indptr[touched[mrow]] + np.arange(M.nnz) - M.indptr[mrow]
-    data[pos], indices[pos] = M.data, M.indices
     out = sp.csr_matrix((data, indices, indptr), shape=K.shape)
     out.has_sorted_indices = True
     return out
