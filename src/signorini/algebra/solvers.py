@@ -18,15 +18,13 @@ registry of :mod:`.backends` names them for the command line.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from concurrent.futures import Future
-from dataclasses import dataclass
-from typing import Protocol
 
 import numpy as np
 import scipy.sparse as sp
 
 from . import beside as background
+from .requests import SolverFactory, SolverRequest
 from .sparse import as_csr, csr_row_indices, diagonal_positions, list_indices, symmetry_defect
 
 __all__ = [
@@ -367,57 +365,6 @@ class SPDSolver:
 
     def _solve(self, b: np.ndarray) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
-
-
-@dataclass(frozen=True)
-class SolverRequest:
-    """What a caller asks of a :class:`SolverFactory` for one sequence of linear systems.
-
-    New fields get defaults, so that a factory written today keeps working when the request
-    grows (a distributed backend may read more of it).
-
-    Attributes
-    ----------
-    symmetric : bool
-        True: the matrices are symmetric positive definite (a Cholesky factorization, e.g.
-        the frictionless and Tresca systems); False: general matrices (an LU factorization,
-        e.g. Coulomb's non-symmetric systems), whose symmetry is not checked.
-    check_symmetry : bool
-        With ``symmetric``: check ``max |A - A^T| <= 1e-12 max |A|`` at each analysis (the
-        contact layer's assembled matrices are symmetric by construction and skip it).
-    ordering : callable () -> (n,) int array, optional
-        A fill-reducing ordering of the unknowns (:attr:`SPDSolver.ordering`), computed only
-        when called: a factory whose backend orders better by itself, or cannot use a given
-        ordering, does not call it (the contact layer's METIS ordering of the mesh's vertex
-        graph, :func:`signorini.contact.ordering.dof_ordering`, needs MKL).
-    rigid_modes : callable () -> (n, k) float array, optional
-        The rigid motions of the bodies written in the system's unknowns (node frames, the
-        relative displacement of contact pairs): the near-nullspace of the matrix before
-        its Dirichlet DOFs are fixed, computed only when called (an algebraic multigrid
-        needs it, :mod:`.petsc_gamg`; the contact layer's
-        :func:`signorini.contact.rigid_modes.system_rigid_modes`).
-    """
-
-    symmetric: bool = True
-    check_symmetry: bool = True
-    ordering: Callable[[], np.ndarray] | None = None
-    rigid_modes: Callable[[], np.ndarray] | None = None
-
-
-class SolverFactory(Protocol):
-    """A callable that makes a new solver for one sequence of linear systems.
-
-    ``factory(request) -> SPDSolver``: a solver that has not factorized yet, for the kind of
-    matrices :class:`SolverRequest` describes. Whoever calls the factory owns the solver and
-    closes it (:meth:`SPDSolver.close`). A factory may raise
-    :class:`BackendUnavailableError` when its backend cannot be used here.
-
-    A backend is an :class:`SPDSolver` subclass (or two: Cholesky and LU) and a factory
-    function in one module; registering it by name is one line of
-    :data:`signorini.algebra.backends.SOLVERS`.
-    """
-
-    def __call__(self, request: SolverRequest, /) -> SPDSolver: ...
 
 
 def checked_ordering(ordering: object, n: int) -> np.ndarray | None:

@@ -19,6 +19,8 @@ in a background thread (``prefetch_ordering``) when the solver will take it
 (:func:`~signorini.algebra.backends.takes_ordering`): METIS runs in PARDISO's analysis
 through ``ctypes``, which releases the interpreter, so it takes the second core while the
 stiffness matrix is assembled on the first (docs/method.md, *Ordering of the unknowns*).
+:class:`SolverAhead` makes the solver of the system as soon as the matrix's pattern is known
+and starts its symbolic analysis there too, beside the rest of the assembly.
 """
 
 from __future__ import annotations
@@ -33,11 +35,12 @@ import scipy.sparse as sp
 from ..algebra.backends import make_solver
 from ..algebra.beside import beside
 from ..algebra.pardiso import metis_ordering
-from ..algebra.solvers import SolverFactory, SPDSolver
+from ..algebra.solvers import SolverFactory, SolverRequest, SPDSolver
 from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
+from .contact_set import ContactSet
 
-__all__ = ["Ordering", "dof_ordering", "ordered_solver", "vertex_graph"]
+__all__ = ["Ordering", "SolverAhead", "dof_ordering", "ordered_solver", "vertex_graph"]
 
 
 def vertex_graph(mesh: Mesh) -> sp.csr_matrix:
@@ -166,3 +169,40 @@ def ordered_solver(
         ordering=Ordering(space) if ordering is None else ordering,
         rigid_modes=rigid_modes,
     )
+
+
+class SolverAhead:
+    """The factory of one mesh's solver whose symbolic analysis starts during the assembly.
+
+    :meth:`start` (:func:`~.system.assemble`'s ``on_pattern``) makes the symmetric solver of
+    the system from ``factory`` with the system's ordering as soon as ``K``'s pattern is
+    known, and starts its analysis beside the rest of the assembly
+    (:meth:`~signorini.algebra.SPDSolver.analyze`); a request for a symmetric system then
+    gets that solver, any other request a new one from ``factory``. Where a contact part's
+    friction law is not symmetric (Coulomb: LU systems on another pattern) nothing starts.
+    The solver does not check the symmetry of ``K``, symmetric by construction.
+    """
+
+    def __init__(self, factory: SolverFactory | None) -> None:
+        self.factory = factory
+        self.linear: SPDSolver | None = None
+
+    def start(self, K: sp.csr_matrix, contact: ContactSet, ordering: Ordering) -> None:
+        if contact.has_friction and not contact.friction.symmetric:
+            return
+        self.linear = make_solver(self.factory, check_symmetry=False, ordering=ordering)
+        self.linear.analyze(K, beside=True)
+
+    def __call__(self, request: SolverRequest) -> SPDSolver:
+        made, self.linear = self.linear, None
+        if made is not None and request.symmetric:
+            return made
+        if made is not None:
+            made.close()
+        return make_solver(
+            self.factory,
+            symmetric=request.symmetric,
+            check_symmetry=request.check_symmetry,
+            ordering=request.ordering,
+            rigid_modes=request.rigid_modes,
+        )

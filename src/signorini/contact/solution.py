@@ -17,12 +17,12 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
-from ..algebra.backends import make_solver, takes_ordering
+from ..algebra.backends import takes_ordering
 from ..algebra.friction import INACTIVE, SLIP, STICK
 from ..algebra.pdas import PDASOptions, solve_pdas
 from ..algebra.ranks import solver_ranks
 from ..algebra.result import SolveReport
-from ..algebra.solvers import SolverFactory, SolverRequest, SPDSolver
+from ..algebra.solvers import SolverFactory, SPDSolver
 from ..algebra.sparse import stiffness_unit
 from ..fem.element import Element
 from ..fem.norms import energy_error2, h1_seminorm_error2
@@ -36,7 +36,7 @@ from .force_control import check_load_carried, initial_active_set
 from .frictional import Solved, check_previous, solve_frictional
 from .nested import NESTED_MIN_NDOF, nested_active_set
 from .node_frames import to_cartesian
-from .ordering import Ordering, ordered_solver
+from .ordering import SolverAhead, ordered_solver
 from .partition import Partition
 from .profile import ContactProfile, contact_profile
 from .rigid_modes import system_rigid_modes
@@ -319,7 +319,7 @@ def solve(
     ahead = None
     if assembled is None:
         serial = not solver_ranks(solver).distributed
-        ahead = _SolverAhead(solver) if serial and takes_ordering(solver) else None
+        ahead = SolverAhead(solver) if serial and takes_ordering(solver) else None
         assembled = assemble(
             problem, mesh, element=element, ranks=solver_ranks(solver),
             prefetch_ordering=ahead is not None, on_pattern=ahead and ahead.start,
@@ -405,43 +405,6 @@ def solve(
         roller_force=assembled.rollers.force(assembled.K, assembled.F, solved.x, ranks),
         partition=assembled.partition,
     )
-
-
-class _SolverAhead:
-    """The factory of one mesh's solver whose symbolic analysis starts during the assembly.
-
-    :meth:`start` (:func:`~.system.assemble`'s ``on_pattern``) makes the symmetric solver of
-    the system from ``factory`` with the system's ordering as soon as ``K``'s pattern is
-    known, and starts its analysis beside the rest of the assembly
-    (:meth:`~signorini.algebra.SPDSolver.analyze`); a request for a symmetric system then
-    gets that solver, any other request a new one from ``factory``. Where a contact part's
-    friction law is not symmetric (Coulomb: LU systems on another pattern) nothing starts.
-    The solver does not check the symmetry of ``K``, symmetric by construction.
-    """
-
-    def __init__(self, factory: SolverFactory | None) -> None:
-        self.factory = factory
-        self.linear: SPDSolver | None = None
-
-    def start(self, K: sp.csr_matrix, contact: ContactSet, ordering: Ordering) -> None:
-        if contact.has_friction and not contact.friction.symmetric:
-            return
-        self.linear = make_solver(self.factory, check_symmetry=False, ordering=ordering)
-        self.linear.analyze(K, beside=True)
-
-    def __call__(self, request: SolverRequest) -> SPDSolver:
-        made, self.linear = self.linear, None
-        if made is not None and request.symmetric:
-            return made
-        if made is not None:
-            made.close()
-        return make_solver(
-            self.factory,
-            symmetric=request.symmetric,
-            check_symmetry=request.check_symmetry,
-            ordering=request.ordering,
-            rigid_modes=request.rigid_modes,
-        )
 
 
 def _solve_system(
