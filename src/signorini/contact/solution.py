@@ -66,6 +66,9 @@ TOUCH_RTOL = 1e-12
 #: ``u0·n − ψ ≥ −WARM_START_RTOL · max(max|u0|, |ψ|)``: the prolongated contact nodes
 #: of the previous level, whose u0·n − ψ is round-off of the displacements
 WARM_START_RTOL = 1e-10
+#: the same with contact pairs: a new slave node's weighted (mortar) gap is met by the
+#: prolongated displacement only to 1.6e-6 (docs/method.md, *Two bodies*)
+PAIR_WARM_START_RTOL = 1e-5
 
 
 def _round_off_scale(u: np.ndarray, gap: np.ndarray) -> np.ndarray:
@@ -342,7 +345,8 @@ def solve(
         if not np.isfinite(u0).all():
             raise ValueError("u0 contains NaN or inf")
         un = cs.normal_displacement(u0)
-        active0 = un - cs.gap >= -WARM_START_RTOL * _round_off_scale(u0, cs.gap)
+        rtol = WARM_START_RTOL if cs.transfer is None else PAIR_WARM_START_RTOL
+        active0 = un - cs.gap >= -rtol * _round_off_scale(u0, cs.gap)
     # K and F divided by a power of 2 when E is extreme (exact; 1 otherwise), so that no
     # product in the factorization overflows or underflows
     diagonal = assembled.K if ranks.size == 1 else sp.diags(ranks.sum(assembled.K.diagonal()))
