@@ -321,3 +321,43 @@ def test_adaptive_coulomb_levels_need_few_iterations():
     ]
     print(f"friction iterations per level: {iterations}")
     assert np.mean(iterations[-8:]) <= 3 and max(iterations[-8:]) <= 5, iterations
+
+
+def test_coulomb_systems_on_a_node_blocked_matrix_take_its_own_pattern(monkeypatch):
+    """Coulomb's non-symmetric rows copy a node's normal row into its tangential row; in
+    an assembled (node-blocked) K both rows store the same columns, so the system takes
+    K's own arrays instead of building the widened pattern: the same iterations and the
+    same solution, bit for bit, as with the widened pattern built."""
+    import signorini.algebra.friction_system as friction_system
+    from signorini.examples import example_6_2_coulomb
+
+    problem = example_6_2_coulomb()
+    levels = list(adaptive(problem, max_ndof=3000))
+    mesh, u0 = levels[-2].next_mesh, levels[-2].next_u0
+    seen = []
+    same_columns = friction_system._same_columns
+
+    def recorded(*args):
+        seen.append(same_columns(*args))
+        return seen[-1]
+
+    monkeypatch.setattr(friction_system, "_same_columns", recorded)
+    own = solve(problem, mesh, u0=u0)
+    assert seen and seen[-1] is not None  # K's own pattern was taken
+    monkeypatch.setattr(friction_system, "_same_columns", lambda *args: None)
+    widened = solve(problem, mesh, u0=u0)
+    assert own.report.iterations == widened.report.iterations >= 1
+    assert np.array_equal(own.u, widened.u)
+    assert np.array_equal(own.tangential_force, widened.tangential_force)
+
+
+def test_a_tangential_row_without_the_normal_rows_columns_is_widened():
+    import scipy.sparse as sp
+
+    from signorini.algebra.friction_system import _same_columns
+
+    K = sp.csr_matrix(np.array([[4.0, 1.0, 1.0], [1.0, 4.0, 0.0], [1.0, 0.0, 4.0]]))
+    K.eliminate_zeros()  # row 1 lacks column 2, which row 0 stores
+    assert _same_columns(K, np.array([0]), np.array([1])) is None
+    blocked = sp.csr_matrix(np.ones((4, 4)) + 3 * np.eye(4))
+    assert np.array_equal(_same_columns(blocked, np.array([0, 2]), np.array([1, 3])), [4, 4])

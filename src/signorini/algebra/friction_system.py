@@ -84,9 +84,10 @@ class CoupledSystem:
 
     The pattern is that of ``K`` with the tangential row of every node whose law has
     ``s' ≠ 0`` widened by the columns of its normal row (in a node-blocked ``K`` both rows
-    have the same columns, so this adds nothing). The positions of ``K``'s entries and of the
-    copies of the normal rows in it are found once; each solve writes the values, zeroes the
-    held rows and columns (diagonal kept) and refactorizes.
+    have the same columns, so this adds nothing, and ``K``'s own arrays are taken). The
+    positions of ``K``'s entries and of the copies of the normal rows in it are found once;
+    each solve writes the values, zeroes the held rows and columns (diagonal kept) and
+    refactorizes.
 
     Parameters
     ----------
@@ -115,20 +116,26 @@ class CoupledSystem:
         self.copy_node = row_node[rows_K[self.copy_src]]
         copy_rows = problem.tangent[self.copy_node]
         copy_cols = K.indices[self.copy_src]
-        rows = np.concatenate([rows_K, copy_rows])
-        cols = np.concatenate([K.indices, copy_cols])
-        pattern = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
-        pattern.sum_duplicates()
-        pattern.sort_indices()
-        self.rows = csr_row_indices(pattern)
+        within = _same_columns(K, problem.normal[coupled], problem.tangent[coupled])
+        if within is not None:  # node blocks: the tangential rows store the normal's columns
+            pattern, self.rows, self.pos_K = K, rows_K, None
+            self.pos_copy = self.copy_src + within[np.searchsorted(coupled, self.copy_node)]
+            self.indptr, self.indices = K.indptr, K.indices
+        else:
+            rows = np.concatenate([rows_K, copy_rows])
+            cols = np.concatenate([K.indices, copy_cols])
+            pattern = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
+            pattern.sum_duplicates()
+            pattern.sort_indices()
+            self.rows = csr_row_indices(pattern)
 
-        def key(r: np.ndarray, c: np.ndarray) -> np.ndarray:  # 64-bit: n² overflows int32
-            return r.astype(np.int64) * n + c
+            def key(r: np.ndarray, c: np.ndarray) -> np.ndarray:  # 64-bit: n² overflows int32
+                return r.astype(np.int64) * n + c
 
-        keys = key(self.rows, pattern.indices)
-        self.pos_K = np.searchsorted(keys, key(rows_K, K.indices))
-        self.pos_copy = np.searchsorted(keys, key(copy_rows, copy_cols))
-        self.indptr, self.indices = pattern.indptr, pattern.indices
+            keys = key(self.rows, pattern.indices)
+            self.pos_K = np.searchsorted(keys, key(rows_K, K.indices))
+            self.pos_copy = np.searchsorted(keys, key(copy_rows, copy_cols))
+            self.indptr, self.indices = pattern.indptr, pattern.indices
         self.diagonal = diagonal_positions(pattern, self.rows)
         self.is_diagonal = self.indices == self.rows
         self.fixed = np.zeros(n, dtype=bool)
@@ -144,8 +151,11 @@ class CoupledSystem:
         p, qp = self.problem, self.problem.qp
         n = qp.n
         factor = np.where(active & ~stick, direction * self.derivative, 0.0)  # σ s' on slip rows
-        data = np.zeros(self.indices.size)
-        data[self.pos_K] = qp.K.data
+        if self.pos_K is None:  # K's own pattern
+            data = qp.K.data.copy()
+        else:
+            data = np.zeros(self.indices.size)
+            data[self.pos_K] = qp.K.data
         data[self.pos_copy] -= factor[self.copy_node] * qp.K.data[self.copy_src]
         A = sp.csr_matrix((data, self.indices, self.indptr), shape=(n, n))
         rhs = qp.F.copy()
@@ -169,3 +179,21 @@ class CoupledSystem:
         x = refine(self.solver.solve, lambda y: b - total(A @ y), b, x, norm, self.solver.backend)
         x[fixed] = values[fixed]
         return x
+
+
+def _same_columns(K: sp.csr_matrix, normal: np.ndarray, tangent: np.ndarray) -> np.ndarray | None:
+    """Where every tangential row ``tangent[k]`` stores the columns of its normal row
+    ``normal[k]``, in the same order (a node-blocked ``K``, as assembled): the offset from
+    an entry of the normal row to the same column's in the tangential row, per pair; None
+    otherwise (the pattern must then be widened)."""
+    start_n, start_t = K.indptr[normal], K.indptr[tangent]
+    length = K.indptr[normal + 1] - start_n
+    if not np.array_equal(length, K.indptr[tangent + 1] - start_t):
+        return None
+    entries = np.arange(length.sum()) - np.repeat(np.cumsum(length) - length, length)
+    if not np.array_equal(
+        K.indices[np.repeat(start_n, length) + entries],
+        K.indices[np.repeat(start_t, length) + entries],
+    ):
+        return None
+    return start_t - start_n
