@@ -15,10 +15,12 @@ does), the strictest floor. At the end it prints the ratios of issues #4 and #26
 measured in this run, and as its last two lines ``ratio_to_ordered_floor=X`` and
 ``ratio_to_floor=X``.
 
-Measured to 5·10⁶ unknowns (``--max-ndof 6000000``, 2026-11-23, 2 cores): 50 levels to
-5 394 800 unknowns in 149 s (sum of floors 145 s, ``ratio_to_floor=1.029``); peak 12 219 MiB
-on the last level, 3.02 x the floor's factor (4040 MiB); 3.49 x at 994 748 unknowns. The
-floor keeps PARDISO's own METIS analysis; the loop orders the unknowns by
+Measured to 5·10⁶ unknowns (``--max-ndof 6000000``, 2026-11-26, 2 cores, a slower day than
+2026-11-23's 149 s): 50 levels to 5 394 800 unknowns in 211 s (sum of floors 212 s with
+PARDISO's own ordering, ``ratio_to_floor=0.997``; 109 s with the loop's,
+``ratio_to_ordered_floor=1.946``); peak 12 461 MiB on the last level, 3.51 x the factor of the
+loop's ordering (3554 MiB; PARDISO's own peak 7368 MiB = 2.07 x). The floor keeps PARDISO's
+own METIS analysis; the loop orders the unknowns by
 :func:`signorini.contact.ordering.dof_ordering`.
 
 With ``--friction coulomb`` (or ``tresca``) the same run solves Example 6.2 with friction on
