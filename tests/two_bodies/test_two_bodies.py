@@ -367,7 +367,7 @@ def test_two_cylinders_adaptive_against_hertz():
     assert 0.09 < m["a"] / (2 / 3) < 0.11
     assert slope <= -0.9
     assert max(level.result.report.kkt.max for level in levels) < 1e-10
-    # the warm start takes the new slave nodes in contact (PAIR_WARM_START_RTOL): one
+    # the warm start takes the new slave nodes in contact (nested.PAIR_WARM_START_RTOL): one
     # factorization per level after the first five, 1.24 solves per level (with the
     # frictionless rule's 1e-10: 1.65 solves and up to two factorizations)
     warm = [level.result.report for level in levels[5:]]

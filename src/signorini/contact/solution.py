@@ -34,7 +34,13 @@ from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
 from .force_control import check_load_carried, initial_active_set
 from .frictional import Solved, check_previous, solve_frictional
-from .nested import NESTED_MIN_NDOF, nested_active_set
+from .nested import (
+    NESTED_MIN_NDOF,
+    WARM_START_RTOL,
+    nested_active_set,
+    round_off_scale,
+    warm_active_set,
+)
 from .node_frames import to_cartesian
 from .ordering import SolverAhead, ordered_solver
 from .partition import Partition
@@ -62,21 +68,6 @@ ERROR_DEGREE = 10
 #: a Dirichlet end point of Γ_C touches the obstacle (for the node classes) where
 #: ``u_D·n − ψ ≥ −TOUCH_RTOL · max(max|u_h|, |ψ|)``
 TOUCH_RTOL = 1e-12
-#: a warm start's node starts in the active set where
-#: ``u0·n − ψ ≥ −WARM_START_RTOL · max(max|u0|, |ψ|)``: the prolongated contact nodes
-#: of the previous level, whose u0·n − ψ is round-off of the displacements
-WARM_START_RTOL = 1e-10
-#: the same with contact pairs: a new slave node's weighted (mortar) gap is met by the
-#: prolongated displacement only to 1.6e-6 (docs/method.md, *Two bodies*)
-PAIR_WARM_START_RTOL = 1e-5
-
-
-def _round_off_scale(u: np.ndarray, gap: np.ndarray) -> np.ndarray:
-    """``max(max|u|, |ψ(z)|)`` per node (the shape of ``gap``): the size of the two numbers
-    ``u(z)·n − ψ(z)`` is the difference of, hence of its round-off. Relative to the
-    displacements and to the gap at the node itself, not to the gap far away (a distant
-    obstacle must not make the test lenient), and invariant under scaling of the problem."""
-    return np.maximum(np.abs(u).max(initial=0.0), np.abs(gap))
 
 
 @dataclass
@@ -229,7 +220,7 @@ class ContactResult:
         cs = self.contact
         loc = cs.edge_local
         gap = cs.edge_normal_gap(self.u)
-        dirichlet_touch = gap >= -TOUCH_RTOL * _round_off_scale(self.u, cs.edge_gap)
+        dirichlet_touch = gap >= -TOUCH_RTOL * round_off_scale(self.u, cs.edge_gap)
         edge_in = np.where(loc >= 0, self.active[np.maximum(loc, 0)], dirichlet_touch)
         return node_classes(cs, self.active, edge_in)
 
@@ -344,9 +335,7 @@ def solve(
             raise ValueError(f"u0 must have shape ({space.n_nodes}, 2), got {u0.shape}")
         if not np.isfinite(u0).all():
             raise ValueError("u0 contains NaN or inf")
-        un = cs.normal_displacement(u0)
-        rtol = WARM_START_RTOL if cs.transfer is None else PAIR_WARM_START_RTOL
-        active0 = un - cs.gap >= -rtol * _round_off_scale(u0, cs.gap)
+        active0 = warm_active_set(cs, u0)
     # K and F divided by a power of 2 when E is extreme (exact; 1 otherwise), so that no
     # product in the factorization overflows or underflows
     diagonal = assembled.K if ranks.size == 1 else sp.diags(ranks.sum(assembled.K.diagonal()))
