@@ -41,11 +41,7 @@ def beside(work: Callable[..., T], *args: object, one_thread: bool = False) -> F
     the factor, and the solution's last bits, are then those of an analysis in the caller's
     thread). A team of two threads of its own waits for work on both cores after its call,
     beside the caller's."""
-    return _WORKER.submit(_one_thread if one_thread else _run, work, *args)
-
-
-def _run(work: Callable[..., T], *args: object) -> T:
-    return work(*args)
+    return _WORKER.submit(_one_thread, work, *args) if one_thread else _WORKER.submit(work, *args)
 
 
 def _one_thread(work: Callable[..., T], *args: object) -> T:

@@ -29,7 +29,7 @@ from .active_system import ActiveSetSystem, refine
 from .friction_kkt import FrictionProblem
 from .ranks import stored_values
 from .solvers import SPDSolver
-from .sparse import abs_matvec, csr_row_indices, diagonal_positions
+from .sparse import abs_matvec, concatenated_ranges, csr_row_indices, diagonal_positions
 
 __all__ = ["CoupledSystem", "SymmetricSystem", "friction_system"]
 
@@ -190,10 +190,8 @@ def _same_columns(K: sp.csr_matrix, normal: np.ndarray, tangent: np.ndarray) -> 
     length = K.indptr[normal + 1] - start_n
     if not np.array_equal(length, K.indptr[tangent + 1] - start_t):
         return None
-    entries = np.arange(length.sum()) - np.repeat(np.cumsum(length) - length, length)
-    if not np.array_equal(
-        K.indices[np.repeat(start_n, length) + entries],
-        K.indices[np.repeat(start_t, length) + entries],
-    ):
+    normal_entries = concatenated_ranges(start_n, length)
+    tangent_entries = concatenated_ranges(start_t, length)
+    if not np.array_equal(K.indices[normal_entries], K.indices[tangent_entries]):
         return None
     return start_t - start_n

@@ -16,6 +16,7 @@ __all__ = [
     "abs_matvec",
     "as_csr",
     "csr_row_indices",
+    "concatenated_ranges",
     "diagonal_positions",
     "list_indices",
     "STIFFNESS_RANGE",
@@ -78,6 +79,12 @@ def csr_row_indices(A: sp.csr_matrix) -> np.ndarray:
     n = A.shape[0]
     dtype = np.int32 if n < np.iinfo(np.int32).max else np.int64
     return np.repeat(np.arange(n, dtype=dtype), np.diff(A.indptr))
+
+
+def concatenated_ranges(start: np.ndarray, length: np.ndarray) -> np.ndarray:
+    """``start[i] + j`` for ``j < length[i]``, range after range: e.g. the positions of the
+    stored entries of some rows of a CSR matrix (``start = indptr[rows]``)."""
+    return np.repeat(start - (np.cumsum(length) - length), length) + np.arange(length.sum())
 
 
 def upper_positions(A: sp.csr_matrix, rows: np.ndarray | None = None) -> tuple[np.ndarray, ...]:

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..algebra.sparse import as_csr, csr_row_indices
+from ..algebra.sparse import as_csr, concatenated_ranges, csr_row_indices
 
 __all__ = ["frame_matrices", "rotate_frames", "to_cartesian", "to_frames"]
 
@@ -158,8 +158,7 @@ def _row_pairs(indptr: np.ndarray, nodes: np.ndarray) -> tuple[np.ndarray, np.nd
     node, paired entry by entry, and the length of row ``2z`` per node."""
     start0, start1 = indptr[2 * nodes], indptr[2 * nodes + 1]
     length = start1 - start0
-    offset = np.arange(length.sum()) - np.repeat(np.cumsum(length) - length, length)
-    pos0 = np.repeat(start0, length) + offset
+    pos0 = concatenated_ranges(start0, length)
     return pos0, pos0 + np.repeat(length, length), length
 
 
@@ -174,8 +173,7 @@ def _column_entries(
     scan of every entry gives them."""
     rows = np.unique(K.indices[pos0])
     start = K.indptr[rows]
-    length = K.indptr[rows + 1] - start
-    positions = np.repeat(start - (np.cumsum(length) - length), length) + np.arange(length.sum())
+    positions = concatenated_ranges(start, K.indptr[rows + 1] - start)
     columns = K.indices[positions]
     col_node = which_node[columns >> 1]
     hit = (col_node >= 0) & (columns % 2 == 0)

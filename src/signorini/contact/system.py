@@ -174,14 +174,11 @@ def assemble(
         )
     n_dofs = space.n_dofs
     cs = contact_set(problem, space)
-    ordering = Ordering(
-        space,
-        None if cs.transfer is None else cs.transfer.nodes,
-        prefetch=prefetch_ordering and ranks.size == 1,
-    )
+    coupling = None if cs.transfer is None else cs.transfer.nodes
+    ordering = Ordering(space, coupling, prefetch=prefetch_ordering and ranks.size == 1)
     part, rows = None, None
     if ranks.size > 1:  # this rank's rows, and with contact pairs the rows they read
-        part = partition(space, ranks, None if cs.transfer is None else cs.transfer.nodes)
+        part = partition(space, ranks, coupling)
         rows = part.owned_nodes
         if cs.transfer is not None:
             rows = rows_read(space.cell_nodes, cs.transfer.dofs, rows)

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..algebra.sparse import concatenated_ranges
 from ..fem.space import P2Space
 from ..problem.fields import ProblemError
 from .constraint_data import edge_weights
@@ -106,8 +107,8 @@ def _add_rows(K: sp.csr_matrix, C: sp.csr_matrix) -> sp.csr_matrix:
     ).tocsr()  # fmt: skip  # duplicates summed, explicit zeros kept, sorted
     start = K.indptr[touched]
     length = K.indptr[touched + 1] - start
+    entries = concatenated_ranges(start, length)  # the touched rows' entries in K
     at = start - (np.cumsum(length) - length)  # each touched row's place in K without them
-    entries = np.repeat(at, length) + np.arange(length.sum())  # theirs in K
     merged = np.repeat(at, np.diff(M.indptr))
     data = np.insert(np.delete(K.data, entries), merged, M.data)
     indices = np.insert(np.delete(K.indices, entries), merged, M.indices)
