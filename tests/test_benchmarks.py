@@ -77,6 +77,36 @@ def test_adaptive_benchmark_reports_consistent_counts_and_floor(tmp_path):
     assert (total - 5e-3) / (floors + 5e-3) <= ratio <= (total + 5e-3) / (floors - 5e-3)
 
 
+def _factor_line(out: str) -> str:
+    return next(line for line in out.splitlines() if line.startswith("peak memory of the loop"))
+
+
+def test_adaptive_benchmark_without_floors_reads_the_loops_factor(tmp_path):
+    """``--no-floor`` runs the same levels without the floors; the factor it reports is the
+    loop's own (its solver's, read after the level), the one the ordered floor reports."""
+    command = [sys.executable, str(ROOT / "benchmarks" / "adaptive.py"), "--max-ndof", "5000"]
+    runs = [
+        subprocess.run(
+            [*command, *extra, "--out", str(tmp_path / name)],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            check=True,
+        ).stdout
+        for name, extra in (("floors", []), ("none", ["--no-floor"]))
+    ]
+    floors, none = runs
+    assert none.strip().splitlines()[-1] == "no floors measured (--no-floor)"
+    lines = none.strip().splitlines()
+    header = lines[0].split()
+    table = [dict(zip(header, line.split(), strict=True)) for line in lines[1 : lines.index("")]]
+    assert int(table[-1]["ndof"]) == 4876 and all(row["floor"] == "nan" for row in table)
+    nnz = [int(re.search(r"8 bytes x (\d+) non-zeros", _factor_line(out))[1]) for out in runs]
+    assert nnz[0] == nnz[1] > 4876
+    peak = float(table[-1]["peakMiB"])
+    assert float(table[-1]["peak/L"]) == pytest.approx(peak * 2**20 / (8 * nnz[1]), rel=0.01)
+
+
 def test_inclined_block_example_runs(tmp_path):
     """The literate example with a non-axis contact normal runs and touches the foundation
     without penetrating it."""
@@ -142,8 +172,9 @@ def test_throughput_benchmark_prints_a_table_of_positive_rates():
     "pardiso" not in available_backends(), reason="compares orderings for MKL PARDISO"
 )
 def test_ordering_benchmark_compares_both_orderings_on_both_meshes():
-    """benchmarks/ordering.py on a small budget: two meshes, both orderings timed, factor
-    sizes and agreement printed, the last line the ratio of the adaptive mesh's solves."""
+    """benchmarks/ordering.py on a small budget: two meshes, both orderings and the block
+    form timed, factor sizes and agreement printed, the last lines the ratios of the adaptive
+    mesh's solves."""
     out = subprocess.run(
         [sys.executable, str(ROOT / "benchmarks" / "ordering.py"), "--max-ndof", "8000"],
         capture_output=True,
@@ -155,12 +186,20 @@ def test_ordering_benchmark_compares_both_orderings_on_both_meshes():
     lines = out.strip().splitlines()
     assert lines[0].startswith("uniform mesh") and "Example 6.2, adaptive mesh" in out
     totals = [float(x) for x in re.findall(r"complete (\d+\.\d+) s;", out)]
-    assert len(totals) == 4 and all(t > 0 for t in totals)
+    assert len(totals) == 6 and all(t > 0 for t in totals)
     ratios = [float(x) for x in re.findall(r"complete solve (\d+\.\d+),", out)]
-    for ratio, own, ours in ((ratios[0], *totals[:2]), (ratios[1], *totals[2:])):
+    assert len(ratios) == 4
+    # per mesh: vertex graph / own, then in blocks / vertex graph
+    pairs = [(0, 1), (1, 2), (3, 4), (4, 5)]
+    for ratio, (i, j) in zip(ratios, pairs, strict=True):
+        own, ours = totals[i], totals[j]
         # the seconds are printed rounded to 1 ms, the ratio to 0.001
         assert (ours - 5e-4) / (own + 5e-4) - 5e-4 <= ratio <= (ours + 5e-4) / (own - 5e-4) + 5e-4
-    agreements = [float(x) for x in re.findall(r"solutions agree to (\S+) ", out)]
-    assert len(agreements) == 2 and max(agreements) < 1e-10
+    agreements = [float(x) for x in re.findall(r"solutions agree to (\d\.\de[-+]\d+)", out)]
+    assert len(agreements) == 4 and max(agreements) < 1e-10
+    memory = [float(x) for x in re.findall(r"PARDISO's memory (\d+) MiB", out)]
+    assert len(memory) == 6 and all(m > 0 for m in memory)
+    assert re.fullmatch(r"blocks_ratio=\d+\.\d{3}", lines[-2])
+    assert float(lines[-2].split("=")[1]) == ratios[3]
     assert re.fullmatch(r"ordering_ratio=\d+\.\d{3}", lines[-1])
-    assert float(lines[-1].split("=")[1]) == ratios[1]
+    assert float(lines[-1].split("=")[1]) == ratios[2]

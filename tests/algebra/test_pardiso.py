@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from linalg_problems import block_spd
+from linalg_problems import block_spd, p2_elasticity
 
 from signorini.algebra import (
     BackendUnavailableError,
@@ -196,3 +196,83 @@ def test_an_analysis_that_reads_the_values_is_done_in_the_callers_thread(backend
         assert solver.analysis_reads_values
         solver.analyze(K, beside=True)
         assert solver.n_analyses == 1
+
+
+def _elasticity_spd(nx: int, ny: int) -> sp.csr_matrix:
+    """A P2 plane-strain stiffness (λ ≠ μ: its off-diagonal node blocks are not symmetric)
+    made definite by a small shift of the stored diagonal."""
+    K, _ = p2_elasticity(nx, ny, lam=2.0, mu=0.5)
+    K.setdiag(K.diagonal() + 0.1)
+    return K
+
+
+@pytest.mark.skipif(not HAS_PARDISO, reason="PARDISO not available")
+def test_node_blocks_go_over_in_blocks_and_solve_as_in_csr():
+    """A matrix of 2 x 2 node blocks is analysed in BSR form, with PARDISO's ordering or one
+    that keeps each node's rows together; the solution, the factor's size and the operation
+    count are those of the CSR form with the same ordering."""
+    K = _elasticity_spd(12, 10)
+    n = K.shape[0]
+    rng = np.random.default_rng(2)
+    b = rng.standard_normal(n)
+    nodes = rng.permutation(n // 2)
+    pairs = np.column_stack([2 * nodes, 2 * nodes + 1]).reshape(-1)
+    for ordering in (None, pairs):
+        with (
+            PardisoSolver(K, ordering=ordering) as blocks,
+            PardisoSolver(K, ordering=ordering, blocks=False) as csr,
+        ):
+            assert (blocks.block_size, csr.block_size) == (2, 1)
+            x, y = blocks.solve(b), csr.solve(b)
+            assert np.linalg.norm(K @ x - b) <= 1e-12 * np.linalg.norm(b)
+            assert np.allclose(x, y, rtol=0, atol=1e-11 * np.abs(y).max())
+            if ordering is not None:  # the same elimination order: about the same factor
+                # (whole 2 x 2 blocks stored: a little more), counted in scalar entries
+                assert 1.0 <= blocks.factor_nnz / csr.factor_nnz <= 1.05
+                assert abs(blocks.factor_mflop - csr.factor_mflop) <= 0.1 * csr.factor_mflop + 1
+
+
+@pytest.mark.skipif(not HAS_PARDISO, reason="PARDISO not available")
+def test_an_ordering_that_splits_a_node_keeps_csr():
+    K = _elasticity_spd(6, 5)
+    n = K.shape[0]
+    split = np.arange(n)
+    split[[1, 2]] = split[[2, 1]]  # node 0's second row after node 1's first
+    b = np.ones(n)
+    with PardisoSolver(K, ordering=split) as solver:
+        assert solver.block_size == 1
+        x = solver.solve(b)
+    assert np.linalg.norm(K @ x - b) <= 1e-12 * np.linalg.norm(b)
+
+
+@pytest.mark.skipif(not HAS_PARDISO, reason="PARDISO not available")
+def test_eliminated_dofs_in_blocks():
+    """PDAS's elimination (``keep``) zeroes entries inside node blocks: the block form
+    factorizes the eliminated matrix as the CSR form does, on one analysis."""
+    K = _elasticity_spd(8, 8)
+    n = K.shape[0]
+    rng = np.random.default_rng(4)
+    elim = SymmetricEliminator(K)
+    b = rng.standard_normal(n)
+    with PardisoSolver(K) as blocks, PardisoSolver(K, blocks=False) as csr:
+        for k in range(3):
+            fixed = np.zeros(n, dtype=bool)
+            fixed[rng.choice(n, 5 + 7 * k, replace=False)] = True  # single rows of a block
+            keep = elim.keep_mask(fixed)
+            blocks.refactorize(keep)
+            csr.refactorize(keep)
+            A = sp.csr_matrix((K.data * keep, K.indices, K.indptr), shape=K.shape)
+            x, y = blocks.solve(b), csr.solve(b)
+            assert np.linalg.norm(A @ x - b) <= 1e-12 * np.linalg.norm(b)
+            assert np.allclose(x, y, rtol=0, atol=1e-11 * np.abs(y).max())
+        assert blocks.n_analyses == 1 and blocks.block_size == 2
+
+
+@pytest.mark.skipif(not HAS_PARDISO, reason="PARDISO not available")
+def test_a_singular_block_matrix_names_its_equation():
+    """In blocks PARDISO reports a zero pivot vaguely; the solver repeats the factorization
+    in CSR form, whose error names the failure and the equation."""
+    K, _ = p2_elasticity(5, 4, lam=2.0, mu=0.5)  # floating: rigid motions are null
+    with pytest.raises(FactorizationError, match="error -4: zero or negative pivot") as info:
+        PardisoSolver(K)
+    assert info.value.equation is not None and 0 <= info.value.equation < K.shape[0]

@@ -5,11 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from linalg_problems import block_spd
+from linalg_problems import block_spd, p2_elasticity
 
 from signorini.algebra.sparse import (
     abs_matvec,
     as_csr,
+    block_upper_positions,
     csr_row_indices,
     diagonal_positions,
     list_indices,
@@ -28,6 +29,44 @@ def test_upper_positions_gather_the_upper_triangle():
     assert positions.dtype == np.int32 and indptr[-1] == positions.size
     rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
     assert positions.size == np.count_nonzero(A.indices >= rows) > U.count_nonzero()
+
+
+def test_block_upper_positions_gather_the_upper_block_triangle():
+    """On a P2 stiffness matrix (λ ≠ μ: off-diagonal node blocks are not symmetric) the
+    positions give each upper block (w ≥ z) row by row, in BSR form; explicit zeros count."""
+    A, _ = p2_elasticity(4, 3, lam=2.0, mu=0.5)
+    A.data[::7] = 0.0
+    positions, indptr, columns = block_upper_positions(A)
+    n = A.shape[0]
+    B = sp.bsr_matrix((A.data[positions].reshape(-1, 2, 2), columns, indptr), shape=A.shape)
+    upper_blocks = np.kron(np.triu(np.ones((n // 2, n // 2))), np.ones((2, 2)))
+    assert np.array_equal(B.toarray(), A.toarray() * upper_blocks)
+    rows = np.repeat(np.arange(n), np.diff(A.indptr))
+    assert columns.size == np.count_nonzero(A.indices >= rows - rows % 2) // 4
+    assert positions.dtype == np.int32 and indptr[-1] == columns.size
+    off = np.flatnonzero(np.repeat(np.arange(n // 2), np.diff(indptr)) != columns)
+    block = A.data[positions].reshape(-1, 2, 2)[off]
+    assert np.abs(block - block.transpose(0, 2, 1)).max() > 0.1  # the test can tell the layout
+
+
+def test_block_upper_positions_refuse_what_is_not_in_2x2_blocks():
+    A, _ = p2_elasticity(3, 2)
+    assert block_upper_positions(A) is not None
+    assert block_upper_positions(sp.identity(5, format="csr")) is None  # odd size
+    assert block_upper_positions(sp.identity(4, format="csr")) is None  # half blocks
+    C = A.tocoo()
+    one = np.flatnonzero((C.row == 2) & (C.col == 5))  # drop one entry of a block
+    D = sp.csr_matrix(
+        (np.delete(C.data, one), (np.delete(C.row, one), np.delete(C.col, one))), shape=A.shape
+    )
+    assert block_upper_positions(D) is None
+    # rows 2z and 2z + 1 with different node columns (each in column pairs)
+    E = sp.csr_matrix(np.kron(np.eye(2), np.ones((2, 2))))
+    F = sp.csr_matrix(
+        ([1.0, 1.0, 1.0, 1.0, 1.0, 1.0], [0, 1, 2, 3, 2, 3], [0, 2, 4, 6]), shape=(3, 4)
+    )
+    G = sp.vstack([F, sp.csr_matrix(([1.0, 1.0], [2, 3], [0, 2]), shape=(1, 4))]).tocsr()
+    assert block_upper_positions(E) is not None and block_upper_positions(G) is None
 
 
 def test_row_indices_and_diagonal_positions():

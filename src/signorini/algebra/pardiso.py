@@ -26,9 +26,9 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
-from .mkl import pardiso_function
+from .mkl import openmp_sleep_at_once, pardiso_function
 from .solvers import BackendUnavailableError, FactorizationError, SolverRequest, SPDSolver
-from .sparse import upper_positions
+from .sparse import block_upper_positions, upper_positions
 
 __all__ = [
     "metis_ordering",
@@ -60,7 +60,8 @@ _PARDISO_ERRORS = {
 class PardisoSolver(SPDSolver):
     """SPD solver on MKL PARDISO (sparse Cholesky) with the analysis done once per pattern.
 
-    The upper triangle (diagonal included) is handed to PARDISO in 0-based CSR form; its
+    The upper triangle (diagonal included) is handed to PARDISO in 0-based CSR form, or, for a
+    matrix of 2 x 2 node blocks, the upper block triangle in BSR form (``blocks``); its
     positions in the full matrix are found once per pattern, so a refactorization only gathers
     values. Settings (``iparm``, 0-based): user values (``[0] = 1``), nested dissection
     ordering from parallel METIS (``[1] = 3``), no iterative refinement by default (``[7] = 0``),
@@ -82,6 +83,11 @@ class PardisoSolver(SPDSolver):
         A fill-reducing ordering (:class:`~.solvers.SPDSolver`), handed to PARDISO as its user
         permutation (``iparm[4] = 1``, ``perm``) instead of its own METIS analysis; the
         symbolic factorization is still PARDISO's.
+    blocks : bool
+        Hand a matrix stored in 2 x 2 node blocks over in BSR form (``iparm[36] = 2``) where
+        the ordering keeps each node's two rows together: the analysis works on the node
+        graph, in about a third of the time and memory (docs/method.md, *Block Cholesky*).
+        False: always CSR.
     """
 
     backend = "pardiso"
@@ -95,8 +101,13 @@ class PardisoSolver(SPDSolver):
         *,
         check_symmetry: bool = True,
         ordering: np.ndarray | None = None,
+        blocks: bool = True,
     ) -> None:
         self._func = pardiso_function()
+        # MKL's OpenMP threads sleep as soon as a call ends instead of spinning for 200 ms
+        # beside the NumPy work between calls (docs/method.md, *Ordering of the unknowns*)
+        openmp_sleep_at_once()
+        self.blocks = blocks
         self._pt = np.zeros(64, dtype=np.int64)
         self._handle_used = False
         iparm = np.zeros(64, dtype=np.int32)
@@ -110,6 +121,7 @@ class PardisoSolver(SPDSolver):
         iparm[26] = 0  # no matrix checker (indices are sorted and checked here)
         iparm[27] = 0  # double precision
         iparm[34] = 1  # 0-based indexing
+        iparm[36] = 0  # CSR, or 2: 2 x 2 blocks (BSR), set per pattern by _load_upper
         iparm[59] = 0  # in-core
         self._iparm = iparm
         self._upos = np.zeros(0, dtype=np.int64)
@@ -117,19 +129,28 @@ class PardisoSolver(SPDSolver):
         self._ja = np.zeros(0, dtype=np.int32)
         self._a = np.zeros(0)
         self._n_eq = 0
+        self._block = 1  # 2: the pattern is handed over in 2 x 2 blocks (BSR)
         self._perm32: np.ndarray | None = None  # PARDISO's perm: a user ordering (iparm[4])
         super().__init__(A, check_symmetry=check_symmetry, ordering=ordering)
 
     @property
     def factor_nnz(self) -> int:
-        """Non-zeros in the Cholesky factor (reported by the last analysis)."""
-        return int(self._iparm[17])
+        """Non-zeros in the Cholesky factor (reported by the last analysis; in 2 x 2 blocks,
+        four per block, as stored)."""
+        return int(self._iparm[17]) * self._block**2
+
+    @property
+    def block_size(self) -> int:
+        """The form of the last analysis: 1, the upper triangle in CSR; 2, the upper block
+        triangle in 2 x 2 blocks (``blocks``)."""
+        return self._block
 
     @property
     def factor_mflop(self) -> int:
         """Floating-point operations of one numerical factorization, in millions (``iparm[18]``,
-        reported by the last analysis); 0 before the first analysis."""
-        return int(self._iparm[18])
+        reported by the last analysis; PARDISO counts a 2 x 2 block's product as one); 0 before
+        the first analysis."""
+        return int(self._iparm[18]) * self._block**3
 
     @property
     def memory_kib(self) -> dict[str, int]:
@@ -178,7 +199,7 @@ class PardisoSolver(SPDSolver):
             meaning = _PARDISO_ERRORS.get(code, "unknown error")
             equation = None
             if code == -4 and phase == 22 and self._iparm[29] > 0:
-                equation = int(self._iparm[29]) - 1
+                equation = (int(self._iparm[29]) - 1) * self._block  # a block's first row
                 meaning += f" (at equation {equation})"
             raise FactorizationError(
                 f"PARDISO phase {phase} failed with error {code}: {meaning}",
@@ -201,20 +222,36 @@ class PardisoSolver(SPDSolver):
         self._handle_used = True
         self._call(11)
 
-    def _load_upper(self, A: sp.csr_matrix, rows: np.ndarray | None = None) -> None:
+    def _load_upper(
+        self, A: sp.csr_matrix, rows: np.ndarray | None = None, *, blocks: bool = True
+    ) -> None:
         """Release the handle and hold the pattern of the upper triangle of ``A`` in
-        PARDISO's 32-bit CSR arrays, with its positions in ``A.data`` for the factorizations,
+        PARDISO's 32-bit arrays, with its positions in ``A.data`` for the factorizations,
         which gather the values (the analysis does not read them, and ``A.data`` may be
-        written meanwhile: :meth:`~.solvers.SPDSolver.analyze`)."""
+        written meanwhile: :meth:`~.solvers.SPDSolver.analyze`).
+
+        With ``blocks``, a matrix stored in 2 x 2 node blocks whose ordering (if any) keeps
+        each node's two rows together goes over as its upper block triangle in BSR form
+        (``iparm[36] = 2``; docs/method.md, *Block Cholesky*); any other in CSR form."""
         self._release()
-        positions, indptr = upper_positions(A, rows)
+        found = None
+        if blocks and self.blocks and _keeps_pairs(self._perm, A.shape[0]):
+            found = block_upper_positions(A, rows)
+        if found is None:
+            positions, indptr = upper_positions(A, rows)
+            columns = A.indices[positions]
+            self._block = 1
+        else:
+            positions, indptr, columns = found
+            self._block = 2
         if positions.size >= 2**31 - 1:
             raise ValueError("the upper triangle has too many entries for 32-bit PARDISO")
+        self._iparm[36] = 0 if self._block == 1 else self._block
         self._upos = positions
         self._ia = indptr.astype(np.int32)
-        self._ja = A.indices[positions].astype(np.int32)
+        self._ja = columns.astype(np.int32)
         self._a = np.zeros(positions.size)
-        self._n_eq = A.shape[0]
+        self._n_eq = A.shape[0] // self._block
 
     def computed_ordering(self, A: sp.csr_matrix) -> np.ndarray:
         """PARDISO's own fill-reducing ordering of canonical CSR ``A`` (an analysis with
@@ -225,7 +262,7 @@ class PardisoSolver(SPDSolver):
         (n,) int64 array
             ``order[k]``: the unknown eliminated k-th.
         """
-        self._load_upper(A)
+        self._load_upper(A, blocks=False)
         self._perm32 = np.zeros(A.shape[0], dtype=np.int32)
         self._iparm[4] = 2
         self._handle_used = True
@@ -245,13 +282,26 @@ class PardisoSolver(SPDSolver):
             self._perm32 = None
         else:
             self._iparm[4] = 1
-            self._perm32 = self._perm.astype(np.int32)
+            self._perm32 = (self._perm[0::2] // 2 if self._block == 2 else self._perm).astype(
+                np.int32
+            )
 
     def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
-        np.take(A.data, self._upos, out=self._a)
+        np.take(A.data, self._upos, out=self._a, mode="clip")  # valid positions: unbuffered
         if keep is not None:  # only the upper triangle is gathered: no copy of the matrix
             self._a *= keep[self._upos]
-        self._call(22)
+        try:
+            self._call(22)
+        except FactorizationError:
+            if self._block == 1:
+                raise
+            # in blocks PARDISO reports a zero pivot vaguely (a singular matrix as error -13):
+            # the same matrix in CSR form says what failed, and at which equation
+            self._load_upper(A, blocks=False)
+            self._use_ordering()
+            self._handle_used = True
+            self._call(11)
+            self._factorize(A, keep)
 
     def _solve(self, b: np.ndarray) -> np.ndarray:
         b = np.asfortranarray(b)  # PARDISO's layout of several right-hand sides (no copy for one)
@@ -327,6 +377,16 @@ class PardisoLUSolver(PardisoSolver):
         self._use_ordering()
         self._handle_used = True
         self._call(11)
+
+
+def _keeps_pairs(perm: np.ndarray | None, n: int) -> bool:
+    """Whether the ordering ``perm`` of ``n`` unknowns (or PARDISO's own, ``None``) can be
+    one of 2 x 2 blocks: each node's rows ``2z, 2z + 1`` eliminated one after the other."""
+    if n % 2:
+        return False
+    return perm is None or bool(
+        np.all(perm[0::2] % 2 == 0) and np.array_equal(perm[1::2], perm[0::2] + 1)
+    )
 
 
 def pardiso_solver(request: SolverRequest) -> PardisoSolver:

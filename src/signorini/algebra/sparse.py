@@ -15,6 +15,7 @@ from .ranks import SERIAL, Ranks
 __all__ = [
     "abs_matvec",
     "as_csr",
+    "block_upper_positions",
     "csr_row_indices",
     "concatenated_ranges",
     "diagonal_positions",
@@ -98,6 +99,64 @@ def upper_positions(A: sp.csr_matrix, rows: np.ndarray | None = None) -> tuple[n
     indptr = np.zeros(A.shape[0] + 1, dtype=np.int64)
     np.cumsum(np.bincount(rows[positions], minlength=A.shape[0]), out=indptr[1:])
     return positions, indptr
+
+
+def block_upper_positions(
+    A: sp.csr_matrix, rows: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The upper block triangle of ``A`` in 2 x 2 blocks (block sparse rows, BSR), where ``A``
+    stores them: ``None`` unless every stored entry lies in a fully stored block of rows
+    ``2z, 2z + 1`` and columns ``2w, 2w + 1`` (the node blocks of a stiffness matrix
+    assembled by :mod:`signorini.fem.stiffness`, docs/method.md, *Block Cholesky*).
+
+    Parameters
+    ----------
+    A : scipy.sparse.csr_matrix, shape (n, n)
+        Canonical (sorted indices).
+    rows : (A.nnz,) int array, optional
+        :func:`csr_row_indices` of ``A``, if known.
+
+    Returns
+    -------
+    positions : (4 m,) int32 (int64 for nnz ≥ 2³¹) array
+        Positions in ``A.data`` of the ``m`` blocks ``(z, w)`` with ``w ≥ z``, block after
+        block in block-row order, each row by row: ``(2z, 2w), (2z, 2w + 1), (2z + 1, 2w),
+        (2z + 1, 2w + 1)``.
+    indptr : (n / 2 + 1,) int64 array
+        The blocks' rows in CSR form.
+    columns : (m,) int array
+        Each block's column ``w``.
+    """
+    n = A.shape[0]
+    if n % 2 or A.nnz == 0:
+        return None
+    length = np.diff(A.indptr)
+    if np.any(length % 2) or not np.array_equal(length[0::2], length[1::2]):
+        return None
+    ind = A.indices
+    first, second = ind[0::2], ind[1::2]  # each row starts at an even position: column pairs
+    if np.any(first % 2) or not np.array_equal(second, first + 1):
+        return None
+    if rows is None:
+        rows = csr_row_indices(A)
+    pair_rows = rows[0::2]
+    starts = 2 * np.flatnonzero(pair_rows % 2 == 0)  # a block's first entry in row 2z
+    below = starts + length[rows[starts]]  # the same block's first entry in row 2z + 1
+    if not np.array_equal(ind[below], ind[starts]):
+        return None
+    upper = ind[starts] >= rows[starts]
+    p = starts[upper]
+    q = below[upper]
+    del starts, below, upper
+    dtype = np.int32 if A.nnz < np.iinfo(np.int32).max else np.int64
+    positions = np.empty((p.size, 4), dtype=dtype)
+    positions[:, 0] = p
+    positions[:, 1] = p + 1
+    positions[:, 2] = q
+    positions[:, 3] = q + 1
+    indptr = np.zeros(n // 2 + 1, dtype=np.int64)
+    np.cumsum(np.bincount(rows[p] // 2, minlength=n // 2), out=indptr[1:])
+    return positions.reshape(-1), indptr, ind[p] // 2
 
 
 def diagonal_positions(A: sp.csr_matrix, rows: np.ndarray) -> np.ndarray:
