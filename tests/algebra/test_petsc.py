@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from linalg_problems import block_spd
+from linalg_problems import block_spd, p2_elasticity
 
 from signorini.algebra import (
     BackendUnavailableError,
@@ -92,6 +92,27 @@ def test_cholesky_agrees_with_superlu_and_keeps_its_analysis():
     assert np.abs(x - exact).max() / np.abs(exact).max() < 1e-12
     assert (solver.n_analyses, solver.n_factorizations, solver.n_solves) == (1, 2, 2)
     solver.close()
+
+
+@needs_petsc
+def test_mumps_cholesky_compresses_node_blocks():
+    """A matrix of 2 x 2 node blocks (a P2 stiffness, λ ≠ μ) goes to MUMPS's Cholesky with its
+    graph compressed to the blocks (ICNTL(15) = -2) and is solved to round-off; a matrix
+    whose rows are not in blocks (a scalar Laplacian) is not compressed."""
+    K, _ = p2_elasticity(10, 8, lam=2.0, mu=0.5)
+    K.setdiag(K.diagonal() + 0.1)
+    L = sp.diags([-np.ones(39), 2.5 * np.ones(40), -np.ones(39)], [-1, 0, 1], format="csr")
+    for A, size in ((K, 2), (L, 1)):
+        b = np.random.default_rng(1).standard_normal(A.shape[0])
+        solver = make_solver(petsc_solver, symmetric=True)
+        solver.factorize(A)
+        x = solver.solve(b)
+        exact = spla.spsolve(A.tocsc(), b)
+        assert np.abs(x - exact).max() <= 1e-12 * np.abs(exact).max()
+        factor = solver._ksp.getPC().getFactorMatrix()
+        assert solver.block_size == size
+        assert int(factor.getMumpsIcntl(15)) == (-2 if size == 2 else 0)
+        solver.close()
 
 
 @needs_petsc

@@ -54,6 +54,7 @@ import scipy.sparse as sp
 
 from .petsc_rows import PetscRows, _world_ranks, row_block
 from .solvers import BackendUnavailableError, FactorizationError, SolverRequest
+from .sparse import in_node_blocks
 
 __all__ = [
     "PetscLUSolver",
@@ -156,6 +157,7 @@ class PetscSolver(PetscRows):
         ordering: np.ndarray | None = None,
     ) -> None:
         self._ksp = self._x = self._b = self._scatter = self._all = None
+        self.block_size = 1  # 2: MUMPS's last analysis compressed 2 x 2 blocks (ICNTL(15))
         super().__init__(A, check_symmetry=check_symmetry, ordering=ordering)
 
     def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
@@ -165,6 +167,8 @@ class PetscSolver(PetscRows):
         own = self._rows(A)
         m = own.size
         indptr, indices = self._csr
+        # every rank's rows in 2 x 2 node blocks: MUMPS's Cholesky analyses the node graph
+        in_blocks = self._ranks.max(0.0 if in_node_blocks(indptr, indices) else 1.0) == 0.0
         values = np.zeros(indices.size)
         mat = PETSc.Mat().createAIJ(
             size=((m, n), (m, n)), csr=(indptr, indices, values), comm=PETSc.COMM_WORLD
@@ -191,6 +195,9 @@ class PetscSolver(PetscRows):
             factor.setMumpsIcntl(7, 5)  # METIS nested dissection for the analysis
         if self.factorization == "lu":
             factor.setMumpsIcntl(10, -REFINEMENT_STEPS)
+        elif in_blocks:  # the graph compressed to 2 x 2 blocks (docs/method.md, *Block Cholesky*)
+            factor.setMumpsIcntl(15, -2)
+        self.block_size = 2 if self.factorization == "cholesky" and in_blocks else 1
         self._mat, self._ksp = mat, ksp
         self._x, self._b = mat.createVecs()
         self._scatter, self._all = PETSc.Scatter.toAll(self._x)

@@ -19,6 +19,7 @@ __all__ = [
     "csr_row_indices",
     "concatenated_ranges",
     "diagonal_positions",
+    "in_node_blocks",
     "list_indices",
     "STIFFNESS_RANGE",
     "stiffness_unit",
@@ -101,6 +102,34 @@ def upper_positions(A: sp.csr_matrix, rows: np.ndarray | None = None) -> tuple[n
     return positions, indptr
 
 
+def _node_block_starts(
+    indptr: np.ndarray, indices: np.ndarray, rows: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Where the rows ``indptr, indices`` (CSR, an even number of them, from an even row)
+    store full 2 x 2 blocks: each block's first entry in row ``2z`` and in row ``2z + 1``,
+    and each entry's row; else None."""
+    length = np.diff(indptr)
+    if length.size % 2 or np.any(length % 2) or not np.array_equal(length[0::2], length[1::2]):
+        return None
+    first, second = indices[0::2], indices[1::2]  # each row starts at an even position: pairs
+    if np.any(first % 2) or not np.array_equal(second, first + 1):
+        return None
+    if rows is None:
+        rows = np.repeat(np.arange(length.size, dtype=np.int64), length)
+    starts = 2 * np.flatnonzero(rows[0::2] % 2 == 0)  # a block's first entry in row 2z
+    below = starts + length[rows[starts]]  # the same block's first entry in row 2z + 1
+    if not np.array_equal(indices[below], indices[starts]):
+        return None
+    return starts, below, rows
+
+
+def in_node_blocks(indptr: np.ndarray, indices: np.ndarray) -> bool:
+    """Whether CSR rows (an even number of them, the first an even row of the whole
+    matrix, e.g. one process's rows) store every entry in a fully stored 2 x 2 block of rows
+    ``2z, 2z + 1`` and columns ``2w, 2w + 1`` (docs/method.md, *Block Cholesky*)."""
+    return _node_block_starts(indptr, indices) is not None
+
+
 def block_upper_positions(
     A: sp.csr_matrix, rows: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
@@ -130,21 +159,11 @@ def block_upper_positions(
     n = A.shape[0]
     if n % 2 or A.nnz == 0:
         return None
-    length = np.diff(A.indptr)
-    if np.any(length % 2) or not np.array_equal(length[0::2], length[1::2]):
+    found = _node_block_starts(A.indptr, A.indices, rows)
+    if found is None:
         return None
-    ind = A.indices
-    first, second = ind[0::2], ind[1::2]  # each row starts at an even position: column pairs
-    if np.any(first % 2) or not np.array_equal(second, first + 1):
-        return None
-    if rows is None:
-        rows = csr_row_indices(A)
-    pair_rows = rows[0::2]
-    starts = 2 * np.flatnonzero(pair_rows % 2 == 0)  # a block's first entry in row 2z
-    below = starts + length[rows[starts]]  # the same block's first entry in row 2z + 1
-    if not np.array_equal(ind[below], ind[starts]):
-        return None
-    upper = ind[starts] >= rows[starts]
+    starts, below, rows = found
+    upper = A.indices[starts] >= rows[starts]
     p = starts[upper]
     q = below[upper]
     del starts, below, upper
@@ -156,7 +175,7 @@ def block_upper_positions(
     positions[:, 3] = q + 1
     indptr = np.zeros(n // 2 + 1, dtype=np.int64)
     np.cumsum(np.bincount(rows[p] // 2, minlength=n // 2), out=indptr[1:])
-    return positions.reshape(-1), indptr, ind[p] // 2
+    return positions.reshape(-1), indptr, A.indices[p] // 2
 
 
 def diagonal_positions(A: sp.csr_matrix, rows: np.ndarray) -> np.ndarray:
