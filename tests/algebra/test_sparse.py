@@ -13,6 +13,7 @@ from signorini.algebra.sparse import (
     block_upper_positions,
     csr_row_indices,
     diagonal_positions,
+    in_node_blocks,
     list_indices,
     symmetry_defect,
     upper_positions,
@@ -67,6 +68,18 @@ def test_block_upper_positions_refuse_what_is_not_in_2x2_blocks():
     )
     G = sp.vstack([F, sp.csr_matrix(([1.0, 1.0], [2, 3], [0, 2]), shape=(1, 4))]).tocsr()
     assert block_upper_positions(E) is not None and block_upper_positions(G) is None
+
+
+def test_in_node_blocks_judges_one_process_rows():
+    """A process's rows of a node-blocked matrix (global columns) are in blocks when they
+    start at a node's first row; rows split inside a node, or a scalar pattern, are not."""
+    A, _ = p2_elasticity(4, 3)
+    for lo, hi, expected in ((10, 30, True), (0, A.shape[0], True), (11, 31, False)):
+        first, last = A.indptr[lo], A.indptr[hi]
+        indptr = A.indptr[lo : hi + 1] - first
+        assert in_node_blocks(indptr, A.indices[first:last]) is expected, (lo, hi)
+    L = sp.diags([np.ones(7), np.ones(8), np.ones(7)], [-1, 0, 1], format="csr")
+    assert not in_node_blocks(L.indptr, L.indices)
 
 
 def test_row_indices_and_diagonal_positions():
