@@ -232,14 +232,38 @@ def _assemble_node_blocks(
     np.multiply(half.indices, 2, out=indices[:, 0])
     np.add(indices[:, 0], 1, out=indices[:, 1])
     indptr = 2 * half.indptr
-    # SciPy's COO -> CSR sizes the data buffer for every COO entry, duplicates included, and
-    # sums them in place without shrinking it: copy the summed part so that K does not keep
-    # the larger buffer alive (about 1.5 x the data of K)
-    data = half.data[: half.nnz].view(np.float64).copy()
+    data = _summed_values(half)
     del half
     out = sp.csr_matrix((data, indices.reshape(-1), indptr), shape=(n_dofs, n_dofs), copy=False)
     out.has_sorted_indices = True
     return out
+
+
+def _summed_values(half: sp.csr_matrix) -> np.ndarray:
+    """The packed values of ``half`` (summed by the COO -> CSR conversion) as float64, in a
+    buffer of their own size.
+
+    SciPy's conversion sizes the data buffer for every COO entry, duplicates included, and
+    sums them in place without shrinking it (``half.data`` is a view of its start), so that
+    K would keep the larger buffer alive (about 1.5 x its data). Where ``half.data`` is that
+    view, the buffer is shrunk in place (``realloc``: no copy; 0.2 s at 10⁶ unknowns);
+    otherwise the values are copied.
+    """
+    data, nnz = half.data, half.nnz
+    buffer = data.base
+    in_place = (
+        isinstance(buffer, np.ndarray)
+        and buffer.flags.owndata
+        and buffer.ndim == 1
+        and buffer.dtype == data.dtype
+        and data.size == nnz
+        and data.ctypes.data == buffer.ctypes.data
+    )
+    if not in_place:
+        return data[:nnz].view(np.float64).copy()
+    half.data = data = None  # no view of the buffer may outlive the resize
+    buffer.resize(nnz, refcheck=False)
+    return buffer.view(np.float64)
 
 
 def _checked_input(
