@@ -32,7 +32,6 @@ from .sparse import block_upper_positions, upper_positions
 
 __all__ = [
     "metis_ordering",
-    "PardisoLUSolver",
     "PardisoSolver",
     "pardiso_problem",
     "pardiso_solver",
@@ -326,59 +325,6 @@ class PardisoSolver(SPDSolver):
             pass
 
 
-class PardisoLUSolver(PardisoSolver):
-    """LU factorization of a general (non-symmetric) real matrix on MKL PARDISO (``mtype = 11``).
-
-    The whole matrix is handed over in 0-based CSR form and PARDISO solves ``A x = b``; the
-    analysis (ordering on ``A + A^T``, symbolic factorization) is done once per pattern, as in
-    :class:`PardisoSolver`. Settings as there, plus PARDISO's defaults for non-symmetric
-    matrices: pivot perturbation 1e-13 (``iparm[9]``), scaling and weighted matching
-    (``iparm[10]``, ``iparm[12]``, computed from the values of the analysed matrix), and two
-    steps of iterative refinement (``iparm[7]``), which a perturbed pivot needs. The caller
-    checks the residual of every solve.
-
-    Parameters
-    ----------
-    A : scipy sparse matrix, optional
-        Factorized right away if given. Its symmetry is not checked.
-    matching : bool
-        Scaling and weighted matching (``iparm[10] = iparm[12] = 1``).
-    ordering : (n,) int array, optional
-        A fill-reducing ordering, as in :class:`PardisoSolver`.
-    """
-
-    _mtype = 11  # real non-symmetric
-    analysis_reads_values = True  # scaling and weighted matching
-
-    def __init__(
-        self,
-        A: sp.spmatrix | None = None,
-        *,
-        matching: bool = True,
-        ordering: np.ndarray | None = None,
-    ) -> None:
-        super().__init__(None, check_symmetry=False, ordering=ordering)
-        self._iparm[7] = 2
-        self._iparm[9] = 13
-        self._iparm[10] = int(matching)
-        self._iparm[12] = int(matching)
-        if A is not None:
-            self.factorize(A)
-
-    def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
-        self._release()
-        if A.nnz >= 2**31 - 1:
-            raise ValueError("the matrix has too many entries for 32-bit PARDISO")
-        self._upos = np.arange(A.nnz)
-        self._ia = A.indptr.astype(np.int32)
-        self._ja = A.indices.astype(np.int32)
-        self._a = A.data.copy()
-        self._n_eq = A.shape[0]
-        self._use_ordering()
-        self._handle_used = True
-        self._call(11)
-
-
 def _keeps_pairs(perm: np.ndarray | None, n: int) -> bool:
     """Whether the ordering ``perm`` of ``n`` unknowns (or PARDISO's own, ``None``) can be
     one of 2 x 2 blocks: each node's rows ``2z, 2z + 1`` eliminated one after the other."""
@@ -392,9 +338,10 @@ def _keeps_pairs(perm: np.ndarray | None, n: int) -> bool:
 def pardiso_solver(request: SolverRequest) -> PardisoSolver:
     """The PARDISO backend's solver factory (:class:`~.solvers.SolverFactory`).
 
-    :class:`PardisoSolver` (Cholesky) for a symmetric request, :class:`PardisoLUSolver`
-    otherwise; the request's ordering, if any, is computed and handed to PARDISO as its user
-    permutation (docs/method.md, *Ordering of the unknowns*).
+    :class:`PardisoSolver` (Cholesky) for a symmetric request,
+    :class:`~.pardiso_lu.PardisoLUSolver` otherwise; the request's ordering, if any, is
+    computed and handed to PARDISO as its user permutation (docs/method.md, *Ordering of the
+    unknowns*).
 
     Raises
     ------
@@ -407,6 +354,8 @@ def pardiso_solver(request: SolverRequest) -> PardisoSolver:
     if request.symmetric:
         solver = PardisoSolver(check_symmetry=request.check_symmetry)
     else:
+        from .pardiso_lu import PardisoLUSolver  # a subclass of PardisoSolver, defined there
+
         solver = PardisoLUSolver()
     if request.ordering is not None:
         solver.ordering = request.ordering()

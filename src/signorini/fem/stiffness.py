@@ -7,15 +7,14 @@ Arrays are vectorized over cells: ``vertices (m, 3, 2)`` is ``points[cells]``
 
 Assembly
 --------
-The stiffness matrix is assembled at the level of nodes: every pair of nodes
-that share a cell gets one full 2x2 block.  The two entries of each block row
-are packed into one complex number, SciPy's COO -> CSR conversion sums the
-duplicates of the resulting (scalar row, node column) matrix, and its data,
-viewed as float64, are the scalar CSR data.  The result has sorted indices and
-a node-block pattern: rows ``2 z`` and ``2 z + 1`` have identical column
-patterns, and columns ``2 w``, ``2 w + 1`` are adjacent (explicit zeros kept).
-At 1.6 M unknowns this takes less memory and time than converting the 144
-scalar entries per cell directly, or sorting node pairs with ``np.unique``.
+The stiffness matrix is assembled at the level of nodes: every pair of nodes that share a
+cell gets one full 2x2 block. The two entries of each block row are packed into one complex
+number, SciPy's COO -> CSR conversion sums the duplicates of the resulting (scalar row, node
+column) matrix, and its data, viewed as float64, are the scalar CSR data. The result has
+sorted indices and a node-block pattern: rows ``2 z`` and ``2 z + 1`` have identical column
+patterns, and columns ``2 w``, ``2 w + 1`` are adjacent (explicit zeros kept). At 1.6 M
+unknowns this takes less memory and time than converting the 144 scalar entries per cell
+directly, or sorting node pairs with ``np.unique``.
 """
 
 from __future__ import annotations
@@ -240,26 +239,16 @@ def _assemble_node_blocks(
 
 
 def _summed_values(half: sp.csr_matrix) -> np.ndarray:
-    """The packed values of ``half`` (summed by the COO -> CSR conversion) as float64, in a
-    buffer of their own size.
-
-    SciPy's conversion sizes the data buffer for every COO entry, duplicates included, and
-    sums them in place without shrinking it (``half.data`` is a view of its start), so that
-    K would keep the larger buffer alive (about 1.5 x its data). Where ``half.data`` is that
-    view, the buffer is shrunk in place (``realloc``: no copy; 0.2 s at 10⁶ unknowns);
-    otherwise the values are copied.
-    """
-    data, nnz = half.data, half.nnz
-    buffer = data.base
-    in_place = (
-        isinstance(buffer, np.ndarray)
-        and buffer.flags.owndata
-        and buffer.ndim == 1
-        and buffer.dtype == data.dtype
-        and data.size == nnz
-        and data.ctypes.data == buffer.ctypes.data
-    )
-    if not in_place:
+    """``half``'s values as float64 in a buffer of their own size (K would keep 1.5 x its data):
+    SciPy's COO -> CSR conversion sums in a COO-sized buffer, ``half.data`` a view of its start,
+    shrunk here in place (``realloc``, no copy) where it can be, else copied."""
+    data, buffer, nnz = half.data, half.data.base, half.nnz
+    layout = (data.dtype, 1, nnz, data.ctypes.data)
+    if (
+        not isinstance(buffer, np.ndarray)
+        or not buffer.flags.owndata
+        or layout != (buffer.dtype, buffer.ndim, data.size, buffer.ctypes.data)
+    ):
         return data[:nnz].view(np.float64).copy()
     half.data = data = None  # no view of the buffer may outlive the resize
     buffer.resize(nnz, refcheck=False)
