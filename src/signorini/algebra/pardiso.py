@@ -215,8 +215,8 @@ class PardisoSolver(SPDSolver):
             finally:
                 self._pt[:] = 0
 
-    def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
-        self._load_upper(A, rows)
+    def _analyze(self, A: sp.csr_matrix, rows: np.ndarray | None, *, blocks: bool = True) -> None:
+        self._load_upper(A, rows, blocks=blocks)
         self._use_ordering()
         self._handle_used = True
         self._call(11)
@@ -296,10 +296,7 @@ class PardisoSolver(SPDSolver):
                 raise
             # in blocks PARDISO reports a zero pivot vaguely (a singular matrix as error -13):
             # the same matrix in CSR form says what failed, and at which equation
-            self._load_upper(A, blocks=False)
-            self._use_ordering()
-            self._handle_used = True
-            self._call(11)
+            self._analyze(A, None, blocks=False)
             self._factorize(A, keep)
 
     def _solve(self, b: np.ndarray) -> np.ndarray:
