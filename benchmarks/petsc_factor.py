@@ -6,11 +6,11 @@ last level the stiffness matrix with the Dirichlet DOFs eliminated (what
 ``--repeat`` times, alternating so that both see the same load on a shared machine. Printed
 per backend: the best time of analysis + factorization, of a refactorization (same pattern,
 analysis kept) and of one solve, and the residual; for MUMPS also its ordering (``INFOG(7)``:
-5 METIS, 1 given), its factor's entries (``INFOG(29)``) and flops (``RINFOG(3)``). Needs the
+0 AMD, 5 METIS, 1 given), its factor's entries (``INFOG(29)``) and flops (``RINFOG(3)``). Needs the
 extra ``signorini[mpi]``.
 
-Backends: ``pardiso``, ``petsc`` (MUMPS Cholesky, its METIS), ``petsc-lu`` (MUMPS LU, its
-METIS), ``petsc-lu-ordered`` (MUMPS LU given the loop's ordering,
+Backends: ``pardiso``, ``petsc`` (MUMPS Cholesky, AMD on one process), ``petsc-lu`` (MUMPS
+LU, AMD on one process), ``petsc-lu-ordered`` (MUMPS LU given the loop's ordering,
 :func:`signorini.contact.ordering.dof_ordering`, as the petsc factory gives it to an LU on one
 process).
 

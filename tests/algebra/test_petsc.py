@@ -7,7 +7,10 @@ failure. The error of a missing petsc4py is tested everywhere.
 
 from __future__ import annotations
 
+import ctypes
+import importlib.util
 import os
+import re
 import sys
 
 import numpy as np
@@ -25,6 +28,7 @@ from signorini.algebra import (
 )
 from signorini.algebra import petsc as petsc_backend
 from signorini.algebra.backends import solver_library
+from signorini.algebra.mkl import mkl_runtime_candidates, mkl_threads_local, mkl_version
 from signorini.algebra.petsc import petsc_solver, row_block
 from signorini.algebra.solvers import SolverRequest
 from signorini.examples import example_6_2, example_6_2_coulomb
@@ -116,6 +120,25 @@ def test_mumps_cholesky_compresses_node_blocks():
 
 
 @needs_petsc
+def test_mumps_orders_by_amd_unless_petsc_options_say_otherwise():
+    """MUMPS's Cholesky orders by AMD (``INFOG(7) = 0``, docs/parallel.md, *MUMPS's
+    ordering*); ``-mat_mumps_icntl_7`` in PETSc's options database is the user's choice."""
+    K, _ = p2_elasticity(8, 8)
+    K.setdiag(K.diagonal() + 0.1)
+    options = petsc_backend.petsc_module().Options()
+    used = []
+    try:
+        for icntl_7 in (None, 5, 3):
+            if icntl_7 is not None:
+                options["mat_mumps_icntl_7"] = icntl_7
+            with make_solver(petsc_solver, K, symmetric=True) as solver:
+                used.append(int(solver._ksp.getPC().getFactorMatrix().getMumpsInfog(7)))
+    finally:
+        options.delValue("mat_mumps_icntl_7")
+    assert used == [0, 5, 3]
+
+
+@needs_petsc
 def test_cholesky_refuses_an_indefinite_matrix_and_lu_solves_it():
     A = block_spd(6, 5, np.random.default_rng(0)).tolil()
     A[4, 4] = -A[4, 4]
@@ -129,9 +152,38 @@ def test_cholesky_refuses_an_indefinite_matrix_and_lu_solves_it():
 
 @needs_petsc
 def test_manifest_names_petsc_and_its_ranks():
-    assert solver_library("petsc").startswith("PETSc 3.") and "MUMPS (1 rank)" in solver_library(
-        "petsc"
-    )
+    blas = " on MKL's BLAS" if petsc_backend._MUMPS_BLAS["mkl"] else ""
+    assert re.fullmatch(rf"PETSc 3\.\d+\.\d+ \+ MUMPS{blas} \(1 rank\)", solver_library("petsc"))
+
+
+@needs_petsc
+def test_mumps_calls_mkls_blas_on_one_thread_where_the_wheel_brings_its_openblas(capfd):
+    """Where PETSc is the ``mpi`` extra's binary wheel and MKL is installed, MUMPS's BLAS
+    calls go to MKL (docs/parallel.md, *MUMPS's BLAS*): MKL's verbose mode lists them, each
+    on one thread, and MKL's thread setting is given back after each MUMPS call."""
+    wheel = importlib.util.find_spec("dolfinx_solver") is not None
+    assert petsc_backend._MUMPS_BLAS["mkl"] == (wheel and mkl_version() is not None)
+    if not petsc_backend._MUMPS_BLAS["mkl"]:
+        pytest.skip("MUMPS keeps its own BLAS here (another PETSc build, or no MKL)")
+    K, _ = p2_elasticity(30, 30, lam=2.0, mu=0.5)
+    K.setdiag(K.diagonal() + 0.1)
+    b = np.random.default_rng(2).standard_normal(K.shape[0])
+    verbose = ctypes.CDLL(mkl_runtime_candidates()[0]).MKL_Verbose
+    verbose.argtypes = [ctypes.c_int]
+    capfd.readouterr()
+    verbose(1)
+    try:
+        with make_solver(petsc_solver, K, symmetric=True) as solver:
+            x = solver.solve(b)
+    finally:
+        verbose(0)
+        ctypes.CDLL(None).fflush(None)
+    calls = re.findall(r"MKL_VERBOSE (D[A-Z]+)\(.*NThr:(\d+)", capfd.readouterr().out)
+    assert {"DGEMM", "DTRSM"} <= {name for name, _ in calls}
+    assert {threads for _, threads in calls} == {"1"}
+    assert mkl_threads_local(0) == 0  # no thread-local setting left behind
+    exact = spla.spsolve(K.tocsc(), b)
+    assert np.abs(x - exact).max() <= 1e-12 * np.abs(exact).max()
 
 
 def same_levels(problem, levels: int, max_ndof: int = 10**6) -> list[tuple[int, float]]:
@@ -190,7 +242,7 @@ def test_an_ordering_renumbers_petsc_and_reaches_mumps_lu(symmetric):
     # the factory computes the ordering for the LU only (PETSc drops it for MUMPS's Cholesky)
     assert not solver.split
     assert solver._order is None if symmetric else np.array_equal(solver._order, ordering)
-    # MUMPS's ordering used: 1 (given) for the LU, its METIS (5) for the Cholesky
+    # MUMPS's ordering used: 1 (given) for the LU, AMD (0) for the Cholesky on one process
     used = int(solver._ksp.getPC().getFactorMatrix().getMumpsInfog(7))
-    assert used == (5 if symmetric else 1)
+    assert used == (0 if symmetric else 1)
     solver.close()

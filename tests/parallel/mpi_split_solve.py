@@ -20,7 +20,7 @@ import scipy.sparse as sp
 from signorini.algebra import FrictionOptions, PDASOptions, solve_friction, solve_pdas
 from signorini.algebra.backends import solver_factory
 from signorini.algebra.friction_kkt import check_friction
-from signorini.algebra.petsc import PetscSolver
+from signorini.algebra.petsc import PetscSolver, petsc_module
 from signorini.algebra.petsc_gamg import GamgSolver
 from signorini.algebra.ranks import world_ranks
 from signorini.algebra.solvers import SolverRequest
@@ -217,9 +217,27 @@ def refusals() -> dict[str, np.ndarray]:
     return {"messages": np.array(messages)}
 
 
+def mumps_orderings() -> np.ndarray:
+    """The orderings MUMPS's Cholesky used (``INFOG(7)``) on a split ``K + I``: by default,
+    and with ``-mat_mumps_icntl_7 5`` (METIS) in PETSc's options database."""
+    a, K_own = assembled(example_6_2(), 1)
+    owned = np.diff(K_own.indptr) > 0
+    A = own_rows((a.K + sp.identity(a.K.shape[0])).tocsr(), owned)
+    options = petsc_module().Options()
+    used = []
+    for icntl_7 in (None, 5):
+        if icntl_7 is not None:
+            options["mat_mumps_icntl_7"] = icntl_7
+        with PetscSolver(A, check_symmetry=False) as solver:
+            used.append(int(solver._ksp.getPC().getFactorMatrix().getMumpsInfog(7)))
+    options.delValue("mat_mumps_icntl_7")
+    return np.array(used)
+
+
 if __name__ == "__main__":
     ranks = world_ranks()
     results = {f"refusals/{k}": v for k, v in refusals().items()}
+    results["mumps_orderings"] = mumps_orderings()
     for case, run in CASES.items():
         for key, value in run().items():
             results[f"{case}/{key}"] = value

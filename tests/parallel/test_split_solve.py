@@ -51,6 +51,13 @@ def case(runs: dict, name: str) -> dict[str, np.ndarray]:
     return {key[len(prefix) :]: value for key, value in runs.items() if key.startswith(prefix)}
 
 
+def test_mumps_orders_by_amd_unless_petsc_options_say_otherwise(runs):
+    """On several ranks too, MUMPS's Cholesky orders by AMD (``INFOG(7) = 0``; faster than
+    METIS on two ranks, docs/parallel.md), and by METIS (5) where PETSc's options database
+    says ``-mat_mumps_icntl_7 5``."""
+    assert runs["mumps_orderings"].tolist() == [0, 5]
+
+
 @pytest.mark.parametrize("name", PDAS + FRICTION)
 def test_the_split_matrix_gives_the_serial_answer(runs, name):
     got = case(runs, name)

@@ -240,8 +240,7 @@ def solver_library(solver: object = None) -> str:
     if name in ("petsc", "petsc-gamg"):
         from .petsc import petsc_library
 
-        library = petsc_library()
-        return library if name == "petsc" else library.replace("MUMPS", "GAMG (CG)", 1)
+        return petsc_library("MUMPS" if name == "petsc" else "GAMG (CG)")
     if name in ("auto", "pardiso", "scipy", "superlu"):
         return f"SuperLU (SciPy {scipy.__version__})"
     return f"{name} (SciPy {scipy.__version__} installed)"

@@ -20,12 +20,16 @@ from pathlib import Path
 from .solvers import BackendUnavailableError
 
 __all__ = [
+    "blas_for_libraries_loaded_later",
     "mkl_runtime_candidates",
     "mkl_threads_local",
     "mkl_version",
     "openmp_sleep_at_once",
     "pardiso_function",
 ]
+
+#: ``MKL_Set_Interface_Layer``'s LP64: 32-bit integers (``mkl_service.h``).
+_MKL_INTERFACE_LP64 = 0
 
 #: File names of MKL's single dynamic library on Linux, macOS and Windows.
 _MKL_RT = re.compile(r"(lib)?mkl_rt(\.\d+)*\.(so(\.\d+)*|dylib|dll)")
@@ -143,6 +147,36 @@ def openmp_sleep_at_once() -> bool:
     func.restype = None
     func(0)
     return True
+
+
+@cache
+def blas_for_libraries_loaded_later() -> bool:
+    """Make MKL's BLAS and LAPACK, on one thread, the ones that the shared libraries loaded
+    from now on call, where they leave the BLAS symbols (``dgemm_``, …) to the dynamic linker.
+
+    MKL's runtime library is loaded into the global symbol scope (``RTLD_GLOBAL``), which the
+    dynamic linker searches before a library's own dependencies: a library loaded later that
+    calls ``dgemm_`` binds to MKL's, not to the BLAS it was linked with. :mod:`.petsc` calls
+    this before it imports petsc4py, for MUMPS's factorization (docs/parallel.md, *MUMPS's
+    BLAS*).
+
+    Returns
+    -------
+    bool
+        True if MKL is loaded globally with 32-bit BLAS integers (LP64, the interface of the
+        BLAS it replaces); False, with nothing changed, where MKL cannot be loaded or its
+        interface layer is already the 64-bit one.
+    """
+    for path in mkl_runtime_candidates():
+        try:
+            lib = ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
+            layer = lib.MKL_Set_Interface_Layer
+        except (OSError, AttributeError):
+            continue
+        layer.argtypes = [ctypes.c_int]
+        layer.restype = ctypes.c_int
+        return layer(_MKL_INTERFACE_LP64) == _MKL_INTERFACE_LP64
+    return False
 
 
 @cache

@@ -39,19 +39,26 @@ Each LU solve does :data:`REFINEMENT_STEPS` steps of iterative refinement inside
 Cholesky factorization (negative pivots counted by MUMPS, ``INFOG(12)``) names the first
 non-positive diagonal entry as its equation, where there is one.
 
-MUMPS's Cholesky orders by METIS nested dissection (``ICNTL(7) = 5``) where PETSc has METIS,
-else by its own choice; the contact layer's ordering (:attr:`SolverRequest.ordering`, METIS on
+MUMPS's Cholesky orders by AMD (``ICNTL(7) = 0``: its analysis is MUMPS's own at every new
+pattern, and METIS's took six times as long), unless PETSc's options database sets
+``-mat_mumps_icntl_7``; the contact layer's ordering (:attr:`SolverRequest.ordering`, METIS on
 the vertex graph) is computed for an LU on one process only (:func:`petsc_solver`).
 """
 
 from __future__ import annotations
 
+import importlib.util
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from functools import cache
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
+from .mkl import blas_for_libraries_loaded_later, mkl_threads_local
 from .petsc_rows import PetscRows, _world_ranks, row_block
 from .solvers import BackendUnavailableError, FactorizationError, SolverRequest
 from .sparse import in_node_blocks
@@ -83,6 +90,8 @@ INSTALL_HINT = (
 def petsc_module() -> Any:
     """``petsc4py.PETSc``, imported once; :class:`BackendUnavailableError` naming the extra
     when petsc4py is missing or its PETSc has no MUMPS."""
+    if "petsc4py.PETSc" not in sys.modules:  # else decided when it was loaded
+        _MUMPS_BLAS["mkl"] = _mkl_blas_for_the_wheel()
     try:
         # The binary wheel's package loads its MPI library before petsc4py (it must come
         # first); other installs of petsc4py do not have it.
@@ -104,16 +113,57 @@ def petsc_module() -> Any:
     return PETSc
 
 
-def petsc_library() -> str:
-    """``"PETSc 3.25.5 + MUMPS (2 ranks)"``: the versions and ``PETSC_COMM_WORLD``'s size,
-    for a run's manifest; what is missing when the backend is not usable."""
+#: Whether MUMPS calls MKL's BLAS instead of the binary wheel's, as :func:`petsc_module`
+#: decided before it loaded PETSc.
+_MUMPS_BLAS = {"mkl": False}
+
+
+def _mkl_blas_for_the_wheel() -> bool:
+    """Let MUMPS call MKL's BLAS instead of the binary wheel's single-threaded OpenBLAS
+    (:func:`.mkl.blas_for_libraries_loaded_later`; docs/parallel.md, *MUMPS's BLAS*): only
+    for the wheel of the ``mpi`` extra, whose BLAS is known to be LP64 OpenBLAS
+    (``libopenblas.so.0``), and only before its PETSc is loaded. Other PETSc builds keep
+    theirs: their BLAS may take 64-bit integers."""
+    try:
+        spec = importlib.util.find_spec("dolfinx_solver")
+    except (ImportError, ValueError, AttributeError):  # e.g. hidden by sys.modules[...] = None
+        return False
+    if spec is None or not spec.submodule_search_locations:
+        return False
+    folders = [Path(folder, "lib") for folder in spec.submodule_search_locations]
+    if not any((folder / "libopenblas.so.0").is_file() for folder in folders):
+        return False
+    return blas_for_libraries_loaded_later()
+
+
+@contextmanager
+def _one_mkl_thread() -> Iterator[None]:
+    """MKL on one thread in the calling thread while MUMPS runs, where MUMPS calls MKL's BLAS:
+    ranks sharing a machine do not oversubscribe its cores, and a second thread did not make
+    MUMPS's factorization faster (docs/parallel.md, *MUMPS's BLAS*). Thread-local, so PARDISO's
+    threads elsewhere keep MKL's setting."""
+    if not _MUMPS_BLAS["mkl"]:
+        yield
+        return
+    previous = mkl_threads_local(1)
+    try:
+        yield
+    finally:
+        mkl_threads_local(previous)
+
+
+def petsc_library(solver: str = "MUMPS") -> str:
+    """``"PETSc 3.25.5 + MUMPS on MKL's BLAS (2 ranks)"``: PETSc's version, the ``solver`` it
+    runs (MUMPS's BLAS named where it is MKL's), and ``PETSC_COMM_WORLD``'s size, for a run's
+    manifest; what is missing when the backend is not usable."""
     try:
         PETSc = petsc_module()
     except BackendUnavailableError as err:
         return f"PETSc (not usable: {err})"
     version = ".".join(map(str, PETSc.Sys.getVersion()))
     size = PETSc.COMM_WORLD.getSize()
-    return f"PETSc {version} + MUMPS ({size} rank{'s' if size > 1 else ''})"
+    blas = " on MKL's BLAS" if solver == "MUMPS" and _MUMPS_BLAS["mkl"] else ""
+    return f"PETSc {version} + {solver}{blas} ({size} rank{'s' if size > 1 else ''})"
 
 
 class PetscSolver(PetscRows):
@@ -127,7 +177,7 @@ class PetscSolver(PetscRows):
         As in :class:`~.solvers.SPDSolver`.
     ordering : (n,) int array, optional
         PETSc's numbering follows it (within each process's rows of a split matrix); an LU
-        on one process hands it to MUMPS, a Cholesky orders by METIS regardless.
+        on one process hands it to MUMPS, a Cholesky orders by AMD regardless.
 
     Attributes
     ----------
@@ -191,8 +241,9 @@ class PetscSolver(PetscRows):
         ksp.setOperators(mat)
         pc.setFactorSetUpSolverType()
         factor = pc.getFactorMatrix()
-        if PETSc.Sys.hasExternalPackage("metis") and not natural:
-            factor.setMumpsIcntl(7, 5)  # METIS nested dissection for the analysis
+        ordering = None if natural else self._mumps_ordering(PETSc)
+        if ordering is not None:
+            factor.setMumpsIcntl(7, ordering)
         if self.factorization == "lu":
             factor.setMumpsIcntl(10, -REFINEMENT_STEPS)
         elif in_blocks:  # the graph compressed to 2 x 2 blocks (docs/method.md, *Block Cholesky*)
@@ -202,9 +253,23 @@ class PetscSolver(PetscRows):
         self._x, self._b = mat.createVecs()
         self._scatter, self._all = PETSc.Scatter.toAll(self._x)
 
+    @staticmethod
+    def _mumps_ordering(PETSc: Any) -> int | None:
+        """MUMPS's ordering for its analysis (``ICNTL(7)``) where PETSc hands it none: AMD (0),
+        unless PETSc's options database sets ``-mat_mumps_icntl_7`` (then None: the user's).
+
+        A new pattern comes at every level, and MUMPS orders it itself. At 10⁶ unknowns
+        METIS's ordering took 4.4 s of MUMPS's 4.5 s analysis, AMD's 0.7 s, for a factor 10 %
+        larger and a factorization 0.3 s slower; the adaptive loop to 10⁶ unknowns took
+        35–44 s with AMD against 75 s with METIS on one rank, 43 s against 55 s on two
+        (docs/parallel.md, *MUMPS's ordering*)."""
+        return None if PETSc.Options().hasName("mat_mumps_icntl_7") else 0
+
     def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
         self._write_values(A, keep)
-        self._set_up("MUMPS could not factorize the matrix (PETSc error {ierr}): it is singular")
+        failure = "MUMPS could not factorize the matrix (PETSc error {ierr}): it is singular"
+        with _one_mkl_thread():
+            self._set_up(failure)
         pc = self._ksp.getPC()
         factor = pc.getFactorMatrix()
         status = int(factor.getMumpsInfog(1))
@@ -244,7 +309,8 @@ class PetscSolver(PetscRows):
         x = np.empty_like(columns)
         for j in range(columns.shape[1]):  # a handful of right-hand sides
             self._b.setArray(self._local_entries(columns[:, j]))  # in PETSc's order
-            self._ksp.solve(self._b, self._x)
+            with _one_mkl_thread():
+                self._ksp.solve(self._b, self._x)
             reason = int(self._ksp.getConvergedReason())
             if reason < 0:
                 raise FactorizationError(
