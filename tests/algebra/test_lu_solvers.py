@@ -55,3 +55,32 @@ def test_superlu_lu_reports_a_singular_matrix():
 def test_an_unknown_backend_name_is_refused():
     with pytest.raises(ValueError, match="unknown backend 'umfpack'"):
         solver_factory("umfpack")
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="needs MKL PARDISO")
+def test_pardiso_lu_refines_the_solves_of_a_factor_with_a_perturbed_pivot_only():
+    """A non-symmetric tridiagonal matrix, then the same pattern with its last two rows made
+    to share their trailing 2 x 2 block (singular; the matrix is not, condition 8.7e3):
+    PARDISO perturbs that pivot (``iparm[13] = 1``) and the solves of that factor are refined
+    (without refinement the residual was 8.5e-13); the regular factor before and after it is
+    solved without a step (``iparm[6] = 0``), its residual at round-off all the same."""
+    from signorini.algebra.pardiso_lu import REFINEMENT_STEPS, PardisoLUSolver
+
+    n = 200
+    rng = np.random.default_rng(3)
+    sub, sup = rng.uniform(-1, 1, n - 1), rng.uniform(-1, 1, n - 1)
+    regular = sp.diags([sub, 4 + rng.uniform(0, 1, n), sup], [-1, 0, 1], format="csr")
+    perturbed = regular.tolil()
+    perturbed[n - 1, n - 2], perturbed[n - 1, n - 1] = regular[n - 2, n - 2], regular[n - 2, n - 1]
+    perturbed = perturbed.tocsr()
+    assert np.linalg.cond(perturbed.toarray()) < 1e4
+    b = np.ones(n)
+    cases = ((regular, 0, 0), (perturbed, 1, REFINEMENT_STEPS), (regular, 0, 0))
+    with PardisoLUSolver() as solver:
+        for A, pivots, steps in cases:
+            solver.factorize(A)
+            assert solver._iparm[13] == pivots
+            x = solver.solve(b)
+            assert solver._iparm[6] == steps  # refinement steps done in the solve
+            assert np.abs(A @ x - b).max() < 1e-14
+        assert solver.n_analyses == 1  # one pattern
