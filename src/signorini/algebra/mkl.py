@@ -151,8 +151,8 @@ def openmp_sleep_at_once() -> bool:
 
 @cache
 def blas_for_libraries_loaded_later() -> bool:
-    """Make MKL's BLAS and LAPACK, on one thread, the ones that the shared libraries loaded
-    from now on call, where they leave the BLAS symbols (``dgemm_``, …) to the dynamic linker.
+    """Make MKL's BLAS and LAPACK the ones that the shared libraries loaded from now on call,
+    where they leave the BLAS symbols (``dgemm_``, …) to the dynamic linker.
 
     MKL's runtime library is loaded into the global symbol scope (``RTLD_GLOBAL``), which the
     dynamic linker searches before a library's own dependencies: a library loaded later that
