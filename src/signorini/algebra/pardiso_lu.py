@@ -53,7 +53,6 @@ class PardisoLUSolver(PardisoSolver):
         ordering: np.ndarray | None = None,
     ) -> None:
         super().__init__(None, check_symmetry=False, ordering=ordering)
-        self._iparm[7] = 0  # set per factorization (_factorize)
         self._iparm[9] = 13
         self._iparm[10] = int(matching)
         self._iparm[12] = int(matching)
