@@ -64,6 +64,7 @@ from .solvers import BackendUnavailableError, FactorizationError, SolverRequest
 from .sparse import in_node_blocks
 
 __all__ = [
+    "MUMPS_ORDERING",
     "PetscLUSolver",
     "PetscSolver",
     "petsc_library",
@@ -78,6 +79,14 @@ __all__ = [
 #: refinement made MUMPS keep the matrix and took 1.6 x the refactorization and 6 x the solve
 #: at 132 000 unknowns, for no gain on the symmetric positive definite systems.
 REFINEMENT_STEPS = 2
+
+#: MUMPS's ordering for its Cholesky's analysis (``ICNTL(7)``), which PETSc does not hand an
+#: ordering: AMD, unless PETSc's options database sets ``-mat_mumps_icntl_7``. A new pattern
+#: comes at every level, and MUMPS orders it itself. At 10⁶ unknowns METIS's ordering took
+#: 4.4 s of MUMPS's 4.5 s analysis, AMD's 0.7 s, for a factor 10 % larger and a factorization
+#: 0.3 s slower; the adaptive loop to 10⁶ unknowns took 35–44 s with AMD against 75 s with
+#: METIS on one rank, 43 s against 55 s on two (docs/parallel.md, *MUMPS's ordering*).
+MUMPS_ORDERING = 0
 
 #: How to install the backend, ending the message of a missing petsc4py.
 INSTALL_HINT = (
@@ -241,9 +250,9 @@ class PetscSolver(PetscRows):
         ksp.setOperators(mat)
         pc.setFactorSetUpSolverType()
         factor = pc.getFactorMatrix()
-        ordering = None if natural else self._mumps_ordering(PETSc)
-        if ordering is not None:
-            factor.setMumpsIcntl(7, ordering)
+        # the user's -mat_mumps_icntl_7, if any, else AMD (MUMPS_ORDERING)
+        if not natural and not PETSc.Options().hasName("mat_mumps_icntl_7"):
+            factor.setMumpsIcntl(7, MUMPS_ORDERING)
         if self.factorization == "lu":
             factor.setMumpsIcntl(10, -REFINEMENT_STEPS)
         elif in_blocks:  # the graph compressed to 2 x 2 blocks (docs/method.md, *Block Cholesky*)
@@ -252,18 +261,6 @@ class PetscSolver(PetscRows):
         self._mat, self._ksp = mat, ksp
         self._x, self._b = mat.createVecs()
         self._scatter, self._all = PETSc.Scatter.toAll(self._x)
-
-    @staticmethod
-    def _mumps_ordering(PETSc: Any) -> int | None:
-        """MUMPS's ordering for its analysis (``ICNTL(7)``) where PETSc hands it none: AMD (0),
-        unless PETSc's options database sets ``-mat_mumps_icntl_7`` (then None: the user's).
-
-        A new pattern comes at every level, and MUMPS orders it itself. At 10⁶ unknowns
-        METIS's ordering took 4.4 s of MUMPS's 4.5 s analysis, AMD's 0.7 s, for a factor 10 %
-        larger and a factorization 0.3 s slower; the adaptive loop to 10⁶ unknowns took
-        35–44 s with AMD against 75 s with METIS on one rank, 43 s against 55 s on two
-        (docs/parallel.md, *MUMPS's ordering*)."""
-        return None if PETSc.Options().hasName("mat_mumps_icntl_7") else 0
 
     def _factorize(self, A: sp.csr_matrix, keep: np.ndarray | None) -> None:
         self._write_values(A, keep)
