@@ -186,16 +186,51 @@ def test_an_error_of_an_analysis_beside_is_raised_by_factorize():
 
 @pytest.mark.parametrize("backend", available_backends())
 def test_an_analysis_that_reads_the_values_is_done_in_the_callers_thread(backend):
-    """LU with matching (and SuperLU) read the values in the analysis: ``beside`` is
-    ignored, and the analysis is done (and counted) before ``analyze`` returns (one beside
-    is counted when a factorization waits for it)."""
+    """PARDISO's LU with weighted matching (and SuperLU) read the values in the analysis:
+    ``beside`` is ignored, and the analysis is done (and counted) before ``analyze`` returns
+    (one beside is counted when a factorization waits for it)."""
     from signorini.algebra import SOLVERS, make_solver
+    from signorini.algebra.pardiso_lu import PardisoLUSolver
 
     K = block_spd(6, 6, np.random.default_rng(2))
-    with make_solver(SOLVERS[backend], symmetric=False) as solver:
+    made = PardisoLUSolver(matching=True) if backend == "pardiso" else None
+    with made or make_solver(SOLVERS[backend], symmetric=False) as solver:
         assert solver.analysis_reads_values
         solver.analyze(K, beside=True)
         assert solver.n_analyses == 1
+
+
+@pytest.mark.skipif(not HAS_PARDISO, reason="PARDISO not available")
+def test_an_lu_without_matching_analyses_beside_and_solves_as_with_it():
+    """PARDISO's LU without weighted matching (the factory's) reads no value in its
+    analysis, which runs beside the caller while the caller writes the values (counted when
+    the factorization waits for it); its solution of a non-symmetric matrix (a stiffness
+    whose rows 2z + 1 have a multiple of rows 2z subtracted, as on Coulomb's slipping nodes)
+    agrees with the matching LU's to round-off."""
+    from signorini.algebra import make_solver, pardiso_solver
+    from signorini.algebra.pardiso_lu import PardisoLUSolver
+
+    K = _elasticity_spd(8, 6)
+    A = K.tolil()
+    for z in range(0, K.shape[0], 6):
+        A[z + 1] = A[z + 1] - 0.9 * A[z]
+    A = sp.csr_matrix(A)
+    b = np.random.default_rng(5).standard_normal(A.shape[0])
+    with PardisoLUSolver(matching=True) as matched:
+        matched.factorize(A)
+        expected = matched.solve(b)
+    with make_solver(pardiso_solver, symmetric=False) as solver:
+        assert not solver.analysis_reads_values
+        values = A.data.copy()
+        A.data[:] = 1.0  # the analysis beside does not read them
+        solver.analyze(A, beside=True)
+        assert solver.n_analyses == 0  # not done yet, or not counted yet
+        A.data[:] = values
+        solver.factorize(A)
+        x = solver.solve(b)
+        assert solver.n_analyses == 1
+    assert np.abs(A @ x - b).max() <= 1e-13 * np.abs(b).max()
+    assert np.abs(x - expected).max() <= 1e-12 * np.abs(expected).max()
 
 
 def _elasticity_spd(nx: int, ny: int) -> sp.csr_matrix:

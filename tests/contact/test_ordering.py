@@ -8,6 +8,7 @@ import pytest
 import scipy.sparse as sp
 from linalg_problems import p2_elasticity
 
+import signorini.algebra.beside as background
 from signorini import adaptive, example_6_2, solve
 from signorini.algebra import (
     SOLVERS,
@@ -196,14 +197,29 @@ def test_an_ordering_started_in_the_background_is_the_ordering(adaptive_mesh):
 
 @needs_pardiso
 @pytest.mark.parametrize("make", [example_6_2, example_6_2_tresca, example_6_2_coulomb])
-def test_solve_with_its_analysis_beside_the_assembly_is_the_solve_without(adaptive_mesh, make):
+def test_solve_with_its_analysis_beside_the_assembly_is_the_solve_without(
+    adaptive_mesh, make, monkeypatch
+):
     """``solve`` with the PARDISO factory orders the unknowns and analyses the matrix beside
-    the assembly (:class:`Ordering`, :meth:`SPDSolver.analyze`); with an assembly passed in,
-    it does both in turn. The solutions are the same bit for bit, with the same counts (one
-    analysis); Coulomb's LU systems (another pattern) are analysed by their own solver."""
+    the assembly (:class:`Ordering`, :meth:`SPDSolver.analyze`): by its Cholesky, or, for
+    Coulomb's systems (on ``K``'s pattern), by its LU. With an assembly passed in, it does
+    both in turn. The solutions are the same bit for bit, with the same counts (one
+    analysis)."""
     problem = make()
     u0 = solve(problem, adaptive_mesh, solver=pardiso_solver).u  # a warm start: no nested solve
+    submitted = []
+    work_beside = background.beside
+
+    def spy(work, *args, **kwargs):
+        submitted.append(getattr(work, "__self__", None))
+        return work_beside(work, *args, **kwargs)
+
+    monkeypatch.setattr(background, "beside", spy)
     beside = solve(problem, adaptive_mesh, u0=u0, solver=pardiso_solver)
+    monkeypatch.setattr(background, "beside", work_beside)
+    analysed = [type(s).__name__ for s in submitted if s is not None]
+    coulomb = make is example_6_2_coulomb
+    assert analysed == ["PardisoLUSolver" if coulomb else "PardisoSolver"]
     in_turn = solve(
         problem, adaptive_mesh, u0=u0, solver=pardiso_solver,
         assembled=assemble(problem, adaptive_mesh),

@@ -174,28 +174,37 @@ def ordered_solver(
 class SolverAhead:
     """The factory of one mesh's solver whose symbolic analysis starts during the assembly.
 
-    :meth:`start` (:func:`~.system.assemble`'s ``on_pattern``) makes the symmetric solver of
-    the system from ``factory`` with the system's ordering as soon as ``K``'s pattern is
-    known, and starts its analysis beside the rest of the assembly
-    (:meth:`~signorini.algebra.SPDSolver.analyze`); a request for a symmetric system then
-    gets that solver, any other request a new one from ``factory``. Where a contact part's
-    friction law is not symmetric (Coulomb: LU systems on another pattern) nothing starts.
-    The solver does not check the symmetry of ``K``, symmetric by construction.
+    :meth:`start` (:func:`~.system.assemble`'s ``on_pattern``) makes the solver of the
+    system from ``factory`` with the system's ordering as soon as ``K``'s pattern is known,
+    and starts its analysis beside the rest of the assembly
+    (:meth:`~signorini.algebra.SPDSolver.analyze`): a symmetric one, or an LU where a contact
+    part's friction law is not symmetric (Coulomb, whose systems
+    (:class:`~signorini.algebra.friction_system.CoupledSystem`) keep ``K``'s pattern where
+    ``K`` is in node blocks). A request of that kind then gets that solver, any other request
+    a new one from ``factory``. Where the LU's analysis would read the values (weighted
+    matching), nothing starts. The solver does not check the symmetry of ``K``, symmetric by
+    construction.
     """
 
     def __init__(self, factory: SolverFactory | None) -> None:
         self.factory = factory
         self.linear: SPDSolver | None = None
+        self.symmetric = True
 
     def start(self, K: sp.csr_matrix, contact: ContactSet, ordering: Ordering) -> None:
-        if contact.has_friction and not contact.friction.symmetric:
+        symmetric = not (contact.has_friction and not contact.friction.symmetric)
+        linear = make_solver(
+            self.factory, symmetric=symmetric, check_symmetry=False, ordering=ordering
+        )
+        if linear.analysis_reads_values:  # it would analyse K's values now, in this thread
+            linear.close()
             return
-        self.linear = make_solver(self.factory, check_symmetry=False, ordering=ordering)
-        self.linear.analyze(K, beside=True)
+        self.linear, self.symmetric = linear, symmetric
+        linear.analyze(K, beside=True)
 
     def __call__(self, request: SolverRequest) -> SPDSolver:
         made, self.linear = self.linear, None
-        if made is not None and request.symmetric:
+        if made is not None and request.symmetric == self.symmetric:
             return made
         if made is not None:
             made.close()
