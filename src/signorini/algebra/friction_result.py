@@ -58,9 +58,9 @@ class FrictionStep:
 class FrictionResult(SolveReport):
     """Solution of :func:`~.friction.solve_friction` and how it was obtained
     (:class:`~.result.SolveReport`; ``n_solves`` counts one linear solve per iteration and
-    ``n_updates`` is 0, as the history has always recorded them, although the symmetric
-    systems solve some iterations by a bordered update of the previous factor, which the
-    counters do not show; ``times`` holds ``analysis``, ``factorization``, ``solve``,
+    ``n_updates`` is 0, as the history has always recorded them, although both kinds of
+    system solve some iterations by a low-rank update of the previous factor, which only
+    ``n_factorizations`` below the iterations shows; ``times`` holds ``analysis``, ``factorization``, ``solve``,
     ``assembly`` (forming the systems), ``total``; ``kkt`` is a
     :class:`~.friction_kkt.FrictionKKT`, the residuals of both laws).
 

@@ -25,7 +25,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from .active_system import ActiveSetSystem, refine
+from .active_system import UPDATE_RTOL, ActiveSetSystem, refine
 from .friction_kkt import FrictionProblem
 from .ranks import stored_values
 from .solvers import SPDSolver
@@ -89,21 +89,34 @@ class CoupledSystem:
     each solve writes the values, zeroes the held rows and columns (diagonal kept) and
     refactorizes.
 
+    Where the states differ from those of the factorization in at most ``max_update`` DOFs
+    (a held DOF released or held, or a slipping row's factor ``σ s'`` changed), the system
+    is solved with the existing LU and a low-rank correction instead (:meth:`_solve_updated`,
+    docs/method.md, *Friction*, "Low-rank updates of Coulomb's systems"), checked by its
+    residual; on one process, with a direct solver.
+
     Parameters
     ----------
     problem : FrictionProblem
     solver : SPDSolver
         A general sparse LU (a factory's solver for ``symmetric=False``).
+    max_update : int
+        Largest number of changed DOFs solved by a low-rank update (0: never).
     """
 
     symmetric = False
 
-    def __init__(self, problem: FrictionProblem, solver: SPDSolver) -> None:
+    def __init__(self, problem: FrictionProblem, solver: SPDSolver, max_update: int = 8) -> None:
         self.problem = problem
         self.solver = solver
         qp = problem.qp
         K = qp.K
         n = K.shape[0]
+        self.max_update = max_update if qp.ranks.size == 1 and solver.rtol is None else 0
+        self.factored: tuple[np.ndarray, np.ndarray] | None = None  # held DOFs, row factors
+        self.normal_of = np.full(n, -1)  # the normal DOF of each tangential one
+        self.normal_of[problem.tangent] = problem.normal
+        self._diagonal: np.ndarray | None = None  # K's, for the updates
         rows_K = csr_row_indices(K)
         contact = np.ones(problem.m, dtype=bool)
         self.derivative = problem.friction.bound_derivative(contact)  # s' in contact
@@ -151,6 +164,26 @@ class CoupledSystem:
         p, qp = self.problem, self.problem.qp
         n = qp.n
         factor = np.where(active & ~stick, direction * self.derivative, 0.0)  # σ s' on slip rows
+        row_factor = np.zeros(n)
+        row_factor[p.tangent] = factor
+        fixed, values = self.fixed, self.values
+        fixed[p.normal] = active
+        values[p.normal] = np.where(active, p.gap, 0.0)
+        fixed[p.tangent] = stick
+        values[p.tangent] = np.where(stick, p.reference, 0.0)
+        rhs = qp.F.copy()
+        rhs[p.tangent] -= factor * qp.F[p.normal]
+        if self.offset.any():  # σ s0 on slip rows (direction is 0 elsewhere)
+            rhs[p.tangent] -= direction * p.slip_bound(np.zeros(p.m), active)
+        if self.factored is not None and self.max_update > 0:
+            held, factored = self.factored
+            changed = np.flatnonzero((held != fixed) | (factored != row_factor))
+            if changed.size <= self.max_update:
+                x = self._solve_updated(rhs, row_factor, changed)
+                self.time_assembly += time.perf_counter() - t0
+                if x is not None:
+                    return x
+                t0 = time.perf_counter()
         if self.pos_K is None:  # K's own pattern
             data = qp.K.data.copy()
         else:
@@ -158,15 +191,6 @@ class CoupledSystem:
             data[self.pos_K] = qp.K.data
         data[self.pos_copy] -= factor[self.copy_node] * qp.K.data[self.copy_src]
         A = sp.csr_matrix((data, self.indices, self.indptr), shape=(n, n))
-        rhs = qp.F.copy()
-        rhs[p.tangent] -= factor * qp.F[p.normal]
-        if self.offset.any():  # σ s0 on slip rows (direction is 0 elsewhere)
-            rhs[p.tangent] -= direction * p.slip_bound(np.zeros(p.m), active)
-        fixed, values = self.fixed, self.values
-        fixed[p.normal] = active
-        values[p.normal] = np.where(active, p.gap, 0.0)
-        fixed[p.tangent] = stick
-        values[p.tangent] = np.where(stick, p.reference, 0.0)
         total = qp.ranks.sum  # of the products with A's rows: each row is on one rank
         b = rhs - total(A @ np.where(fixed, values, 0.0))
         b[fixed] = stored_values(data, self.diagonal[fixed], qp.ranks) * values[fixed]
@@ -178,7 +202,94 @@ class CoupledSystem:
         norm = lambda: qp.ranks.max(float(abs_matvec(A, np.ones(n)).max(initial=0.0)))  # noqa: E731
         x = refine(self.solver.solve, lambda y: b - total(A @ y), b, x, norm, self.solver.backend)
         x[fixed] = values[fixed]
+        self.factored = (fixed.copy(), row_factor)
         return x
+
+    def _solve_updated(
+        self, rhs: np.ndarray, row_factor: np.ndarray, changed: np.ndarray
+    ) -> np.ndarray | None:
+        """The system of the current held DOFs and ``row_factor`` from the LU of the
+        factorized one (:attr:`factored`), or None if the result fails its residual check.
+
+        The two matrices differ in the rows ``C = changed`` and in the columns ``D ⊆ C`` of
+        the DOFs held in one and free in the other: ``A₁ = A₀ + P_C R + G P_Dᵀ`` with
+        ``R = (A₁ − A₀)[C, :]`` and ``G`` the columns ``D`` outside the rows ``C``. With
+        ``U = [P_C, G]``, ``Vᵀ = [R; P_Dᵀ]`` (Sherman–Morrison–Woodbury)
+        ``x = y − Z (I + Vᵀ Z)⁻¹ Vᵀ y``, ``[y, Z] = A₀⁻¹ [b, U]``: one solve with
+        ``1 + |C| + |D|`` right-hand sides.
+        """
+        K = self.problem.qp.K
+        held, factored = self.factored
+        fixed, values = self.fixed, self.values
+        if self._diagonal is None:
+            self._diagonal = K.diagonal()
+        diagonal = self._diagonal
+        b = rhs - self._product(np.where(fixed, values, 0.0), row_factor)
+        b[fixed] = diagonal[fixed] * values[fixed]
+        if changed.size == 0:  # the factorized system itself, with another load
+            x = self.solver.solve(b)
+        else:
+            swapped = changed[held[changed] != fixed[changed]]
+            R = self._rows(changed, fixed, row_factor) - self._rows(changed, held, factored)
+            G = self._columns(swapped, changed, fixed, row_factor)
+            U = np.zeros((K.shape[0], 1 + changed.size + swapped.size), order="F")
+            U[:, 0] = b
+            U[changed, 1 + np.arange(changed.size)] = 1.0
+            U[:, 1 + changed.size :] = G
+            Y = self.solver.solve(U)
+            y, Z = Y[:, 0], Y[:, 1:]
+            capacitance = np.eye(Z.shape[1]) + np.vstack([R @ Z, Z[swapped]])
+            try:
+                w = np.linalg.solve(capacitance, np.concatenate([R @ y, y[swapped]]))
+            except np.linalg.LinAlgError:
+                return None
+            x = y - Z @ w
+        x[fixed] = values[fixed]
+        product = self._product(np.where(fixed, 0.0, x), row_factor)
+        product[fixed] = diagonal[fixed] * x[fixed]
+        scale = max(np.abs(b).max(), np.abs(diagonal).max() * np.abs(x).max(), 1e-300)
+        if not np.abs(b - product).max() <= UPDATE_RTOL * scale:  # also NaN
+            return None
+        return x
+
+    def _product(self, v: np.ndarray, row_factor: np.ndarray) -> np.ndarray:
+        """``K v`` with ``σ s'`` times the normal row's product subtracted on slipping
+        rows: the product of the system's free rows with ``v`` (held columns not zeroed)."""
+        p = self.problem
+        Kv = self.problem.qp.K @ v
+        out = Kv.copy()
+        out[p.tangent] -= row_factor[p.tangent] * Kv[p.normal]
+        return out
+
+    def _rows(self, dofs: np.ndarray, fixed: np.ndarray, row_factor: np.ndarray) -> np.ndarray:
+        """The rows ``dofs`` of the system of ``fixed`` and ``row_factor``, dense."""
+        K = self.problem.qp.K
+        rows = K[dofs].toarray()
+        slipping = np.flatnonzero(row_factor[dofs] != 0)
+        if slipping.size:
+            normal_rows = K[self.normal_of[dofs[slipping]]].toarray()
+            rows[slipping] -= row_factor[dofs[slipping], None] * normal_rows
+        rows[:, fixed] = 0.0  # held columns (a free row's own diagonal is free)
+        held = np.flatnonzero(fixed[dofs])
+        rows[held] = 0.0
+        rows[held, dofs[held]] = self._diagonal[dofs[held]]
+        return rows
+
+    def _columns(
+        self, swapped: np.ndarray, changed: np.ndarray, fixed: np.ndarray, row_factor: np.ndarray
+    ) -> np.ndarray:
+        """``(n, |swapped|)``: the columns ``swapped`` of the new system minus the old one's
+        outside the rows ``changed`` (rows that are the same in both): a released DOF's column
+        of ``K`` (with the slipping rows' correction), a newly held one's negated."""
+        K = self.problem.qp.K
+        columns = K[swapped].toarray()  # K symmetric: rows for columns
+        slipping = np.flatnonzero(row_factor != 0)
+        if slipping.size:
+            columns[:, slipping] -= row_factor[slipping] * columns[:, self.normal_of[slipping]]
+        columns[:, fixed] = 0.0  # held rows keep their diagonal only
+        columns[:, changed] = 0.0  # those rows are in R
+        columns *= np.where(fixed[swapped], -1.0, 1.0)[:, None]
+        return columns.T
 
 
 def _same_columns(K: sp.csr_matrix, normal: np.ndarray, tangent: np.ndarray) -> np.ndarray | None:
