@@ -93,7 +93,8 @@ class CoupledSystem:
     (a held DOF released or held, or a slipping row's factor ``σ s'`` changed), the system
     is solved with the existing LU and a low-rank correction instead (:meth:`_solve_updated`,
     docs/method.md, *Friction*, "Low-rank updates of Coulomb's systems"), checked by its
-    residual; on one process, with a direct solver.
+    residual; with a direct solver (on several ranks the rows and products of ``K`` it
+    reads are summed over them, as the symmetric updates do).
 
     Parameters
     ----------
@@ -112,7 +113,7 @@ class CoupledSystem:
         qp = problem.qp
         K = qp.K
         n = K.shape[0]
-        self.max_update = max_update if qp.ranks.size == 1 and solver.rtol is None else 0
+        self.max_update = max_update if solver.rtol is None else 0  # exact solves only
         self.factored: tuple[np.ndarray, np.ndarray] | None = None  # held DOFs, row factors
         self.normal_of = np.full(n, -1)  # the normal DOF of each tangential one
         self.normal_of[problem.tangent] = problem.normal
@@ -222,7 +223,7 @@ class CoupledSystem:
         held, factored = self.factored
         fixed, values = self.fixed, self.values
         if self._diagonal is None:
-            self._diagonal = K.diagonal()
+            self._diagonal = self.problem.qp.diagonal()  # on every rank
         diagonal = self._diagonal
         b = rhs - self._product(np.where(fixed, values, 0.0), row_factor)
         b[fixed] = diagonal[fixed] * values[fixed]
@@ -255,19 +256,19 @@ class CoupledSystem:
     def _product(self, v: np.ndarray, row_factor: np.ndarray) -> np.ndarray:
         """``K v`` with ``σ s'`` times the normal row's product subtracted on slipping
         rows: the product of the system's free rows with ``v`` (held columns not zeroed)."""
-        p = self.problem
-        Kv = self.problem.qp.K @ v
+        p, qp = self.problem, self.problem.qp
+        Kv = qp.ranks.sum(qp.K @ v)
         out = Kv.copy()
         out[p.tangent] -= row_factor[p.tangent] * Kv[p.normal]
         return out
 
     def _rows(self, dofs: np.ndarray, fixed: np.ndarray, row_factor: np.ndarray) -> np.ndarray:
         """The rows ``dofs`` of the system of ``fixed`` and ``row_factor``, dense."""
-        K = self.problem.qp.K
-        rows = K[dofs].toarray()
+        K, total = self.problem.qp.K, self.problem.qp.ranks.sum  # each row on one rank
+        rows = total(K[dofs].toarray())
         slipping = np.flatnonzero(row_factor[dofs] != 0)
         if slipping.size:
-            normal_rows = K[self.normal_of[dofs[slipping]]].toarray()
+            normal_rows = total(K[self.normal_of[dofs[slipping]]].toarray())
             rows[slipping] -= row_factor[dofs[slipping], None] * normal_rows
         rows[:, fixed] = 0.0  # held columns (a free row's own diagonal is free)
         held = np.flatnonzero(fixed[dofs])
@@ -281,8 +282,8 @@ class CoupledSystem:
         """``(n, |swapped|)``: the columns ``swapped`` of the new system minus the old one's
         outside the rows ``changed`` (rows that are the same in both): a released DOF's column
         of ``K`` (with the slipping rows' correction), a newly held one's negated."""
-        K = self.problem.qp.K
-        columns = K[swapped].toarray()  # K symmetric: rows for columns
+        K, total = self.problem.qp.K, self.problem.qp.ranks.sum  # each row on one rank
+        columns = total(K[swapped].toarray())  # K symmetric: rows for columns
         slipping = np.flatnonzero(row_factor != 0)
         if slipping.size:
             columns[:, slipping] -= row_factor[slipping] * columns[:, self.normal_of[slipping]]
