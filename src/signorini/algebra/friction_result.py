@@ -60,8 +60,8 @@ class FrictionResult(SolveReport):
     (:class:`~.result.SolveReport`; ``n_solves`` counts one linear solve per iteration and
     ``n_updates`` is 0, as the history has always recorded them, although both kinds of
     system solve some iterations by a low-rank update of the previous factor, which only
-    ``n_factorizations`` below the iterations shows; ``times`` holds ``analysis``, ``factorization``, ``solve``,
-    ``assembly`` (forming the systems), ``total``; ``kkt`` is a
+    ``n_factorizations`` below the iterations shows; ``times`` holds ``analysis``,
+    ``factorization``, ``solve``, ``assembly`` (forming the systems), ``total``; ``kkt`` is a
     :class:`~.friction_kkt.FrictionKKT`, the residuals of both laws).
 
     Attributes
