@@ -24,12 +24,11 @@ class PardisoLUSolver(PardisoSolver):
     analysis (ordering on ``A + A^T``, symbolic factorization) is done once per pattern, as in
     :class:`PardisoSolver`. Settings as there, plus PARDISO's pivot perturbation 1e-13 for
     non-symmetric matrices (``iparm[9]``) and :data:`REFINEMENT_STEPS` steps of iterative
-    refinement (``iparm[7]``) in the solves of a
-    factor with perturbed pivots (``iparm[13] > 0``), which need them. A factor without is
-    solved without refinement: its residual is at round-off either way, and each step costs
-    another solve (Coulomb's system at 205 154 unknowns: 0.045–0.073 s per solve against
-    0.150–0.207 s with two steps, the residuals alike). The caller checks the residual of
-    every solve.
+    refinement (``iparm[7]``) in the solves of a factor with perturbed pivots
+    (``iparm[13] > 0``), which need them. A factor without is solved without refinement: its
+    residual is at round-off either way, and each step costs another solve (Coulomb's system
+    at 205 154 unknowns: 0.045–0.073 s per solve against 0.150–0.207 s with two steps, the
+    residuals alike). The caller checks the residual of every solve.
 
     Without ``matching`` (the default) the analysis reads no value, so that it can run beside
     the caller (:meth:`~.solvers.SPDSolver.analyze`): Coulomb's systems, whose diagonal is
