@@ -401,7 +401,7 @@ def test_coulomb_systems_a_few_nodes_away_are_solved_by_a_low_rank_update(backen
 def test_an_update_that_fails_its_residual_check_is_refactorized(monkeypatch):
     """With a residual bound no update meets, every changed system is factorized anew: the
     same solution, a factorization per system."""
-    import signorini.algebra.friction_system as friction_system
+    import signorini.algebra.active_system as active_system
 
     S = block()
     r = run(S, COULOMB, 0.5)
@@ -409,7 +409,7 @@ def test_an_update_that_fails_its_residual_check_is_refactorized(monkeypatch):
     states = _coulomb_variants(r.state, r.direction)[:3]
     with make_solver(pardiso_solver, symmetric=False) as lu:
         expected = [CoupledSystem(problem, lu).solve(*s) for s in states]
-    monkeypatch.setattr(friction_system, "UPDATE_RTOL", 0.0)
+    monkeypatch.setattr(active_system, "UPDATE_RTOL", 0.0)
     with make_solver(pardiso_solver, symmetric=False) as lu:
         system = CoupledSystem(problem, lu)
         for s, y in zip(states, expected, strict=True):

@@ -38,6 +38,7 @@ __all__ = [
     "check_residual",
     "forward_error",
     "refine",
+    "update_accepted",
 ]
 
 logger = logging.getLogger(__name__)
@@ -66,6 +67,14 @@ REFINE_STEPS = 3
 #: Largest residual of a low-rank updated solve, relative to ``max(max |b|, max |diag A| max |x|)``;
 #: above it the system is refactorized.
 UPDATE_RTOL = 1e-12
+
+
+def update_accepted(residual: float, b: np.ndarray, diagonal: np.ndarray, x: np.ndarray) -> bool:
+    """Whether a low-rank updated solve ``x`` of ``A x = b`` is accepted: its residual
+    ``max |b − A x|`` (NaN fails) at most :data:`UPDATE_RTOL` times the size of both sides,
+    ``max(max |b|, max |diag A| max |x|)`` (``diagonal``: that of the matrix factorized)."""
+    scale = max(np.abs(b).max(), np.abs(diagonal).max() * np.abs(x).max(), 1e-300)
+    return bool(residual <= UPDATE_RTOL * scale)
 
 
 def check_residual(residual: np.ndarray | float, b: np.ndarray, backend: str) -> None:
@@ -368,9 +377,7 @@ class ActiveSetSystem:
         x = z - W @ y
         x[released] = y[:r]
         x[fixed1] = values[fixed1]
-        # accepted at round-off: relative to the size of both sides of A x = b
-        scale = max(np.abs(b).max(), np.abs(self.diagonal).max() * np.abs(x).max(), 1e-300)
-        if not self.residual(b, x) <= UPDATE_RTOL * scale:
+        if not update_accepted(self.residual(b, x), b, self.diagonal, x):
             return None
         self.n_updates += 1
         return x

@@ -25,7 +25,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from .active_system import UPDATE_RTOL, ActiveSetSystem, refine
+from .active_system import ActiveSetSystem, refine, update_accepted
 from .friction_kkt import FrictionProblem
 from .ranks import stored_values
 from .solvers import SPDSolver
@@ -249,8 +249,7 @@ class CoupledSystem:
         x[fixed] = values[fixed]
         product = self._product(np.where(fixed, 0.0, x), row_factor)
         product[fixed] = diagonal[fixed] * x[fixed]
-        scale = max(np.abs(b).max(), np.abs(diagonal).max() * np.abs(x).max(), 1e-300)
-        if not np.abs(b - product).max() <= UPDATE_RTOL * scale:  # also NaN
+        if not update_accepted(float(np.abs(b - product).max()), b, diagonal, x):
             return None
         return x
 
