@@ -7,13 +7,16 @@ matrix (analysis + factorization + solve with a fresh solver), measured in the s
 not counted in our total. Each level's row ends with its peak resident memory (``peakMiB``:
 ``VmHWM``, reset when the level starts, read before the floor's solve) and that over the
 memory of its Cholesky factor (``peak/L``, 8 bytes per non-zero PARDISO reports, the factor of
-the loop's ordering); the summary gives PARDISO's own memory on the last level
-(``iparm[14..16]``). The floor is measured twice: with PARDISO's own ordering (``floor``,
-``ratio``) and with the loop's ordering (``ordered``, ``ratio_o``: the solver is offered
+the loop's ordering); the summary gives PARDISO's own memory on the last level, that of the
+loop's largest solver (``iparm[14..16]``, read as it is closed). The floor is measured
+twice: with PARDISO's own ordering (``floor``, ``ratio``) and with the loop's ordering
+(``ordered``, ``ratio_o``: the solver is offered
 :func:`signorini.contact.ordering.dof_ordering`, computed inside the timed solve, as the loop
 does), the strictest floor. At the end it prints the ratios of issues #4 and #26, each
-measured in this run, and as its last two lines ``ratio_to_ordered_floor=X`` and
-``ratio_to_floor=X``.
+measured in this run: the last level's peak beyond PARDISO's own memory, the ratio to the
+ordered floors split into the phases' shares (which sum to it: what the linear solves cost
+against what the rest of the loop costs), and as its last two lines
+``ratio_to_ordered_floor=X`` and ``ratio_to_floor=X``.
 
 Measured to 5·10⁶ unknowns (``--max-ndof 6000000``, 2026-11-26, 2 cores, a slower day than
 2026-11-23's 149 s): 50 levels to 5 394 800 unknowns in 211 s (sum of floors 212 s with
@@ -80,12 +83,10 @@ def reduced_system(problem, mesh):
     return K, b, lambda: dof_ordering(a.space, coupling)
 
 
-def floor_seconds(
-    problem, mesh, backend: str, *, ordered: bool = False
-) -> tuple[float, int, dict[str, int]]:
+def floor_seconds(problem, mesh, backend: str, *, ordered: bool = False) -> tuple[float, int]:
     """One analysis + factorization + solve of the level's matrix (Dirichlet DOFs
-    eliminated), with a fresh solver; also the factor's non-zeros and PARDISO's own memory
-    (``iparm[14..16]`` in KiB) when known. ``ordered``: the solver is offered the loop's
+    eliminated), with a fresh solver; also the factor's non-zeros when known. ``ordered``:
+    the solver is offered the loop's
     ordering (METIS on the vertex graph, computed inside the timed solve, as in the loop);
     otherwise PARDISO orders by itself."""
     K, b, ordering = reduced_system(problem, mesh)
@@ -96,8 +97,7 @@ def floor_seconds(
         solver.solve(b)
         seconds = time.perf_counter() - t0
         nnz = int(getattr(solver, "factor_nnz", 0))
-        memory = dict(getattr(solver, "memory_kib", {}))
-    return seconds, nnz, memory
+    return seconds, nnz
 
 
 def peak_rss_bytes() -> int:
@@ -201,20 +201,23 @@ def main() -> None:
     level_peaks: list[int] = []  # bytes, each level's own
     with_floors = 0  # bytes: the process's peak, floor measurements included
     factory = solver_factory(args.backend)
-    made: list = []  # the level's solvers, for the factor's size without a floor
+    made: list[tuple[int, dict[str, int]]] = []  # the level's solvers: factor size, memory
 
     def remembering(request):
+        """The factory's solver, whose factor size and PARDISO memory (which closing the
+        solver zeroes) are remembered when it is closed."""
         solver = factory(request)
-        made.append(solver)
+        close = solver.close
+
+        def closing():
+            nnz = int(getattr(solver, "factor_nnz", 0))
+            made.append((nnz, dict(getattr(solver, "memory_kib", {}))))
+            close()
+
+        solver.close = closing
         return solver
 
-    remembering.takes_ordering = getattr(factory, "takes_ordering", False)
-    generator = adaptive(
-        problem,
-        theta=args.theta,
-        max_ndof=args.max_ndof,
-        solver=remembering if args.no_floor else factory,
-    )
+    generator = adaptive(problem, theta=args.theta, max_ndof=args.max_ndof, solver=remembering)
     while True:
         resettable = reset_peak()
         t0 = time.perf_counter()
@@ -232,17 +235,15 @@ def main() -> None:
         mesh = level.result.mesh
         backend = r.backend
         del level  # free the level before the floor measurement
+        # the loop's own solvers (closed): the largest factor's size and PARDISO's memory
+        last_nnz, memory = max(made, key=lambda m: m[0], default=(0, {}))
+        made.clear()
         if args.no_floor:
             level_floor = level_ordered = float("nan")
-            largest = max(made, key=lambda s: int(getattr(s, "factor_nnz", 0)), default=None)
-            last_nnz = int(getattr(largest, "factor_nnz", 0))
-            memory = dict(getattr(largest, "memory_kib", {}))
-            made.clear()
-            del largest
         else:
-            level_floor, own_nnz, memory = floor_seconds(problem, mesh, backend)
-            level_ordered, last_nnz, _ = floor_seconds(problem, mesh, backend, ordered=True)
-            last_nnz = last_nnz or own_nnz
+            level_floor, own_nnz = floor_seconds(problem, mesh, backend)
+            level_ordered, ordered_nnz = floor_seconds(problem, mesh, backend, ordered=True)
+            last_nnz = ordered_nnz or own_nnz  # the Cholesky factor, also under Coulomb's LU
         level_peaks.append(level_peak)
         with_floors = max(with_floors, level_peak_bytes(resettable))
         total += level_total
@@ -320,13 +321,20 @@ def main() -> None:
             f"{factor_bytes / 2**20:.0f} MiB (8 bytes x {last_nnz} non-zeros, the loop's "
             f"ordering): ratio {peak / factor_bytes:.2f} (target <= 2.5)"
         )
-    if memory and any(memory.values()):  # a closed solver's are 0 (--no-floor)
+    if memory and any(memory.values()):
         own = max(memory["analysis_peak"], memory["permanent"] + memory["factorization"])
         print(
-            f"PARDISO's own memory on the last level (KiB): analysis peak iparm[14] = "
+            f"PARDISO's own memory on the last level (the loop's solver, KiB): analysis peak "
+            f"iparm[14] = "
             f"{memory['analysis_peak']}, permanent iparm[15] = {memory['permanent']}, "
             f"factorization iparm[16] = {memory['factorization']}; its peak "
             f"{own / 2**10:.0f} MiB = {own * 1024 / factor_bytes:.2f} x the factor"
+        )
+        rest = level_peaks[-1] - own * 1024
+        print(
+            f"the last level's peak beyond PARDISO's own: {rest / 2**20:.0f} MiB = "
+            f"{rest / factor_bytes:.2f} x the factor (the matrix and the triangle handed to "
+            "PARDISO, mesh, contact data, vectors, the interpreter and its libraries)"
         )
     elif not factor_bytes:
         print(f"peak memory {peak / 2**20:.0f} MiB (factor size unknown for {backend})")
@@ -334,6 +342,12 @@ def main() -> None:
     if args.no_floor:
         print("no floors measured (--no-floor)")
         return
+    shares = dict(phases, between=total - sum(phases.values()))
+    print(
+        "ratio_to_ordered_floor by phase (each phase's total over the sum of ordered floors; "
+        "between: the loop's work outside the phases): "
+        + " + ".join(f"{k} {v / ordered_floor:.3f}" for k, v in shares.items())
+    )
     print(f"ratio_to_ordered_floor={total / ordered_floor:.3f}")
     print(f"ratio_to_floor={total / floor:.3f}")
 

@@ -68,6 +68,17 @@ def test_adaptive_benchmark_reports_consistent_counts_and_floor(tmp_path):
     solves = [int(row["solves"]) for row in table if int(row["level"]) >= 5]
     mean = float(summary["PDAS linear solves per level after level 5"].split(": ")[1].split()[0])
     assert mean == pytest.approx(np.mean(solves), abs=5e-3)
+    # the phases' shares of ratio_to_ordered_floor sum to it, and PDAS's is its sum over the floors
+    assert lines[-2].startswith("ratio_to_ordered_floor=")
+    by_phase = lines[-3].split(": ")[-1].split(" + ")
+    shares = {word.split()[0]: float(word.split()[1]) for word in by_phase}
+    assert list(shares) == ["assemble", "pdas", "estimate", "mark", "refine", "output", "between"]
+    assert sum(shares.values()) == pytest.approx(float(lines[-2].split("=")[1]), abs=5e-3)
+    ordered = sum(float(row["ordered"]) for row in table)
+    pdas = sum(float(row["pdas"]) for row in table)
+    slack = 5e-4 * len(table)  # each printed value rounded to 1 ms
+    low, high = (pdas - slack) / (ordered + slack), (pdas + slack) / (ordered - slack)
+    assert low - 5e-4 <= shares["pdas"] <= high + 5e-4
     # ratio_to_floor: the last line, the ratio of the two sums printed above it
     assert lines[-1].startswith("ratio_to_floor=")
     ratio = float(lines[-1].split("=")[1])
@@ -105,6 +116,14 @@ def test_adaptive_benchmark_without_floors_reads_the_loops_factor(tmp_path):
     assert nnz[0] == nnz[1] > 4876
     peak = float(table[-1]["peakMiB"])
     assert float(table[-1]["peak/L"]) == pytest.approx(peak * 2**20 / (8 * nnz[1]), rel=0.01)
+    # PARDISO's own memory is the loop's solver's either way, and with the rest it makes the
+    # last level's peak
+    own = [next(ln for ln in out.splitlines() if "PARDISO's own memory" in ln) for out in runs]
+    assert own[0] == own[1] and "its peak" in own[1]
+    own_ratio = float(re.search(r"= ([\d.]+) x the factor", own[1])[1])
+    rest = next(line for line in none.splitlines() if "beyond PARDISO's own" in line)
+    rest_ratio = float(re.search(r"= ([\d.]+) x the factor", rest)[1])
+    assert own_ratio + rest_ratio == pytest.approx(float(table[-1]["peak/L"]), abs=0.02)
 
 
 def test_inclined_block_example_runs(tmp_path):
