@@ -53,6 +53,7 @@ docs/method.md, *Two bodies*).
 from __future__ import annotations
 
 import argparse
+import functools
 import resource
 import tempfile
 import time
@@ -98,6 +99,27 @@ def floor_seconds(problem, mesh, backend: str, *, ordered: bool = False) -> tupl
         seconds = time.perf_counter() - t0
         nnz = int(getattr(solver, "factor_nnz", 0))
     return seconds, nnz
+
+
+def remembering_factory(factory, made: list[tuple[int, dict[str, int]]]):
+    """``factory`` (its attributes too: :func:`~signorini.algebra.backends.takes_ordering`,
+    :func:`~signorini.algebra.ranks.solver_ranks`), whose solvers append their factor's size
+    and PARDISO's memory to ``made`` when closed (closing zeroes ``iparm[14..16]``)."""
+
+    @functools.wraps(factory)
+    def remembering(request):
+        solver = factory(request)
+        close = solver.close
+
+        def closing():
+            nnz = int(getattr(solver, "factor_nnz", 0))
+            made.append((nnz, dict(getattr(solver, "memory_kib", {}))))
+            close()
+
+        solver.close = closing
+        return solver
+
+    return remembering
 
 
 def peak_rss_bytes() -> int:
@@ -202,21 +224,7 @@ def main() -> None:
     with_floors = 0  # bytes: the process's peak, floor measurements included
     factory = solver_factory(args.backend)
     made: list[tuple[int, dict[str, int]]] = []  # the level's solvers: factor size, memory
-
-    def remembering(request):
-        """The factory's solver, whose factor size and PARDISO memory (which closing the
-        solver zeroes) are remembered when it is closed."""
-        solver = factory(request)
-        close = solver.close
-
-        def closing():
-            nnz = int(getattr(solver, "factor_nnz", 0))
-            made.append((nnz, dict(getattr(solver, "memory_kib", {}))))
-            close()
-
-        solver.close = closing
-        return solver
-
+    remembering = remembering_factory(factory, made)
     generator = adaptive(problem, theta=args.theta, max_ndof=args.max_ndof, solver=remembering)
     while True:
         resettable = reset_peak()

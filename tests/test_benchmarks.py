@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import importlib.util
 import re
 import subprocess
 import sys
@@ -10,8 +11,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
-from signorini.algebra import available_backends
+from signorini.algebra import SolverRequest, available_backends, solver_factory
+from signorini.algebra.backends import takes_ordering
+from signorini.algebra.ranks import solver_ranks
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -124,6 +128,31 @@ def test_adaptive_benchmark_without_floors_reads_the_loops_factor(tmp_path):
     rest = next(line for line in none.splitlines() if "beyond PARDISO's own" in line)
     rest_ratio = float(re.search(r"= ([\d.]+) x the factor", rest)[1])
     assert own_ratio + rest_ratio == pytest.approx(float(table[-1]["peak/L"]), abs=0.02)
+
+
+def test_adaptive_benchmark_factory_keeps_what_the_loop_reads():
+    """The factory the benchmark hands the loop keeps the wrapped factory's attributes, so the
+    loop computes the ordering and the analysis ahead exactly as with the factory itself, and
+    it remembers each solver's factor size and memory as the solver is closed."""
+    path = ROOT / "benchmarks" / "adaptive.py"
+    spec = importlib.util.spec_from_file_location("bench_adaptive", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    for name in ("pardiso", "scipy", "auto"):
+        factory = solver_factory(name)
+        made: list = []
+        wrapped = bench.remembering_factory(factory, made)
+        assert takes_ordering(wrapped) == takes_ordering(factory), name
+        assert solver_ranks(wrapped) == solver_ranks(factory), name
+    if takes_ordering(solver_factory("pardiso")):
+        made = []
+        wrapped = bench.remembering_factory(solver_factory("pardiso"), made)
+        A = sp.diags([-np.ones(99), 4 * np.ones(100), -np.ones(99)], [-1, 0, 1]).tocsr()
+        solver = wrapped(SolverRequest(check_symmetry=False))
+        solver.factorize(A)
+        memory = solver.memory_kib
+        solver.close()
+        assert made == [(solver.factor_nnz, memory)] and any(memory.values())
 
 
 def test_inclined_block_example_runs(tmp_path):
