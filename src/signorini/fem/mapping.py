@@ -286,8 +286,16 @@ class IsoparametricCells:
         return np.einsum("qa,mai->mqi", p2.basis(xi), self.nodes)
 
     def jacobians(self, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``J (m, q, d, 2)`` and ``det J (m, q)`` at each point."""
-        J = np.einsum("qaj,mai->mqij", p2.grad_basis(xi), self.nodes)
+        """``J (m, q, d, 2)`` and ``det J (m, q)`` at each point.
+
+        ``J = Σ_a x_a ⊗ ∇φ_a(ξ)`` summed elementwise in the order a = 0 … 5: a cell's
+        Jacobians depend on its own nodes alone, bit for bit (:mod:`signorini.fem.fixed_order`).
+        """
+        g = p2.grad_basis(xi)[None, :, :, None, :]  # (1, q, 6, 1, 2)
+        x = self.nodes[:, None, :, :, None]  # (m, 1, 6, d, 1)
+        J = x[:, :, 0] * g[:, :, 0]
+        for a in range(1, g.shape[2]):  # a loop over the local basis functions
+            J += x[:, :, a] * g[:, :, a]
         return J, _det(J)
 
     def inverse_transpose(self, xi: np.ndarray) -> np.ndarray:

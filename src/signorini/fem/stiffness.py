@@ -26,6 +26,7 @@ import scipy.sparse as sp
 
 from . import p2
 from .element import ELEMENTS, P2, Element
+from .fixed_order import rows_times
 from .mapping import AffineCells, CellMap, Cells
 from .material import CellMaterials, Material, on_cells
 from .quadrature import triangle_rule
@@ -145,10 +146,10 @@ def element_blocks(
             rows = np.flatnonzero(material.index == k)
             if rows.size:
                 basis = _stiffness_basis(mat.lam_eff, mat.mu, dof_order, degree, n_p > 1, name)
-                out[rows] = fac[rows] @ basis
+                out[rows] = rows_times(fac[rows], basis)
         return out
     basis = _stiffness_basis(material.lam_eff, material.mu, dof_order, degree, n_p > 1, name)
-    return np.matmul(fac, basis, out=out)
+    return rows_times(fac, basis, out=out)
 
 
 def element_stiffness(vertices: np.ndarray, material: Material) -> np.ndarray:
@@ -415,36 +416,19 @@ def _row_blocks(
     """The element blocks ``(e, 4 k²)`` of the cells ``cells (n_cells,) bool`` and their
     nodes ``(e, k)``, group after group in the order of the whole assembly.
 
-    Each block equals the whole assembly's bit for bit: the GEMM of :func:`element_blocks`
-    gives a row the same value whatever the other rows, except that NumPy multiplies a
-    single row by a matrix-vector product, rounded differently; so a group (or, with
-    materials by region, a material of a group) that has several cells but of which only one
-    is asked for is computed with a second of its cells, whose block is dropped.
+    Each block equals the whole assembly's bit for bit, whatever other cells are computed
+    beside it: :func:`element_blocks` forms every cell's block from that cell's data alone
+    (elementwise operations and :func:`~signorini.fem.fixed_order.rows_times`, no BLAS).
     """
-    work = []  # (group, its rows computed, their materials, how many are kept)
+    work = []  # (group's rows computed, their materials, their cells' rows in the mesh)
     for g in mapping.groups:
         index = np.arange(mapping.n_cells)[g.cells]  # the group's cells, in its order
         slot = np.flatnonzero(cells[index])
-        mat = on_cells(material, g.cells)
-        kind = mat.index if isinstance(mat, CellMaterials) else np.zeros(len(g), np.int64)
-        asked = np.bincount(kind[slot], minlength=kind.max(initial=0) + 1)
-        lone = np.flatnonzero((asked == 1) & (np.bincount(kind) > 1))
-        kept = slot.size
-        if lone.size:  # one more cell of each such kind (a loop over materials)
-            taken = np.zeros(len(g), dtype=bool)
-            taken[slot] = True
-            slot = np.concatenate([slot, [np.flatnonzero((kind == k) & ~taken)[0] for k in lone]])
-        if kept:
-            work.append((g.rows(slot), on_cells(mat, slot), kept, index[slot[:kept]]))
-    blocks = np.empty((sum(w[2] for w in work), 4 * element.n_local**2))
+        if slot.size:
+            work.append((g.rows(slot), on_cells(on_cells(material, g.cells), slot), index[slot]))
+    blocks = np.empty((sum(len(w[2]) for w in work), 4 * element.n_local**2))
     start = 0
-    for group, mat, kept, _ in work:  # into one array (no copy), as the whole assembly does
-        rows = blocks[start : start + kept]
-        if kept == len(group):
-            element_blocks(group, mat, out=rows, element=element)
-        else:  # with the extra cells of lone kinds
-            rows[:] = element_blocks(group, mat, element=element)[:kept]
-        start += kept
-    if len(work) == 1:
-        return blocks, nodes[work[0][3]]
-    return blocks, nodes[np.concatenate([w[3] for w in work])] if work else nodes[:0]
+    for group, mat, index in work:  # into one array (no copy), as the whole assembly does
+        element_blocks(group, mat, out=blocks[start : start + len(index)], element=element)
+        start += len(index)
+    return blocks, nodes[np.concatenate([w[2] for w in work])] if work else nodes[:0]
