@@ -33,11 +33,12 @@ def figures_command(name: str, out: Path, status) -> list[Path]:
     from ..output.run import RunFolder
     from .identity import check_problem
     from .problems import label, load
+    from .settings import recorded_arguments
 
     folder = RunFolder.open(out, purpose="draw the figures")
     status.folder = folder
     job = load(name)
-    options = AdaptiveOptions.from_record(folder.manifest.get("arguments", {}))
+    options = AdaptiveOptions.from_record(recorded_arguments(folder.manifest, folder.file))
     check_problem(folder, name, job, options, f"figures {name} {out}")
     return figures(label(name), folder.path)
 
@@ -80,7 +81,7 @@ def compare_uniform(
     from .. import plots
 
     out = folder.path
-    uni = out / "uniform"
+    uni = folder.sub_folder("uniform")  # refused if it is a link out of the folder
     folder.add_files("uniform/history.csv")
     history = HistoryWriter(uni / "history.csv")
     say(f"{problem.name}: uniform refinement for comparison -> {uni}")

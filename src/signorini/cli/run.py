@@ -20,14 +20,14 @@ from ..loop import COLUMNS, Level, adaptive
 from ..output import HistoryWriter, write_columns
 from ..output.check import CHECK, write_check
 from ..output.environment import environment
-from ..output.run import STATE, ResumeState, RunFolder
+from ..output.run import ResumeState, RunFolder
 from ..output.vtu import write_fields
 from .figures import compare_uniform, draw_figures
 from .identity import check_problem, name_the_problem, problem_data
 from .levels import Clock, Printer, Status, write_levels
 from .problems import RunProblem, label, load, problem_id, with_curves_of
 from .ranks import follow, launched_ranks
-from .settings import RunSettings, new_settings, resumed_settings
+from .settings import RunSettings, new_settings, recorded_arguments, resumed_settings
 
 __all__ = ["run"]
 
@@ -61,7 +61,7 @@ def run(args: argparse.Namespace, status: Status | None = None) -> int:
         status.folder = folder
         if args.example is None:
             raise name_the_problem(folder, f"run PROBLEM --resume {args.resume}")
-        settings = resumed_settings(args, folder.manifest.get("arguments", {}))
+        settings = resumed_settings(args, recorded_arguments(folder.manifest, folder.file))
         name = args.example  # checked by its data (_restart), never by the manifest's name
         if folder.manifest.get("status") == "finished":
             say(f"the run in {args.resume} is finished: nothing to resume")
@@ -109,10 +109,10 @@ def _open_resumed(args: argparse.Namespace) -> RunFolder:
 def _restart(
     folder: RunFolder, name: str, job: RunProblem, settings: RunSettings, verb: str
 ) -> ResumeState:
-    """Check that ``job`` is the run's problem (when a level finished), then the saved
-    state of the resumed run, its mesh with the problem's curves again (the state holds
-    arrays only)."""
-    if (folder.path / STATE).is_file():
+    """Check that ``job`` is the run's problem (when the folder holds anything a level
+    saved, whatever file is missing), then the saved state of the resumed run, its mesh
+    with the problem's curves again (the state holds arrays only)."""
+    if folder.saved_work():
         check_problem(folder, name, job, settings.options, verb)
     state = folder.restart(_environment(settings))
     if state.mesh is not None:
