@@ -53,15 +53,17 @@ def pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> l
 def draw_figures(
     label: str,
     folder: RunFolder,
-    last: Level,
+    last: Level | None,
     metrics: Metrics | None,
     say: Callable[[str], None],
 ) -> None:
-    """Announce, draw and record the figures of a run whose last level is ``last``."""
+    """Announce, draw and record the figures of a run whose last level is ``last`` (None:
+    the convergence figures of its history only)."""
     out = folder.path
-    say(f"drawing the figures of {label} (convergence history, mesh, deformed body) ...")
+    kinds = "convergence history, mesh, deformed body" if last else "convergence history"
+    say(f"drawing the figures of {label} ({kinds}) ...")
     written = figures(label, out, last)
-    if metrics is not None and metrics.pressure is not None:
+    if last is not None and metrics is not None and metrics.pressure is not None:
         written += pressure_figure(label, out, last, metrics)
     folder.add_files(*(str(p.relative_to(out)) for p in written))
     say(f"figures: {', '.join(str(p.name) for p in written)}")
