@@ -15,6 +15,7 @@ import shutil
 import signal
 from pathlib import Path
 
+import numpy as np
 import pytest
 from test_cli import interrupt_after_level
 
@@ -237,3 +238,35 @@ def test_a_manifest_that_is_not_json_is_reported_as_such(part, capsys):
         f"signorini: error: cannot resume: {file} is JSON but not the manifest of a run (an "
         "object whose 'files' lists the names of the run's files)\n"
     )
+
+
+# ---------------------------------------------------------------------- an edited state or history
+@pytest.mark.parametrize(
+    "change, fault",
+    [
+        ({"level": np.array(-1)}, "says level -1 finished: not a state signorini saved"),
+        ({"u0": np.zeros((7, 2))}, "holds a warm start of shape (7, 2) on a mesh of"),
+        ({"u0": np.full((1, 1), np.nan)}, "holds a warm start of shape (1, 1)"),
+    ],
+)
+def test_an_edited_resume_state_is_refused_naming_the_file(part, capsys, change, fault):
+    file = part / "resume.npz"
+    with np.load(file) as data:
+        arrays = {name: data[name] for name in data.files}
+    np.savez(file, **{**arrays, **change})
+    assert main(resume("example-6.2", part)) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"signorini: error: cannot resume: {file} {fault}"), err
+
+
+def test_an_edited_history_is_refused_before_the_run_goes_on(part, capsys):
+    file = part / "history.csv"
+    lines = file.read_text().splitlines()
+    lines[2] = "x" + lines[2][1:]  # level 1's index
+    file.write_text("\n".join(lines) + "\n")
+    assert main(resume("example-6.2", part)) == 2
+    assert capsys.readouterr().err == (
+        f"signorini: error: cannot resume: line 3 of {file} is not the row of level 1 of a "
+        "run (its level, its ndof or its number of fields); start again with --overwrite\n"
+    )
+    assert json.loads((part / "signorini-run.json").read_text())["status"] == "interrupted"

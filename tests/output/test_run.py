@@ -75,7 +75,7 @@ def test_overwrite_removes_exactly_the_old_runs_files(tmp_path):
 def test_saved_state_rebuilds_the_mesh_and_warm_start_exactly(tmp_path):
     levels = list(adaptive(example_6_2(), max_ndof=700))
     folder, _ = RunFolder.create(tmp_path / "r", PROBLEM, {})
-    rows = "level,eta\n" + "".join(f"{i},{i / 3!r}\n" for i in range(len(levels)))
+    rows = "level,ndof,eta\n" + "".join(f"{i},{10 + i},{i / 3!r}\n" for i in range(len(levels)))
     (tmp_path / "r" / "history.csv").write_text(rows)
     for name in ("level_000.vtu", "level_003.vtu", "level_004.vtu"):
         (tmp_path / "r" / name).write_bytes(b"")

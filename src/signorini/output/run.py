@@ -117,6 +117,11 @@ def _writer(manifest: dict) -> str:
     return f" (pid {pid}{f' on {host}' if host else ''})" if pid else ""
 
 
+def _count(text: str | None) -> bool:
+    """Whether a history entry is a positive integer, as the loop writes ``ndof``."""
+    return text is not None and text.isascii() and text.isdigit() and int(text) > 0
+
+
 def file_digest(path: str | os.PathLike) -> str:
     """SHA-256 of a file's bytes, as hex."""
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
@@ -316,6 +321,14 @@ class RunFolder:
                 f"{STATE} says level {state.level} finished; start again with --overwrite"
             )
         state.history_rows = rows[: state.level + 1]
+        for i, row in enumerate(state.history_rows):
+            fields = (row.get("level"), row.get("ndof"))
+            if None in row or None in row.values() or fields[0] != str(i) or not _count(fields[1]):
+                raise RunFolderError(
+                    f"cannot resume: line {i + 2} of {path / 'history.csv'} is not the row of "
+                    f"level {i} of a run (its level, its ndof or its number of fields); start "
+                    "again with --overwrite"
+                )
         for name in folder_listing(path):
             m = re.fullmatch(r"level_(\d{3,})\.vtu", name)
             if m and int(m.group(1)) > state.level:

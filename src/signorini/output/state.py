@@ -100,6 +100,7 @@ def read_state(folder: str | os.PathLike) -> ResumeState | None:
             mesh = Mesh(*arrays, [str(n) for n in data["part_names"]], **options)
             mesh = mesh if options["validate"] else validated_bodies(mesh)
             u0 = np.array(data["u0"]) if "u0" in data else None
+        _check_state(file, level, mesh, u0)
     except RunFolderError as exc:
         raise RunFolderError(f"cannot resume: {exc}") from None
     except (OSError, ValueError, KeyError, EOFError, MemoryError) as exc:
@@ -107,6 +108,23 @@ def read_state(folder: str | os.PathLike) -> ResumeState | None:
             f"cannot resume: {file} is unreadable ({exc}); start again with --overwrite"
         ) from None
     return ResumeState(level, final, mesh, u0, [])
+
+
+def _check_state(file: Path, level: int, mesh: Mesh, u0: np.ndarray | None) -> None:
+    """Refuse a saved state whose level is negative or whose warm start is not finite values
+    at the nodes of its mesh (P2: vertices then edge midpoints; P1: vertices)."""
+    if level < 0:
+        raise RunFolderError(f"{file} says level {level} finished: not a state signorini saved")
+    if u0 is None:
+        return
+    nodes = (mesh.n_points, mesh.n_points + mesh.n_edges)
+    if u0.ndim != 2 or u0.shape[1] != 2 or u0.shape[0] not in nodes:
+        raise RunFolderError(
+            f"{file} holds a warm start of shape {u0.shape} on a mesh of {nodes[0]} points and "
+            f"{mesh.n_edges} edges: not a state signorini saved"
+        )
+    if u0.dtype.kind != "f" or not np.isfinite(u0).all():
+        raise RunFolderError(f"{file} holds a warm start that is not finite numbers")
 
 
 def _mesh_options(data) -> dict:
