@@ -122,11 +122,12 @@ def _failed(work: _Run, status: Status, exc: Exception, figures: bool) -> RunFai
             drawn = ", their figures drawn"
         except Exception as again:
             drawn = f", their figures not drawn ({type(again).__name__}: {again})"
-    work.folder.set_status("failed", error=f"{phase}: {error}")
-    return RunFailed(
-        f"the run failed {phase} ({status.finished()}{drawn}; {MANIFEST} records the "
-        f"failure): {error}"
-    )
+    try:
+        work.folder.set_status("failed", error=f"{phase}: {error}")
+        recorded = f"{MANIFEST} records the failure"
+    except OSError as again:  # a full disk, a folder removed meanwhile
+        recorded = f"{MANIFEST} could not record the failure: {again}"
+    return RunFailed(f"the run failed {phase} ({status.finished()}{drawn}; {recorded}): {error}")
 
 
 # ---------------------------------------------------------------------- the steps
