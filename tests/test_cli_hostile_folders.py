@@ -121,6 +121,20 @@ def test_a_link_named_like_a_runs_file_is_refused(part, tmp_path, capsys):
     )
 
 
+def test_a_manifest_listing_a_users_file_does_not_make_overwrite_remove_it(part, capsys):
+    file = part / "signorini-run.json"
+    manifest = json.loads(file.read_text())
+    manifest["files"] += ["notes.txt", "uniform/notes.txt"]
+    file.write_text(json.dumps(manifest))
+    (part / "uniform").mkdir()
+    for notes in (part / "notes.txt", part / "uniform" / "notes.txt"):
+        notes.write_text("the user's notes")
+    assert main([*PART, "--max-levels", "1", "--out", str(part), "--overwrite"]) == 0
+    assert (part / "notes.txt").read_text() == "the user's notes"
+    assert (part / "uniform" / "notes.txt").read_text() == "the user's notes"
+    assert len(list(part.glob("level_*.vtu"))) == 1
+
+
 def test_a_history_linked_to_dev_zero_is_not_read(part, capsys):
     """Read, it would fill the memory."""
     (part / "history.csv").unlink()

@@ -52,16 +52,17 @@ def test_overwrite_removes_exactly_the_old_runs_files(tmp_path):
         STATE,
         "example-6.2_estimator.png",
         "mesh.pdf",
-        "listed.dat",
+        "listed.png",
         "uniform/history.csv",
         ".level_029.vtu.ab_12xyz.vtu",
     ]
     (out / "uniform").mkdir()
     for name in ours:
         (out / name).write_bytes(b"")
-    folder.add_files("listed.dat")
+    folder.add_files("listed.png", "listed.dat")  # a manifest may list any name
     folder.close()
     theirs = ["notes.txt", "level_1.vtu", "photo.png", "uniform/mine.csv", "sub/level_000.vtu"]
+    theirs += ["listed.dat"]  # not of a kind a run writes
     (out / "sub").mkdir()
     for name in theirs:
         (out / name).write_text("keep")

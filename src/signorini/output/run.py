@@ -8,9 +8,10 @@ The rule (one for every run of the command line):
   run writes, recorded before the file is written.
 - A run starts only in a folder that does not exist or is empty. A non-empty folder is
   refused unless ``overwrite`` is given; then exactly the old run's files are removed first:
-  those its manifest lists, plus the names the command line writes (``level_NNN.vtu``,
-  ``history.csv``, ``history.md``, ``resume.npz``, ``uniform/history.csv``, the manifest,
-  and with a manifest the figures named after its problem). Any other file stays.
+  the names the command line writes (``level_NNN.vtu``, ``history.csv``, ``history.md``,
+  ``resume.npz``, ``uniform/history.csv``, the manifest, and with a manifest the figures
+  named after its problem), plus those its manifest lists that are of a kind a run writes
+  (:mod:`.run_files`). Any other file stays.
 - Temporary files of interrupted atomic writes (:func:`~signorini.output.files.is_temporary`)
   are removed by the next run into the folder, whatever its options.
 - After each finished level the run saves ``resume.npz`` atomically: that level's index, the

@@ -2,11 +2,11 @@
 anyone (:mod:`.guard`): a link or a pipe among them is refused before anything is read,
 written or removed.
 
-A run's files are those its manifest (``signorini-run.json``) lists, the names the command
-line writes (``level_NNN.vtu``, ``history.csv``, ``history.md``, ``fields.md``,
-``resume.npz``, ``signorini-check.npz``, the ``.pvd`` collections, ``uniform/history.csv``,
-the manifest) and the figures named after the run's problem; ``uniform`` is its one
-sub-folder.
+A run's files are the names the command line writes (``level_NNN.vtu``, ``history.csv``,
+``history.md``, ``fields.md``, ``resume.npz``, ``signorini-check.npz``, the ``.pvd``
+collections, ``uniform/history.csv``, the manifest), the figures named after the run's
+problem, and those its manifest (``signorini-run.json``) lists that are of a kind a run
+writes (VTU, CSV, Markdown, JSON, NPZ, PNG, PDF); ``uniform`` is its one sub-folder.
 """
 
 from __future__ import annotations
@@ -37,6 +37,8 @@ _RUN_FILE = re.compile(
     r"|signorini-check\.npz|levels\.pvd|levels_ndof\.pvd)$"
 )
 _FIGURE_NAMES = ("mesh", "deformed", "adaptive_vs_uniform")
+# the kinds of file a run writes: a name its manifest lists is its only with one of these
+_RUN_SUFFIXES = (".vtu", ".pvd", ".csv", ".md", ".json", ".npz", ".png", ".pdf")
 UNIFORM = "uniform"
 
 
@@ -87,11 +89,12 @@ def read_manifest(path: Path) -> dict | None:
 
 
 def _run_entries(path: Path) -> list[Path]:
-    """The files in ``path`` and its ``uniform`` sub-folder that a run writes: those
-    its manifest lists, the names the command line writes and the figures named after
-    the run's problem."""
+    """The files in ``path`` and its ``uniform`` sub-folder that a run writes: the names the
+    command line writes, the figures named after the run's problem, and those its manifest
+    lists if they are of a kind a run writes (a manifest may come from anyone: listing
+    ``notes.txt`` does not make it the run's)."""
     manifest = read_manifest(path) or {}
-    listed = set(manifest.get("files", []))
+    listed = {n for n in manifest.get("files", []) if n.endswith(_RUN_SUFFIXES)}
     label = problem_text(manifest, "label", "")
     stems = "|".join(re.escape(n) for n in (*_FIGURE_NAMES, *([label] if label else [])))
     figure = re.compile(rf"^({stems})[\w.-]*\.(png|pdf)$")
