@@ -61,6 +61,9 @@ def test_a_link_is_not_followed_and_a_device_not_read(tmp_path):
     with pytest.raises(RunFolderError, match="uniform is a symbolic link"):
         check_not_linked(tmp_path / "uniform")
     assert read_bounded(tmp_path / "missing") is None
+    (tmp_path / "sub").write_text("")
+    with pytest.raises(RunFolderError, match="sub is a file, not a folder: refused"):
+        check_not_linked(tmp_path / "sub")
 
 
 def test_a_file_larger_than_a_run_writes_is_refused_before_it_is_read(tmp_path):
