@@ -1,7 +1,8 @@
 """The command line's run folders under hostile or unlucky use: paths through ``..``, a second
-process on a folder, SIGKILL and SIGTERM, a closed stdout, a kill while drawing, ``figures``
-with another problem; problem files with a load path; the VTU output a ParaView user reads
-(stress, von Mises, pvd collections, fields.md) and the manifest's environment."""
+process on a folder, SIGKILL and SIGTERM, a closed stdout, a kill while drawing, a level that
+fails, a truncated level file, ``figures`` with another problem; problem files with a load
+path; the VTU output a ParaView user reads (stress, von Mises, pvd collections, fields.md) and
+the manifest's environment."""
 
 from __future__ import annotations
 
@@ -152,6 +153,78 @@ def test_a_kill_while_drawing_leaves_no_empty_figure(tmp_path, capsys, monkeypat
     figures = {p.name: p.stat().st_size for p in out.iterdir() if p.suffix in (".png", ".pdf")}
     assert len(figures) == 2 and min(figures.values()) > 0, figures
     assert not [p for p in os.listdir(out) if p.startswith(".")]
+
+
+@pytest.mark.slow  # ~10 s of drawing
+def test_a_failed_run_records_its_error_and_draws_its_finished_levels(
+    tmp_path, capsys, monkeypatch
+):
+    """A failure in a level (here the solver's) left the manifest at "running" and drew no
+    figure: now the manifest says "failed" with the error, the finished levels' figures are
+    drawn, and --resume continues the run."""
+    import signorini.loop as loop
+
+    solve, calls = loop.solve, []
+
+    def failing(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 4:
+            raise FloatingPointError("overflow in the factorization")
+        return solve(*args, **kwargs)
+
+    monkeypatch.setattr(loop, "solve", failing)
+    out = tmp_path / "crash"
+    assert main(["run", "example-6.2", "--max-ndof", "3000", "--out", str(out), "--quiet"]) == 2
+    error = "FloatingPointError: overflow in the factorization"
+    assert capsys.readouterr().err == (
+        f"signorini: error: the run failed at level 3 (levels 0-2 finished in {out}, their "
+        f"figures drawn; signorini-run.json records the failure): {error}\n"
+    )
+    manifest = json.loads((out / "signorini-run.json").read_text())
+    assert manifest["status"] == "failed" and manifest["error"] == f"at level 3: {error}"
+    pictures = {p.name for p in out.glob("*.png")}
+    assert {"mesh.png", "deformed.png", "example-6.2_estimator.png"} <= pictures
+    assert pictures <= set(manifest["files"])
+    _, rows = read_history(out / "history.csv")
+    assert len(rows) == 3
+    monkeypatch.undo()
+    resume = ["run", "example-6.2", "--resume", str(out), "--quiet", "--no-figures"]
+    assert main(resume) == 0
+    manifest = json.loads((out / "signorini-run.json").read_text())
+    assert manifest["status"] == "finished" and "error" not in manifest
+
+
+def test_a_truncated_level_file_read_by_the_figures_is_a_recorded_failure(
+    tmp_path, capsys, monkeypatch
+):
+    """meshio ends the process (sys.exit) on a truncated VTU file: the run ended with the
+    manifest at "running" and no message naming the file."""
+    import signorini.cli.run as cli_run
+    import signorini.plots as plots
+
+    draw = cli_run.draw_figures
+
+    def truncated_then_drawn(label, folder, last, metrics, say):
+        vtu = folder.path / "level_000.vtu"  # cut short (a full disk, another process)
+        vtu.write_bytes(vtu.read_bytes()[:1000])
+        return draw(label, folder, last, metrics, say)
+
+    monkeypatch.setattr(cli_run, "draw_figures", truncated_then_drawn)
+    monkeypatch.setattr(plots, "readable_level", lambda n_cells, most=0: 0)
+    out = tmp_path / "t"
+    assert main([*RUN_62[:3], "1200", "--out", str(out), "--quiet"]) == 2
+    _, rows = read_history(out / "history.csv")
+    fault = (
+        f"{out / 'level_000.vtu'} is not a readable level file of a run (ReadError; truncated, "
+        "or not a VTU file signorini wrote)"
+    )
+    assert capsys.readouterr().err == (
+        f"signorini: error: the run failed while drawing the figures (levels 0-{len(rows) - 1} "
+        f"finished in {out}; signorini-run.json records the failure): {fault}\n"
+    )
+    manifest = json.loads((out / "signorini-run.json").read_text())
+    assert manifest["status"] == "failed"
+    assert manifest["error"] == f"while drawing the figures: {fault}"
 
 
 def test_figures_refuses_a_problem_that_is_not_the_folders(tmp_path, capsys):

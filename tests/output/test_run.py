@@ -52,16 +52,17 @@ def test_overwrite_removes_exactly_the_old_runs_files(tmp_path):
         STATE,
         "example-6.2_estimator.png",
         "mesh.pdf",
-        "listed.dat",
+        "listed.png",
         "uniform/history.csv",
         ".level_029.vtu.ab_12xyz.vtu",
     ]
     (out / "uniform").mkdir()
     for name in ours:
         (out / name).write_bytes(b"")
-    folder.add_files("listed.dat")
+    folder.add_files("listed.png", "listed.dat")  # a manifest may list any name
     folder.close()
     theirs = ["notes.txt", "level_1.vtu", "photo.png", "uniform/mine.csv", "sub/level_000.vtu"]
+    theirs += ["listed.dat"]  # not of a kind a run writes
     (out / "sub").mkdir()
     for name in theirs:
         (out / name).write_text("keep")
@@ -75,7 +76,7 @@ def test_overwrite_removes_exactly_the_old_runs_files(tmp_path):
 def test_saved_state_rebuilds_the_mesh_and_warm_start_exactly(tmp_path):
     levels = list(adaptive(example_6_2(), max_ndof=700))
     folder, _ = RunFolder.create(tmp_path / "r", PROBLEM, {})
-    rows = "level,eta\n" + "".join(f"{i},{i / 3!r}\n" for i in range(len(levels)))
+    rows = "level,ndof,eta\n" + "".join(f"{i},{10 + i},{i / 3!r}\n" for i in range(len(levels)))
     (tmp_path / "r" / "history.csv").write_text(rows)
     for name in ("level_000.vtu", "level_003.vtu", "level_004.vtu"):
         (tmp_path / "r" / name).write_bytes(b"")

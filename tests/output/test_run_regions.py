@@ -4,6 +4,7 @@ import numpy as np
 
 from signorini.mesh.builders import rectangle
 from signorini.output.run import RunFolder
+from signorini.output.state import read_state
 
 from .test_run import PROBLEM
 
@@ -14,6 +15,6 @@ def test_saved_state_keeps_the_cell_regions(tmp_path):
     folder, _ = RunFolder.create(tmp_path / "r", PROBLEM, {})
     folder.save_state(0, mesh, None, final=False)
     folder.close()  # the folder is locked per open descriptor
-    saved = RunFolder.open(tmp_path / "r")._read_state().mesh
+    saved = read_state(tmp_path / "r").mesh
     assert saved.region_names == ("base", "coating")
     np.testing.assert_array_equal(saved.cell_region, mesh.cell_region)

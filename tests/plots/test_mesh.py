@@ -88,6 +88,11 @@ def test_read_level_mesh_gives_back_the_triangulation(tmp_path):
     points, cells = read_level_mesh(tmp_path / "level_000.vtu")
     np.testing.assert_array_equal(points, result.mesh.points)
     np.testing.assert_array_equal(cells, result.mesh.cells)
+    # a truncated file is named (meshio.read would end the process with sys.exit)
+    vtu = tmp_path / "level_000.vtu"
+    vtu.write_bytes(vtu.read_bytes()[:1000])
+    with pytest.raises(ValueError, match=f"^{vtu} is not a readable level file of a run"):
+        read_level_mesh(vtu)
 
 
 def test_mesh_figure_height_follows_a_wide_body(tmp_path, captured):

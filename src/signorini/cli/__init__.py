@@ -12,7 +12,9 @@ unless ``--overwrite`` is given, locks it while it writes, and records its files
 and environment in ``signorini-run.json``. Each level's VTU file, history row and resume
 state are written (atomically) as soon as the level is done, so an interrupted run keeps
 what it finished and ``--resume`` continues it, after checking that the problem named is the
-one that produced its levels (:mod:`.identity`); the figures follow at the end. Ctrl-C stops
+one that produced its levels (:mod:`.identity`); the figures follow at the end. A run that
+fails (a solver's error in a level, an unreadable file) records ``failed`` and the error in
+its manifest, draws the figures of the levels it finished and exits with status 2. Ctrl-C stops
 a run with one line saying what finished and where (exit status 130), SIGTERM likewise (exit
 status 143); a closed stdout (``| head``) only stops the progress lines.
 

@@ -33,11 +33,12 @@ def figures_command(name: str, out: Path, status) -> list[Path]:
     from ..output.run import RunFolder
     from .identity import check_problem
     from .problems import label, load
+    from .settings import recorded_arguments
 
     folder = RunFolder.open(out, purpose="draw the figures")
     status.folder = folder
     job = load(name)
-    options = AdaptiveOptions.from_record(folder.manifest.get("arguments", {}))
+    options = AdaptiveOptions.from_record(recorded_arguments(folder.manifest, folder.file))
     check_problem(folder, name, job, options, f"figures {name} {out}")
     return figures(label(name), folder.path)
 
@@ -52,15 +53,17 @@ def pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> l
 def draw_figures(
     label: str,
     folder: RunFolder,
-    last: Level,
+    last: Level | None,
     metrics: Metrics | None,
     say: Callable[[str], None],
 ) -> None:
-    """Announce, draw and record the figures of a run whose last level is ``last``."""
+    """Announce, draw and record the figures of a run whose last level is ``last`` (None:
+    the convergence figures of its history only)."""
     out = folder.path
-    say(f"drawing the figures of {label} (convergence history, mesh, deformed body) ...")
+    kinds = "convergence history, mesh, deformed body" if last else "convergence history"
+    say(f"drawing the figures of {label} ({kinds}) ...")
     written = figures(label, out, last)
-    if metrics is not None and metrics.pressure is not None:
+    if last is not None and metrics is not None and metrics.pressure is not None:
         written += pressure_figure(label, out, last, metrics)
     folder.add_files(*(str(p.relative_to(out)) for p in written))
     say(f"figures: {', '.join(str(p.name) for p in written)}")
@@ -80,7 +83,7 @@ def compare_uniform(
     from .. import plots
 
     out = folder.path
-    uni = out / "uniform"
+    uni = folder.sub_folder("uniform")  # refused if it is a link out of the folder
     folder.add_files("uniform/history.csv")
     history = HistoryWriter(uni / "history.csv")
     say(f"{problem.name}: uniform refinement for comparison -> {uni}")

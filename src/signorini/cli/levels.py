@@ -119,16 +119,21 @@ class Status:
     done: int = -1  # last level whose files are complete
     phase: str = "while starting"
     say: Callable[[str], None] = field(default_factory=Printer)
+    last: Level | None = None  # the last level whose files are complete, if solved here
+
+    def finished(self) -> str:
+        """What finished, and where (``levels 0-5 finished in results/6.2``)."""
+        out = self.folder.path if self.folder is not None else "no folder"
+        if self.done < 0:
+            return f"no level finished in {out}"
+        levels = "level 0" if self.done == 0 else f"levels 0-{self.done}"
+        return f"{levels} finished in {out}"
 
     def interrupted(self, how: str = "interrupted") -> str:
         if self.folder is None:
             return f"signorini: {how} before the run started; nothing was written"
         out = self.folder.path
-        if self.done < 0:
-            finished = f"no level finished in {out}"
-        else:
-            levels = "level 0" if self.done == 0 else f"levels 0-{self.done}"
-            finished = f"{levels} finished in {out}"
+        finished = self.finished()
         command = f"signorini run {shlex.quote(self.problem)} --resume {shlex.quote(str(out))}"
         return f"signorini: {how} {self.phase}; {finished}; continue with: {command}"
 
@@ -165,7 +170,7 @@ def write_levels(
             else:
                 folder.save_state(k, level.next_mesh, level.next_u0, final=False)
         if status is not None:
-            status.done = k
+            status.done, status.last = k, level
             status.phase = f"at level {k + 1}"
         line = progress(level)
         say(line + (clock.lap(level) if clock is not None else ""))

@@ -20,16 +20,19 @@ from ..loop import COLUMNS, Level, adaptive
 from ..output import HistoryWriter, write_columns
 from ..output.check import CHECK, write_check
 from ..output.environment import environment
-from ..output.run import STATE, ResumeState, RunFolder
+from ..output.run import MANIFEST, ResumeState, RunFolder
 from ..output.vtu import write_fields
 from .figures import compare_uniform, draw_figures
 from .identity import check_problem, name_the_problem, problem_data
 from .levels import Clock, Printer, Status, write_levels
-from .problems import RunProblem, label, load, problem_id, with_curves_of
+from .problems import ProblemFileError, RunProblem, label, load, problem_id, with_curves_of
 from .ranks import follow, launched_ranks
-from .settings import RunSettings, new_settings, resumed_settings
+from .settings import RunSettings, new_settings, recorded_arguments, resumed_settings
 
-__all__ = ["run"]
+__all__ = ["RunFailed", "run"]
+
+#: errors whose message is written for the user as it is (others are named by their type)
+_TOLD = (ValueError, RuntimeError, OSError, ProblemFileError)
 
 
 @dataclass
@@ -61,7 +64,7 @@ def run(args: argparse.Namespace, status: Status | None = None) -> int:
         status.folder = folder
         if args.example is None:
             raise name_the_problem(folder, f"run PROBLEM --resume {args.resume}")
-        settings = resumed_settings(args, folder.manifest.get("arguments", {}))
+        settings = resumed_settings(args, recorded_arguments(folder.manifest, folder.file))
         name = args.example  # checked by its data (_restart), never by the manifest's name
         if folder.manifest.get("status") == "finished":
             say(f"the run in {args.resume} is finished: nothing to resume")
@@ -83,17 +86,48 @@ def run(args: argparse.Namespace, status: Status | None = None) -> int:
     if state is not None:
         status.done = state.level
     work = _Run(name, settings, job, folder, state, say)
-    last = _solve_levels(work, status)
-    if last is not None and not args.no_figures:
-        status.phase = "while drawing the figures"
-        draw_figures(work.label, folder, last, job.metrics, say)
-    options = settings.options
-    if settings.compare_uniform and not options.uniform and last is not None:
-        status.phase = "during the uniform comparison"
-        compare_uniform(job.problem, options, args.no_figures, folder, say, job.metrics, job.path)
+    try:
+        last = _solve_levels(work, status)
+        if last is not None and not args.no_figures:
+            status.phase = "while drawing the figures"
+            draw_figures(work.label, folder, last, job.metrics, say)
+        options = settings.options
+        if settings.compare_uniform and not options.uniform and last is not None:
+            status.phase = "during the uniform comparison"
+            compare_uniform(
+                job.problem, options, args.no_figures, folder, say, job.metrics, job.path
+            )
+    except Exception as exc:
+        raise _failed(work, status, exc, figures=not args.no_figures) from exc
     folder.set_status("finished")
     say(f"solver backend: {last.record.backend}" if last else "no level finished")
     return 0
+
+
+class RunFailed(RuntimeError):
+    """A run that stopped on an error once its folder was claimed; the message says where,
+    what finished and the error."""
+
+
+def _failed(work: _Run, status: Status, exc: Exception, figures: bool) -> RunFailed:
+    """Record the failure ``exc`` of a run in its manifest (status ``failed``, with the error),
+    after drawing the figures of the levels that finished (a failure in a level: a solver's,
+    a problem's; a resumed run without a level solved here draws its history only); the
+    error for the user."""
+    error = str(exc) if isinstance(exc, _TOLD) else f"{type(exc).__name__}: {exc}"
+    phase, drawn = status.phase, ""
+    if figures and status.done >= 0 and phase.startswith("at level"):
+        try:
+            draw_figures(work.label, work.folder, status.last, work.job.metrics, work.say)
+            drawn = ", their figures drawn"
+        except Exception as again:
+            drawn = f", their figures not drawn ({type(again).__name__}: {again})"
+    try:
+        work.folder.set_status("failed", error=f"{phase}: {error}")
+        recorded = f"{MANIFEST} records the failure"
+    except OSError as again:  # a full disk, a folder removed meanwhile
+        recorded = f"{MANIFEST} could not record the failure: {again}"
+    return RunFailed(f"the run failed {phase} ({status.finished()}{drawn}; {recorded}): {error}")
 
 
 # ---------------------------------------------------------------------- the steps
@@ -109,10 +143,10 @@ def _open_resumed(args: argparse.Namespace) -> RunFolder:
 def _restart(
     folder: RunFolder, name: str, job: RunProblem, settings: RunSettings, verb: str
 ) -> ResumeState:
-    """Check that ``job`` is the run's problem (when a level finished), then the saved
-    state of the resumed run, its mesh with the problem's curves again (the state holds
-    arrays only)."""
-    if (folder.path / STATE).is_file():
+    """Check that ``job`` is the run's problem (when the folder holds anything a level
+    saved, whatever file is missing), then the saved state of the resumed run, its mesh
+    with the problem's curves again (the state holds arrays only)."""
+    if folder.saved_work():
         check_problem(folder, name, job, settings.options, verb)
     state = folder.restart(_environment(settings))
     if state.mesh is not None:

@@ -4,14 +4,25 @@ line or, with ``--resume``, from the interrupted run's manifest."""
 from __future__ import annotations
 
 import argparse
+import json
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+from pathlib import Path
 
 from ..algebra.backends import solver_factory
-from ..loop.options import AdaptiveOptions, OptionError
+from ..loop.options import LEGACY_KEYS, AdaptiveOptions, OptionError
 from .parser import FILE_FLAGS, OPTION_FLAGS, flag
 
-__all__ = ["RunSettings", "new_settings", "resumed_settings"]
+__all__ = ["RunSettings", "new_settings", "recorded_arguments", "resumed_settings"]
+
+#: what each recorded argument is, as the command line's parser gives it (a field no flag
+#: sets, ``warm_start``, is recorded as the switch it is)
+_KINDS = {
+    **{f.name: type(f.default).__name__ for f in fields(AdaptiveOptions)},
+    "solver": "str",
+    **{name: "bool" for name in FILE_FLAGS},
+}
+_KIND_TEXT = {"bool": "true or false", "int": "an integer", "float": "a number", "str": "a name"}
 
 
 @dataclass(frozen=True)
@@ -70,6 +81,52 @@ def new_settings(args: argparse.Namespace) -> RunSettings:
     return RunSettings(options, **{name: bool(getattr(args, name)) for name in FILE_FLAGS})
 
 
+def _is_kind(value: object, kind: str) -> bool:
+    """Whether a JSON value is what the parser gives for ``kind`` (``int`` for
+    ``--max-ndof``: neither a bool, nor a float such as ``Infinity``)."""
+    if kind == "bool":
+        return isinstance(value, bool)
+    if kind == "int":
+        return isinstance(value, int) and not isinstance(value, bool)
+    if kind == "float":
+        return isinstance(value, (int, float)) and not isinstance(value, bool)
+    return isinstance(value, str)
+
+
+def recorded_arguments(manifest: Mapping[str, object], file: Path) -> dict[str, object]:
+    """The ``arguments`` a run's manifest records, checked as strictly as the command line
+    checks its flags (the values :class:`~signorini.loop.AdaptiveOptions` then checks are
+    those the parser can give: ``max_ndof`` an integer, as ``--max-ndof`` takes).
+
+    Parameters
+    ----------
+    manifest : mapping
+        The manifest (:attr:`signorini.output.run.RunFolder.manifest`).
+    file : Path
+        The manifest's file, for the messages.
+
+    Raises
+    ------
+    ValueError
+        Naming the file and the first argument that is unknown or of another kind.
+    """
+    stored = manifest.get("arguments", {})
+    edited = "; it was edited or not written by signorini: start a new run (--overwrite)"
+    if not isinstance(stored, dict):
+        raise ValueError(f"{file}: its arguments are not a JSON object{edited}")
+    for key, value in stored.items():
+        kind = _KINDS.get(LEGACY_KEYS.get(key, key))
+        if kind is None:
+            raise ValueError(f"{file} records an unknown argument {key!r}{edited}")
+        if not _is_kind(value, kind):
+            name = LEGACY_KEYS.get(key, key)
+            raise ValueError(
+                f"{file} records {key} = {json.dumps(value)}, which {flag(name)} never "
+                f"takes ({_KIND_TEXT[kind]}){edited}"
+            )
+    return dict(stored)
+
+
 def resumed_settings(args: argparse.Namespace, stored: Mapping[str, object]) -> RunSettings:
     """The settings an interrupted run recorded (``stored``, its manifest's ``arguments``,
     also as written before the options had their present names); flags given again must
@@ -81,7 +138,7 @@ def resumed_settings(args: argparse.Namespace, stored: Mapping[str, object]) -> 
         Listing every flag given with another value than the run's.
     """
     options = _checked(AdaptiveOptions.from_record, stored)
-    record = {**options.to_record(), **{name: bool(stored.get(name)) for name in FILE_FLAGS}}
+    record = {**options.to_record(), **{name: stored.get(name, False) for name in FILE_FLAGS}}
     conflicts = []
     for dest in (*OPTION_FLAGS, *FILE_FLAGS):
         given = _given(args, dest)

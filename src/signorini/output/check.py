@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .files import replacing
+from .guard import RunFolderError, open_npz
 
 __all__ = ["CHECK", "MESH_ARRAYS", "RTOL", "differences", "read_check", "write_check"]
 
@@ -60,11 +61,22 @@ def write_check(folder: str | os.PathLike, data: dict[str, np.ndarray]) -> Path:
 
 def read_check(folder: str | os.PathLike) -> dict[str, np.ndarray] | None:
     """The saved problem data of a run folder, None if it has none or it is unreadable
-    (plain arrays only: no pickled objects are loaded)."""
+    (plain arrays only: no pickled objects are loaded).
+
+    Raises
+    ------
+    RunFolderError
+        If the file is a symbolic link, not a regular file (a named pipe is never waited
+        on) or holds more than its size in arrays (:func:`~.guard.open_npz`).
+    """
     try:
-        with np.load(Path(folder) / CHECK, allow_pickle=False) as saved:
+        with open_npz(Path(folder) / CHECK) as saved:
+            if saved is None:
+                return None
             return {name: np.array(saved[name]) for name in saved.files}
-    except (OSError, ValueError, KeyError, EOFError):
+    except (OSError, ValueError, KeyError, EOFError, MemoryError) as exc:
+        if isinstance(exc, RunFolderError):
+            raise
         return None
 
 

@@ -10,6 +10,7 @@ file's format; the figures (:mod:`signorini.plots`) and the tests read histories
 from __future__ import annotations
 
 import csv
+import errno
 import io as _io
 import math
 import os
@@ -20,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .files import atomic_write
+from .guard import read_bounded
 
 __all__ = [
     "HistoryWriter",
@@ -133,12 +135,20 @@ def read_history(path: str | os.PathLike) -> dict[str, np.ndarray]:
     FileNotFoundError
         If the file does not exist.
     ValueError
-        If the file has no header, repeated or empty column names, or a row whose number of
-        fields differs from the header's.
+        If the file is not a regular file (a named pipe, a device: never waited on or read
+        without end), is larger than :data:`~.guard.MAX_TEXT_BYTES`, has no header,
+        repeated or empty column names, or a row whose number of fields differs from the
+        header's.
     """
     path = Path(path)
-    with path.open(newline="", encoding="utf-8") as fh:
-        rows = [r for r in csv.reader(fh) if r]  # blank lines dropped
+    data = read_bounded(path, follow_links=True)
+    if data is None:
+        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), str(path))
+    try:
+        text = data.decode("utf-8")
+        rows = [r for r in csv.reader(_io.StringIO(text, newline="")) if r]  # blank lines dropped
+    except (UnicodeDecodeError, csv.Error) as exc:
+        raise ValueError(f"{path}: not a CSV history ({exc})") from None
     if not rows:
         raise ValueError(f"{path}: empty file, expected a CSV header line")
     header = [h.strip() for h in rows[0]]

@@ -4,13 +4,14 @@ The rule (one for every run of the command line):
 
 - A run writes ``signorini-run.json`` (the *manifest*) into its folder before anything else:
   the problem, the arguments that decide the numbers and the files, the run's status
-  (``running``, ``interrupted``, ``finished``) and the name of every file the run writes,
-  recorded before the file is written.
+  (``running``, ``interrupted``, ``failed``, ``finished``) and the name of every file the
+  run writes, recorded before the file is written.
 - A run starts only in a folder that does not exist or is empty. A non-empty folder is
   refused unless ``overwrite`` is given; then exactly the old run's files are removed first:
-  those its manifest lists, plus the names the command line writes (``level_NNN.vtu``,
-  ``history.csv``, ``history.md``, ``resume.npz``, ``uniform/history.csv``, the manifest,
-  and with a manifest the figures named after its problem). Any other file stays.
+  the names the command line writes (``level_NNN.vtu``, ``history.csv``, ``history.md``,
+  ``resume.npz``, ``uniform/history.csv``, the manifest, and with a manifest the figures
+  named after its problem), plus those its manifest lists that are of a kind a run writes
+  (:mod:`.run_files`). Any other file stays.
 - Temporary files of interrupted atomic writes (:func:`~signorini.output.files.is_temporary`)
   are removed by the next run into the folder, whatever its options.
 - After each finished level the run saves ``resume.npz`` atomically: that level's index, the
@@ -25,6 +26,14 @@ The rule (one for every run of the command line):
   names and compare, so that one folder never holds the levels of two problems.
 - Paths are resolved (``os.path.realpath``) before any check: ``--out newdir/..`` is the
   folder it names, and is refused if it is not empty.
+- Inside the folder nothing is followed or waited for (:mod:`.guard`, :mod:`.run_files`): a
+  folder where a run's file or its ``uniform`` sub-folder is a symbolic link, a named pipe
+  or a device is refused before anything is read, written or removed, and what is read is
+  bounded. A manifest that is not JSON is reported as such, naming the file.
+- ``--resume`` checks the run's problem (:mod:`.check`) whenever the folder holds anything a
+  level saved, whatever file is missing, and refuses to start again from level 0 over the
+  finished levels of a history when ``resume.npz`` is missing.
+- A run that fails records ``failed`` as its status and the error that stopped it.
 - A run holds an OS lock on its folder (``fcntl.flock`` on the folder itself, released when
   the process ends, however it ends): a second run into a folder that a live process is
   writing, or a ``--resume`` of it, is refused; a folder whose writer died (SIGKILL) is not
@@ -42,8 +51,6 @@ import io
 import json
 import os
 import re
-import shutil
-from dataclasses import dataclass
 from pathlib import Path
 
 try:  # POSIX; elsewhere runs are not locked
@@ -53,9 +60,20 @@ except ImportError:  # pragma: no cover - Windows
 
 import numpy as np
 
-from ..mesh.bodies import body_of_cells, validated_bodies
 from ..mesh.mesh import Mesh
-from .files import atomic_write, describe_names, folder_listing, remove_temporaries, replacing
+from .check import CHECK
+from .files import atomic_write, describe_names, folder_listing, remove_temporaries
+from .guard import RunFolderError, check_not_linked, read_bounded
+from .run_files import (
+    MANIFEST,
+    UNIFORM,
+    check_entries,
+    load_manifest,
+    problem_text,
+    read_manifest,
+    remove_run_files,
+)
+from .state import STATE, ResumeState, read_state, write_state
 
 __all__ = [
     "MANIFEST",
@@ -67,20 +85,8 @@ __all__ = [
     "resolved",
 ]
 
-MANIFEST = "signorini-run.json"
-STATE = "resume.npz"
+
 _FORMAT = 1
-# files of a run, by name, in the run's folder and in its "uniform" sub-folder
-_RUN_FILE = re.compile(
-    r"^(level_\d{3,}\.vtu|history\.csv|history\.md|fields\.md|resume\.npz|signorini-run\.json"
-    r"|signorini-check\.npz|levels\.pvd|levels_ndof\.pvd)$"
-)
-_FIGURE_NAMES = ("mesh", "deformed", "adaptive_vs_uniform")
-UNIFORM = "uniform"
-
-
-class RunFolderError(ValueError):
-    """An output folder that cannot be used as asked (the message says why and what to do)."""
 
 
 def resolved(path: str | os.PathLike) -> Path:
@@ -112,36 +118,14 @@ def _writer(manifest: dict) -> str:
     return f" (pid {pid}{f' on {host}' if host else ''})" if pid else ""
 
 
+def _count(text: str | None) -> bool:
+    """Whether a history entry is a positive integer, as the loop writes ``ndof``."""
+    return text is not None and text.isascii() and text.isdigit() and int(text) > 0
+
+
 def file_digest(path: str | os.PathLike) -> str:
     """SHA-256 of a file's bytes, as hex."""
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
-
-@dataclass
-class ResumeState:
-    """What :meth:`RunFolder.restart` found: where to continue an interrupted run.
-
-    Attributes
-    ----------
-    level : int
-        Index of the last finished level (-1 when none finished).
-    final : bool
-        Whether that level was the run's last (only the figures may be missing).
-    mesh : Mesh or None
-        The next level's mesh; when ``final``, the last level's own mesh (None when no
-        level finished).
-    u0 : (n_nodes, 2) float array or None
-        The warm start on ``mesh``: the next level's, or when ``final`` the last level's
-        solution.
-    history_rows : list of dict
-        The history rows of levels ``0 … level``, as text.
-    """
-
-    level: int
-    final: bool
-    mesh: Mesh | None
-    u0: np.ndarray | None
-    history_rows: list[dict]
 
 
 class RunFolder:
@@ -195,23 +179,27 @@ class RunFolder:
         Raises
         ------
         RunFolderError
-            If ``path`` is an existing file, a folder another live process is writing, or a
-            non-empty folder without ``overwrite``.
+            If ``path`` is an existing file, a folder another live process is writing, a
+            non-empty folder without ``overwrite``, or a folder where a file or sub-folder
+            of a run is a symbolic link or not a regular file (:func:`~.run_files.check_entries`).
         """
         path = resolved(path)
         cls._check_is_folder(path)
         path.mkdir(parents=True, exist_ok=True)
         lock = cls._claim(path, "output folder")
         try:
+            check_entries(path)
             removed = remove_temporaries(path) + remove_temporaries(path / UNIFORM)
             present = folder_listing(path)
             if present and not overwrite:
-                old = cls._read_manifest(path)
+                try:
+                    old, fault = load_manifest(path), ""
+                except RunFolderError as exc:
+                    old, fault = None, f" ({exc})"
                 what = (
-                    f"it holds a run of {old.get('problem', {}).get('name', '?')} "
-                    f"({cls._status_of(old)})"
+                    f"it holds a run of {problem_text(old)} ({cls._status_of(old)})"
                     if old
-                    else f"it holds {len(present)} file(s): {describe_names(present)}"
+                    else f"it holds {len(present)} file(s): {describe_names(present)}{fault}"
                 )
                 raise RunFolderError(
                     f"output folder {path} is not empty: {what}. Give --overwrite to remove "
@@ -219,7 +207,7 @@ class RunFolder:
                     "to continue an interrupted run, or another --out folder"
                 )
             if present:
-                removed += cls._remove_run_files(path)
+                removed += remove_run_files(path)
             folder = cls(
                 path,
                 {
@@ -247,18 +235,31 @@ class RunFolder:
         Raises
         ------
         RunFolderError
-            If ``path`` is not a folder with a manifest, or another live process is writing
-            it.
+            If ``path`` is not a folder with a manifest (a JSON object listing the run's
+            files), another live process is writing it, or a file or sub-folder of the run
+            in it is a symbolic link or not a regular file (:func:`~.run_files.check_entries`).
         """
         path = resolved(path)
         if not path.is_dir():
             raise RunFolderError(f"cannot {purpose}: {path} is not a folder")
-        manifest = cls._read_manifest(path)
-        if manifest is None:
-            raise RunFolderError(
-                f"cannot {purpose}: {path} holds no {MANIFEST}, so no run of signorini wrote it"
-            )
-        return cls(path, manifest, cls._claim(path, f"cannot {purpose}: the folder"))
+        try:
+            manifest = load_manifest(path)
+            if manifest is None:
+                raise RunFolderError(f"{path} holds no {MANIFEST}, so no run of signorini wrote it")
+            lock = cls._claim(path, "the folder")
+        except RunFolderError as exc:
+            raise RunFolderError(f"cannot {purpose}: {exc}") from None
+        try:
+            check_entries(path)
+        except RunFolderError as exc:
+            cls._unlock(lock)
+            raise RunFolderError(f"cannot {purpose}: {exc}") from None
+        return cls(path, manifest, lock)
+
+    @property
+    def file(self) -> Path:
+        """The manifest's file."""
+        return self.path / MANIFEST
 
     def close(self) -> None:
         """Release the folder's lock (also released when the process ends)."""
@@ -269,12 +270,11 @@ class RunFolder:
     def _claim(cls, path: Path, what: str) -> int | None:
         lock = _lock(path)
         if lock is None:
-            old = cls._read_manifest(path) or {}
-            name = old.get("problem", {}).get("name", "?") if isinstance(old, dict) else "?"
+            old = read_manifest(path) or {}
             raise RunFolderError(
                 f"{what} {path} is being written by another process{_writer(old)}, a run of "
-                f"{name}: wait until it ends (or stop it: it keeps its finished levels), then "
-                "--resume or --overwrite it"
+                f"{problem_text(old)}: wait until it ends (or stop it: it keeps its finished "
+                "levels), then --resume or --overwrite it"
             )
         return lock
 
@@ -300,19 +300,36 @@ class RunFolder:
         Raises
         ------
         RunFolderError
-            If the saved state is unreadable or inconsistent with the history.
+            If the saved state is unreadable or inconsistent with the history, or missing
+            while the history holds finished levels (they would be replaced).
         """
         path = self.path
         remove_temporaries(path)
         remove_temporaries(path / UNIFORM)
-        state = self._read_state()
+        state = read_state(path)
         rows = self._history_rows()
+        if state is None and rows:
+            raise RunFolderError(
+                f"cannot resume: {path / 'history.csv'} holds {len(rows)} finished level(s) "
+                f"but {path} holds no {STATE}, the state to continue from, so resuming would "
+                "replace them: start again with --overwrite (which removes them), or give "
+                "another --out folder"
+            )
+        state = state or ResumeState(-1, False, None, None, [])
         if len(rows) < state.level + 1:
             raise RunFolderError(
                 f"cannot resume: {path / 'history.csv'} has {len(rows)} level(s) but "
                 f"{STATE} says level {state.level} finished; start again with --overwrite"
             )
         state.history_rows = rows[: state.level + 1]
+        for i, row in enumerate(state.history_rows):
+            fields = (row.get("level"), row.get("ndof"))
+            if None in row or None in row.values() or fields[0] != str(i) or not _count(fields[1]):
+                raise RunFolderError(
+                    f"cannot resume: line {i + 2} of {path / 'history.csv'} is not the row of "
+                    f"level {i} of a run (its level, its ndof or its number of fields); start "
+                    "again with --overwrite"
+                )
         for name in folder_listing(path):
             m = re.fullmatch(r"level_(\d{3,})\.vtu", name)
             if m and int(m.group(1)) > state.level:
@@ -333,37 +350,46 @@ class RunFolder:
             files.extend(new)
             self._write_manifest()
 
-    def set_status(self, status: str) -> None:
-        """Record the run's status: ``running``, ``interrupted`` or ``finished`` (a finished
-        run needs no resume state: ``resume.npz`` is removed)."""
+    def set_status(self, status: str, error: str | None = None) -> None:
+        """Record the run's status: ``running``, ``interrupted``, ``failed`` (with the
+        ``error`` that stopped it, recorded as ``error``) or ``finished`` (a finished run needs
+        no resume state: ``resume.npz`` is removed)."""
         self.manifest["status"] = status
+        self.manifest.pop("error", None)
+        if error is not None:
+            self.manifest["error"] = error
         self._write_manifest()
         if status == "finished":
             (self.path / STATE).unlink(missing_ok=True)
+
+    def sub_folder(self, name: str) -> Path:
+        """The run's sub-folder ``name`` (``uniform``), created if missing.
+
+        Raises
+        ------
+        RunFolderError
+            If it is a symbolic link (a run never writes through one) or not a folder.
+        """
+        sub = self.path / name
+        check_not_linked(sub)
+        sub.mkdir(exist_ok=True)
+        check_not_linked(sub)  # not replaced by a link meanwhile
+        return sub
+
+    def saved_work(self) -> list[str]:
+        """The names in the folder that show a level was solved: the problem data, the
+        resume state, the history and the level files, whatever kind of file they are."""
+        return [
+            name
+            for name in folder_listing(self.path)
+            if name in (CHECK, STATE, "history.csv") or re.fullmatch(r"level_\d{3,}\.vtu", name)
+        ]
 
     def save_state(self, level: int, mesh: Mesh, u0: np.ndarray | None, final: bool) -> None:
         """Save atomically that ``level`` finished, with the next level's mesh and warm start
         (``final``: that level was the run's last; then its own mesh and solution)."""
         self.add_files(STATE)
-        arrays: dict[str, np.ndarray] = {
-            "level": np.array(level, dtype=np.int64),
-            "final": np.array(final),
-        }
-        if mesh is not None:
-            arrays.update(
-                points=mesh.points,
-                cells=mesh.cells,
-                boundary=mesh.boundary,
-                boundary_part=mesh.boundary_part,
-                part_names=np.array(mesh.part_names, dtype=str),
-                cell_region=mesh.cell_region,
-                region_names=np.array(mesh.region_names, dtype=str),
-                bodies=np.array(int(body_of_cells(mesh).max(initial=0)) + 1),
-            )
-            if u0 is not None:
-                arrays["u0"] = np.asarray(u0, dtype=np.float64)
-        with replacing(self.path / STATE) as tmp, open(tmp, "wb") as fh:
-            np.savez(fh, **arrays)
+        write_state(self.path, level, mesh, u0, final)
 
     # ------------------------------------------------------------------ internals
     @staticmethod
@@ -373,74 +399,18 @@ class RunFolder:
                 f"--out {path} is an existing file, not a folder: give a folder name"
             )
 
-    @staticmethod
-    def _read_manifest(path: Path) -> dict | None:
-        try:
-            manifest = json.loads((path / MANIFEST).read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            return None
-        return manifest if isinstance(manifest, dict) else None
-
     def _write_manifest(self) -> None:
         text = json.dumps(self.manifest, indent=1, sort_keys=True) + "\n"
         atomic_write(self.path / MANIFEST, text.encode())
 
-    @classmethod
-    def _remove_run_files(cls, path: Path) -> list[Path]:
-        """Remove what a previous run wrote into ``path``, never any other file."""
-        manifest = cls._read_manifest(path) or {}
-        listed = {str(n) for n in manifest.get("files", [])}
-        label = str(manifest.get("problem", {}).get("label", ""))
-        stems = "|".join(re.escape(n) for n in (*_FIGURE_NAMES, *([label] if label else [])))
-        figure = re.compile(rf"^({stems})[\w.-]*\.(png|pdf)$")
-        removed = []
-        for sub in ("", UNIFORM):
-            folder = path / sub if sub else path
-            for name in folder_listing(folder):
-                rel = f"{sub}/{name}" if sub else name
-                target = folder / name
-                if not target.is_file():
-                    continue
-                if rel in listed or _RUN_FILE.match(name) or (not sub and figure.match(name)):
-                    target.unlink()
-                    removed.append(target)
-        uniform = path / UNIFORM
-        if uniform.is_dir() and not os.listdir(uniform):
-            shutil.rmtree(uniform)
-        return removed
-
-    def _read_state(self) -> ResumeState:
-        file = self.path / STATE
-        if not file.is_file():  # no level finished
-            return ResumeState(-1, False, None, None, [])
-        try:
-            with np.load(file) as data:
-                level, final = int(data["level"]), bool(data["final"])
-                options = _mesh_options(data)
-                arrays = (data[k] for k in ("points", "cells", "boundary", "boundary_part"))
-                mesh = Mesh(*arrays, [str(n) for n in data["part_names"]], **options)
-                mesh = mesh if options["validate"] else validated_bodies(mesh)
-                u0 = np.array(data["u0"]) if "u0" in data else None
-        except (OSError, ValueError, KeyError) as exc:
-            raise RunFolderError(
-                f"cannot resume: {file} is unreadable ({exc}); start again with --overwrite"
-            ) from None
-        return ResumeState(level, final, mesh, u0, [])
-
     def _history_rows(self) -> list[dict]:
         file = self.path / "history.csv"
-        if not file.is_file():
+        data = read_bounded(file)
+        if data is None:
             return []
-        text = file.read_text(encoding="utf-8")
-        return list(csv.DictReader(io.StringIO(text)))
-
-
-def _mesh_options(data) -> dict:
-    """The saved mesh's cell regions (none in a state saved before regions existed), and
-    whether it is checked as one mesh (not as the union of several bodies, whose points may
-    coincide where they touch: :func:`~signorini.mesh.bodies.validated_bodies`)."""
-    options = {"validate": "bodies" not in data or int(data["bodies"]) == 1}
-    if "cell_region" in data:
-        options["cell_region"] = data["cell_region"]
-        options["region_names"] = [str(n) for n in data["region_names"]]
-    return options
+        try:
+            return list(csv.DictReader(io.StringIO(data.decode("utf-8"))))
+        except (UnicodeDecodeError, csv.Error) as exc:
+            raise RunFolderError(
+                f"cannot resume: {file} is not a CSV history ({exc}); start again with --overwrite"
+            ) from None

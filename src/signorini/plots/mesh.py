@@ -65,10 +65,24 @@ def read_level_mesh(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     cells (3 vertices, then 3 midpoints), or for a P1 run the vertices and ``triangle``
     cells, as :func:`~signorini.output.write_vtu` writes them; the triangulation is the
     first three columns and the vertices they number.
+
+    Raises
+    ------
+    ValueError
+        Naming the file, if it is unreadable (truncated, or not a VTU file: ``meshio.read``
+        would end the process with ``sys.exit``, so the VTU reader is called itself) or not
+        a level file of a run.
     """
     import meshio
 
-    m = meshio.read(path)
+    try:
+        m = meshio.vtu.read(os.fspath(path))
+    except Exception as exc:
+        detail = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
+        raise ValueError(
+            f"{path} is not a readable level file of a run ({detail}; truncated, or not a VTU "
+            "file signorini wrote)"
+        ) from None
     blocks = [b.data for b in m.cells if b.type in ("triangle6", "triangle")]
     if len(blocks) != 1:
         raise ValueError(
