@@ -20,6 +20,7 @@ from signorini.algebra.ranks import solver_ranks
 ROOT = Path(__file__).resolve().parents[1]
 
 
+@pytest.mark.slow
 def test_adaptive_benchmark_reports_consistent_counts_and_floor(tmp_path):
     """benchmarks/adaptive.py on a 5000-unknown budget: its table agrees with the history it
     writes, each level's ratio is its total over its floor, the summary lines follow from the
@@ -96,6 +97,7 @@ def _factor_line(out: str) -> str:
     return next(line for line in out.splitlines() if line.startswith("peak memory of the loop"))
 
 
+@pytest.mark.slow
 def test_adaptive_benchmark_without_floors_reads_the_loops_factor(tmp_path):
     """``--no-floor`` runs the same levels without the floors; the factor it reports is the
     loop's own (its solver's, read after the level), the one the ordered floor reports."""
@@ -155,6 +157,7 @@ def test_adaptive_benchmark_factory_keeps_what_the_loop_reads():
         assert made == [(solver.factor_nnz, memory)] and any(memory.values())
 
 
+@pytest.mark.slow
 def test_inclined_block_example_runs(tmp_path):
     """The literate example with a non-axis contact normal runs and touches the foundation
     without penetrating it."""
@@ -216,6 +219,7 @@ def test_throughput_benchmark_prints_a_table_of_positive_rates():
         assert share == pytest.approx(100 * gflops / peak, rel=0.05, abs=0.01), (share, peak)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(
     "pardiso" not in available_backends(), reason="compares orderings for MKL PARDISO"
 )

@@ -186,6 +186,7 @@ def test_run_options_eta5_no_vtu_quiet(tmp_path, capsys):
     assert not math.isclose(paper, estimate(solve(example_6_1())).eta_terms[4], rel_tol=0.5)
 
 
+@pytest.mark.slow
 def test_bad_theta_exits_with_a_message_and_no_traceback(tmp_path):
     out = tmp_path / "bad"
     proc = subprocess.run(
@@ -259,6 +260,7 @@ def test_unknown_problem_exits_2(tmp_path, capsys, name, message):
     assert code == 2 and re.search(message, err) and "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_run_a_problem_file(tmp_path, capsys):
     """A user's Python file defining problem() runs through the same pipeline."""
     source = tmp_path / "wedge.py"
@@ -395,6 +397,7 @@ def interrupt_after_level(monkeypatch, k: int) -> None:
     monkeypatch.setattr(cli_levels, "progress", stop)
 
 
+@pytest.mark.slow
 def test_resume_after_an_interrupt_gives_the_uninterrupted_run(tmp_path, capsys, monkeypatch):
     full, part = tmp_path / "full", tmp_path / "part"
     args = ["run", "example-6.2", "--max-ndof", "2500", "--theta", "0.5", "--no-figures"]
@@ -501,6 +504,7 @@ def wait_for_level(proc, k: int, timeout: float = 120) -> None:
     raise AssertionError(f"no level {k} within {timeout} s")
 
 
+@pytest.mark.slow
 def test_ctrl_c_prints_one_line_and_exits_130(tmp_path):
     out = tmp_path / "big"
     proc = run_in_subprocess(out, "--max-ndof", "1000000")
@@ -524,6 +528,7 @@ def test_ctrl_c_prints_one_line_and_exits_130(tmp_path):
     assert not [n for n in os.listdir(out) if n.startswith(".")]
 
 
+@pytest.mark.slow
 def test_sigkill_then_resume_gives_the_uninterrupted_run(tmp_path, capsys):
     """Killed at any moment (possibly inside a VTU write), the run is continued by
     --resume: temporaries removed, the same history and files as an uninterrupted run."""
@@ -838,6 +843,7 @@ def test_resume_after_an_interrupt_while_drawing_redraws_from_the_last_level(
     assert not (out / "resume.npz").exists()
 
 
+@pytest.mark.slow
 def test_a_problem_file_in_an_old_form_is_told_so(tmp_path):
     """Python hides DeprecationWarnings outside __main__; those raised at the problem file's
     own lines (here a traction g(x, n)) are shown, pointing at the file."""
@@ -895,6 +901,7 @@ def problem():
 """
 
 
+@pytest.mark.slow
 def test_resume_keeps_the_curves_of_the_problem(tmp_path, capsys, monkeypatch):
     """The saved state holds arrays only; a resumed run refines on the problem's curves
     again, so it gives the uninterrupted run's levels (not a run refined on chords)."""
@@ -914,6 +921,7 @@ def test_resume_keeps_the_curves_of_the_problem(tmp_path, capsys, monkeypatch):
     assert_same_history(a, b)
 
 
+@pytest.mark.slow
 def test_the_deformed_figure_of_a_frictional_result_marks_stick_and_slip(tmp_path, monkeypatch):
     """The figures of a last level with friction pass the node states, the contact nodes'
     displacement and p_t to the deformed-body figure; without friction none of them."""
@@ -964,6 +972,7 @@ def test_the_deformed_figure_of_a_frictional_result_marks_stick_and_slip(tmp_pat
     assert without.tangential_pressure is None
 
 
+@pytest.mark.slow
 def test_resume_of_two_touching_bodies_gives_the_uninterrupted_run(tmp_path, capsys, monkeypatch):
     """The two-cylinder run (two bodies whose points coincide where they touch) resumes
     from its state file: the union's bodies are checked one by one, and the history and the

@@ -63,6 +63,7 @@ def test_a_problem_file_named_dots_does_not_default_to_the_parent_folder(
 
 
 # ---------------------------------------------------------------------- lock and signals
+@pytest.mark.slow
 def test_a_folder_a_live_process_writes_is_refused_and_a_dead_one_is_not_running(tmp_path, capsys):
     out = tmp_path / "busy"
     proc = run_in_subprocess(out, "--max-ndof", "1000000")
@@ -89,6 +90,7 @@ def test_a_folder_a_live_process_writes_is_refused_and_a_dead_one_is_not_running
     assert main([*again, "--quiet", "--no-figures"]) == 0
 
 
+@pytest.mark.slow
 def test_sigterm_ends_a_run_as_ctrl_c_does(tmp_path):
     out = tmp_path / "term"
     proc = run_in_subprocess(out, "--max-ndof", "1000000")
@@ -107,6 +109,7 @@ def test_sigterm_ends_a_run_as_ctrl_c_does(tmp_path):
     assert len(rows) >= 3 and len(list(out.glob("level_*.vtu"))) == len(rows)
 
 
+@pytest.mark.slow
 def test_a_closed_stdout_stops_the_progress_lines_not_the_run(tmp_path):
     """``signorini run ... | head -2``: the run ends cleanly with every file."""
     out = tmp_path / "piped"
@@ -132,6 +135,7 @@ def test_a_closed_stdout_stops_the_progress_lines_not_the_run(tmp_path):
     assert len(rows) > 5 and len(list(out.glob("level_*.vtu"))) == len(rows)
 
 
+@pytest.mark.slow
 def test_a_kill_while_drawing_leaves_no_empty_figure(tmp_path, capsys, monkeypatch):
     """A figure is written to a temporary file and moved into place: stopped in the middle
     of a write, no figure file is left (empty or partial), only the finished ones."""
@@ -227,6 +231,7 @@ def test_a_truncated_level_file_read_by_the_figures_is_a_recorded_failure(
     assert manifest["error"] == f"while drawing the figures: {fault}"
 
 
+@pytest.mark.slow
 def test_figures_refuses_a_problem_that_is_not_the_folders(tmp_path, capsys):
     out = tmp_path / "r"
     assert main([*RUN_62[:3], "300", "--out", str(out), "--no-figures", "--quiet"]) == 0
@@ -266,6 +271,7 @@ def problem():
 """
 
 
+@pytest.mark.slow
 def test_a_problem_files_load_path_is_solved_and_resumed(tmp_path, capsys, monkeypatch):
     """A file with ``load_path()``: the history of ``adaptive(problem, path=steps)``, and
     after an interrupt and ``--resume`` the uninterrupted history."""
@@ -414,6 +420,7 @@ def test_the_time_left_is_the_growth_of_ndof_times_the_time_per_unknown():
     assert clock.left(1, 1e-3) is None  # no growth to go by
 
 
+@pytest.mark.slow
 def test_verbose_shows_the_librarys_log_lines(tmp_path):
     argv = [sys.executable, "-m", "signorini.cli", "run", "example-6.2", "--max-levels", "2"]
     for extra, expected in (([], False), (["--verbose"], True)):

@@ -7,9 +7,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
+@pytest.mark.slow
 def test_cold_benchmark_reports_agreement_iterations_and_ratio():
     out = subprocess.run(
         [sys.executable, str(ROOT / "benchmarks" / "cold.py"), "--max-ndof", "40000"],

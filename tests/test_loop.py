@@ -206,6 +206,7 @@ def test_level_record_docs_name_every_field_and_what_ndof_counts():
     assert level.record.ndof == 162 - 2 * 9
 
 
+@pytest.mark.slow
 def test_warm_start_needs_few_pdas_solves():
     """Example 6.2: from level 5 on, the prolongated solution's contact set is nearly right,
     so PDAS needs at most 2 solves per level on average (cold starts need several)."""

@@ -43,6 +43,7 @@ def probe(mode: str) -> dict:
     return json.loads(out)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc and /proc only")
 def test_freed_memory_is_kept_and_reused_without_page_faults():
     tuned, plain = probe("tuned"), probe("plain")

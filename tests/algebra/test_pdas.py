@@ -402,6 +402,7 @@ def test_no_constraints_is_a_linear_solve():
 # ----------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("backend", BACKEND_LIST)
 def test_just_touching_converges_cold_and_warm(backend):
     # 33k unknowns: the solution's round-off (|x_c - g| ~ 1e-12 |g|) decided the active set by

@@ -67,6 +67,7 @@ def assert_same_solution(a, b, rtol: float = 1e-12) -> None:
     assert np.abs(a.contact_force - b.contact_force).max() <= rtol * force
 
 
+@pytest.mark.slow
 def test_a_toy_backend_solves_example_6_2_adaptively_as_the_default_solver_does():
     problem = example_6_2()
     toy = list(adaptive(problem, max_ndof=2500, solver=dense_solver))

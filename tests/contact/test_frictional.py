@@ -309,6 +309,7 @@ def test_warm_start_reads_the_states_off_the_displacement():
     assert np.abs(again.u - res.u).max() < 1e-12 * np.abs(res.u).max()
 
 
+@pytest.mark.slow
 def test_adaptive_coulomb_levels_need_few_iterations():
     """Warm-started from the previous level, a level of Example 6.2 with Coulomb friction
     needs about two linear solves (from the update rule at the prolongated solution it

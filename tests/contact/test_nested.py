@@ -42,6 +42,7 @@ def _agreement(a, b) -> tuple[float, float]:
     return float(du), float(dl)
 
 
+@pytest.mark.slow
 def test_nested_solve_is_the_cold_solution_in_fewer_iterations(fine, cold):
     problem, mesh = fine
     nested = solve(problem, mesh)
@@ -56,6 +57,7 @@ def test_nested_solve_is_the_cold_solution_in_fewer_iterations(fine, cold):
     assert its[0] <= 3 and its[1] >= 3 * its[0], its
 
 
+@pytest.mark.slow
 def test_coarse_mesh_has_the_fine_cells_at_the_contact_part(fine):
     problem, mesh = fine
     coarse = coarse_mesh(problem.mesh, mesh, problem.contact_parts)
@@ -97,6 +99,7 @@ def test_a_mesh_that_is_not_a_refinement_still_gets_the_same_solution():
     assert du <= 1e-10 and dl <= 1e-10, (du, dl)
 
 
+@pytest.mark.slow
 def test_warm_starts_small_meshes_and_the_switch_leave_pdas_alone(fine, cold):
     problem, mesh = fine
     warm = solve(problem, mesh, u0=cold.u)

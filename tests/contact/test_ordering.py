@@ -93,6 +93,7 @@ def test_metis_ordering_is_a_permutation_and_pardiso_uses_a_given_one():
     assert nnz_metis < 1.3 * nnz_own
 
 
+@pytest.mark.slow
 @needs_pardiso
 def test_vertex_graph_ordering_is_no_worse_than_pardisos_own(adaptive_mesh):
     """Measured on Example 6.2's graded adaptive mesh and on a uniform one: the P2 order
@@ -137,6 +138,7 @@ def test_solution_does_not_depend_on_the_ordering(backend):
         assert (solver.ordering is not None) == (solver.backend == "pardiso")
 
 
+@pytest.mark.slow
 @needs_pardiso
 def test_solve_uses_the_ordering_and_agrees_with_pardisos_own(adaptive_mesh):
     problem = example_6_2()
@@ -177,6 +179,7 @@ def test_vertex_graph_has_an_entry_per_edge_both_ways():
     assert G.nnz == 2 * mesh.n_edges and (G != G.T).nnz == 0 and G.diagonal().sum() == 0
 
 
+@pytest.mark.slow
 @needs_pardiso
 def test_an_ordering_started_in_the_background_is_the_ordering(adaptive_mesh):
     """:class:`Ordering` with ``prefetch`` (METIS beside the caller, on one MKL thread) gives
@@ -195,6 +198,7 @@ def test_an_ordering_started_in_the_background_is_the_ordering(adaptive_mesh):
     assert np.array_equal(pair.ordering(), dof_ordering(pair.space, coupling))
 
 
+@pytest.mark.slow
 @needs_pardiso
 @pytest.mark.parametrize("make", [example_6_2, example_6_2_tresca, example_6_2_coulomb])
 def test_solve_with_its_analysis_beside_the_assembly_is_the_solve_without(

@@ -88,6 +88,7 @@ def measure(res: ContactResult) -> dict[str, float]:
     return {"P": P, "Q": Q, "a": a, "c": c, "directions": set(direction[slip].tolist())}
 
 
+@pytest.mark.slow
 def test_the_stick_zone_follows_cattaneo_mindlin_on_loading_and_unloading(path):
     """Press, pull twice, move back halfway: c/a on loading and c'/a on unloading against
     the theory, the slip directions, and KKT of both laws at every step."""
@@ -124,6 +125,7 @@ def test_the_stick_zone_follows_cattaneo_mindlin_on_loading_and_unloading(path):
     assert back["directions"] == {-1}, back["directions"]  # reversed slip at both edges
 
 
+@pytest.mark.slow
 def test_coulomb_friction_is_path_dependent(mesh, path):
     """The static (one-step) solve of a load against the end of a load path.
 
@@ -167,6 +169,7 @@ def test_coulomb_friction_is_path_dependent(mesh, path):
     assert (ms["Q"] - mp["Q"]) / mp["Q"] > 0.02
 
 
+@pytest.mark.slow
 def test_with_coupling_the_stick_zone_departs_from_cattaneo_mindlin(mesh):
     """The same press and pull with ν = 0.3 (β = 0.286): the normal and tangential problems
     couple, and c/a departs from √(1 − Q/(F P)) by far more than h/a, so the agreement at

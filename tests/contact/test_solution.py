@@ -269,6 +269,7 @@ def reduced_qp(system):
     return K, b, B, free, x_d
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["6.1", "6.2"])
 def test_agrees_with_scipy_trust_constr(name):
     pb = EXAMPLES[name]()

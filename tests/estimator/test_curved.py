@@ -6,6 +6,7 @@ does there, and the adaptive loop on a half-disc pressed onto a rigid plane."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.integrate import quad
 
 from signorini.contact.solution import solve
@@ -340,6 +341,7 @@ def half_disc(n: int = 4, radius: float = 1.0) -> Mesh:
     return mesh.with_curve("arc", Circle((0.0, radius), radius))
 
 
+@pytest.mark.slow
 def test_adaptive_loop_on_a_half_disc_pressed_onto_a_rigid_plane():
     """A half-disc (E = 1, ν = 0.3, R = 1) pushed 0.01 down by its flat side onto the
     half-plane y ≤ 0: contact half-width a ≈ 0.078 R on the arc. The adaptive loop with the
@@ -393,6 +395,7 @@ def test_adaptive_loop_on_a_half_disc_pressed_onto_a_rigid_plane():
     assert eta4["n_z"] < 0.5 * eta4["body normal"], eta4
 
 
+@pytest.mark.slow
 def test_straight_contact_part_against_a_disc_splits_along_the_obstacle_direction():
     """A block [−1, 1] × [0, 1] pushed 0.01 down onto the cylinder of radius 1 below it: the
     contact part is straight but n_z is radial (the obstacle's). η4 splits the traction along

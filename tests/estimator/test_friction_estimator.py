@@ -135,6 +135,7 @@ def _sweep(levels: int):
     return rows
 
 
+@pytest.mark.slow
 def test_manufactured_stick_slip_estimator_and_error_decay_alike():
     """Uniform refinement: η_h and the energy error both like Ndof⁻¹, efficiency bounded."""
     rows = _sweep(5)
@@ -272,6 +273,7 @@ def _block(friction, clamp_ends: bool = False, nx: int = 16) -> ContactProblem:
     )
 
 
+@pytest.mark.slow
 def test_adaptive_coulomb_rate_and_where_it_refines():
     """Coulomb (F = 0.3) on the pressed block: η_h like Ndof⁻¹ over the last levels; the
     smallest contact edges sit at the ends of the contact zone and at the stick–slip

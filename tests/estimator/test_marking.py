@@ -20,6 +20,7 @@ indicators = st.lists(
 thetas = st.floats(min_value=0.0, max_value=1.0, exclude_min=True)
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None)
 @given(eta2=indicators, theta=thetas)
 def test_doerfler_set_reaches_theta_and_is_minimal(eta2, theta):

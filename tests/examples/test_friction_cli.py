@@ -22,6 +22,7 @@ def rows_of(path: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(fh))
 
 
+@pytest.mark.slow
 def test_run_example_6_2_coulomb_end_to_end(tmp_path, capsys):
     out = tmp_path / "coulomb"
     assert main(["run", "example-6.2-coulomb", "--max-ndof", "1500", "--out", str(out)]) == 0
@@ -47,6 +48,7 @@ def test_run_example_6_2_coulomb_end_to_end(tmp_path, capsys):
     assert {"example-6.2-coulomb_contributions.png", "deformed.png", "mesh.png"} <= figures
 
 
+@pytest.mark.slow
 def test_run_partial_slip_resumed_after_an_interrupt(tmp_path, capsys, monkeypatch):
     """partial-slip solves press and pull on every level; interrupted after level 2 and
     resumed, it gives the history of the uninterrupted run (counts exactly, numbers to
@@ -81,6 +83,7 @@ def test_run_partial_slip_resumed_after_an_interrupt(tmp_path, capsys, monkeypat
     assert "c_over_a_theory" in described and "Cattaneo" in described
 
 
+@pytest.mark.slow
 def test_adaptive_benchmark_with_coulomb_friction(tmp_path):
     """benchmarks/adaptive.py --friction coulomb on a small budget: its ``iters`` column is the
     history's semismooth Newton iterations, every level has a floor, and it ends on

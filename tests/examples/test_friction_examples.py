@@ -97,6 +97,7 @@ def check_kkt(levels) -> None:
     assert worst <= 1e-10, worst
 
 
+@pytest.mark.slow
 def test_example_6_2_coulomb_rate_refinement_and_kkt(coulomb_levels):
     levels = coulomb_levels
     print("\nlevel  Ndof    η_h       η8        stick slip  iterations")
@@ -116,6 +117,7 @@ def test_example_6_2_coulomb_rate_refinement_and_kkt(coulomb_levels):
     check_refined_at_transitions(last, axis=1, zone=(0.2, 0.8))
 
 
+@pytest.mark.slow
 def test_partial_slip_rate_refinement_kkt_and_cattaneo_mindlin(slip_levels):
     levels = slip_levels
     print("\nlevel  Ndof    η_h       c/a     theory  Q/(F P)  iterations (both steps)")

@@ -25,6 +25,7 @@ def levels():
     return list(adaptive(hertz(), max_ndof=BUDGET, metrics=hertz_metrics))
 
 
+@pytest.mark.slow
 def test_a_and_p0_within_one_percent_of_hertz_at_the_final_level(levels):
     print("\nlevel   ndof   a/R       a error   p0 error")
     for level in levels:
@@ -41,6 +42,7 @@ def test_a_and_p0_within_one_percent_of_hertz_at_the_final_level(levels):
     )
 
 
+@pytest.mark.slow
 def test_pressure_profile_within_two_percent_of_p0_away_from_the_ends(levels):
     result = levels[-1].result
     zone = hertz_contact(result)
@@ -54,6 +56,7 @@ def test_pressure_profile_within_two_percent_of_p0_away_from_the_ends(levels):
     assert misfit < 0.02, f"pressure off the Hertz profile by {misfit:.3%} of p0"
 
 
+@pytest.mark.slow
 def test_estimator_decays_like_one_over_ndof(levels):
     ndof = [level.record.ndof for level in levels]
     eta = [level.record.eta for level in levels]
@@ -62,6 +65,7 @@ def test_estimator_decays_like_one_over_ndof(levels):
     assert slope <= -0.9, f"η_h decays like Ndof^{slope:.3f}"
 
 
+@pytest.mark.slow
 def test_refinement_concentrates_at_the_two_ends_of_the_contact_zone(levels):
     result = levels[-1].result
     mesh = result.mesh
@@ -79,6 +83,7 @@ def test_refinement_concentrates_at_the_two_ends_of_the_contact_zone(levels):
     assert mesh.h.max() > 50 * mesh.h[smallest].max()  # graded, not uniform
 
 
+@pytest.mark.slow
 def test_every_level_meets_kkt_to_1e_10(levels):
     worst = max(level.result.report.kkt.max for level in levels)
     print(f"\nlargest relative KKT residual over {len(levels)} levels: {worst:.2e}")
@@ -102,6 +107,7 @@ def test_rotated_problem_gives_the_rotated_solution():
     assert m1 == pytest.approx(m0, rel=1e-9, abs=1e-12)
 
 
+@pytest.mark.slow
 def test_straight_chords_put_the_peak_pressure_percents_off_on_coarse_meshes():
     a = 0.099  # the default example's half-width, a / R
     errors = {}
@@ -122,6 +128,7 @@ def test_straight_chords_put_the_peak_pressure_percents_off_on_coarse_meshes():
     assert abs(errors[5, True]) < 0.005 and abs(errors[10, True]) < 0.005, errors
 
 
+@pytest.mark.slow
 def test_default_depth_gives_a_over_r_about_one_tenth(levels):
     assert DEPTH == 0.015
     assert levels[-1].record.extra["a"] == pytest.approx(0.099, abs=0.002)
@@ -140,6 +147,7 @@ def test_scaled_problem_gives_the_same_relative_errors():
         assert m2[key] == pytest.approx(m1[key], rel=1e-8, abs=1e-12)
 
 
+@pytest.mark.slow
 def test_command_line_writes_the_hertz_columns_and_the_pressure_figure(tmp_path):
     from signorini.cli import main
     from signorini.output import read_history

@@ -104,6 +104,7 @@ def energy_slope() -> tuple[float, list[float]]:
     return float(np.polyfit(np.log(ndof), np.log(err), 1)[0]), err
 
 
+@pytest.mark.slow
 def test_isoparametric_cells_give_the_optimal_rate_with_a_dirichlet_arc_and_chords_do_not(
     monkeypatch,
 ):

@@ -261,6 +261,7 @@ def piece_at(edges: np.ndarray, t: np.ndarray) -> np.ndarray:
     return a + t * (4 * m - 3 * a - b) + t**2 * (2 * (a + b - 2 * m))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("nearest_samples", [24, 2])  # 2: most points compare all pieces
 def test_quadratic_boundary_projection_is_the_nearest_point_of_the_pieces(
     monkeypatch, nearest_samples

@@ -225,6 +225,7 @@ def solve_annulus(mesh: Mesh, data_on_circles: bool) -> tuple[int, float]:
     return space.n_dofs, float(np.sqrt(e2.sum()))
 
 
+@pytest.mark.slow
 def test_energy_error_converges_like_1_over_ndof_on_second_order_files_only(tmp_path):
     # one file per mesh size (a mesh generator's sequence); the Dirichlet data of the annulus
     # are given on its circles. On the chords of a first-order file they are imposed O(H^2)

@@ -20,6 +20,7 @@ from tests.test_cli import (
 )
 
 
+@pytest.mark.slow
 def test_a_p1_run_records_its_element_and_resumes_with_it(tmp_path, capsys, monkeypatch):
     full, part = tmp_path / "full", tmp_path / "part"
     args = ["run", "example-6.2", "--element", "p1", "--max-ndof", "1500", "--no-figures"]

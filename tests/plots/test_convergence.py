@@ -41,6 +41,7 @@ def check_legend_slopes(info: dict, last: int | None = None) -> dict[str, float]
     return stated
 
 
+@pytest.mark.slow
 def test_error_and_estimator_figure(tmp_path, captured):
     import matplotlib.pyplot as plt
 
@@ -66,6 +67,7 @@ def test_error_and_estimator_figure(tmp_path, captured):
     assert plt.get_fignums() == []  # nothing left open in pyplot
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("last", [2, 4])
 def test_stated_slopes_follow_last(tmp_path, captured, last):
     """Rate −1/2 on the first levels, −1 on the last: the stated slope depends on how many
@@ -78,6 +80,7 @@ def test_stated_slopes_follow_last(tmp_path, captured, last):
     assert stated == {STYLES["eta"]["label"]: round(expected, 2)}
 
 
+@pytest.mark.slow
 def test_efficiency_figure_from_csv_path(tmp_path, captured):
     h = synthetic_history()
     h["efficiency"] = np.array([np.nan, 1.2, 1.4, 1.5, 1.6, 1.6])
@@ -96,6 +99,7 @@ def test_efficiency_figure_from_csv_path(tmp_path, captured):
     assert info["ylim"][0] == pytest.approx((0.0, 1.2 * y.max()))
 
 
+@pytest.mark.slow
 def test_contributions_draw_each_known_term_and_list_vanishing_ones(tmp_path, captured, caplog):
     h = synthetic_history(zero_terms=("eta_2", "eta_6"))
     h["eta_4"][2] = 0.0  # a single zero leaves a gap, not an error
@@ -137,6 +141,7 @@ def test_estimator_figure_and_suffix_kept(tmp_path, captured):
     assert {200.0, 500.0, 1000.0, 2000.0} <= set(captured[0]["xticks"][0])
 
 
+@pytest.mark.slow
 def test_adaptive_vs_uniform_figure(tmp_path, captured):
     uniform_ndof = np.array([150.0, 560.0, 2200.0, 8700.0])
     histories = {
@@ -194,6 +199,7 @@ def test_slopes_are_fitted_over_the_finer_half_and_the_legend_says_so(tmp_path, 
     assert info["caption"] == r"slopes: least squares on $N_{\mathrm{dof}} \geq 1000$"
 
 
+@pytest.mark.slow
 def test_zero_and_round_off_terms_sit_on_the_zero_strip(tmp_path, captured):
     h = synthetic_history(zero_terms=("eta_6",))
     eta7 = h["eta_7"].copy()
@@ -217,6 +223,7 @@ def test_zero_and_round_off_terms_sit_on_the_zero_strip(tmp_path, captured):
     assert r"$\eta_6 \equiv 0$" in info["legend"]
 
 
+@pytest.mark.slow
 def test_a_term_at_round_off_on_every_level_is_named_so(tmp_path, captured):
     h = synthetic_history(zero_terms=())
     h["eta_7"] = 1e-17 * np.ones(NDOF.size)

@@ -13,6 +13,7 @@ from signorini.plots.deformed import NODE_STATES, displacement_scale
 from .figure_checks import check_written
 
 
+@pytest.mark.slow
 def test_deformed_figure_with_pressure_and_obstacle(tmp_path, captured):
     mesh = rectangle(nx=6, ny=6)
     p, c = mesh.points, mesh.cells
@@ -45,6 +46,7 @@ def test_deformed_figure_with_pressure_and_obstacle(tmp_path, captured):
     assert info["xlabel"][:2] == [r"$x$", r"$y$"]
 
 
+@pytest.mark.slow
 def test_deformed_figure_with_obstacle_only(tmp_path, captured):
     mesh = rectangle(nx=2, ny=2)
     y = np.linspace(0.0, 1.0, 11)
@@ -103,6 +105,7 @@ def test_displacement_scale(size, u_max, scale):
     assert drawn <= 0.25 and (u_max == 0 or drawn >= 0.02)  # visible, and not folding over
 
 
+@pytest.mark.slow
 def test_obstacle_from_the_gap_is_drawn_at_true_scale(tmp_path, captured):
     """The surface ``z + ψ(z) n_z`` of the small-deformation model, not scaled with the
     displacement (which once bent a flat obstacle), and the title says which is scaled."""
@@ -141,6 +144,7 @@ def test_free_boundary_ends_lie_between_active_and_inactive_neighbours():
         free_boundary_ends(pts, active[:3])
 
 
+@pytest.mark.slow
 def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
     """With node states the stick and slip nodes are marked on the drawn body (at
     ``contact_points + scale * contact_displacement``; inactive ones not) and on the friction
@@ -194,6 +198,7 @@ def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
         plot_deformed(p, c, u, tmp_path / "x", contact(tangential_pressure=p_t[:3]), scale=5.0)
 
 
+@pytest.mark.slow
 def test_obstacle_from_gaps_is_left_out_where_the_gap_is_far(tmp_path, captured):
     """A half-disc over a plane: the plane is drawn straight (y = 0, not the parabola
     ``scale · ψ`` once made of it), only near the contact zone."""

@@ -36,6 +36,7 @@ def punch_arrays():
     return last_arrays(punch(), 1500)
 
 
+@pytest.mark.slow
 def test_hertz_plane_is_drawn_straight_and_the_arc_spans_pi_r(hertz_arrays, tmp_path, captured):
     a = hertz_arrays
     outline = a["obstacle"]["arc"]
@@ -70,6 +71,7 @@ def test_hertz_plane_is_drawn_straight_and_the_arc_spans_pi_r(hertz_arrays, tmp_
     assert info["titles"][1] == "contact part 'arc'" and info["xlabel"][1] == r"arc length $s$"
 
 
+@pytest.mark.slow
 def test_punch_outline_is_its_polyline_with_rounded_corners(punch_arrays, tmp_path, captured):
     a = punch_arrays
     problem = punch()

@@ -59,6 +59,7 @@ def test_refuses_arrays_of_different_lengths(tmp_path):
         plot_pressure_comparison([0.0], [1.0], [[0.0]], [[1.0]], tmp_path / "p")
 
 
+@pytest.mark.slow
 def test_partial_slip_zoom_shows_cattaneo_mindlin(tmp_path, captured):
     """The contact zone of ``partial-slip`` zoomed to |x| <= 1.5 a (once the stick zone was
     7 % of the axis), with Hertz's pressure and Cattaneo–Mindlin's friction stress for the

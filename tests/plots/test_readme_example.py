@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 from signorini.cli import main
 
 README_EXAMPLE = """\
@@ -11,6 +13,7 @@ plots.plot_contributions(history, "results/example-6.1/contributions", title="Ex
 """
 
 
+@pytest.mark.slow
 def test_readme_example_draws_a_figure_from_a_history(tmp_path, monkeypatch, captured):
     monkeypatch.chdir(tmp_path)
     assert main(["run", "example-6.1", "--max-ndof", "800", "--quiet", "--no-figures"]) == 0
