@@ -9,9 +9,10 @@ divides the operation count PARDISO reports (``iparm[18]``, Mflop) by the time o
 numerical factorization alone (the fastest of ``--repeat`` refactorizations, the analysis
 done before), and compares that rate with the machine's dense peak: the best of
 ``--repeat`` products of two ``--blas-n`` × ``--blas-n`` float64 matrices with NumPy
-(2 n³ flop each). The result is a Markdown table; README.md (*Performance*) shows two runs'
-(2 cores shared with other jobs: at 10⁶ unknowns refinement, assembly and estimator 1.9–2.6
-million unknowns per second, the factorization 32.7 GFlop/s = 27 % of the dense peak).
+(2 n³ flop each). The result is a Markdown table; benchmarks/README.md (*Throughput of each
+phase*) shows two runs' (2 cores shared with other jobs: at 10⁶ unknowns refinement, assembly
+and estimator 1.9–2.6 million unknowns per second, the factorization 32.7 GFlop/s = 27 % of the
+dense peak).
 
     python benchmarks/throughput.py                     # levels at 1e5 and 1e6 unknowns
     python benchmarks/throughput.py --sizes 200000 --blas-n 2000
