@@ -37,7 +37,7 @@ ONE_THREAD = dict.fromkeys(("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_
 def test_the_petsc_backend_and_the_mpi_runs_pass():
     env = {**os.environ, "SIGNORINI_REQUIRE_PETSC": "1", "MPLBACKEND": "Agg", **ONE_THREAD}
     done = subprocess.run(
-        [MPI_PYTHON, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/parallel",
+        [MPI_PYTHON, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-m", "", "tests/parallel",
          "tests/algebra/test_petsc.py", f"--ignore={SERIAL_ONLY}"],
         cwd=ROOT, env=env, capture_output=True, text=True, timeout=1200,
     )  # fmt: skip
