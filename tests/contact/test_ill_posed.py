@@ -11,7 +11,7 @@ from signorini.fem.material import Material
 from signorini.loop import adaptive
 from signorini.mesh.builders import rectangle
 from signorini.mesh.mesh import Mesh
-from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError, Roller
 from signorini.problem.obstacles import HalfPlane
 
 MATERIAL = Material.from_young(10.0, 0.3)
@@ -165,3 +165,27 @@ def test_a_corner_far_from_opposite_is_solved():
     # tilted by 0.1 rad from opposite: a (sharp) corner, two constraints solved exactly
     result = solve(_pinched(0.1))
     assert result.report.kkt.max < 1e-10
+
+
+def _floated(bottom: Contact) -> ContactProblem:
+    """The unit square under force control: held sideways by a roller on its left, pressed
+    down by a traction on its top, held vertically by its bottom's contact alone."""
+    return ContactProblem(
+        rectangle(nx=2, ny=2),
+        MATERIAL,
+        {
+            "top": Neumann((0.0, -0.1)),
+            "right": Neumann(),
+            "left": Roller(),
+            "bottom": bottom,
+        },
+    )
+
+
+def test_a_deep_overlap_under_force_control_is_refused_by_depth():
+    # the floor 0.5 deep, its normal right: no Dirichlet node moves the body out of it
+    problem = _floated(Contact(obstacle=HalfPlane((0.0, 0.5), (0.0, 1.0))))
+    with pytest.raises(
+        ProblemError, match=r"'bottom' starts 0\.5 deep .*move the body out by at most 0 "
+    ):
+        solve(problem)

@@ -331,7 +331,9 @@ def check_initial_overlap(
     if deep.size == 0:
         return
     value, _ = _dirichlet_values(problem, space, problem.dirichlet_nodes(space))
-    moved = (value @ -direction[deep].T).max(axis=0)  # (deep,) max_y u_D(y)·(−n_z)
+    # (deep,) max_y u_D(y)·(−n_z); with no Dirichlet node (a body under force control) the
+    # Dirichlet data move the body out by nothing
+    moved = (value @ -direction[deep].T).max(axis=0) if len(value) else np.zeros(deep.size)
     need = -gap[deep] - moved
     worst = int(np.argmax(need))
     if need[worst] <= DEEP_OVERLAP * size:
