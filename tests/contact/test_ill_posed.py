@@ -12,7 +12,7 @@ from signorini.loop import adaptive
 from signorini.mesh.builders import rectangle
 from signorini.mesh.mesh import Mesh
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError, Roller
-from signorini.problem.obstacles import HalfPlane
+from signorini.problem.obstacles import Disc, HalfPlane, Polyline
 
 MATERIAL = Material.from_young(10.0, 0.3)
 
@@ -182,6 +182,19 @@ def _floated(bottom: Contact) -> ContactProblem:
     )
 
 
+def test_a_reversed_half_plane_normal_under_force_control_is_refused_by_direction():
+    # the floor at y = −0.5 with its normal pointing down, away from the body: the whole
+    # square is inside the obstacle. Before: NumPy's "zero-size array to reduction operation
+    # maximum" from the overlap check, which has no Dirichlet node to read
+    problem = _floated(Contact(obstacle=HalfPlane((0.0, -0.5), (0.0, -1.0))))
+    with pytest.raises(
+        ProblemError,
+        match=r"HalfPlane.*contact part 'bottom' lies on the body's side.*ψ = -0\.5.*"
+        r"n_z = \(0, 1\).*points into the body, n_z·n = -1 .*n = \(0, -1\)",
+    ):
+        solve(problem)
+
+
 def test_a_deep_overlap_under_force_control_is_refused_by_depth():
     # the floor 0.5 deep, its normal right: no Dirichlet node moves the body out of it
     problem = _floated(Contact(obstacle=HalfPlane((0.0, 0.5), (0.0, 1.0))))
@@ -189,3 +202,37 @@ def test_a_deep_overlap_under_force_control_is_refused_by_depth():
         ProblemError, match=r"'bottom' starts 0\.5 deep .*move the body out by at most 0 "
     ):
         solve(problem)
+
+
+@pytest.mark.parametrize("centre", [(0.5, 0.1), (0.5, 0.01), (0.3, 0.2)])
+def test_a_disc_centred_inside_the_body_is_refused_by_direction(centre):
+    # overlaps of 0.2, 0.29 and 0.1, all below the depth bound 0.354: before, the bottom was
+    # pulled down through the disc (u_y = −0.2 at (0.5, 0)), its directions n_z = (0, 1)
+    problem = _on_foundation(Contact(obstacle=Disc(centre, 0.3)))
+    with pytest.raises(
+        ProblemError, match=r"Disc.*'bottom' lies on the body's side.*points into the body"
+    ):
+        solve(problem)
+    with pytest.raises(ProblemError, match="lies on the body's side"):
+        next(adaptive(problem))
+
+
+#: a punch below the square, x in [0.2, 0.8], y <= 0.1 (walked with the obstacle on the left)
+PUNCH = [(0.8, -1.0), (0.8, 0.1), (0.2, 0.1), (0.2, -1.0)]
+
+
+@pytest.mark.parametrize(
+    "obstacle",
+    [
+        Disc((0.5, -0.25), 0.3),  # a cylinder pressed 0.05 into the bottom from below
+        Disc((0.5, -0.3), 0.3),  # touching
+        Polyline(PUNCH),  # a punch from below, 0.1 into the bottom
+        Polyline(PUNCH, radius=0.15),
+        HalfPlane((0.0, 0.2), (0.1, 1.0)),  # a tilted floor, 0.2 deep at most
+    ],
+    ids=["disc-in", "disc-touching", "punch-sharp", "punch-rounded", "tilted-floor"],
+)
+def test_an_obstacle_outside_the_body_overlapping_it_is_solved(obstacle):
+    # directions out of the body, or along it beside the punch's side walls (n_z·n = 0)
+    result = solve(_on_foundation(Contact(obstacle=obstacle)))
+    assert result.report.kkt.max < 1e-8

@@ -27,6 +27,7 @@ __all__ = [
     "DEEP_OVERLAP",
     "check_dirichlet_admissible",
     "check_initial_overlap",
+    "check_obstacle_side",
     "directions_and_gaps",
     "edge_weights",
     "friction_data",
@@ -95,6 +96,88 @@ def directions_and_gaps(
             direction[sel] = _body_normals(problem, space, name, edge_nodes[sel], chord[sel])
         gap[sel] = psi[inverse].reshape(-1, edge_nodes.shape[1])
     return direction, gap
+
+
+#: a node inside an obstacle shape is refused when its constraint direction points into the
+#: body by more than this: ``n_z·n < −SIDE_TOL`` with the body's outward unit normal ``n``.
+#: Both are unit vectors computed from coordinates, exact to about 1e-15 (measured: −1.2e-16
+#: at the equator of hertz's arc, where the exact value is 0); the margin lets a direction
+#: along the boundary (a node beside a punch's side wall, pushed out sideways) pass however
+#: it is rounded, and refuses every direction that pulls the body outward by more than
+#: 1e-8 of its penetration (docs/method.md, *Obstacles as shapes*, "Obstacle on the body's
+#: side")
+SIDE_TOL = 1e-8
+
+
+def check_obstacle_side(
+    problem: ContactProblem,
+    space: LagrangeSpace,
+    cs_edges: tuple,
+    chord: np.ndarray,
+    constraint: tuple,
+) -> None:
+    """Refuse an obstacle shape that lies on the body's side of its contact part.
+
+    A node ``z`` with ``ψ(z) < 0`` is inside the obstacle, and the constraint
+    ``u(z)·n_z ≤ ψ(z)`` moves it by at least ``|ψ(z)|`` along ``−n_z`` to the obstacle's
+    surface point closest to it. Pressed by an obstacle outside it, the body is pushed in:
+    ``n_z`` (into the obstacle) points out of the body, ``n_z·n > 0`` with the body's
+    outward normal ``n``, or along its boundary (``n_z·n = 0``, beside a punch's side wall).
+    Where ``n_z·n < 0`` the closest surface lies on the body's inner side (a :class:`Disc`
+    centred inside the body, a :class:`HalfPlane` whose normal points away from the body):
+    the constraint pulls the contact side outward through the obstacle, however shallow the
+    overlap, and the "solution" is that of another problem. Refused beyond round-off,
+    ``ψ(z) < −DIRICHLET_POINT_TOL · extent`` and ``n_z·n < −SIDE_TOL``; gap functions (the
+    direction is the body's normal) and the slaves of contact pairs are not concerned.
+
+    Parameters
+    ----------
+    problem : ContactProblem
+    space : LagrangeSpace
+    cs_edges : tuple of (tuple of str, (n_ce,) int array, (n_ce, m) int array)
+        The contact parts, the part of each contact edge and its nodes ``[start, end,
+        midpoint]`` (P1: ``[start, end]``).
+    chord : (n_ce, 2) float array
+        The outward unit normal of each edge (the part's own on a straight part).
+    constraint : tuple of (n_ce, m, 2) and (n_ce, m) float arrays
+        The direction n_z and the gap ψ(z) at those nodes.
+
+    Raises
+    ------
+    ProblemError
+        Naming the part, its obstacle, the node, ψ, n_z, the body's normal and their product.
+    """
+    parts, edge_part, edge_nodes = cs_edges
+    direction, gap = constraint
+    pts = space.mesh.points
+    depth_tol = DIRICHLET_POINT_TOL * float(np.abs(pts).max() + np.ptp(pts, axis=0).max())
+    for i, name in enumerate(parts):  # a loop over parts
+        obstacle = problem.conditions[name].obstacle
+        if obstacle is None or name in problem.pairs:
+            continue
+        sel = np.flatnonzero(edge_part == i)
+        normal = _body_normals(problem, space, name, edge_nodes[sel], chord[sel])
+        along = np.einsum("ejc,ejc->ej", direction[sel], normal).ravel()
+        inside = gap[sel].ravel() < -depth_tol
+        bad = np.flatnonzero(inside & (along < -SIDE_TOL))
+        if bad.size == 0:
+            continue
+        k = bad[np.argmin(along[bad])]
+        x = space.node_points[edge_nodes[sel].ravel()[k]]
+        n_z, n = direction[sel].reshape(-1, 2)[k] + 0.0, normal.reshape(-1, 2)[k] + 0.0
+        count = np.unique(edge_nodes[sel].ravel()[bad]).size
+        raise ProblemError(
+            f"the obstacle {obstacle!r} of contact part {name!r} lies on the body's side of "
+            f"it: the node at ({x[0]:.12g}, {x[1]:.12g}) starts inside it (ψ = "
+            f"{gap[sel].ravel()[k]:.6g}), and its constraint direction n_z = ({n_z[0]:.6g}, "
+            f"{n_z[1]:.6g}) (the obstacle's normal into it at its surface point nearest the node) "
+            f"points into the "
+            f"body, n_z·n = {along[k]:.6g} with the body's outward normal n = ({n[0]:.6g}, "
+            f"{n[1]:.6g}) ({count} such node(s)): the constraint would pull the contact side "
+            "outward through the obstacle instead of pushing it back. Place the obstacle "
+            "outside the body, against the contact part (a Disc's centre outside the body; a "
+            "HalfPlane's normal pointing from the obstacle towards the body)"
+        )
 
 
 def edge_weights(space: LagrangeSpace, edges: np.ndarray, edge_nodes: np.ndarray):

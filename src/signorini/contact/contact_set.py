@@ -34,6 +34,7 @@ from ..problem.problem import ContactProblem
 from .constraint_data import (
     check_dirichlet_admissible,
     check_initial_overlap,
+    check_obstacle_side,
     directions_and_gaps,
     edge_weights,
     friction_data,
@@ -267,7 +268,8 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     ProblemError
         If every contact node is a Dirichlet node, a Dirichlet value violates the contact
         constraint at a node shared with a contact part
-        (:func:`check_dirichlet_admissible`), an obstacle starts deeper inside the body than a
+        (:func:`check_dirichlet_admissible`), an obstacle shape lies on the body's side of its
+        contact part (:func:`check_obstacle_side`), an obstacle starts deeper inside the body than a
         quarter of its size (:func:`check_initial_overlap`), contact parts with the same
         direction at a shared node have different gaps, two directions at a corner are nearly
         parallel, a node lies on more than two contact parts, or a gap function or obstacle
@@ -293,6 +295,8 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     direction, edge_gap = directions_and_gaps(
         problem, space, (parts, edge_part, edge_nodes), chord, couplings
     )
+    cs_edges = (parts, edge_part, edge_nodes)
+    check_obstacle_side(problem, space, cs_edges, chord, (direction, edge_gap))
 
     # candidates: one per (node, part), Dirichlet nodes left out
     n_parts = len(parts)
