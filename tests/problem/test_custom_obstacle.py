@@ -94,3 +94,36 @@ def test_a_custom_floor_solves_as_the_gap_function_and_the_half_plane():
     np.testing.assert_allclose(own.u[bottom, 1], -depth, rtol=1e-10)
     assert_same_solution(own, by_gap)
     assert_same_solution(own, by_shape)
+
+
+class Broken(Obstacle):
+    """A shape whose own method divides by zero."""
+
+    def _gap_and_direction(self, x):
+        return 1 / 0
+
+
+@pytest.mark.parametrize(
+    ("obstacle", "message"),
+    [
+        (
+            signorini.SignedDistance(lambda x: 1 / 0),
+            r"the obstacle of contact part 'bottom': SignedDistance\(phi=<lambda>.*\): phi\(x\) "
+            r"raised ZeroDivisionError: division by zero \(called with points x of shape \(",
+        ),
+        (
+            Broken(),
+            r"the obstacle <.*Broken.*> of contact part 'bottom' raised ZeroDivisionError in "
+            r"gap_and_direction: division by zero",
+        ),
+    ],
+    ids=["signed-distance", "own-shape"],
+)
+def test_an_obstacle_that_raises_is_named_with_its_part_and_error(obstacle, message):
+    # before: a bare ZeroDivisionError from inside the contact set
+    with pytest.raises(signorini.ProblemError, match=message) as info:
+        solve(pressed_block(Contact(obstacle=obstacle)))
+    cause = info.value.__cause__
+    while cause is not None and not isinstance(cause, ZeroDivisionError):
+        cause = cause.__cause__
+    assert isinstance(cause, ZeroDivisionError)

@@ -158,3 +158,17 @@ def test_one_material_for_both_layers_leaves_an_interface_jump():
     wrong = dataclasses.replace(result, problem=dataclasses.replace(problem, material=BASE))
     eta = np.sqrt(estimate(wrong).eta2_cell.sum(axis=1))
     assert eta[1] > 0.5 * P
+
+
+def test_a_region_selector_that_raises_is_named_with_its_error():
+    # before: the bare ZeroDivisionError of the selector
+    def coating(x):
+        return x[:, 1] > 1 / 0
+
+    with pytest.raises(
+        MeshError,
+        match=r"the selector of region 'coating' raised ZeroDivisionError: division by zero "
+        r"\(it is called with the cell centroids x of shape \(32, 2\)\)",
+    ) as info:
+        rectangle(regions={"base": lambda x: x[:, 1] < 0.5, "coating": coating})
+    assert isinstance(info.value.__cause__, ZeroDivisionError)

@@ -89,6 +89,11 @@ def directions_and_gaps(
                 psi, n = cond.obstacle.gap_and_direction(x)
             except ValueError as err:
                 raise ProblemError(f"the obstacle of contact part {name!r}: {err}") from err
+            except Exception as err:  # a shape of one's own that raises
+                raise ProblemError(
+                    f"the obstacle {cond.obstacle!r} of contact part {name!r} raised "
+                    f"{type(err).__name__} in gap_and_direction: {err}"
+                ) from err
             direction[sel] = n[inverse].reshape(-1, edge_nodes.shape[1], 2)
         else:
             what = f"the gap function of contact part {name!r}"
