@@ -222,3 +222,18 @@ def test_a_contrast_within_double_precision_is_solved_without_a_warning():
         warnings.simplefilter("error")
         result = solve(_layers(Material.from_young(1e7, 0.3), base=Material.from_young(10.0, 0.3)))
     assert result.report.kkt.max < 1e-6
+
+
+def test_a_plane_strain_region_beside_a_plane_stress_one_is_refused_naming_both():
+    # before: accepted, each region with its own 2D law
+    with pytest.raises(
+        ProblemError,
+        match=r"region\(s\) \['base'\] are in plane strain and region\(s\) \['coating'\] in "
+        r"plane stress.*same plane=",
+    ):
+        _layers(Material.from_young(200.0, 0.2, plane="stress"))
+    plate = _layers(
+        Material.from_young(200.0, 0.2, plane="stress"),
+        base=Material.from_young(10.0, 0.3, plane="stress"),
+    )
+    assert {m.plane for m in plate.material.values()} == {"stress"}

@@ -50,7 +50,8 @@ def check_materials(material: object, mesh: Mesh) -> None:
     ------
     ProblemError
         Naming the regions without a material, the names that are not regions, a value
-        that is not a :class:`Material`, or the stiffest and softest regions where their
+        that is not a :class:`Material`, regions in plane strain beside regions in plane
+        stress, or the stiffest and softest regions where their
         spread ``κ_D`` exceeds :data:`CONTRAST_MAX`.
 
     Warns
@@ -82,7 +83,22 @@ def check_materials(material: object, mesh: Mesh) -> None:
     for name, m in given.items():
         if not isinstance(m, Material):
             raise ProblemError(f"the material of region {name!r} must be {kind}, got {m!r}")
+    _check_planes(regions, [given[r] for r in regions])
     _check_spread(regions, [given[r] for r in regions])
+
+
+def _check_planes(names: list[str], materials: list[Material]) -> None:
+    """One 2D reduction for the whole body: a plane-strain region (a long body, ε_zz = 0)
+    beside a plane-stress one (a thin plate, σ_zz = 0) describes no 3D body."""
+    strain = [n for n, m in zip(names, materials, strict=True) if m.plane == "strain"]
+    stress = [n for n, m in zip(names, materials, strict=True) if m.plane == "stress"]
+    if strain and stress:
+        raise ProblemError(
+            f"material: region(s) {strain} are in plane strain and region(s) {stress} in plane "
+            "stress; one body is either long (plane strain, ε_zz = 0) or a thin plate (plane "
+            "stress, σ_zz = 0) throughout: give every region the same plane= (docs/method.md, "
+            "*Plane stress*)"
+        )
 
 
 def _describe(name: str, m: Material) -> str:
