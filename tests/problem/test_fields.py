@@ -9,6 +9,16 @@ import warnings
 import numpy as np
 import pytest
 
+from signorini import (
+    Contact,
+    ContactProblem,
+    Dirichlet,
+    Material,
+    Neumann,
+    Roller,
+    rectangle,
+    solve,
+)
 from signorini.problem.fields import (
     CALL_NAMED,
     CALL_POSITIONAL,
@@ -172,3 +182,63 @@ def re_repr(value) -> str:
 
 def test_problem_error_is_a_value_error():
     assert issubclass(ProblemError, ValueError)
+
+
+@pytest.mark.parametrize(
+    ("build", "message"),
+    [
+        (lambda: Neumann((0.0, -1e300)), r"Neumann\(traction=\.\.\.\) = \(0\.0, -1e\+300\) is "),
+        (lambda: Dirichlet((1e200, None)), r"Dirichlet\(value=\.\.\.\) = \(1e\+200, None\) is "),
+        (lambda: Contact(gap=1e300), r"Contact\(gap=\.\.\.\) = 1e\+300 is "),
+    ],
+)
+def test_numbers_whose_squares_overflow_are_refused_naming_the_condition(build, message):
+    with pytest.raises(ProblemError, match=message + r".*beyond ±1\.34e\+150.*overflow"):
+        build()
+
+
+def _floated(**kwargs) -> ContactProblem:
+    """The unit square under force control: a roller on its left, its bottom on a floor."""
+    conditions = {
+        "left": Roller(),
+        "right": Neumann(),
+        "top": Neumann(kwargs.pop("top", (0.0, -1.0))),
+        "bottom": Contact(gap=0.0),
+    }
+    return ContactProblem(
+        rectangle(nx=2, ny=2), Material.from_young(10.0, 0.3), conditions, **kwargs
+    )
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"body_force": lambda x: (0.0, -1e300)}, r"body_force returned 1e\+300"),
+        (
+            {"top": lambda x: (0.0, -1e300)},
+            r"the traction of Neumann part 'top' returned 1e\+300 in magnitude at x = \(",
+        ),
+    ],
+    ids=["body-force", "traction"],
+)
+def test_a_load_function_whose_squares_overflow_is_named(kwargs, message):
+    # before: NumPy's "array must not contain infs or NaNs" from the force-control check
+    with pytest.raises(ProblemError, match=message + r".*beyond ±1\.34e\+150"):
+        solve(_floated(**kwargs))
+
+
+def test_a_dirichlet_function_whose_squares_overflow_is_named():
+    problem = ContactProblem(
+        rectangle(nx=2, ny=2),
+        Material.from_young(10.0, 0.3),
+        {
+            "left": Neumann(),
+            "right": Neumann(),
+            "top": Dirichlet(lambda x: np.column_stack([0 * x[:, 0], -1e300 + 0 * x[:, 0]])),
+            "bottom": Contact(gap=0.0),
+        },
+    )
+    with pytest.raises(
+        ProblemError, match=r"the Dirichlet value of part 'top' returned 1e\+300 .*beyond"
+    ):
+        solve(problem)

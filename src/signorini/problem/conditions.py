@@ -90,12 +90,7 @@ class Dirichlet:
                     f"Dirichlet(value=...) must be {_COMPONENT}; got {value!r} (a part with "
                     "no component held needs Neumann((0, 0)))"
                 )
-            try:
-                check_numbers(given, 1, "Dirichlet(value=...)", _DIRICHLET)
-            except ProblemError:
-                raise ProblemError(
-                    f"Dirichlet(value=...) must be {_COMPONENT}; got {value!r}"
-                ) from None
+            check_numbers(given, 1, "Dirichlet(value=...)", _COMPONENT, shown=value)
         else:
             check_numbers(value, 2, "Dirichlet(value=...)", _DIRICHLET)
 
