@@ -66,7 +66,8 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
     Raises
     ------
     MeshError
-        If the file cannot be read as a mesh, has no triangles (e.g. only line groups were
+        If the file cannot be read as a mesh, has a node with a NaN or infinite coordinate,
+        has no triangles (e.g. only line groups were
         saved: add a physical surface group or save all elements), is not flat in the
         xy-plane, has no boundary lines in a physical group (every boundary edge must be in
         one), or lacks a requested part; or if a second-order midpoint is off the chord of
@@ -99,6 +100,7 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
         raise MeshError(f"{path} contains no triangles (it has {found or 'no cells'}){hint}")
     cells = np.concatenate([b.data[:, :3] for _, b in tri]).astype(np.int64)
     xyz = np.asarray(m.points, dtype=np.float64)
+    _check_finite(path, xyz)
     # drop points that no triangle uses (e.g. geometry points), renumber
     used = np.unique(cells)
     renumber = np.full(len(xyz), -1, dtype=np.int64)
@@ -148,6 +150,19 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
         return _with_quadratic_boundaries(mesh, _given_midpoints(m, renumber))
     except MeshError as exc:
         raise MeshError(f"{path}: {exc}") from None
+
+
+def _check_finite(path: Path, xyz: np.ndarray) -> None:
+    """Refuse a file with a NaN or infinite coordinate in any of its nodes (vertices, edge
+    midpoints, geometry points alike: a corrupt file), naming the first."""
+    bad = np.flatnonzero(~np.isfinite(xyz).all(axis=1))
+    if bad.size:
+        k = int(bad[0])
+        more = f" (and {bad.size - 1} more)" if bad.size > 1 else ""
+        raise MeshError(
+            f"{path}: node {k + 1} of the file (in its order) has a non-finite coordinate, "
+            f"{tuple(float(v) for v in xyz[k])}{more}; every node needs finite coordinates"
+        )
 
 
 def _surface_regions(m: object, tri: list, tags: list | None) -> np.ndarray | None:
