@@ -31,14 +31,8 @@ from ..fem.space import LagrangeSpace
 from ..mesh.geometry import segment_normals
 from ..problem.fields import ProblemError
 from ..problem.problem import ContactProblem
-from .constraint_data import (
-    check_dirichlet_admissible,
-    check_initial_overlap,
-    check_obstacle_side,
-    directions_and_gaps,
-    edge_weights,
-    friction_data,
-)
+from .admissible import check_dirichlet_admissible, check_initial_overlap, check_obstacle_side
+from .constraint_data import directions_and_gaps, edge_weights, friction_data
 from .mortar import mortar_coupling
 from .rows import MIN_CORNER_ANGLE, SAME_DIRECTION, constraint_rows
 from .two_body import PairTransfer, pair_transfer
