@@ -1,5 +1,7 @@
 """Contact data that no displacement can satisfy, refused before any level: a Dirichlet value
-that pushes a node shared with a contact part into the obstacle (u_D·n > ψ there)."""
+that pushes a node shared with a contact part into the obstacle (u_D·n > ψ there), or into a
+master body held there too; an obstacle shape deep inside the body, or on its side of the
+contact part."""
 
 from __future__ import annotations
 
@@ -9,6 +11,7 @@ import pytest
 from signorini.contact.solution import solve
 from signorini.fem.material import Material
 from signorini.loop import adaptive
+from signorini.mesh.bodies import union
 from signorini.mesh.builders import rectangle
 from signorini.mesh.mesh import Mesh
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError, Roller
@@ -235,4 +238,54 @@ PUNCH = [(0.8, -1.0), (0.8, 0.1), (0.2, 0.1), (0.2, -1.0)]
 def test_an_obstacle_outside_the_body_overlapping_it_is_solved(obstacle):
     # directions out of the body, or along it beside the punch's side walls (n_z·n = 0)
     result = solve(_on_foundation(Contact(obstacle=obstacle)))
+    assert result.report.kkt.max < 1e-8
+
+
+def _stacked(upper_left, lower_left) -> ContactProblem:
+    """Two blocks: "upper" on [0, 1] × [1, 2] on "lower" on [0, 1] × [0, 1] (non-matching
+    edges), the lower's bottom held, both left sides given, the upper's bottom the slave."""
+    upper = rectangle(0.0, 1.0, 1.0, 2.0, 4, 4, pattern="right")
+    lower = rectangle(0.0, 1.0, 0.0, 1.0, 5, 5, pattern="right")
+    return ContactProblem(
+        union({"upper": upper, "lower": lower}),
+        MATERIAL,
+        {
+            "upper.top": Neumann(),
+            "upper.left": Dirichlet(upper_left),
+            "upper.right": Neumann(),
+            "upper.bottom": Contact(master="lower.top"),
+            "lower.bottom": Dirichlet(),
+            "lower.left": lower_left,
+            "lower.right": Neumann(),
+        },
+    )
+
+
+def test_dirichlet_value_into_the_master_is_refused_as_into_an_obstacle():
+    # the upper's left side pushed down by 0.1 onto the lower's held corner (0, 1): as the
+    # one body's check refuses it against an obstacle. Before: accepted (no check on a slave)
+    problem = _stacked((0.0, -0.1), Dirichlet((0.0, 0.0)))
+    with pytest.raises(ProblemError) as info:
+        solve(problem)
+    msg = str(info.value)
+    for text in (
+        "node at (0, 1) lies on Dirichlet part 'upper.left' and contact part 'upper.bottom'",
+        "relative to the node of master part 'lower.top' facing it at (0, 1), held at u_D = "
+        "(0, 0), u_D = (0, -0.1) moves it by u_D·n = 0.1",
+        "beyond the gap ψ = 0 by 0.1",
+    ):
+        assert text in msg, msg
+
+
+@pytest.mark.parametrize(
+    ("upper_left", "lower_left"),
+    [
+        ((0.0, 0.1), Dirichlet((0.0, 0.0))),  # lifted off the master's held corner
+        ((0.0, -0.1), Dirichlet((0.0, -0.1))),  # both corners moved down together
+        ((0.0, -0.01), Neumann()),  # the master's corner is free to give way
+    ],
+    ids=["lifted", "together", "master-free"],
+)
+def test_admissible_dirichlet_values_beside_a_slave_are_solved(upper_left, lower_left):
+    result = solve(_stacked(upper_left, lower_left))
     assert result.report.kkt.max < 1e-8

@@ -6,6 +6,9 @@ side of its contact part, and one that starts deeper inside the body than the mo
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..fem.space import LagrangeSpace
@@ -13,6 +16,9 @@ from ..problem.fields import ProblemError
 from ..problem.problem import ContactProblem
 from ..problem.rollers import held_nodes
 from .constraint_data import _body_normals
+
+if TYPE_CHECKING:
+    from .mortar import MortarCoupling
 
 __all__ = [
     "DEEP_OVERLAP",
@@ -121,6 +127,7 @@ def check_dirichlet_admissible(
     nodes: np.ndarray,
     constraint: tuple,
     parts: tuple,
+    couplings: Mapping[str, MortarCoupling] | None = None,
 ) -> None:
     """Refuse Dirichlet data that violate the contact constraint at a node of a contact part.
 
@@ -130,6 +137,13 @@ def check_dirichlet_admissible(
     these boundary values keeps the body out of the obstacle) and the discrete solutions
     converge to nothing; the estimator's η7 sees the violation at that node on every level
     (docs/method.md, *The continuous problem*).
+
+    On the slave of a contact pair the constraint is on the displacement relative to the
+    master's at the node's point π(z) on it, ``(u(z) − u(π(z)))·n_z ≤ ψ(z)`` with the
+    pointwise gap ``ψ(z) = (π(z) − z)·n_z``: the same check where the master's displacement
+    there is prescribed too (π(z) is a Dirichlet node of the master: the end of the master
+    part beside its Dirichlet part), and none where the master is free to move there
+    (docs/method.md, *Two bodies*).
 
     Parameters
     ----------
@@ -141,24 +155,34 @@ def check_dirichlet_admissible(
         The constraint direction n_z and the gap ψ(z) of each entry.
     parts : tuple of (tuple of str, (j,) int array)
         The contact parts' names and the part of each entry.
+    couplings : mapping slave part -> MortarCoupling, optional
+        The contact pairs' couplings; without them the slaves' entries are not checked.
 
     Raises
     ------
     ProblemError
-        Naming the node's coordinates, the Dirichlet and the contact part, u_D·n and ψ.
+        Naming the node's coordinates, the Dirichlet and the contact part, u_D·n and ψ
+        (on a slave: the master's node and its u_D as well).
     """
     names, part = parts
-    # on the slave of a contact pair the master's displacement is part of the constraint and
-    # an unknown near the node: no check there (docs/method.md, *Two bodies*)
-    one_body = ~np.isin(np.asarray(names, dtype=object)[part], list(problem.pairs))
-    nodes, part = nodes[one_body], part[one_body]
+    value, owner = _dirichlet_values(problem, space, nodes)
+    direction, gap = (np.array(a, dtype=np.float64) for a in constraint)
+    master = np.full(nodes.size, -1)  # the master's Dirichlet node at π(z), on a slave
+    entry_part = np.asarray(names, dtype=object)[part]
+    keep = ~np.isin(entry_part, list(problem.pairs))
+    held = held_nodes(problem, space).values if couplings else None
+    for slave, c in (couplings or {}).items():  # a loop over pairs
+        on = np.flatnonzero(entry_part == slave)
+        k, gap_z = _held_master_node(problem, space, c, np.searchsorted(c.slave_nodes, nodes[on]))
+        on, k, gap_z = on[k >= 0], k[k >= 0], gap_z[k >= 0]
+        master[on], gap[on], keep[on] = k, gap_z, True
+        value[on] -= held[k]
+    nodes, part, owner, master = nodes[keep], part[keep], owner[keep], master[keep]
+    value, direction, gap = value[keep], direction[keep], gap[keep]
     parts = (names, part)
-    constraint = tuple(a[one_body] for a in constraint)
     if nodes.size == 0:
         return
-    direction, gap = constraint
     x = space.node_points[nodes]
-    value, owner = _dirichlet_values(problem, space, nodes)
     normal_value = np.einsum("kc,kc->k", value, direction)
     excess = normal_value - gap
     pts = space.mesh.points
@@ -169,15 +193,46 @@ def check_dirichlet_admissible(
         return
     i = bad[np.argmax(excess[bad])]
     more = f" (and {bad.size - 1} more such node(s))" if bad.size > 1 else ""
+    relative = ""
+    if master[i] >= 0:
+        slave = parts[0][parts[1][i]]
+        y, u_m = space.node_points[master[i]], held[master[i]]
+        relative = (
+            f" relative to the node of master part {problem.pairs[slave]!r} facing it at "
+            f"({y[0]:.12g}, {y[1]:.12g}), held at u_D = ({u_m[0]:.6g}, {u_m[1]:.6g}),"
+        )
     raise ProblemError(
         f"the node at ({x[i, 0]:.12g}, {x[i, 1]:.12g}) lies on Dirichlet part {owner[i]!r} and "
-        f"contact part {parts[0][parts[1][i]]!r}{more}: its prescribed displacement u_D = "
-        f"({value[i, 0]:.6g}, {value[i, 1]:.6g}) moves it by u_D·n = {normal_value[i]:.6g} "
+        f"contact part {parts[0][parts[1][i]]!r}{more}: its prescribed displacement{relative} "
+        f"u_D = ({value[i, 0]:.6g}, {value[i, 1]:.6g}) moves it by u_D·n = {normal_value[i]:.6g} "
         f"along the constraint direction n = ({direction[i, 0]:.6g}, {direction[i, 1]:.6g}), "
         f"beyond the gap ψ = {gap[i]:.6g} by {excess[i]:.6g}: the Dirichlet data violate the "
         "contact constraint, so no admissible displacement exists. Make u_D·n ≤ ψ at the "
         "parts' common nodes (e.g. move the obstacle or change u_D)"
     )
+
+
+def _held_master_node(
+    problem: ContactProblem, space: LagrangeSpace, coupling: MortarCoupling, row: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """For the slave nodes ``coupling.slave_nodes[row]``: the master's Dirichlet node (held
+    in both components) at their point π(z) on the master, within the round-off of a
+    coordinate, or −1; and the pointwise gap ``(π(z) − z)·n_z``."""
+    x = space.node_points[coupling.slave_nodes[row]]
+    pi, n = coupling.master_point[row], coupling.normal[row]
+    master_nodes = space.part_nodes([coupling.master])
+    held = problem.dirichlet_nodes(space)
+    candidates = master_nodes[np.isin(master_nodes, held)]
+    k = np.full(row.size, -1)
+    if candidates.size and row.size:
+        y = space.node_points[candidates]
+        distance = np.hypot(*(pi[:, None, :] - y[None, :, :]).transpose(2, 0, 1))
+        nearest = np.argmin(np.where(np.isnan(distance), np.inf, distance), axis=1)
+        pts = space.mesh.points
+        tol = DIRICHLET_POINT_TOL * float(np.abs(pts).max() + np.ptp(pts, axis=0).max())
+        close = distance[np.arange(row.size), nearest] <= tol
+        k[close] = candidates[nearest[close]]
+    return k, np.einsum("kc,kc->k", pi - x, n)
 
 
 #: the deepest initial penetration accepted beyond what the Dirichlet data move the body, as

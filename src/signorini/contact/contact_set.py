@@ -307,6 +307,7 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
         cand_node[held],
         (direction.reshape(-1, 2)[first[held]], edge_gap.ravel()[first[held]]),
         (parts, ukey[held] % n_parts),
+        couplings,
     )
     kept = np.flatnonzero(free)
     check_initial_overlap(
