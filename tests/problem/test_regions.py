@@ -237,3 +237,25 @@ def test_a_plane_strain_region_beside_a_plane_stress_one_is_refused_naming_both(
         base=Material.from_young(10.0, 0.3, plane="stress"),
     )
     assert {m.plane for m in plate.material.values()} == {"stress"}
+
+
+def test_a_near_incompressible_region_beside_a_compressible_one_is_warned_about():
+    # ν = 0.499999999 in the coating: its forces lose digits, and the solve's KKT residuals
+    # (9e-7 on Example 6.2's square split so) stayed below the solver's warning
+    with pytest.warns(
+        IllConditionedWarning,
+        match=r"region 'coating' \(E = 10, ν = 0\.499999999, plane strain\) is close to "
+        r"incompressible beside the other regions: its \(λ\* \+ μ\) / μ = 1 / \(1 − 2ν\) is "
+        r"5e\+08",
+    ):
+        _layers(Material.from_young(10.0, 0.499999999))
+    with pytest.warns(
+        IllConditionedWarning,
+        match=r"3\.33333e\+10 of region 'coating' \(E = 200, ν = 0\.499999999.*8\.67e\+09 times "
+        r"the smallest μ = 3\.84615, of region 'base'.*\(region 'coating' is close to "
+        r"incompressible itself: its \(λ\* \+ μ\) / μ = 1 / \(1 − 2ν\) is 5e\+08\)",
+    ):
+        _layers(Material.from_young(200.0, 0.499999999))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # ν = 0.49: 50, far below
+        _layers(Material.from_young(200.0, 0.49))

@@ -36,6 +36,9 @@ _EPS = float(np.finfo(np.float64).eps)
 #: Measured on a layered block: contrast 1e8 gives KKT 5e-7, 1e10 gives 5e-5, 1e12 gives
 #: 4e-3 (the soft layer held, 1e12 is refused as a singular system)
 CONTRAST_WARN = 1e-2 * KKT_WARN / _EPS
+#: a region's own ``(λ* + μ) / μ`` (``1 / (1 − 2ν)`` in plane strain) above which a message
+#: says it is close to incompressible (ν > 0.4995)
+NEARLY_INCOMPRESSIBLE = 1e3
 #: ``κ_D`` beyond which the softest region's stiffness is below the round-off of the
 #: stiffest's (``eps κ_D > 1``): where they meet, the sum of their entries holds nothing of
 #: the soft one, so the matrix cannot represent both
@@ -127,6 +130,12 @@ def _check_spread(names: list[str], materials: list[Material]) -> None:
             f"is {spread:.3g} times the smallest μ = {bottom[j]:.6g}, of "
             f"{_describe(names[j], materials[j])}"
         )
+        own = float(top[i] / bottom[i])
+        if own > NEARLY_INCOMPRESSIBLE:
+            what += (
+                f" (region {names[i]!r} is close to incompressible itself: its (λ* + μ) / μ = "
+                f"1 / (1 − 2ν) is {own:.3g})"
+            )
     if spread > CONTRAST_MAX:
         raise ProblemError(
             f"material: {what}, beyond 1/eps = {CONTRAST_MAX:.3g}: double precision cannot "
