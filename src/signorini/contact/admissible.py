@@ -11,8 +11,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..algebra.ranks import Ranks
 from ..fem.space import LagrangeSpace
-from ..problem.fields import ProblemError
+from ..problem.fields import DATA_MAX, ProblemError
 from ..problem.problem import ContactProblem
 from ..problem.rollers import held_nodes
 from .constraint_data import _body_normals
@@ -27,6 +28,7 @@ __all__ = [
     "SIDE_TOL",
     "check_dirichlet_admissible",
     "check_initial_overlap",
+    "check_load_size",
     "check_obstacle_side",
 ]
 
@@ -321,4 +323,46 @@ def check_initial_overlap(
         "deep (it would pull the body through the obstacle with strains of order one). Place "
         "the obstacle at the body's surface (ψ ≈ 0) and move it in by steps of a load path, or "
         "shift the obstacle out"
+    )
+
+
+def check_load_size(K, F: np.ndarray, loads: Mapping[str, float], ranks: Ranks) -> None:
+    """Refuse loads whose displacement would overflow: ``F = K u`` on the free rows gives
+    ``max |u| ≥ max |F| / ‖K‖∞``, and beyond :data:`~signorini.problem.fields.DATA_MAX` the
+    squares of such displacements (norms, energies, η7²) overflow double precision. Loads
+    scale with the stiffness (E = 1e300 with loads to match is solved), so they are bounded
+    through the displacement, not by their own size.
+
+    Parameters
+    ----------
+    K : (n, n) or a rank's rows, sparse
+        The assembled stiffness matrix.
+    F : (n,) float array
+        The assembled load vector.
+    loads : mapping name -> float
+        The largest entry of each load's own vector, e.g. ``{"the traction of Neumann part
+        'top'": 0.5}``, to name the largest.
+    ranks : Ranks
+
+    Raises
+    ------
+    ProblemError
+        Naming the largest load, the displacement bound and the limit.
+    """
+    row_sum = float(np.asarray(abs(K).sum(axis=1)).max(initial=0.0))
+    if ranks.size > 1:
+        row_sum = ranks.max(row_sum)
+    force = float(np.abs(F).max(initial=0.0))
+    if not loads or (np.isfinite(force) and force <= DATA_MAX * row_sum):
+        return
+    name = max(loads, key=loads.get)
+    with np.errstate(over="ignore", divide="ignore"):
+        moved = force / row_sum if row_sum > 0 else np.inf
+    raise ProblemError(
+        f"{name} is too large for the body's stiffness: the load vector reaches "
+        f"{force:.3g} (largest of {name}: {loads[name]:.3g}) against the stiffness matrix's "
+        f"largest row sum {row_sum:.3g}, so the displacement reaches at least {moved:.3g} "
+        f"(F = K u), beyond ±{DATA_MAX:.3g}, where its squares overflow double precision. "
+        "State the loads in the units of E (a load 1e300 times the modulus moves nothing "
+        "like a small-deformation body), or check their size"
     )

@@ -92,7 +92,7 @@ def directions_and_gaps(
             direction[sel] = n[inverse].reshape(-1, edge_nodes.shape[1], 2)
         else:
             what = f"the gap function of contact part {name!r}"
-            psi = evaluate_field(cond.gap_field(), x, what, shape=())
+            psi = evaluate_field(cond.gap_field(), x, what, shape=(), bounded=True)
             direction[sel] = _body_normals(problem, space, name, edge_nodes[sel], chord[sel])
         gap[sel] = psi[inverse].reshape(-1, edge_nodes.shape[1])
     return direction, gap

@@ -45,10 +45,11 @@ VectorField = Callable[[np.ndarray], np.ndarray]
 CALL_X, CALL_NAMED, CALL_POSITIONAL = "x", "named", "positional"
 
 
-#: The largest magnitude of a datum (a load, a displacement, a gap; a number given or a
-#: function's value): its square summed over 1e8 entries (a norm of a load vector, an
-#: energy, an estimator's η²) stays below the largest double, 1.8e308. Beyond it the
-#: computation overflows to inf, e.g. the force-control check's norm of a load of 1e155
+#: The largest magnitude of a length (a Dirichlet value, a gap; a number given or a
+#: function's value) and of a displacement the loads cause: its square summed over 1e8
+#: entries (a norm, an energy, the estimator's η7²) stays below the largest double, 1.8e308.
+#: Loads themselves scale with the stiffness (E may be 1e300) and are bounded through the
+#: displacement they cause (:func:`signorini.contact.admissible.check_load_size`)
 DATA_MAX = float(np.sqrt(np.finfo(np.float64).max / 1e8))
 
 
@@ -74,7 +75,9 @@ def constant_field(value: float | tuple[float, ...], shape: tuple[int, ...] = (2
     return lambda x: np.broadcast_to(v, np.shape(x)[:-1] + shape).copy()
 
 
-def check_numbers(value, size: int, argument: str, expected: str, *, shown=None) -> None:
+def check_numbers(
+    value, size: int, argument: str, expected: str, *, shown=None, bounded: bool = False
+) -> None:
     """Check data given as numbers: ``size`` finite real numbers.
 
     Parameters
@@ -89,11 +92,13 @@ def check_numbers(value, size: int, argument: str, expected: str, *, shown=None)
         What the argument may be, e.g. ``"two finite numbers (u_x, u_y) or a function u_D(x)"``.
     shown : object, optional
         The argument as the user gave it, for the message, where ``value`` is a part of it.
+    bounded : bool
+        A length (a displacement, a gap): its magnitude must not exceed :data:`DATA_MAX`.
 
     Raises
     ------
     ProblemError
-        Naming the argument, what was expected and what was given; also for numbers beyond
+        Naming the argument, what was expected and what was given; also for a length beyond
         :data:`DATA_MAX` in magnitude.
     """
     bad = isinstance(value, str | bytes)
@@ -107,7 +112,7 @@ def check_numbers(value, size: int, argument: str, expected: str, *, shown=None)
     shown = value if shown is None else shown
     if bad:
         raise ProblemError(f"{argument} must be {expected}; got {shown!r}")
-    if _too_large(values):
+    if bounded and _too_large(values):
         raise ProblemError(
             f"{argument} = {shown!r} is beyond ±{DATA_MAX:.3g}, where the sums of squares "
             "the computation forms (norms, energies) overflow double precision; state the "
@@ -189,6 +194,7 @@ def evaluate_field(
     shape: tuple[int, ...] = (2,),
     *,
     normal: np.ndarray | None = None,
+    bounded: bool = False,
 ) -> np.ndarray:
     """Evaluate a user function at points ``x (..., 2)``, checking its output.
 
@@ -210,6 +216,9 @@ def evaluate_field(
         field, ``(2, 2)`` for a gradient.
     normal : (..., 2) float array, optional
         Outward unit normals, broadcastable to ``x``.
+    bounded : bool
+        A length (a Dirichlet value, a gap): its values must not exceed :data:`DATA_MAX` in
+        magnitude.
 
     Returns
     -------
@@ -219,7 +228,7 @@ def evaluate_field(
     ------
     ProblemError
         If the function raises, returns something other than ``(n,) + shape`` numbers (or one
-        value of shape ``shape``), NaN or infinite values, or values beyond
+        value of shape ``shape``), NaN or infinite values, or (``bounded``) values beyond
         :data:`DATA_MAX` in magnitude.
     """
     x = np.asarray(x, dtype=np.float64)
@@ -252,7 +261,7 @@ def evaluate_field(
         )
     if not np.isfinite(values).all():
         raise ProblemError(f"{what} returned NaN or inf")
-    if _too_large(values):
+    if bounded and _too_large(values):
         k = int(np.argmax(np.abs(values).reshape(points.shape[0], -1).max(axis=1)))
         raise ProblemError(
             f"{what} returned {np.abs(values).max():.6g} in magnitude at x = "
