@@ -242,13 +242,15 @@ def _check_no_crossing(points: np.ndarray) -> None:
     as the obstacle's boundary is) meet, or are collinear and overlap. A crossing boundary
     has no left side: the obstacle it would bound is not a region.
 
-    Every pair is tested at once (chunked): segments ``p + t d`` and ``q + s e`` meet where
-    ``t = (q − p) × e / (d × e)`` and ``s = (q − p) × d / (d × e)`` lie in their ranges.
+    The candidates are the pairs whose x-extents overlap (found by sorting) and every pair
+    with an end ray; they are tested at once (chunked): segments ``p + t d`` and ``q + s e``
+    meet where ``t = (q − p) × e / (d × e)`` and ``s = (q − p) × d / (d × e)`` lie in their
+    ranges.
     """
     m = points.shape[0] - 1  # segments
     if m < 3:
         return
-    i, j = np.triu_indices(m, k=2)
+    i, j = _candidates(points)
     lo = np.zeros(m)
     hi = np.ones(m)
     lo[0], hi[-1] = -np.inf, np.inf
@@ -287,6 +289,28 @@ def _check_no_crossing(points: np.ndarray) -> None:
                 f"{points[q].tolist()} to {points[q + 1].tolist()} meet, so it bounds no "
                 "region on its left; walk the obstacle's outline once, without crossings"
             )
+
+
+def _candidates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs ``i < j − 1`` of the segments of ``points (m + 1, 2)`` that may meet: those whose
+    x-extents overlap (segment ``j``'s left end within segment ``i``'s extent or the other
+    way round, by a sort), and every pair with the first or the last segment (rays)."""
+    m = points.shape[0] - 1
+    x = np.stack([points[:-1, 0], points[1:, 0]], axis=1)
+    lo, hi = x.min(axis=1), x.max(axis=1)
+    order = np.argsort(lo, kind="stable")
+    start = np.searchsorted(lo[order], lo, "left")
+    count = np.searchsorted(lo[order], hi, "right") - start
+    first = np.repeat(np.arange(m), count)
+    offset = np.arange(first.size) - np.repeat(np.cumsum(count) - count, count)
+    second = order[np.repeat(start, count) + offset]
+    rays = np.arange(m)
+    a = np.concatenate([first, np.zeros(m, np.int64), rays])
+    b = np.concatenate([second, rays, np.full(m, m - 1)])
+    a, b = np.minimum(a, b), np.maximum(a, b)
+    keep = b - a >= 2
+    pairs = np.unique(np.stack([a[keep], b[keep]], axis=1), axis=0)
+    return pairs[:, 0], pairs[:, 1]
 
 
 def _direction(offset, distance, sign, normal):
