@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
 from linalg_problems import p2_elasticity
 
 from signorini.algebra import kkt_residuals
+from signorini.algebra.kkt import KKTResiduals, ill_conditioned_message
 
 
 def test_kkt_residuals_closed_form():
@@ -100,3 +103,34 @@ def test_scales_follow_the_forces_not_the_stiffness():
     rigid = kkt_residuals(K - sp.identity(2, format="csr"), np.zeros(2), x, [0], 2.0)
     assert rigid.force_scale == rigid.round_off_scale == 2 * k
     assert rigid.stationarity == 0.0
+
+
+def test_the_warning_of_a_tensile_contact_force_says_its_size_and_the_forces_round_off():
+    """Example 6.2's 4 × 4 mesh with ν = 0.499999999 ends with a tensile force of 0.00876 at an
+    active node: the warning said only "kkt_dual 6.5e-05". Its residuals, as measured there."""
+    kkt = KKTResiduals(
+        primal=0.0,
+        dual=6.455e-05,
+        complementarity=9.7e-09,
+        stationarity=2.9e-07,
+        dirichlet=0.0,
+        force_scale=45.31,
+        disp_scale=0.2,
+        contact_force=135.7406,
+        contact_force_scale=135.7406,
+        round_off_scale=7.5697e10,
+    )
+    message = ill_conditioned_message(kkt, 1e-6, 1e3 * np.finfo(np.float64).eps)
+    for text in (
+        "only to 6.5e-05 relative (kkt_dual 6.5e-05)",
+        "an active contact constraint carries a tensile force of 0.00876, 6.5e-05 of the total "
+        "contact force 135.741, within the round-off band of the forces, 0.0168 (2.2e-13 max "
+        "|K||x|)",
+        "the contact forces are exact to about that size",
+        "close to incompressible, in any region, a contrast of stiffness between regions",
+    ):
+        assert text in message, message
+    # no tensile force: no word of one
+    assert "tensile" not in ill_conditioned_message(
+        dataclasses.replace(kkt, dual=0.0, stationarity=2e-6), 1e-6, 2.2e-13
+    )

@@ -167,3 +167,23 @@ def test_read_mesh_mixed_orientation_is_reported(tmp_path):
     # gmsh_square lists every other triangle clockwise
     mesh = read_mesh(write(tmp_path, gmsh_square(example_6_2().mesh)))
     np.testing.assert_array_equal(mesh.reoriented, np.arange(0, 32, 2))
+
+
+@pytest.mark.parametrize(
+    ("order", "node", "axis"),
+    [(1, 3, 2), (2, 3, 2), (2, 27, 1), (1, 3, 0)],
+    ids=["z", "z-second-order", "midpoint", "x"],
+)
+def test_a_nan_coordinate_is_refused_naming_the_node(tmp_path, order, node, axis):
+    # before: a NaN in z (the flatness test compares NaN: False) or in a second-order
+    # midpoint (its offset from the chord compares the same) was read as if it were not there
+    m = gmsh_square(example_6_2().mesh, order=order)
+    points = m.points.copy()
+    points[node, axis] = np.nan
+    m.points = points
+    path = tmp_path / "nan.msh"
+    meshio.write(path, m, file_format="gmsh22", binary=False)
+    with pytest.raises(
+        MeshError, match=rf"nan\.msh: node {node + 1} of the file .* non-finite coordinate, \("
+    ):
+        read_mesh(path)

@@ -377,3 +377,25 @@ def test_two_elements_giving_an_edge_different_midpoints_are_refused(tmp_path):
     lines[0, 2] = len(m.points) - 1  # the line's own midpoint node, off the triangle's
     with pytest.raises(MeshError, match=r"has two midpoints 0.001 apart"):
         read_mesh(write(tmp_path, m))
+
+
+def test_a_first_order_file_of_a_curved_part_says_it_stays_polygonal(tmp_path, caplog):
+    # before: read without a word, its arcs polygonal on every refined mesh
+    with caplog.at_level("WARNING", logger="signorini.mesh.gmsh"):
+        read_mesh(write(tmp_path, gmsh_file(sector(8), order=1)))
+    (record,) = caplog.records
+    message = record.getMessage()
+    for text in (
+        "sector.msh is a first-order mesh",
+        "part(s) ['inner', 'outer'] look curved",
+        "stay polygonal",
+        "save the mesh second order",
+        "triangle6",
+        "Mesh.with_curve",
+    ):
+        assert text in message, message
+    caplog.clear()
+    with caplog.at_level("WARNING", logger="signorini.mesh.gmsh"):
+        read_mesh(write(tmp_path, gmsh_file(sector(8), order=2), "curved.msh"))
+        read_mesh(write(tmp_path, gmsh_file(sector(8, curved=False), order=2), "chords.msh"))
+    assert not caplog.records  # second order: the file says what the boundary is

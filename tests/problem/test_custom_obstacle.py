@@ -94,3 +94,82 @@ def test_a_custom_floor_solves_as_the_gap_function_and_the_half_plane():
     np.testing.assert_allclose(own.u[bottom, 1], -depth, rtol=1e-10)
     assert_same_solution(own, by_gap)
     assert_same_solution(own, by_shape)
+
+
+class Broken(Obstacle):
+    """A shape whose own method divides by zero."""
+
+    def _gap_and_direction(self, x):
+        return 1 / 0
+
+
+@pytest.mark.parametrize(
+    ("obstacle", "message"),
+    [
+        (
+            signorini.SignedDistance(lambda x: 1 / 0),
+            r"the obstacle of contact part 'bottom': SignedDistance\(phi=<lambda>.*\): phi\(x\) "
+            r"raised ZeroDivisionError: division by zero \(called with points x of shape \(",
+        ),
+        (
+            Broken(),
+            r"the obstacle <.*Broken.*> of contact part 'bottom' raised ZeroDivisionError in "
+            r"gap_and_direction: division by zero",
+        ),
+    ],
+    ids=["signed-distance", "own-shape"],
+)
+def test_an_obstacle_that_raises_is_named_with_its_part_and_error(obstacle, message):
+    # before: a bare ZeroDivisionError from inside the contact set
+    with pytest.raises(signorini.ProblemError, match=message) as info:
+        solve(pressed_block(Contact(obstacle=obstacle)))
+    cause = info.value.__cause__
+    while cause is not None and not isinstance(cause, ZeroDivisionError):
+        cause = cause.__cause__
+    assert isinstance(cause, ZeroDivisionError)
+
+
+class Returns(Obstacle):
+    """A shape that returns what it is given, whatever the points."""
+
+    def __init__(self, answer):
+        self.answer = answer
+
+    def __repr__(self):
+        return "Returns()"
+
+    def _gap_and_direction(self, x):
+        return self.answer(x)
+
+
+@pytest.mark.parametrize(
+    ("answer", "message"),
+    [
+        (
+            lambda x: (x[:, 1], np.tile([0.0, -1.0], (len(x) + 1, 1))),
+            r"must return psi of shape \(\d+,\) and n of shape \(\d+, 2\) for x of shape",
+        ),
+        (
+            lambda x: (x[:, 1] / 0.0, np.tile([0.0, -1.0], (len(x), 1))),
+            r"is not finite at x\[0\] = \[0\.0, 0\.0\] \(psi nan",
+        ),
+        (
+            lambda x: (x[:, 1], np.tile([0.0, -2.0], (len(x), 1))),
+            r"must return unit directions n; at x\[0\] = .* it returned \[0\.0, -2\.0\] of "
+            r"length 2",
+        ),
+    ],
+    ids=["shape", "nan", "not-unit"],
+)
+def test_a_shape_of_ones_own_that_answers_wrongly_is_refused_naming_it(answer, message):
+    # before: a wrong shape or NaN went on into the contact set (NumPy's broadcasting errors,
+    # or NaN gaps), a direction of length 2 halved the constraint silently
+    with (
+        np.errstate(divide="ignore", invalid="ignore"),
+        pytest.raises(
+            signorini.ProblemError,
+            match=r"the obstacle of contact part 'bottom': Returns\(\): gap_and_direction.*"
+            + message,
+        ),
+    ):
+        solve(pressed_block(Contact(obstacle=Returns(answer))))

@@ -9,6 +9,16 @@ import warnings
 import numpy as np
 import pytest
 
+from signorini import (
+    Contact,
+    ContactProblem,
+    Dirichlet,
+    Material,
+    Neumann,
+    Roller,
+    rectangle,
+    solve,
+)
 from signorini.problem.fields import (
     CALL_NAMED,
     CALL_POSITIONAL,
@@ -172,3 +182,72 @@ def re_repr(value) -> str:
 
 def test_problem_error_is_a_value_error():
     assert issubclass(ProblemError, ValueError)
+
+
+@pytest.mark.parametrize(
+    ("build", "message"),
+    [
+        (lambda: Dirichlet((1e200, None)), r"Dirichlet\(value=\.\.\.\) = \(1e\+200, None\) is "),
+        (lambda: Dirichlet((0.0, -1e300)), r"Dirichlet\(value=\.\.\.\) = \(0\.0, -1e\+300\) is "),
+        (lambda: Contact(gap=1e300), r"Contact\(gap=\.\.\.\) = 1e\+300 is "),
+    ],
+)
+def test_lengths_whose_squares_overflow_are_refused_naming_the_condition(build, message):
+    with pytest.raises(ProblemError, match=message + r".*beyond ±1\.34e\+150.*overflow"):
+        build()
+
+
+def _floated(young=10.0, **kwargs) -> ContactProblem:
+    """The unit square under force control: a roller on its left, its bottom on a floor."""
+    conditions = {
+        "left": Roller(),
+        "right": Neumann(),
+        "top": Neumann(kwargs.pop("top", (0.0, -1.0))),
+        "bottom": Contact(gap=0.0),
+    }
+    return ContactProblem(
+        rectangle(nx=2, ny=2), Material.from_young(young, 0.3), conditions, **kwargs
+    )
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"top": (0.0, -1e300)}, r"the traction of Neumann part 'top' is too large"),
+        ({"body_force": lambda x: (0.0, -1e300)}, r"the body force is too large"),
+        ({"top": lambda x: (0.0, -1e160)}, r"the traction of Neumann part 'top' is too large"),
+    ],
+    ids=["traction", "body-force", "traction-function"],
+)
+def test_a_load_whose_displacement_overflows_is_refused_naming_it(kwargs, message):
+    # before: NumPy's "array must not contain infs or NaNs" from the force-control check
+    with pytest.raises(
+        ProblemError,
+        match=message + r" for the body's stiffness: .* so the displacement reaches at least "
+        r".* beyond ±1\.34e\+150",
+    ):
+        solve(_floated(**kwargs))
+
+
+def test_a_load_as_extreme_as_the_modulus_is_solved_under_force_control():
+    # E = 1e300 pressed by 0.1 E: the same displacement as E = 10 pressed by 1
+    small, large = solve(_floated()), solve(_floated(1e300, top=(0.0, -1e299)))
+    np.testing.assert_allclose(large.u, small.u, rtol=1e-12, atol=1e-14)
+    assert large.total_contact_force == pytest.approx(1e299, rel=1e-12)
+
+
+def test_a_dirichlet_function_whose_squares_overflow_is_named():
+    problem = ContactProblem(
+        rectangle(nx=2, ny=2),
+        Material.from_young(10.0, 0.3),
+        {
+            "left": Neumann(),
+            "right": Neumann(),
+            "top": Dirichlet(lambda x: np.column_stack([0 * x[:, 0], -1e300 + 0 * x[:, 0]])),
+            "bottom": Contact(gap=0.0),
+        },
+    )
+    with pytest.raises(
+        ProblemError, match=r"the Dirichlet value of part 'top' returned 1e\+300 .*beyond"
+    ):
+        solve(problem)

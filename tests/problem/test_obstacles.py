@@ -139,6 +139,27 @@ def test_polyline_corner_arc_centre_sees_the_tangent_points():
             "Polyline: the polyline turns back on itself at points[1] = [2.0, 0.0]",
         ),
         (
+            lambda: Polyline([[0, 0], [2, 0], [2, 1], [1, 1], [1, -1], [0, -2]]),
+            "Polyline: the polyline crosses itself: the segments points[0]–points[1] (extended "
+            "to a ray) from [0.0, 0.0] to [2.0, 0.0] and points[3]–points[4] from [1.0, 1.0] "
+            "to [1.0, -1.0] meet",
+        ),
+        (  # only the end rays cross: the last one, walked down x = -1, the first at (-1, 0)
+            lambda: Polyline([[0, 0], [1, 0], [1, 1], [-1, 1], [-1, 0.5]]),
+            "Polyline: the polyline crosses itself: the segments points[0]–points[1] (extended "
+            "to a ray) from [0.0, 0.0] to [1.0, 0.0] and points[3]–points[4] (extended to a "
+            "ray) from [-1.0, 1.0] to [-1.0, 0.5] meet",
+        ),
+        (  # touching: the walk returns through a corner
+            lambda: Polyline([[0, 0], [2, 0], [2, 1], [1, 1], [1, 0], [0, -2]]),
+            "Polyline: the polyline crosses itself: the segments points[0]–points[1]",
+        ),
+        (  # a collinear overlap of two segments that are not neighbours
+            lambda: Polyline([[0, 0], [2, 0], [2, 1], [3, 1], [3, 0], [1, 0], [1, -1]]),
+            "Polyline: the polyline crosses itself: the segments points[0]–points[1] (extended "
+            "to a ray) from [0.0, 0.0] to [2.0, 0.0] and points[4]–points[5]",
+        ),
+        (
             lambda: Polyline(PUNCH, radius=1.5),
             "Polyline: radius 1.5 is too large: the rounded corners need 3 of the segment "
             "from points[1] to points[2], which is 2 long",

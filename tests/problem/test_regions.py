@@ -1,10 +1,13 @@
 """Materials by cell region: regions on meshes and through refinement, a material per region
 in ContactProblem, and a layered block solved and estimated exactly across its interface."""
 
+import warnings
+
 import numpy as np
 import pytest
 
 from signorini import Contact, ContactProblem, Dirichlet, Material, Neumann, adaptive, rectangle
+from signorini.algebra import FactorizationError, IllConditionedWarning
 from signorini.contact.solution import solve
 from signorini.estimator.residual import estimate
 from signorini.fem.material import CellMaterials
@@ -158,3 +161,101 @@ def test_one_material_for_both_layers_leaves_an_interface_jump():
     wrong = dataclasses.replace(result, problem=dataclasses.replace(problem, material=BASE))
     eta = np.sqrt(estimate(wrong).eta2_cell.sum(axis=1))
     assert eta[1] > 0.5 * P
+
+
+def test_a_region_selector_that_raises_is_named_with_its_error():
+    # before: the bare ZeroDivisionError of the selector
+    def coating(x):
+        return x[:, 1] > 1 / 0
+
+    with pytest.raises(
+        MeshError,
+        match=r"the selector of region 'coating' raised ZeroDivisionError: division by zero "
+        r"\(it is called with the cell centroids x of shape \(32, 2\)\)",
+    ) as info:
+        rectangle(regions={"base": lambda x: x[:, 1] < 0.5, "coating": coating})
+    assert isinstance(info.value.__cause__, ZeroDivisionError)
+
+
+def _layers(coating: Material, base: Material = BASE, held: str = "top") -> ContactProblem:
+    """The layered unit square on a rigid plane, pressed down by its top or (``held =
+    "left"``) held at its left side."""
+    conditions = {
+        "left": Neumann(),
+        "right": Neumann(),
+        "top": Neumann((0.0, -P)),
+        "bottom": Contact(gap=0.0),
+    }
+    conditions[held] = Dirichlet((0.0, -0.01) if held == "top" else (0.0, 0.0))
+    mesh = rectangle(0, 1, 0, 1, nx=4, ny=4, regions=LAYERS)
+    return ContactProblem(mesh, {"base": base, "coating": coating}, conditions)
+
+
+def test_a_contrast_of_1e12_is_warned_about_naming_the_regions_not_a_floating_part():
+    # before: no word at the problem, and a soft held coating gave "Usually a part of the body
+    # is not held" from the solver, though every part is held
+    with pytest.warns(
+        IllConditionedWarning,
+        match=r"region 'base' \(E = 10, ν = 0\.3, plane strain\) is 2\.5e\+12 times the "
+        r"smallest μ = 3\.84615e-12, of region 'coating' \(E = 1e-11.*fewer than 3 digits.*"
+        r"although every part is held",
+    ):
+        _layers(Material.from_young(1e-11, 0.3))
+    with pytest.warns(IllConditionedWarning, match=r"2\.5e\+14 times"):
+        problem = _layers(Material.from_young(1e-13, 0.3))
+    # pivots of 1e-13 against a diagonal of 46: refused whatever the backend
+    with pytest.raises(FactorizationError, match="contrast of stiffness between regions"):
+        solve(problem)
+
+
+def test_a_contrast_beyond_double_precision_is_refused_naming_the_regions():
+    with pytest.raises(
+        ProblemError,
+        match=r"material: the largest modulus .* of region 'coating' \(E = 1e\+17.*is 2\.5e\+16 "
+        r"times the smallest μ = 3\.84615, of region 'base'.*beyond 1/eps",
+    ):
+        _layers(Material.from_young(1e17, 0.3), base=Material.from_young(10.0, 0.3))
+
+
+def test_a_contrast_within_double_precision_is_solved_without_a_warning():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = solve(_layers(Material.from_young(1e7, 0.3), base=Material.from_young(10.0, 0.3)))
+    assert result.report.kkt.max < 1e-6
+
+
+def test_a_plane_strain_region_beside_a_plane_stress_one_is_refused_naming_both():
+    # before: accepted, each region with its own 2D law
+    with pytest.raises(
+        ProblemError,
+        match=r"region\(s\) \['base'\] are in plane strain and region\(s\) \['coating'\] in "
+        r"plane stress.*same plane=",
+    ):
+        _layers(Material.from_young(200.0, 0.2, plane="stress"))
+    plate = _layers(
+        Material.from_young(200.0, 0.2, plane="stress"),
+        base=Material.from_young(10.0, 0.3, plane="stress"),
+    )
+    assert {m.plane for m in plate.material.values()} == {"stress"}
+
+
+def test_a_near_incompressible_region_beside_a_compressible_one_is_warned_about():
+    # ν = 0.499999999 in the coating: its forces lose digits, and the solve's KKT residuals
+    # (9e-7 on Example 6.2's square split so) stayed below the solver's warning
+    with pytest.warns(
+        IllConditionedWarning,
+        match=r"region 'coating' \(E = 10, ν = 0\.499999999, plane strain\) is close to "
+        r"incompressible beside the other regions: its \(λ\* \+ μ\) / μ = 1 / \(1 − 2ν\) is "
+        r"5e\+08",
+    ):
+        _layers(Material.from_young(10.0, 0.499999999))
+    with pytest.warns(
+        IllConditionedWarning,
+        match=r"3\.33333e\+10 of region 'coating' \(E = 200, ν = 0\.499999999.*8\.67e\+09 times "
+        r"the smallest μ = 3\.84615, of region 'base'.*\(region 'coating' is close to "
+        r"incompressible itself: its \(λ\* \+ μ\) / μ = 1 / \(1 − 2ν\) is 5e\+08\)",
+    ):
+        _layers(Material.from_young(200.0, 0.499999999))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # ν = 0.49: 50, far below
+        _layers(Material.from_young(200.0, 0.49))

@@ -21,7 +21,14 @@ from .qp import BoundQP, check_qp, check_vector
 from .ranks import SERIAL, Ranks
 from .sparse import abs_matvec
 
-__all__ = ["KKTResiduals", "contact_scale", "force_scale", "kkt_residuals", "round_off_scale"]
+__all__ = [
+    "KKTResiduals",
+    "contact_scale",
+    "force_scale",
+    "ill_conditioned_message",
+    "kkt_residuals",
+    "round_off_scale",
+]
 
 #: Forces are round-off when they are at most this times ``|K| |x| + |F|``, the bound of the
 #: round-off of ``F - K x`` (about eps times the number of entries in a row, 18 to 40 for P2).
@@ -247,4 +254,30 @@ def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
         contact_force=contact_force,
         contact_force_scale=float(contact),
         round_off_scale=round_off,
+    )
+
+
+def ill_conditioned_message(kkt: KKTResiduals, bound: float, band: float) -> str:
+    """What an :class:`~.solvers.IllConditionedWarning` says of a solution whose KKT
+    residuals ``kkt`` exceed ``bound``: each residual above it and, for a tensile contact
+    force (``dual``), its size against the total contact force and against the active set's
+    round-off band on the forces, ``band · max (|K| |x|)`` (the band of
+    :func:`~.pdas.solve_pdas`, relative to ``round_off_scale``; docs/method.md, *Solver*)."""
+    above = ", ".join(f"{k} {v:.1e}" for k, v in kkt.columns().items() if v > bound)
+    text = f"the solution meets its KKT conditions only to {kkt.max:.1e} relative ({above})"
+    if kkt.dual > bound:
+        tensile = kkt.dual * kkt.contact_force_scale
+        width = band * kkt.round_off_scale
+        where = "within" if tensile <= width else "beyond"
+        text += (
+            f"; an active contact constraint carries a tensile force of {tensile:.3g}, "
+            f"{kkt.dual:.1e} of the total contact force {kkt.contact_force:.6g}, {where} the "
+            f"round-off band of the forces, {width:.3g} ({band:.1e} max |K||x|), inside which "
+            "a force's sign does not decide whether its node is in contact: the contact "
+            "forces are exact to about that size, no better"
+        )
+    return (
+        text + ": the stiffness matrix is too ill-conditioned for double precision (a material "
+        "close to incompressible, in any region, a contrast of stiffness between regions, "
+        "sliver cells or a slender body)"
     )

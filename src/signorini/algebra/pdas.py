@@ -40,7 +40,7 @@ import scipy.sparse as sp
 from .active_system import ActiveSetSystem
 from .backends import make_solver
 from .inexact import InexactRule
-from .kkt import qp_residuals
+from .kkt import ill_conditioned_message, qp_residuals
 from .primal import primal_active_set
 from .qp import BoundQP, check_qp, check_vector
 from .ranks import SERIAL, Ranks
@@ -217,10 +217,7 @@ def solve_pdas(
     kkt = qp_residuals(qp, x)
     if not kkt.max <= KKT_WARN:
         warnings.warn(
-            f"the solution meets its KKT conditions only to {kkt.max:.1e} relative "
-            f"({', '.join(f'{k} {v:.1e}' for k, v in kkt.columns().items() if v > KKT_WARN)}): "
-            "the stiffness matrix is too ill-conditioned for double precision (a material "
-            "close to incompressible, sliver cells or a slender body)",
+            ill_conditioned_message(kkt, KKT_WARN, _FORCE_ROUNDOFF),
             IllConditionedWarning,
             stacklevel=2,
         )

@@ -76,7 +76,10 @@ SINGULAR_CAUSES = (
     "Usually a part of the body is not held: it has no Dirichlet condition and can move "
     "rigidly. A body so slender that its stiffness matrix is singular in double precision "
     "does the same (measured with P2 on cantilevers of length/thickness L/h: within 1 % of "
-    "beam theory up to L/h = 1000, 1 % off at 1500, refused from 2000)."
+    "beam theory up to L/h = 1000, 1 % off at 1500, refused from 2000). So does a contrast "
+    "of stiffness between regions of about 1e12 or more, or a region close to incompressible "
+    "beside others, with every part held: ContactProblem warns about those, naming the "
+    "regions and the ratio of their moduli."
 )
 
 

@@ -18,15 +18,11 @@ from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.normals import node_normals
 from ..problem.problem import ContactProblem
-from ..problem.rollers import held_nodes
 
 if TYPE_CHECKING:
     from .mortar import MortarCoupling
 
 __all__ = [
-    "DEEP_OVERLAP",
-    "check_dirichlet_admissible",
-    "check_initial_overlap",
     "directions_and_gaps",
     "edge_weights",
     "friction_data",
@@ -88,10 +84,15 @@ def directions_and_gaps(
                 psi, n = cond.obstacle.gap_and_direction(x)
             except ValueError as err:
                 raise ProblemError(f"the obstacle of contact part {name!r}: {err}") from err
+            except Exception as err:  # a shape of one's own that raises
+                raise ProblemError(
+                    f"the obstacle {cond.obstacle!r} of contact part {name!r} raised "
+                    f"{type(err).__name__} in gap_and_direction: {err}"
+                ) from err
             direction[sel] = n[inverse].reshape(-1, edge_nodes.shape[1], 2)
         else:
             what = f"the gap function of contact part {name!r}"
-            psi = evaluate_field(cond.gap_field(), x, what, shape=())
+            psi = evaluate_field(cond.gap_field(), x, what, shape=(), bounded=True)
             direction[sel] = _body_normals(problem, space, name, edge_nodes[sel], chord[sel])
         gap[sel] = psi[inverse].reshape(-1, edge_nodes.shape[1])
     return direction, gap
@@ -188,163 +189,3 @@ def _integrator(space: LagrangeSpace, on_part: np.ndarray, edges: tuple, what: s
         return np.bincount(loc[inside], weights=share.ravel()[inside], minlength=k)
 
     return integrate
-
-
-#: a Dirichlet value may exceed the gap at a node it shares with a contact part by round-off:
-#: this fraction of the larger of max|u_D| and max|ψ| there, plus
-#: :data:`DIRICHLET_POINT_TOL` times the extent of the mesh (round-off of a distance
-#: computed from coordinates)
-DIRICHLET_GAP_RTOL = 1e-9
-DIRICHLET_POINT_TOL = 1e-12
-
-
-def check_dirichlet_admissible(
-    problem: ContactProblem,
-    space: LagrangeSpace,
-    nodes: np.ndarray,
-    constraint: tuple,
-    parts: tuple,
-) -> None:
-    """Refuse Dirichlet data that violate the contact constraint at a node of a contact part.
-
-    At a node on the closure of both Γ_D and Γ_C the displacement is prescribed, so the
-    constraint ``u(z)·n_z ≤ ψ(z)`` of the contact part holds only if ``u_D(z)·n_z ≤ ψ(z)``:
-    otherwise the admissible set K of the continuous problem is empty (no displacement with
-    these boundary values keeps the body out of the obstacle) and the discrete solutions
-    converge to nothing; the estimator's η7 sees the violation at that node on every level
-    (docs/method.md, *The continuous problem*).
-
-    Parameters
-    ----------
-    problem : ContactProblem
-    space : P2Space
-    nodes : (j,) int array
-        Dirichlet nodes on contact edges, one entry per (node, contact part).
-    constraint : tuple of (j, 2) and (j,) float arrays
-        The constraint direction n_z and the gap ψ(z) of each entry.
-    parts : tuple of (tuple of str, (j,) int array)
-        The contact parts' names and the part of each entry.
-
-    Raises
-    ------
-    ProblemError
-        Naming the node's coordinates, the Dirichlet and the contact part, u_D·n and ψ.
-    """
-    names, part = parts
-    # on the slave of a contact pair the master's displacement is part of the constraint and
-    # an unknown near the node: no check there (docs/method.md, *Two bodies*)
-    one_body = ~np.isin(np.asarray(names, dtype=object)[part], list(problem.pairs))
-    nodes, part = nodes[one_body], part[one_body]
-    parts = (names, part)
-    constraint = tuple(a[one_body] for a in constraint)
-    if nodes.size == 0:
-        return
-    direction, gap = constraint
-    x = space.node_points[nodes]
-    value, owner = _dirichlet_values(problem, space, nodes)
-    normal_value = np.einsum("kc,kc->k", value, direction)
-    excess = normal_value - gap
-    pts = space.mesh.points
-    extent = float(np.abs(pts).max() + np.ptp(pts, axis=0).max())
-    scale = max(float(np.abs(value).max()), float(np.abs(gap).max()))
-    bad = np.flatnonzero(excess > DIRICHLET_GAP_RTOL * scale + DIRICHLET_POINT_TOL * extent)
-    if bad.size == 0:
-        return
-    i = bad[np.argmax(excess[bad])]
-    more = f" (and {bad.size - 1} more such node(s))" if bad.size > 1 else ""
-    raise ProblemError(
-        f"the node at ({x[i, 0]:.12g}, {x[i, 1]:.12g}) lies on Dirichlet part {owner[i]!r} and "
-        f"contact part {parts[0][parts[1][i]]!r}{more}: its prescribed displacement u_D = "
-        f"({value[i, 0]:.6g}, {value[i, 1]:.6g}) moves it by u_D·n = {normal_value[i]:.6g} "
-        f"along the constraint direction n = ({direction[i, 0]:.6g}, {direction[i, 1]:.6g}), "
-        f"beyond the gap ψ = {gap[i]:.6g} by {excess[i]:.6g}: the Dirichlet data violate the "
-        "contact constraint, so no admissible displacement exists. Make u_D·n ≤ ψ at the "
-        "parts' common nodes (e.g. move the obstacle or change u_D)"
-    )
-
-
-#: the deepest initial penetration accepted beyond what the Dirichlet data move the body, as
-#: a fraction of the body's size (the diagonal of its bounding box); docs/method.md,
-#: *Obstacles as shapes*, "Initial overlap"
-DEEP_OVERLAP = 0.25
-
-
-def _dirichlet_values(problem: ContactProblem, space: LagrangeSpace, nodes: np.ndarray):
-    """``u_D`` at the Dirichlet nodes ``nodes (j,)`` (held in both components, from one part
-    or two, a roller's among them: :func:`~signorini.problem.rollers.held_nodes`) and the
-    Dirichlet or Roller part of each (the later one at a node on two)."""
-    value = held_nodes(problem, space).values[nodes]
-    owner = np.full(nodes.size, "", dtype=object)
-    for name in problem.dirichlet_parts:  # a loop over parts
-        owner[np.isin(nodes, space.part_nodes([name]))] = name
-    return value, owner
-
-
-def check_initial_overlap(
-    problem: ContactProblem,
-    space: LagrangeSpace,
-    nodes: np.ndarray,
-    constraint: tuple,
-    parts: tuple,
-) -> None:
-    """Refuse an obstacle shape that starts deeper inside the body than its linearisation
-    covers.
-
-    Only shapes (``Contact(obstacle=...)``) are checked: their constraint is linearised at the
-    point of the obstacle closest to the node, which for a node deep inside may lie on the far
-    side of the obstacle (the body is pulled through it). A gap function ``ψ`` states the
-    linear model's data directly and is taken as given at any size (a manufactured solution
-    may have a large one).
-    A node ``z`` with ``ψ(z) < 0`` starts inside the obstacle: ``u(z)·(−n_z) ≥ |ψ(z)|``. At a
-    Dirichlet node ``y`` the displacement is ``u_D(y)``, so ``u`` changes by at least
-    ``need = |ψ(z)| − max_y u_D(y)·(−n_z)`` between the two, within the body's size ``d`` (the
-    diagonal of its bounding box): the displacement gradient is at least ``need / d``
-    somewhere. Small-deformation elasticity and the linearised constraint are first-order
-    models in that gradient; beyond ``need > DEEP_OVERLAP · d`` (a gradient of 1/4, where the
-    neglected quadratic terms are an eighth of the linear ones) the solution is not a
-    small-deformation one: refused. An overlap that the Dirichlet data themselves move the
-    body out of (a translation) needs no strain and stays accepted; so does the paper's
-    Example 6.2 (``ψ = −0.2`` on the unit square, u_D = 0: 0.14 d). docs/method.md,
-    *Obstacles as shapes*.
-
-    Parameters
-    ----------
-    problem : ContactProblem
-    space : P2Space
-    nodes : (k,) int array
-        The constrained nodes (not Dirichlet nodes), one entry per (node, contact part).
-    constraint : tuple of (k, 2) and (k,) float arrays
-        The direction n_z and the gap ψ(z) of each entry.
-    parts : tuple of (tuple of str, (k,) int array)
-        The contact parts' names and the part of each entry.
-
-    Raises
-    ------
-    ProblemError
-        Naming the part, the node, its depth, the Dirichlet data's share and the body's size.
-    """
-    direction, gap = constraint
-    pts = space.mesh.points
-    size = float(np.hypot(*np.ptp(pts, axis=0)))
-    shape = np.array([problem.conditions[p].obstacle is not None for p in parts[0]])
-    deep = np.flatnonzero((-gap > DEEP_OVERLAP * size) & shape[parts[1]])
-    if deep.size == 0:
-        return
-    value, _ = _dirichlet_values(problem, space, problem.dirichlet_nodes(space))
-    moved = (value @ -direction[deep].T).max(axis=0)  # (deep,) max_y u_D(y)·(−n_z)
-    need = -gap[deep] - moved
-    worst = int(np.argmax(need))
-    if need[worst] <= DEEP_OVERLAP * size:
-        return
-    i = deep[worst]
-    x, name = space.node_points[nodes[i]], parts[0][parts[1][i]]
-    raise ProblemError(
-        f"the obstacle of contact part {name!r} starts {-gap[i]:.6g} deep inside the body at "
-        f"({x[0]:.12g}, {x[1]:.12g}) (ψ = {gap[i]:.6g}; the Dirichlet data move the body out "
-        f"by at most {moved[worst]:.6g} along the constraint direction), more than "
-        f"{DEEP_OVERLAP} times the body's size {size:.6g} (its bounding box's diagonal): the "
-        "linearised, small-deformation contact model cannot represent an initial overlap that "
-        "deep (it would pull the body through the obstacle with strains of order one). Place "
-        "the obstacle at the body's surface (ψ ≈ 0) and move it in by steps of a load path, or "
-        "shift the obstacle out"
-    )

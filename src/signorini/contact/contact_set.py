@@ -31,13 +31,8 @@ from ..fem.space import LagrangeSpace
 from ..mesh.geometry import segment_normals
 from ..problem.fields import ProblemError
 from ..problem.problem import ContactProblem
-from .constraint_data import (
-    check_dirichlet_admissible,
-    check_initial_overlap,
-    directions_and_gaps,
-    edge_weights,
-    friction_data,
-)
+from .admissible import check_dirichlet_admissible, check_initial_overlap, check_obstacle_side
+from .constraint_data import directions_and_gaps, edge_weights, friction_data
 from .mortar import mortar_coupling
 from .rows import MIN_CORNER_ANGLE, SAME_DIRECTION, constraint_rows
 from .two_body import PairTransfer, pair_transfer
@@ -267,7 +262,8 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     ProblemError
         If every contact node is a Dirichlet node, a Dirichlet value violates the contact
         constraint at a node shared with a contact part
-        (:func:`check_dirichlet_admissible`), an obstacle starts deeper inside the body than a
+        (:func:`check_dirichlet_admissible`), an obstacle shape lies on the body's side of its
+        contact part (:func:`check_obstacle_side`), an obstacle starts deeper inside the body than a
         quarter of its size (:func:`check_initial_overlap`), contact parts with the same
         direction at a shared node have different gaps, two directions at a corner are nearly
         parallel, a node lies on more than two contact parts, or a gap function or obstacle
@@ -293,6 +289,8 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     direction, edge_gap = directions_and_gaps(
         problem, space, (parts, edge_part, edge_nodes), chord, couplings
     )
+    cs_edges = (parts, edge_part, edge_nodes)
+    check_obstacle_side(problem, space, cs_edges, chord, (direction, edge_gap))
 
     # candidates: one per (node, part), Dirichlet nodes left out
     n_parts = len(parts)
@@ -309,6 +307,7 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
         cand_node[held],
         (direction.reshape(-1, 2)[first[held]], edge_gap.ravel()[first[held]]),
         (parts, ukey[held] % n_parts),
+        couplings,
     )
     kept = np.flatnonzero(free)
     check_initial_overlap(

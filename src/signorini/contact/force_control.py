@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import nnls
 
-from ..problem.fields import ProblemError
+from ..problem.fields import DATA_MAX, ProblemError
 from ..problem.rigid import describe_motion, motion_field
 from .node_frames import to_frames
 from .system import Assembled
@@ -53,8 +53,13 @@ def check_load_carried(problem, assembled: Assembled) -> None:
     r = motion_field(space.mesh, motions, space.node_points)  # (k, n_nodes, 2)
     nodes, frames = assembled.frame_nodes, assembled.frames
     y = np.stack([to_frames(ri.ravel(), nodes, frames) for ri in r])  # k ≤ 3
-    work = y @ assembled.F  # (k,)
-    scale = np.abs(y) @ np.abs(assembled.F)  # (k,)
+    # a load beyond DATA_MAX (E extreme, the loads with it) is divided by a power of 2 near
+    # its size (exact), so that the norms below do not overflow
+    big = np.abs(assembled.F).max(initial=0.0)
+    e = int(np.frexp(big)[1]) if big > DATA_MAX else 0
+    F = np.ldexp(assembled.F, -e)
+    work = y @ F  # (k,)
+    scale = np.abs(y) @ np.abs(F)  # (k,)
     along = np.einsum("knc,nc->kn", r[:, cs.nodes], cs.normal)  # (k, n_constraints)
     parts = list(cs.parts)
     size = float(np.linalg.norm(scale))
@@ -73,8 +78,8 @@ def check_load_carried(problem, assembled: Assembled) -> None:
             f"the load pulls the body away from its contacts: along the free rigid motion "
             f"{describe_motion(space.mesh, m)} (held by no Dirichlet part or Roller) the "
             f"contact parts {parts} can only push, and no contact forces Λ_z ≥ 0 balance "
-            f"the load's work {work[i]:.6g} along it. Reverse the load, or hold the motion "
-            "with a Dirichlet part or a Roller (docs/method.md, *Force control*)"
+            f"the load's work {np.ldexp(work, e)[i]:.6g} along it. Reverse the load, or hold "
+            "the motion with a Dirichlet part or a Roller (docs/method.md, *Force control*)"
         )
     # the load must lie inside the cone of contact forces, not on its edge: a motion the
     # contacts resist one way only, with no load along it, leaves the position undetermined
@@ -87,9 +92,9 @@ def check_load_carried(problem, assembled: Assembled) -> None:
                     f"the load does not press the body onto its contacts along the rigid "
                     f"motion {describe_motion(space.mesh, motions[i])}, which only the "
                     f"contact parts {parts} hold, and only one way (load along it "
-                    f"{work[i]:.6g}): the body's position along it is not determined. Hold "
-                    "it with a Dirichlet part or a Roller, or load the body towards the "
-                    "obstacle (docs/method.md, *Force control*)"
+                    f"{np.ldexp(work, e)[i]:.6g}): the body's position along it is not "
+                    "determined. Hold it with a Dirichlet part or a Roller, or load the body "
+                    "towards the obstacle (docs/method.md, *Force control*)"
                 )
 
 

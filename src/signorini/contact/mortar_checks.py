@@ -11,7 +11,7 @@ from scipy.sparse.csgraph import connected_components
 from ..fem.space import P2Space
 from ..mesh.validation import MeshError
 from ..problem.fields import ProblemError
-from .constraint_data import DEEP_OVERLAP
+from .admissible import DEEP_OVERLAP
 
 __all__ = ["COVERAGE_TOL", "check_coupling", "check_pair", "pair_size"]
 

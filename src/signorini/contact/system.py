@@ -24,6 +24,7 @@ from ..problem.fields import ProblemError, evaluate_field
 from ..problem.normals import straight_normal
 from ..problem.problem import ContactProblem
 from ..problem.rollers import HeldNodes, held_nodes
+from .admissible import check_load_size
 from .contact_set import ContactSet, contact_set
 from .node_frames import frame_matrices, rotate_frames
 from .ordering import Ordering
@@ -204,8 +205,9 @@ def assemble(
             f"mu = {np.max(m.mu):.3g}); state E in larger units (e.g. GPa instead of Pa)"
         )
     F = np.zeros(n_dofs)
+    loads = {}  # the largest entry of each load's vector, by its name in messages
     if problem.body_force is not None:
-        F += assemble_body_force(
+        f = assemble_body_force(
             space.mapping,
             space.cell_dofs,
             n_dofs,
@@ -213,6 +215,8 @@ def assemble(
             degree=LOAD_DEGREE,
             element=space.element,
         )
+        F += f
+        loads["the body force"] = float(np.abs(f).max(initial=0.0))
     for name in problem.neumann_parts:
         cond: Neumann = problem.conditions[name]
         if cond.is_zero:
@@ -226,9 +230,13 @@ def assemble(
             return evaluate_field(g, x, f"the traction of Neumann part {name!r}", normal=n)
 
         for rows, geometry in space.boundary_edges(edges):
-            F += assemble_edge_load(
+            g = assemble_edge_load(
                 geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE, element=space.element
             )
+            F += g
+            what = f"the traction of Neumann part {name!r}"
+            loads[what] = max(loads.get(what, 0.0), float(np.abs(g).max(initial=0.0)))
+    check_load_size(K, F, loads, ranks)
     if cs.transfer is not None:  # contact pairs: the relative displacement's basis
         K, F = two_body_system(K, F, cs.transfer.dofs)
         if part is not None:

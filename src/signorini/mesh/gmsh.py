@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import io as _io
+import logging
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -17,6 +18,8 @@ from .topology import edge_keys
 
 __all__ = ["read_mesh"]
 
+logger = logging.getLogger(__name__)
+
 
 #: Relative spread of z (against the mesh's extent in x and y) below which z is constant.
 FLAT_TOL = 1e-10
@@ -24,6 +27,12 @@ FLAT_TOL = 1e-10
 #: Distance of a second-order midpoint from its chord's midpoint, relative to the mesh's
 #: size (the larger of its diameter and its largest coordinate), below which it is straight.
 STRAIGHT_TOL = 1e-12
+
+#: A first-order part looks curved when its boundary turns by less than this (radians, 40°)
+#: at two or more of its vertices and by more than round-off: the chords of an arc meshed
+#: with three or more cells per quarter circle turn by 30° or less each; a polygon's corners
+#: (an octagon's 45°, a rectangle's 90°) turn by more, and a straight part by none
+CURVED_TURN = np.radians(40.0)
 
 #: Local node pairs of the edges of a ``triangle6`` (nodes 3, 4, 5 are their midpoints).
 _TRIANGLE6_EDGES = ((0, 1, 3), (1, 2, 4), (2, 0, 5))
@@ -52,7 +61,9 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
     first-order one. :meth:`Mesh.with_curve` replaces the curve (e.g. by the exact circle).
     Only boundary edges may be curved: interior edges with midpoints off their chords (e.g.
     after Gmsh's high-order optimisation) are refused, since the P2 space puts interior
-    midpoint nodes on the chords.
+    midpoint nodes on the chords. A first-order file whose boundary parts look curved (their
+    edges turn by less than :data:`CURVED_TURN` at two or more vertices) is read with those
+    parts polygonal, and a warning is logged naming them and how to get curved cells.
 
     Parameters
     ----------
@@ -66,7 +77,8 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
     Raises
     ------
     MeshError
-        If the file cannot be read as a mesh, has no triangles (e.g. only line groups were
+        If the file cannot be read as a mesh, has a node with a NaN or infinite coordinate,
+        has no triangles (e.g. only line groups were
         saved: add a physical surface group or save all elements), is not flat in the
         xy-plane, has no boundary lines in a physical group (every boundary edge must be in
         one), or lacks a requested part; or if a second-order midpoint is off the chord of
@@ -99,6 +111,7 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
         raise MeshError(f"{path} contains no triangles (it has {found or 'no cells'}){hint}")
     cells = np.concatenate([b.data[:, :3] for _, b in tri]).astype(np.int64)
     xyz = np.asarray(m.points, dtype=np.float64)
+    _check_finite(path, xyz)
     # drop points that no triangle uses (e.g. geometry points), renumber
     used = np.unique(cells)
     renumber = np.full(len(xyz), -1, dtype=np.int64)
@@ -145,9 +158,58 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
     try:
         boundary = {k: np.concatenate(v) for k, v in groups.items()}
         mesh = Mesh.from_arrays(points, cells, boundary, regions=regions)
-        return _with_quadratic_boundaries(mesh, _given_midpoints(m, renumber))
+        given = _given_midpoints(m, renumber)
+        if not len(given[0]):
+            _warn_if_polygonal(path, mesh)
+        return _with_quadratic_boundaries(mesh, given)
     except MeshError as exc:
         raise MeshError(f"{path}: {exc}") from None
+
+
+def _check_finite(path: Path, xyz: np.ndarray) -> None:
+    """Refuse a file with a NaN or infinite coordinate in any of its nodes (vertices, edge
+    midpoints, geometry points alike: a corrupt file), naming the first."""
+    bad = np.flatnonzero(~np.isfinite(xyz).all(axis=1))
+    if bad.size:
+        k = int(bad[0])
+        more = f" (and {bad.size - 1} more)" if bad.size > 1 else ""
+        raise MeshError(
+            f"{path}: node {k + 1} of the file (in its order) has a non-finite coordinate, "
+            f"{tuple(float(v) for v in xyz[k])}{more}; every node needs finite coordinates"
+        )
+
+
+def _warn_if_polygonal(path: Path, mesh: Mesh) -> None:
+    """Log a warning naming the parts of a first-order ``mesh`` that look curved: boundary
+    parts whose edges turn by less than :data:`CURVED_TURN` (and more than 1e-8 rad) at two
+    or more of their vertices stay polygonal, however the mesh is refined."""
+    curved = []
+    for index, name in enumerate(mesh.part_names):  # a loop over parts, not edges
+        ab = mesh.oriented_boundary(mesh.boundary_edge[mesh.boundary_part == index])
+        if len(ab) < 3:
+            continue
+        d = mesh.points[ab[:, 1]] - mesh.points[ab[:, 0]]
+        after = np.full(mesh.n_points, -1)
+        after[ab[:, 0]] = np.arange(len(ab))  # the part's edge leaving each vertex
+        nxt = after[ab[:, 1]]
+        e = np.flatnonzero(nxt >= 0)
+        u, v = d[e], d[nxt[e]]
+        turn = np.abs(
+            np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], np.einsum("ij,ij->i", u, v))
+        )
+        if np.count_nonzero((turn > 1e-8) & (turn < CURVED_TURN)) >= 2:
+            curved.append(name)
+    if curved:
+        logger.warning(
+            "%s is a first-order mesh (triangle and line elements): its boundary part(s) %s "
+            "look curved (their edges turn by small angles) but stay polygonal, the chords "
+            "between the file's vertices, on every refined mesh, and the cells along them "
+            "are straight. For curved cells save the mesh second order (Gmsh: "
+            "Mesh.ElementOrder = 2, or gmsh -order 2: triangle6 and line3 elements), or give "
+            "the part its exact curve with Mesh.with_curve(part, Circle(...))",
+            path,
+            curved,
+        )
 
 
 def _surface_regions(m: object, tri: list, tags: list | None) -> np.ndarray | None:

@@ -43,8 +43,8 @@ def region_labels(
     Raises
     ------
     MeshError
-        Naming the fault: a wrong length or kind, a selector's bad return, a cell claimed by
-        none or by two selectors (with its centroid).
+        Naming the fault: a wrong length or kind, a selector that raises (chained) or returns
+        the wrong thing, a cell claimed by none or by two selectors (with its centroid).
     """
     n = len(centroids)
     if regions is None:
@@ -84,7 +84,13 @@ def _from_selectors(
                 f"the selector of region {name!r} must be a function f(x) of the cell "
                 f"centroids x (n, 2), got {type(select).__name__}"
             )
-        mask = np.asarray(select(centroids))
+        try:
+            mask = np.asarray(select(centroids))
+        except Exception as exc:
+            raise MeshError(
+                f"the selector of region {name!r} raised {type(exc).__name__}: {exc} (it is "
+                f"called with the cell centroids x of shape ({n}, 2))"
+            ) from exc
         if mask.shape != (n,) or mask.dtype != bool:
             raise MeshError(
                 f"the selector of region {name!r} must return a bool array of shape ({n},) "

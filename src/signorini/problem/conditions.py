@@ -90,14 +90,9 @@ class Dirichlet:
                     f"Dirichlet(value=...) must be {_COMPONENT}; got {value!r} (a part with "
                     "no component held needs Neumann((0, 0)))"
                 )
-            try:
-                check_numbers(given, 1, "Dirichlet(value=...)", _DIRICHLET)
-            except ProblemError:
-                raise ProblemError(
-                    f"Dirichlet(value=...) must be {_COMPONENT}; got {value!r}"
-                ) from None
+            check_numbers(given, 1, "Dirichlet(value=...)", _COMPONENT, shown=value, bounded=True)
         else:
-            check_numbers(value, 2, "Dirichlet(value=...)", _DIRICHLET)
+            check_numbers(value, 2, "Dirichlet(value=...)", _DIRICHLET, bounded=True)
 
     @property
     def components(self) -> tuple[bool, bool]:
@@ -145,7 +140,7 @@ class Roller:
     value: float = 0.0
 
     def __post_init__(self) -> None:
-        check_numbers(self.value, 1, "Roller(value=...)", "a finite number")
+        check_numbers(self.value, 1, "Roller(value=...)", "a finite number", bounded=True)
 
 
 @dataclass(frozen=True)
@@ -286,7 +281,7 @@ class Contact:
         if callable(self.gap):
             check_function(self.gap, "Contact(gap=...)", _GAP)
         else:
-            check_numbers(self.gap, 1, "Contact(gap=...)", _GAP)
+            check_numbers(self.gap, 1, "Contact(gap=...)", _GAP, bounded=True)
         if self.normal is not None:
             check_numbers(self.normal, 2, "Contact(normal=...)", _NORMAL)
             if not np.any(np.asarray(self.normal, dtype=np.float64)):

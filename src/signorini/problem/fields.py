@@ -45,6 +45,18 @@ VectorField = Callable[[np.ndarray], np.ndarray]
 CALL_X, CALL_NAMED, CALL_POSITIONAL = "x", "named", "positional"
 
 
+#: The largest magnitude of a length (a Dirichlet value, a gap; a number given or a
+#: function's value) and of a displacement the loads cause: its square summed over 1e8
+#: entries (a norm, an energy, the estimator's η7²) stays below the largest double, 1.8e308.
+#: Loads themselves scale with the stiffness (E may be 1e300) and are bounded through the
+#: displacement they cause (:func:`signorini.contact.admissible.check_load_size`)
+DATA_MAX = float(np.sqrt(np.finfo(np.float64).max / 1e8))
+
+
+def _too_large(values: np.ndarray) -> bool:
+    return values.size > 0 and float(np.abs(values).max()) > DATA_MAX
+
+
 class ProblemError(ValueError):
     """Raised for an ill-posed or inconsistent problem definition."""
 
@@ -63,7 +75,9 @@ def constant_field(value: float | tuple[float, ...], shape: tuple[int, ...] = (2
     return lambda x: np.broadcast_to(v, np.shape(x)[:-1] + shape).copy()
 
 
-def check_numbers(value, size: int, argument: str, expected: str) -> None:
+def check_numbers(
+    value, size: int, argument: str, expected: str, *, shown=None, bounded: bool = False
+) -> None:
     """Check data given as numbers: ``size`` finite real numbers.
 
     Parameters
@@ -76,11 +90,16 @@ def check_numbers(value, size: int, argument: str, expected: str) -> None:
         The argument, as the user wrote it, e.g. ``"Dirichlet(value=...)"``.
     expected : str
         What the argument may be, e.g. ``"two finite numbers (u_x, u_y) or a function u_D(x)"``.
+    shown : object, optional
+        The argument as the user gave it, for the message, where ``value`` is a part of it.
+    bounded : bool
+        A length (a displacement, a gap): its magnitude must not exceed :data:`DATA_MAX`.
 
     Raises
     ------
     ProblemError
-        Naming the argument, what was expected and what was given.
+        Naming the argument, what was expected and what was given; also for a length beyond
+        :data:`DATA_MAX` in magnitude.
     """
     bad = isinstance(value, str | bytes)
     if not bad:
@@ -90,8 +109,15 @@ def check_numbers(value, size: int, argument: str, expected: str) -> None:
             bad = True
         else:
             bad = values.size != size or values.ndim > 1 or not np.isfinite(values).all()
+    shown = value if shown is None else shown
     if bad:
-        raise ProblemError(f"{argument} must be {expected}; got {value!r}")
+        raise ProblemError(f"{argument} must be {expected}; got {shown!r}")
+    if bounded and _too_large(values):
+        raise ProblemError(
+            f"{argument} = {shown!r} is beyond ±{DATA_MAX:.3g}, where the sums of squares "
+            "the computation forms (norms, energies) overflow double precision; state the "
+            "problem in units that make its data smaller"
+        )
 
 
 def check_function(
@@ -168,6 +194,7 @@ def evaluate_field(
     shape: tuple[int, ...] = (2,),
     *,
     normal: np.ndarray | None = None,
+    bounded: bool = False,
 ) -> np.ndarray:
     """Evaluate a user function at points ``x (..., 2)``, checking its output.
 
@@ -189,6 +216,9 @@ def evaluate_field(
         field, ``(2, 2)`` for a gradient.
     normal : (..., 2) float array, optional
         Outward unit normals, broadcastable to ``x``.
+    bounded : bool
+        A length (a Dirichlet value, a gap): its values must not exceed :data:`DATA_MAX` in
+        magnitude.
 
     Returns
     -------
@@ -198,7 +228,8 @@ def evaluate_field(
     ------
     ProblemError
         If the function raises, returns something other than ``(n,) + shape`` numbers (or one
-        value of shape ``shape``), or NaN or infinite values.
+        value of shape ``shape``), NaN or infinite values, or (``bounded``) values beyond
+        :data:`DATA_MAX` in magnitude.
     """
     x = np.asarray(x, dtype=np.float64)
     lead = x.shape[:-1]
@@ -230,4 +261,12 @@ def evaluate_field(
         )
     if not np.isfinite(values).all():
         raise ProblemError(f"{what} returned NaN or inf")
+    if bounded and _too_large(values):
+        k = int(np.argmax(np.abs(values).reshape(points.shape[0], -1).max(axis=1)))
+        raise ProblemError(
+            f"{what} returned {np.abs(values).max():.6g} in magnitude at x = "
+            f"({points[k, 0]:.12g}, {points[k, 1]:.12g}), beyond ±{DATA_MAX:.3g}, where the sums "
+            "of squares the computation forms (norms, energies) overflow double precision; "
+            "state the problem in units that make its data smaller"
+        )
     return values.reshape(lead + shape)

@@ -16,6 +16,7 @@ import numpy as np
 
 __all__ = [
     "TIE",
+    "UNIT_RTOL",
     "MovedObstacle",
     "Obstacle",
     "checked_point",
@@ -97,6 +98,13 @@ class Obstacle(ABC):
         n : (n, 2) float array
             Unit normal of the obstacle at the closest point, pointing into the obstacle;
             ``x + psi[:, None] * n`` is that closest point.
+
+        Raises
+        ------
+        ValueError
+            Naming the shape: for points that are not a finite ``(n, 2)`` array, or where the
+            shape's answer is not ``(n,)`` and ``(n, 2)`` finite numbers with unit directions
+            (within :data:`UNIT_RTOL`).
         """
         try:
             points = np.asarray(x, dtype=np.float64)
@@ -107,7 +115,8 @@ class Obstacle(ABC):
         if not np.isfinite(points).all():
             k = int(np.flatnonzero(~np.isfinite(points).all(axis=1))[0])
             raise ValueError(f"{self!r}: x[{k}] is not finite: {points[k]}")
-        return self._gap_and_direction(points)
+        psi, n = self._gap_and_direction(points)
+        return _checked_answer(self, points, psi, n)
 
     @abstractmethod
     def _gap_and_direction(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -131,6 +140,40 @@ class Obstacle(ABC):
         Moving a moved obstacle adds the displacements.
         """
         return MovedObstacle(self, displacement)
+
+
+#: how far from 1 the length of a direction an obstacle returns may be
+UNIT_RTOL = 1e-6
+
+
+def _checked_answer(shape: Obstacle, x: np.ndarray, psi, n) -> tuple[np.ndarray, np.ndarray]:
+    """``psi (n,)`` and ``n (n, 2)`` as a shape returned them for ``x (n, 2)``, refused with
+    a ValueError naming the shape unless finite numbers of those shapes with unit ``n``."""
+    try:
+        psi, n = np.asarray(psi, dtype=np.float64), np.asarray(n, dtype=np.float64)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{shape!r}: gap_and_direction did not return numbers: {err}") from err
+    if psi.shape != x.shape[:1] or n.shape != x.shape:
+        raise ValueError(
+            f"{shape!r}: gap_and_direction must return psi of shape {x.shape[:1]} and n of "
+            f"shape {x.shape} for x of shape {x.shape}, got {psi.shape} and {n.shape}"
+        )
+    bad = ~(np.isfinite(psi) & np.isfinite(n).all(axis=1))
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(
+            f"{shape!r}: gap_and_direction is not finite at x[{k}] = {x[k].tolist()} (psi "
+            f"{psi[k]}, n {n[k].tolist()})"
+        )
+    length = np.hypot(n[:, 0], n[:, 1])
+    off = np.abs(length - 1.0) > UNIT_RTOL
+    if off.any():
+        k = int(np.flatnonzero(off)[0])
+        raise ValueError(
+            f"{shape!r}: gap_and_direction must return unit directions n; at x[{k}] = "
+            f"{x[k].tolist()} it returned {n[k].tolist()} of length {length[k]:.6g}"
+        )
+    return psi, n
 
 
 class MovedObstacle(Obstacle):

@@ -140,7 +140,14 @@ class SignedDistance(Obstacle):
 
     def _call(self, function, name: str, x: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
         try:
-            value = np.asarray(function(x), dtype=np.float64)
+            raw = function(x)
+        except Exception as err:
+            raise ValueError(
+                f"{self!r}: {name}(x) raised {type(err).__name__}: {err} (called with points "
+                f"x of shape {x.shape})"
+            ) from err
+        try:
+            value = np.asarray(raw, dtype=np.float64)
         except (TypeError, ValueError) as err:
             raise ValueError(f"{self!r}: {name}(x) did not return numbers: {err}") from err
         if value.shape != shape:

@@ -33,8 +33,8 @@ class Polyline(Obstacle):
     Parameters
     ----------
     points : (m, 2) float array, m >= 2
-        Corners in order; all distinct, no turn back on the same line. That the polyline does
-        not cross itself is not checked.
+        Corners in order; all distinct, no turn back on the same line, and the polyline
+        (its end segments extended to rays) does not cross or touch itself.
     radius : float, >= 0
         Radius of the rounded convex corners.
 
@@ -67,6 +67,7 @@ class Polyline(Obstacle):
             raise ValueError(
                 f"Polyline: points[{i}] and points[{j}] are the same point {points[j].tolist()}"
             )
+        _check_no_crossing(points)
         tangent = edge / length[:, None]
         turn = cross(tangent[:-1], tangent[1:])
         along = np.einsum("ij,ij->i", tangent[:-1], tangent[1:])
@@ -229,6 +230,87 @@ class Polyline(Obstacle):
         length = np.hypot(total[:, 0], total[:, 1])
         opposite = length <= 1e-12
         return np.where(opposite[:, None], first, total / np.where(opposite, 1.0, length)[:, None])
+
+
+#: pairs of segments tested at once by :func:`_check_no_crossing` (memory ~ 20 floats each)
+_PAIRS_CHUNK = 1 << 18
+
+
+def _check_no_crossing(points: np.ndarray) -> None:
+    """Refuse a polyline ``points (m, 2)`` that crosses or touches itself: two segments that
+    are not neighbours (the first one extended backwards and the last one forwards to rays,
+    as the obstacle's boundary is) meet, or are collinear and overlap. A crossing boundary
+    has no left side: the obstacle it would bound is not a region.
+
+    The candidates are the pairs whose x-extents overlap (found by sorting) and every pair
+    with an end ray; they are tested at once (chunked): segments ``p + t d`` and ``q + s e``
+    meet where ``t = (q − p) × e / (d × e)`` and ``s = (q − p) × d / (d × e)`` lie in their
+    ranges.
+    """
+    m = points.shape[0] - 1  # segments
+    if m < 3:
+        return
+    i, j = _candidates(points)
+    lo = np.zeros(m)
+    hi = np.ones(m)
+    lo[0], hi[-1] = -np.inf, np.inf
+    d = np.diff(points, axis=0)
+    scale = float(np.hypot(*np.ptp(points, axis=0)))
+    for start in range(0, i.size, _PAIRS_CHUNK):
+        a, b = i[start : start + _PAIRS_CHUNK], j[start : start + _PAIRS_CHUNK]
+        offset = points[b] - points[a]
+        det = cross(d[a], d[b])
+        parallel = np.abs(det) <= TIE * np.hypot(*d[a].T) * np.hypot(*d[b].T)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = cross(offset, d[b]) / det
+            u = cross(offset, d[a]) / det
+        meet = ~parallel & (t >= lo[a]) & (t <= hi[a]) & (u >= lo[b]) & (u <= hi[b])
+        # collinear pieces overlap where their extents along the line overlap
+        on_line = parallel & (np.abs(cross(offset, d[a])) <= TIE * scale * np.hypot(*d[a].T))
+        along = d[a] / np.hypot(*d[a].T)[:, None]
+        t0 = np.einsum("kc,kc->k", offset, along)  # b's start along a, from a's start
+        t1 = t0 + np.einsum("kc,kc->k", d[b], along)
+        b_lo = np.where(b == m - 1, np.where(t1 > t0, t0, -np.inf), np.minimum(t0, t1))
+        b_hi = np.where(b == m - 1, np.where(t1 > t0, np.inf, t0), np.maximum(t0, t1))
+        a_lo = np.where(a == 0, -np.inf, 0.0)
+        a_hi = np.hypot(*d[a].T)
+        meet |= on_line & (b_lo <= a_hi) & (a_lo <= b_hi)
+        if meet.any():
+            k = int(np.flatnonzero(meet)[0])
+            p, q = int(a[k]), int(b[k])
+
+            def named(n: int) -> str:
+                ray = " (extended to a ray)" if n in (0, m - 1) else ""
+                return f"points[{n}]–points[{n + 1}]{ray}"
+
+            raise ValueError(
+                f"Polyline: the polyline crosses itself: the segments {named(p)} from "
+                f"{points[p].tolist()} to {points[p + 1].tolist()} and {named(q)} from "
+                f"{points[q].tolist()} to {points[q + 1].tolist()} meet, so it bounds no "
+                "region on its left; walk the obstacle's outline once, without crossings"
+            )
+
+
+def _candidates(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs ``i < j − 1`` of the segments of ``points (m + 1, 2)`` that may meet: those whose
+    x-extents overlap (segment ``j``'s left end within segment ``i``'s extent or the other
+    way round, by a sort), and every pair with the first or the last segment (rays)."""
+    m = points.shape[0] - 1
+    x = np.stack([points[:-1, 0], points[1:, 0]], axis=1)
+    lo, hi = x.min(axis=1), x.max(axis=1)
+    order = np.argsort(lo, kind="stable")
+    start = np.searchsorted(lo[order], lo, "left")
+    count = np.searchsorted(lo[order], hi, "right") - start
+    first = np.repeat(np.arange(m), count)
+    offset = np.arange(first.size) - np.repeat(np.cumsum(count) - count, count)
+    second = order[np.repeat(start, count) + offset]
+    rays = np.arange(m)
+    a = np.concatenate([first, np.zeros(m, np.int64), rays])
+    b = np.concatenate([second, rays, np.full(m, m - 1)])
+    a, b = np.minimum(a, b), np.maximum(a, b)
+    keep = b - a >= 2
+    pairs = np.unique(np.stack([a[keep], b[keep]], axis=1), axis=0)
+    return pairs[:, 0], pairs[:, 1]
 
 
 def _direction(offset, distance, sign, normal):

@@ -30,6 +30,7 @@ from ..mesh.mesh import Mesh
 from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann, Roller
 from .corners import check_corner_friction
 from .fields import ProblemError, VectorField, check_function
+from .materials import check_materials
 from .normals import straight_normal
 from .pairs import check_bodies_held, contact_pairs
 from .rigid import free_rigid_motions
@@ -112,7 +113,7 @@ class ContactProblem:
         mesh = self.mesh
         if not isinstance(mesh, Mesh):
             raise ProblemError(f"mesh must be a signorini Mesh, got {type(mesh).__name__}")
-        _check_materials(self.material, mesh)
+        check_materials(self.material, mesh)
         if not isinstance(self.conditions, Mapping):
             raise ProblemError(
                 "conditions must be a mapping part name -> Dirichlet | Neumann | Contact, "
@@ -276,40 +277,6 @@ class ContactProblem:
                     f"is not its outward normal {tuple(np.round(mean, 12))}"
                 )
         return mean
-
-
-def _check_materials(material: object, mesh: Mesh) -> None:
-    """A :class:`Material`, or a mapping giving each cell region of ``mesh`` one.
-
-    Raises
-    ------
-    ProblemError
-        Naming the regions without a material, the names that are not regions, or a value
-        that is not a :class:`Material`.
-    """
-    kind = "a signorini Material (Material.from_young or Material.from_lame)"
-    if isinstance(material, Material):
-        return
-    if not isinstance(material, Mapping):
-        raise ProblemError(
-            f"material must be {kind}, or a mapping region name -> Material, got "
-            f"{type(material).__name__}"
-        )
-    given = {str(k): v for k, v in material.items()}
-    regions = list(mesh.region_names)
-    unknown = sorted(set(given) - set(regions))
-    missing = [r for r in regions if r not in given]
-    if unknown or missing:
-        raise ProblemError(
-            "material must give each cell region of the mesh one Material: "
-            + (f"region(s) {missing} have none" if missing else "")
-            + ("; " if missing and unknown else "")
-            + (f"{unknown} are not regions of the mesh" if unknown else "")
-            + f"; its regions are {regions}"
-        )
-    for name, m in given.items():
-        if not isinstance(m, Material):
-            raise ProblemError(f"the material of region {name!r} must be {kind}, got {m!r}")
 
 
 #: How many floating components an error message describes (the rest are counted).

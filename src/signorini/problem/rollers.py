@@ -150,7 +150,10 @@ def held_nodes(problem, space: P2Space, *, values: bool = True) -> HeldNodes:
         order[nodes[:, None], np.flatnonzero(held)[None, :]] = rank[name]
         if values:
             v = evaluate_field(
-                cond.field(), space.node_points[nodes], f"the Dirichlet value of part {name!r}"
+                cond.field(),
+                space.node_points[nodes],
+                f"the Dirichlet value of part {name!r}",
+                bounded=True,
             )
             val[nodes[:, None], np.flatnonzero(held)[None, :]] = v[:, held]
     node, normal, value, part = _roller_rows(problem, space.mesh)
