@@ -14,9 +14,10 @@ from signorini.contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
 from signorini.contact.solution import INACTIVE, SLIP, STICK, solve
 from signorini.estimator.residual import estimate
 from signorini.examples import example_6_2
+from signorini.examples.two_bodies import two_cylinders
 from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle
-from signorini.mesh.refine import refine_uniform
+from signorini.mesh.refine import refine_nvb, refine_uniform
 from signorini.output import write_vtu
 from signorini.problem import Contact, ContactProblem, Coulomb, Dirichlet, Neumann
 from signorini.problem.obstacles import Disc
@@ -164,3 +165,16 @@ def test_friction_fields(tmp_path):
     np.testing.assert_array_equal(
         pd["contact_state"][cs.nodes], np.where(frictionless.active, SLIP, INACTIVE)
     )
+
+
+def test_body_field_is_the_unions_body_after_refinement(tmp_path):
+    """Two cylinders with the upper one refined all over: the refined mesh starts with lower
+    cells, and the ``body`` field still says 0 for the upper cells (the union's first body,
+    whose regions come first), 1 for the lower ones."""
+    problem = two_cylinders()
+    upper = problem.mesh.cell_region == problem.mesh.region_names.index("upper")
+    mesh = refine_nvb(problem.mesh, upper).mesh
+    assert mesh.region_names[mesh.cell_region[0]] == "lower"  # the cells' order changed
+    cell_data = meshio.read(write_vtu(tmp_path / "pair.vtu", solve(problem, mesh))).cell_data
+    np.testing.assert_array_equal(cell_data["region"][0], mesh.cell_region)
+    np.testing.assert_array_equal(cell_data["body"][0], mesh.cell_region)  # one region a body

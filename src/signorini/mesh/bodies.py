@@ -115,19 +115,28 @@ def _check_apart(names: list[str], meshes: list[Mesh]) -> None:
 
 def body_of_cells(mesh: Mesh) -> np.ndarray:
     """The body ``(n_cells,)`` of each cell: the connected components of the cells joined
-    through shared edges, numbered in the order of their first cell (for a union, or a
-    refinement of one, the bodies in the union's order when each body is connected)."""
+    through shared edges, numbered in the order of their smallest point index (ties, cells
+    meeting at a point only, in the order of their first cell).
+
+    A union numbers its points body after body and refinement keeps the old points' indices
+    (new points follow), so on a union and on every refinement of one the bodies are in the
+    union's order when each body is connected; the cells' order, which refinement changes,
+    does not enter.
+    """
     e2c = mesh.edge2cell
     inner = e2c[:, 1] >= 0
     n = mesh.n_cells
     graph = sp.coo_matrix(
         (np.ones(int(inner.sum()), dtype=np.int8), (e2c[inner, 0], e2c[inner, 1])), shape=(n, n)
     )
-    _, label = connected_components(graph, directed=False)
-    _, first, inverse = np.unique(label, return_index=True, return_inverse=True)
-    rank = np.empty(first.size, dtype=np.int64)
-    rank[np.argsort(first)] = np.arange(first.size)
-    return rank[inverse]
+    n_comp, label = connected_components(graph, directed=False)
+    first_point = np.full(n_comp, mesh.n_points)
+    np.minimum.at(first_point, label, mesh.cells.min(axis=1))
+    first_cell = np.full(n_comp, n)
+    np.minimum.at(first_cell, label, np.arange(n))
+    rank = np.empty(n_comp, dtype=np.int64)
+    rank[np.lexsort((first_cell, first_point))] = np.arange(n_comp)
+    return rank[label]
 
 
 def validated_bodies(mesh: Mesh) -> Mesh:
