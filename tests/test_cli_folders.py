@@ -399,6 +399,8 @@ def test_a_run_writes_pvd_collections_fields_md_and_its_environment(tmp_path, ca
     assert set(m.point_data) == set(POINT_FIELDS)
     for name in [*m.point_data, "eta2", "eta2_k"]:
         assert f"| `{name}` |" in fields, name
+    assert {k: v.tolist() for k, v in m.field_data.items()} == {"region:body": [0]}
+    assert "| `region` | region name |\n|---|---|\n| 0 | `body` |" in fields  # the run's names
     env = json.loads((out / "signorini-run.json").read_text())["environment"]
     assert set(env) >= {"signorini", "python", "numpy", "scipy", "solver_library", "date", "host"}
     assert env["numpy"] == np.__version__ and env["python"] == sys.version.split()[0]

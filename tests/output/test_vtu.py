@@ -14,10 +14,13 @@ from signorini.contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
 from signorini.contact.solution import INACTIVE, SLIP, STICK, solve
 from signorini.estimator.residual import estimate
 from signorini.examples import example_6_2
+from signorini.examples.two_bodies import two_cylinders
 from signorini.fem.material import Material
+from signorini.mesh.bodies import union
 from signorini.mesh.builders import rectangle
-from signorini.mesh.refine import refine_uniform
+from signorini.mesh.refine import refine_nvb, refine_uniform
 from signorini.output import write_vtu
+from signorini.output.vtu import write_fields
 from signorini.problem import Contact, ContactProblem, Coulomb, Dirichlet, Neumann
 from signorini.problem.obstacles import Disc
 
@@ -164,3 +167,80 @@ def test_friction_fields(tmp_path):
     np.testing.assert_array_equal(
         pd["contact_state"][cs.nodes], np.where(frictionless.active, SLIP, INACTIVE)
     )
+
+
+def test_body_field_is_the_unions_body_after_refinement(tmp_path):
+    """Two cylinders with the upper one refined all over: the refined mesh starts with lower
+    cells, and the ``body`` field still says 0 for the upper cells (the union's first body,
+    whose regions come first), 1 for the lower ones."""
+    problem = two_cylinders()
+    upper = problem.mesh.cell_region == problem.mesh.region_names.index("upper")
+    mesh = refine_nvb(problem.mesh, upper).mesh
+    assert mesh.region_names[mesh.cell_region[0]] == "lower"  # the cells' order changed
+    cell_data = meshio.read(write_vtu(tmp_path / "pair.vtu", solve(problem, mesh))).cell_data
+    np.testing.assert_array_equal(cell_data["region"][0], mesh.cell_region)
+    np.testing.assert_array_equal(cell_data["body"][0], mesh.cell_region)  # one region a body
+
+
+def test_region_and_body_names_round_trip_as_field_data(tmp_path, solved):
+    """The names of the regions and bodies are the VTU file's field data, ``region:<name>``
+    and ``body:<name>`` -> the index in the cell field, read back by meshio; one body has
+    its region only."""
+    pair = solve(two_cylinders())
+    m = meshio.read(write_vtu(tmp_path / "pair.vtu", pair))
+    assert {k: v.tolist() for k, v in m.field_data.items()} == {
+        "region:upper": [0],
+        "region:lower": [1],
+        "body:upper": [0],
+        "body:lower": [1],
+    }
+    one = meshio.read(write_vtu(tmp_path / "one.vtu", solved[0]))
+    assert {k: v.tolist() for k, v in one.field_data.items()} == {"region:body": [0]}
+    assert "body" not in one.cell_data
+
+
+def test_region_names_that_xml_must_escape(tmp_path):
+    """A region name with XML's special characters reads back as it was."""
+    odd = 'steel & "rubber" <soft>'
+    halves = {odd: lambda x: x[:, 0] < 0.5, "b": lambda x: x[:, 0] > 0.5}
+    mesh = rectangle(0, 1, 0, 1, nx=2, ny=2, regions=halves)
+    problem = ContactProblem(
+        mesh,
+        {odd: Material.from_young(1.0, 0.3), "b": Material.from_young(2.0, 0.3)},
+        {
+            "top": Dirichlet((0.0, -0.01)),
+            "bottom": Dirichlet((0.0, 0.0)),
+            "left": Neumann(),
+            "right": Neumann(),
+        },
+    )
+    m = meshio.read(write_vtu(tmp_path / "odd.vtu", solve(problem)))
+    names = {k: int(v[0]) for k, v in m.field_data.items()}
+    assert names == {f"region:{r}": k for k, r in enumerate(mesh.region_names)}
+    assert f"region:{odd}" in names
+
+
+def test_fields_md_says_which_index_is_which_name(tmp_path):
+    """fields.md lists the field data and, for the run's mesh, each region index and body
+    number with its name (a body with two regions is named once)."""
+    halves = {"a": lambda x: x[:, 0] < 0.5, "b": lambda x: x[:, 0] > 0.5}
+    mesh = union(
+        {
+            "upper": rectangle(0, 1, 1, 2, 2, 2, regions=halves),
+            "lower": rectangle(0, 1, 0, 1, 2, 2),
+        }
+    )
+    text = write_fields(tmp_path / "fields.md", mesh).read_text()
+    for line in (
+        "| `region:<name>` |",
+        "| `body:<name>` |",
+        "| 0 | `upper.a` |",
+        "| 1 | `upper.b` |",
+        "| 2 | `lower` |",
+        "| `body` | body name |",
+        "| 0 | `upper` |",
+        "| 1 | `lower` |",
+    ):
+        assert line in text, line
+    one = write_fields(tmp_path / "one.md", rectangle(0, 1, 0, 1, 2, 2)).read_text()
+    assert "| 0 | `body` |" in one and "| `body` | body name |" not in one

@@ -22,6 +22,7 @@ from signorini.fem.space import P2Space
 from signorini.fem.stiffness import assemble_stiffness
 from signorini.mesh.bodies import body_of_cells, union
 from signorini.mesh.builders import rectangle
+from signorini.mesh.refine import refine_nvb, refine_uniform
 from signorini.mesh.validation import MeshError
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
 
@@ -247,6 +248,29 @@ def test_union_names_and_bodies():
     body = body_of_cells(m)
     assert np.array_equal(np.bincount(body), [8, 18])
     assert np.array_equal(body, m.cell_region)
+
+
+def union_body(mesh) -> np.ndarray:
+    """The union's body of each cell, from its region ("body" or "body.region")."""
+    names = [r.split(".")[0] for r in mesh.region_names]
+    bodies = list(dict.fromkeys(names))
+    return np.array([bodies.index(n) for n in names])[mesh.cell_region]
+
+
+@pytest.mark.parametrize("example", [two_cylinders, hertz_pair])
+def test_body_labels_are_the_unions_order_on_every_level(example):
+    """Refining all of the upper body puts lower cells ahead of upper ones (refinement keeps
+    the unrefined cells first), refining a few cells brings upper ones back to the front:
+    the labels follow the union on every level, not the cells' order."""
+    mesh = example().mesh
+    swapped = 0
+    for level in range(6):
+        expected = union_body(mesh)
+        swapped += int(expected[0] != 0)
+        np.testing.assert_array_equal(body_of_cells(mesh), expected, err_msg=f"level {level}")
+        marked = expected == 0 if level % 2 == 0 else np.flatnonzero(expected == 1)[:3]
+        mesh = refine_nvb(mesh, marked).mesh if level < 4 else refine_uniform(mesh).mesh
+    assert swapped >= 2  # the cells' order did change (a lower cell first)
 
 
 def test_body_held_only_by_its_pair_is_refused():

@@ -203,7 +203,7 @@ def _solve_levels(work: _Run, status: Status) -> Level | None:
     vtu = not work.settings.no_vtu
     if vtu:
         work.folder.add_files("fields.md")
-        write_fields(out / "fields.md")
+        write_fields(out / "fields.md", job.problem.mesh)  # its regions' and bodies' names
     history = HistoryWriter(out / "history.csv", rows=state.history_rows if state else ())
     mode = "uniform" if options.uniform else f"adaptive, theta={options.theta}"
     say(

@@ -21,7 +21,7 @@ from .mesh import Mesh
 from .regions import DEFAULT_REGION
 from .validation import MeshError, winding_numbers
 
-__all__ = ["BODY_SEPARATOR", "body_of_cells", "union"]
+__all__ = ["BODY_SEPARATOR", "body_names", "body_of_cells", "union"]
 
 #: joins a body's name and its part's or region's name in the union
 BODY_SEPARATOR = "."
@@ -115,19 +115,46 @@ def _check_apart(names: list[str], meshes: list[Mesh]) -> None:
 
 def body_of_cells(mesh: Mesh) -> np.ndarray:
     """The body ``(n_cells,)`` of each cell: the connected components of the cells joined
-    through shared edges, numbered in the order of their first cell (for a union, or a
-    refinement of one, the bodies in the union's order when each body is connected)."""
+    through shared edges, numbered in the order of their smallest point index (ties, cells
+    meeting at a point only, in the order of their first cell).
+
+    A union numbers its points body after body and refinement keeps the old points' indices
+    (new points follow), so on a union and on every refinement of one the bodies are in the
+    union's order when each body is connected; the cells' order, which refinement changes,
+    does not enter.
+    """
     e2c = mesh.edge2cell
     inner = e2c[:, 1] >= 0
     n = mesh.n_cells
     graph = sp.coo_matrix(
         (np.ones(int(inner.sum()), dtype=np.int8), (e2c[inner, 0], e2c[inner, 1])), shape=(n, n)
     )
-    _, label = connected_components(graph, directed=False)
-    _, first, inverse = np.unique(label, return_index=True, return_inverse=True)
-    rank = np.empty(first.size, dtype=np.int64)
-    rank[np.argsort(first)] = np.arange(first.size)
-    return rank[inverse]
+    n_comp, label = connected_components(graph, directed=False)
+    first_point = np.full(n_comp, mesh.n_points)
+    np.minimum.at(first_point, label, mesh.cells.min(axis=1))
+    first_cell = np.full(n_comp, n)
+    np.minimum.at(first_cell, label, np.arange(n))
+    rank = np.empty(n_comp, dtype=np.int64)
+    rank[np.lexsort((first_cell, first_point))] = np.arange(n_comp)
+    return rank[label]
+
+
+def body_names(mesh: Mesh, body: np.ndarray | None = None) -> list[str]:
+    """The name of each body of :func:`body_of_cells`, in its order: the union's name, read
+    from the body's regions (``"name"`` or ``"name.region"``, :func:`union`). A body whose
+    regions do not all carry one name, or whose name another body carries too (a mesh that
+    is not a union, a body in pieces), is ``"body <number>"``. ``body``: the mesh's
+    :func:`body_of_cells` where the caller has it."""
+    body = body_of_cells(mesh) if body is None else body
+    prefix = np.array([r.split(BODY_SEPARATOR, 1)[0] for r in mesh.region_names])
+    pairs = np.unique(np.column_stack([body, mesh.cell_region]), axis=0)
+    names = []
+    for b in range(int(body.max(initial=-1)) + 1):  # a loop over bodies
+        own = np.unique(prefix[pairs[pairs[:, 0] == b, 1]])
+        names.append(str(own[0]) if own.size == 1 else "")
+    return [
+        name if name and names.count(name) == 1 else f"body {b}" for b, name in enumerate(names)
+    ]
 
 
 def validated_bodies(mesh: Mesh) -> Mesh:

@@ -1,8 +1,9 @@
 """Discrete solutions as quadratic-triangle VTU files (ParaView), the ``.pvd`` collections of
 a run's levels, and the description of every field (``fields.md``), all written atomically.
 
-:data:`POINT_FIELDS` and :data:`CELL_FIELDS` are the one list of the fields: the writer
-fills them and ``fields.md`` describes them (a field added to the writer is added there).
+:data:`POINT_FIELDS`, :data:`CELL_FIELDS` and :data:`NAME_FIELDS` (the field data naming
+the regions and bodies) are the one list of the fields: the writer fills them and
+``fields.md`` describes them (a field added to the writer is added there).
 """
 
 from __future__ import annotations
@@ -10,15 +11,19 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from pathlib import Path
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from ..mesh.bodies import body_of_cells
+from ..mesh.bodies import body_names, body_of_cells
+from ..mesh.mesh import Mesh
 from .files import atomic_write, replacing
 
 __all__ = [
     "CELL_FIELDS",
+    "NAME_FIELDS",
     "POINT_FIELDS",
+    "name_fields",
     "von_mises",
     "write_fields",
     "write_pvd",
@@ -48,12 +53,21 @@ POINT_FIELDS: dict[str, str] = {
     "contact_state": "0 inactive, 1 stick, 2 slip (a frictionless node in contact slips), −1 "
     "off Γ_C",
 }
+#: Field data of a level's VTU file (one Int32 value each; ParaView's Information panel and
+#: the spreadsheet's Field Data list them, meshio.read returns them as ``field_data``).
+NAME_FIELDS: dict[str, str] = {
+    "region:<name>": "the index, in the `region` cell field, of the region named after the colon",
+    "body:<name>": "the number, in the `body` cell field, of the body named after the colon "
+    "(with several bodies)",
+}
 #: Cell data of a level's VTU file (the eta2 fields with an estimate): name -> meaning.
 CELL_FIELDS: dict[str, str] = {
     "region": "the cell's material region, an index into the mesh's region names "
-    "(mesh.region_names; 0 where the mesh has one region)",
+    "(mesh.region_names; 0 where the mesh has one region): the field data `region:<name>` "
+    "holds each name's index, and *Regions and bodies* below lists them",
     "body": "with several bodies (a union mesh), the cell's body: 0, 1, … in the union's "
-    "order (not written for one body)",
+    "order (not written for one body): the field data `body:<name>` holds each body's "
+    "number, and *Regions and bodies* below lists them",
     "eta2": "the squared element indicator η_T² (the sum of the contributions)",
     "eta2_k": "the squared contribution η_k,T² of term k = 1, 2, … (docs/method.md, "
     "*Estimator*): one field per term",
@@ -144,7 +158,40 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     )
     with replacing(path) as tmp:
         meshio.write(tmp, mesh, file_format="vtu")
+        _append_field_data(tmp, name_fields(space.mesh, body))
     return Path(path)
+
+
+def name_fields(mesh: Mesh, body: np.ndarray | None = None) -> dict[str, int]:
+    """The field data of :data:`NAME_FIELDS`: ``region:<name>`` -> the region's index, and
+    with several bodies ``body:<name>`` -> the body's number (in its ``body`` cell field;
+    ``body``: the mesh's :func:`~signorini.mesh.bodies.body_of_cells` where known)."""
+    fields = {f"region:{name}": k for k, name in enumerate(mesh.region_names)}
+    names = body_names(mesh, body)
+    if len(names) > 1:
+        fields.update({f"body:{name}": b for b, name in enumerate(names)})
+    return fields
+
+
+_GRID_END = b"</UnstructuredGrid>\n</VTKFile>\n"
+
+
+def _append_field_data(path: Path, fields: dict[str, int]) -> None:
+    """Add ``fields`` as the VTK field data of the VTU file at ``path`` (meshio's VTU writer
+    writes none): a ``FieldData`` element after the piece, where VTK's reader finds it as
+    well as before, appended in place without rewriting the file."""
+    arrays = "".join(
+        f'<DataArray type="Int32" Name={quoteattr(name)} NumberOfTuples="1" '
+        f'format="ascii">{value}</DataArray>\n'
+        for name, value in fields.items()
+    )
+    with open(path, "r+b") as f:
+        f.seek(-len(_GRID_END), os.SEEK_END)
+        end = f.tell()
+        if f.read() != _GRID_END:
+            raise RuntimeError(f"{path}: meshio's VTU file does not end as expected")
+        f.seek(end)
+        f.write(b"<FieldData>\n" + arrays.encode() + b"</FieldData>\n" + _GRID_END)
 
 
 def write_pvd(folder: str | os.PathLike, levels: Sequence[tuple[int, int]]) -> list[Path]:
@@ -173,8 +220,10 @@ def write_pvd(folder: str | os.PathLike, levels: Sequence[tuple[int, int]]) -> l
     return written
 
 
-def write_fields(path: str | os.PathLike) -> Path:
-    """Write the description of the VTU files' fields as Markdown (``fields.md``)."""
+def write_fields(path: str | os.PathLike, mesh: Mesh | None = None) -> Path:
+    """Write the description of the VTU files' fields as Markdown (``fields.md``); with the
+    run's ``mesh``, which region index and which body number is which name (the same on
+    every level: refinement keeps the regions, and the bodies' order is the union's)."""
     lines = [
         "# Fields of the level_NNN.vtu files",
         "",
@@ -194,5 +243,18 @@ def write_fields(path: str | os.PathLike) -> Path:
         "| field | meaning |",
         "|---|---|",
         *(f"| `{name}` | {text} |" for name, text in CELL_FIELDS.items()),
+        "",
+        "## Field data",
+        "",
+        "| field | meaning |",
+        "|---|---|",
+        *(f"| `{name}` | {text} |" for name, text in NAME_FIELDS.items()),
     ]
+    if mesh is not None:
+        lines += ["", "## Regions and bodies", "", "| `region` | region name |", "|---|---|"]
+        lines += [f"| {k} | `{name}` |" for k, name in enumerate(mesh.region_names)]
+        names = body_names(mesh)
+        if len(names) > 1:
+            lines += ["", "| `body` | body name |", "|---|---|"]
+            lines += [f"| {b} | `{name}` |" for b, name in enumerate(names)]
     return atomic_write(path, ("\n".join(lines) + "\n").encode())
