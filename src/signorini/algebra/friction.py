@@ -21,6 +21,8 @@ linear system of these states (:mod:`.friction_system`) and updates them with th
 the semismooth Newton step for the equations ``Λ_n = max(0, Λ_n + c (x_n − g))`` and
 ``Λ_t = P_[−s, s](Λ_t + c (x_t − x_ref))``, of which in 2D the slip branch ``Λ_t = σ s`` is
 linear. It stops when the states repeat, and then checks the KKT residuals of both laws.
+Where Coulomb's states cycle, the fixed point on its slip bound finishes the solve
+(:mod:`.friction_fixed_point`).
 The constant ``c`` is :data:`C_FACTOR` times the mean diagonal of ``K`` over the normal DOFs,
 not the diagonal itself as in :func:`~.pdas.solve_pdas`: it only decides whether a node
 slipping against its force sticks (small ``c``) or flips its direction (large ``c``), and
@@ -50,6 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .backends import make_solver
+from .friction_fixed_point import solve_by_fixed_point
 from .friction_kkt import FrictionProblem, friction_kkt
 from .friction_result import (
     INACTIVE,
@@ -173,6 +176,7 @@ def solve_friction(
         If a system is singular.
     """
     t_start = time.perf_counter()
+    method, inner_assembly = "semismooth-newton", 0.0
     if not isinstance(problem, FrictionProblem):
         raise ValueError(
             f"problem must be a FrictionProblem (from check_friction), got {type(problem).__name__}"
@@ -189,7 +193,17 @@ def solve_friction(
     try:
         system = friction_system(problem, solver)
         with InexactRule(solver) as inexact:  # an iterative solver's stopping rule
-            x, states, history = _iterate(system, states, rule, options.max_iter, inexact)
+            try:
+                x, states, history = _iterate(system, states, rule, options.max_iter, inexact)
+            except FrictionConvergenceError as failed:
+                if failed.reason != "cycling" or system.symmetric:
+                    raise
+                # Coulomb's states cycle: the fixed point on its slip bound finishes
+                x, states, history, inner_assembly = solve_by_fixed_point(
+                    system, failed, (rule, _rule_constants(problem, None)), options,
+                    lambda *args: _iterate(*args, inexact),
+                )  # fmt: skip
+                method = "fixed-point"
     finally:
         used = {key: value - before[key] for key, value in solver_usage(solver).items()}
         backend_name = solver.backend
@@ -205,12 +219,13 @@ def solve_friction(
         raise FrictionConvergenceError(message, history, "kkt", x, _state(*states), direction)
     multiplier_n, multiplier_t = _multipliers(problem, x, states)
     times = {key: used[key] for key in ("analysis", "factorization", "solve")}
-    times["assembly"] = system.time_assembly
+    times["assembly"] = system.time_assembly + inner_assembly
     times["total"] = time.perf_counter() - t_start
     state = _state(active, stick, direction)
     logger.info(
-        "friction (%s systems): %d solves, stick %d, slip %d of %d nodes, KKT residual %.2e",
+        "friction (%s systems, %s): %d solves, stick %d, slip %d of %d nodes, KKT residual %.2e",
         "symmetric" if system.symmetric else "non-symmetric",
+        method,
         len(history),
         int((state == STICK).sum()),
         int((state == SLIP).sum()),
@@ -229,6 +244,7 @@ def solve_friction(
         kkt=kkt,
         backend=backend_name,
         symmetric=system.symmetric,
+        method=method,
         c_scale=rule[0],
         n_factorizations=int(used["n_factorizations"]),
         n_analyses=int(used["n_analyses"]),
