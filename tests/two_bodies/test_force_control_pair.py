@@ -141,3 +141,23 @@ def test_two_bodies_held_only_by_each_other_are_refused():
     })  # fmt: skip
     with pytest.raises(ProblemError, match="neither is held in all its rigid motions"):
         ContactProblem(mesh=mesh, material=MATERIALS, conditions=conditions)
+
+
+def test_the_loaded_block_may_be_the_master_of_the_pair():
+    """The support [0.3, 0.7] x [0, 1] narrower than the block: it is the slave, the free
+    block the master; the free motion's normal component at a constraint is then the
+    master's transferred motion (−r·n through T_d)."""
+    mesh = union({"a": block(), "b": rectangle(0.3, 0.7, 0.0, 1.0, 3, 5)})
+    conditions = {p: Neumann() for p in mesh.part_names if p != "a.bottom"}
+    conditions.update({
+        "a.top": Neumann(load),
+        "a.guide": Dirichlet((0.0, None)),
+        "b.top": Contact(master="a.bottom"),
+        "b.bottom": Dirichlet((0.0, 0.0)),
+    })  # fmt: skip
+    problem = ContactProblem(mesh=mesh, material=MATERIALS, conditions=conditions)
+    assert problem.rigid_parts == ("a.top",)
+    r = solve(problem)
+    assert r.report.kkt.max < 1e-10, r.report.kkt
+    assert r.total_contact_force == pytest.approx(LOAD_Y, rel=1e-12)
+    assert r.active.all()
