@@ -1,6 +1,6 @@
 """Coulomb friction by the fixed point on its slip bound: the fallback of the semismooth Newton
-method where its node states cycle (docs/method.md, *Friction*, "When Coulomb's iteration
-cycles").
+method where its node states cycle, one node at a time too (docs/method.md, *When the
+iteration cycles*).
 
 Coulomb's problem is a fixed point of Tresca's: with the slip bound ``s = F Λ_n`` given, the
 problem is the classical Tresca problem (a convex minimisation, bound on every node), whose
