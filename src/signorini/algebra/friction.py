@@ -321,7 +321,8 @@ def _iterate(
     Raises
     ------
     FrictionConvergenceError
-        On cycling or at ``max_iter``.
+        On cycling (also at ``max_iter`` one node at a time, after a cycle) or at
+        ``max_iter``.
     """
     p = system.problem
     history: list[FrictionStep] = []
@@ -359,6 +360,9 @@ def _iterate(
         seen[key] = it + 1
         previous, states = states, new
     message = f"the frictional active set iteration did not converge in max_iter = {max_iter}"
+    if single:  # each step changes one node: a larger bound may be all it needs
+        message += " (its states cycled, and it went on one node at a time: raise max_iter)"
     raise FrictionConvergenceError(
-        message, history, "max_iter", x, node_state(*states), states[2].astype(np.int8)
-    )
+        message, history, "cycling" if single else "max_iter", x, node_state(*states),
+        states[2].astype(np.int8),
+    )  # fmt: skip

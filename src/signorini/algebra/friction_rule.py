@@ -117,9 +117,11 @@ def multipliers(p: FrictionProblem, x: np.ndarray, states: States) -> tuple[np.n
 
 def one_change(states: States, new: States) -> States:
     """``states`` with the first node whose state or direction differs in ``new`` given
-    its new ones: the least-index rule of Murty's principal pivoting method, which cannot
-    cycle on a P-matrix complementarity problem (Murty [1]_), used by the iteration once its
-    states have cycled (:func:`~.friction._iterate`). A fixed point of it is one of the rule.
+    its new ones, a slipping node whose direction reverses sticking first (the friction
+    force goes from one bound of ``[−s, s]`` to the other through the inside): the
+    least-index rule of Murty's principal pivoting method, which cannot cycle on a P-matrix
+    complementarity problem (Murty [1]_), used by the iteration once its states have cycled
+    (:func:`~.friction._iterate`). A fixed point of it is one of the rule.
 
     References
     ----------
@@ -128,7 +130,9 @@ def one_change(states: States, new: States) -> States:
     """
     changed = (states[0] != new[0]) | (states[1] != new[1]) | (states[2] != new[2])
     first = np.flatnonzero(changed)[:1]
-    out = tuple(a.copy() for a in states)
-    for a, b in zip(out, new, strict=True):  # the three state arrays
-        a[first] = b[first]
-    return out
+    active, stick, direction = (a.copy() for a in states)
+    active[first], stick[first], direction[first] = new[0][first], new[1][first], new[2][first]
+    # a slip that reverses passes through stick: the force moves from one bound to the other
+    flip = (direction[first] == -states[2][first]) & (states[2][first] != 0)
+    stick[first[flip]], direction[first[flip]] = True, 0.0
+    return active, stick, direction
