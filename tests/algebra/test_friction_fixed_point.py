@@ -26,7 +26,7 @@ from signorini.algebra.friction_result import SLIP, STICK, FrictionConvergenceEr
 from signorini.algebra.friction_system import CoupledSystem
 from signorini.algebra.inexact import InexactRule
 from signorini.algebra.superlu import superlu_solver
-from signorini.problem.friction import Coulomb
+from signorini.problem.friction import Coulomb, Tresca
 
 COEFFICIENT = 0.2
 
@@ -120,3 +120,24 @@ def test_a_fixed_point_that_does_not_finish_says_what_to_do():
         fixed_point_only(p, max_iter=2)
     assert "did not reach the KKT tolerance" in str(err.value)
     assert err.value.reason == "cycling"
+
+
+def test_classical_tresca_that_cycles_finishes_one_node_at_a_time(caplog):
+    """Classical Tresca (a convex problem) with a constant c a hundred times the mean
+    diagonal: the slip directions flip back and forth, and one node at a time, a reversing
+    slip sticking first, ends at the minimiser the default c finds."""
+    S = pressed_block(8, 4, shift=0.02)
+    system = (S.K, S.F, S.normal, S.tangent, S.gap, S.dirichlet, S.dirichlet_values)
+    free = check_friction(*system, laws=Tresca(0.0), weight=0.0)
+    bound = 0.3 * solve_friction(free).multiplier_n.max()
+    p = check_friction(*system, laws=Tresca(0.0), weight=bound)
+    reference = solve_friction(p)
+    with caplog.at_level(logging.INFO, logger="signorini.algebra.friction"):
+        r = solve_friction(
+            p, options=FrictionOptions(c=100 * float(S.K.diagonal()[S.normal].mean()))
+        )
+    assert "one node at a time" in caplog.text
+    assert r.symmetric and r.method == "semismooth-newton"
+    assert r.kkt.max < 1e-12, r.kkt
+    assert rel(r.x, reference.x) < 1e-12, rel(r.x, reference.x)
+    assert np.array_equal(r.state, reference.state)
