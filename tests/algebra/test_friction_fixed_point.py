@@ -141,3 +141,18 @@ def test_classical_tresca_that_cycles_finishes_one_node_at_a_time(caplog):
     assert r.kkt.max < 1e-12, r.kkt
     assert rel(r.x, reference.x) < 1e-12, rel(r.x, reference.x)
     assert np.array_equal(r.state, reference.state)
+
+
+def test_a_tresca_bound_in_contact_only_that_cycles_says_what_to_do():
+    """Tresca acting only in contact jumps where Λ_n vanishes: on 16 x 8 squares it cycles
+    one node at a time too, and the error names the law that does not."""
+    S = pressed_block(16, 8, shift=0.005)
+    system = (S.K, S.F, S.normal, S.tangent, S.gap, S.dirichlet, S.dirichlet_values)
+    free = check_friction(*system, laws=Tresca(0.0), weight=0.0)
+    bound = 0.3 * solve_friction(free).multiplier_n.max()
+    p = check_friction(*system, laws=Tresca(0.0, everywhere=False), weight=bound)
+    with pytest.raises(FrictionConvergenceError, match="one node at a time too") as err:
+        solve_friction(p)
+    assert "Tresca(..., everywhere=True)" in str(err.value) and err.value.reason == "cycling"
+    classical = solve_friction(check_friction(*system, laws=Tresca(0.0), weight=bound))
+    assert classical.kkt.max < 1e-12

@@ -261,6 +261,19 @@ def solve_friction(
 # ----------------------------------------------------------------------------------------------
 
 
+def _cycle_hint(p: FrictionProblem) -> str:
+    """What to do where the iteration cycles one node at a time too."""
+    law = p.friction
+    in_contact = p.symmetric and bool((law.can_rub & ~law.everywhere).any())
+    return (
+        "A Tresca bound acting only in contact is discontinuous where the contact force "
+        "vanishes: the classical law, Tresca(..., everywhere=True), is not; else apply the "
+        "load in more steps"
+        if in_contact
+        else "Apply the load in more steps"
+    ) + " (a load path: docs/method.md, *Load paths*)"
+
+
 def _rule_constants(problem: FrictionProblem, c: float | None) -> tuple[float, float]:
     """``(c, d)``: the constant of the update rule (given, or :data:`C_FACTOR`
     ``d``) and the mean diagonal ``d`` of ``K`` over the normal DOFs (1 without nodes)."""
@@ -352,7 +365,8 @@ def _iterate(
         if key in seen:
             message = (
                 f"the frictional active set iteration cycles: the states computed in iteration "
-                f"{it} are the ones iteration {seen[key]} used"
+                f"{it} are the ones iteration {seen[key]} used, one node at a time too. "
+                + _cycle_hint(p)
             )
             raise FrictionConvergenceError(
                 message, history, "cycling", x, node_state(*states), states[2].astype(np.int8)
