@@ -273,12 +273,16 @@ def test_body_labels_are_the_unions_order_on_every_level(example):
     assert swapped >= 2  # the cells' order did change (a lower cell first)
 
 
-def test_body_held_only_by_its_pair_is_refused():
+def test_body_held_only_by_its_pair_is_under_force_control():
     """The upper block on a roller only (its vertical motion held by nothing but the pair)
-    is refused before any work, naming the body's parts."""
-    with pytest.raises(ProblemError, match=r"held by its own Dirichlet and Roller parts in 2"):
-        two_blocks({"a.top": Neumann((0.0, -1.0)), "a.left": Dirichlet((0.0, None)),
-                    "a.bottom": Contact(master="b.top"), "b.top": None})  # fmt: skip
+    is under force control: the pair carries the load on its top
+    (tests/two_bodies/test_force_control_pair.py checks it further)."""
+    problem = two_blocks({"a.top": Neumann((0.0, -1.0)), "a.left": Dirichlet((0.0, None)),
+                          "a.bottom": Contact(master="b.top"), "b.top": None})  # fmt: skip
+    assert problem.rigid_motions.shape == (1, 3)
+    result = solve(problem)
+    assert result.total_contact_force == pytest.approx(1.0, rel=1e-12)
+    assert result.report.kkt.max < 1e-10
 
 
 def sheared_blocks(friction) -> ContactProblem:

@@ -21,6 +21,10 @@ linear system of these states (:mod:`.friction_system`) and updates them with th
 the semismooth Newton step for the equations ``Λ_n = max(0, Λ_n + c (x_n − g))`` and
 ``Λ_t = P_[−s, s](Λ_t + c (x_t − x_ref))``, of which in 2D the slip branch ``Λ_t = σ s`` is
 linear. It stops when the states repeat, and then checks the KKT residuals of both laws.
+Once the states cycle, each iteration changes one node only (the least-index rule,
+:func:`~.friction_rule.one_change`); where Coulomb's states cycle even so, the fixed point
+on its slip bound finishes the solve (:mod:`.friction_fixed_point`; docs/method.md, *When
+the iteration cycles*).
 The constant ``c`` is :data:`C_FACTOR` times the mean diagonal of ``K`` over the normal DOFs,
 not the diagonal itself as in :func:`~.pdas.solve_pdas`: it only decides whether a node
 slipping against its force sticks (small ``c``) or flips its direction (large ``c``), and
@@ -50,6 +54,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .backends import make_solver
+from .friction_fixed_point import solve_by_fixed_point
 from .friction_kkt import FrictionProblem, friction_kkt
 from .friction_result import (
     INACTIVE,
@@ -58,6 +63,15 @@ from .friction_result import (
     FrictionConvergenceError,
     FrictionResult,
     FrictionStep,
+)
+from .friction_rule import (
+    States,
+    iteration_step,
+    multipliers,
+    node_state,
+    one_change,
+    states_key,
+    update_states,
 )
 from .friction_system import CoupledSystem, SymmetricSystem, friction_system
 from .inexact import InexactRule
@@ -72,13 +86,6 @@ logger = logging.getLogger(__name__)
 #: the normal DOFs (docs/method.md, *Friction*). Measured on the pressed block of the tests
 #: (65-129 nodes, Tresca and Coulomb): 10⁻² to 10⁻⁸ give the same iterations; 1 cycles.
 C_FACTOR = 1e-6
-
-#: Relative band in which a node keeps its state (as ``_ACTIVE_RTOL`` in :mod:`.pdas`): where
-#: ``|Λ_n + c (x_n − g)|`` or ``| |Λ_t + c (x_t − x_ref)| − s |`` is at most this times
-#: ``max(max |F|, c max |x|)``, both states satisfy the laws to round-off.
-_STATE_RTOL = 1e-9
-
-States = tuple[np.ndarray, np.ndarray, np.ndarray]  # active, stick (m,) bool; direction (m,)
 
 
 @dataclass(frozen=True)
@@ -173,6 +180,7 @@ def solve_friction(
         If a system is singular.
     """
     t_start = time.perf_counter()
+    method, inner_assembly = "semismooth-newton", 0.0
     if not isinstance(problem, FrictionProblem):
         raise ValueError(
             f"problem must be a FrictionProblem (from check_friction), got {type(problem).__name__}"
@@ -189,7 +197,17 @@ def solve_friction(
     try:
         system = friction_system(problem, solver)
         with InexactRule(solver) as inexact:  # an iterative solver's stopping rule
-            x, states, history = _iterate(system, states, rule, options.max_iter, inexact)
+            try:
+                x, states, history = _iterate(system, states, rule, options.max_iter, inexact)
+            except FrictionConvergenceError as failed:
+                if failed.reason != "cycling" or system.symmetric:
+                    raise
+                # Coulomb's states cycle: the fixed point on its slip bound finishes
+                x, states, history, inner_assembly = solve_by_fixed_point(
+                    system, failed, (rule, _rule_constants(problem, None)), options,
+                    lambda *args: _iterate(*args, inexact),
+                )  # fmt: skip
+                method = "fixed-point"
     finally:
         used = {key: value - before[key] for key, value in solver_usage(solver).items()}
         backend_name = solver.backend
@@ -202,15 +220,16 @@ def solve_friction(
             f"the states repeat, but the KKT residual {kkt.max:.2e} exceeds {options.kkt_tol:.0e}"
         )
         direction = direction.astype(np.int8)
-        raise FrictionConvergenceError(message, history, "kkt", x, _state(*states), direction)
-    multiplier_n, multiplier_t = _multipliers(problem, x, states)
+        raise FrictionConvergenceError(message, history, "kkt", x, node_state(*states), direction)
+    multiplier_n, multiplier_t = multipliers(problem, x, states)
     times = {key: used[key] for key in ("analysis", "factorization", "solve")}
-    times["assembly"] = system.time_assembly
+    times["assembly"] = system.time_assembly + inner_assembly
     times["total"] = time.perf_counter() - t_start
-    state = _state(active, stick, direction)
+    state = node_state(active, stick, direction)
     logger.info(
-        "friction (%s systems): %d solves, stick %d, slip %d of %d nodes, KKT residual %.2e",
+        "friction (%s systems, %s): %d solves, stick %d, slip %d of %d nodes, KKT residual %.2e",
         "symmetric" if system.symmetric else "non-symmetric",
+        method,
         len(history),
         int((state == STICK).sum()),
         int((state == SLIP).sum()),
@@ -229,6 +248,7 @@ def solve_friction(
         kkt=kkt,
         backend=backend_name,
         symmetric=system.symmetric,
+        method=method,
         c_scale=rule[0],
         n_factorizations=int(used["n_factorizations"]),
         n_analyses=int(used["n_analyses"]),
@@ -239,6 +259,19 @@ def solve_friction(
 # ----------------------------------------------------------------------------------------------
 # The steps of solve_friction
 # ----------------------------------------------------------------------------------------------
+
+
+def _cycle_hint(p: FrictionProblem) -> str:
+    """What to do where the iteration cycles one node at a time too."""
+    law = p.friction
+    in_contact = p.symmetric and bool((law.can_rub & ~law.everywhere).any())
+    return (
+        "A Tresca bound acting only in contact is discontinuous where the contact force "
+        "vanishes: the classical law, Tresca(..., everywhere=True), is not; else apply the "
+        "load in more steps"
+        if in_contact
+        else "Apply the load in more steps"
+    ) + " (a load path: docs/method.md, *Load paths*)"
 
 
 def _rule_constants(problem: FrictionProblem, c: float | None) -> tuple[float, float]:
@@ -266,7 +299,7 @@ def _initial_states(
             return none[0], law.can_rub & law.everywhere, none[2]
         x = check_vector(x0, problem.qp.n, "x0")
         r = problem.qp.F - problem.qp.matvec(x)
-        return _update(problem, rule, x, r[problem.normal], r[problem.tangent], none)
+        return update_states(problem, rule, x, r[problem.normal], r[problem.tangent], none)
     state = np.asarray(state0)
     if state.shape != (m,) or not np.isin(state, (INACTIVE, STICK, SLIP)).all():
         raise ValueError(f"state0 must have shape ({m},) and hold INACTIVE, STICK or SLIP")
@@ -301,20 +334,23 @@ def _iterate(
     Raises
     ------
     FrictionConvergenceError
-        On cycling or at ``max_iter``.
+        On cycling (also at ``max_iter`` one node at a time, after a cycle) or at
+        ``max_iter``.
     """
     p = system.problem
     history: list[FrictionStep] = []
-    seen = {_key(states): 1}
-    previous = states
+    seen = {states_key(states): 1}
+    previous, single = states, False
     for it in range(1, max_iter + 1):
         x = system.solve(*states)
-        history.append(_step(it, previous, states))
+        history.append(iteration_step(it, previous, states))
         logger.debug("friction %s", history[-1])
-        lam_n, lam_t = _multipliers(p, x, states)
-        new = _update(p, rule, x, lam_n, lam_t, states)
-        key = _key(new)
-        if key == _key(states):
+        lam_n, lam_t = multipliers(p, x, states)
+        new = update_states(p, rule, x, lam_n, lam_t, states)
+        if single:
+            new = one_change(states, new)
+        key = states_key(new)
+        if key == states_key(states):
             if inexact.stop():
                 return x, states, history
             seen, previous = {key: it + 1}, states  # solve them again, tightly
@@ -322,102 +358,25 @@ def _iterate(
         if key in seen and not inexact.tight:  # a cycle of loose solves: go on tightly
             inexact.tighten()
             seen = {}
+        if key in seen and not single:  # a cycle: from here on one node at a time
+            logger.info("friction: the states cycle at iteration %d; one node at a time", it)
+            single, new = True, one_change(states, new)
+            key, seen = states_key(new), {states_key(states): it}
         if key in seen:
             message = (
                 f"the frictional active set iteration cycles: the states computed in iteration "
-                f"{it} are the ones iteration {seen[key]} used"
+                f"{it} are the ones iteration {seen[key]} used, one node at a time too. "
+                + _cycle_hint(p)
             )
             raise FrictionConvergenceError(
-                message, history, "cycling", x, _state(*states), states[2].astype(np.int8)
+                message, history, "cycling", x, node_state(*states), states[2].astype(np.int8)
             )
         seen[key] = it + 1
         previous, states = states, new
     message = f"the frictional active set iteration did not converge in max_iter = {max_iter}"
+    if single:  # each step changes one node: a larger bound may be all it needs
+        message += " (its states cycled, and it went on one node at a time: raise max_iter)"
     raise FrictionConvergenceError(
-        message, history, "max_iter", x, _state(*states), states[2].astype(np.int8)
-    )
-
-
-def _update(
-    p: FrictionProblem,
-    rule: tuple[float, float],
-    x: np.ndarray,
-    lam_n: np.ndarray,
-    lam_t: np.ndarray,
-    states: States,
-) -> States:
-    """The update rule (module docstring) with a round-off band.
-
-    A node keeps its state where the decision is round-off. Of the two terms of
-    ``Λ_n + c (x_n − g)`` and of ``Λ_t + c (x_t − x_ref)``, one is imposed exactly by the last
-    solve and the other is computed, so the band is that of the computed one:
-    :data:`_STATE_RTOL` ``max(max |F|, d max |x|)`` for a residual ``Λ`` (as in :mod:`.pdas`),
-    ``c`` :data:`_STATE_RTOL` ``max |x|`` for a displacement.
-
-    Parameters
-    ----------
-    p : FrictionProblem
-    rule : (c, d)
-        The constant of the rule and the mean diagonal of ``K`` over the normal DOFs.
-    x : (n,) float array
-        The last iterate.
-    lam_n, lam_t : (m,) float arrays
-        Its multipliers (``lam_n`` zero off contact, ``lam_t`` its imposed value off stick).
-    states : the states of the last solve
-
-    Returns
-    -------
-    active, stick : (m,) bool arrays
-    direction : (m,) float array
-        ±1 where slipping with a positive bound, 0 elsewhere.
-    """
-    active, stick, direction = states
-    c, d = rule
-    scale_x = np.abs(x).max(initial=0.0)
-    band_force = _STATE_RTOL * max(np.abs(p.qp.F).max(initial=0.0), d * scale_x)
-    band_disp = c * _STATE_RTOL * scale_x
-    value_n = lam_n + c * (x[p.normal] - p.gap)
-    band_n = np.where(active, band_force, band_disp)
-    new_active = np.where(np.abs(value_n) <= band_n, active, value_n > 0)
-    s = p.slip_bound(value_n, new_active)
-    acts = p.friction.everywhere | new_active
-    y = lam_t + c * (x[p.tangent] - p.reference)
-    margin = np.abs(y) - s
-    band_t = np.where(stick, band_force, band_disp)
-    new_stick = np.where(np.abs(margin) <= band_t, stick, margin < 0) & acts
-    slip = acts & ~new_stick & p.friction.can_rub
-    new_direction = np.where(slip, np.where(np.abs(y) > band_t, np.sign(y), direction), 0.0)
-    return new_active, new_stick, new_direction
-
-
-def _key(states: States) -> bytes:
-    active, stick, direction = states
-    return active.tobytes() + stick.tobytes() + direction.astype(np.int8).tobytes()
-
-
-def _state(active: np.ndarray, stick: np.ndarray, direction: np.ndarray) -> np.ndarray:
-    """INACTIVE / STICK / SLIP per node, (m,) int8."""
-    state = np.where(stick, STICK, SLIP).astype(np.int8)
-    state[~active] = INACTIVE
-    return state
-
-
-def _step(iteration: int, previous: States, states: States) -> FrictionStep:
-    state = _state(*states)
-    changed = (state != _state(*previous)) | (states[2] != previous[2])
-    return FrictionStep(
-        iteration=iteration,
-        n_inactive=int((state == INACTIVE).sum()),
-        n_stick=int((state == STICK).sum()),
-        n_slip=int((state == SLIP).sum()),
-        n_changed=int(changed.sum()),
-    )
-
-
-def _multipliers(p: FrictionProblem, x: np.ndarray, states: States) -> tuple[np.ndarray, ...]:
-    """``Λ_n`` (0 off contact) and ``Λ_t`` (its imposed value off stick), (m,) each."""
-    active, stick, direction = states
-    r = p.qp.F - p.qp.matvec(x)
-    multiplier_n = np.where(active, r[p.normal], 0.0)
-    imposed = direction * p.slip_bound(multiplier_n, active)
-    return multiplier_n, np.where(stick, r[p.tangent], imposed)
+        message, history, "cycling" if single else "max_iter", x, node_state(*states),
+        states[2].astype(np.int8),
+    )  # fmt: skip

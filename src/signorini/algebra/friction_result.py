@@ -79,6 +79,10 @@ class FrictionResult(SolveReport):
         ±1 where it slips.
     symmetric : bool
         Whether the systems were symmetric (every law with ``s' = 0``: Cholesky) or not (LU).
+    method : str
+        ``"semismooth-newton"``, or ``"fixed-point"`` where Coulomb's node states cycled and
+        the fixed point on its slip bound finished the solve (:mod:`.friction_fixed_point`;
+        ``iterations`` counts the solves of both).
     """
 
     kkt: FrictionKKT
@@ -87,6 +91,7 @@ class FrictionResult(SolveReport):
     state: np.ndarray
     direction: np.ndarray
     symmetric: bool
+    method: str = "semismooth-newton"
 
     FORCES: ClassVar[tuple[str, ...]] = ("multiplier_n", "multiplier_t")
 

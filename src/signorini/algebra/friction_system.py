@@ -21,6 +21,7 @@ sparsity pattern per call, so the solver analyses it once.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -206,6 +207,17 @@ class CoupledSystem:
         x[fixed] = values[fixed]
         self.factored = (fixed.copy(), row_factor)
         return x
+
+    def rebound(self, bound: np.ndarray) -> None:
+        """Make the slip bounds of a system whose laws all have ``s' = 0`` the weights
+        ``bound (m,)`` of its laws (:class:`~.friction_fixed_point.GivenBound`): only the
+        loads of later solves change, the factorization and the pattern are kept."""
+        if self.derivative.any():
+            raise ValueError("rebound needs laws with s' = 0 at every node")
+        friction = replace(self.problem.friction, weight=np.asarray(bound, dtype=np.float64))
+        self.problem = replace(self.problem, friction=friction)
+        m = self.problem.m
+        self.offset = self.problem.slip_bound(np.zeros(m), np.ones(m, dtype=bool))
 
     def _solve_updated(
         self, rhs: np.ndarray, row_factor: np.ndarray, changed: np.ndarray

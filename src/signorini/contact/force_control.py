@@ -16,12 +16,13 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import nnls
 
+from ..mesh.bodies import body_of_cells
 from ..problem.fields import DATA_MAX, ProblemError
 from ..problem.rigid import describe_motion, motion_field
 from .node_frames import to_frames
 from .system import Assembled
 
-__all__ = ["check_load_carried", "initial_active_set"]
+__all__ = ["check_load_carried", "initial_active_set", "motion_fields"]
 
 #: relative size below which the load's work along a free motion, or the misfit of its
 #: balance by contact forces, is zero (the load's own scale: Σ |F_i| |r_i|)
@@ -29,6 +30,26 @@ LOAD_RTOL = 1e-10
 #: the load must stay balanced by contact forces when moved by this much (relative to its
 #: scale) along each free motion: strictly inside the cone of contact forces
 STRICT_RTOL = 1e-6
+
+
+def motion_fields(problem, assembled: Assembled) -> np.ndarray:
+    """The free rigid motions of ``problem`` at the P2 nodes of ``assembled``, ``(k,
+    n_nodes, 2)``, as the unknowns the constraints bound: each zero off its body where the
+    problem has contact pairs (``problem.rigid_parts`` names a part of it), and then the
+    relative displacement ``ũ = (I − T_d) u`` of the pairs (docs/method.md, *Two bodies*), so
+    that ``r̃(z)·n_z`` is the motion's normal component at constraint ``z``, a master's
+    motion included, and the load's work ``F̃·r̃ = F·r``."""
+    space, cs = assembled.space, assembled.contact
+    r = motion_field(space.mesh, problem.rigid_motions, space.node_points)
+    if not problem.rigid_parts:
+        return r
+    mesh = space.mesh
+    cell_body = body_of_cells(mesh)
+    node_body = np.zeros(space.n_nodes, dtype=np.int64)
+    node_body[space.cell_nodes.ravel()] = np.repeat(cell_body, space.cell_nodes.shape[1])
+    first_cell = [mesh.edge2cell[mesh.part_edges(p)[0], 0] for p in problem.rigid_parts]
+    r = r * (node_body[None, :] == cell_body[first_cell][:, None])[..., None]
+    return np.stack([cs.relative(ri) for ri in r])  # k ≤ 3 per body
 
 
 def check_load_carried(problem, assembled: Assembled) -> None:
@@ -50,7 +71,7 @@ def check_load_carried(problem, assembled: Assembled) -> None:
     """
     space, cs = assembled.space, assembled.contact
     motions = problem.rigid_motions
-    r = motion_field(space.mesh, motions, space.node_points)  # (k, n_nodes, 2)
+    r = motion_fields(problem, assembled)  # (k, n_nodes, 2)
     nodes, frames = assembled.frame_nodes, assembled.frames
     y = np.stack([to_frames(ri.ravel(), nodes, frames) for ri in r])  # k ≤ 3
     # a load beyond DATA_MAX (E extreme, the loads with it) is divided by a power of 2 near
@@ -108,11 +129,11 @@ def initial_active_set(problem, assembled: Assembled) -> np.ndarray:
     -------
     (k,) bool array over the constraints of ``assembled.contact``.
     """
-    space, cs = assembled.space, assembled.contact
+    cs = assembled.contact
     gap = cs.gap
     first = gap <= gap.min() + 1e-12 * max(np.abs(gap).max(), np.finfo(float).tiny)
     motions = problem.rigid_motions
-    r = motion_field(space.mesh, motions, space.node_points[cs.nodes[first]])
+    r = motion_fields(problem, assembled)[:, cs.nodes[first]]
     along = np.einsum("knc,nc->kn", r, cs.normal[first])
     s = np.linalg.svd(along, compute_uv=False)
     if s.size == motions.shape[0] and s.min() > 1e-9 * max(s.max(), 1.0):

@@ -12,8 +12,11 @@ nodal values at ``[start, end, midpoint]``:
   at the contact force ``Λ_z`` (:mod:`signorini.algebra.laws`; Tresca ``s_z = ∫ s ψ_z``,
   so ``b_z = s_z / w_z``; Coulomb ``F Λ_z``, so ``b_z = F p_z``): ``|p_t,z| ≤ b_z`` is the
   solver's nodal law ``|Λ_t,z| ≤ s_z`` divided by ``w_z``; 0 on frictionless parts;
-- ``u_t(z) = ũ_h(z)·t_z``, ``t_z`` the constraint's tangent (``ContactSet.edge_tangent``),
-  ``ũ_h`` relative to the master with two bodies (``ContactSet.edge_relative``).
+- ``u_t(z) = ũ_h(z)·t_z − u_t,ref(z)``, ``t_z`` the constraint's tangent
+  (``ContactSet.edge_tangent``), ``ũ_h`` relative to the master with two bodies
+  (``ContactSet.edge_relative``), ``u_t,ref`` the reference the law's slip starts from
+  (``ContactResult.tangential_reference``: a load step's previous displacement, a moving
+  obstacle's motion; 0 for one step at rest).
 
 At a Dirichlet end point of Γ_C the stresses are 0 and ``u_t = u_D·t``; its third of the edge
 is given to the edge's midpoint (Dirichlet nodes carry no term).
@@ -53,6 +56,9 @@ def friction_edges(result: ContactResult, unit: float = 1.0) -> FrictionEdges | 
     row = np.maximum(loc, 0)
     tangent = cs.edge_tangent[..., 0, :]
     slip = np.einsum("ejc,ejc->ej", cs.edge_relative(result.u), tangent)
+    # the law acts on the slip from the reference (a load step's previous one, the
+    # obstacle's motion): so does the friction work
+    slip = slip - np.where(inside, result.tangential_reference[row], 0.0)
     return FrictionEdges(
         friction=np.where(inside, result.tangential_pressure[row], 0.0) / unit,
         bound=np.where(inside, bound[row], 0.0) / unit,

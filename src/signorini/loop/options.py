@@ -68,7 +68,10 @@ class AdaptiveOptions:
         friction, the semismooth Newton method from its update rule at that solution).
     fallback : bool
         Where PDAS cycles or reaches its iteration bound, finish that level's solve with the
-        primal active set method instead of raising (:func:`signorini.solve`).
+        primal active set method instead of raising (:func:`signorini.solve`). Frictional
+        solves need no flag: where their states cycle they go on one node at a time, and
+        Coulomb's then by the fixed point on its slip bound (docs/method.md, *When the
+        iteration cycles*).
     solver : SolverFactory or SPDSolver
         The linear solver of every level (:func:`signorini.solve`'s ``solver``): a factory
         makes one per solve, default :func:`~signorini.algebra.auto_solver`; a solver object

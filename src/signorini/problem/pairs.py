@@ -11,9 +11,9 @@ from ..mesh.bodies import body_of_cells
 from ..mesh.mesh import Mesh
 from .conditions import Contact
 from .fields import ProblemError
-from .rigid import motion_conditions, null_motions
+from .rigid import free_rigid_motions
 
-__all__ = ["check_bodies_held", "contact_pairs"]
+__all__ = ["contact_pairs", "pair_rigid_motions"]
 
 
 def contact_pairs(mesh: Mesh, conditions: Mapping[str, object]) -> dict[str, str]:
@@ -60,36 +60,63 @@ def contact_pairs(mesh: Mesh, conditions: Mapping[str, object]) -> dict[str, str
     return pairs
 
 
-def check_bodies_held(
+def pair_rigid_motions(
     mesh: Mesh,
     held: Mapping[str, object],
     pairs: Mapping[str, str],
+    contact_parts: list[str],
     rollers: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
-) -> None:
-    """Each body with a part in a contact pair must have its rigid motions held by its own
-    Dirichlet and Roller parts (a body held only through a pair, under force control, is not
-    supported; docs/method.md, *Two bodies*). ``held``: the parts holding Cartesian
-    components; ``rollers``: the oblique and curved roller parts, each part's vertices and
-    normals there.
+) -> tuple[np.ndarray, tuple[str, ...]]:
+    """The rigid motions of the bodies of a union with contact pairs that their own
+    Dirichlet and Roller parts leave free (docs/method.md, *Force control*, "In a contact
+    pair"): a body may be under force control where the bodies across its pairs are held by
+    their own parts in all 3 rigid motions (a loaded part on a deformable support). ``held``:
+    the parts holding Cartesian components; ``rollers``: the oblique and curved roller parts,
+    each part's vertices and normals there; ``contact_parts``: every part with a
+    :class:`Contact` condition (the slaves and the parts on rigid obstacles).
+
+    Returns
+    -------
+    motions : (k, 3) float array
+        The free motions, each of one body, as :func:`~.rigid.free_rigid_motions` gives them
+        (coefficients in the frame of the whole mesh).
+    parts : tuple of k str
+        For each motion, a boundary part of its body (the body is found from it on any
+        refinement of the mesh).
 
     Raises
     ------
     ProblemError
-        Naming the body (by its parts) and how many rigid motions its own parts leave free.
+        Naming the body (by its parts), if a free body touches across a pair another body
+        that is not held in all its rigid motions by its own parts (two bodies held only by
+        each other), or if a free motion is tangential to every contact part of its body.
     """
-    if not pairs:
-        return
     body = body_of_cells(mesh)
     edge_body = np.full(mesh.n_edges, -1)
     edge_body[mesh.edge_part >= 0] = body[mesh.edge2cell[mesh.edge_part >= 0, 0]]
-    paired = np.concatenate([mesh.part_edges(p) for p in (*pairs, *pairs.values())])
-    for b in np.unique(edge_body[paired]):  # a loop over bodies
-        rank = 3 - null_motions(motion_conditions(mesh, held, rollers, edge_body == b)).shape[0]
-        if rank < 3:
-            parts = [p for p in mesh.part_names if (edge_body[mesh.part_edges(p)] == b).any()]
-            raise ProblemError(
-                f"the body with the parts {parts} is held by its own Dirichlet and Roller "
-                f"parts in {rank} of its 3 rigid motions; a body in a contact pair must be "
-                "held by its own parts (a body held only through its contact with another, "
-                "under force control, is not supported yet): add a Dirichlet or Roller part"
-            )
+    part_body = {p: int(edge_body[mesh.part_edges(p)[0]]) for p in mesh.part_names}
+    masters = set(pairs.values())
+
+    def parts_of(b: int) -> list[str]:
+        return [p for p in mesh.part_names if part_body[p] == b]
+
+    free = {}
+    for b in range(int(body.max(initial=-1)) + 1):  # a loop over bodies
+        own = [p for p in parts_of(b) if p in contact_parts or p in masters]
+        free[b] = free_rigid_motions(mesh, held, own, rollers, on_edges=edge_body == b)
+    for slave, master in pairs.items():  # a loop over pairs
+        a, b = part_body[slave], part_body[master]
+        for loose, other in ((a, b), (b, a)):
+            if free[loose].shape[0] and free[other].shape[0]:
+                raise ProblemError(
+                    f"the bodies with the parts {parts_of(loose)} and {parts_of(other)} "
+                    f"touch in the contact pair {slave!r} / {master!r}, and neither is held "
+                    f"in all its rigid motions by its own Dirichlet and Roller parts: a body "
+                    "under force control needs the body across its pairs held (add a "
+                    "Dirichlet or Roller part to one of them)"
+                )
+    motions = [free[b] for b in free if free[b].shape[0]]
+    if not motions:
+        return np.zeros((0, 3)), ()
+    names = tuple(parts_of(b)[0] for b in free for _ in range(free[b].shape[0]))
+    return np.concatenate(motions), names

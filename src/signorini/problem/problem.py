@@ -32,7 +32,7 @@ from .corners import check_corner_friction
 from .fields import ProblemError, VectorField, check_function
 from .materials import check_materials
 from .normals import straight_normal
-from .pairs import check_bodies_held, contact_pairs
+from .pairs import contact_pairs, pair_rigid_motions
 from .rigid import free_rigid_motions
 from .rollers import check_roller_part, held_nodes, roller_normals
 
@@ -94,7 +94,10 @@ class ContactProblem:
     A body whose rigid motions are held only partly by Dirichlet and Roller parts, the rest
     by its contact parts (semi-coercive: a body under force control), is accepted;
     :attr:`rigid_motions` holds those motions, and the solver checks that the load presses
-    the body onto its contacts along them (docs/method.md, *Force control*).
+    the body onto its contacts along them (docs/method.md, *Force control*). With contact
+    pairs each body's motions are its own, :attr:`rigid_parts` names a boundary part of the
+    body of each, and a body may be under force control where the bodies across its pairs
+    are held by their own parts (a loaded part on a deformable support).
     """
 
     mesh: Mesh
@@ -107,6 +110,7 @@ class ContactProblem:
     held: dict[str, Dirichlet] = field(init=False, repr=False)
     rollers: dict[str, Roller] = field(init=False, repr=False)
     rigid_motions: np.ndarray = field(init=False, repr=False)
+    rigid_parts: tuple[str, ...] = field(init=False, repr=False)
     pairs: dict[str, str] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -158,17 +162,17 @@ class ContactProblem:
         )
         if self.dirichlet_parts:
             _check_components(mesh, self.dirichlet_parts, self.contact_parts)
-        check_bodies_held(mesh, self.held, self.pairs, self._roller_vertices())
-        object.__setattr__(
-            self,
-            "rigid_motions",
-            free_rigid_motions(
-                mesh,
-                self.held,
-                [p for p in self.contact_parts if p not in self.pairs],
-                self._roller_vertices(),
-            ),
-        )
+        if self.pairs:  # each body's own motions (docs/method.md, *Force control*)
+            motions, parts = pair_rigid_motions(
+                mesh, self.held, self.pairs, self.contact_parts, self._roller_vertices()
+            )
+        else:
+            motions, parts = (
+                free_rigid_motions(mesh, self.held, self.contact_parts, self._roller_vertices()),
+                (),
+            )
+        object.__setattr__(self, "rigid_motions", motions)
+        object.__setattr__(self, "rigid_parts", parts)
         _warn_if_slender(mesh)
         normals = {name: self._segment_normal(name) for name in self.contact_parts}
         normals = {name: n for name, n in normals.items() if n is not None}

@@ -108,13 +108,15 @@ def free_rigid_motions(
     held: Mapping[str, object],
     contact_parts: list[str],
     rollers: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
+    on_edges: np.ndarray | None = None,
 ) -> np.ndarray:
     """The rigid motions ``(k, 3)`` (orthonormal coefficients, ``k ≤ 3``) that the held
     components of ``held`` (part name → :class:`~.conditions.Dirichlet`) and the normal
     components held by ``rollers`` (part name → its vertices ``(m, 2)`` and the normals
     ``n (m, 2)`` there: ``r·n = 0``) leave free. A roller on an oblique straight part holds
     the translation along its normal; on a circular arc it leaves the rotation about the
-    centre free.
+    centre free. With ``on_edges`` (a bool mask of the edges), the motions of one body of a
+    union: only its held parts' edges and rollers count (:func:`motion_conditions`).
 
     Raises
     ------
@@ -122,7 +124,7 @@ def free_rigid_motions(
         If a free motion is tangential to every contact part (or there is none): nothing
         holds it. The message names the motion.
     """
-    free = null_motions(motion_conditions(mesh, held, rollers))
+    free = null_motions(motion_conditions(mesh, held, rollers, on_edges))
     if free.shape[0] == 0:
         return free
     normals, mids = [], []
