@@ -9,7 +9,10 @@
 
 All five share one frame (:func:`~signorini.plots.frame.convergence_figure`): log ``N_dof``
 axis, one styled curve per quantity with its fitted slope in the legend, a reference slope
-triangle below the data, exact zeros and round-off on a ``≈0`` strip below the axes.
+triangle below the data, exact zeros and round-off on a ``≈0`` strip below the axes: a
+contribution below ``ROUNDOFF · η_h``, and η_h or a contribution at or below the round-off
+level of η_h (the history's ``eta_roundoff``, docs/method.md, *Round-off*), which is noise
+and gets no slope.
 The slopes are least-squares fits over the finer half of the run in log ``N_dof``
 (:func:`~signorini.plots.slopes.finer_half_slope`), and the legend's title says so.
 A *history* is a mapping from column name to a 1-d array, one entry per level (e.g.
@@ -83,14 +86,17 @@ def plot_error_and_estimator(
     """
     if last is not None:
         check_last(last)
-    h = history_columns(history, ("ndof", "eta", "error_energy"))
+    h = history_columns(history, ("ndof", "eta", "error_energy"), ("eta_roundoff",))
     ndof = h["ndof"]
     if not np.any(np.isfinite(h["error_energy"]) & (h["error_energy"] > 0)):
         raise ValueError(
             "the history has no positive finite error_energy value; plot the "
             "estimator alone with plot_estimator"
         )
-    curves = [Curve.of(key, ndof, h[key], last) for key in ("error_energy", "eta")]
+    curves = [
+        Curve.of("error_energy", ndof, h["error_energy"], last),
+        Curve.of("eta", ndof, h["eta"], last, floor=h.get("eta_roundoff")),
+    ]
     return convergence_figure(
         path, curves, "error, estimator", title=title, note=fit_note([ndof], last)
     )
@@ -194,7 +200,9 @@ def plot_contributions(
     if last is not None:
         check_last(last)
     h = history_columns(
-        history, ("ndof",), (*CONTRIBUTIONS, *FRICTION_CONTRIBUTIONS, "n_stick", "eta")
+        history,
+        ("ndof",),
+        (*CONTRIBUTIONS, *FRICTION_CONTRIBUTIONS, "n_stick", "eta", "eta_roundoff"),
     )
     keys = [k for k in CONTRIBUTIONS if k in h]
     friction = [k for k in FRICTION_CONTRIBUTIONS if k in h]
@@ -209,7 +217,9 @@ def plot_contributions(
     for key in keys:
         v = h[key]
         if np.any(np.isfinite(v)):
-            curves.append(Curve.of(key, h["ndof"], v, last, reference=reference))
+            curves.append(
+                Curve.of(key, h["ndof"], v, last, reference=reference, floor=h.get("eta_roundoff"))
+            )
         else:
             log.warning("estimator contribution %s has no known value; skipped", key)
     return convergence_figure(
@@ -249,8 +259,8 @@ def plot_estimator(
     """
     if last is not None:
         check_last(last)
-    h = history_columns(history, ("ndof", "eta"))
-    curves = [Curve.of("eta", h["ndof"], h["eta"], last)]
+    h = history_columns(history, ("ndof", "eta"), ("eta_roundoff",))
+    curves = [Curve.of("eta", h["ndof"], h["eta"], last, floor=h.get("eta_roundoff"))]
     return convergence_figure(
         path, curves, r"$\eta_h$", title=title, note=fit_note([h["ndof"]], last)
     )
