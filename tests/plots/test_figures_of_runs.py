@@ -59,7 +59,7 @@ def test_every_figure_of_the_examples_is_readable(tmp_path, captured, monkeypatc
     titles = [i["titles"][0] for i in captured if "deformed body" in i["titles"][0]]
     assert titles[1:] == [
         "example-6.2: deformed body\ndisplacement at true scale",
-        "inclined_block: deformed body\ndisplacement \u00d75, obstacle at true scale",
+        "inclined block: deformed body\ndisplacement \u00d75, obstacle at true scale",
     ]
     # the mesh figures: a readable level, the three kinds of boundary marked
     meshes = [i for i in captured if ": mesh, level" in i["titles"][0]]

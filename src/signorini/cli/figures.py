@@ -17,12 +17,15 @@ from .levels import write_levels
 __all__ = ["compare_uniform", "draw_figures", "figures", "figures_command", "pressure_figure"]
 
 
-def figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
-    """The run's figures (:func:`signorini.plots.run_figures.run_figures`)."""
+def figures(
+    example: str, out: Path, last: Level | None = None, name: str | None = None
+) -> list[Path]:
+    """The run's figures (:func:`signorini.plots.run_figures.run_figures`), titled with the
+    problem's ``name`` (default: the last level's problem's)."""
     from ..loop.arrays import level_arrays
     from ..plots.run_figures import run_figures
 
-    return run_figures(example, out, None if last is None else level_arrays(last))
+    return run_figures(example, out, None if last is None else level_arrays(last), name)
 
 
 def figures_command(name: str, out: Path, status) -> list[Path]:
@@ -39,7 +42,7 @@ def figures_command(name: str, out: Path, status) -> list[Path]:
     job = load(name)
     options = AdaptiveOptions.from_record(folder.manifest.get("arguments", {}))
     check_problem(folder, name, job, options, f"figures {name} {out}")
-    return figures(label(name), folder.path)
+    return figures(label(name), folder.path, name=job.problem.name)
 
 
 def pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> list[Path]:
@@ -91,10 +94,12 @@ def compare_uniform(
         return
     say("drawing adaptive against uniform refinement ...")
     histories = {"adaptive": out / "history.csv", "uniform": uni / "history.csv"}
-    written = plots.plot_adaptive_vs_uniform(histories, out / "adaptive_vs_uniform", key="eta")
+    written = plots.plot_adaptive_vs_uniform(
+        histories, out / "adaptive_vs_uniform", key="eta", title=problem.name
+    )
     if problem.exact is not None:
         written += plots.plot_adaptive_vs_uniform(
-            histories, out / "adaptive_vs_uniform_error", key="error_energy"
+            histories, out / "adaptive_vs_uniform_error", key="error_energy", title=problem.name
         )
     folder.add_files(*(str(Path(p).relative_to(out)) for p in written))
     say(f"figures: {', '.join(str(p.name) for p in written)}")

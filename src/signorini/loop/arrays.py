@@ -41,7 +41,8 @@ def level_arrays(level: Level) -> dict[str, Any]:
         and ``normal (k, 2)`` n_z; ``obstacle``, each contact part's obstacle outline near
         it (:func:`obstacle_outline`); ``along``, each contact part's constraints and their arc
         length (:func:`arc_lengths`); ``pairs``, the contact pairs between bodies
-        (slave part -> master part; docs/method.md, *Two bodies*); with friction on some
+        (slave part -> master part; docs/method.md, *Two bodies*); ``name``, the problem's
+        name (figure titles); with friction on some
         contact part also ``state (k,)`` as the labels ``"inactive"``, ``"stick"``,
         ``"slip"``, ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)`` p_t,z.
     """
@@ -66,6 +67,7 @@ def level_arrays(level: Level) -> dict[str, Any]:
         "obstacle": obstacle_outline(cs, res.space.node_points, problem.conditions),
         "along": arc_lengths(cs, res.space.node_points),
         "pairs": dict(problem.pairs),
+        "name": problem.name,
     }
     if cs.has_friction:
         arrays["state"] = np.where(

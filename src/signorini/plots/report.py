@@ -33,7 +33,10 @@ def has_known_values(history: Mapping[str, np.ndarray], column: str) -> bool:
 
 
 def make_figures(
-    history_path: str | os.PathLike, out_dir: str | os.PathLike, example_name: str
+    history_path: str | os.PathLike,
+    out_dir: str | os.PathLike,
+    example_name: str,
+    title: str | None = None,
 ) -> list[Path]:
     """The convergence figures of one run, drawn from its ``history.csv``.
 
@@ -55,6 +58,8 @@ def make_figures(
     example_name : str
         Name of the run; files are named ``<example_name>_<figure>.png`` / ``.pdf`` (with
         characters other than letters, digits, ``.``, ``_``, ``-`` replaced by ``_``).
+    title : str, optional
+        Title of every figure (the command line gives the problem's ``name``).
 
     Returns
     -------
@@ -66,10 +71,10 @@ def make_figures(
     out = Path(out_dir)
     written: list[Path] = []
     if has_known_values(history, "error_energy"):
-        written += plot_error_and_estimator(history, out / f"{slug}_error_estimator")
-        written += plot_efficiency(history, out / f"{slug}_efficiency")
+        written += plot_error_and_estimator(history, out / f"{slug}_error_estimator", title=title)
+        written += plot_efficiency(history, out / f"{slug}_efficiency", title=title)
     else:
-        written += plot_estimator(history, out / f"{slug}_estimator")
+        written += plot_estimator(history, out / f"{slug}_estimator", title=title)
     if any(k in history for k in CONTRIBUTIONS):
-        written += plot_contributions(history, out / f"{slug}_contributions")
+        written += plot_contributions(history, out / f"{slug}_contributions", title=title)
     return written

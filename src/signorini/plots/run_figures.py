@@ -45,7 +45,9 @@ class KnownPressure(Protocol):
     title: str
 
 
-def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) -> list[Path]:
+def run_figures(
+    example: str, out: Path, last: Mapping[str, Any] | None = None, name: str | None = None
+) -> list[Path]:
     """The run's convergence figures; with its last level also the mesh and the deformed body.
 
     The mesh figure shows the finest level of at most ``plots.READABLE_CELLS`` cells (read back
@@ -58,7 +60,7 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
     Parameters
     ----------
     example : str
-        The run's name (file names and titles).
+        The run's label (file names; titles when no ``name`` is known).
     out : pathlib.Path
         The run folder, with its ``history.csv``.
     last : mapping, optional
@@ -71,9 +73,16 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         name -> the obstacle's outline at true scale) and ``along`` (part name -> rows and
         arc length); with friction also ``state (k,)`` (labels,
         :data:`~signorini.plots.deformed.NODE_STATES`),
-        ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)``.
+        ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)``; ``name``, the
+        problem's name.
+    name : str, optional
+        The problem's name (:attr:`ContactProblem.name
+        <signorini.problem.problem.ContactProblem.name>`), which every figure's title begins
+        with; default ``last["name"]``, else ``example``.
     """
-    written = list(plots.make_figures(out / "history.csv", out, example))
+    if name is None:
+        name = str(last.get("name", example)) if last is not None else example
+    written = list(plots.make_figures(out / "history.csv", out, example, title=name))
     if last is None:
         return written
     # the level the mesh figure shows
@@ -104,7 +113,7 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         points,
         cells,
         out / "mesh",
-        title=mesh_title(example, level, cells.shape[0], last["level"]),
+        title=mesh_title(name, level, cells.shape[0], last["level"]),
         highlight=plots.boundary_groups(points, cells, segments),
         colors=("#1f77b4", "#2ca02c", "#d62728"),
         **zoom,
@@ -124,7 +133,7 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
             last["contact_points"], last["pressure"], along=last["along"], **friction
         ),
         obstacle=_joined(last["obstacle"].values()),
-        title=f"{example}: deformed bod{'ies' if last.get('pairs') else 'y'}",
+        title=f"{name}: deformed bod{'ies' if last.get('pairs') else 'y'}",
         # bodies in contact pressed together overlap in a magnified drawing
         scale=1.0 if last.get("pairs") else "auto",
     )
