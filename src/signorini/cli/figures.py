@@ -18,14 +18,20 @@ __all__ = ["compare_uniform", "draw_figures", "figures", "figures_command", "pre
 
 
 def figures(
-    example: str, out: Path, last: Level | None = None, name: str | None = None
+    example: str,
+    out: Path,
+    last: Level | None = None,
+    name: str | None = None,
+    element: str | None = None,
 ) -> list[Path]:
     """The run's figures (:func:`signorini.plots.run_figures.run_figures`), titled with the
-    problem's ``name`` (default: the last level's problem's)."""
+    problem's ``name``, the reference slopes of its ``element`` (default: the last level's
+    problem's and element)."""
     from ..loop.arrays import level_arrays
     from ..plots.run_figures import run_figures
 
-    return run_figures(example, out, None if last is None else level_arrays(last), name)
+    arrays = None if last is None else level_arrays(last)
+    return run_figures(example, out, arrays, name, element)
 
 
 def figures_command(name: str, out: Path, status) -> list[Path]:
@@ -42,7 +48,7 @@ def figures_command(name: str, out: Path, status) -> list[Path]:
     job = load(name)
     options = AdaptiveOptions.from_record(folder.manifest.get("arguments", {}))
     check_problem(folder, name, job, options, f"figures {name} {out}")
-    return figures(label(name), folder.path, name=job.problem.name)
+    return figures(label(name), folder.path, name=job.problem.name, element=options.element)
 
 
 def pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> list[Path]:
@@ -81,6 +87,7 @@ def compare_uniform(
     """Uniform refinement to the same budget (with the run's options, but no tolerance), and
     one plot of both convergence histories."""
     from .. import plots
+    from ..plots.slopes import optimal_slope
 
     out = folder.path
     uni = out / "uniform"
@@ -94,12 +101,13 @@ def compare_uniform(
         return
     say("drawing adaptive against uniform refinement ...")
     histories = {"adaptive": out / "history.csv", "uniform": uni / "history.csv"}
+    drawn = {"title": problem.name, "reference_slope": optimal_slope(options.element)}
     written = plots.plot_adaptive_vs_uniform(
-        histories, out / "adaptive_vs_uniform", key="eta", title=problem.name
+        histories, out / "adaptive_vs_uniform", key="eta", **drawn
     )
     if problem.exact is not None:
         written += plots.plot_adaptive_vs_uniform(
-            histories, out / "adaptive_vs_uniform_error", key="error_energy", title=problem.name
+            histories, out / "adaptive_vs_uniform_error", key="error_energy", **drawn
         )
     folder.add_files(*(str(Path(p).relative_to(out)) for p in written))
     say(f"figures: {', '.join(str(p.name) for p in written)}")

@@ -56,12 +56,14 @@ def plot_error_and_estimator(
     path: str | os.PathLike,
     title: str | None = None,
     last: int | None = None,
+    reference_slope: float = -1.0,
 ) -> list[Path]:
     """Fig. 6.1(a): energy error and estimator ``η_h`` (5.1) against ``N_dof``, log-log.
 
     The legend gives the slope of each curve fitted over the finer half of the run
-    (:func:`~signorini.plots.slopes.finer_half_slope`) and states that range; a slope −1
-    triangle (the optimal rate of P2 in 2D, ``N_dof^{-1}``) is drawn below the data.
+    (:func:`~signorini.plots.slopes.finer_half_slope`) and states that range; a triangle of
+    slope ``reference_slope`` (the element's optimal rate in 2D: ``N_dof^{-1}`` for P2,
+    ``N_dof^{-1/2}`` for P1) is drawn below the data.
 
     Parameters
     ----------
@@ -73,6 +75,9 @@ def plot_error_and_estimator(
         Axes title.
     last : int, optional
         Fit the slopes over the last ``last`` levels instead of the finer half of the run.
+    reference_slope : float, default -1.0
+        Slope of the reference triangle: the element's optimal rate
+        (:func:`~signorini.plots.slopes.optimal_slope`: −1 for P2, −1/2 for P1).
 
     Returns
     -------
@@ -98,7 +103,12 @@ def plot_error_and_estimator(
         Curve.of("eta", ndof, h["eta"], last, floor=h.get("eta_roundoff")),
     ]
     return convergence_figure(
-        path, curves, "error, estimator", title=title, note=fit_note([ndof], last)
+        path,
+        curves,
+        "error, estimator",
+        title=title,
+        reference_slope=reference_slope,
+        note=fit_note([ndof], last),
     )
 
 
@@ -168,6 +178,7 @@ def plot_contributions(
     path: str | os.PathLike,
     title: str | None = None,
     last: int | None = None,
+    reference_slope: float = -1.0,
 ) -> list[Path]:
     """Figs. 6.2 / 6.4: the estimator contributions ``η_1 … η_7`` of (5.1) against ``N_dof``,
     and for a frictional run the friction work ``η_8``.
@@ -176,8 +187,8 @@ def plot_contributions(
     :data:`~signorini.plots.frame.ROUNDOFF`; e.g. ``η_7 ≈ 1e-17``), is drawn as a hollow marker
     on the ``≈0`` strip below the log axes and left out of the fitted slope; a term that is
     zero on every level (``η_6``, ``η_7`` in Example 6.1, where the whole contact boundary is
-    active) is listed as ``η_k ≡ 0``. A slope −1 triangle is drawn below the curves and the
-    legend gives each fitted slope over the finer half of the run, and says so.
+    active) is listed as ``η_k ≡ 0``. A ``reference_slope`` triangle is drawn below the
+    curves and the legend gives each fitted slope over the finer half of the run, and says so.
 
     Parameters
     ----------
@@ -191,6 +202,9 @@ def plot_contributions(
         Axes title.
     last : int, optional
         Fit the slopes over the last ``last`` levels instead of the finer half of the run.
+    reference_slope : float, default -1.0
+        Slope of the reference triangle: the element's optimal rate
+        (:func:`~signorini.plots.slopes.optimal_slope`: −1 for P2, −1/2 for P1).
 
     Returns
     -------
@@ -229,6 +243,7 @@ def plot_contributions(
         title=title,
         height=3.4,
         legend="outside lower center",
+        reference_slope=reference_slope,
         note=fit_note([h["ndof"]], last),
     )
 
@@ -238,8 +253,10 @@ def plot_estimator(
     path: str | os.PathLike,
     title: str | None = None,
     last: int | None = None,
+    reference_slope: float = -1.0,
 ) -> list[Path]:
-    """Fig. 6.3(a): the estimator ``η_h`` (5.1) against ``N_dof``, log-log, slope −1 triangle.
+    """Fig. 6.3(a): the estimator ``η_h`` (5.1) against ``N_dof``, log-log, with a triangle of
+    the element's optimal slope (``reference_slope``).
 
     Parameters
     ----------
@@ -250,7 +267,10 @@ def plot_estimator(
     title : str, optional
         Axes title.
     last : int, optional
-        Fit the slope over the last ``last`` levels instead of the finer half of the run.
+        Fit the slopes over the last ``last`` levels instead of the finer half of the run.
+    reference_slope : float, default -1.0
+        Slope of the reference triangle: the element's optimal rate
+        (:func:`~signorini.plots.slopes.optimal_slope`: −1 for P2, −1/2 for P1).
 
     Returns
     -------
@@ -262,7 +282,12 @@ def plot_estimator(
     h = history_columns(history, ("ndof", "eta"), ("eta_roundoff",))
     curves = [Curve.of("eta", h["ndof"], h["eta"], last, floor=h.get("eta_roundoff"))]
     return convergence_figure(
-        path, curves, r"$\eta_h$", title=title, note=fit_note([h["ndof"]], last)
+        path,
+        curves,
+        r"$\eta_h$",
+        title=title,
+        reference_slope=reference_slope,
+        note=fit_note([h["ndof"]], last),
     )
 
 

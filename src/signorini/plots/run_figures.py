@@ -46,14 +46,19 @@ class KnownPressure(Protocol):
 
 
 def run_figures(
-    example: str, out: Path, last: Mapping[str, Any] | None = None, name: str | None = None
+    example: str,
+    out: Path,
+    last: Mapping[str, Any] | None = None,
+    name: str | None = None,
+    element: str | None = None,
 ) -> list[Path]:
     """The run's convergence figures; with its last level also the mesh and the deformed body.
 
     The mesh figure shows the finest level of at most ``plots.READABLE_CELLS`` cells (read back
     from its ``level_NNN.vtu``; the last level when that file is missing or holds another
     mesh), with Γ_D, Γ_N and Γ_C marked. The deformed body is drawn with a stated displacement
-    scale, the obstacle at true scale, the pressure per contact part against its arc length;
+    scale and the obstacle's gaps magnified by it (the obstacle drawn where the drawn body
+    touches it), the pressure per contact part against its arc length;
     with friction its stick and slip nodes marked and the friction stress drawn with the
     pressure.
 
@@ -70,8 +75,9 @@ def run_figures(
         whose parts refinement splits), ``parts`` (part names by kind: ``"dirichlet"``,
         ``"neumann"``, ``"contact"``), and per contact node ``contact_points (k, 2)``,
         ``active (k,)``, ``pressure (k,)``, ``gap (k,)``, ``normal (k, 2)``, ``obstacle`` (part
-        name -> the obstacle's outline at true scale) and ``along`` (part name -> rows and
-        arc length); with friction also ``state (k,)`` (labels,
+        name -> the obstacle's outline at true scale), ``obstacle_offset`` (part name -> the
+        gap vector of each outline point; without it the obstacle is drawn at true scale)
+        and ``along`` (part name -> rows and arc length); with friction also ``state (k,)`` (labels,
         :data:`~signorini.plots.deformed.NODE_STATES`),
         ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)``; ``name``, the
         problem's name.
@@ -79,10 +85,16 @@ def run_figures(
         The problem's name (:attr:`ContactProblem.name
         <signorini.problem.problem.ContactProblem.name>`), which every figure's title begins
         with; default ``last["name"]``, else ``example``.
+    element : {"P2", "P1"}, optional
+        The run's element, whose optimal rate the reference triangles show; default
+        ``last["element"]``, else P2.
     """
-    if name is None:
-        name = str(last.get("name", example)) if last is not None else example
-    written = list(plots.make_figures(out / "history.csv", out, example, title=name))
+    known = {} if last is None else last
+    name = str(known.get("name", example)) if name is None else name
+    element = str(known.get("element", "P2")) if element is None else element
+    written = list(
+        plots.make_figures(out / "history.csv", out, example, title=name, element=element)
+    )
     if last is None:
         return written
     # the level the mesh figure shows
@@ -133,6 +145,10 @@ def run_figures(
             last["contact_points"], last["pressure"], along=last["along"], **friction
         ),
         obstacle=_joined(last["obstacle"].values()),
+        # the obstacle where the drawn body touches it: its gaps magnified with the body
+        obstacle_offset=_joined(last["obstacle_offset"].values())
+        if "obstacle_offset" in last
+        else None,
         title=f"{name}: deformed bod{'ies' if last.get('pairs') else 'y'}",
         # bodies in contact pressed together overlap in a magnified drawing
         scale=1.0 if last.get("pairs") else "auto",

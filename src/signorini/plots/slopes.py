@@ -13,6 +13,7 @@ import numpy as np
 from matplotlib.patches import Polygon
 from numpy.typing import ArrayLike
 
+from ..fem.element import Element, element_of
 from ..output.history import fitted_slope
 from .style import format_number
 
@@ -22,10 +23,18 @@ __all__ = [
     "fit_note",
     "fit_start",
     "finer_half_slope",
+    "optimal_slope",
     "slope_label",
     "steady_slope",
     "triangle_vertices",
 ]
+
+
+def optimal_slope(element: str | Element = "P2") -> float:
+    """The slope of the reference triangle: the optimal rate ``N_dof^{-k/2}`` of the energy
+    error of elements of degree k in 2D (−1 for P2, −1/2 for P1; :attr:`Element.degree
+    <signorini.fem.element.Element.degree>`)."""
+    return -element_of(element).degree / 2.0
 
 
 def fit_start(ndof: ArrayLike) -> float:
