@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from signorini.plots import plot_contributions, plot_estimator
+from signorini.plots import plot_adaptive_vs_uniform, plot_contributions, plot_estimator
 
 
 def noise_history() -> dict[str, np.ndarray]:
@@ -46,3 +46,12 @@ def test_levels_above_the_round_off_level_keep_their_rate(tmp_path, captured):
     plot_estimator(h, tmp_path / "e")
     (info,) = captured
     assert info["legend"] == [r"$\eta_h$, slope −1.00"]
+
+
+def test_adaptive_against_uniform_states_no_rate_for_noise(tmp_path, captured):
+    noise = noise_history()
+    uniform = {key: value[::2] for key, value in noise.items()}
+    plot_adaptive_vs_uniform({"adaptive": noise, "uniform": uniform}, tmp_path / "a")
+    (info,) = captured
+    assert info["legend"][:2] == ["adaptive (noise)", "uniform (noise)"]
+    assert not any("slope" in t for t in info["legend"]) and not info["patches"]

@@ -329,12 +329,16 @@ def plot_adaptive_vs_uniform(
         check_last(last)
     if not isinstance(histories, Mapping) or not histories:
         raise ValueError("histories must be a non-empty mapping from label to history")
-    runs = {str(label): history_columns(h, ("ndof", key)) for label, h in histories.items()}
+    runs = {
+        str(label): history_columns(h, ("ndof", key), ("eta_roundoff",))
+        for label, h in histories.items()
+    }
     curves = [
-        Curve(
-            h["ndof"],
-            h[key],
-            slope_label(label, h["ndof"], h[key], last),
+        _run_curve(
+            label,
+            h,
+            key,
+            last,
             _RUN_COLORS[i % len(_RUN_COLORS)],
             _RUN_MARKERS[i % len(_RUN_MARKERS)],
         )
@@ -351,3 +355,18 @@ def plot_adaptive_vs_uniform(
         reference_slope=reference_slope,
         note=fit_note([h["ndof"] for h in runs.values()], last),
     )
+
+
+def _run_curve(
+    label: str, h: dict[str, np.ndarray], key: str, last: int | None, color: str, marker: str
+) -> Curve:
+    """One run of :func:`plot_adaptive_vs_uniform`; an η at or below its round-off level
+    (``eta_roundoff``) is noise: out of the fit, drawn as :meth:`Curve.of` draws it."""
+    values = h[key]
+    floor = h.get("eta_roundoff") if key.startswith("eta") else None
+    noise = None if floor is None else np.isfinite(values) & (values <= floor)
+    if noise is None or not noise.any():
+        return Curve(h["ndof"], values, slope_label(label, h["ndof"], values, last), color, marker)
+    fitted = np.where(noise, np.nan, values)
+    name = slope_label(label, h["ndof"], fitted, last) if (~noise).any() else f"{label} (noise)"
+    return Curve(h["ndof"], values, name, color, marker, np.zeros(values.shape, bool), noise, floor)
