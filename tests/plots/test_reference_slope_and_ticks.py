@@ -24,13 +24,17 @@ def triangle_slope(info: dict) -> float:
 
 
 def test_the_optimal_slope_follows_the_degree():
-    assert optimal_slope("P2") == -1.0 and optimal_slope("p1") == -0.5
+    from signorini.fem.element import P1, P2
+
+    assert optimal_slope(P2.degree) == -1.0 and optimal_slope(P1.degree) == -0.5
+    with pytest.raises(ValueError, match="degree must be 1"):
+        optimal_slope(3)
 
 
-@pytest.mark.parametrize(("element", "slope", "text"), [("P2", -1.0, "−1"), ("P1", -0.5, "−0.50")])
-def test_make_figures_draw_the_elements_reference_slope(tmp_path, captured, element, slope, text):
+@pytest.mark.parametrize(("degree", "slope", "text"), [(2, -1.0, "−1"), (1, -0.5, "−0.50")])
+def test_make_figures_draw_the_elements_reference_slope(tmp_path, captured, degree, slope, text):
     h = synthetic_history()
-    make_figures(write_csv(tmp_path / "h.csv", h), tmp_path, "run", element=element)
+    make_figures(write_csv(tmp_path / "h.csv", h), tmp_path, "run", degree=degree)
     assert len(captured) == 3  # error and estimator, efficiency, contributions
     for info in (captured[0], captured[2]):
         assert triangle_slope(info) == pytest.approx(slope, rel=1e-12)

@@ -27,11 +27,13 @@ def figures(
     """The run's figures (:func:`signorini.plots.run_figures.run_figures`), titled with the
     problem's ``name``, the reference slopes of its ``element`` (default: the last level's
     problem's and element)."""
+    from ..fem.element import element_of
     from ..loop.arrays import level_arrays
     from ..plots.run_figures import run_figures
 
     arrays = None if last is None else level_arrays(last)
-    return run_figures(example, out, arrays, name, element)
+    degree = None if element is None else element_of(element).degree
+    return run_figures(example, out, arrays, name, degree)
 
 
 def figures_command(name: str, out: Path, status) -> list[Path]:
@@ -87,6 +89,7 @@ def compare_uniform(
     """Uniform refinement to the same budget (with the run's options, but no tolerance), and
     one plot of both convergence histories."""
     from .. import plots
+    from ..fem.element import element_of
     from ..plots.slopes import optimal_slope
 
     out = folder.path
@@ -101,7 +104,8 @@ def compare_uniform(
         return
     say("drawing adaptive against uniform refinement ...")
     histories = {"adaptive": out / "history.csv", "uniform": uni / "history.csv"}
-    drawn = {"title": problem.name, "reference_slope": optimal_slope(options.element)}
+    degree = element_of(options.element).degree
+    drawn = {"title": problem.name, "reference_slope": optimal_slope(degree)}
     written = plots.plot_adaptive_vs_uniform(
         histories, out / "adaptive_vs_uniform", key="eta", **drawn
     )

@@ -45,8 +45,8 @@ def level_arrays(level: Level) -> dict[str, Any]:
         obstacle_offset``, where the magnified body touches it); ``along``, each contact
         part's constraints and their arc length (:func:`arc_lengths`); ``pairs``, the
         contact pairs between bodies (slave part -> master part; docs/method.md, *Two
-        bodies*); ``name``, the problem's name (figure titles), and ``element`` (``"P2"`` or
-        ``"P1"``); with friction on some
+        bodies*); ``name``, the problem's name (figure titles), and ``degree``, the element's
+        (2 for P2, 1 for P1); with friction on some
         contact part also ``state (k,)`` as the labels ``"inactive"``, ``"stick"``,
         ``"slip"``, ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)`` p_t,z.
     """
@@ -72,7 +72,7 @@ def level_arrays(level: Level) -> dict[str, Any]:
         "along": arc_lengths(cs, res.space.node_points),
         "pairs": dict(problem.pairs),
         "name": problem.name,
-        "element": res.space.element.name,
+        "degree": res.space.element.degree,
     }
     if cs.has_friction:
         arrays["state"] = np.where(

@@ -38,7 +38,7 @@ def make_figures(
     out_dir: str | os.PathLike,
     example_name: str,
     title: str | None = None,
-    element: str = "P2",
+    degree: int = 2,
 ) -> list[Path]:
     """The convergence figures of one run, drawn from its ``history.csv``.
 
@@ -62,8 +62,8 @@ def make_figures(
         characters other than letters, digits, ``.``, ``_``, ``-`` replaced by ``_``).
     title : str, optional
         Title of every figure (the command line gives the problem's ``name``).
-    element : {"P2", "P1"}
-        The run's element: the reference triangles have its optimal slope
+    degree : {2, 1}
+        The degree of the run's element: the reference triangles have its optimal slope
         (:func:`~signorini.plots.slopes.optimal_slope`: −1 for P2, −1/2 for P1).
 
     Returns
@@ -75,7 +75,7 @@ def make_figures(
     slug = re.sub(r"[^A-Za-z0-9._-]+", "_", str(example_name)).strip("_.") or "example"
     out = Path(out_dir)
     written: list[Path] = []
-    drawn = {"title": title, "reference_slope": optimal_slope(element)}
+    drawn = {"title": title, "reference_slope": optimal_slope(degree)}
     if has_known_values(history, "error_energy"):
         written += plot_error_and_estimator(history, out / f"{slug}_error_estimator", **drawn)
         written += plot_efficiency(history, out / f"{slug}_efficiency", title=title)

@@ -50,7 +50,7 @@ def run_figures(
     out: Path,
     last: Mapping[str, Any] | None = None,
     name: str | None = None,
-    element: str | None = None,
+    degree: int | None = None,
 ) -> list[Path]:
     """The run's convergence figures; with its last level also the mesh and the deformed body.
 
@@ -85,16 +85,14 @@ def run_figures(
         The problem's name (:attr:`ContactProblem.name
         <signorini.problem.problem.ContactProblem.name>`), which every figure's title begins
         with; default ``last["name"]``, else ``example``.
-    element : {"P2", "P1"}, optional
-        The run's element, whose optimal rate the reference triangles show; default
-        ``last["element"]``, else P2.
+    degree : {2, 1}, optional
+        The degree of the run's element, whose optimal rate the reference triangles show;
+        default ``last["degree"]``, else 2 (P2).
     """
     known = {} if last is None else last
     name = str(known.get("name", example)) if name is None else name
-    element = str(known.get("element", "P2")) if element is None else element
-    written = list(
-        plots.make_figures(out / "history.csv", out, example, title=name, element=element)
-    )
+    degree = int(known.get("degree", 2)) if degree is None else degree
+    written = list(plots.make_figures(out / "history.csv", out, example, title=name, degree=degree))
     if last is None:
         return written
     # the level the mesh figure shows

@@ -13,7 +13,6 @@ import numpy as np
 from matplotlib.patches import Polygon
 from numpy.typing import ArrayLike
 
-from ..fem.element import Element, element_of
 from ..output.history import fitted_slope
 from .style import format_number
 
@@ -30,11 +29,13 @@ __all__ = [
 ]
 
 
-def optimal_slope(element: str | Element = "P2") -> float:
+def optimal_slope(degree: int = 2) -> float:
     """The slope of the reference triangle: the optimal rate ``N_dof^{-k/2}`` of the energy
     error of elements of degree k in 2D (−1 for P2, −1/2 for P1; :attr:`Element.degree
     <signorini.fem.element.Element.degree>`)."""
-    return -element_of(element).degree / 2.0
+    if isinstance(degree, bool) or degree not in (1, 2):
+        raise ValueError(f"degree must be 1 (P1) or 2 (P2), got {degree!r}")
+    return -int(degree) / 2.0
 
 
 def fit_start(ndof: ArrayLike) -> float:
