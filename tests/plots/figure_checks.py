@@ -168,7 +168,8 @@ def layout_faults(fig: Figure, margin_in: float = 0.3) -> list[str]:
 
     - a text or legend that leaves the canvas, even in part (a clipped title);
     - two texts or legends that overlap (an x label under a legend, a legend over the slope
-      triangle's labels); tick labels of one axis are checked against other texts only;
+      triangle's labels, two tick labels of one axis: ``5×10³`` into ``5.5×10³`` on a short
+      log axis);
     - a legend inside the axes over a marker of a curve;
     - an empty horizontal band of the canvas taller than ``margin_in`` inches, between the
       drawn elements or at the top or bottom (a wide body in a tall figure).
@@ -190,8 +191,6 @@ def layout_faults(fig: Figure, margin_in: float = 0.3) -> list[str]:
     for i in range(len(boxes)):
         for j in range(i + 1, len(boxes)):
             (n1, b1), (n2, b2) = boxes[i], boxes[j]
-            if " tick " in n1 and " tick " in n2 and n1.split(" tick ")[0] == n2.split(" tick ")[0]:
-                continue  # two ticks of one axis: matplotlib spaces them
             w = min(b1.x1, b2.x1) - max(b1.x0, b2.x0)
             h = min(b1.y1, b2.y1) - max(b1.y0, b2.y0)
             if w > tol and h > tol:

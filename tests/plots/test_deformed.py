@@ -106,9 +106,10 @@ def test_displacement_scale(size, u_max, scale):
 
 
 @pytest.mark.slow
-def test_obstacle_from_the_gap_is_drawn_at_true_scale(tmp_path, captured):
-    """The surface ``z + ψ(z) n_z`` of the small-deformation model, not scaled with the
-    displacement (which once bent a flat obstacle), and the title says which is scaled."""
+def test_obstacle_from_the_gap_is_drawn_with_the_gaps_scaled(tmp_path, captured):
+    """The surface ``z + ψ(z) n_z`` of the small-deformation model drawn as the drawn body
+    meets it, ``z + s ψ(z) n_z`` (at true scale the magnified body would pass through it, or
+    float above it), and the title says both are scaled."""
     mesh = rectangle(nx=4, ny=4)
     p, c = mesh.points, mesh.cells
     u = np.column_stack([np.zeros(len(p)), -0.5 * (1.0 - p[:, 1])])  # |u| up to 0.5
@@ -120,11 +121,11 @@ def test_obstacle_from_the_gap_is_drawn_at_true_scale(tmp_path, captured):
     )
     (info,) = captured
     assert " ".join(info["titles"][0].split()) == (
-        "deformed body, displacement \u00d70.2, obstacle at true scale"
+        "deformed body, displacement and obstacle gaps \u00d70.2"
     )
-    x, y = info["lines"]["obstacle (true scale)"]
+    x, y = info["lines"]["obstacle, gaps \u00d70.2"]
     np.testing.assert_allclose(x, bottom[::-1, 0])  # ordered along the boundary
-    np.testing.assert_allclose(y, -gap[::-1])
+    np.testing.assert_allclose(y, -0.2 * gap[::-1])
     with pytest.raises(ValueError, match="gap and normal"):
         plot_deformed(p, c, u, tmp_path / "x", ContactDrawing(bottom, gap=gap))
     with pytest.raises(ValueError, match="scale must be"):
@@ -200,8 +201,10 @@ def test_stick_and_slip_nodes_are_marked(tmp_path, captured):
 
 @pytest.mark.slow
 def test_obstacle_from_gaps_is_left_out_where_the_gap_is_far(tmp_path, captured):
-    """A half-disc over a plane: the plane is drawn straight (y = 0, not the parabola
-    ``scale · ψ`` once made of it), only near the contact zone."""
+    """A half-disc over a plane, drawn ten times magnified: the plane where the magnified
+    body meets it, ``x + 10 ψ n`` (the curve ``y = −9 ψ`` the magnified gaps of the curved
+    side trace, through the touching point), only near the contact zone: where the drawn
+    gap ``10 ψ`` is at most 0.1 of the body's size 2 (``MAGNIFIED_REACH``)."""
     theta = np.linspace(np.pi, 2 * np.pi, 41)
     arc = np.column_stack([np.cos(theta), 1 + np.sin(theta)])
     points = np.vstack([[0.0, 1.0], arc])
@@ -216,6 +219,8 @@ def test_obstacle_from_gaps_is_left_out_where_the_gap_is_far(tmp_path, captured)
     (label,) = [k for k in info["lines"] if k.startswith("obstacle")]
     x, y = info["lines"][label]
     shown = np.isfinite(y)
-    assert np.all(gap[shown] <= 0.25 * 2.0) and not shown.all() and shown.any()
-    np.testing.assert_array_equal(y[shown], 0.0)
-    assert info["data_lim"][0].y0 > -0.01  # not down to 1 − 10 · 1 = −9
+    order = np.argsort(arc[:, 0], kind="stable")
+    assert np.all(10.0 * gap[order][shown] <= 0.1 * 2.0) and not shown.all() and shown.any()
+    np.testing.assert_allclose(y[shown], -9.0 * gap[order][shown], rtol=0, atol=1e-15)
+    assert 0.0 in y[shown]  # the touching point, where the body is drawn
+    assert info["data_lim"][0].y0 >= -0.18 - 1e-12  # not down to 1 − 10 · 1 = −9

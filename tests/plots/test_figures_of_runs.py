@@ -49,17 +49,18 @@ def test_every_figure_of_the_examples_is_readable(tmp_path, captured, monkeypatc
     assert figures["adaptive_vs_uniform"]["caption"] == (
         "slopes: least squares on the finer half of each run"
     )
-    # Example 6.1: |u| up to 0.88 on the unit square is drawn shrunk, and the title says so
+    # Example 6.1: |u| up to 0.88 on the unit square is drawn shrunk, the obstacle's gaps
+    # with it (where the drawn body touches it), and the title says so
     e1 = [i for i in captured if i["titles"][0].startswith("example-6.1: deformed")]
     assert e1[0]["titles"][0] == (
-        "example-6.1: deformed body\ndisplacement \u00d70.1, obstacle at true scale"
+        "example-6.1: deformed body\ndisplacement and obstacle gaps \u00d70.1"
     )
-    assert "obstacle (true scale)" in e1[0]["legend"]
+    assert "obstacle, gaps \u00d70.1" in e1[0]["legend"]
     # Example 6.2 (|u| <= 0.2) at true scale, the inclined block (|u| <= 0.03 on 2) magnified
     titles = [i["titles"][0] for i in captured if "deformed body" in i["titles"][0]]
     assert titles[1:] == [
         "example-6.2: deformed body\ndisplacement at true scale",
-        "inclined_block: deformed body\ndisplacement \u00d75, obstacle at true scale",
+        "inclined block: deformed body\ndisplacement and obstacle gaps \u00d75",
     ]
     # the mesh figures: a readable level, the three kinds of boundary marked
     meshes = [i for i in captured if ": mesh, level" in i["titles"][0]]

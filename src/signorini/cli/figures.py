@@ -17,12 +17,23 @@ from .levels import write_levels
 __all__ = ["compare_uniform", "draw_figures", "figures", "figures_command", "pressure_figure"]
 
 
-def figures(example: str, out: Path, last: Level | None = None) -> list[Path]:
-    """The run's figures (:func:`signorini.plots.run_figures.run_figures`)."""
+def figures(
+    example: str,
+    out: Path,
+    last: Level | None = None,
+    name: str | None = None,
+    element: str | None = None,
+) -> list[Path]:
+    """The run's figures (:func:`signorini.plots.run_figures.run_figures`), titled with the
+    problem's ``name``, the reference slopes of its ``element`` (default: the last level's
+    problem's and element)."""
+    from ..fem.element import element_of
     from ..loop.arrays import level_arrays
     from ..plots.run_figures import run_figures
 
-    return run_figures(example, out, None if last is None else level_arrays(last))
+    arrays = None if last is None else level_arrays(last)
+    degree = None if element is None else element_of(element).degree
+    return run_figures(example, out, arrays, name, degree)
 
 
 def figures_command(name: str, out: Path, status) -> list[Path]:
@@ -40,7 +51,7 @@ def figures_command(name: str, out: Path, status) -> list[Path]:
     job = load(name)
     options = AdaptiveOptions.from_record(recorded_arguments(folder.manifest, folder.file))
     check_problem(folder, name, job, options, f"figures {name} {out}")
-    return figures(label(name), folder.path)
+    return figures(label(name), folder.path, name=job.problem.name, element=options.element)
 
 
 def pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> list[Path]:
@@ -81,6 +92,8 @@ def compare_uniform(
     """Uniform refinement to the same budget (with the run's options, but no tolerance), and
     one plot of both convergence histories."""
     from .. import plots
+    from ..fem.element import element_of
+    from ..plots.slopes import optimal_slope
 
     out = folder.path
     uni = folder.sub_folder("uniform")  # refused if it is a link out of the folder
@@ -94,10 +107,14 @@ def compare_uniform(
         return
     say("drawing adaptive against uniform refinement ...")
     histories = {"adaptive": out / "history.csv", "uniform": uni / "history.csv"}
-    written = plots.plot_adaptive_vs_uniform(histories, out / "adaptive_vs_uniform", key="eta")
+    degree = element_of(options.element).degree
+    drawn = {"title": problem.name, "reference_slope": optimal_slope(degree)}
+    written = plots.plot_adaptive_vs_uniform(
+        histories, out / "adaptive_vs_uniform", key="eta", **drawn
+    )
     if problem.exact is not None:
         written += plots.plot_adaptive_vs_uniform(
-            histories, out / "adaptive_vs_uniform_error", key="error_energy"
+            histories, out / "adaptive_vs_uniform_error", key="error_energy", **drawn
         )
     folder.add_files(*(str(Path(p).relative_to(out)) for p in written))
     say(f"figures: {', '.join(str(p.name) for p in written)}")

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..loop import AdaptiveOptions, Level
+from ..loop import AdaptiveOptions, Level, roundoff_text
 from ..output import HistoryWriter, write_vtu
 from ..output.run import RunFolder
 from ..output.vtu import write_pvd
@@ -174,5 +174,7 @@ def write_levels(
             status.phase = f"at level {k + 1}"
         line = progress(level)
         say(line + (clock.lap(level) if clock is not None else ""))
+        if level.record.stop == "round-off":
+            say(f"stopped at level {k}: {roundoff_text(level.record)}")
         last = level
     return last

@@ -191,8 +191,8 @@ def stacked_blocks(
     uniform compression in each block, ``σ_yy = −p`` in both; the contact pressure is ``p``
     everywhere along the interface (docs/method.md, *Two bodies*, the contact patch test;
     :data:`BLOCKS_METRICS` print its deviation per level). The estimator is at round-off on
-    every mesh, so an adaptive run refines noise: ``signorini run stacked-blocks --tol 1e-10``
-    stops at the initial mesh.
+    every mesh, so an adaptive run stops on its first mesh: η_h is below its round-off level
+    (docs/method.md, *Round-off*), and a finer mesh would refine noise.
     """
     n_upper, n_lower = edges
     upper = rectangle(0.0, 1.0, 1.0, 2.0, n_upper, n_upper, pattern="right")

@@ -72,6 +72,12 @@ class Element:
     def __repr__(self) -> str:
         return self.name
 
+    @property
+    def degree(self) -> int:
+        """The polynomial degree k: 2 for P2, 1 for P1. The energy error of a smooth solution
+        (and η_h with it) decays at best like ``h^k``, i.e. ``N_dof^{-k/2}`` in 2D."""
+        return 2 if self.n_local == 6 else 1
+
     def cell_coefficients(self, u_cell: np.ndarray) -> np.ndarray:
         """The P2 coefficients ``(m, 12)`` of fields of this element with interleaved cell
         coefficients ``u_cell (m, 2 n_local)``: unchanged for P2; for P1 the vertex values,

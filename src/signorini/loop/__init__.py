@@ -25,6 +25,7 @@ from ..contact.partition import partition
 from ..contact.solution import ContactResult, solve
 from ..estimator.marking import mark_doerfler
 from ..estimator.residual import Estimate, estimate
+from ..estimator.roundoff import roundoff_level
 from ..fem.space import space_of
 from ..mesh.mesh import Mesh
 from ..mesh.refine import refine_nvb, refine_uniform
@@ -32,7 +33,15 @@ from ..problem.problem import ContactProblem
 from .options import AdaptiveOptions, OptionError, check_count
 from .record import COLUMNS, LevelRecord, level_record
 
-__all__ = ["COLUMNS", "AdaptiveOptions", "Level", "LevelRecord", "OptionError", "adaptive"]
+__all__ = [
+    "COLUMNS",
+    "AdaptiveOptions",
+    "Level",
+    "LevelRecord",
+    "OptionError",
+    "adaptive",
+    "roundoff_text",
+]
 
 log = logging.getLogger(__name__)
 
@@ -82,7 +91,10 @@ def adaptive(
     """Run SOLVE → ESTIMATE → MARK → REFINE, yielding each finished level.
 
     Stops after the level whose refinement would exceed ``max_ndof`` free unknowns, when
-    ``η_h ≤ tol``, or after ``max_levels`` levels (:class:`AdaptiveOptions`). The four
+    ``η_h ≤ tol``, when η_h reaches its round-off level (``η_h ≤``
+    :func:`~signorini.estimator.roundoff.roundoff_level`: the problem is solved to
+    round-off, and finer meshes would refine noise), or after ``max_levels`` levels
+    (:class:`AdaptiveOptions`); the last level's :attr:`LevelRecord.stop` says which. The four
     steps stay in one function (:func:`_levels`, about 50 lines of code) so that the loop
     reads top to bottom as in docs/method.md, *Marking and refinement*. The arguments are
     checked when ``adaptive`` is called, before any work.
@@ -217,7 +229,9 @@ def _levels(
             _add_path_counts(record, steps)
         if metrics is not None:
             record.extra.update(_measured(metrics, result))
-        last = level == options.max_levels - 1 or est.eta <= options.tol
+        record.eta_roundoff = roundoff_level(result)
+        record.stop = _stop_reason(record, options)
+        last = bool(record.stop)
         marked = next_mesh = None
         if not last:
             t0 = time.perf_counter()
@@ -236,6 +250,7 @@ def _levels(
             record.t_refine = time.perf_counter() - t0
             if last:
                 marked = next_mesh = None  # the budget ends the run: this marking is discarded
+                record.stop = "max_ndof"
             else:
                 record.n_marked = int(marked.sum())
         log.info(
@@ -245,6 +260,8 @@ def _levels(
             record.eta,
             record.pdas_iterations,
         )
+        if record.stop == "round-off":
+            log.info("stopped: %s", roundoff_text(record))
         yield Level(record, result, est, marked, next_mesh, u0)
         if last:
             return
@@ -252,6 +269,28 @@ def _levels(
         # here while the next level is solved (whose factorization is the run's memory peak)
         del result, warm, steps, est, marked, refinement
         mesh = next_mesh
+
+
+def _stop_reason(record: LevelRecord, options: AdaptiveOptions) -> str:
+    """Why the loop ends after this level, before refining (:attr:`LevelRecord.stop`): ``"tol"``
+    for ``η_h ≤ tol``, ``"round-off"`` for η_h at its round-off level, ``"max_levels"``;
+    ``""`` to go on (the budget, ``"max_ndof"``, is known only once the mesh is refined)."""
+    if record.eta <= options.tol:
+        return "tol"
+    if record.eta <= record.eta_roundoff:  # False for a NaN level: no level known
+        return "round-off"
+    if record.level == options.max_levels - 1:
+        return "max_levels"
+    return ""
+
+
+def roundoff_text(record: LevelRecord) -> str:
+    """What a run says when it stops at round-off (its log and the command line)."""
+    return (
+        f"eta = {record.eta:.3e} is at the round-off level {record.eta_roundoff:.3e} of this "
+        "problem (docs/method.md, *Round-off*): it is solved to round-off on this mesh, and "
+        "a finer mesh would refine noise; no rate is fitted to noise"
+    )
 
 
 def _estimator_ranks(result: ContactResult, solver: object) -> dict[str, object]:

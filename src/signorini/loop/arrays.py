@@ -18,7 +18,7 @@ from ..fem.element import P1
 if TYPE_CHECKING:
     from . import Level
 
-__all__ = ["arc_lengths", "level_arrays", "obstacle_outline"]
+__all__ = ["arc_lengths", "level_arrays", "obstacle_offset", "obstacle_outline"]
 
 #: Points sampled along each contact edge where the obstacle's outline is drawn.
 OUTLINE_SAMPLES = 9
@@ -39,9 +39,14 @@ def level_arrays(level: Level) -> dict[str, Any]:
         ``"neumann"`` and ``"contact"`` parts; per constraint (k of them)
         ``contact_points (k, 2)``, ``active (k,)``, ``pressure (k,)`` p_z, ``gap (k,)`` ψ(z)
         and ``normal (k, 2)`` n_z; ``obstacle``, each contact part's obstacle outline near
-        it (:func:`obstacle_outline`); ``along``, each contact part's constraints and their arc
-        length (:func:`arc_lengths`); ``pairs``, the contact pairs between bodies
-        (slave part -> master part; docs/method.md, *Two bodies*); with friction on some
+        it (:func:`obstacle_outline`), and ``obstacle_offset``, the gap vector ``ψ n`` from
+        the body's point to each point of the outline (:func:`obstacle_offset`: a drawing of
+        the displacement magnified by s draws the obstacle at ``obstacle + (s − 1)
+        obstacle_offset``, where the magnified body touches it); ``along``, each contact
+        part's constraints and their arc length (:func:`arc_lengths`); ``pairs``, the
+        contact pairs between bodies (slave part -> master part; docs/method.md, *Two
+        bodies*); ``name``, the problem's name (figure titles), and ``degree``, the element's
+        (2 for P2, 1 for P1); with friction on some
         contact part also ``state (k,)`` as the labels ``"inactive"``, ``"stick"``,
         ``"slip"``, ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)`` p_t,z.
     """
@@ -63,9 +68,11 @@ def level_arrays(level: Level) -> dict[str, Any]:
         "pressure": res.pressure,
         "gap": cs.gap,
         "normal": cs.normal,
-        "obstacle": obstacle_outline(cs, res.space.node_points, problem.conditions),
+        **_obstacle_arrays(cs, res.space.node_points, problem.conditions),
         "along": arc_lengths(cs, res.space.node_points),
         "pairs": dict(problem.pairs),
+        "name": problem.name,
+        "degree": res.space.element.degree,
     }
     if cs.has_friction:
         arrays["state"] = np.where(
@@ -94,8 +101,28 @@ def _on_edges(ends: np.ndarray, m: int) -> np.ndarray:
 def obstacle_outline(
     cs: ContactSet, node_points: np.ndarray, conditions: Mapping[str, Any]
 ) -> dict[str, np.ndarray]:
+    """Each contact part's obstacle near the part at true scale (the outline of
+    :func:`obstacle_offset`)."""
+    both = obstacle_offset(cs, node_points, conditions)
+    return {name: outline for name, (outline, _) in both.items()}
+
+
+def _obstacle_arrays(
+    cs: ContactSet, node_points: np.ndarray, conditions: Mapping[str, Any]
+) -> dict[str, dict[str, np.ndarray]]:
+    """``obstacle`` and ``obstacle_offset`` of :func:`level_arrays`."""
+    both = obstacle_offset(cs, node_points, conditions)
+    return {
+        "obstacle": {name: outline for name, (outline, _) in both.items()},
+        "obstacle_offset": {name: offset for name, (_, offset) in both.items()},
+    }
+
+
+def obstacle_offset(
+    cs: ContactSet, node_points: np.ndarray, conditions: Mapping[str, Any]
+) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Each contact part's obstacle near the part at true scale, as a polyline broken by NaN
-    rows.
+    rows, and the gap vector from the part to each of its points.
 
     Along each contact edge, :data:`OUTLINE_SAMPLES` points ``x`` of the (P2) edge are mapped
     to the obstacle: against a shape (:mod:`signorini.problem.obstacles`, a user's
@@ -117,8 +144,13 @@ def obstacle_outline(
     Returns
     -------
     dict
-        Part name -> ``(e * (OUTLINE_SAMPLES + 1), 2)`` float array, ``e`` the part's contact
-        edges: one run of points per edge, a NaN row after each.
+        Part name -> ``(outline, offset)``, two ``(e * (OUTLINE_SAMPLES + 1), 2)`` float
+        arrays, ``e`` the part's contact edges: the outline, one run of points per edge with
+        a NaN row after each, and ``offset = outline − x``, the gap vector ``ψ n`` from the
+        point ``x`` of the edge each outline point belongs to. A drawing that magnifies the
+        displacement by ``s`` draws the body's ``x`` at ``x + s u`` and must draw the
+        obstacle at ``x + s ψ n = outline + (s − 1) offset``: there the magnified body
+        touches it (u·n = ψ), as the true body touches the true obstacle.
     """
     m = OUTLINE_SAMPLES
     size = float(np.ptp(node_points, axis=0).max()) if node_points.size else 0.0
@@ -129,8 +161,8 @@ def obstacle_outline(
         sel = cs.edge_part == i
         out = np.full((int(sel.sum()), m + 1, 2), np.nan)
         obstacle = conditions[name].obstacle
+        x = _on_edges(_p2_edge(node_points[cs.edge_nodes[sel]]), m).reshape(-1, 2)
         if obstacle is not None:
-            x = _on_edges(_p2_edge(node_points[cs.edge_nodes[sel]]), m).reshape(-1, 2)
             g, n = obstacle.gap_and_direction(x)
             out[:, :m] = (x + g[:, None] * n).reshape(-1, m, 2)
             psi = g.reshape(-1, m)
@@ -140,7 +172,9 @@ def obstacle_outline(
             out[:, :m] = _on_edges(ends, m)
             psi = _on_edges(_p2_edge(cs.edge_gap[sel]), m)
         out[:, :m][np.abs(psi) > OUTLINE_REACH * size] = np.nan
-        outline[name] = out.reshape(-1, 2)
+        offset = out.copy()
+        offset[:, :m] -= x.reshape(-1, m, 2)
+        outline[name] = (out.reshape(-1, 2), offset.reshape(-1, 2))
     return outline
 
 

@@ -31,6 +31,8 @@ COLUMNS: dict[str, str] = {
     "error_h1": "H¹ seminorm of u − u_h (only with an exact solution, else nan), "
     "unit of displacement",
     "efficiency": "eta / error_energy (only with an exact solution, else nan), no unit",
+    "eta_roundoff": "the round-off level of eta on this mesh (docs/method.md, *Round-off*): "
+    "an eta at or below it is noise, and the loop stops there; same unit as eta",
     "pdas_iterations": "primal-dual active set iterations",
     "n_solves": "linear solves done by the active set method",
     "n_factorizations": "numerical factorizations of the stiffness matrix",
@@ -46,6 +48,9 @@ COLUMNS: dict[str, str] = {
     "friction every node in contact)",
     "contact_force": "sum of the nodal contact forces Λ_z, unit of force per thickness",
     "n_marked": "cells marked for refinement on this level (0 on the last level)",
+    "stop": "why the run ends after this level, empty on the others: tol (eta <= tol), "
+    "round-off (eta at eta_roundoff), max_ndof (the next mesh would exceed the budget), "
+    "max_levels",
     "kkt_primal": "largest penetration u·n − ψ, relative to the contact's displacement scale "
     "(docs/method.md, *Solver*), no unit",
     "kkt_dual": "largest negative contact force, relative to the total contact force",
@@ -98,6 +103,10 @@ class LevelRecord:
         else NaN.
     efficiency : float
         ``eta / error_energy`` (NaN without an exact solution).
+    eta_roundoff : float
+        The round-off level of η_h on this mesh
+        (:func:`~signorini.estimator.roundoff.roundoff_level`): an η_h at or below it is
+        noise, and the loop stops there.
     pdas_iterations, n_solves, n_factorizations, n_analyses, n_updates : int
         Active set iterations; linear solves; numerical factorizations; symbolic analyses;
         solves done by a low-rank update of an existing factor.
@@ -112,6 +121,9 @@ class LevelRecord:
         Sum of the nodal contact forces Λ_z (force per unit thickness).
     n_marked : int
         Cells marked for refinement (0 on the last level).
+    stop : str
+        Why the loop ends after this level (``""`` on the others): ``"tol"``,
+        ``"round-off"``, ``"max_ndof"`` or ``"max_levels"``.
     kkt_primal, kkt_dual, kkt_complementarity, kkt_stationarity, kkt_dirichlet : float
         The KKT residuals of the discrete problem, each relative to the quantity it is about
         (:class:`signorini.algebra.kkt.KKTResiduals`; docs/method.md, *Solver*); with
@@ -145,6 +157,7 @@ class LevelRecord:
     error_energy: float = math.nan
     error_h1: float = math.nan
     efficiency: float = math.nan
+    eta_roundoff: float = math.nan
     pdas_iterations: int = 0
     n_solves: int = 0
     n_factorizations: int = 0
@@ -159,6 +172,7 @@ class LevelRecord:
     n_slip: int = 0
     contact_force: float = 0.0
     n_marked: int = 0
+    stop: str = ""
     kkt_primal: float = math.nan
     kkt_dual: float = math.nan
     kkt_complementarity: float = math.nan

@@ -9,10 +9,11 @@ so that a figure can be redrawn from the files a run leaves (``history.csv``, me
 - :mod:`.slopes`: fitted slopes in legends (over the finer half of the run, stated in the
   legend; printed only where the curve has a steady rate) and slope triangles;
 - :mod:`.mesh`: a triangulation (Fig. 6.3(b)); :mod:`.deformed`: the deformed body with its
-  obstacles at true scale, and the contact stresses per contact part against arc length
-  (:mod:`.contact_stress`; without arc lengths against the coordinate of
-  :mod:`.contact_line`); :mod:`.pressure`: a computed pressure beside a known one (with
-  friction, the friction stress beside a known one, zoomed on the contact zone);
+  obstacles where the drawn body touches them (their gaps magnified as the displacement is),
+  and the contact stresses per contact part against arc length (:mod:`.contact_stress`;
+  without arc lengths against the coordinate of :mod:`.contact_line`); :mod:`.pressure`: a
+  computed pressure beside a known one (with friction, the friction stress beside a known
+  one, zoomed on the contact zone);
 - :mod:`.report`: the figures a finished run gets, chosen by what its history contains;
   :mod:`.run_figures`: a run folder's figures, from its history and its last level as plain
   arrays.

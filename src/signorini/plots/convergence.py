@@ -9,7 +9,10 @@
 
 All five share one frame (:func:`~signorini.plots.frame.convergence_figure`): log ``N_dof``
 axis, one styled curve per quantity with its fitted slope in the legend, a reference slope
-triangle below the data, exact zeros and round-off on a ``≈0`` strip below the axes.
+triangle below the data, exact zeros and round-off on a ``≈0`` strip below the axes: a
+contribution below ``ROUNDOFF · η_h``, and η_h or a contribution at or below the round-off
+level of η_h (the history's ``eta_roundoff``, docs/method.md, *Round-off*), which is noise
+and gets no slope.
 The slopes are least-squares fits over the finer half of the run in log ``N_dof``
 (:func:`~signorini.plots.slopes.finer_half_slope`), and the legend's title says so.
 A *history* is a mapping from column name to a 1-d array, one entry per level (e.g.
@@ -53,12 +56,14 @@ def plot_error_and_estimator(
     path: str | os.PathLike,
     title: str | None = None,
     last: int | None = None,
+    reference_slope: float = -1.0,
 ) -> list[Path]:
     """Fig. 6.1(a): energy error and estimator ``η_h`` (5.1) against ``N_dof``, log-log.
 
     The legend gives the slope of each curve fitted over the finer half of the run
-    (:func:`~signorini.plots.slopes.finer_half_slope`) and states that range; a slope −1
-    triangle (the optimal rate of P2 in 2D, ``N_dof^{-1}``) is drawn below the data.
+    (:func:`~signorini.plots.slopes.finer_half_slope`) and states that range; a triangle of
+    slope ``reference_slope`` (the element's optimal rate in 2D: ``N_dof^{-1}`` for P2,
+    ``N_dof^{-1/2}`` for P1) is drawn below the data.
 
     Parameters
     ----------
@@ -70,6 +75,9 @@ def plot_error_and_estimator(
         Axes title.
     last : int, optional
         Fit the slopes over the last ``last`` levels instead of the finer half of the run.
+    reference_slope : float, default -1.0
+        Slope of the reference triangle: the element's optimal rate
+        (:func:`~signorini.plots.slopes.optimal_slope`: −1 for P2, −1/2 for P1).
 
     Returns
     -------
@@ -83,16 +91,24 @@ def plot_error_and_estimator(
     """
     if last is not None:
         check_last(last)
-    h = history_columns(history, ("ndof", "eta", "error_energy"))
+    h = history_columns(history, ("ndof", "eta", "error_energy"), ("eta_roundoff",))
     ndof = h["ndof"]
     if not np.any(np.isfinite(h["error_energy"]) & (h["error_energy"] > 0)):
         raise ValueError(
             "the history has no positive finite error_energy value; plot the "
             "estimator alone with plot_estimator"
         )
-    curves = [Curve.of(key, ndof, h[key], last) for key in ("error_energy", "eta")]
+    curves = [
+        Curve.of("error_energy", ndof, h["error_energy"], last),
+        Curve.of("eta", ndof, h["eta"], last, floor=h.get("eta_roundoff")),
+    ]
     return convergence_figure(
-        path, curves, "error, estimator", title=title, note=fit_note([ndof], last)
+        path,
+        curves,
+        "error, estimator",
+        title=title,
+        reference_slope=reference_slope,
+        note=fit_note([ndof], last),
     )
 
 
@@ -162,6 +178,7 @@ def plot_contributions(
     path: str | os.PathLike,
     title: str | None = None,
     last: int | None = None,
+    reference_slope: float = -1.0,
 ) -> list[Path]:
     """Figs. 6.2 / 6.4: the estimator contributions ``η_1 … η_7`` of (5.1) against ``N_dof``,
     and for a frictional run the friction work ``η_8``.
@@ -170,8 +187,8 @@ def plot_contributions(
     :data:`~signorini.plots.frame.ROUNDOFF`; e.g. ``η_7 ≈ 1e-17``), is drawn as a hollow marker
     on the ``≈0`` strip below the log axes and left out of the fitted slope; a term that is
     zero on every level (``η_6``, ``η_7`` in Example 6.1, where the whole contact boundary is
-    active) is listed as ``η_k ≡ 0``. A slope −1 triangle is drawn below the curves and the
-    legend gives each fitted slope over the finer half of the run, and says so.
+    active) is listed as ``η_k ≡ 0``. A ``reference_slope`` triangle is drawn below the
+    curves and the legend gives each fitted slope over the finer half of the run, and says so.
 
     Parameters
     ----------
@@ -185,6 +202,9 @@ def plot_contributions(
         Axes title.
     last : int, optional
         Fit the slopes over the last ``last`` levels instead of the finer half of the run.
+    reference_slope : float, default -1.0
+        Slope of the reference triangle: the element's optimal rate
+        (:func:`~signorini.plots.slopes.optimal_slope`: −1 for P2, −1/2 for P1).
 
     Returns
     -------
@@ -194,7 +214,9 @@ def plot_contributions(
     if last is not None:
         check_last(last)
     h = history_columns(
-        history, ("ndof",), (*CONTRIBUTIONS, *FRICTION_CONTRIBUTIONS, "n_stick", "eta")
+        history,
+        ("ndof",),
+        (*CONTRIBUTIONS, *FRICTION_CONTRIBUTIONS, "n_stick", "eta", "eta_roundoff"),
     )
     keys = [k for k in CONTRIBUTIONS if k in h]
     friction = [k for k in FRICTION_CONTRIBUTIONS if k in h]
@@ -209,7 +231,9 @@ def plot_contributions(
     for key in keys:
         v = h[key]
         if np.any(np.isfinite(v)):
-            curves.append(Curve.of(key, h["ndof"], v, last, reference=reference))
+            curves.append(
+                Curve.of(key, h["ndof"], v, last, reference=reference, floor=h.get("eta_roundoff"))
+            )
         else:
             log.warning("estimator contribution %s has no known value; skipped", key)
     return convergence_figure(
@@ -219,6 +243,7 @@ def plot_contributions(
         title=title,
         height=3.4,
         legend="outside lower center",
+        reference_slope=reference_slope,
         note=fit_note([h["ndof"]], last),
     )
 
@@ -228,8 +253,10 @@ def plot_estimator(
     path: str | os.PathLike,
     title: str | None = None,
     last: int | None = None,
+    reference_slope: float = -1.0,
 ) -> list[Path]:
-    """Fig. 6.3(a): the estimator ``η_h`` (5.1) against ``N_dof``, log-log, slope −1 triangle.
+    """Fig. 6.3(a): the estimator ``η_h`` (5.1) against ``N_dof``, log-log, with a triangle of
+    the element's optimal slope (``reference_slope``).
 
     Parameters
     ----------
@@ -240,7 +267,10 @@ def plot_estimator(
     title : str, optional
         Axes title.
     last : int, optional
-        Fit the slope over the last ``last`` levels instead of the finer half of the run.
+        Fit the slopes over the last ``last`` levels instead of the finer half of the run.
+    reference_slope : float, default -1.0
+        Slope of the reference triangle: the element's optimal rate
+        (:func:`~signorini.plots.slopes.optimal_slope`: −1 for P2, −1/2 for P1).
 
     Returns
     -------
@@ -249,10 +279,15 @@ def plot_estimator(
     """
     if last is not None:
         check_last(last)
-    h = history_columns(history, ("ndof", "eta"))
-    curves = [Curve.of("eta", h["ndof"], h["eta"], last)]
+    h = history_columns(history, ("ndof", "eta"), ("eta_roundoff",))
+    curves = [Curve.of("eta", h["ndof"], h["eta"], last, floor=h.get("eta_roundoff"))]
     return convergence_figure(
-        path, curves, r"$\eta_h$", title=title, note=fit_note([h["ndof"]], last)
+        path,
+        curves,
+        r"$\eta_h$",
+        title=title,
+        reference_slope=reference_slope,
+        note=fit_note([h["ndof"]], last),
     )
 
 
@@ -294,12 +329,16 @@ def plot_adaptive_vs_uniform(
         check_last(last)
     if not isinstance(histories, Mapping) or not histories:
         raise ValueError("histories must be a non-empty mapping from label to history")
-    runs = {str(label): history_columns(h, ("ndof", key)) for label, h in histories.items()}
+    runs = {
+        str(label): history_columns(h, ("ndof", key), ("eta_roundoff",))
+        for label, h in histories.items()
+    }
     curves = [
-        Curve(
-            h["ndof"],
-            h[key],
-            slope_label(label, h["ndof"], h[key], last),
+        _run_curve(
+            label,
+            h,
+            key,
+            last,
             _RUN_COLORS[i % len(_RUN_COLORS)],
             _RUN_MARKERS[i % len(_RUN_MARKERS)],
         )
@@ -316,3 +355,18 @@ def plot_adaptive_vs_uniform(
         reference_slope=reference_slope,
         note=fit_note([h["ndof"] for h in runs.values()], last),
     )
+
+
+def _run_curve(
+    label: str, h: dict[str, np.ndarray], key: str, last: int | None, color: str, marker: str
+) -> Curve:
+    """One run of :func:`plot_adaptive_vs_uniform`; an η at or below its round-off level
+    (``eta_roundoff``) is noise: out of the fit, drawn as :meth:`Curve.of` draws it."""
+    values = h[key]
+    floor = h.get("eta_roundoff") if key.startswith("eta") else None
+    noise = None if floor is None else np.isfinite(values) & (values <= floor)
+    if noise is None or not noise.any():
+        return Curve(h["ndof"], values, slope_label(label, h["ndof"], values, last), color, marker)
+    fitted = np.where(noise, np.nan, values)
+    name = slope_label(label, h["ndof"], fitted, last) if (~noise).any() else f"{label} (noise)"
+    return Curve(h["ndof"], values, name, color, marker, np.zeros(values.shape, bool), noise, floor)

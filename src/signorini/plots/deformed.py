@@ -2,6 +2,8 @@
 
 The displacement is magnified or shrunk by a stated factor (:func:`displacement_scale`): at
 true scale a large displacement folds the drawn body over itself, a small one is invisible.
+The obstacle's gaps are magnified by the same factor, so that the drawn body touches the drawn
+obstacle where the body is in contact, and passes through it nowhere.
 With friction the contact nodes that stick and slip are marked on the body, and the friction
 stress p_t is drawn with the pressure.
 """
@@ -39,9 +41,13 @@ __all__ = [
 DRAWN_FRACTION = 0.1
 #: Displacements between these fractions of the body's size are drawn at true scale.
 TRUE_SCALE_RANGE = (0.02, 0.25)
-#: The obstacle drawn from gaps is left out where the gap exceeds this fraction of the
+#: The obstacle drawn from gaps is left out where the drawn gap exceeds this fraction of the
 #: body's size (a shape far from most of a curved contact part, e.g. the plane under a disc).
 OBSTACLE_REACH = 0.25
+#: With the displacement magnified, the obstacle is drawn only where its magnified gap is
+#: below this fraction of the body's size: near the contact zone, where the drawn body meets
+#: it (farther out, the magnified gaps of a curved side bend a plane into a curve).
+MAGNIFIED_REACH = 0.1
 
 #: The states a contact node may be in, as ``ContactDrawing(state=...)`` names them.
 NODE_STATES = ("inactive", "stick", "slip")
@@ -183,6 +189,7 @@ def plot_deformed(
     *,
     scale: float | str = "auto",
     obstacle: ArrayLike | None = None,
+    obstacle_offset: ArrayLike | None = None,
     title: str | None = None,
     show_mesh: bool = True,
 ) -> list[Path]:
@@ -218,10 +225,11 @@ def plot_deformed(
         problem*).
     gap : (k,) float array, optional
         The gap ``ψ`` at ``contact_points`` along ``normal`` (k, 2): the obstacle is then
-        drawn at ``contact_points + gap * normal``, ordered along the boundary, at true scale
-        (the obstacle's surface for a gap given along the body's normal, the closest points
-        of a shape); left out where ``|gap|`` exceeds :data:`OBSTACLE_REACH` times the
-        body's size. Not together with ``obstacle``.
+        drawn at ``contact_points + scale * gap * normal``, ordered along the boundary, with
+        its gaps magnified as the displacement is (at true scale, the obstacle's surface for
+        a gap given along the body's normal, the closest points of a shape); left out where
+        ``scale * |gap|`` exceeds :data:`OBSTACLE_REACH` times the body's size. Not together
+        with ``obstacle``.
     state : (k,) str array, optional
         Each contact node's state, one of :data:`NODE_STATES` (``"inactive"``, ``"stick"``,
         ``"slip"``): the stick and slip nodes are marked. Needs ``contact_displacement``.
@@ -240,8 +248,21 @@ def plot_deformed(
         Magnification of the displacement in the drawing; "auto":
         :func:`displacement_scale`.
     obstacle : (j, 2) float array, optional
-        Polyline of the obstacle in physical coordinates (NaN rows break it), drawn as
-        given, at true scale (e.g. :func:`signorini.loop.arrays.obstacle_outline`).
+        Polyline of the obstacle in physical coordinates (NaN rows break it) at true scale
+        (e.g. :func:`signorini.loop.arrays.obstacle_outline`); drawn as given unless
+        ``obstacle_offset`` is given.
+    obstacle_offset : (j, 2) float array, optional
+        The gap vector ``ψ n`` from the body's point ``x`` each point of ``obstacle`` belongs
+        to (:func:`signorini.loop.arrays.obstacle_offset`). The obstacle is then drawn where
+        the drawn body touches it: at ``x + scale ψ n = obstacle + (scale − 1) *
+        obstacle_offset``, its gaps magnified as the displacement is, so that a contact node
+        (``u·n = ψ``), drawn at ``x + scale u``, lies on it, as the true body lies on the
+        true obstacle; points with ``scale |ψ n|`` beyond :data:`OBSTACLE_REACH` times the
+        body's size (:data:`MAGNIFIED_REACH` for ``scale > 1``) are left out. A rigid plane
+        under a flat side is drawn as a plane moved by the magnified gap; under a curved
+        side (a disc on a plane) as the curve the magnified gaps trace; a gap function ψ as
+        ``x + scale ψ n``. The legend and the title say the gaps' scale; without
+        ``obstacle_offset``, that the obstacle is at true scale.
     title : str, optional
         First line of the body's title (default "deformed body").
     show_mesh : bool, default True
@@ -281,8 +302,17 @@ def plot_deformed(
     states = None
     if state is not None:
         states = _checked_states(state, contact_displacement, cp)
+    reach = OBSTACLE_REACH * float(np.ptp(p, axis=0).max())
     obs = None if obstacle is None else np.asarray(obstacle, dtype=np.float64).reshape(-1, 2)
-    obstacle_label = STYLES["obstacle"]["label"]
+    offset = None
+    if obstacle_offset is not None:
+        if obs is None:
+            raise ValueError("obstacle_offset is the obstacle's: give obstacle too")
+        offset = np.asarray(obstacle_offset, dtype=np.float64)
+        if offset.shape != obs.shape:
+            raise ValueError(
+                f"obstacle_offset must have the shape of obstacle {obs.shape}, got {offset.shape}"
+            )
     if gap is not None:
         g = np.asarray(gap, dtype=np.float64)
         n = np.asarray(normal, dtype=np.float64)
@@ -292,20 +322,27 @@ def plot_deformed(
                 f"contact_points, got {g.shape} and {n.shape}"
             )
         order = np.argsort(contact_coordinate(cp)[0], kind="stable")
-        obs = (cp + g[:, None] * n)[order]
-        far = np.abs(g[order]) > OBSTACLE_REACH * float(np.ptp(p, axis=0).max())
+        obs, offset = (cp + g[:, None] * n)[order], (g[:, None] * n)[order]
+    if offset is not None:  # where the drawn body touches the obstacle
+        obs = obs + (scale - 1.0) * offset
+        drawn_gap = scale * np.hypot(offset[:, 0], offset[:, 1])
+        far = drawn_gap > (reach if scale <= 1.0 else MAGNIFIED_REACH / OBSTACLE_REACH * reach)
         obs[far] = np.nan  # a gap in the drawn line
-        if far.all():
+        if np.isnan(obs).all():
             obs = None
     drawn = [p + scale * u] + ([] if obs is None else [obs])
     lo = np.min([np.nanmin(d, axis=0) for d in drawn], axis=0)
     hi = np.max([np.nanmax(d, axis=0) for d in drawn], axis=0)
     aspect = float((hi[1] - lo[1]) / max(hi[0] - lo[0], 1e-300))
     body = float(np.clip(2.2 * aspect, 0.8, 3.0))  # inches of the equal-aspect box
-    said = scale_text(scale)
+    said, obstacle_label = scale_text(scale), STYLES["obstacle"]["label"]
     if obs is not None and scale != 1.0:
-        said += ", obstacle at true scale"
-        obstacle_label += " (true scale)"
+        if offset is not None:  # the obstacle where the drawn body touches it
+            said = f"displacement and obstacle gaps \u00d7{scale:g}"
+            obstacle_label += f", gaps \u00d7{scale:g}"
+        else:
+            said += ", obstacle at true scale"
+            obstacle_label += " (true scale)"
     head = f"{title}\n{said}" if title else f"deformed body, {said}"
     parts = _checked_along(along, cp) if pressure is not None else None
     with mpl.rc_context(RC):

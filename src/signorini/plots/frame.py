@@ -50,6 +50,21 @@ class Curve:
     #: (n,) bool: levels whose value is exactly zero or round-off, drawn on the ``≈0`` strip
     #: (None: those where ``values == 0``).
     negligible: np.ndarray | None = None
+    #: (n,) bool: levels whose value is at or below η_h's round-off level (``floor`` of
+    #: :meth:`of`): noise, drawn as hollow markers without a line and out of every fit.
+    noise: np.ndarray | None = None
+    #: (n,) the round-off level of η_h per level, drawn as a dashed line where ``noise``.
+    floor: np.ndarray | None = None
+
+    @property
+    def unfitted(self) -> np.ndarray:
+        """(n,) bool: the levels out of every fit and triangle: ≈0 or noise."""
+        return self.near_zero | self.noise if self.at_floor else self.near_zero
+
+    @property
+    def at_floor(self) -> bool:
+        """Whether some level's value is noise (at η_h's round-off level)."""
+        return self.noise is not None and bool(np.any(self.noise))
 
     @property
     def near_zero(self) -> np.ndarray:
@@ -66,25 +81,37 @@ class Curve:
         values: np.ndarray,
         last: int | None = None,
         reference: np.ndarray | None = None,
+        floor: np.ndarray | None = None,
     ) -> Curve:
         """The history column ``key`` in its :data:`STYLES`, its fitted slope in the label.
 
         With ``reference`` (n,), values ``<= ROUNDOFF * reference`` count as round-off: on the
-        ``≈0`` strip and out of the fit, like exact zeros.
+        ``≈0`` strip and out of the fit, like exact zeros. Values ``<= floor`` (n,), the
+        round-off level of η_h of each level (the history's ``eta_roundoff``,
+        :func:`~signorini.estimator.roundoff.roundoff_level`; NaN where unknown), are noise:
+        drawn as hollow markers above the dashed round-off level, out of the fit; noise has
+        no rate, and none is printed for it.
         """
         style = STYLES[key]
         values = np.asarray(values, dtype=np.float64)
         small = np.isfinite(values) & (values <= 0.0)
         if reference is not None:
             small |= np.isfinite(values) & (values <= ROUNDOFF * np.asarray(reference))
-        shown = np.where(small, np.nan, values)
+        noise = np.zeros(values.shape, dtype=bool)
+        if floor is not None:
+            floor = np.asarray(floor, dtype=np.float64)
+            noise = np.isfinite(values) & (values <= floor) & ~small
+        shown = np.where(small | noise, np.nan, values)
         if np.any(np.isfinite(shown) & (shown > 0)):
             label = slope_label(style["label"], ndof, shown, last)
+        elif noise.any():
+            label = style["label"] + " (noise)"
         elif np.all(values[small] == 0.0):
             label = style["label"][:-1] + r" \equiv 0$"
         else:
             label = style["label"][:-1] + r" \approx 0$ (round-off)"
-        return cls(ndof, values, label, style["color"], style["marker"], small)
+        marker = style["color"], style["marker"]
+        return cls(ndof, values, label, *marker, small, noise, floor if noise.any() else None)
 
 
 def convergence_figure(
@@ -143,16 +170,23 @@ def convergence_figure(
             ax, zero_ax = fig.add_subplot(), None
         log_log_axes(ax, ylabel, log_y=log_y)
         n_rows = sum(1 for c in drawn if c.near_zero.any())
+        floors: list[tuple[np.ndarray, np.ndarray]] = []
         rows = iter(np.linspace(-0.5, 0.5, n_rows) if n_rows > 1 else [0.0])
         for c in curves:
             if not isinstance(c, Curve):
                 ax.plot([], [], linestyle="none", marker="", label=c)
                 continue
-            shown = positive(np.where(c.near_zero, np.nan, c.values))
+            noise = c.unfitted & ~c.near_zero
+            shown = positive(np.where(c.unfitted, np.nan, c.values))
+            hollow = {"color": c.color, "marker": c.marker, "mfc": "none", "ls": ""}
             if np.any(np.isfinite(shown)):
                 ax.plot(c.ndof, shown, color=c.color, marker=c.marker, label=c.label)
-            else:  # only ≈0 values: the legend entry shows the strip's hollow marker
-                ax.plot([], [], color=c.color, marker=c.marker, mfc="none", ls="", label=c.label)
+            if noise.any():  # noise: hollow markers, no line, and the level they are under
+                solid = np.any(np.isfinite(shown))
+                ax.plot(c.ndof[noise], c.values[noise], **hollow, label="_" if solid else c.label)
+                floors.append((c.ndof, c.floor))
+            elif not np.any(np.isfinite(shown)):  # only ≈0 values: the strip's hollow marker
+                ax.plot([], [], **hollow, label=c.label)
             if zero_ax is not None and c.near_zero.any():
                 zero_ax.plot(  # each curve on its own row of the strip, so none hides another
                     c.ndof[c.near_zero],
@@ -163,11 +197,19 @@ def convergence_figure(
                     linestyle="none",
                     clip_on=False,
                 )
+        if floors:  # one dashed line: the curves share η_h's round-off level
+            ndof, level = floors[0]
+            # a dash at each level's value, so that a run of one level shows it too
+            ax.plot(
+                ndof, level, color="0.45", ls="--", lw=0.9, marker="_", ms=9, label=_FLOOR_LABEL
+            )
+            if not any(", slope" in c.label for c in drawn):
+                note = None  # no slope is stated: no range it is fitted over
         if zero_ax is not None:
             _zero_strip(ax, zero_ax)
             note = "\n".join(filter(None, [note, _ZERO_NOTE]))
         if reference_slope is not None:
-            series = [(c.ndof, np.where(c.near_zero, np.nan, c.values)) for c in drawn]
+            series = [(c.ndof, np.where(c.unfitted, np.nan, c.values)) for c in drawn]
             draw_slope_triangle(ax, series, float(reference_slope))
         if decorate is not None:
             decorate(ax)
@@ -187,6 +229,7 @@ def convergence_figure(
 
 
 _ZERO_NOTE = r"$\approx$0: exactly 0, or round-off below $10^{-10}\,\eta_h$"
+_FLOOR_LABEL = r"round-off level of $\eta_h$: below it, noise (no rate)"
 
 _LEGEND_PLACES = ("upper right", "lower left", "lower right", "upper left", "center right")
 

@@ -16,6 +16,7 @@ from .convergence import (
     plot_error_and_estimator,
     plot_estimator,
 )
+from .slopes import optimal_slope
 from .style import CONTRIBUTIONS
 
 __all__ = ["make_figures", "has_known_values"]
@@ -33,7 +34,11 @@ def has_known_values(history: Mapping[str, np.ndarray], column: str) -> bool:
 
 
 def make_figures(
-    history_path: str | os.PathLike, out_dir: str | os.PathLike, example_name: str
+    history_path: str | os.PathLike,
+    out_dir: str | os.PathLike,
+    example_name: str,
+    title: str | None = None,
+    degree: int = 2,
 ) -> list[Path]:
     """The convergence figures of one run, drawn from its ``history.csv``.
 
@@ -55,6 +60,11 @@ def make_figures(
     example_name : str
         Name of the run; files are named ``<example_name>_<figure>.png`` / ``.pdf`` (with
         characters other than letters, digits, ``.``, ``_``, ``-`` replaced by ``_``).
+    title : str, optional
+        Title of every figure (the command line gives the problem's ``name``).
+    degree : {2, 1}
+        The degree of the run's element: the reference triangles have its optimal slope
+        (:func:`~signorini.plots.slopes.optimal_slope`: −1 for P2, −1/2 for P1).
 
     Returns
     -------
@@ -65,11 +75,12 @@ def make_figures(
     slug = re.sub(r"[^A-Za-z0-9._-]+", "_", str(example_name)).strip("_.") or "example"
     out = Path(out_dir)
     written: list[Path] = []
+    drawn = {"title": title, "reference_slope": optimal_slope(degree)}
     if has_known_values(history, "error_energy"):
-        written += plot_error_and_estimator(history, out / f"{slug}_error_estimator")
-        written += plot_efficiency(history, out / f"{slug}_efficiency")
+        written += plot_error_and_estimator(history, out / f"{slug}_error_estimator", **drawn)
+        written += plot_efficiency(history, out / f"{slug}_efficiency", title=title)
     else:
-        written += plot_estimator(history, out / f"{slug}_estimator")
+        written += plot_estimator(history, out / f"{slug}_estimator", **drawn)
     if any(k in history for k in CONTRIBUTIONS):
-        written += plot_contributions(history, out / f"{slug}_contributions")
+        written += plot_contributions(history, out / f"{slug}_contributions", **drawn)
     return written

@@ -45,20 +45,27 @@ class KnownPressure(Protocol):
     title: str
 
 
-def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) -> list[Path]:
+def run_figures(
+    example: str,
+    out: Path,
+    last: Mapping[str, Any] | None = None,
+    name: str | None = None,
+    degree: int | None = None,
+) -> list[Path]:
     """The run's convergence figures; with its last level also the mesh and the deformed body.
 
     The mesh figure shows the finest level of at most ``plots.READABLE_CELLS`` cells (read back
     from its ``level_NNN.vtu``; the last level when that file is missing or holds another
     mesh), with Γ_D, Γ_N and Γ_C marked. The deformed body is drawn with a stated displacement
-    scale, the obstacle at true scale, the pressure per contact part against its arc length;
+    scale and the obstacle's gaps magnified by it (the obstacle drawn where the drawn body
+    touches it), the pressure per contact part against its arc length;
     with friction its stick and slip nodes marked and the friction stress drawn with the
     pressure.
 
     Parameters
     ----------
     example : str
-        The run's name (file names and titles).
+        The run's label (file names; titles when no ``name`` is known).
     out : pathlib.Path
         The run folder, with its ``history.csv``.
     last : mapping, optional
@@ -68,12 +75,24 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         whose parts refinement splits), ``parts`` (part names by kind: ``"dirichlet"``,
         ``"neumann"``, ``"contact"``), and per contact node ``contact_points (k, 2)``,
         ``active (k,)``, ``pressure (k,)``, ``gap (k,)``, ``normal (k, 2)``, ``obstacle`` (part
-        name -> the obstacle's outline at true scale) and ``along`` (part name -> rows and
-        arc length); with friction also ``state (k,)`` (labels,
+        name -> the obstacle's outline at true scale), ``obstacle_offset`` (part name -> the
+        gap vector of each outline point; without it the obstacle is drawn at true scale)
+        and ``along`` (part name -> rows and arc length); with friction also ``state (k,)`` (labels,
         :data:`~signorini.plots.deformed.NODE_STATES`),
-        ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)``.
+        ``contact_displacement (k, 2)`` and ``tangential_pressure (k,)``; ``name``, the
+        problem's name.
+    name : str, optional
+        The problem's name (:attr:`ContactProblem.name
+        <signorini.problem.problem.ContactProblem.name>`), which every figure's title begins
+        with; default ``last["name"]``, else ``example``.
+    degree : {2, 1}, optional
+        The degree of the run's element, whose optimal rate the reference triangles show;
+        default ``last["degree"]``, else 2 (P2).
     """
-    written = list(plots.make_figures(out / "history.csv", out, example))
+    known = {} if last is None else last
+    name = str(known.get("name", example)) if name is None else name
+    degree = int(known.get("degree", 2)) if degree is None else degree
+    written = list(plots.make_figures(out / "history.csv", out, example, title=name, degree=degree))
     if last is None:
         return written
     # the level the mesh figure shows
@@ -104,7 +123,7 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
         points,
         cells,
         out / "mesh",
-        title=mesh_title(example, level, cells.shape[0], last["level"]),
+        title=mesh_title(name, level, cells.shape[0], last["level"]),
         highlight=plots.boundary_groups(points, cells, segments),
         colors=("#1f77b4", "#2ca02c", "#d62728"),
         **zoom,
@@ -124,7 +143,11 @@ def run_figures(example: str, out: Path, last: Mapping[str, Any] | None = None) 
             last["contact_points"], last["pressure"], along=last["along"], **friction
         ),
         obstacle=_joined(last["obstacle"].values()),
-        title=f"{example}: deformed bod{'ies' if last.get('pairs') else 'y'}",
+        # the obstacle where the drawn body touches it: its gaps magnified with the body
+        obstacle_offset=_joined(last["obstacle_offset"].values())
+        if "obstacle_offset" in last
+        else None,
+        title=f"{name}: deformed bod{'ies' if last.get('pairs') else 'y'}",
         # bodies in contact pressed together overlap in a magnified drawing
         scale=1.0 if last.get("pairs") else "auto",
     )

@@ -22,10 +22,20 @@ __all__ = [
     "fit_note",
     "fit_start",
     "finer_half_slope",
+    "optimal_slope",
     "slope_label",
     "steady_slope",
     "triangle_vertices",
 ]
+
+
+def optimal_slope(degree: int = 2) -> float:
+    """The slope of the reference triangle: the optimal rate ``N_dof^{-k/2}`` of the energy
+    error of elements of degree k in 2D (−1 for P2, −1/2 for P1; :attr:`Element.degree
+    <signorini.fem.element.Element.degree>`)."""
+    if isinstance(degree, bool) or degree not in (1, 2):
+        raise ValueError(f"degree must be 1 (P1) or 2 (P2), got {degree!r}")
+    return -int(degree) / 2.0
 
 
 def fit_start(ndof: ArrayLike) -> float:

@@ -22,7 +22,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.font_manager import FontProperties
-from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
+from matplotlib.ticker import FixedLocator, LogFormatterSciNotation, LogLocator, NullFormatter
 
 from ..estimator.names import TERM_TABLE
 from ..output.files import replacing
@@ -41,6 +41,7 @@ __all__ = [
     "positive",
     "log_log_axes",
     "tidy_log_ticks",
+    "log_tick_sets",
     "format_number",
     "fit_title",
     "trim_height",
@@ -214,17 +215,72 @@ def log_log_axes(ax: Any, ylabel: str, log_y: bool = True) -> None:
     ax.set_ylabel(ylabel)
 
 
-def tidy_log_ticks(ax: Any) -> None:
-    """Label only major ticks; below two decades add 2 and 5 times powers of ten as majors.
+#: Mantissas of the major ticks a short log axis may get, coarsest first.
+TICK_MANTISSAS: tuple[tuple[float, ...], ...] = (
+    (1.0,),
+    (1.0, 2.0, 5.0),
+    (1.0, 2.0, 3.0, 5.0),
+    (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0),
+    tuple(np.arange(1.0, 10.0, 0.5)),
+    tuple(np.arange(1.0, 10.0, 0.25)),
+)
 
-    Matplotlib otherwise labels minor ticks on short log axes, and the labels overlap.
+
+def log_tick_sets(lo: float, hi: float) -> list[np.ndarray]:
+    """The candidate major ticks of a log axis over ``[lo, hi]``, one array per
+    :data:`TICK_MANTISSAS` (coarsest first): ``m · 10^k`` inside the interval."""
+    k = np.arange(np.floor(np.log10(lo)) - 1, np.ceil(np.log10(hi)) + 1)
+    sets = []
+    for mantissas in TICK_MANTISSAS:
+        t = np.unique(np.outer(10.0**k, mantissas).ravel())
+        sets.append(t[(t >= lo * (1 - 1e-9)) & (t <= hi * (1 + 1e-9))])
+    return sets
+
+
+def tidy_log_ticks(ax: Any) -> None:
+    """Label only major ticks, and give a log axis of less than two decades the most labelled
+    ticks whose labels do not overlap.
+
+    Matplotlib labels minor ticks on short log axes, and where no more than one power or
+    1-2-5 value lies in the view it falls back to linear ticks (5000, 5500, …, 9000) whose
+    labels ``5.5×10³`` run into each other. A short axis gets the finest set of
+    :func:`log_tick_sets` with two ticks or more in its view, then coarser ones while two of
+    their labels overlap, as measured by the figure's renderer after its layout (a set of one
+    tick cannot overlap).
     """
-    for axis, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+    fig = ax.get_figure()
+    for axis, limits in ((ax.xaxis, ax.get_xlim), (ax.yaxis, ax.get_ylim)):
         if axis.get_scale() != "log":
             continue
         axis.set_minor_formatter(NullFormatter())
-        if lo > 0 and np.log10(hi / lo) < 2.0:
-            axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
-            axis.set_major_formatter(
-                LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(np.inf, np.inf))
-            )
+        lo, hi = sorted(limits())
+        if not (lo > 0 and np.log10(hi / lo) < 2.0):
+            continue
+        axis.set_major_formatter(
+            LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(np.inf, np.inf))
+        )
+        sets = log_tick_sets(lo, hi)
+        start = next((j for j, t in enumerate(sets) if t.size >= 2), len(sets) - 1)
+        for ticks in sets[start::-1]:
+            axis.set_major_locator(FixedLocator(ticks))
+            if ticks.size < 2 or not _labels_overlap(fig, axis):
+                break
+        axis.set_minor_locator(LogLocator(base=10.0, subs=np.arange(1.0, 10.0)))
+        limits_set = ax.set_xlim if axis is ax.xaxis else ax.set_ylim
+        limits_set(lo, hi)  # fixed ticks must not widen the view
+
+
+def _labels_overlap(fig: Figure, axis: Any) -> bool:
+    """Whether two tick labels of ``axis`` overlap in the laid-out figure."""
+    engine = fig.get_layout_engine()
+    if engine is not None:
+        engine.execute(fig)
+    fig.draw_without_rendering()
+    renderer = fig.canvas.get_renderer()
+    boxes = [t.get_window_extent(renderer) for t in axis.get_ticklabels() if t.get_text()]
+    boxes.sort(key=lambda b: (b.x0, b.y0))
+    return any(
+        min(a.x1, b.x1) - max(a.x0, b.x0) > 0.5 and min(a.y1, b.y1) - max(a.y0, b.y0) > 0.5
+        for i, a in enumerate(boxes)
+        for b in boxes[i + 1 :]
+    )

@@ -1,0 +1,80 @@
+"""The round-off level of the estimator: the η_h that floating point alone gives a solution.
+
+Below it η_h measures the rounding of the discrete solution, not its discretization error,
+and refining cannot lower it: the adaptive loop stops there (:func:`signorini.adaptive`;
+docs/method.md, *Marking and refinement*, "Round-off").
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..contact.solution import ContactResult
+from ..fem.material import Material
+from ..problem.problem import ContactProblem
+
+__all__ = ["ROUNDOFF_FACTOR", "hooke_norm", "roundoff_level"]
+
+#: The factor of :func:`roundoff_level`: about 10² from the second derivatives of the P2
+#: basis in η1 (and the first derivatives in the jumps η2 … η5) times 10² for the linear
+#: solve, which makes the nodal errors a small multiple of ε times the condition's growth.
+#: Measured: η_h of the contact patch test (``stacked-blocks``, exact in P2) is 2·10² to
+#: 1.2·10³ times ``ε ‖C‖ max|u_h| sqrt(n_cells)`` over 55 adaptive levels (640 to 90 000
+#: unknowns); the other examples' η_h lie 10⁶ times above the level or more.
+ROUNDOFF_FACTOR = 1e4
+
+
+def hooke_norm(problem: ContactProblem) -> float:
+    """``‖C‖``, the largest of the problem's materials' Hooke's law on symmetric 2 × 2 strains.
+
+    σ = λ* tr(ε) I + 2 μ ε has the eigenvalues ``2 (λ* + μ)`` (ε ∝ I) and ``2 μ`` (trace
+    free ε), λ* the plane-strain or plane-stress λ (:attr:`Material.lam_eff
+    <signorini.fem.material.Material.lam_eff>`): ``‖C‖ = max(2 (λ* + μ), 2 μ)``.
+    """
+    material = problem.material
+    materials = [material] if isinstance(material, Material) else list(material.values())
+    return max(max(2.0 * (m.lam_eff + m.mu), 2.0 * m.mu) for m in materials)
+
+
+def roundoff_level(result: ContactResult) -> float:
+    """η_h of ``result``'s mesh that round-off alone gives: ``ROUNDOFF_FACTOR ε ‖C‖ U √n``.
+
+    The terms of η_h are derivatives of u_h: rounding each nodal value of u_h by ``ε U``
+    (``U = max |u_h|``, the displacement's own scale; ε the machine epsilon) changes σ(u_h)
+    on a cell of size h by about ``‖C‖ ε U / h`` (:func:`hooke_norm`) and div σ(u_h) by
+    ``‖C‖ ε U / h²``; the weights of η1 (``h_T ‖·‖_{L²(T)}``, ~h²) and of the jumps
+    (``h_e^{1/2} ‖·‖_{L²(e)}``, ~h) turn both into ``‖C‖ ε U`` per cell whatever its size, and
+    the squares of ``n`` cells add up to ``‖C‖ ε U √n``. :data:`ROUNDOFF_FACTOR` is the
+    constant of the basis' derivatives and of the linear solve, which rounds with the
+    condition of the stiffness matrix. The level is therefore a property of the problem's
+    scale (its stiffness and its displacement) and of the mesh's size, not of the mesh's
+    grading; an η_h at or below it is noise: a rate fitted to it, or a marking of it, means
+    nothing.
+
+    Parameters
+    ----------
+    result : ContactResult
+        A discrete solution.
+
+    Returns
+    -------
+    float
+        The level in the unit of η_h's stress terms (stress × length); 0 for ``u_h = 0``
+        and NaN where the product overflows (no level known: the loop does not stop on it).
+
+    References
+    ----------
+    N. J. Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., SIAM 2002,
+    Chapter 3 (rounding of sums and products) and Section 7.2 (a linear solve's forward error
+    as ε times the condition number).
+    """
+    u = np.asarray(result.u, dtype=np.float64)
+    scale = float(np.abs(u).max(initial=0.0))
+    if scale == 0.0:
+        return 0.0
+    n_cells = result.mesh.n_cells
+    eps = float(np.finfo(np.float64).eps)
+    level = ROUNDOFF_FACTOR * eps * hooke_norm(result.problem) * scale * math.sqrt(n_cells)
+    return float(level) if math.isfinite(level) else math.nan
