@@ -5,8 +5,8 @@
 from __future__ import annotations
 
 import csv
-import re
 import math
+import re
 
 import numpy as np
 import pytest
