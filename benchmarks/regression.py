@@ -4,6 +4,7 @@ the command line, compared level by level.
     python benchmarks/regression.py snapshot DIR      # run every case into DIR
     python benchmarks/regression.py compare OLD NEW   # compare two snapshots
     python benchmarks/regression.py compare OLD NEW --skip n_factorizations
+    python benchmarks/regression.py compare OLD NEW --exact    # bit for bit
 
 ``snapshot`` runs each case of :data:`CASES` with ``signorini run`` (VTU files kept, figures
 off) into ``DIR/<case>``. ``compare`` reads both snapshots and prints, per case, the largest
@@ -13,6 +14,9 @@ relative to the largest contact force, KKT residuals absolutely) and of each lev
 line is ``regression: same`` or ``regression: DIFFERENT (...)``; the exit status is 0 or 1.
 ``--skip COLUMN`` (repeatable) leaves out a history column that a change alters by design,
 e.g. ``n_factorizations`` where solves become low-rank updates (the change's note says so).
+``--exact`` is the check of a change that moves tables and names but no arithmetic: every
+history column (timings excluded), every level's mesh and every nodal field must then be
+equal bit for bit, and the last line names the first difference found.
 """
 
 from __future__ import annotations
@@ -132,6 +136,74 @@ def _compare_meshes(old: Path, new: Path) -> tuple[float, str, list[str]]:
     return worst, where, faults
 
 
+def _bits_differ(x: np.ndarray, y: np.ndarray) -> bool:
+    """Whether two arrays differ in dtype, shape or any bit (NaNs alike, -0.0 is not 0.0)."""
+    x, y = np.ascontiguousarray(x), np.ascontiguousarray(y)
+    return x.dtype != y.dtype or x.shape != y.shape or x.tobytes() != y.tobytes()
+
+
+def _exact_history(old: Path, new: Path, skip: frozenset[str]) -> str | None:
+    """The first history entry (level by level, column by column) whose text differs."""
+    a, b = _history(old), _history(new)
+    if len(a) != len(b):
+        return f"{len(a)} levels against {len(b)}"
+    if a and list(a[0]) != list(b[0]):
+        return f"columns differ: {sorted(set(a[0]) ^ set(b[0]))}"
+    for r, s in zip(a, b, strict=True):
+        for column in r:
+            if column in skip or column.startswith("t_"):
+                continue
+            if r[column] != s[column]:
+                return f"{column} at level {r['level']}: {r[column]} against {s[column]}"
+    return None
+
+
+def _exact_meshes(old: Path, new: Path) -> str | None:
+    """The first VTU file whose points, cells, nodal or cell fields differ in any bit."""
+    import meshio
+
+    files = sorted(p.name for p in old.glob("*.vtu"))
+    if files != sorted(p.name for p in new.glob("*.vtu")):
+        return "other VTU files"
+    for name in files:
+        m, n = meshio.read(old / name), meshio.read(new / name)
+        if _bits_differ(m.points, n.points):
+            return f"{name}: points differ"
+        if [c.type for c in m.cells] != [c.type for c in n.cells]:
+            return f"{name}: cell types differ"
+        for ca, cb in zip(m.cells, n.cells, strict=True):
+            if _bits_differ(ca.data, cb.data):
+                return f"{name}: {ca.type} cells differ"
+        for kind, x_data, y_data in (
+            ("field", m.point_data, n.point_data),
+            ("cell field", m.cell_data, n.cell_data),
+        ):
+            if sorted(x_data) != sorted(y_data):
+                return f"{name}: {kind}s {sorted(set(x_data) ^ set(y_data))} in one only"
+        for field, x in m.point_data.items():
+            if _bits_differ(x, n.point_data[field]):
+                return f"{name}: field {field} differs"
+        for field, blocks in m.cell_data.items():
+            other = n.cell_data[field]
+            if len(blocks) != len(other) or any(map(_bits_differ, blocks, other)):
+                return f"{name}: cell field {field} differs"
+    return None
+
+
+def compare_exact(old: Path, new: Path, skip: frozenset[str] = frozenset()) -> bool:
+    """Every case bit for bit; the last line names the first difference found."""
+    first = None
+    if skip:
+        print(f"history columns left out: {', '.join(sorted(skip))}")
+    for name in CASES:
+        fault = _exact_history(old / name, new / name, skip)
+        fault = fault or _exact_meshes(old / name, new / name)
+        print(f"{name:16s} " + ("bit-identical" if fault is None else f"differs: {fault}"))
+        first = first or (fault and f"{name}: {fault}")
+    print("regression: same" if first is None else f"regression: DIFFERENT ({first})")
+    return first is None
+
+
 def compare(old: Path, new: Path, skip: frozenset[str] = frozenset()) -> bool:
     same = True
     if skip:
@@ -153,9 +225,12 @@ def main(argv: list[str]) -> int:
     if len(argv) == 2 and argv[0] == "snapshot":
         snapshot(Path(argv[1]))
         return 0
+    exact = "--exact" in argv[3:]
+    argv = argv[:3] + [a for a in argv[3:] if a != "--exact"]
     skip = frozenset(argv[k + 1] for k in range(3, len(argv) - 1, 2) if argv[k] == "--skip")
     if len(argv) >= 3 and argv[0] == "compare" and len(argv) == 3 + 2 * len(skip):
-        return 0 if compare(Path(argv[1]), Path(argv[2]), skip) else 1
+        check = compare_exact if exact else compare
+        return 0 if check(Path(argv[1]), Path(argv[2]), skip) else 1
     print(__doc__)
     return 2
 

@@ -157,6 +157,62 @@ def test_adaptive_benchmark_factory_keeps_what_the_loop_reads():
         assert made == [(solver.factor_nnz, memory)] and any(memory.values())
 
 
+def _tiny_snapshot(folder: Path, cases, eta: float = 0.1, u: float = 0.3) -> None:
+    """A hand-made snapshot: per case a two-level history and one level's P2 mesh."""
+    import meshio
+
+    points = np.array([[0, 0], [1, 0], [0, 1], [0.5, 0], [0.5, 0.5], [0, 0.5]], float)
+    for name in cases:
+        out = folder / name
+        out.mkdir(parents=True)
+        with open(out / "history.csv", "w", newline="") as f:
+            writer = csv.writer(f)
+            writer.writerow(["level", "ndof", "eta", "backend", "t_solve"])
+            for level in range(2):
+                writer.writerow([level, 12 * (level + 1), repr(eta / (level + 1)), "scipy", 0.1])
+        field = np.linspace(0.0, u, 12).reshape(6, 2)
+        mesh = meshio.Mesh(points, [("triangle6", np.arange(6)[None])], {"u": field})
+        mesh.write(out / "level_000.vtu")
+
+
+def test_regression_compare_exact_asks_for_every_bit(tmp_path, capsys):
+    """benchmarks/regression.py compare --exact: two hand-made snapshots are the same when
+    equal but for timings, and DIFFERENT, naming the first case and entry, at one bit of a
+    nodal field or of a history value, where the tolerant compare still says same."""
+    path = ROOT / "benchmarks" / "regression.py"
+    spec = importlib.util.spec_from_file_location("bench_regression", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    cases = list(bench.CASES)
+    last = cases[-1]
+
+    def run(*args: str) -> tuple[int, str]:
+        status = bench.main(["compare", *map(str, args)])
+        return status, capsys.readouterr().out.strip().splitlines()[-1]
+
+    _tiny_snapshot(tmp_path / "old", cases)
+    _tiny_snapshot(tmp_path / "new", cases)
+    with open(tmp_path / "new" / cases[0] / "history.csv") as f:
+        text = f.read()
+    assert text.count(",0.1\n") == 2  # the timings
+    (tmp_path / "new" / cases[0] / "history.csv").write_text(text.replace(",0.1\n", ",0.2\n"))
+    assert run(tmp_path / "old", tmp_path / "new", "--exact") == (0, "regression: same")
+
+    _tiny_snapshot(tmp_path / "field", cases[:-1])
+    _tiny_snapshot(tmp_path / "field", [last], u=np.nextafter(0.3, 1.0))
+    status, line = run(tmp_path / "old", tmp_path / "field", "--exact")
+    assert status == 1 and line == f"regression: DIFFERENT ({last}: level_000.vtu: field u differs)"
+    assert run(tmp_path / "old", tmp_path / "field") == (0, "regression: same")
+
+    _tiny_snapshot(tmp_path / "eta", cases[:1], eta=np.nextafter(0.1, 1.0))
+    _tiny_snapshot(tmp_path / "eta", cases[1:-1])
+    _tiny_snapshot(tmp_path / "eta", [last], u=np.nextafter(0.3, 1.0))
+    status, line = run(tmp_path / "old", tmp_path / "eta", "--exact")
+    assert status == 1 and line.startswith(f"regression: DIFFERENT ({cases[0]}: eta at level 0")
+    skipped = run(tmp_path / "old", tmp_path / "eta", "--skip", "eta", "--exact")
+    assert skipped == (1, f"regression: DIFFERENT ({last}: level_000.vtu: field u differs)")
+
+
 @pytest.mark.slow
 def test_inclined_block_example_runs(tmp_path):
     """The literate example with a non-axis contact normal runs and touches the foundation

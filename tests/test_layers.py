@@ -2,7 +2,9 @@
 
 Every module of ``signorini`` is read as text; each import of the package (relative, or
 absolute ``signorini.x``) must name the module's own layer, a layer of its row of
-:data:`ALLOWED`, or a module of its row of :data:`DOORS`.
+:data:`ALLOWED`, or a module of its row of :data:`DOORS`. The package itself (a bare
+``import signorini``, or a name taken from it) counts as its top layer ``__init__``, which
+no module below may import.
 """
 
 from __future__ import annotations
@@ -25,7 +27,8 @@ _CONTACT = _GROUND | {"fem", "problem", "contact"}
 #: for the friction-law protocol its laws implement. The leaves ``output`` and ``plots`` take
 #: arrays and plain records: of the package only ``mesh`` (a mesh read back from a file, pure
 #: geometry helpers) and, for ``plots``, the history files ``output`` reads; the command line
-#: is the only module that joins them to the numerics.
+#: is the only module that joins them to the numerics. ``version`` holds the package's
+#: version for the package and its leaves.
 ALLOWED: dict[str, frozenset[str]] = {
     "mesh": frozenset(),
     "algebra": frozenset(),
@@ -35,11 +38,12 @@ ALLOWED: dict[str, frozenset[str]] = {
     "estimator": _CONTACT,
     "loop": _CONTACT | {"estimator"},
     "examples": _CONTACT | {"estimator", "loop"},
-    "output": frozenset({"mesh"}),
+    "output": frozenset({"mesh", "version"}),
     "plots": frozenset({"mesh", "output"}),
     "runtime": frozenset(),
-    "cli": _CONTACT | {"estimator", "loop", "examples", "output", "plots", "runtime"},
-    "__init__": _CONTACT | {"estimator", "loop", "examples", "output"},
+    "version": frozenset(),
+    "cli": _CONTACT | {"estimator", "loop", "examples", "output", "plots", "runtime", "version"},
+    "__init__": _CONTACT | {"estimator", "loop", "examples", "output", "version"},
 }
 
 #: Single modules a layer may import beyond its row of :data:`ALLOWED`: plain data that
@@ -67,7 +71,9 @@ def imported_modules(path: Path, root: Path = PACKAGE) -> set[str]:
     """The modules and subpackages of the package (dotted, relative to it: ``mesh.mesh``,
     ``estimator``) that ``path`` imports, whether relatively, as ``signorini.x`` or as
     ``from signorini import x``; ``from .pkg import name`` counts as ``pkg.name`` when
-    ``name`` is a module of ``pkg``."""
+    ``name`` is a module of ``pkg``. The package itself, imported bare (``import signorini``)
+    or as the source of a name (``from signorini import Mesh``, ``from .. import x`` up to the
+    top), is ``__init__``."""
     package = path.relative_to(root).with_suffix("").parts[:-1]
     if path.name == "__init__.py":
         package = path.relative_to(root).parts[:-1]
@@ -76,8 +82,8 @@ def imported_modules(path: Path, root: Path = PACKAGE) -> set[str]:
         if isinstance(node, ast.Import):
             for alias in node.names:
                 first, *rest = alias.name.split(".")
-                if first == root.name and rest:
-                    found.add(_resolved(rest, root))
+                if first == root.name:
+                    found.add(_resolved(rest, root) or "__init__")
             continue
         if not isinstance(node, ast.ImportFrom):
             continue
@@ -93,7 +99,7 @@ def imported_modules(path: Path, root: Path = PACKAGE) -> set[str]:
         target = base + module
         for alias in node.names:
             name = _resolved([*target, alias.name], root)
-            found.add(name if name else alias.name)
+            found.add(name or _resolved(target, root) or "__init__")
     return {name for name in found if name}
 
 
@@ -146,6 +152,7 @@ def test_the_import_reader_sees_every_kind_of_relative_import():
     assert imported_layers(loop) >= {"contact", "estimator", "loop", "mesh", "problem"}
     assert imported_layers(PACKAGE / "mesh" / "refine.py") == {"mesh"}
     assert "estimator.names" in imported_modules(PACKAGE / "plots" / "style.py")
+    assert imported_modules(PACKAGE / "output" / "environment.py") == {"version"}
 
 
 @pytest.fixture
@@ -171,6 +178,10 @@ def package(tmp_path):
         ("plots", "from ..estimator.residual import Estimate\n", "imports estimator.residual"),
         ("output", "from ..contact.solution import ContactResult\n", "imports contact.solution"),
         ("problem", "def f():\n    from ..contact import solve\n", "imports contact"),
+        ("output", "def f():\n    import signorini\n", "output/probe.py imports __init__"),
+        ("mesh", "from signorini import __version__\n", "mesh/probe.py imports __init__"),
+        ("fem", "from .. import Mesh\n", "fem/probe.py imports __init__"),
+        ("cli", "import signorini as s\n", "cli/probe.py imports __init__"),
     ],
 )
 def test_a_forbidden_import_is_reported(package, layer, source, reported):

@@ -32,8 +32,7 @@ from .problem import (
     Tresca,
 )
 from .problem.obstacles import Disc, HalfPlane, Obstacle, Polyline, SignedDistance
-
-__version__ = "0.1.0"
+from .version import __version__ as __version__  # the package's version, kept in one place
 
 __all__ = [
     "Circle",

@@ -9,6 +9,7 @@ from ..algebra.backends import SOLVERS
 from ..estimator.residual import ETA5_VARIANTS
 from ..examples import EXAMPLES
 from ..loop.options import AdaptiveOptions
+from ..version import __version__
 
 __all__ = ["FILE_FLAGS", "OPTION_FLAGS", "TRUST", "flag", "parser"]
 
@@ -42,15 +43,13 @@ def flag(field: str) -> str:
 
 def parser() -> argparse.ArgumentParser:
     """The parser of ``signorini run | figures``; the defaults shown are the options'."""
-    import signorini  # the package's version; the package is loaded before its modules
-
     default = AdaptiveOptions()
     p = argparse.ArgumentParser(
         prog="signorini",
         description="Adaptive P2 finite elements for the Signorini problem, with or without "
         "friction.",
     )
-    p.add_argument("--version", action="version", version=f"signorini {signorini.__version__}")
+    p.add_argument("--version", action="version", version=f"signorini {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
     run = sub.add_parser(
         "run",

@@ -13,6 +13,7 @@ from ..fem.mapping import AffineCells, CellMap, Cells, Edges
 from ..fem.material import CellMaterials, Material, on_cells, stress
 from ..fem.p2 import REFERENCE_NODES, edge_basis, edge_reference_points
 from ..mesh.geometry import segment_normals
+from ..mesh.reference import TRIANGLE
 from .owned import per_cell_of
 
 __all__ = ["CellStress", "direction_field", "edge_traction", "vertex_stress"]
@@ -163,7 +164,7 @@ def edge_traction(
     (m, q, 2) float array
     """
     # flat indices (one gather each, faster than indexing two axes)
-    v0, v1 = 3 * cell + k, 3 * cell + (k + 1) % 3
+    v0, v1 = 3 * cell + TRIANGLE.edges[k, 0], 3 * cell + TRIANGLE.edges[k, 1]
     corners = cells.ravel()
     _, n = segment_normals(points[corners[v0]], points[corners[v1]])
     # σ n at the edge's two vertices, then linear along it (σ is linear on the cell)

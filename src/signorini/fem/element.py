@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..mesh.reference import TRIANGLE
 from . import p1, p2
 
 __all__ = ["ELEMENTS", "Element", "P1", "P2", "element_of"]
@@ -85,7 +86,8 @@ class Element:
         if self.n_local == 6:
             return u_cell
         u = np.asarray(u_cell, dtype=np.float64).reshape(-1, 3, 2)
-        mid = 0.5 * (u + u[:, [1, 2, 0]])
+        start, end = TRIANGLE.edges.T
+        mid = 0.5 * (u[:, start] + u[:, end])
         return np.concatenate([u, mid], axis=1).reshape(-1, 12)
 
     def edge_values(self, values: np.ndarray) -> np.ndarray:
@@ -118,7 +120,7 @@ P2 = Element(
         (0.5, 2 / 3, 2, (2.0, -2.0)),
     ),
     node_parts=((0.0, 1 / 3, 0), (2 / 3, 1.0, 1), (1 / 3, 2 / 3, 2)),
-    vtk_cell="triangle6",
+    vtk_cell=TRIANGLE.vtk_p2_name,
 )
 
 #: P1: the hat φ_z is the basis function (m_z = w_z = |e|/2 per edge at a vertex), γ̃_p the
@@ -135,7 +137,7 @@ P1 = Element(
     basis_share=(1 / 2, 1 / 2),
     hat_pieces=((0.0, 0.5, 0, (1.0, -1.0)), (0.5, 1.0, 1, (0.0, 1.0))),
     node_parts=((0.0, 0.5, 0), (0.5, 1.0, 1)),
-    vtk_cell="triangle",
+    vtk_cell=TRIANGLE.vtk_name,
 )
 
 #: the elements by name

@@ -30,6 +30,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from ..mesh.geometry import segment_normals
+from ..mesh.reference import TRIANGLE
 from . import iso, p2
 
 __all__ = [
@@ -42,8 +43,7 @@ __all__ = [
 ]
 
 #: local nodes ``[start, end, midpoint]`` of local edge k = 0, 1, 2 of a P2 cell
-EDGE_NODES = np.array([[0, 1, 3], [1, 2, 4], [2, 0, 5]])
-EDGE_NODES.setflags(write=False)
+EDGE_NODES = TRIANGLE.edge_nodes
 
 _ALL = slice(None)
 
@@ -252,7 +252,8 @@ class AffineCells:
     def local_edges(self, slot: np.ndarray, k: np.ndarray) -> StraightEdges:
         """Local edge ``k`` of the cells at rows ``slot`` of this group."""
         flat = self.vertices.reshape(-1, self.vertices.shape[-1])
-        return StraightEdges(np.stack([flat[3 * slot + k], flat[3 * slot + (k + 1) % 3]], 1))
+        start, end = 3 * slot + TRIANGLE.edges[k, 0], 3 * slot + TRIANGLE.edges[k, 1]
+        return StraightEdges(np.stack([flat[start], flat[end]], 1))
 
 
 class IsoparametricCells:

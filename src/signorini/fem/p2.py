@@ -2,7 +2,8 @@
 
 Conventions (fixed for the whole package)
 -----------------------------------------
-* Reference triangle with vertices (0, 0), (1, 0), (0, 1); barycentric
+* Reference triangle :data:`~signorini.mesh.reference.TRIANGLE` (the owner of the local
+  vertices and edges) with vertices (0, 0), (1, 0), (0, 1); barycentric
   coordinates ``l0 = 1 - x - y``, ``l1 = x``, ``l2 = y``.
 * Local node order: the 3 vertices, then the midpoints of local edges
   0 (v0-v1), 1 (v1-v2), 2 (v2-v0) -- the VTK quadratic triangle, meshio's
@@ -29,6 +30,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..mesh.reference import TRIANGLE
+
 __all__ = [
     "REFERENCE_NODES",
     "barycentric",
@@ -48,14 +51,17 @@ __all__ = [
     "physical_points",
 ]
 
-#: Reference coordinates of the 6 local nodes, shape (6, 2).
-REFERENCE_NODES = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5]])
+#: Reference coordinates of the 6 local nodes, shape (6, 2): the vertices, then the
+#: midpoints of the local edges.
+REFERENCE_NODES = np.concatenate(
+    [TRIANGLE.vertices, 0.5 * TRIANGLE.vertices[TRIANGLE.edges].sum(axis=1)]
+)
 REFERENCE_NODES.setflags(write=False)
 
 # gradients of the barycentric coordinates l0, l1, l2 on the reference triangle
 _GRAD_L = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
-# midpoint a = 3 + k lies on local edge k joining vertices k and (k + 1) % 3
-_EDGE_VERTS = ((0, 1), (1, 2), (2, 0))
+# midpoint a = 3 + k lies on local edge k, joining vertices TRIANGLE.edges[k]
+_EDGE_VERTS = tuple(tuple(e) for e in TRIANGLE.edges.tolist())
 
 
 def _as_points(xi: np.ndarray) -> np.ndarray:
@@ -179,8 +185,9 @@ def edge_basis(t: np.ndarray) -> np.ndarray:
 def edge_reference_points(local_edge: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Reference coordinates of points on local edges.
 
-    Local edge ``k`` runs from local vertex ``k`` to local vertex ``(k + 1) % 3``
-    (counter-clockwise around the cell); ``t = 0`` is its start.
+    Local edge ``k`` runs from local vertex ``TRIANGLE.edges[k, 0]`` (``k``) to
+    ``TRIANGLE.edges[k, 1]`` (``k + 1`` mod 3), counter-clockwise around the cell; ``t = 0``
+    is its start.
 
     Parameters
     ----------
@@ -196,8 +203,8 @@ def edge_reference_points(local_edge: np.ndarray, t: np.ndarray) -> np.ndarray:
     """
     le = np.asarray(local_edge)
     t = np.asarray(t, dtype=np.float64)
-    start = REFERENCE_NODES[:3][le]  # (..., 2)
-    end = REFERENCE_NODES[:3][(le + 1) % 3]
+    start = TRIANGLE.vertices[TRIANGLE.edges[le, 0]]  # (..., 2)
+    end = TRIANGLE.vertices[TRIANGLE.edges[le, 1]]
     return start[..., None, :] + t[:, None] * (end - start)[..., None, :]
 
 

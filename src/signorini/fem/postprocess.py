@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh.geometry import segment_normals
+from ..mesh.reference import TRIANGLE
 from . import iso, p2
 from .mapping import CellMap
 from .material import CellMaterials, Material, _per_cell, on_cells, stress, stress_zz
@@ -100,7 +101,8 @@ def edge_traction(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Traction ``sigma(u_h) n`` along one local edge of each cell, ``n`` outward.
 
-    Local edge ``k`` runs from local vertex ``k`` to ``(k + 1) % 3``; ``t`` is the
+    Local edge ``k`` runs from local vertex ``k`` to ``k + 1`` mod 3 (``TRIANGLE.edges[k]``,
+    :mod:`signorini.mesh.reference`); ``t`` is the
     parameter along it (0 at the start).  The neighbour across an interior edge
     traverses it the other way: evaluate it at ``1 - t`` to get the same
     physical points (its normal is the opposite one), e.g. for the jump
@@ -126,7 +128,7 @@ def edge_traction(
     le = np.asarray(local_edge)
     xi = p2.edge_reference_points(le, t)
     rows = np.arange(v.shape[0])
-    _, normal = segment_normals(v[rows, le], v[rows, (le + 1) % 3])
+    _, normal = segment_normals(v[rows, TRIANGLE.edges[le, 0]], v[rows, TRIANGLE.edges[le, 1]])
     return traction(v, u_cell, material, xi, normal), normal
 
 

@@ -17,6 +17,7 @@ from functools import cached_property
 import numpy as np
 
 from ..mesh.mesh import Mesh
+from ..mesh.reference import TRIANGLE
 from ..mesh.refine import Refinement
 from ..mesh.validation import MeshError
 from . import iso
@@ -340,7 +341,8 @@ class P1Space(LagrangeSpace):
         """``(n_cells, 6, 2)`` each cell's vertices and chord midpoints: the P2 node points of
         its (affine) map."""
         v = self.vertices
-        return np.concatenate([v, 0.5 * (v + v[:, [1, 2, 0]])], axis=1)
+        start, end = TRIANGLE.edges.T
+        return np.concatenate([v, 0.5 * (v[:, start] + v[:, end])], axis=1)
 
     def dof_order(self, vertex_order: np.ndarray) -> np.ndarray:
         """The order of the DOFs of an order of the vertices, the two DOFs of a node

@@ -13,6 +13,7 @@ import numpy as np
 
 from .curves import QuadraticBoundary
 from .mesh import Mesh, MeshError
+from .reference import INTERVAL, TRIANGLE
 from .regions import DEFAULT_REGION
 from .topology import edge_keys
 
@@ -33,9 +34,6 @@ STRAIGHT_TOL = 1e-12
 #: with three or more cells per quarter circle turn by 30° or less each; a polygon's corners
 #: (an octagon's 45°, a rectangle's 90°) turn by more, and a straight part by none
 CURVED_TURN = np.radians(40.0)
-
-#: Local node pairs of the edges of a ``triangle6`` (nodes 3, 4, 5 are their midpoints).
-_TRIANGLE6_EDGES = ((0, 1, 3), (1, 2, 4), (2, 0, 5))
 
 
 def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Mesh:
@@ -99,7 +97,8 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
     except (Exception, SystemExit) as exc:  # meshio raises many types for foreign files
         detail = " ".join(said.getvalue().split()) if isinstance(exc, SystemExit) else exc
         raise MeshError(f"{path} is not a mesh file meshio can read: {detail}") from None
-    tri = [(i, b) for i, b in enumerate(m.cells) if b.type in ("triangle", "triangle6")]
+    names = (TRIANGLE.vtk_name, TRIANGLE.vtk_p2_name)
+    tri = [(i, b) for i, b in enumerate(m.cells) if b.type in names]
     if not tri:
         found = sorted({b.type for b in m.cells})
         hint = (
@@ -232,10 +231,10 @@ def _given_midpoints(m: object, renumber: np.ndarray) -> tuple[np.ndarray, np.nd
     the ``triangle6`` and ``line3`` elements of the meshio mesh ``m`` (repeats included)."""
     pairs, mids = [np.zeros((0, 2), dtype=np.int64)], [np.zeros((0, 2))]
     for block in m.cells:
-        if block.type == "triangle6":
-            local = np.array(_TRIANGLE6_EDGES)
-        elif block.type == "line3":
-            local = np.array([[0, 1, 2]])
+        if block.type == TRIANGLE.vtk_p2_name:  # each edge's two ends and its midpoint node
+            local = TRIANGLE.edge_nodes
+        elif block.type == INTERVAL.vtk_p2_name:
+            local = INTERVAL.edge_nodes
         else:
             continue
         nodes = block.data[:, local].reshape(-1, 3)
@@ -307,9 +306,11 @@ def _check_vertex_jacobians(mesh: Mesh, mid: np.ndarray, curved: np.ndarray) -> 
     (n_edges,)`` bool)."""
     cells = np.flatnonzero(curved[mesh.cell2edge].any(1))
     x = mesh.points[mesh.cells[cells]]  # (c, 3, 2)
-    m = mid[mesh.cell2edge[cells]]  # (c, 3, 2): local edge k joins vertices k and k + 1
-    forward = 4 * m - 3 * x - np.roll(x, -1, axis=1)  # along edge k, leaving vertex k
-    back = 4 * np.roll(m, 1, axis=1) - 3 * x - np.roll(x, 1, axis=1)  # along edge k - 1
+    m = mid[mesh.cell2edge[cells]]  # (c, 3, 2): local edge k joins TRIANGLE.edges[k]
+    leaving = np.argsort(TRIANGLE.edges[:, 0])  # the local edge leaving vertex k: k
+    arriving = np.argsort(TRIANGLE.edges[:, 1])  # the one arriving at vertex k: k - 1
+    forward = 4 * m[:, leaving] - 3 * x - x[:, TRIANGLE.edges[leaving, 1]]
+    back = 4 * m[:, arriving] - 3 * x - x[:, TRIANGLE.edges[arriving, 0]]
     det = forward[..., 0] * back[..., 1] - forward[..., 1] * back[..., 0]
     bad = np.flatnonzero(~(det > 0).all(1))
     if bad.size:

@@ -3,7 +3,8 @@
 Conventions (fixed for the whole package)
 -----------------------------------------
 - ``points (n_points, 2)`` float64, ``cells (n_cells, 3)`` int64, counter-clockwise.
-- Local edge ``k`` of a cell joins its local vertices ``k`` and ``(k + 1) % 3``.
+- Local edge ``k`` of a cell joins its local vertices ``TRIANGLE.edges[k]``, ``k`` and ``k + 1``
+  mod 3 (:mod:`signorini.mesh.reference`, the one owner of local topology).
 - Local edge 0 (``cells[:, 0]``–``cells[:, 1]``) is the *refinement edge* of newest vertex
   bisection and ``cells[:, 2]`` the newest vertex. :meth:`Mesh.from_arrays` puts the longest
   edge first; refinement keeps the convention.
@@ -35,6 +36,7 @@ import numpy as np
 from .curves import Curve
 from .geometry import signed_area
 from .parts import check_parts, part_indices
+from .reference import TRIANGLE
 from .regions import DEFAULT_REGION, RegionSpec, region_labels
 from .topology import boundary_edges, edge_keys, edge_topology, longest_edge_first
 from .validation import (
@@ -365,8 +367,8 @@ class Mesh:
         """Vertex pairs ``(k, 2)`` of boundary edges, counter-clockwise around their cell."""
         cell = self.edge2cell[edge_index, 0]
         local = self.edge_local[edge_index, 0]
-        a = self.cells[cell, local]
-        b = self.cells[cell, (local + 1) % 3]
+        a = self.cells[cell, TRIANGLE.edges[local, 0]]
+        b = self.cells[cell, TRIANGLE.edges[local, 1]]
         return np.stack([a, b], axis=1)
 
     # ------------------------------------------------------------------ geometry
@@ -413,9 +415,10 @@ class Mesh:
         """Smallest interior angle (radians) over all cells."""
         p = self.points[self.cells]
         angles = []
-        for k in range(3):
-            u = p[:, (k + 1) % 3] - p[:, k]
-            v = p[:, (k + 2) % 3] - p[:, k]
+        for k in range(3):  # at vertex k: edge k leaves it, edge k - 1 arrives
+            (_, b), (c, _) = TRIANGLE.edges[k], TRIANGLE.edges[k - 1]
+            u = p[:, b] - p[:, k]
+            v = p[:, c] - p[:, k]
             cos = (u * v).sum(1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
             angles.append(np.arccos(np.clip(cos, -1.0, 1.0)))
         return float(np.min(angles))

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .reference import TRIANGLE
 from .validation import MeshError
 
 __all__ = ["boundary_edges", "edge_keys", "edge_topology", "longest_edge_first"]
@@ -35,7 +36,7 @@ def boundary_edges(cells: np.ndarray) -> np.ndarray:
         Counter-clockwise triangles.
     """
     cells = np.asarray(cells, dtype=np.int64)
-    local = cells[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
+    local = cells[:, TRIANGLE.edges].reshape(-1, 2)
     n = int(cells.max()) + 1 if cells.size else 0
     keys = edge_keys(local, n)
     _, first, counts = np.unique(keys, return_index=True, return_counts=True)
@@ -44,7 +45,7 @@ def boundary_edges(cells: np.ndarray) -> np.ndarray:
 
 def edge_topology(cells: np.ndarray, n_points: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``edges (n_edges, 2)`` (``min`` vertex first), ``cell2edge (n_cells, 3)`` (the edge of
-    local edge ``k``, vertices ``k`` and ``k + 1``) and ``edge2cell (n_edges, 2)`` (column 0
+    local edge ``k``, vertices ``TRIANGLE.edges[k]``) and ``edge2cell (n_edges, 2)`` (column 0
     the first cell seen, column 1 the other or ``-1``) of the triangles ``cells (n_cells, 3)``;
     read-only.
 
@@ -53,7 +54,7 @@ def edge_topology(cells: np.ndarray, n_points: int) -> tuple[np.ndarray, np.ndar
     MeshError
         If an edge is shared by more than two cells.
     """
-    local = cells[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
+    local = cells[:, TRIANGLE.edges].reshape(-1, 2)
     keys = edge_keys(local, n_points)
     uniq, first, inverse, counts = np.unique(
         keys, return_index=True, return_inverse=True, return_counts=True
@@ -66,10 +67,10 @@ def edge_topology(cells: np.ndarray, n_points: int) -> tuple[np.ndarray, np.ndar
             f"({pairs[0, 0]}, {pairs[0, 1]})"
         )
     edges = np.sort(local[first], axis=1)
-    cell2edge = inverse.reshape(-1, 3)
+    cell2edge = inverse.reshape(-1, TRIANGLE.n_edges)
     n_edges = uniq.size
     # edge2cell: column 0 = the first cell seen, column 1 = the other (or -1)
-    owner = np.repeat(np.arange(cells.shape[0], dtype=np.int64), 3)
+    owner = np.repeat(np.arange(cells.shape[0], dtype=np.int64), TRIANGLE.n_edges)
     edge2cell = np.full((n_edges, 2), -1, dtype=np.int64)
     edge2cell[:, 0] = owner[first]
     second = np.ones(inverse.size, dtype=bool)
@@ -79,9 +80,11 @@ def edge_topology(cells: np.ndarray, n_points: int) -> tuple[np.ndarray, np.ndar
 
 
 def longest_edge_first(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
-    """Rotate each cell's vertices cyclically so that local edge 0 is its longest edge."""
+    """Rotate each cell's vertices cyclically so that local edge 0 is its longest edge (the
+    rotation by ``k`` makes local edge ``k`` of :data:`TRIANGLE` local edge 0)."""
     p = points[cells]
-    length2 = ((p[:, [1, 2, 0]] - p) ** 2).sum(-1)  # edge k: vertex k -> k+1
+    start, end = TRIANGLE.edges.T
+    length2 = ((p[:, end] - p[:, start]) ** 2).sum(-1)  # local edge k
     k = np.argmax(length2, axis=1)
     rows = np.arange(len(cells))[:, None]
     return cells[rows, (k[:, None] + np.arange(3)[None, :]) % 3]

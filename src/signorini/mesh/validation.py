@@ -22,6 +22,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .geometry import signed_area
+from .reference import TRIANGLE
 
 if TYPE_CHECKING:
     from .mesh import Mesh
@@ -116,7 +117,8 @@ def aspect_ratios(points: np.ndarray, cells: np.ndarray, area: np.ndarray) -> np
     """``(n_cells,)`` each cell's longest edge over its smallest height, ``h_max² / (2|A|)``
     (``inf`` for a zero area): 2/√3 for an equilateral triangle."""
     p = points[cells]
-    h2 = ((p - np.roll(p, 1, axis=1)) ** 2).sum(-1).max(axis=1)
+    start, end = TRIANGLE.edges.T
+    h2 = ((p[:, end] - p[:, start]) ** 2).sum(-1).max(axis=1)
     with np.errstate(divide="ignore"):
         return h2 / (2.0 * np.abs(area))
 
@@ -228,7 +230,7 @@ def _check_boundary_labelled(mesh: Mesh, is_bnd: np.ndarray) -> None:
 
 def _check_opposite_traversal(mesh: Mesh, is_bnd: np.ndarray) -> None:
     """Neighbouring cells traverse a shared edge in opposite directions (else they overlap)."""
-    local = mesh.cells[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
+    local = mesh.cells[:, TRIANGLE.edges].reshape(-1, 2)
     forward = local[:, 0] < local[:, 1]
     inner = ~is_bnd[mesh.cell2edge.ravel()]
     counts = np.bincount(mesh.cell2edge.ravel()[inner & forward], minlength=mesh.n_edges)

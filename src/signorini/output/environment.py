@@ -10,6 +10,8 @@ import sys
 import numpy as np
 import scipy
 
+from ..version import __version__
+
 __all__ = ["environment"]
 
 
@@ -23,10 +25,8 @@ def environment(solver_library: str) -> dict[str, str]:
         The sparse solver library the run uses, with its version
         (:func:`signorini.algebra.backends.solver_library`).
     """
-    import signorini  # the package is loaded before its modules
-
     return {
-        "signorini": signorini.__version__,
+        "signorini": __version__,
         "python": platform.python_version(),
         "numpy": np.__version__,
         "scipy": scipy.__version__,
