@@ -12,7 +12,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import signal
 from pathlib import Path
 
 import numpy as np
@@ -22,20 +21,6 @@ from test_cli import interrupt_after_level
 from signorini.cli import main
 
 PART = ["run", "example-6.2", "--max-ndof", "3000", "--no-figures", "--quiet"]
-
-
-@pytest.fixture
-def no_blocking():
-    """Fail (instead of hanging) if the code blocks on a named pipe for 60 s."""
-
-    def blocked(signum, frame):
-        raise AssertionError("blocked on a named pipe")
-
-    previous = signal.signal(signal.SIGALRM, blocked)
-    signal.alarm(60)
-    yield
-    signal.alarm(0)
-    signal.signal(signal.SIGALRM, previous)
 
 
 @pytest.fixture(scope="module")

@@ -4,7 +4,6 @@ never followed, named pipes never waited on, reads bounded."""
 from __future__ import annotations
 
 import os
-import signal
 
 import numpy as np
 import pytest
@@ -21,20 +20,6 @@ from signorini.output.guard import (
 from signorini.output.run import RunFolder
 
 from .test_run import PROBLEM
-
-
-@pytest.fixture
-def no_blocking():
-    """Fail (instead of hanging) if the code blocks on a named pipe for 30 s."""
-
-    def blocked(signum, frame):
-        raise AssertionError("blocked on a named pipe")
-
-    previous = signal.signal(signal.SIGALRM, blocked)
-    signal.alarm(30)
-    yield
-    signal.alarm(0)
-    signal.signal(signal.SIGALRM, previous)
 
 
 def test_a_named_pipe_is_refused_without_being_waited_on(tmp_path, no_blocking):
