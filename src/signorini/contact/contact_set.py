@@ -158,9 +158,9 @@ class ContactSet:
 
     @property
     def constrained_dofs(self) -> np.ndarray:
-        """``(k,)`` the DOF each constraint bounds in the node frames: ``2z`` (``2z + 1`` for
-        a corner's second constraint)."""
-        return 2 * self.nodes + self.second
+        """``(k,)`` the DOF each constraint bounds in the node frames: ``d z`` (``d z + 1``
+        for a corner's second constraint), ``d = normal.shape[1]`` the components a node."""
+        return self.normal.shape[1] * self.nodes + self.second
 
     @cached_property
     def frame_nodes(self) -> np.ndarray:
@@ -270,6 +270,7 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
         does not give finite numbers.
     """
     mesh = space.mesh
+    d = space.n_components
     parts = tuple(problem.contact_parts)
     if not parts:
         return _empty(parts)
@@ -305,7 +306,7 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
         problem,
         space,
         cand_node[held],
-        (direction.reshape(-1, 2)[first[held]], edge_gap.ravel()[first[held]]),
+        (direction.reshape(-1, d)[first[held]], edge_gap.ravel()[first[held]]),
         (parts, ukey[held] % n_parts),
         couplings,
     )
@@ -314,12 +315,12 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
         problem,
         space,
         cand_node[kept],
-        (direction.reshape(-1, 2)[first[kept]], edge_gap.ravel()[first[kept]]),
+        (direction.reshape(-1, d)[first[kept]], edge_gap.ravel()[first[kept]]),
         (parts, ukey[kept] % n_parts),
     )
     row_of, starts = constraint_rows(
         cand_node[kept],
-        direction.reshape(-1, 2)[first[kept]],
+        direction.reshape(-1, d)[first[kept]],
         edge_gap.ravel()[first[kept]],
         space.node_points,
         (parts, ukey[kept] % n_parts),
@@ -338,7 +339,7 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     inside = loc >= 0
     k = nodes.size
     part = ukey[lead] % n_parts
-    normal = direction.reshape(-1, 2)[first[lead]]
+    normal = direction.reshape(-1, d)[first[lead]]
     friction = friction_data(problem, space, edge_part, edge_nodes, edge_local, part, second)
     return ContactSet(
         nodes=nodes,

@@ -1,12 +1,12 @@
 """Node frames: the two DOFs of a contact node in its constraint frame.
 
 A node ``z`` with one constraint has a unit direction ``n = (n1, n2)`` and the tangent
-``t = (-n2, n1)``. With interleaved DOFs (``dof = 2 * node + component``), the Cartesian values
-``u = (x[2z], x[2z + 1])`` and the frame values ``(u.n, u.t)`` are related by the 2 x 2 block
-``Q_z = [n t]``: ``u = Q_z (u.n, u.t)``. ``Q`` is block diagonal with ``Q_z`` at the listed
-nodes and the identity elsewhere, so the constraint ``u(z).n <= gap`` of docs/method.md, *The
-continuous problem* becomes a bound on the single DOF ``2z`` of the rotated system
-``Q^T K Q y = Q^T F``.
+``t = (-n2, n1)``. With interleaved DOFs (``dof = d * node + component``; ``d = 2``, the size
+``Q.shape[-1]`` of a frame), the Cartesian values ``u = (x[2z], x[2z + 1])`` and the frame
+values ``(u.n, u.t)`` are related by the 2 x 2 block ``Q_z = [n t]``: ``u = Q_z (u.n, u.t)``.
+``Q`` is block diagonal with ``Q_z`` at the listed nodes and the identity elsewhere, so the
+constraint ``u(z).n <= gap`` of docs/method.md, *The continuous problem* becomes a bound on
+the single DOF ``2z`` of the rotated system ``Q^T K Q y = Q^T F``.
 
 A corner node with two constraints along independent directions ``n, m`` takes the frame
 ``Q_z = A_z^{-1}``, ``A_z`` the matrix with rows ``n`` and ``m``: then ``y = (u.n, u.m)`` and
@@ -30,6 +30,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..algebra.sparse import as_csr, concatenated_ranges, csr_row_indices
+from ..fem.space import node_dofs
 
 __all__ = ["frame_matrices", "rotate_frames", "to_cartesian", "to_frames"]
 
@@ -126,7 +127,7 @@ def to_frames(x: np.ndarray, nodes: np.ndarray, normals: np.ndarray) -> np.ndarr
     # a rotation's inverse is its transpose; a general frame's is computed
     Q = frame_matrices(normals)
     M = Q if normals.ndim == 2 else np.linalg.inv(Q).transpose(0, 2, 1)
-    _transform_pairs(2 * nodes, 2 * nodes + 1, M, y)
+    _transform_pairs(*node_dofs(nodes, Q.shape[-1]).T, M, y)
     return y
 
 
@@ -149,7 +150,7 @@ def to_cartesian(y: np.ndarray, nodes: np.ndarray, normals: np.ndarray) -> np.nd
     x = np.array(y, dtype=np.float64)
     nodes = np.asarray(nodes, dtype=np.int64)
     Q = frame_matrices(normals)
-    _transform_pairs(2 * nodes, 2 * nodes + 1, Q.transpose(0, 2, 1), x)
+    _transform_pairs(*node_dofs(nodes, Q.shape[-1]).T, Q.transpose(0, 2, 1), x)
     return x
 
 
@@ -284,5 +285,5 @@ def rotate_frames(
     data = K.data
     _transform_pairs(first, first + 1, Q[col_node], data)
     _transform_pairs(pos0, pos1, np.repeat(Q, length, axis=0), data)
-    _transform_pairs(2 * nodes, 2 * nodes + 1, Q, F_rot)
+    _transform_pairs(*node_dofs(nodes, Q.shape[-1]).T, Q, F_rot)
     return K, F_rot

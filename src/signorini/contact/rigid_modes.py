@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..fem.space import node_dofs
 from ..mesh.bodies import body_of_cells
 from .node_frames import to_frames
 from .system import Assembled
@@ -44,17 +45,21 @@ def system_rigid_modes(assembled: Assembled) -> np.ndarray:
     count = np.bincount(body, minlength=n_bodies)
     centre = (
         np.stack(
-            [np.bincount(body, weights=points[:, k], minlength=n_bodies) for k in range(2)], axis=1
+            [
+                np.bincount(body, weights=points[:, k], minlength=n_bodies)
+                for k in range(space.mesh.dim)
+            ],
+            axis=1,
         )
         / np.maximum(count, 1)[:, None]
     )
     local = points - centre[body]
     modes = np.zeros((space.n_dofs, 3 * n_bodies))
-    nodes = np.arange(space.n_nodes)
-    modes[2 * nodes, 3 * body] = 1.0
-    modes[2 * nodes + 1, 3 * body + 1] = 1.0
-    modes[2 * nodes, 3 * body + 2] = -local[:, 1]
-    modes[2 * nodes + 1, 3 * body + 2] = local[:, 0]
+    x, y = node_dofs(np.arange(space.n_nodes), space.n_components).T  # the 2D modes
+    modes[x, 3 * body] = 1.0
+    modes[y, 3 * body + 1] = 1.0
+    modes[x, 3 * body + 2] = -local[:, 1]
+    modes[y, 3 * body + 2] = local[:, 0]
     transfer = assembled.contact.transfer
     if transfer is not None:  # the relative displacement of the contact pairs
         modes = modes - transfer.dofs @ modes

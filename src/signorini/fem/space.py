@@ -3,7 +3,7 @@ interpolation, prolongation; :func:`space_of` chooses one by its element.
 
 Global P2 nodes are the mesh vertices (node index = point index) followed by the edge
 midpoints (node index = ``n_points + edge index``). Vector DOFs are interleaved:
-``dof = 2 * node + component``. Local node order on a cell: its three vertices, then the
+``dof = d * node + component``, ``d = mesh.dim``. Local node order on a cell: its vertices, then the
 midpoints of local edges 0, 1, 2 (the order of VTK's quadratic triangle / meshio ``triangle6``).
 Global P1 nodes are the mesh vertices; a P1 space is affine on every cell (a curved boundary
 part is approximated by its chords; docs/method.md, *P1 elements and their estimator*).
@@ -25,7 +25,26 @@ from .element import P1, P2, Element, element_of
 from .mapping import CellMap, QuadraticEdges, StraightEdges, edge_groups
 from .p2 import basis_barycentric
 
-__all__ = ["LagrangeSpace", "P1Space", "P2Space", "space_of"]
+__all__ = ["LagrangeSpace", "P1Space", "P2Space", "node_dofs", "space_of"]
+
+
+def node_dofs(nodes: np.ndarray, n_components: int) -> np.ndarray:
+    """The interleaved DOFs ``n_components * node + c`` of ``nodes``.
+
+    Parameters
+    ----------
+    nodes : (...) int array
+        Global nodes.
+    n_components : int
+        The components per node, ``d``.
+
+    Returns
+    -------
+    (..., d) int array
+        ``[d * node, d * node + 1, …, d * node + d − 1]`` per node, in the dtype of ``nodes``.
+    """
+    nodes = np.asarray(nodes)
+    return n_components * nodes[..., None] + np.arange(n_components, dtype=nodes.dtype)
 
 
 class LagrangeSpace:
@@ -48,14 +67,20 @@ class LagrangeSpace:
         self.mesh = mesh
 
     @property
+    def n_components(self) -> int:
+        """The components of a displacement per node, ``mesh.dim`` (elasticity)."""
+        return self.mesh.dim
+
+    @property
     def n_dofs(self) -> int:
-        return 2 * self.n_nodes
+        return self.n_components * self.n_nodes
 
     @cached_property
     def cell_dofs(self) -> np.ndarray:
-        """``(n_cells, 2 n_local)`` interleaved global DOFs (local DOF ``2 * node + component``)."""
+        """``(n_cells, d n_local)`` interleaved global DOFs (local DOF ``d * node + component``,
+        ``d = n_components``)."""
         n = self.cell_nodes
-        return np.stack([2 * n, 2 * n + 1], axis=-1).reshape(len(n), 2 * n.shape[1])
+        return node_dofs(n, self.n_components).reshape(len(n), -1)
 
     @cached_property
     def mapping(self) -> CellMap:
@@ -69,11 +94,11 @@ class LagrangeSpace:
         return self.mesh.points[self.mesh.cells]
 
     def interpolate(self, func: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-        """Nodal interpolant ``(n_nodes, 2)`` of a vector field ``func(x (n, 2)) -> (n, 2)``."""
+        """Nodal interpolant ``(n_nodes, d)`` of a vector field ``func(x (n, d)) -> (n, d)``."""
         values = np.asarray(func(self.node_points), dtype=np.float64)
-        if values.shape != (self.n_nodes, 2):
+        if values.shape != (self.n_nodes, self.n_components):
             raise ValueError(
-                f"the function to interpolate must return shape ({self.n_nodes}, 2)"
+                f"the function to interpolate must return shape {(self.n_nodes, self.n_components)}"
                 f" for {self.n_nodes} points, got {values.shape}"
             )
         return values
@@ -183,7 +208,7 @@ class P2Space(LagrangeSpace):
         edges = self.mesh.edges
         key = np.concatenate([2 * position, 2 * position[edges].min(axis=1) + 1])
         nodes = np.argsort(key, kind="stable")
-        return np.stack([2 * nodes, 2 * nodes + 1], axis=-1).ravel()
+        return node_dofs(nodes, self.n_components).ravel()
 
     def edge_nodes(self, edge_index: np.ndarray) -> np.ndarray:
         """``(k, 3)`` nodes ``[start, end, midpoint]`` of boundary edges, counter-clockwise."""
@@ -348,7 +373,7 @@ class P1Space(LagrangeSpace):
         """The order of the DOFs of an order of the vertices, the two DOFs of a node
         together (as :meth:`P2Space.dof_order`)."""
         nodes = np.asarray(vertex_order, dtype=np.int64)
-        return np.stack([2 * nodes, 2 * nodes + 1], axis=-1).ravel()
+        return node_dofs(nodes, self.n_components).ravel()
 
     def edge_nodes(self, edge_index: np.ndarray) -> np.ndarray:
         """``(k, 2)`` nodes ``[start, end]`` of boundary edges, counter-clockwise."""

@@ -3,7 +3,8 @@ for the P2 element (the paper's) or P1 (:mod:`signorini.fem.element`).
 
 Arrays are vectorized over cells: ``vertices (m, 3, 2)`` is ``points[cells]``
 (counter-clockwise), ``cell_dofs (m, 12)`` the interleaved global DOFs,
-``cell_dofs[:, 2 a + c] = 2 * node_a + c`` in the local node order of :mod:`signorini.fem.p2`.
+``cell_dofs[:, d a + c] = d * node_a + c`` (``d = 2`` components a node) in the local node
+order of :mod:`signorini.fem.p2`.
 
 Assembly
 --------
@@ -24,6 +25,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
+from ..mesh.reference import TRIANGLE
 from . import p2
 from .element import ELEMENTS, P2, Element
 from .fixed_order import rows_times
@@ -32,6 +34,10 @@ from .material import CellMaterials, Material, on_cells
 from .quadrature import triangle_rule
 
 __all__ = ["assemble_stiffness", "element_blocks", "element_stiffness"]
+
+# The components per node, ``d`` (``space.n_components`` of a triangle mesh): the node blocks
+# are ``d x d``; the complex packing of :func:`_assemble_node_blocks` is the d = 2 branch.
+_D = TRIANGLE.dim
 
 
 # On a straight triangle, grad phi_a = J^{-T} ghat_a with ghat_a linear, so
@@ -267,7 +273,7 @@ def _checked_input(
         raise ValueError(f"n_dofs must be a non-negative integer, got {n_dofs!r}") from None
     if n < 0 or n != n_dofs:
         raise ValueError(f"n_dofs must be a non-negative integer, got {n_dofs!r}")
-    if n % 2:
+    if n % _D:
         raise ValueError(f"n_dofs must be even (two components per node), got {n}")
     if not isinstance(material, Material | CellMaterials):
         raise ValueError(f"material must be a Material, got {type(material).__name__}")
@@ -295,13 +301,13 @@ def _checked_input(
         raise ValueError(
             f"cell_dofs out of range: values in [{d.min()}, {d.max()}] but n_dofs = {n}"
         )
-    ev, od = d[:, 0::2], d[:, 1::2]
-    if np.any(ev % 2) or np.any(od != ev + 1):
+    ev, od = d[:, 0::_D], d[:, 1::_D]
+    if np.any(ev % _D) or np.any(od != ev + 1):
         raise ValueError(
             "cell_dofs must be interleaved: cell_dofs[:, 2a] = 2 * node_a and "
             "cell_dofs[:, 2a + 1] = 2 * node_a + 1"
         )
-    return ev.astype(np.int64, copy=False) // 2, n
+    return ev.astype(np.int64, copy=False) // _D, n
 
 
 def assemble_stiffness(
@@ -364,19 +370,19 @@ def assemble_stiffness(
         vertices = mapping.groups[0].vertices if mapping is not None else cells
         if mapping is not None and len(mapping.groups) > 1:
             vertices = mapping.per_cell(lambda g: g.vertices)
-        nodes, n = _checked_input(vertices, cell_dofs, n_dofs, material, 2 * element.n_local)
+        nodes, n = _checked_input(vertices, cell_dofs, n_dofs, material, _D * element.n_local)
         if rows is not None:
             _check_rows(rows, n)
     else:
-        nodes = np.asarray(cell_dofs, dtype=np.int64)[:, 0::2] // 2
+        nodes = np.asarray(cell_dofs, dtype=np.int64)[:, 0::_D] // _D
         n = int(n_dofs)
     if mapping is None:
         mapping = CellMap(cells)
     if rows is not None:
-        kept = np.asarray(rows, dtype=bool)[0::2]
+        kept = np.asarray(rows, dtype=bool)[0::_D]
         blocks, nodes = _row_blocks(mapping, nodes, material, element, kept[nodes].any(axis=1))
         k = element.n_local
-        return _assemble_node_blocks(nodes, n // 2, blocks.reshape(-1, k, k, 2, 2), kept)
+        return _assemble_node_blocks(nodes, n // _D, blocks.reshape(-1, k, k, _D, _D), kept)
     if len(mapping.groups) == 1:
         g = mapping.groups[0]
         blocks = element_blocks(g, on_cells(material, g.cells), element=element)
@@ -389,7 +395,7 @@ def assemble_stiffness(
             start += len(g)
         nodes = nodes[np.concatenate([g.cells for g in mapping.groups])]
     k = element.n_local
-    return _assemble_node_blocks(nodes, n // 2, blocks.reshape(-1, k, k, 2, 2))
+    return _assemble_node_blocks(nodes, n // _D, blocks.reshape(-1, k, k, _D, _D))
 
 
 def _check_rows(rows: object, n_dofs: int) -> None:
@@ -398,7 +404,7 @@ def _check_rows(rows: object, n_dofs: int) -> None:
     r = np.asarray(rows)
     if r.dtype != np.bool_ or r.shape != (n_dofs,):
         raise ValueError(f"rows must be a bool array of shape ({n_dofs},), got {r.dtype} {r.shape}")
-    split = np.flatnonzero(r[0::2] != r[1::2])
+    split = np.flatnonzero(r[0::_D] != r[1::_D])
     if split.size:
         raise ValueError(
             f"rows must take both DOFs of a node or neither; node {split[0]} has one "

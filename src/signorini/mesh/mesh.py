@@ -286,6 +286,11 @@ class Mesh:
         return mesh
 
     # ------------------------------------------------------------------ sizes
+    @cached_property
+    def dim(self) -> int:
+        """The dimension of the cells and the points, ``(n_points, dim)``: 2 (a triangle's)."""
+        return TRIANGLE.dim
+
     @property
     def n_points(self) -> int:
         return self.points.shape[0]
@@ -395,10 +400,9 @@ class Mesh:
 
     @cached_property
     def curved_midpoints(self) -> np.ndarray:
-        """``(n_edges, 2)`` edge midpoints, on the curve for edges of a part that carries
-        one (:meth:`Curve.halfway` of the edge's ends): where refinement puts new vertices
-        and the P2 space its edge nodes. The same array as :attr:`edge_midpoints` when no
-        part carries a curve."""
+        """``(n_edges, 2)`` edge midpoints, on the curve for edges of a part that carries one
+        (:meth:`Curve.halfway` of the edge's ends): where refinement puts new vertices and the
+        P2 space its edge nodes; :attr:`edge_midpoints` when no part carries a curve."""
         if all(c is None for c in self.curves):
             return self.edge_midpoints
         mid = self.edge_midpoints.copy()
@@ -436,9 +440,8 @@ class Mesh:
         return float(self.edge_length[self.part_edges(name)].sum())
 
     def __repr__(self) -> str:
-        return (
-            f"Mesh(n_points={self.n_points}, n_cells={self.n_cells}, parts={list(self.part_names)})"
-        )
+        parts = list(self.part_names)
+        return f"Mesh(n_points={self.n_points}, n_cells={self.n_cells}, parts={parts})"
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:

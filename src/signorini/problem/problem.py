@@ -40,14 +40,14 @@ __all__ = ["ContactProblem", "SlenderBodyWarning", "free_ndof"]
 
 
 def free_ndof(space: P2Space, dirichlet_nodes: np.ndarray) -> int:
-    """The paper's Ndof: the free scalar unknowns of ``space``, ``2 n_nodes − 2 n_D``.
+    """The paper's Ndof: the free scalar unknowns of ``space``, ``d n_nodes − d n_D``.
 
-    All DOFs of the space minus both DOFs of each of the ``n_D`` nodes ``dirichlet_nodes``
-    on the closure of Γ_D; constrained contact DOFs are counted (docs/method.md, *Data
-    conventions*). The one definition of the count that budgets (``max_ndof``) and histories
-    (``ndof``) use.
+    All DOFs of the space (``d = space.n_components`` a node) minus the ``d`` DOFs of each
+    of the ``n_D`` nodes ``dirichlet_nodes`` on the closure of Γ_D; constrained contact DOFs
+    are counted (docs/method.md, *Data conventions*). The one definition of the count that
+    budgets (``max_ndof``) and histories (``ndof``) use.
     """
-    return space.n_dofs - 2 * len(dirichlet_nodes)
+    return space.n_dofs - space.n_components * len(dirichlet_nodes)
 
 
 @dataclass(frozen=True)
@@ -241,7 +241,7 @@ class ContactProblem:
         for name in self.rollers:  # a loop over parts
             nodes, normals = roller_normals(self.mesh, name)
             v, first = np.unique(nodes[:, :2].ravel(), return_index=True)
-            out[name] = (self.mesh.points[v], normals[:, :2].reshape(-1, 2)[first])
+            out[name] = (self.mesh.points[v], normals[:, :2].reshape(-1, self.mesh.dim)[first])
         return out
 
     def free_ndof(self, mesh: Mesh | LagrangeSpace) -> int:
@@ -273,7 +273,7 @@ class ContactProblem:
         if not straight:
             return None
         if given is not None:
-            g = np.asarray(given, dtype=np.float64).reshape(2)  # checked by Contact
+            g = np.asarray(given, dtype=np.float64).reshape(mesh.dim)  # checked by Contact
             g = g / np.linalg.norm(g)
             if np.abs(g - mean).max() > 1e-6:
                 raise ProblemError(
@@ -339,9 +339,9 @@ def _check_components(mesh: Mesh, dirichlet_parts: list[str], contact_parts: lis
         return
     # cells, bounding box and boundary parts of each component
     n_cells = np.bincount(label, minlength=n_comp)
-    xy = mesh.points[mesh.cells]  # (n_cells, 3, 2)
-    lo = np.full((n_comp, 2), np.inf)
-    hi = np.full((n_comp, 2), -np.inf)
+    xy = mesh.points[mesh.cells]  # (n_cells, 3, dim)
+    lo = np.full((n_comp, mesh.dim), np.inf)
+    hi = np.full((n_comp, mesh.dim), -np.inf)
     np.minimum.at(lo, label, xy.min(axis=1))
     np.maximum.at(hi, label, xy.max(axis=1))
     be = np.flatnonzero(mesh.edge_part >= 0)
