@@ -27,15 +27,12 @@ ROUNDOFF_FACTOR = 1e4
 
 
 def hooke_norm(problem: ContactProblem) -> float:
-    """``‖C‖``, the largest of the problem's materials' Hooke's law on symmetric 2 × 2 strains.
-
-    σ = λ* tr(ε) I + 2 μ ε has the eigenvalues ``2 (λ* + μ)`` (ε ∝ I) and ``2 μ`` (trace
-    free ε), λ* the plane-strain or plane-stress λ (:attr:`Material.lam_eff
-    <signorini.fem.material.Material.lam_eff>`): ``‖C‖ = max(2 (λ* + μ), 2 μ)``.
-    """
+    """``‖C‖`` of the problem's stiffest material (:attr:`Material.hooke_norm
+    <signorini.fem.material.Material.hooke_norm>`, the largest eigenvalue of its 2D Hooke's
+    law)."""
     material = problem.material
     materials = [material] if isinstance(material, Material) else list(material.values())
-    return max(max(2.0 * (m.lam_eff + m.mu), 2.0 * m.mu) for m in materials)
+    return max(m.hooke_norm for m in materials)
 
 
 def roundoff_level(result: ContactResult) -> float:

@@ -167,6 +167,13 @@ class Material:
             return self.lam
         return 2.0 * self.lam * self.mu / (self.lam + 2.0 * self.mu)
 
+    @property
+    def hooke_norm(self) -> float:
+        """``‖C‖``, the largest eigenvalue of the 2D Hooke's law on symmetric strains:
+        σ = λ* tr(ε) I + 2 μ ε has ``2 (λ* + μ)`` on ε ∝ I and ``2 μ`` on trace-free ε, so
+        ``max(2 (λ* + μ), 2 μ)`` (λ* = :attr:`lam_eff`)."""
+        return max(2.0 * (self.lam_eff + self.mu), 2.0 * self.mu)
+
     def stress_zz(self, grad_u: np.ndarray) -> np.ndarray:
         """The out-of-plane stress σ_zz of displacement gradients ``grad_u (..., 2, 2)``:
         ``lam (ε_xx + ε_yy)`` in plane strain, zero in plane stress; shape ``(...)``."""

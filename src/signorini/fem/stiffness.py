@@ -46,7 +46,7 @@ _D = TRIANGLE.dim
 # (R exact with the degree-2 rule), and
 #   K[(a, i), (b, j)] = lam B_ab[i, j] + mu B_ab[j, i] + mu delta_ij tr B_ab.
 # K is linear in the 16 numbers P, which satisfy P[ij, kl] = P[ji, lk]; the 10
-# independent ones are gathered per cell and K = P10 @ KREF (one GEMM).
+# independent ones are gathered per cell and K = P10 @ KREF (one product, fixed_order.rows_times).
 _P_PAIRS = [
     ((i, j, k, l), (j, i, l, k))
     for i in range(2)
@@ -131,14 +131,16 @@ def element_blocks(
     One integrand for every geometry: ``K = sum_q P(x_q) R_q`` with the 10 geometric factors
     ``P = det J * Jit (x) Jit`` at the points of the rule and ``R_q`` the reference gradients'
     products there. Where the Jacobian is constant on each cell (affine cells) ``P`` has one
-    point and ``R`` is summed over the rule first (one GEMM with a (10, 144) matrix).
+    point and ``R`` is summed over the rule first (one product with a (10, 144) matrix,
+    :func:`~signorini.fem.fixed_order.rows_times`: no BLAS, so a cell's block depends on that
+    cell alone).
 
     ``degree`` defaults to ``2 * cells.order``: the degree of the integrand's numerator
     ``(cof J grad phi_a) . C (cof J grad phi_b)``, exact on affine cells (degree 2); on the
     quadratic maps of isoparametric cells (degree 4) the rational remainder is far below the
     discretisation error (Ciarlet-Raviart: degree 2k - 2 suffices for the optimal rate).
     ``out (m, 144)``, if given, receives the result. With a :class:`CellMaterials` of the
-    group's cells, one GEMM per material on its rows.
+    group's cells, one product per material on its rows.
     """
     degree = 2 * cells.order if degree is None else degree
     xi, _ = triangle_rule(degree)
