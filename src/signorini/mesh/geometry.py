@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["segment_normals", "signed_area"]
+from .reference import TRIANGLE
+
+__all__ = ["min_angle", "segment_normals", "signed_area"]
 
 
 def segment_normals(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -48,3 +50,16 @@ def signed_area(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
     p0, p1, p2 = (points[cells[:, k]] for k in range(3))
     d1, d2 = p1 - p0, p2 - p0
     return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+
+
+def min_angle(points: np.ndarray, cells: np.ndarray) -> float:
+    """Smallest interior angle (radians) of the triangles ``cells (n_cells, 3)``."""
+    p = points[cells]
+    angles = []
+    for k in range(3):  # at vertex k: edge k leaves it, edge k - 1 arrives
+        (_, b), (c, _) = TRIANGLE.edges[k], TRIANGLE.edges[k - 1]
+        u = p[:, b] - p[:, k]
+        v = p[:, c] - p[:, k]
+        cos = (u * v).sum(1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
+        angles.append(np.arccos(np.clip(cos, -1.0, 1.0)))
+    return float(np.min(angles))

@@ -34,16 +34,22 @@ from functools import cached_property
 import numpy as np
 
 from .curves import Curve
-from .geometry import signed_area
+from .geometry import min_angle, signed_area
 from .parts import check_parts, part_indices
-from .reference import TRIANGLE
-from .regions import DEFAULT_REGION, RegionSpec, region_labels
-from .topology import boundary_edges, edge_keys, edge_topology, longest_edge_first
+from .reference import TRIANGLE, ReferenceCell
+from .regions import RegionSpec, checked_regions, region_labels
+from .topology import (
+    boundary_edges,
+    entity_topology,
+    facet_local,
+    longest_edge_first,
+    rows_of,
+)
 from .validation import (
     MeshError,
     as_cells,
     as_points,
-    format_indices,
+    check_on_curve,
     nondegenerate_area,
     validate_mesh,
 )
@@ -135,29 +141,13 @@ class Mesh:
                 f"curves needs one Curve or None per part ({len(self.part_names)}), got "
                 f"{self.curves!r}"
             )
-        self._set_regions(cell_region, region_names)
+        self.cell_region, self.region_names = checked_regions(
+            cell_region, region_names, self.cells.shape[0]
+        )
         for a in (self.points, self.cells, self.boundary, self.boundary_part, self.cell_region):
             a.flags.writeable = False
         if validate:
             validate_mesh(self)
-
-    def _set_regions(
-        self, cell_region: np.ndarray | None, region_names: tuple[str, ...] | list[str] | None
-    ) -> None:
-        n = self.cells.shape[0]
-        if cell_region is None:
-            cell_region = np.zeros(n, dtype=np.int64)
-        names = (DEFAULT_REGION,) if region_names is None else tuple(str(r) for r in region_names)
-        region = np.ascontiguousarray(cell_region, dtype=np.int64).reshape(-1)
-        if region.shape != (n,) or (n and (region.min() < 0 or region.max() >= len(names))):
-            raise MeshError(
-                f"cell_region must give each of the {n} cells an index into region_names "
-                f"{list(names)}, got shape {region.shape}"
-                + (f" and values in [{region.min()}, {region.max()}]" if region.size else "")
-            )
-        if len(set(names)) != len(names):
-            raise MeshError(f"region_names must be distinct, got {list(names)}")
-        self.cell_region, self.region_names = region, names
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -259,16 +249,7 @@ class Mesh:
                 f"ProjectedCurve), got {type(curve).__name__}"
             )
         vertices = np.unique(self.boundary[self.boundary_part == index])
-        x = self.points[vertices]
-        distance = np.hypot(*(curve.project(x) - x).T)
-        diameter = float(np.hypot(*np.ptp(self.points, axis=0)))
-        if np.any(distance > rtol * diameter):
-            k = int(np.argmax(distance))
-            raise MeshError(
-                f"with_curve: vertex {vertices[k]} {x[k].tolist()} of part {part!r} lies "
-                f"{distance[k]:.3g} from {curve!r}, more than rtol * diameter = "
-                f"{rtol * diameter:.3g}"
-            )
+        check_on_curve(self.points, vertices, curve, part, rtol)
         curves = list(self.curves)
         curves[index] = curve
         mesh = Mesh(
@@ -286,10 +267,16 @@ class Mesh:
         return mesh
 
     # ------------------------------------------------------------------ sizes
-    @cached_property
+    @property
+    def reference(self) -> ReferenceCell:
+        """The reference cell of the cells, :data:`~signorini.mesh.reference.TRIANGLE`: the
+        one owner of their local topology (edges, facets, VTK names)."""
+        return TRIANGLE
+
+    @property
     def dim(self) -> int:
         """The dimension of the cells and the points, ``(n_points, dim)``: 2 (a triangle's)."""
-        return TRIANGLE.dim
+        return self.reference.dim
 
     @property
     def n_points(self) -> int:
@@ -303,57 +290,63 @@ class Mesh:
     def n_edges(self) -> int:
         return self.edges.shape[0]
 
+    @property
+    def n_facets(self) -> int:
+        return self.facets.shape[0]
+
     # ------------------------------------------------------------------ topology
     @cached_property
-    def _topology(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return edge_topology(self.cells, self.n_points)
+    def _topology(self) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        return entity_topology(self.cells, self.n_points, self.reference.edges)
 
     @property
     def edges(self) -> np.ndarray:
-        """``(n_edges, 2)`` vertex pairs, ``min`` first."""
+        """``(n_edges, 2)`` vertex pairs, ``min`` first: the carriers of the P2 edge nodes."""
         return self._topology[0]
 
     @property
     def cell2edge(self) -> np.ndarray:
-        """``(n_cells, 3)`` edge index of local edge ``k`` (vertices ``k``, ``k+1``)."""
+        """``(n_cells, n_edges of the cell)`` edge index of local edge ``k``
+        (``reference.edges[k]``)."""
         return self._topology[1]
 
     @property
-    def edge2cell(self) -> np.ndarray:
-        """``(n_edges, 2)`` adjacent cells, ``-1`` outside the domain."""
+    def facets(self) -> np.ndarray:
+        """``(n_facets, dim)`` the vertices of each facet, sorted: where boundary parts,
+        tractions, jumps and contact live. A triangle's facets are its edges, so in 2D this
+        is :attr:`edges` (the same array)."""
+        return self._topology[0]
+
+    @property
+    def cell2facet(self) -> np.ndarray:
+        """``(n_cells, n_facets of the cell)`` facet index of local facet ``k``
+        (``reference.facets[k]``); :attr:`cell2edge` in 2D."""
+        return self._topology[1]
+
+    @property
+    def facet2cell(self) -> np.ndarray:
+        """``(n_facets, 2)`` the cells of each facet, ``-1`` outside the domain (boundary
+        facets have their cell in column 0)."""
         return self._topology[2]
 
     @cached_property
-    def edge_local(self) -> np.ndarray:
-        """``(n_edges, 2)`` local index ``k`` of each edge in its cells ``edge2cell[:, 0]`` and
-        ``edge2cell[:, 1]`` (``-1`` outside the domain): ``cell2edge[edge2cell[e, s],
-        edge_local[e, s]] == e``."""
-        cells = np.repeat(np.arange(self.n_cells), 3)
-        k = np.tile(np.arange(3), self.n_cells)
-        e = self.cell2edge.ravel()
-        slot = (self.edge2cell[e, 0] != cells).astype(np.int64)
-        out = np.full((self.n_edges, 2), -1, dtype=np.int64)
-        out[e, slot] = k
-        return _frozen(out)
+    def facet_local(self) -> np.ndarray:
+        """``(n_facets, 2)`` local index ``k`` of each facet in its cells ``facet2cell[:, 0]``
+        and ``facet2cell[:, 1]`` (``-1`` outside): ``cell2facet[facet2cell[f, s],
+        facet_local[f, s]] == f``."""
+        return facet_local(self.cell2facet, self.facet2cell)
 
     @cached_property
-    def boundary_edge(self) -> np.ndarray:
-        """``(n_boundary,)`` mesh edge index of each row of :attr:`boundary`."""
-        keys = edge_keys(self.edges, self.n_points)  # sorted by construction
-        k = edge_keys(self.boundary, self.n_points)
-        pos = np.minimum(np.searchsorted(keys, k), keys.size - 1)
-        if keys.size == 0 or not np.array_equal(keys[pos], k):
-            bad = np.flatnonzero(keys[pos] != k)
-            raise MeshError(f"boundary edge(s) {format_indices(bad)} are not edges of the mesh")
-        return _frozen(pos)
+    def boundary_facet(self) -> np.ndarray:
+        """``(n_boundary,)`` mesh facet index of each row of :attr:`boundary`."""
+        return rows_of(self.facets, self.boundary, self.n_points)
 
     @cached_property
-    def edge_part(self) -> np.ndarray:
-        """``(n_edges,)`` boundary part index of each edge, ``-1`` for interior edges."""
-        part = np.full(self.n_edges, -1, dtype=np.int64)
-        part[self.boundary_edge] = self.boundary_part
-        part.flags.writeable = False
-        return part
+    def facet_part(self) -> np.ndarray:
+        """``(n_facets,)`` boundary part index of each facet, ``-1`` for interior facets."""
+        part = np.full(self.n_facets, -1, dtype=np.int64)
+        part[self.boundary_facet] = self.boundary_part
+        return _frozen(part)
 
     def part_index(self, name: str) -> int:
         """Index of boundary part ``name``; a clear error if there is none."""
@@ -364,17 +357,23 @@ class Mesh:
                 f"the mesh has no boundary part {name!r}; its parts are {list(self.part_names)}"
             ) from None
 
-    def part_edges(self, name: str) -> np.ndarray:
-        """Mesh edge indices of boundary part ``name``."""
-        return self.boundary_edge[self.boundary_part == self.part_index(name)]
+    def part_facets(self, name: str) -> np.ndarray:
+        """Mesh facet indices of boundary part ``name``."""
+        return self.boundary_facet[self.boundary_part == self.part_index(name)]
 
-    def oriented_boundary(self, edge_index: np.ndarray) -> np.ndarray:
-        """Vertex pairs ``(k, 2)`` of boundary edges, counter-clockwise around their cell."""
-        cell = self.edge2cell[edge_index, 0]
-        local = self.edge_local[edge_index, 0]
-        a = self.cells[cell, TRIANGLE.edges[local, 0]]
-        b = self.cells[cell, TRIANGLE.edges[local, 1]]
-        return np.stack([a, b], axis=1)
+    def oriented_boundary(self, facet_index: np.ndarray) -> np.ndarray:
+        """The vertices ``(k, dim)`` of boundary facets in their cell's local order
+        (``reference.facets``): counter-clockwise around their cell in 2D."""
+        cell = self.facet2cell[facet_index, 0]
+        local = self.reference.facets[self.facet_local[facet_index, 0]]
+        return self.cells[cell[:, None], local]
+
+    # the 2D names of the facet arrays (a triangle's facets are its edges)
+    edge2cell = facet2cell
+    edge_local = property(lambda self: self.facet_local, doc="The 2D name of facet_local.")
+    boundary_edge = property(lambda self: self.boundary_facet, doc="The 2D name.")
+    edge_part = property(lambda self: self.facet_part, doc="The 2D name of facet_part.")
+    part_edges = part_facets
 
     # ------------------------------------------------------------------ geometry
     @cached_property
@@ -387,6 +386,11 @@ class Mesh:
         """``(n_edges,)`` lengths."""
         d = self.points[self.edges[:, 1]] - self.points[self.edges[:, 0]]
         return _frozen(np.hypot(d[:, 0], d[:, 1]))
+
+    @property
+    def facet_measure(self) -> np.ndarray:
+        """``(n_facets,)`` the facets' measures |F|: :attr:`edge_length` in 2D."""
+        return self.edge_length
 
     @cached_property
     def h(self) -> np.ndarray:
@@ -417,15 +421,7 @@ class Mesh:
 
     def min_angle(self) -> float:
         """Smallest interior angle (radians) over all cells."""
-        p = self.points[self.cells]
-        angles = []
-        for k in range(3):  # at vertex k: edge k leaves it, edge k - 1 arrives
-            (_, b), (c, _) = TRIANGLE.edges[k], TRIANGLE.edges[k - 1]
-            u = p[:, b] - p[:, k]
-            v = p[:, c] - p[:, k]
-            cos = (u * v).sum(1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
-            angles.append(np.arccos(np.clip(cos, -1.0, 1.0)))
-        return float(np.min(angles))
+        return min_angle(self.points, self.cells)
 
     def region_cells(self, name: str) -> np.ndarray:
         """Indices of the cells of region ``name``."""
@@ -435,9 +431,11 @@ class Mesh:
             )
         return np.flatnonzero(self.cell_region == self.region_names.index(name))
 
-    def part_length(self, name: str) -> float:
-        """Total length of boundary part ``name``."""
-        return float(self.edge_length[self.part_edges(name)].sum())
+    def part_measure(self, name: str) -> float:
+        """Total measure of boundary part ``name`` (its length in 2D)."""
+        return float(self.facet_measure[self.part_facets(name)].sum())
+
+    part_length = part_measure
 
     def __repr__(self) -> str:
         parts = list(self.part_names)

@@ -15,7 +15,7 @@ import numpy as np
 
 from .validation import MeshError
 
-__all__ = ["DEFAULT_REGION", "RegionSpec", "region_labels", "with_regions"]
+__all__ = ["DEFAULT_REGION", "RegionSpec", "checked_regions", "region_labels", "with_regions"]
 
 #: The one region of a mesh built without regions.
 DEFAULT_REGION = "body"
@@ -147,3 +147,31 @@ def with_regions(mesh, regions: RegionSpec):
         cell_region=region,
         region_names=names,
     )
+
+
+def checked_regions(
+    cell_region: np.ndarray | None, region_names: tuple[str, ...] | list[str] | None, n: int
+) -> tuple[np.ndarray, tuple[str, ...]]:
+    """The cells' region indices ``(n,)`` (read-only) and the region names of a mesh of ``n``
+    cells, checked; by default every cell in one region, :data:`DEFAULT_REGION`.
+
+    Raises
+    ------
+    MeshError
+        If ``cell_region`` does not give each cell an index into ``region_names``, or the
+        names repeat.
+    """
+    if cell_region is None:
+        cell_region = np.zeros(n, dtype=np.int64)
+    names = (DEFAULT_REGION,) if region_names is None else tuple(str(r) for r in region_names)
+    region = np.ascontiguousarray(cell_region, dtype=np.int64).reshape(-1)
+    if region.shape != (n,) or (n and (region.min() < 0 or region.max() >= len(names))):
+        raise MeshError(
+            f"cell_region must give each of the {n} cells an index into region_names "
+            f"{list(names)}, got shape {region.shape}"
+            + (f" and values in [{region.min()}, {region.max()}]" if region.size else "")
+        )
+    if len(set(names)) != len(names):
+        raise MeshError(f"region_names must be distinct, got {list(names)}")
+    region.flags.writeable = False
+    return region, names

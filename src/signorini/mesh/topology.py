@@ -1,7 +1,13 @@
-"""The topology of a triangulation as pure functions on its arrays (docs/method.md, *Data
-conventions*): each undirected edge once, the edges of each cell and the cells of each edge,
-the boundary edges, and the cell order that puts the refinement edge first.
+"""The topology of a simplicial mesh as pure functions on its arrays, every entity list read
+from the reference cell (docs/method.md, *Data conventions*): each entity (edge, facet) once,
+the entities of each cell, the cells of each facet and a facet's local index in them, the
+boundary facets, and the cell order that puts the refinement edge first.
 :class:`~signorini.mesh.mesh.Mesh` caches their results.
+
+One function, :func:`entity_topology`, builds every list from a table of local entities
+(``TRIANGLE.edges``, ``TRIANGLE.facets``, ``TETRAHEDRON.edges``, ``TETRAHEDRON.facets``), as
+scikit-fem builds its ``t2f``/``f2t`` from ``refdom`` tables: the entities of the cells are
+``cells[:, local]``, numbered by the sorted key of their vertex sets.
 """
 
 from __future__ import annotations
@@ -9,9 +15,19 @@ from __future__ import annotations
 import numpy as np
 
 from .reference import TRIANGLE
-from .validation import MeshError
+from .validation import MeshError, format_indices
 
-__all__ = ["boundary_edges", "edge_keys", "edge_topology", "longest_edge_first"]
+__all__ = [
+    "boundary_edges",
+    "boundary_facets",
+    "edge_keys",
+    "edge_topology",
+    "entity_keys",
+    "entity_topology",
+    "facet_local",
+    "longest_edge_first",
+    "rows_of",
+]
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -20,63 +36,137 @@ def _frozen(a: np.ndarray) -> np.ndarray:
     return a
 
 
-def edge_keys(pairs: np.ndarray, n_points: int) -> np.ndarray:
-    """Unique int64 key of each undirected vertex pair ``(n, 2)``."""
-    lo = np.minimum(pairs[:, 0], pairs[:, 1]).astype(np.int64)
-    hi = np.maximum(pairs[:, 0], pairs[:, 1]).astype(np.int64)
-    return lo * np.int64(n_points) + hi
-
-
-def boundary_edges(cells: np.ndarray) -> np.ndarray:
-    """Edges ``(n_boundary, 2)`` that belong to exactly one cell, oriented counter-clockwise.
-
-    Parameters
-    ----------
-    cells : (n_cells, 3) int array
-        Counter-clockwise triangles.
-    """
-    cells = np.asarray(cells, dtype=np.int64)
-    local = cells[:, TRIANGLE.edges].reshape(-1, 2)
-    n = int(cells.max()) + 1 if cells.size else 0
-    keys = edge_keys(local, n)
-    _, first, counts = np.unique(keys, return_index=True, return_counts=True)
-    return local[first[counts == 1]]
-
-
-def edge_topology(cells: np.ndarray, n_points: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``edges (n_edges, 2)`` (``min`` vertex first), ``cell2edge (n_cells, 3)`` (the edge of
-    local edge ``k``, vertices ``TRIANGLE.edges[k]``) and ``edge2cell (n_edges, 2)`` (column 0
-    the first cell seen, column 1 the other or ``-1``) of the triangles ``cells (n_cells, 3)``;
-    read-only.
+def entity_keys(tuples: np.ndarray, n_points: int) -> np.ndarray:
+    """Unique int64 key of each unordered vertex set ``tuples (n, k)``: its sorted vertices
+    as the digits of a number in base ``n_points`` (for ``k = 2``, ``min * n_points + max``).
 
     Raises
     ------
     MeshError
-        If an edge is shared by more than two cells.
+        If ``n_points ** k`` does not fit into an int64.
     """
-    local = cells[:, TRIANGLE.edges].reshape(-1, 2)
-    keys = edge_keys(local, n_points)
+    k = tuples.shape[1]
+    if k > 2 and float(n_points) ** k >= 2.0**63:
+        raise MeshError(f"{n_points} points are too many for int64 keys of {k}-vertex entities")
+    if k == 2:
+        lo = np.minimum(tuples[:, 0], tuples[:, 1]).astype(np.int64)
+        hi = np.maximum(tuples[:, 0], tuples[:, 1]).astype(np.int64)
+        return lo * np.int64(n_points) + hi
+    s = np.sort(tuples, axis=1).astype(np.int64)
+    key = s[:, 0]
+    for j in range(1, k):  # a loop over an entity's vertices
+        key = key * np.int64(n_points) + s[:, j]
+    return key
+
+
+def edge_keys(pairs: np.ndarray, n_points: int) -> np.ndarray:
+    """Unique int64 key of each undirected vertex pair ``(n, 2)`` (:func:`entity_keys`)."""
+    return entity_keys(pairs, n_points)
+
+
+def boundary_facets(cells: np.ndarray, local: np.ndarray = TRIANGLE.facets) -> np.ndarray:
+    """Facets ``(n_boundary, k)`` that belong to exactly one cell, in their cell's local
+    order ``local`` (for positively oriented cells: counter-clockwise edges of triangles,
+    outward faces of tetrahedra).
+
+    Parameters
+    ----------
+    cells : (n_cells, n_vertices) int array
+        Positively oriented cells.
+    local : (n_facets, k) int array
+        The reference cell's facets, e.g. :attr:`TRIANGLE.facets`.
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    tuples = cells[:, local].reshape(-1, local.shape[1])
+    n = int(cells.max()) + 1 if cells.size else 0
+    _, first, counts = np.unique(entity_keys(tuples, n), return_index=True, return_counts=True)
+    return tuples[first[counts == 1]]
+
+
+def boundary_edges(cells: np.ndarray) -> np.ndarray:
+    """The boundary edges ``(n_boundary, 2)`` of counter-clockwise triangles ``cells (n_cells,
+    3)``, counter-clockwise: :func:`boundary_facets` of the triangle."""
+    return boundary_facets(cells, TRIANGLE.facets)
+
+
+def entity_topology(
+    cells: np.ndarray, n_points: int, local: np.ndarray, *, facets: bool = True
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """The entities of ``cells`` whose local vertices are the rows of ``local``: ``entities
+    (n, k)`` (sorted vertices, numbered by :func:`entity_keys`), ``cell2entity (n_cells,
+    n_local)`` (the entity of local entity ``j``) and, for facets, ``entity2cell (n, 2)``
+    (column 0 the first cell seen, column 1 the other or ``-1``; ``None`` for entities of
+    lower dimension, which may have any number of cells); read-only.
+
+    Raises
+    ------
+    MeshError
+        If a facet is shared by more than two cells.
+    """
+    tuples = cells[:, local].reshape(-1, local.shape[1])
     uniq, first, inverse, counts = np.unique(
-        keys, return_index=True, return_inverse=True, return_counts=True
+        entity_keys(tuples, n_points), return_index=True, return_inverse=True, return_counts=True
     )
-    if counts.max(initial=0) > 2:
+    if facets and counts.max(initial=0) > 2:
         bad = np.flatnonzero(counts > 2)
-        pairs = local[first[bad]]
+        what = "edge" if local.shape[1] == 2 else "face"
         raise MeshError(
-            f"non-manifold mesh: {bad.size} edge(s) shared by more than two cells, first "
-            f"({pairs[0, 0]}, {pairs[0, 1]})"
+            f"non-manifold mesh: {bad.size} {what}(s) shared by more than two cells, first "
+            f"{tuple(int(v) for v in tuples[first[bad[0]]])}"
         )
-    edges = np.sort(local[first], axis=1)
-    cell2edge = inverse.reshape(-1, TRIANGLE.n_edges)
-    n_edges = uniq.size
-    # edge2cell: column 0 = the first cell seen, column 1 = the other (or -1)
-    owner = np.repeat(np.arange(cells.shape[0], dtype=np.int64), TRIANGLE.n_edges)
-    edge2cell = np.full((n_edges, 2), -1, dtype=np.int64)
-    edge2cell[:, 0] = owner[first]
+    entities = np.sort(tuples[first], axis=1)
+    cell2entity = inverse.reshape(-1, local.shape[0])
+    if not facets:
+        return _frozen(entities), _frozen(cell2entity), None
+    owner = np.repeat(np.arange(cells.shape[0], dtype=np.int64), local.shape[0])
+    entity2cell = np.full((uniq.size, 2), -1, dtype=np.int64)
+    entity2cell[:, 0] = owner[first]
     second = np.ones(inverse.size, dtype=bool)
     second[first] = False
-    edge2cell[inverse[second], 1] = owner[second]
-    return _frozen(edges), _frozen(cell2edge), _frozen(edge2cell)
+    entity2cell[inverse[second], 1] = owner[second]
+    return _frozen(entities), _frozen(cell2entity), _frozen(entity2cell)
+
+
+def edge_topology(cells: np.ndarray, n_points: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``edges (n_edges, 2)``, ``cell2edge (n_cells, 3)`` and ``edge2cell (n_edges, 2)`` of
+    triangles ``cells (n_cells, 3)``: :func:`entity_topology` of :attr:`TRIANGLE.edges`, the
+    triangle's facets."""
+    edges, cell2edge, edge2cell = entity_topology(cells, n_points, TRIANGLE.edges)
+    assert edge2cell is not None
+    return edges, cell2edge, edge2cell
+
+
+def facet_local(cell2facet: np.ndarray, facet2cell: np.ndarray) -> np.ndarray:
+    """``(n_facets, 2)`` local index of each facet in its cells ``facet2cell[:, 0]`` and
+    ``facet2cell[:, 1]`` (``-1`` outside the domain): ``cell2facet[facet2cell[f, s],
+    facet_local[f, s]] == f``; read-only."""
+    n_cells, n_local = cell2facet.shape
+    cells = np.repeat(np.arange(n_cells), n_local)
+    k = np.tile(np.arange(n_local), n_cells)
+    f = cell2facet.ravel()
+    slot = (facet2cell[f, 0] != cells).astype(np.int64)
+    out = np.full(facet2cell.shape, -1, dtype=np.int64)
+    out[f, slot] = k
+    return _frozen(out)
+
+
+def rows_of(entities: np.ndarray, tuples: np.ndarray, n_points: int) -> np.ndarray:
+    """The row of ``entities (n, k)`` (sorted by key, as :func:`entity_topology` makes them)
+    of each vertex set ``tuples (m, k)``, in any vertex order; read-only.
+
+    Raises
+    ------
+    MeshError
+        Naming the rows of ``tuples`` that are not entities.
+    """
+    keys = entity_keys(entities, n_points)  # sorted by construction
+    k = entity_keys(tuples, n_points)
+    pos = np.minimum(np.searchsorted(keys, k), keys.size - 1)
+    if keys.size == 0 or not np.array_equal(keys[pos], k):
+        bad = np.flatnonzero(keys[pos] != k)
+        what = "edge" if tuples.shape[1] == 2 else "face"
+        raise MeshError(f"boundary {what}(s) {format_indices(bad)} are not {what}s of the mesh")
+    return _frozen(pos)
 
 
 def longest_edge_first(points: np.ndarray, cells: np.ndarray) -> np.ndarray:

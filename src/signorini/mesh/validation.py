@@ -25,6 +25,7 @@ from .geometry import signed_area
 from .reference import TRIANGLE
 
 if TYPE_CHECKING:
+    from .curves import Curve
     from .mesh import Mesh
 
 __all__ = [
@@ -33,6 +34,7 @@ __all__ = [
     "as_points",
     "check_orientation",
     "nondegenerate_area",
+    "check_on_curve",
     "format_indices",
     "validate_mesh",
     "winding_numbers",
@@ -421,3 +423,26 @@ def validate_mesh(mesh: Mesh) -> None:
     _check_no_hanging_node(mesh, is_bnd)
     _check_no_overlap(mesh, is_bnd)
     _check_boundary_labelled(mesh, is_bnd)
+
+
+def check_on_curve(
+    points: np.ndarray, vertices: np.ndarray, curve: Curve, part: str, rtol: float
+) -> None:
+    """Check that the ``vertices`` of boundary part ``part`` lie on ``curve``: within ``rtol``
+    times the diameter of ``points`` (the diagonal of their bounding box).
+
+    Raises
+    ------
+    MeshError
+        Naming the vertex farthest off the curve and its distance.
+    """
+    x = points[vertices]
+    distance = np.hypot(*(curve.project(x) - x).T)
+    diameter = float(np.hypot(*np.ptp(points, axis=0)))
+    if np.any(distance > rtol * diameter):
+        k = int(np.argmax(distance))
+        raise MeshError(
+            f"with_curve: vertex {vertices[k]} {x[k].tolist()} of part {part!r} lies "
+            f"{distance[k]:.3g} from {curve!r}, more than rtol * diameter = "
+            f"{rtol * diameter:.3g}"
+        )
