@@ -41,6 +41,8 @@ Method (exact up to quadrature round-off, cost driven by the support of v):
   level.
 * :mod:`.norms`: the public functions, with the per-edge shares.
 * :mod:`.parameters`: every tuning constant, with the reason for its value.
+* :mod:`.localised`: a computable upper bound of η7 by facet norms, the replacement for
+  surfaces (not part of the 2D estimator).
 
 Cost: O(k) vectorized work to find S and the runs (k = number of edges), then
 O(|S|^2 + |S| r) panel pairs (r = number of zero runs), processed in blocks.
@@ -55,15 +57,27 @@ References
    fractional Sobolev spaces", Bull. Sci. Math. 136 (2012) 521-573.
 """
 
+from .localised import (
+    FacetNorms,
+    curve_weights,
+    facet_norms2_positive_part,
+    localised_bound2,
+    localised_bound2_positive_part,
+)
 from .norms import hhalf_norm2_positive_part, hhalf_seminorm2_positive_part, l2_norm2_positive_part
 from .panels import segment_inverse_square_integral
 from .pieces import PositivePartPieces, positive_part_pieces
 
 __all__ = [
+    "FacetNorms",
     "PositivePartPieces",
+    "curve_weights",
+    "facet_norms2_positive_part",
     "hhalf_norm2_positive_part",
     "hhalf_seminorm2_positive_part",
     "l2_norm2_positive_part",
+    "localised_bound2",
+    "localised_bound2_positive_part",
     "positive_part_pieces",
     "segment_inverse_square_integral",
 ]
