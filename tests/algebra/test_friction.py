@@ -1,4 +1,4 @@
-"""Frictional contact solver (signorini.algebra.friction) against independent computations.
+"""Frictional contact solver (signorini.algebra.friction.newton) against independent computations.
 
 The systems are the rotated P2 systems of a block pressed onto a curved obstacle and pulled
 sideways (:func:`contact_problems.pressed_block`): contact in the middle, open ends, stick
@@ -27,10 +27,10 @@ from signorini.algebra import (
     solve_pdas,
     superlu_solver,
 )
-from signorini.algebra.friction import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
-from signorini.algebra.friction_kkt import check_friction
-from signorini.algebra.friction_result import FrictionConvergenceError
-from signorini.algebra.friction_system import CoupledSystem
+from signorini.algebra.errors import FrictionConvergenceError
+from signorini.algebra.friction.kkt import check_friction
+from signorini.algebra.friction.newton import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
+from signorini.algebra.friction.system import CoupledSystem
 from signorini.problem.friction import Coulomb, Tresca
 
 #: The laws as the solver asks them; each node's data is its weight (Tresca: the bound s,

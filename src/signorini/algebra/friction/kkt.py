@@ -12,7 +12,7 @@ rows, ``Λ = F − K x`` (``Λ_n ≥ 0`` is the contact force; the obstacle acts
   contact, or ``F Λ_n`` for Coulomb); laws may differ from node to node.
 
 :func:`check_friction` turns the problem's arrays and laws into the :class:`FrictionProblem`
-that :func:`~.friction.solve_friction` solves, or raises a :class:`ValueError` naming the
+that :func:`~.newton.solve_friction` solves, or raises a :class:`ValueError` naming the
 argument;
 :func:`friction_kkt` measures how far a point is from satisfying both laws.
 """
@@ -23,11 +23,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .kkt import contact_scale, force_scale, normal_law_columns
+from ..kkt import contact_scale, force_scale, normal_law_columns
+from ..qp import BoundQP, _index_array, check_qp, check_vector
+from ..ranks import Ranks
+from ..sparse import as_csr
 from .laws import LawGroups, check_laws
-from .qp import BoundQP, _index_array, check_qp, check_vector
-from .ranks import Ranks
-from .sparse import as_csr
 
 __all__ = ["FrictionKKT", "FrictionProblem", "check_friction", "friction_kkt"]
 

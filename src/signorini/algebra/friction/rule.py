@@ -1,4 +1,4 @@
-"""The update rule of the frictional active set method (:mod:`.friction`): the node states
+"""The update rule of the frictional active set method (:mod:`.friction.newton`): the node states
 of the next iteration from an iterate, and the records of an iteration.
 
 The states are ``(active, stick, direction)``: ``(m,)`` bool, bool and float (±1 where a
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction_kkt import FrictionProblem
-from .friction_result import INACTIVE, SLIP, STICK, FrictionStep
+from .kkt import FrictionProblem
+from .result import INACTIVE, SLIP, STICK, FrictionStep
 
 __all__ = [
     "States",
@@ -121,7 +121,7 @@ def one_change(states: States, new: States) -> States:
     force goes from one bound of ``[−s, s]`` to the other through the inside): the
     least-index rule of Murty's principal pivoting method, which cannot cycle on a P-matrix
     complementarity problem (Murty [1]_), used by the iteration once its states have cycled
-    (:func:`~.friction._iterate`). A fixed point of it is one of the rule.
+    (:func:`~.newton._iterate`). A fixed point of it is one of the rule.
 
     References
     ----------

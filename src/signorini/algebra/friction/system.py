@@ -26,11 +26,11 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse as sp
 
-from .active_system import ActiveSetSystem, refine, update_accepted
-from .friction_kkt import FrictionProblem
-from .ranks import stored_values
-from .solvers import SPDSolver
-from .sparse import abs_matvec, concatenated_ranges, csr_row_indices, diagonal_positions
+from ..active_system import ActiveSetSystem, refine, update_accepted
+from ..backends.solvers import SPDSolver
+from ..ranks import stored_values
+from ..sparse import abs_matvec, concatenated_ranges, csr_row_indices, diagonal_positions
+from .kkt import FrictionProblem
 
 __all__ = ["CoupledSystem", "SymmetricSystem", "friction_system"]
 
@@ -210,7 +210,7 @@ class CoupledSystem:
 
     def rebound(self, bound: np.ndarray) -> None:
         """Make the slip bounds of a system whose laws all have ``s' = 0`` the weights
-        ``bound (m,)`` of its laws (:class:`~.friction_fixed_point.GivenBound`): only the
+        ``bound (m,)`` of its laws (:class:`~.friction.fixed_point.GivenBound`): only the
         loads of later solves change, the factorization and the pattern are kept."""
         if self.derivative.any():
             raise ValueError("rebound needs laws with s' = 0 at every node")
