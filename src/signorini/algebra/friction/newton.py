@@ -293,7 +293,7 @@ def _initial_states(
             return none[0], law.can_rub & law.everywhere, none[2]
         x = check_vector(x0, problem.qp.n, "x0")
         r = problem.qp.F - problem.qp.matvec(x)
-        return update_states(problem, rule, x, r[problem.normal], r[problem.tangent], none)
+        return update_states(problem, rule, x, r[problem.normal], r[problem.tangent_2d], none)
     state = np.asarray(state0)
     if state.shape != (m,) or not np.isin(state, (INACTIVE, STICK, SLIP)).all():
         raise ValueError(f"state0 must have shape ({m},) and hold INACTIVE, STICK or SLIP")

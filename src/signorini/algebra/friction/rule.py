@@ -73,7 +73,7 @@ def update_states(
     new_active = np.where(np.abs(value_n) <= band_n, active, value_n > 0)
     s = p.slip_bound(value_n, new_active)
     acts = p.friction.everywhere | new_active
-    y = lam_t + c * (x[p.tangent] - p.reference)
+    y = lam_t + c * (x[p.tangent_2d] - p.reference)
     margin = np.abs(y) - s
     band_t = np.where(stick, band_force, band_disp)
     new_stick = np.where(np.abs(margin) <= band_t, stick, margin < 0) & acts
@@ -112,7 +112,7 @@ def multipliers(p: FrictionProblem, x: np.ndarray, states: States) -> tuple[np.n
     r = p.qp.F - p.qp.matvec(x)
     multiplier_n = np.where(active, r[p.normal], 0.0)
     imposed = direction * p.slip_bound(multiplier_n, active)
-    return multiplier_n, np.where(stick, r[p.tangent], imposed)
+    return multiplier_n, np.where(stick, r[p.tangent_2d], imposed)
 
 
 def one_change(states: States, new: States) -> States:
