@@ -78,8 +78,8 @@ def test_the_pin_converges_where_the_coulomb_states_cycle():
     p, a = frictional_problem(problem, r.mesh)
     x = r.report.x
     lam = a.F - a.K @ x
-    lam_n, lam_t = lam[p.normal], lam[p.tangent]
-    slide = x[p.tangent] - p.reference
+    lam_n, lam_t = lam[p.normal], lam[p.tangent_2d]
+    slide = x[p.tangent_2d] - p.reference
     scale, disp = lam_n.max(), np.abs(x).max()
     stick, slip = r.state == STICK, r.state == SLIP
     assert np.all(x[p.normal] <= p.gap + 1e-12 * disp)
