@@ -102,7 +102,8 @@ def floor_seconds(problem, mesh, backend: str, *, ordered: bool = False) -> tupl
 
 
 def remembering_factory(factory, made: list[tuple[int, dict[str, int]]]):
-    """``factory`` (its attributes too: :func:`~signorini.algebra.backends.takes_ordering`,
+    """``factory`` (its attributes too:
+    :func:`~signorini.algebra.backends.selection.takes_ordering`,
     :func:`~signorini.algebra.ranks.solver_ranks`), whose solvers append their factor's size
     and PARDISO's memory to ``made`` when closed (closing zeroes ``iparm[14..16]``)."""
 

@@ -30,7 +30,7 @@ from signorini.algebra import (
     solve_pdas,
     superlu_solver,
 )
-from signorini.algebra.pardiso_lu import PardisoLUSolver
+from signorini.algebra.backends.pardiso_lu import PardisoLUSolver
 from signorini.contact.system import assemble
 from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle

@@ -38,7 +38,7 @@ import scipy.sparse as sp
 
 from signorini import adaptive, example_6_2
 from signorini.algebra import solver_factory
-from signorini.algebra.petsc import petsc_module, row_block
+from signorini.algebra.backends.petsc import petsc_module, row_block
 from signorini.contact import assemble
 
 

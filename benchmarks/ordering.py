@@ -48,7 +48,7 @@ from cold import load_mesh
 
 from signorini import example_6_2
 from signorini.algebra import SymmetricEliminator
-from signorini.algebra.pardiso import PardisoSolver
+from signorini.algebra.backends.pardiso import PardisoSolver
 from signorini.contact import assemble
 from signorini.contact.ordering import dof_ordering
 from signorini.mesh.builders import rectangle

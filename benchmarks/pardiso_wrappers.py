@@ -47,8 +47,8 @@ import time
 import numpy as np
 
 from signorini import example_6_2, refine_uniform
+from signorini.algebra.backends.pardiso import PardisoSolver
 from signorini.algebra.elimination import SymmetricEliminator
-from signorini.algebra.pardiso import PardisoSolver
 from signorini.contact import assemble
 from signorini.runtime import retain_freed_memory
 

@@ -32,7 +32,7 @@ from signorini.algebra import SOLVERS, make_solver
 
 def solver_of(backend: str, ordering):
     if backend.startswith("petsc-lu"):
-        from signorini.algebra.petsc import PetscLUSolver
+        from signorini.algebra.backends.petsc import PetscLUSolver
 
         return PetscLUSolver(ordering=ordering() if backend.endswith("ordered") else None)
     return make_solver(SOLVERS[backend], check_symmetry=False)

@@ -27,7 +27,7 @@ import numpy as np
 from adaptive import reduced_system  # benchmarks/adaptive.py: the floor's system
 
 from signorini import adaptive, example_6_2
-from signorini.algebra.pardiso import PardisoSolver, pardiso_solver
+from signorini.algebra.backends.pardiso import PardisoSolver, pardiso_solver
 from signorini.runtime import retain_freed_memory
 
 

@@ -14,7 +14,7 @@ import pytest
 import scipy.sparse as sp
 
 from signorini.algebra import SolverRequest, available_backends, solver_factory
-from signorini.algebra.backends import takes_ordering
+from signorini.algebra.backends.selection import takes_ordering
 from signorini.algebra.ranks import solver_ranks
 
 ROOT = Path(__file__).resolve().parents[1]

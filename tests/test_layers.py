@@ -144,6 +144,14 @@ def test_a_door_imports_nothing_of_the_package():
             assert imported_modules(path) == set(), door
 
 
+def test_the_errors_of_the_linear_algebra_are_its_bottom():
+    """``algebra.errors`` imports nothing of the package, so every module of ``algebra`` (the
+    backends, the active set core, the friction room) imports it at its top."""
+    assert imported_modules(PACKAGE / "algebra" / "errors.py") == set()
+    ranks = imported_modules(PACKAGE / "algebra" / "ranks.py")
+    assert ranks == {"algebra.backends.petsc_import", "algebra.errors"}
+
+
 def test_the_import_reader_sees_every_kind_of_relative_import():
     """``from ..x import``, ``from .x import`` at the top and ``from . import`` inside a layer."""
     solution = imported_layers(PACKAGE / "contact" / "solution.py")
@@ -174,7 +182,11 @@ def package(tmp_path):
         ("mesh", "import signorini.problem.obstacles\n", "imports problem.obstacles"),
         ("fem", "from signorini import contact\n", "fem/probe.py imports contact"),
         ("plots", "from ..loop import Level\n", "plots/probe.py imports loop"),
-        ("plots", "from ..algebra.friction_result import STICK\n", "imports algebra.friction"),
+        (
+            "plots",
+            "from ..algebra.friction.result import STICK\n",
+            "imports algebra.friction.result",
+        ),
         ("plots", "from ..estimator.residual import Estimate\n", "imports estimator.residual"),
         ("output", "from ..contact.solution import ContactResult\n", "imports contact.solution"),
         ("problem", "def f():\n    from ..contact import solve\n", "imports contact"),

@@ -118,8 +118,8 @@ print(json.dumps({"grown": rss() - before}))
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc and /proc only")
 def test_memory_a_thread_freed_is_reused_by_the_main_thread():
     """One heap for every thread (``M_ARENA_MAX = 1``): what a background thread
-    (:mod:`signorini.algebra.beside`) freed serves the main thread's next allocation, so the
-    process does not keep both threads' peaks."""
+    (:mod:`signorini.algebra.backends.beside`) freed serves the main thread's next allocation, so
+    the process does not keep both threads' peaks."""
     out = subprocess.run(
         [sys.executable, "-c", THREADED], capture_output=True, text=True, check=True
     ).stdout

@@ -9,7 +9,7 @@ suits the command line and benchmarks (the adaptive loop's memory grows level by
 anyway); the library never calls it on import.
 
 Every thread then shares the one heap (``M_ARENA_MAX = 1``): glibc gives a second thread an
-arena of its own, and what the background thread of :mod:`signorini.algebra.beside` (METIS,
+arena of its own, and what the background thread of :mod:`signorini.algebra.backends.beside` (METIS,
 PARDISO's analysis) freed would stay in that arena, out of the main thread's reach, so the
 process would keep both threads' peaks (measured: 3282 MiB instead of 2693 MiB at 1.2 M
 unknowns).

@@ -1,4 +1,5 @@
-"""The backends by name (signorini.algebra.backends): "auto", the registry, loud fallback."""
+"""The backends by name (signorini.algebra.backends.selection): "auto", the registry, loud
+fallback."""
 
 from __future__ import annotations
 
@@ -15,17 +16,16 @@ from signorini.algebra import (
     SolverFallbackWarning,
     auto_solver,
     available_backends,
-    backends,
     make_solver,
-    mkl,
-    pardiso,
     pardiso_solver,
     solve_pdas,
     solver_factory,
     solver_name,
     superlu_solver,
 )
-from signorini.algebra.petsc import petsc_module
+from signorini.algebra.backends import mkl, pardiso
+from signorini.algebra.backends import selection as backends
+from signorini.algebra.backends.petsc import petsc_module
 
 try:  # the optional "petsc" backend (signorini[mpi]) is listed where it loads
     petsc_module()

@@ -1,4 +1,4 @@
-"""Frictional contact solver (signorini.algebra.friction) against independent computations.
+"""Frictional contact solver (signorini.algebra.friction.newton) against independent computations.
 
 The systems are the rotated P2 systems of a block pressed onto a curved obstacle and pulled
 sideways (:func:`contact_problems.pressed_block`): contact in the middle, open ends, stick
@@ -7,6 +7,7 @@ and slip zones.
 
 from __future__ import annotations
 
+import re
 from functools import cache
 from types import SimpleNamespace
 
@@ -27,10 +28,10 @@ from signorini.algebra import (
     solve_pdas,
     superlu_solver,
 )
-from signorini.algebra.friction import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
-from signorini.algebra.friction_kkt import check_friction
-from signorini.algebra.friction_result import FrictionConvergenceError
-from signorini.algebra.friction_system import CoupledSystem
+from signorini.algebra.errors import FrictionConvergenceError
+from signorini.algebra.friction.kkt import check_friction
+from signorini.algebra.friction.newton import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
+from signorini.algebra.friction.system import CoupledSystem
 from signorini.problem.friction import Coulomb, Tresca
 
 #: The laws as the solver asks them; each node's data is its weight (Tresca: the bound s,
@@ -432,3 +433,50 @@ def test_the_coulomb_matrix_keeps_the_pattern_of_a_non_blocked_k():
     r = run(S, COULOMB, 0.5, K=K)
     ref = run(S, COULOMB, 0.5)
     assert rel(r.x, ref.x) < 1e-12
+
+
+def test_the_tangent_is_a_basis_of_one_column_in_2d():
+    """``tangent (m, d − 1)``: in 2D ``(m, 1)``; a 1-D tangent (indices or a mask) is that
+    column, and both give the same solve bit for bit."""
+    S = block()
+    K, F, normal, tangent, gap, dirichlet, values = args(S)
+    weight = 0.3 * np.ones(normal.size)
+    line = check_friction(*args(S), laws=COULOMB, weight=weight)
+    basis = check_friction(
+        K, F, normal, tangent[:, None], gap, dirichlet, values, laws=COULOMB, weight=weight
+    )
+    mask = np.zeros(K.shape[0], dtype=bool)
+    mask[tangent] = True
+    masked = check_friction(K, F, normal, mask, gap, dirichlet, values, laws=COULOMB, weight=weight)
+    for problem in (line, basis, masked):
+        assert problem.tangent.shape == (normal.size, 1) and problem.tangent.dtype == np.int64
+        np.testing.assert_array_equal(problem.tangent_2d, np.sort(tangent))
+    assert np.array_equal(line.tangent, basis.tangent)
+    a, b = solve_friction(line), solve_friction(basis)
+    assert np.array_equal(a.x, b.x) and np.array_equal(a.state, b.state)
+
+
+@pytest.mark.parametrize(
+    "shape, error, message",
+    [
+        ("two columns", NotImplementedError, "2 tangential DOFs per node (d = 3)"),
+        ("one row short", ValueError, "tangent must be (m, d - 1) = (33, d - 1)"),
+        ("no column", ValueError, "tangent must be (m, d - 1)"),
+        ("three axes", ValueError, "tangent must be (m,) or (m, d - 1)"),
+        ("floats", ValueError, "tangent must hold integer DOF indices"),
+    ],
+)
+def test_a_tangent_basis_of_the_wrong_shape_is_refused(shape, error, message):
+    S = block()
+    K, F, normal, tangent, gap, dirichlet, values = args(S)
+    free = np.setdiff1d(np.arange(K.shape[0]), np.concatenate([normal, tangent, dirichlet]))
+    column = tangent[:, None]
+    bad = {
+        "two columns": np.column_stack([tangent, free[: tangent.size]]),
+        "one row short": column[:-1],
+        "no column": column[:, :0],
+        "three axes": column[:, :, None],
+        "floats": column.astype(float),
+    }[shape]
+    with pytest.raises(error, match=re.escape(message)):
+        check_friction(K, F, normal, bad, gap, dirichlet, values, laws=TRESCA, weight=0.1)

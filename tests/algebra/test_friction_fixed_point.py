@@ -1,6 +1,6 @@
-"""Where the frictional iteration's states cycle (signorini.algebra.friction): one node at a
+"""Where the frictional iteration's states cycle (signorini.algebra.friction.newton): one node at a
 time, then Coulomb's fallback, the fixed point on the slip bound
-(signorini.algebra.friction_fixed_point), against the converged iteration of the default c.
+(signorini.algebra.friction.fixed_point), against the converged iteration of the default c.
 
 The iteration cycles on the pressed block of :func:`contact_problems.pressed_block` when its
 constant ``c`` is large (the mean diagonal of ``K`` or a hundred times it; docs/method.md,
@@ -18,14 +18,20 @@ import numpy as np
 import pytest
 from contact_problems import pressed_block
 
-from signorini.algebra.backends import make_solver
-from signorini.algebra.friction import FrictionOptions, _iterate, _rule_constants, solve_friction
-from signorini.algebra.friction_fixed_point import GivenBound, solve_by_fixed_point
-from signorini.algebra.friction_kkt import check_friction
-from signorini.algebra.friction_result import SLIP, STICK, FrictionConvergenceError
-from signorini.algebra.friction_system import CoupledSystem
+from signorini.algebra.backends.selection import make_solver
+from signorini.algebra.backends.superlu import superlu_solver
+from signorini.algebra.errors import FrictionConvergenceError
+from signorini.algebra.friction.fixed_point import GivenBound, solve_by_fixed_point
+from signorini.algebra.friction.kkt import check_friction
+from signorini.algebra.friction.newton import (
+    FrictionOptions,
+    _iterate,
+    _rule_constants,
+    solve_friction,
+)
+from signorini.algebra.friction.result import SLIP, STICK
+from signorini.algebra.friction.system import CoupledSystem
 from signorini.algebra.inexact import InexactRule
-from signorini.algebra.superlu import superlu_solver
 from signorini.problem.friction import Coulomb, Tresca
 
 COEFFICIENT = 0.2
@@ -70,7 +76,7 @@ def test_a_cycling_iteration_goes_on_one_node_at_a_time(caplog):
     S, p = problem()
     reference = solve_friction(p)
     assert reference.method == "semismooth-newton" and reference.iterations < 10
-    with caplog.at_level(logging.INFO, logger="signorini.algebra.friction"):
+    with caplog.at_level(logging.INFO, logger="signorini.algebra.friction.newton"):
         r = solve_friction(p, options=FrictionOptions(c=mean_diagonal()))
     assert "one node at a time" in caplog.text
     assert r.method == "semismooth-newton"
@@ -132,7 +138,7 @@ def test_classical_tresca_that_cycles_finishes_one_node_at_a_time(caplog):
     bound = 0.3 * solve_friction(free).multiplier_n.max()
     p = check_friction(*system, laws=Tresca(0.0), weight=bound)
     reference = solve_friction(p)
-    with caplog.at_level(logging.INFO, logger="signorini.algebra.friction"):
+    with caplog.at_level(logging.INFO, logger="signorini.algebra.friction.newton"):
         r = solve_friction(
             p, options=FrictionOptions(c=100 * float(S.K.diagonal()[S.normal].mean()))
         )

@@ -20,10 +20,10 @@ from signorini.algebra import (
     solve_pdas,
     superlu_solver,
 )
-from signorini.algebra.friction import FrictionOptions, solve_friction
-from signorini.algebra.friction_kkt import check_friction
+from signorini.algebra.backends.superlu import SuperLUSolver
+from signorini.algebra.friction.kkt import check_friction
+from signorini.algebra.friction.newton import FrictionOptions, solve_friction
 from signorini.algebra.inexact import CONFIRM_RTOL, KKT_RTOL
-from signorini.algebra.superlu import SuperLUSolver
 from signorini.problem.friction import Tresca
 
 LOOSE = 1e-6

@@ -64,7 +64,7 @@ def test_pardiso_lu_refines_the_solves_of_a_factor_with_a_perturbed_pivot_only()
     PARDISO perturbs that pivot (``iparm[13] = 1``) and the solves of that factor are refined
     (without refinement the residual was 8.5e-13); the regular factor before and after it is
     solved without a step (``iparm[6] = 0``), its residual at round-off all the same."""
-    from signorini.algebra.pardiso_lu import REFINEMENT_STEPS, PardisoLUSolver
+    from signorini.algebra.backends.pardiso_lu import REFINEMENT_STEPS, PardisoLUSolver
 
     n = 200
     rng = np.random.default_rng(3)

@@ -1,4 +1,5 @@
-"""MKL PARDISO backend (signorini.algebra.pardiso): finding MKL, pattern reuse, failures."""
+"""MKL PARDISO backend (signorini.algebra.backends.pardiso): finding MKL, pattern reuse,
+failures."""
 
 from __future__ import annotations
 
@@ -18,11 +19,10 @@ from signorini.algebra import (
     FactorizationError,
     SymmetricEliminator,
     available_backends,
-    mkl,
-    pardiso,
 )
-from signorini.algebra.mkl import mkl_runtime_candidates
-from signorini.algebra.pardiso import PardisoSolver, pardiso_problem
+from signorini.algebra.backends import mkl, pardiso
+from signorini.algebra.backends.mkl import mkl_runtime_candidates
+from signorini.algebra.backends.pardiso import PardisoSolver, pardiso_problem
 
 HAS_PARDISO = "pardiso" in available_backends()
 
@@ -190,7 +190,7 @@ def test_an_analysis_that_reads_the_values_is_done_in_the_callers_thread(backend
     ``beside`` is ignored, and the analysis is done (and counted) before ``analyze`` returns
     (one beside is counted when a factorization waits for it)."""
     from signorini.algebra import SOLVERS, make_solver
-    from signorini.algebra.pardiso_lu import PardisoLUSolver
+    from signorini.algebra.backends.pardiso_lu import PardisoLUSolver
 
     K = block_spd(6, 6, np.random.default_rng(2))
     made = PardisoLUSolver(matching=True) if backend == "pardiso" else None
@@ -208,7 +208,7 @@ def test_an_lu_without_matching_analyses_beside_and_solves_as_with_it():
     whose rows 2z + 1 have a multiple of rows 2z subtracted, as on Coulomb's slipping nodes)
     agrees with the matching LU's to round-off."""
     from signorini.algebra import make_solver, pardiso_solver
-    from signorini.algebra.pardiso_lu import PardisoLUSolver
+    from signorini.algebra.backends.pardiso_lu import PardisoLUSolver
 
     K = _elasticity_spd(8, 6)
     A = K.tolil()

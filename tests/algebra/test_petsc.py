@@ -1,4 +1,4 @@
-"""The PETSc + MUMPS backend (signorini.algebra.petsc) against PARDISO and SuperLU.
+"""The PETSc + MUMPS backend (signorini.algebra.backends.petsc) against PARDISO and SuperLU.
 
 Runs where petsc4py with MUMPS is importable (the extra ``signorini[mpi]``) and is skipped
 elsewhere, except where ``SIGNORINI_REQUIRE_PETSC=1`` (CI's MPI stage) turns the skip into a
@@ -26,11 +26,11 @@ from signorini.algebra import (
     make_solver,
     solver_factory,
 )
-from signorini.algebra import petsc as petsc_backend
-from signorini.algebra.backends import solver_library
-from signorini.algebra.mkl import mkl_runtime_candidates, mkl_threads_local, mkl_version
-from signorini.algebra.petsc import petsc_solver, row_block
-from signorini.algebra.solvers import SolverRequest
+from signorini.algebra.backends import petsc as petsc_backend
+from signorini.algebra.backends.mkl import mkl_runtime_candidates, mkl_threads_local, mkl_version
+from signorini.algebra.backends.petsc import petsc_solver, row_block
+from signorini.algebra.backends.selection import solver_library
+from signorini.algebra.backends.solvers import SolverRequest
 from signorini.examples import example_6_2, example_6_2_coulomb
 from signorini.loop import adaptive
 

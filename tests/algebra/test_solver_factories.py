@@ -1,5 +1,6 @@
 """Solvers as objects: a backend added in a few lines, the factory protocol, and what a solver
-object given to solve() means (signorini.algebra.solvers, signorini.algebra.backends)."""
+object given to solve() means (signorini.algebra.backends.solvers,
+signorini.algebra.backends.selection)."""
 
 from __future__ import annotations
 

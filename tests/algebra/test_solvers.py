@@ -1,4 +1,4 @@
-"""The SPD solver interface on every available backend (signorini.algebra.solvers)."""
+"""The SPD solver interface on every available backend (signorini.algebra.backends.solvers)."""
 
 from __future__ import annotations
 

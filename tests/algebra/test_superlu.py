@@ -1,4 +1,4 @@
-"""SuperLU backend specifics (signorini.algebra.superlu)."""
+"""SuperLU backend specifics (signorini.algebra.backends.superlu)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import scipy.sparse as sp
 from linalg_problems import block_spd
 
 from signorini.algebra import FactorizationError
-from signorini.algebra.superlu import SuperLULUSolver, SuperLUSolver
+from signorini.algebra.backends.superlu import SuperLULUSolver, SuperLUSolver
 
 
 def test_pivot_check_is_what_rejects_an_indefinite_matrix():

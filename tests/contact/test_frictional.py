@@ -329,7 +329,7 @@ def test_coulomb_systems_on_a_node_blocked_matrix_take_its_own_pattern(monkeypat
     an assembled (node-blocked) K both rows store the same columns, so the system takes
     K's own arrays instead of building the widened pattern: the same iterations and the
     same solution, bit for bit, as with the widened pattern built."""
-    import signorini.algebra.friction_system as friction_system
+    import signorini.algebra.friction.system as friction_system
     from signorini.examples import example_6_2_coulomb
 
     problem = example_6_2_coulomb()
@@ -355,7 +355,7 @@ def test_coulomb_systems_on_a_node_blocked_matrix_take_its_own_pattern(monkeypat
 def test_a_tangential_row_without_the_normal_rows_columns_is_widened():
     import scipy.sparse as sp
 
-    from signorini.algebra.friction_system import _same_columns
+    from signorini.algebra.friction.system import _same_columns
 
     K = sp.csr_matrix(np.array([[4.0, 1.0, 1.0], [1.0, 4.0, 0.0], [1.0, 0.0, 4.0]]))
     K.eliminate_zeros()  # row 1 lacks column 2, which row 0 stores

@@ -4,7 +4,7 @@ moved along a load path (``shape.moved(d)``) enters the gap and the friction law
 import numpy as np
 import pytest
 
-from signorini.algebra.friction import SLIP
+from signorini.algebra.friction.newton import SLIP
 from signorini.contact.load_path import solve_path
 from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle

@@ -8,7 +8,7 @@ import pytest
 import scipy.sparse as sp
 from linalg_problems import p2_elasticity
 
-import signorini.algebra.beside as background
+import signorini.algebra.backends.beside as background
 from signorini import adaptive, example_6_2, solve
 from signorini.algebra import (
     SOLVERS,
@@ -18,8 +18,8 @@ from signorini.algebra import (
     pardiso_solver,
     superlu_solver,
 )
-from signorini.algebra.backends import takes_ordering
-from signorini.algebra.pardiso import PardisoSolver, metis_ordering
+from signorini.algebra.backends.pardiso import PardisoSolver, metis_ordering
+from signorini.algebra.backends.selection import takes_ordering
 from signorini.contact import assemble
 from signorini.contact.ordering import Ordering, dof_ordering, ordered_solver, vertex_graph
 from signorini.examples import example_6_2_coulomb, example_6_2_tresca, two_cylinders

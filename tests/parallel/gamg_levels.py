@@ -69,7 +69,7 @@ def recording(factory):
 if __name__ == "__main__":
     name, n_levels, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
     numbers = run(name, n_levels, "petsc-gamg")
-    from signorini.algebra.petsc import petsc_module
+    from signorini.algebra.backends.petsc import petsc_module
 
     comm = petsc_module().COMM_WORLD
     if comm.getRank() == 0:

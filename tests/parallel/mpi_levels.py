@@ -51,7 +51,7 @@ def run(problem: str, levels: int, solver: str) -> dict[str, np.ndarray]:
 if __name__ == "__main__":
     name, n_levels, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
     numbers = run(name, n_levels, "petsc")
-    from signorini.algebra.petsc import petsc_module
+    from signorini.algebra.backends.petsc import petsc_module
 
     comm = petsc_module().COMM_WORLD
     if comm.getRank() == 0:

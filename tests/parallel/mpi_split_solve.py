@@ -18,12 +18,12 @@ import numpy as np
 import scipy.sparse as sp
 
 from signorini.algebra import FrictionOptions, PDASOptions, solve_friction, solve_pdas
-from signorini.algebra.backends import solver_factory
-from signorini.algebra.friction_kkt import check_friction
-from signorini.algebra.petsc import PetscSolver, petsc_module
-from signorini.algebra.petsc_gamg import GamgSolver
+from signorini.algebra.backends.petsc import PetscSolver, petsc_module
+from signorini.algebra.backends.petsc_gamg import GamgSolver
+from signorini.algebra.backends.selection import solver_factory
+from signorini.algebra.backends.solvers import SolverRequest
+from signorini.algebra.friction.kkt import check_friction
 from signorini.algebra.ranks import world_ranks
-from signorini.algebra.solvers import SolverRequest
 from signorini.contact.ordering import dof_ordering
 from signorini.contact.partition import partition
 from signorini.contact.rigid_modes import system_rigid_modes

@@ -162,14 +162,14 @@ def test_the_near_nullspace_cuts_the_iterations():
 
 
 def _gamg():
-    from signorini.algebra.petsc_gamg import petsc_gamg_solver
+    from signorini.algebra.backends.petsc_gamg import petsc_gamg_solver
 
     return petsc_gamg_solver
 
 
 def test_the_factory_gives_mumps_lu_for_non_symmetric_systems_and_checks_its_input():
-    from signorini.algebra.petsc import PetscLUSolver
-    from signorini.algebra.petsc_gamg import GamgSolver
+    from signorini.algebra.backends.petsc import PetscLUSolver
+    from signorini.algebra.backends.petsc_gamg import GamgSolver
 
     lu = _gamg()(SolverRequest(symmetric=False))
     assert isinstance(lu, PetscLUSolver) and lu.rtol is None  # exact: the direct path

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from signorini.algebra import BackendUnavailableError, available_backends
-from signorini.algebra.petsc import petsc_module
+from signorini.algebra.backends.petsc import petsc_module
 
 from .mpi_levels import run
 

@@ -21,8 +21,8 @@ import pytest
 import scipy.sparse as sp
 
 from signorini import Contact, ContactProblem, HalfPlane, Material, Neumann, Roller
-from signorini.algebra.backends import SOLVERS
-from signorini.algebra.friction_kkt import FrictionProblem
+from signorini.algebra.backends.selection import SOLVERS
+from signorini.algebra.friction.kkt import FrictionProblem
 from signorini.algebra.ranks import SERIAL, Ranks
 from signorini.contact import solution
 from signorini.contact.partition import partition
@@ -344,7 +344,7 @@ def mpi_launcher() -> tuple[list[str] | None, str | None]:
     """``mpiexec`` (beside this Python, or on PATH; with Open MPI's flags for root and
     oversubscription) and None, or None and why the MPI run cannot be made."""
     try:
-        from signorini.algebra.petsc import petsc_module
+        from signorini.algebra.backends.petsc import petsc_module
 
         petsc_module()
     except Exception as err:  # BackendUnavailableError: no petsc4py here

@@ -2,60 +2,57 @@
 their backends, the primal-dual active set method (PDAS) for bound constraints, and its
 semismooth Newton extension to Tresca and Coulomb friction.
 
+The active set core stays at the top: it is what both rooms build on (the backends on
+``sparse`` and ``ranks``, the frictional solver on ``qp``, ``kkt``, ``active_system`` and
+``inexact``). ``errors`` is the bottom, importing nothing of the package.
+
 =====================  ==========================================================================
+``errors``             every error and warning: factorization, backend, convergence
 ``sparse``             CSR helpers: checks, row indices, upper triangle, diagonal positions
-``elimination``        symmetric elimination of fixed DOFs in place (pattern kept)
-``solvers``            the SPD solver interface (analysis once per pattern), its errors; the
-                       solver factory protocol and its request
-``superlu``            SuperLU backend (always available): SPD, LU for non-symmetric; factory
-``mkl``                how MKL's runtime library is found and loaded
-``pardiso``            MKL PARDISO through ctypes (SPD, non-symmetric LU), its factory; METIS
-``petsc_gamg``         CG + GAMG through PETSc, the rigid-body near-nullspace (``"petsc-gamg"``)
-``backends``           the backends by name (``SOLVERS``, ``"auto"``), ``make_solver``
 ``ranks``              the processes sharing a run's matrices: their collectives (``SERIAL``)
+``elimination``        symmetric elimination of fixed DOFs in place (pattern kept)
 ``qp``                 the bound-constrained QP's data, checked at the public entry
 ``kkt``                KKT residuals of a point
 ``inexact``            the inexact stopping rule of an iterative solver: loose, then tight
 ``active_system``      one active set's linear system: refactorization or bordered update
 ``primal``             the primal active set fallback
-``result``             the report of both solvers, PDAS steps and result, the convergence errors
+``result``             the report of both solvers, PDAS steps and result
 ``pdas``               ``solve_pdas``: the PDAS iteration
-``laws``               the friction-law protocol and per-node law groups
-``friction_kkt``       the frictional contact problem's data, checks and KKT residuals
-``friction_system``    one iteration's system: symmetric, or non-symmetric where s' ≠ 0
-``friction_result``    node states, steps, result and failure of a frictional solve
-``friction``           ``solve_friction``: semismooth Newton for Tresca and Coulomb friction
+``backends``           the SPD solvers (:mod:`.backends`): interface, SuperLU, PARDISO, PETSc,
+                       the backends by name
+``friction``           the frictional solver (:mod:`.friction`): laws, problem, Newton method
 =====================  ==========================================================================
 """
 
-from .backends import (
+from .backends.pardiso import pardiso_solver
+from .backends.selection import (
     SOLVERS,
-    SolverFallbackWarning,
     auto_solver,
     available_backends,
     make_solver,
     solver_factory,
     solver_name,
 )
+from .backends.solvers import SolverFactory, SolverRequest, SPDSolver
+from .backends.superlu import superlu_solver
 from .elimination import SymmetricEliminator, eliminate_symmetric
-from .friction import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
-from .friction_kkt import FrictionKKT, FrictionProblem, check_friction
-from .friction_result import FrictionConvergenceError, FrictionResult, FrictionStep
-from .kkt import KKTResiduals, kkt_residuals
-from .laws import FrictionLaw, LawGroups
-from .pardiso import pardiso_solver
-from .pdas import PDASOptions, solve_pdas
-from .result import ConvergenceError, PDASConvergenceError, PDASResult, PDASStep, SolveReport
-from .solvers import (
+from .errors import (
     BackendUnavailableError,
+    ConvergenceError,
     FactorizationError,
+    FrictionConvergenceError,
     IllConditionedWarning,
+    PDASConvergenceError,
     SingularSystemError,
-    SolverFactory,
-    SolverRequest,
-    SPDSolver,
+    SolverFallbackWarning,
 )
-from .superlu import superlu_solver
+from .friction.kkt import FrictionKKT, FrictionProblem, check_friction
+from .friction.laws import FrictionLaw, LawGroups
+from .friction.newton import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
+from .friction.result import FrictionResult, FrictionStep
+from .kkt import KKTResiduals, kkt_residuals
+from .pdas import PDASOptions, solve_pdas
+from .result import PDASResult, PDASStep, SolveReport
 
 __all__ = [
     "BackendUnavailableError",

@@ -16,16 +16,11 @@ from collections.abc import Callable
 
 import numpy as np
 
+from .backends.solvers import SPDSolver
 from .elimination import SymmetricEliminator
+from .errors import SINGULAR_CAUSES, FactorizationError, IllConditionedWarning, SingularSystemError
 from .inexact import check_iterative
 from .qp import BoundQP
-from .solvers import (
-    SINGULAR_CAUSES,
-    FactorizationError,
-    IllConditionedWarning,
-    SingularSystemError,
-    SPDSolver,
-)
 from .sparse import abs_matvec
 
 __all__ = [

@@ -3,7 +3,7 @@ active set iterations*; docs/method.md, *Solver*).
 
 A direct solver solves every system of an active set iteration to round-off, and the
 iteration stops when the active set repeats (:func:`~.pdas.solve_pdas`,
-:func:`~.friction.solve_friction`). An iterative solver (:attr:`~.solvers.SPDSolver.rtol` not
+:func:`~.newton.solve_friction`). An iterative solver (:attr:`~.solvers.SPDSolver.rtol` not
 None, e.g. :mod:`.petsc_gamg`) solves each system to its relative residual ``rtol`` only.
 Then, in the spirit of the inexact strategy of Hüeber, Mair and Wohlmuth [1]_:
 
@@ -12,7 +12,7 @@ Then, in the spirit of the inexact strategy of Hüeber, Mair and Wohlmuth [1]_:
    applied to that solution; every later solve of the call is as tight;
 3. the iteration stops when the set repeats after a tight solve. Its iterate is the
    solution of the final set's system to :data:`CONFIRM_RTOL`, and its KKT residuals
-   (:mod:`.kkt`, :mod:`.friction_kkt`) are reported as they are; on Example 6.2 and the
+   (:mod:`.kkt`, :mod:`.friction.kkt`) are reported as they are; on Example 6.2 and the
    two-body tests they stay below :data:`KKT_RTOL` (tests/parallel/test_gamg.py).
 
 A loose solve's residual is checked against the solver's own tolerance
@@ -33,7 +33,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .solvers import SingularSystemError, SPDSolver
+from .backends.solvers import SPDSolver
+from .errors import SingularSystemError
 
 __all__ = ["CONFIRM_RTOL", "KKT_RTOL", "RESIDUAL_SLACK", "InexactRule", "check_iterative"]
 
@@ -104,7 +105,7 @@ def check_iterative(
 ) -> np.ndarray:
     """``x`` if its true residual meets the solver's tolerance, ``‖b − A x‖₂ ≤``
     :data:`RESIDUAL_SLACK` ``max(rtol ‖b‖₂, eps ‖A‖∞ ‖x‖₂)`` (the second term: the round-off
-    of ``A x``); a :class:`~.solvers.SingularSystemError` otherwise.
+    of ``A x``); a :class:`~.errors.SingularSystemError` otherwise.
 
     Parameters
     ----------

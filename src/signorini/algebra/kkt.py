@@ -100,7 +100,7 @@ class KKTResiduals:
 
 def normal_law_columns(kkt) -> dict[str, float]:
     """The history columns of the normal law's residuals of ``kkt`` (a
-    :class:`KKTResiduals` or a :class:`~.friction_kkt.FrictionKKT`): ``kkt_primal``,
+    :class:`KKTResiduals` or a :class:`~.friction.kkt.FrictionKKT`): ``kkt_primal``,
     ``kkt_dual``, ``kkt_complementarity``, ``kkt_stationarity``, ``kkt_dirichlet``."""
     return {
         "kkt_primal": kkt.primal,
@@ -258,7 +258,7 @@ def qp_residuals(qp: BoundQP, x: np.ndarray) -> KKTResiduals:
 
 
 def ill_conditioned_message(kkt: KKTResiduals, bound: float, band: float) -> str:
-    """What an :class:`~.solvers.IllConditionedWarning` says of a solution whose KKT
+    """What an :class:`~.errors.IllConditionedWarning` says of a solution whose KKT
     residuals ``kkt`` exceed ``bound``: each residual above it and, for a tensile contact
     force (``dual``), its size against the total contact force and against the active set's
     round-off band on the forces, ``band · max (|K| |x|)`` (the band of

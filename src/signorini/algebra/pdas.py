@@ -15,7 +15,7 @@ caller keeps the solver).
 
 For an M-matrix ``K`` the method converges monotonically; for a general SPD matrix (P2
 elements are not M-matrices) it converges locally superlinearly [2]_ but may cycle. Cycling
-and the iteration bound are detected and reported by :class:`~.result.PDASConvergenceError`,
+and the iteration bound are detected and reported by :class:`~.errors.PDASConvergenceError`,
 unless ``fallback=True``, which finishes with the primal active set method of :mod:`.primal`.
 
 References
@@ -38,14 +38,15 @@ import numpy as np
 import scipy.sparse as sp
 
 from .active_system import ActiveSetSystem
-from .backends import make_solver
+from .backends.selection import make_solver
+from .backends.solvers import SolverFactory, SPDSolver, solver_usage
+from .errors import IllConditionedWarning, PDASConvergenceError
 from .inexact import InexactRule
 from .kkt import ill_conditioned_message, qp_residuals
 from .primal import primal_active_set
 from .qp import BoundQP, check_qp, check_vector
 from .ranks import SERIAL, Ranks
-from .result import PDASConvergenceError, PDASResult, PDASStep
-from .solvers import IllConditionedWarning, SolverFactory, SPDSolver, solver_usage
+from .result import PDASResult, PDASStep
 from .sparse import abs_matvec
 
 __all__ = ["KKT_WARN", "PDASOptions", "solve_pdas"]
@@ -66,7 +67,7 @@ _FORCE_ROUNDOFF = 1e3 * float(np.finfo(np.float64).eps)
 
 
 #: A solution whose largest relative KKT residual exceeds this gets an
-#: :class:`~.solvers.IllConditionedWarning`: its forces have fewer than six digits (the
+#: :class:`~.errors.IllConditionedWarning`: its forces have fewer than six digits (the
 #: residuals are honest, docs/method.md, *Solver*; measured: 1e-6 at ν = 0.499999999, 1e-7
 #: with a sliver cell of aspect ratio 1e9).
 KKT_WARN = 1e-6
@@ -156,7 +157,7 @@ def solve_pdas(
     solver : SPDSolver or SolverFactory, optional
         An :class:`SPDSolver` is used and kept (not closed; its symbolic analysis is reused
         when ``K`` has the pattern it was analysed for). A factory
-        (:class:`~.solvers.SolverFactory`, default :func:`~.backends.auto_solver`) makes one
+        (:class:`~.solvers.SolverFactory`, default :func:`~.selection.auto_solver`) makes one
         for this call, released afterwards.
     ranks : Ranks
         The processes that split ``K`` by rows (:attr:`~.qp.BoundQP.ranks`; docs/parallel.md):
@@ -174,7 +175,7 @@ def solve_pdas(
         For malformed input, naming the argument.
     PDASConvergenceError
         If the active set cycles or ``max_iter`` is reached and ``options.fallback`` is False.
-    signorini.algebra.solvers.FactorizationError
+    signorini.algebra.backends.solvers.FactorizationError
         If ``K`` restricted to the free DOFs is not positive definite.
 
     Notes

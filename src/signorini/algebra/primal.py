@@ -15,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from .active_system import ActiveSetSystem
-from .result import PDASConvergenceError, PDASStep
+from .errors import PDASConvergenceError
+from .result import PDASStep
 
 __all__ = ["primal_active_set"]
 

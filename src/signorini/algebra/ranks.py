@@ -19,6 +19,9 @@ from typing import Any
 
 import numpy as np
 
+from .backends.petsc_import import petsc_module
+from .errors import BackendUnavailableError
+
 __all__ = ["SERIAL", "Ranks", "solver_ranks", "stored_values", "world_ranks"]
 
 
@@ -105,9 +108,6 @@ def world_ranks() -> Ranks:
     BackendUnavailableError
         If petsc4py or mpi4py is missing, naming the extra that brings them.
     """
-    from .petsc import petsc_module
-    from .solvers import BackendUnavailableError
-
     PETSc = petsc_module()
     try:
         comm = PETSc.COMM_WORLD.tompi4py()

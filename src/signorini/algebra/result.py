@@ -2,7 +2,7 @@
 
 :class:`SolveReport` is what both solvers, the primal-dual active set method for frictionless
 contact (:class:`PDASResult`) and the semismooth Newton method for friction
-(:class:`~.friction_result.FrictionResult`), report in the same words: counters, KKT
+(:class:`~.friction.result.FrictionResult`), report in the same words: counters, KKT
 residuals as named relative numbers (``kkt.columns()``, ``kkt.max``), the iteration history,
 the backend and the times. :class:`ConvergenceError` is the failure of either.
 """
@@ -17,20 +17,10 @@ import numpy as np
 from .kkt import KKTResiduals
 
 __all__ = [
-    "ConvergenceError",
-    "PDASConvergenceError",
     "PDASResult",
     "PDASStep",
     "SolveReport",
-    "with_history",
 ]
-
-
-def with_history(message: str, history: list) -> str:
-    """An error message followed by the last 20 steps of an iteration's history."""
-    lines = "\n".join(str(step) for step in history[-20:])
-    skipped = f"\n  ({len(history) - 20} earlier steps not shown)" if len(history) > 20 else ""
-    return f"{message}\niteration history:{skipped}\n{lines}"
 
 
 @dataclass(frozen=True)
@@ -90,7 +80,7 @@ class SolveReport:
         symbolic analyses, and iterations solved with the previous factorization and a
         low-rank correction.
     history : list
-        One step per iteration (:class:`PDASStep`, :class:`~.friction_result.FrictionStep`),
+        One step per iteration (:class:`PDASStep`, :class:`~.friction.result.FrictionStep`),
         each printable on one line.
     kkt : KKTResiduals or FrictionKKT
         The relative KKT residuals at ``x``: ``kkt.max`` and ``kkt.columns()``, the named
@@ -151,48 +141,3 @@ class PDASResult(SolveReport):
     method: str
 
     FORCES: ClassVar[tuple[str, ...]] = ("multiplier",)
-
-
-class ConvergenceError(RuntimeError):
-    """An active set iteration (PDAS or the frictional semismooth Newton method) cycled, hit
-    its bound, or stopped at a point whose KKT residuals are too large.
-
-    Attributes
-    ----------
-    history : list
-        The steps of the iteration.
-    reason : str
-        ``"cycling"``, ``"max_iter"`` or ``"kkt"``.
-    x : numpy array or None
-        The last iterate.
-    """
-
-    def __init__(self, message: str, history: list, reason: str, x: np.ndarray | None) -> None:
-        super().__init__(with_history(message, history))
-        self.history = history
-        self.reason = reason
-        self.x = x
-
-
-class PDASConvergenceError(ConvergenceError):
-    """The active set iteration cycled or hit its bound.
-
-    Attributes
-    ----------
-    history : list of PDASStep
-    reason : str
-        ``"cycling"`` or ``"max_iter"``.
-    x, active : numpy arrays
-        The last iterate and its active set.
-    """
-
-    def __init__(
-        self,
-        message: str,
-        history: list[PDASStep],
-        reason: str,
-        x: np.ndarray | None = None,
-        active: np.ndarray | None = None,
-    ) -> None:
-        super().__init__(message, history, reason, x)
-        self.active = active

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..algebra.backends import SOLVERS
+from ..algebra.backends.selection import SOLVERS
 from ..estimator.residual import ETA5_VARIANTS
 from ..examples import EXAMPLES
 from ..loop.options import AdaptiveOptions

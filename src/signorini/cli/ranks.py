@@ -14,7 +14,7 @@ import os
 import sys
 from dataclasses import replace
 
-from ..algebra.backends import solver_name
+from ..algebra.backends.selection import solver_name
 from ..loop import AdaptiveOptions, adaptive
 from .problems import RunProblem
 from .settings import RunSettings
@@ -48,7 +48,7 @@ def follow(args: argparse.Namespace, settings: RunSettings, job: RunProblem) -> 
     """
     if solver_name(settings.options.solver) not in ("petsc", "petsc-gamg"):
         return False
-    from ..algebra.petsc import petsc_module
+    from ..algebra.backends.petsc import petsc_module
 
     comm = petsc_module().COMM_WORLD
     if comm.getSize() == 1:

@@ -15,7 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from ..algebra.backends import solver_library, solver_name
+from ..algebra.backends.selection import solver_library, solver_name
 from ..loop import COLUMNS, Level, adaptive
 from ..output import HistoryWriter, write_columns
 from ..output.check import CHECK, write_check

@@ -9,7 +9,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
 
-from ..algebra.backends import solver_factory
+from ..algebra.backends.selection import solver_factory
 from ..loop.options import LEGACY_KEYS, AdaptiveOptions, OptionError
 from .parser import FILE_FLAGS, OPTION_FLAGS, flag
 

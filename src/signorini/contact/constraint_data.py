@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..algebra.laws import LawGroups
+from ..algebra.friction.laws import LawGroups
 from ..fem import iso, p2
 from ..fem.quadrature import gauss_legendre
 from ..fem.space import LagrangeSpace
@@ -135,9 +135,9 @@ def friction_data(
     second: np.ndarray,
 ) -> LawGroups:
     """The friction laws per constraint: each frictional part's law, the law of each
-    constraint and its nodal weight (:meth:`~signorini.algebra.laws.FrictionLaw.nodal_weight`,
-    e.g. Tresca's ``s_z = ∫ s ψ_z ds``, Coulomb's F); a corner node's constraints are
-    frictionless."""
+    constraint and its nodal weight
+    (:meth:`~signorini.algebra.friction.laws.FrictionLaw.nodal_weight`, e.g. Tresca's
+    ``s_z = ∫ s ψ_z ds``, Coulomb's F); a corner node's constraints are frictionless."""
     k = part.size
     index = np.full(k, -1, dtype=np.int64)
     weight = np.zeros(k)

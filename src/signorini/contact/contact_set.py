@@ -26,7 +26,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..algebra.laws import LawGroups
+from ..algebra.friction.laws import LawGroups
 from ..fem.space import LagrangeSpace
 from ..mesh.geometry import segment_normals
 from ..problem.fields import ProblemError
@@ -103,7 +103,7 @@ class ContactSet:
         Row of the constraint of each contact edge's nodes (for the edge's part), ``-1`` at
         Dirichlet nodes.
     friction : LawGroups
-        The friction laws of the frictional parts (:mod:`signorini.algebra.laws`), the law
+        The friction laws of the frictional parts (:mod:`signorini.algebra.friction.laws`), the law
         of each constraint (``-1``: frictionless; a corner's constraints are frictionless)
         and its nodal weight (Tresca: ``s_z = ∫ s ψ_z ds`` over the constraint's part, force
         per unit thickness; Coulomb: its coefficient F); docs/method.md, *Friction*.

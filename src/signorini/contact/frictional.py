@@ -1,13 +1,14 @@
 """SOLVE with friction: the assembled system of a problem whose contact parts carry friction
-laws (Tresca, Coulomb, or any :class:`~signorini.algebra.laws.FrictionLaw`, mixed part by
-part), handed to the semismooth Newton method of :mod:`signorini.algebra.friction`
+laws (Tresca, Coulomb, or any :class:`~signorini.algebra.friction.laws.FrictionLaw`, mixed part by
+part), handed to the semismooth Newton method of :mod:`signorini.algebra.friction.newton`
 (docs/method.md, *Friction: the algebraic problem and its solver*).
 
-Every constraint is one contact node with its normal DOF ``2z`` and tangential DOF ``2z + 1``
-in the node frame ``[n t]``; each node has its part's law (the contact set's
-:class:`~signorini.algebra.laws.LawGroups`), frictionless parts none (no friction force). The
-systems are symmetric (Cholesky) when every law in play is (Tresca), else LU. Tresca is by
-default the classical problem, the bound acting on every node of Γ_C (the minimiser of
+Every constraint is one contact node with its normal DOF ``d z`` and tangential DOFs
+``d z + j`` (``j = 1 … d − 1``, the frictional problem's ``tangent (m, d − 1)``; in 2D
+``2z + 1``) in the node frame ``[n t_1 … t_{d−1}]``; each node has its part's law (the contact set's
+:class:`~signorini.algebra.friction.laws.LawGroups`), frictionless parts none (no friction
+force). The systems are symmetric (Cholesky) when every law in play is (Tresca), else LU.
+Tresca is by default the classical problem, the bound acting on every node of Γ_C (the minimiser of
 ``½ a(u, u) − L(u) + Σ_z s_z |u_t(z)|`` subject to ``u(z)·n_z ≤ ψ(z)``).
 
 A load step of a quasi-static path (docs/method.md, *Load paths*) gets the previous step's
@@ -21,12 +22,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..algebra.friction import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
-from ..algebra.friction_kkt import check_friction
-from ..algebra.laws import LawGroups
+from ..algebra.backends.solvers import SolverFactory, SPDSolver
+from ..algebra.friction.kkt import check_friction
+from ..algebra.friction.laws import LawGroups
+from ..algebra.friction.newton import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
 from ..algebra.result import SolveReport
-from ..algebra.solvers import SolverFactory, SPDSolver
-from ..fem.space import LagrangeSpace
+from ..fem.space import LagrangeSpace, node_dofs
 from ..problem.fields import ProblemError
 from .contact_set import ContactSet
 from .node_frames import to_frames
@@ -245,9 +246,11 @@ def solve_frictional(
         # *Force control*): those nodes stick, the others are out of contact
         state0 = np.where(active0, STICK, INACTIVE).astype(np.int64)
         warm = {"state0": state0, "direction0": np.zeros(cs.size, dtype=np.int64)}
-    nodes = cs.nodes
+    # the frame [n t_1 … t_{d−1}] of each node: its normal DOF, then its d − 1 tangential DOFs
+    frame_dofs = node_dofs(cs.nodes, assembled.space.n_components)
     problem = check_friction(
-        K, F, 2 * nodes, 2 * nodes + 1, cs.gap, assembled.dirichlet, assembled.dirichlet_values,
+        K, F, frame_dofs[:, 0], frame_dofs[:, 1:], cs.gap,
+        assembled.dirichlet, assembled.dirichlet_values,
         laws=law.laws, weight=law.weight, law_index=law.index, reference=reference,
     ).on_ranks(assembled.ranks)  # fmt: skip
     options = FrictionOptions(max_iter=max_iter)

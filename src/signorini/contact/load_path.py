@@ -16,7 +16,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..algebra.solvers import SolverFactory, SPDSolver
+from ..algebra.backends.solvers import SolverFactory, SPDSolver
 from ..mesh.mesh import Mesh
 from ..problem.problem import ContactProblem
 from .solution import ContactResult, solve

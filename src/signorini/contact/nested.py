@@ -21,7 +21,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..algebra.result import PDASConvergenceError
+from ..algebra.errors import PDASConvergenceError
 from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
 from ..mesh.refine import refine_nvb

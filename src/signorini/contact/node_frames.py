@@ -1,7 +1,9 @@
-"""Node frames: the two DOFs of a contact node in its constraint frame.
+"""Node frames: the ``d`` DOFs of a contact node in its constraint frame ``[n t_1 … t_{d−1}]``
+(a normal, then a basis of the tangent plane: ``ContactSet.tangent (k, d − 1, d)``, the
+frictional problem's tangential DOFs ``(m, d − 1)``). The kernels here are the ``d = 2`` ones.
 
 A node ``z`` with one constraint has a unit direction ``n = (n1, n2)`` and the tangent
-``t = (-n2, n1)``. With interleaved DOFs (``dof = d * node + component``; ``d = 2``, the size
+``t_1 = t = (-n2, n1)``. With interleaved DOFs (``dof = d * node + component``; ``d = 2``, the size
 ``Q.shape[-1]`` of a frame), the Cartesian values ``u = (x[2z], x[2z + 1])`` and the frame
 values ``(u.n, u.t)`` are related by the 2 x 2 block ``Q_z = [n t]``: ``u = Q_z (u.n, u.t)``.
 ``Q`` is block diagonal with ``Q_z`` at the listed nodes and the identity elsewhere, so the

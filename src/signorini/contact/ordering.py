@@ -16,7 +16,7 @@ object is used as it is.
 
 :class:`Ordering` computes the ordering once per system. :func:`~.system.assemble` starts it
 in a background thread (``prefetch_ordering``) when the solver will take it
-(:func:`~signorini.algebra.backends.takes_ordering`): METIS runs in PARDISO's analysis
+(:func:`~signorini.algebra.backends.selection.takes_ordering`): METIS runs in PARDISO's analysis
 through ``ctypes``, which releases the interpreter, so it takes the second core while the
 stiffness matrix is assembled on the first (docs/method.md, *Ordering of the unknowns*).
 :class:`SolverAhead` makes the solver of the system as soon as the matrix's pattern is known
@@ -32,10 +32,10 @@ from contextlib import AbstractContextManager, nullcontext
 import numpy as np
 import scipy.sparse as sp
 
-from ..algebra.backends import make_solver
-from ..algebra.beside import beside
-from ..algebra.pardiso import metis_ordering
-from ..algebra.solvers import SolverFactory, SolverRequest, SPDSolver
+from ..algebra.backends.beside import beside
+from ..algebra.backends.pardiso import metis_ordering
+from ..algebra.backends.selection import make_solver
+from ..algebra.backends.solvers import SolverFactory, SolverRequest, SPDSolver
 from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
 from .contact_set import ContactSet
@@ -76,7 +76,7 @@ def ordering_graph(mesh: Mesh, coupling: sp.spmatrix | None = None) -> sp.csr_ma
 
 def dof_ordering(space: LagrangeSpace, coupling: sp.spmatrix | None = None) -> np.ndarray:
     """A nested dissection ordering of the space's DOFs: METIS on the vertex graph
-    (:func:`~signorini.algebra.pardiso.metis_ordering`), with the node pairs ``coupling``
+    (:func:`~signorini.algebra.backends.pardiso.metis_ordering`), with the node pairs ``coupling``
     joins (a contact pair's mortar transfer, docs/method.md, *Two bodies*), extended to the
     edge nodes by :meth:`~signorini.fem.space.P2Space.dof_order`.
 
@@ -94,7 +94,7 @@ class Ordering:
 
     With ``prefetch`` the graph is built here, in the caller's thread, and only METIS (in
     PARDISO's analysis, which releases the interpreter) runs in the background
-    (:func:`~signorini.algebra.beside.beside`) while the caller goes on (the stiffness
+    (:func:`~signorini.algebra.backends.beside.beside`) while the caller goes on (the stiffness
     matrix's assembly, :func:`~.system.assemble`); the first call waits for it and extends
     it to the DOFs. The result is the same either way, and an error of the background work
     (e.g. MKL missing) is raised by that call.
@@ -179,7 +179,7 @@ class SolverAhead:
     and starts its analysis beside the rest of the assembly
     (:meth:`~signorini.algebra.SPDSolver.analyze`): a symmetric one, or an LU where a contact
     part's friction law is not symmetric (Coulomb, whose systems
-    (:class:`~signorini.algebra.friction_system.CoupledSystem`) keep ``K``'s pattern where
+    (:class:`~signorini.algebra.friction.system.CoupledSystem`) keep ``K``'s pattern where
     ``K`` is in node blocks). A request of that kind then gets that solver, any other request
     a new one from ``factory``. Where the LU's analysis would read the values (weighted
     matching), nothing starts. The solver does not check the symmetry of ``K``, symmetric by

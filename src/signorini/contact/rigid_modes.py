@@ -1,5 +1,5 @@
 """The rigid motions of the bodies in the unknowns of an assembled system: the near-nullspace
-an algebraic multigrid builds its coarse spaces from (:mod:`signorini.algebra.petsc_gamg`).
+an algebraic multigrid builds its coarse spaces from (:mod:`signorini.algebra.backends.petsc_gamg`).
 
 Each body (a connected component of the mesh, :func:`~signorini.mesh.bodies.body_of_cells`)
 moves rigidly by ``u(x) = a + ω (−(y − y_b), x − x_b)``, ``(x_b, y_b)`` its centroid: two

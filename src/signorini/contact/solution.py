@@ -17,12 +17,12 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
-from ..algebra.backends import takes_ordering
-from ..algebra.friction import INACTIVE, SLIP, STICK
+from ..algebra.backends.selection import takes_ordering
+from ..algebra.backends.solvers import SolverFactory, SPDSolver
+from ..algebra.friction.newton import INACTIVE, SLIP, STICK
 from ..algebra.pdas import PDASOptions, solve_pdas
 from ..algebra.ranks import solver_ranks
 from ..algebra.result import SolveReport
-from ..algebra.solvers import SolverFactory, SPDSolver
 from ..algebra.sparse import stiffness_unit
 from ..fem.element import Element
 from ..fem.norms import energy_error2, h1_seminorm_error2

@@ -154,7 +154,7 @@ def assemble(
     everything else are the same on every rank. On one process nothing changes.
 
     With ``prefetch_ordering`` (on one process; :func:`~.solution.solve` asks for it when its
-    solver takes an ordering, :func:`~signorini.algebra.backends.takes_ordering`) the
+    solver takes an ordering, :func:`~signorini.algebra.backends.selection.takes_ordering`) the
     fill-reducing ordering of the unknowns (:attr:`Assembled.ordering`) is started in a
     background thread before the stiffness matrix is assembled, and runs beside it.
     ``on_pattern(K, contact, ordering)`` is called as soon as ``K``'s pattern is final (its

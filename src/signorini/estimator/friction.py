@@ -9,7 +9,7 @@ nodal values at ``[start, end, midpoint]``:
 - ``p_t,z = Λ_t,z / w_z``, the consistent friction stress (``ContactResult.tangential_pressure``;
   the obstacle acts on the body with ``−Λ_t t``, so ``p_t ≈ −σ_t``);
 - ``b_z = s_z / w_z``, the slip bound as a stress, with ``s_z`` the node's friction law's bound
-  at the contact force ``Λ_z`` (:mod:`signorini.algebra.laws`; Tresca ``s_z = ∫ s ψ_z``,
+  at the contact force ``Λ_z`` (:mod:`signorini.algebra.friction.laws`; Tresca ``s_z = ∫ s ψ_z``,
   so ``b_z = s_z / w_z``; Coulomb ``F Λ_z``, so ``b_z = F p_z``): ``|p_t,z| ≤ b_z`` is the
   solver's nodal law ``|Λ_t,z| ≤ s_z`` divided by ``w_z``; 0 on frictionless parts;
 - ``u_t(z) = ũ_h(z)·t_z − u_t,ref(z)``, ``t_z`` the constraint's tangent

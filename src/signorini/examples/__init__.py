@@ -4,7 +4,7 @@ curved geometry.
 - :mod:`.paper`: the paper's numerical experiments (Section 6);
 - :mod:`.hertz`: an elastic half-disc pressed onto a rigid plane, with the Hertz solution;
 - :mod:`.punch`: a rigid punch with rounded corners pressed into a block held against a wall;
-- :mod:`.friction`: Example 6.2 with Tresca or Coulomb friction on its contact part;
+- :mod:`.friction.newton`: Example 6.2 with Tresca or Coulomb friction on its contact part;
 - :mod:`.partial_slip`: the Hertz half-disc pressed on a plane with Coulomb friction, then
   pulled sideways (Cattaneo–Mindlin), a load path of two steps;
 - :mod:`.two_bodies`: contact between two elastic bodies: two cylinders (Hertz), two

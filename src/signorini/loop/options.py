@@ -16,8 +16,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ..algebra.backends import auto_solver, solver_factory, solver_name
-from ..algebra.solvers import SolverFactory, SPDSolver
+from ..algebra.backends.selection import auto_solver, solver_factory, solver_name
+from ..algebra.backends.solvers import SolverFactory, SPDSolver
 from ..estimator.marking import check_theta
 from ..estimator.residual import ETA5_VARIANTS
 from ..fem.element import element_of

@@ -127,7 +127,7 @@ class LevelRecord:
     kkt_primal, kkt_dual, kkt_complementarity, kkt_stationarity, kkt_dirichlet : float
         The KKT residuals of the discrete problem, each relative to the quantity it is about
         (:class:`signorini.algebra.kkt.KKTResiduals`; docs/method.md, *Solver*); with
-        friction those of :class:`signorini.algebra.friction_kkt.FrictionKKT`.
+        friction those of :class:`signorini.algebra.friction.kkt.FrictionKKT`.
     kkt_tangential_bound, kkt_tangential_complementarity : float
         With friction, the residuals of the tangential law (docs/method.md, *Friction*);
         NaN without.

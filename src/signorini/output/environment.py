@@ -23,7 +23,7 @@ def environment(solver_library: str) -> dict[str, str]:
     ----------
     solver_library : str
         The sparse solver library the run uses, with its version
-        (:func:`signorini.algebra.backends.solver_library`).
+        (:func:`signorini.algebra.backends.selection.solver_library`).
     """
     return {
         "signorini": __version__,

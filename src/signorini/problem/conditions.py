@@ -226,7 +226,7 @@ class Contact:
         :class:`~signorini.problem.obstacles.SignedDistance`.
     friction : Tresca, Coulomb, another friction law, or None
         The friction law on the part (:mod:`signorini.problem.friction`, or any object of the
-        protocol :class:`signorini.algebra.laws.FrictionLaw`); ``None`` for frictionless
+        protocol :class:`signorini.algebra.friction.laws.FrictionLaw`); ``None`` for frictionless
         contact.
     master : str or None
         Contact with a second deformable body: the boundary part of the other body (the

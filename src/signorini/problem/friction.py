@@ -11,9 +11,10 @@ Signorini conditions in the normal direction:
 Discretely the laws hold node-wise with the nodal contact forces (3.17): ``|Λ_t,z| ≤ s_z``
 with ``s_z = ∫ s ψ_z ds`` (Tresca) or ``|Λ_t,z| ≤ F Λ_n,z`` (Coulomb).
 
-Both implement the friction-law protocol :class:`signorini.algebra.laws.FrictionLaw` that the
-contact layer, the solver and the estimator ask (its slip bound from a nodal weight and the
-normal force, the bound's derivative, whether the systems stay symmetric): a new law is one
+Both implement the friction-law protocol
+:class:`signorini.algebra.friction.laws.FrictionLaw` that the contact layer, the solver and
+the estimator ask (its slip bound from a nodal weight and the normal force,
+the bound's derivative, whether the systems stay symmetric): a new law is one
 class with the same five members, given as ``Contact(friction=...)``.
 
 The laws check their data when they are built (numbers must be finite and ``≥ 0``, a function
@@ -144,7 +145,7 @@ class Coulomb:
 
 Friction = Tresca | Coulomb
 """The built-in friction laws; ``Contact(friction=...)`` takes any object with their five
-members (:class:`signorini.algebra.laws.FrictionLaw`)."""
+members (:class:`signorini.algebra.friction.laws.FrictionLaw`)."""
 
-#: what a friction law has (:class:`signorini.algebra.laws.FrictionLaw`)
+#: what a friction law has (:class:`signorini.algebra.friction.laws.FrictionLaw`)
 LAW_MEMBERS = ("symmetric", "everywhere", "nodal_weight", "slip_bound", "bound_derivative")

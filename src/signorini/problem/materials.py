@@ -18,8 +18,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from ..algebra.errors import IllConditionedWarning
 from ..algebra.pdas import KKT_WARN
-from ..algebra.solvers import IllConditionedWarning
 from ..fem.material import Material
 from ..mesh.mesh import Mesh
 from .fields import ProblemError

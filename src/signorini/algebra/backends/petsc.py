@@ -47,21 +47,19 @@ the vertex graph) is computed for an LU on one process only (:func:`petsc_solver
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
-from functools import cache
-from pathlib import Path
-from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
-from .mkl import blas_for_libraries_loaded_later, mkl_threads_local
-from .petsc_rows import PetscRows, _world_ranks, row_block
-from .solvers import BackendUnavailableError, FactorizationError, SolverRequest
-from .sparse import in_node_blocks
+from ..errors import BackendUnavailableError, FactorizationError
+from ..ranks import world_ranks
+from ..sparse import in_node_blocks
+from .mkl import mkl_threads_local
+from .petsc_import import _MUMPS_BLAS, petsc_library, petsc_module
+from .petsc_rows import PetscRows, row_block
+from .solvers import SolverRequest
 
 __all__ = [
     "MUMPS_ORDERING",
@@ -88,62 +86,6 @@ REFINEMENT_STEPS = 2
 #: METIS on one rank, 43 s against 55 s on two (docs/parallel.md, *MUMPS's ordering*).
 MUMPS_ORDERING = 0
 
-#: How to install the backend, ending the message of a missing petsc4py.
-INSTALL_HINT = (
-    "install the extra: pip install 'signorini[mpi]' (binary PETSc + MUMPS + MPICH wheels, "
-    "Python >= 3.12), or use a petsc4py built with MUMPS (docs/parallel.md, Install)"
-)
-
-
-@cache
-def petsc_module() -> Any:
-    """``petsc4py.PETSc``, imported once; :class:`BackendUnavailableError` naming the extra
-    when petsc4py is missing or its PETSc has no MUMPS."""
-    if "petsc4py.PETSc" not in sys.modules:  # else decided when it was loaded
-        _MUMPS_BLAS["mkl"] = _mkl_blas_for_the_wheel()
-    try:
-        # The binary wheel's package loads its MPI library before petsc4py (it must come
-        # first); other installs of petsc4py do not have it.
-        import dolfinx_solver  # noqa: F401
-    except ImportError:
-        pass
-    try:
-        from petsc4py import PETSc
-    except ImportError as err:
-        raise BackendUnavailableError(
-            f"the petsc backend needs petsc4py, which is not importable ({err}): {INSTALL_HINT}"
-        ) from err
-    if not PETSc.Sys.hasExternalPackage("mumps"):
-        version = ".".join(map(str, PETSc.Sys.getVersion()))
-        raise BackendUnavailableError(
-            f"the petsc backend needs MUMPS, and this PETSc ({version}) was built without it: "
-            f"{INSTALL_HINT}"
-        )
-    return PETSc
-
-
-#: Whether MUMPS calls MKL's BLAS instead of the binary wheel's, as :func:`petsc_module`
-#: decided before it loaded PETSc.
-_MUMPS_BLAS = {"mkl": False}
-
-
-def _mkl_blas_for_the_wheel() -> bool:
-    """Let MUMPS call MKL's BLAS instead of the binary wheel's single-threaded OpenBLAS
-    (:func:`.mkl.blas_for_libraries_loaded_later`; docs/parallel.md, *MUMPS's BLAS*): only
-    for the wheel of the ``mpi`` extra, whose BLAS is known to be LP64 OpenBLAS
-    (``libopenblas.so.0``), and only before its PETSc is loaded. Other PETSc builds keep
-    theirs: their BLAS may take 64-bit integers."""
-    try:
-        spec = importlib.util.find_spec("dolfinx_solver")
-    except (ImportError, ValueError, AttributeError):  # e.g. hidden by sys.modules[...] = None
-        return False
-    if spec is None or not spec.submodule_search_locations:
-        return False
-    folders = [Path(folder, "lib") for folder in spec.submodule_search_locations]
-    if not any((folder / "libopenblas.so.0").is_file() for folder in folders):
-        return False
-    return blas_for_libraries_loaded_later()
-
 
 @contextmanager
 def _one_mkl_thread() -> Iterator[None]:
@@ -159,20 +101,6 @@ def _one_mkl_thread() -> Iterator[None]:
         yield
     finally:
         mkl_threads_local(previous)
-
-
-def petsc_library(solver: str = "MUMPS") -> str:
-    """``"PETSc 3.25.5 + MUMPS on MKL's BLAS (2 ranks)"``: PETSc's version, the ``solver`` it
-    runs (MUMPS's BLAS named where it is MKL's), and ``PETSC_COMM_WORLD``'s size, for a run's
-    manifest; what is missing when the backend is not usable."""
-    try:
-        PETSc = petsc_module()
-    except BackendUnavailableError as err:
-        return f"PETSc (not usable: {err})"
-    version = ".".join(map(str, PETSc.Sys.getVersion()))
-    size = PETSc.COMM_WORLD.getSize()
-    blas = " on MKL's BLAS" if solver == "MUMPS" and _MUMPS_BLAS["mkl"] else ""
-    return f"PETSc {version} + {solver}{blas} ({size} rank{'s' if size > 1 else ''})"
 
 
 class PetscSolver(PetscRows):
@@ -373,4 +301,4 @@ def _lu_ordering(request: SolverRequest) -> np.ndarray | None:
 
 
 #: The ranks the backend's matrices are split over (:func:`~.ranks.solver_ranks`).
-petsc_solver.ranks = _world_ranks  # type: ignore[attr-defined]
+petsc_solver.ranks = world_ranks  # type: ignore[attr-defined]

@@ -7,14 +7,13 @@ from typing import ClassVar
 
 import numpy as np
 
-from .friction_kkt import FrictionKKT
-from .result import ConvergenceError, SolveReport
+from ..result import SolveReport
+from .kkt import FrictionKKT
 
 __all__ = [
     "INACTIVE",
     "SLIP",
     "STICK",
-    "FrictionConvergenceError",
     "FrictionResult",
     "FrictionStep",
 ]
@@ -56,13 +55,13 @@ class FrictionStep:
 
 @dataclass(kw_only=True)
 class FrictionResult(SolveReport):
-    """Solution of :func:`~.friction.solve_friction` and how it was obtained
+    """Solution of :func:`~.newton.solve_friction` and how it was obtained
     (:class:`~.result.SolveReport`; ``n_solves`` counts one linear solve per iteration and
     ``n_updates`` is 0, as the history has always recorded them, although both kinds of
     system solve some iterations by a low-rank update of the previous factor, which only
     ``n_factorizations`` below the iterations shows; ``times`` holds ``analysis``,
     ``factorization``, ``solve``, ``assembly`` (forming the systems), ``total``; ``kkt`` is a
-    :class:`~.friction_kkt.FrictionKKT`, the residuals of both laws).
+    :class:`~.friction.kkt.FrictionKKT`, the residuals of both laws).
 
     Attributes
     ----------
@@ -81,7 +80,7 @@ class FrictionResult(SolveReport):
         Whether the systems were symmetric (every law with ``s' = 0``: Cholesky) or not (LU).
     method : str
         ``"semismooth-newton"``, or ``"fixed-point"`` where Coulomb's node states cycled and
-        the fixed point on its slip bound finished the solve (:mod:`.friction_fixed_point`;
+        the fixed point on its slip bound finished the solve (:mod:`.friction.fixed_point`;
         ``iterations`` counts the solves of both).
     """
 
@@ -94,30 +93,3 @@ class FrictionResult(SolveReport):
     method: str = "semismooth-newton"
 
     FORCES: ClassVar[tuple[str, ...]] = ("multiplier_n", "multiplier_t")
-
-
-class FrictionConvergenceError(ConvergenceError):
-    """The frictional active set iteration cycled, hit its bound, or stopped at a point whose
-    KKT residuals are too large.
-
-    Attributes
-    ----------
-    history : list of FrictionStep
-    reason : str
-        ``"cycling"``, ``"max_iter"`` or ``"kkt"``.
-    x, state, direction : numpy arrays
-        The last iterate and the states used for it.
-    """
-
-    def __init__(
-        self,
-        message: str,
-        history: list[FrictionStep],
-        reason: str,
-        x: np.ndarray | None = None,
-        state: np.ndarray | None = None,
-        direction: np.ndarray | None = None,
-    ) -> None:
-        super().__init__(message, history, reason, x)
-        self.state = state
-        self.direction = direction

@@ -12,7 +12,7 @@ make solvers themselves: they ask a *solver factory* (:class:`SolverFactory`), a
 that takes a :class:`SolverRequest` (symmetric or not, check the symmetry or not, a
 fill-reducing ordering on demand) and returns a new :class:`SPDSolver`. A backend module
 supplies one (:func:`~.pardiso.pardiso_solver`, :func:`~.superlu.superlu_solver`); the
-registry of :mod:`.backends` names them for the command line.
+registry of :mod:`.selection` names them for the command line.
 """
 
 from __future__ import annotations
@@ -23,91 +23,17 @@ from concurrent.futures import Future
 import numpy as np
 import scipy.sparse as sp
 
+from ..sparse import as_csr, csr_row_indices, diagonal_positions, list_indices, symmetry_defect
 from . import beside as background
 from .requests import SolverFactory, SolverRequest
-from .sparse import as_csr, csr_row_indices, diagonal_positions, list_indices, symmetry_defect
 
 __all__ = [
-    "BackendUnavailableError",
-    "FactorizationError",
-    "IllConditionedWarning",
-    "SINGULAR_CAUSES",
     "SPDSolver",
-    "SingularSystemError",
     "SolverFactory",
     "SolverRequest",
     "checked_ordering",
     "solver_usage",
 ]
-
-
-class FactorizationError(np.linalg.LinAlgError):
-    """The matrix could not be factorized as symmetric positive definite.
-
-    A subclass of :class:`numpy.linalg.LinAlgError` (itself a :class:`ValueError`).
-
-    Attributes
-    ----------
-    backend : str
-        The backend that failed.
-    code : int or None
-        The backend's error code (PARDISO's ``error``), if any.
-    equation : int or None
-        0-based index of the equation where a non-positive pivot was met, if known.
-    """
-
-    def __init__(
-        self,
-        message: str,
-        *,
-        backend: str = "",
-        code: int | None = None,
-        equation: int | None = None,
-    ) -> None:
-        super().__init__(message)
-        self.backend = backend
-        self.code = code
-        self.equation = equation
-
-
-#: What usually makes a stiffness matrix singular in floating point; ends the messages of
-#: :class:`SingularSystemError` and of a failed factorization in an active set solve.
-SINGULAR_CAUSES = (
-    "Usually a part of the body is not held: it has no Dirichlet condition and can move "
-    "rigidly. A body so slender that its stiffness matrix is singular in double precision "
-    "does the same (measured with P2 on cantilevers of length/thickness L/h: within 1 % of "
-    "beam theory up to L/h = 1000, 1 % off at 1500, refused from 2000). So does a contrast "
-    "of stiffness between regions of about 1e12 or more, or a region close to incompressible "
-    "beside others, with every part held: ContactProblem warns about those, naming the "
-    "regions and the ratio of their moduli."
-)
-
-
-class SingularSystemError(FactorizationError):
-    """A solve whose residual shows the matrix is singular or too ill-conditioned.
-
-    Raised whatever the backend, when the relative residual ``max |b - A x| / max |b|`` of a
-    solve exceeds its bound: a factorization that went through with a near-zero pivot gives
-    a garbage solution that only its residual reveals.
-
-    Attributes
-    ----------
-    residual : float
-        The relative residual of the failed solve.
-    """
-
-    def __init__(self, message: str, *, backend: str = "", residual: float = np.nan) -> None:
-        super().__init__(message, backend=backend)
-        self.residual = residual
-
-
-class IllConditionedWarning(RuntimeWarning):
-    """A linear system was solved, but so ill-conditioned that its solution may have lost
-    digits; the message gives the estimated relative error."""
-
-
-class BackendUnavailableError(RuntimeError):
-    """A solver backend that was asked for cannot be loaded here; the message says why."""
 
 
 class SPDSolver:

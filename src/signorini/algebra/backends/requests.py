@@ -58,11 +58,11 @@ class SolverFactory(Protocol):
     ``factory(request) -> SPDSolver``: a solver that has not factorized yet, for the kind of
     matrices :class:`SolverRequest` describes. Whoever calls the factory owns the solver and
     closes it (:meth:`~.solvers.SPDSolver.close`). A factory may raise
-    :class:`~.solvers.BackendUnavailableError` when its backend cannot be used here.
+    :class:`~.errors.BackendUnavailableError` when its backend cannot be used here.
 
     A backend is an :class:`SPDSolver` subclass (or two: Cholesky and LU) and a factory
     function in one module; registering it by name is one line of
-    :data:`signorini.algebra.backends.SOLVERS`.
+    :data:`signorini.algebra.backends.selection.SOLVERS`.
     """
 
     def __call__(self, request: SolverRequest, /) -> SPDSolver: ...

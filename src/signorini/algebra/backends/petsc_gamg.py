@@ -42,7 +42,7 @@ solution; every other from zero. The active set methods read
 :attr:`GamgSolver.rtol` and follow the inexact stopping rule of :mod:`.inexact`
 (docs/parallel.md, *Inexact active set iterations*). A solve that does not reach its
 tolerance in :attr:`GamgSolver.max_it` iterations, or meets an indefinite matrix, raises
-:class:`~.solvers.SingularSystemError`.
+:class:`~.errors.SingularSystemError`.
 
 **Non-symmetric systems** (Coulomb friction) are not for CG: the factory returns the
 ``"petsc"`` backend's MUMPS LU for them (:class:`~.petsc.PetscLUSolver`), exact to round-off.
@@ -58,10 +58,12 @@ from collections.abc import Callable
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import SingularSystemError
+from ..ranks import world_ranks
+from ..sparse import abs_matvec
 from .petsc import PetscLUSolver
-from .petsc_rows import PetscRows, _world_ranks, row_block
-from .solvers import SingularSystemError, SolverRequest, SPDSolver
-from .sparse import abs_matvec
+from .petsc_rows import PetscRows, row_block
+from .solvers import SolverRequest, SPDSolver
 
 __all__ = ["GamgSolver", "RTOL", "petsc_gamg_solver"]
 
@@ -330,4 +332,4 @@ def petsc_gamg_solver(request: SolverRequest) -> SPDSolver:
 
 #: The ranks the backend's matrices are split over (:func:`~.ranks.solver_ranks`): on several,
 #: the contact layer hands each rank its own rows.
-petsc_gamg_solver.ranks = _world_ranks  # type: ignore[attr-defined]
+petsc_gamg_solver.ranks = world_ranks  # type: ignore[attr-defined]

@@ -26,11 +26,11 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse as sp
 
-from .active_system import ActiveSetSystem, refine, update_accepted
-from .friction_kkt import FrictionProblem
-from .ranks import stored_values
-from .solvers import SPDSolver
-from .sparse import abs_matvec, concatenated_ranges, csr_row_indices, diagonal_positions
+from ..active_system import ActiveSetSystem, refine, update_accepted
+from ..backends.solvers import SPDSolver
+from ..ranks import stored_values
+from ..sparse import abs_matvec, concatenated_ranges, csr_row_indices, diagonal_positions
+from .kkt import FrictionProblem
 
 __all__ = ["CoupledSystem", "SymmetricSystem", "friction_system"]
 
@@ -75,7 +75,7 @@ class SymmetricSystem:
         (±1 on slipping nodes): ``x (n,)``."""
         p = self.problem
         load = p.qp.F.copy()
-        load[p.tangent] -= direction * p.slip_bound(np.zeros(p.m), active)
+        load[p.tangent_2d] -= direction * p.slip_bound(np.zeros(p.m), active)
         x, _ = self.inner.solve(np.concatenate([active, stick]), load)
         return x
 
@@ -117,7 +117,7 @@ class CoupledSystem:
         self.max_update = max_update if solver.rtol is None else 0  # exact solves only
         self.factored: tuple[np.ndarray, np.ndarray] | None = None  # held DOFs, row factors
         self.normal_of = np.full(n, -1)  # the normal DOF of each tangential one
-        self.normal_of[problem.tangent] = problem.normal
+        self.normal_of[problem.tangent_2d] = problem.normal
         self._diagonal: np.ndarray | None = None  # K's, for the updates
         rows_K = csr_row_indices(K)
         contact = np.ones(problem.m, dtype=bool)
@@ -129,9 +129,9 @@ class CoupledSystem:
         row_node[problem.normal[coupled]] = coupled
         self.copy_src = np.flatnonzero(row_node[rows_K] >= 0)
         self.copy_node = row_node[rows_K[self.copy_src]]
-        copy_rows = problem.tangent[self.copy_node]
+        copy_rows = problem.tangent_2d[self.copy_node]
         copy_cols = K.indices[self.copy_src]
-        within = _same_columns(K, problem.normal[coupled], problem.tangent[coupled])
+        within = _same_columns(K, problem.normal[coupled], problem.tangent_2d[coupled])
         if within is not None:  # node blocks: the tangential rows store the normal's columns
             pattern, self.rows, self.pos_K = K, rows_K, None
             self.pos_copy = self.copy_src + within[np.searchsorted(coupled, self.copy_node)]
@@ -167,16 +167,16 @@ class CoupledSystem:
         n = qp.n
         factor = np.where(active & ~stick, direction * self.derivative, 0.0)  # σ s' on slip rows
         row_factor = np.zeros(n)
-        row_factor[p.tangent] = factor
+        row_factor[p.tangent_2d] = factor
         fixed, values = self.fixed, self.values
         fixed[p.normal] = active
         values[p.normal] = np.where(active, p.gap, 0.0)
-        fixed[p.tangent] = stick
-        values[p.tangent] = np.where(stick, p.reference, 0.0)
+        fixed[p.tangent_2d] = stick
+        values[p.tangent_2d] = np.where(stick, p.reference, 0.0)
         rhs = qp.F.copy()
-        rhs[p.tangent] -= factor * qp.F[p.normal]
+        rhs[p.tangent_2d] -= factor * qp.F[p.normal]
         if self.offset.any():  # σ s0 on slip rows (direction is 0 elsewhere)
-            rhs[p.tangent] -= direction * p.slip_bound(np.zeros(p.m), active)
+            rhs[p.tangent_2d] -= direction * p.slip_bound(np.zeros(p.m), active)
         if self.factored is not None and self.max_update > 0:
             held, factored = self.factored
             changed = np.flatnonzero((held != fixed) | (factored != row_factor))
@@ -210,7 +210,7 @@ class CoupledSystem:
 
     def rebound(self, bound: np.ndarray) -> None:
         """Make the slip bounds of a system whose laws all have ``s' = 0`` the weights
-        ``bound (m,)`` of its laws (:class:`~.friction_fixed_point.GivenBound`): only the
+        ``bound (m,)`` of its laws (:class:`~.friction.fixed_point.GivenBound`): only the
         loads of later solves change, the factorization and the pattern are kept."""
         if self.derivative.any():
             raise ValueError("rebound needs laws with s' = 0 at every node")
@@ -271,7 +271,7 @@ class CoupledSystem:
         p, qp = self.problem, self.problem.qp
         Kv = qp.ranks.sum(qp.K @ v)
         out = Kv.copy()
-        out[p.tangent] -= row_factor[p.tangent] * Kv[p.normal]
+        out[p.tangent_2d] -= row_factor[p.tangent_2d] * Kv[p.normal]
         return out
 
     def _rows(self, dofs: np.ndarray, fixed: np.ndarray, row_factor: np.ndarray) -> np.ndarray:

@@ -12,13 +12,13 @@ solution gives a new ``Λ_n``. The map ``s ↦ F Λ_n(s)`` is a contraction for 
 converges where the coupled semismooth Newton method, which linearises ``s = F Λ_n`` inside
 its systems, may cycle between node states (a large constant ``c``, a curved contact zone
 of two bodies with small forces at its ends). Each inner Tresca problem is solved by the
-same active set method (:func:`~.friction._iterate`) on one :class:`~.friction_system.
+same active set method (:func:`~.newton._iterate`) on one :class:`~.friction.system.
 CoupledSystem` whose slip bounds change between the outer iterations
-(:meth:`~.friction_system.CoupledSystem.rebound`): with the node states unchanged the new
+(:meth:`~.friction.system.CoupledSystem.rebound`): with the node states unchanged the new
 bound only changes the load, and the solve reuses the LU. When the inner states repeat from
 one outer iteration to the next, the coupled iteration is tried again from them; from the
 states of the solution it converges in one solve (quadratic convergence restored). The
-fixed point stops when the Coulomb KKT residuals (:func:`~.friction_kkt.friction_kkt`) meet
+fixed point stops when the Coulomb KKT residuals (:func:`~.friction.kkt.friction_kkt`) meet
 the tolerance.
 
 References
@@ -37,10 +37,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from .friction_kkt import FrictionProblem, friction_kkt
-from .friction_result import INACTIVE, STICK, FrictionConvergenceError, FrictionStep
-from .friction_system import CoupledSystem
+from ..errors import FrictionConvergenceError
+from .kkt import FrictionProblem, friction_kkt
 from .laws import LawGroups
+from .result import INACTIVE, STICK, FrictionStep
+from .system import CoupledSystem
 
 __all__ = ["GivenBound", "solve_by_fixed_point"]
 

@@ -7,7 +7,7 @@ Real symmetric positive definite mode (``mtype = 2``, sparse Cholesky) on the up
 MKL is found and loaded by :mod:`.mkl`. :func:`pardiso_problem` loads it, solves a 2 x 2
 system, and says why PARDISO cannot be used (``None`` when it can);
 :func:`pardiso_solver` (the backend's solver factory) turns it into an error, the ``"auto"``
-choice of :mod:`.backends` into a warning.
+choice of :mod:`.selection` into a warning.
 :func:`metis_ordering` returns PARDISO's METIS ordering of a graph (docs/method.md,
 *Ordering of the unknowns*).
 
@@ -26,9 +26,10 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import BackendUnavailableError, FactorizationError
+from ..sparse import block_upper_positions, upper_positions
 from .mkl import openmp_sleep_at_once, pardiso_function
-from .solvers import BackendUnavailableError, FactorizationError, SolverRequest, SPDSolver
-from .sparse import block_upper_positions, upper_positions
+from .solvers import SolverRequest, SPDSolver
 
 __all__ = [
     "metis_ordering",
@@ -71,7 +72,7 @@ class PardisoSolver(SPDSolver):
     :class:`FactorizationError` with the equation.
 
     MKL is found by :func:`pardiso_function`; when it cannot be loaded the constructor raises
-    :class:`~.solvers.BackendUnavailableError`. The MKL handle is freed by :meth:`close` (also
+    :class:`~.errors.BackendUnavailableError`. The MKL handle is freed by :meth:`close` (also
     called on garbage collection and at the end of a ``with`` block).
 
     Parameters
@@ -359,7 +360,7 @@ def pardiso_solver(request: SolverRequest) -> PardisoSolver:
     return solver
 
 
-#: PARDISO takes the ordering it is offered (:func:`~.backends.takes_ordering`)
+#: PARDISO takes the ordering it is offered (:func:`~.selection.takes_ordering`)
 pardiso_solver.takes_ordering = True  # type: ignore[attr-defined]
 
 

@@ -35,7 +35,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from .qp import check_vector
+from ..qp import check_vector
 
 __all__ = ["FrictionLaw", "LawGroups", "check_laws"]
 

@@ -1,6 +1,6 @@
 """Frictional contact by a primal-dual active set (semismooth Newton) method, in node frames.
 
-The problem (:mod:`.friction_kkt`; docs/method.md, *Friction: the algebraic problem and its
+The problem (:mod:`.friction.kkt`; docs/method.md, *Friction: the algebraic problem and its
 solver*): at each frictional contact node a normal DOF ``x_n ≤ g`` with the Signorini
 conditions, and a tangential DOF with the node's friction law (:mod:`.laws`; its slip bound
 ``s``, e.g. Tresca's given bound or Coulomb's ``F Λ_n`` in the static one-step form; laws may
@@ -9,9 +9,9 @@ tangential displacement (the previous load step's in a quasi-static path). ``Λ 
 on these rows are the nodal contact forces.
 
 The method of Hüeber, Stadler and Wohlmuth [1]_ in its 2D form: every node is
-:data:`~.friction_result.INACTIVE`, :data:`~.friction_result.STICK` or
-:data:`~.friction_result.SLIP` (with a slip direction σ = ±1); one iteration solves the
-linear system of these states (:mod:`.friction_system`) and updates them with the rule
+:data:`~.friction.result.INACTIVE`, :data:`~.friction.result.STICK` or
+:data:`~.friction.result.SLIP` (with a slip direction σ = ±1); one iteration solves the
+linear system of these states (:mod:`.friction.system`) and updates them with the rule
 
 - in contact where ``Λ_n + c (x_n − g) > 0``;
 - among those (and out of contact where a law acts everywhere), stick where
@@ -22,8 +22,8 @@ the semismooth Newton step for the equations ``Λ_n = max(0, Λ_n + c (x_n − g
 ``Λ_t = P_[−s, s](Λ_t + c (x_t − x_ref))``, of which in 2D the slip branch ``Λ_t = σ s`` is
 linear. It stops when the states repeat, and then checks the KKT residuals of both laws.
 Once the states cycle, each iteration changes one node only (the least-index rule,
-:func:`~.friction_rule.one_change`); where Coulomb's states cycle even so, the fixed point
-on its slip bound finishes the solve (:mod:`.friction_fixed_point`; docs/method.md, *When
+:func:`~.friction.rule.one_change`); where Coulomb's states cycle even so, the fixed point
+on its slip bound finishes the solve (:mod:`.friction.fixed_point`; docs/method.md, *When
 the iteration cycles*).
 The constant ``c`` is :data:`C_FACTOR` times the mean diagonal of ``K`` over the normal DOFs,
 not the diagonal itself as in :func:`~.pdas.solve_pdas`: it only decides whether a node
@@ -31,7 +31,7 @@ slipping against its force sticks (small ``c``) or flips its direction (large ``
 flipping made the iteration cycle (docs/method.md, *Friction*).
 
 When every law in play has a bound independent of ``Λ_n`` (Tresca) the systems are SPD;
-otherwise they are solved by LU (:mod:`.friction_system`). A Tresca bound acts on every node
+otherwise they are solved by LU (:mod:`.friction.system`). A Tresca bound acts on every node
 (``everywhere``), the classical Tresca problem: the minimisation of
 ``1/2 x^T K x − F^T x + Σ s |x_t − x_ref|`` subject to ``x_n ≤ g``; or only on nodes in
 contact (``Λ_n > 0``, where the bound models a known contact pressure), which is
@@ -53,18 +53,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .backends import make_solver
-from .friction_fixed_point import solve_by_fixed_point
-from .friction_kkt import FrictionProblem, friction_kkt
-from .friction_result import (
-    INACTIVE,
-    SLIP,
-    STICK,
-    FrictionConvergenceError,
-    FrictionResult,
-    FrictionStep,
-)
-from .friction_rule import (
+from ..backends.selection import make_solver
+from ..backends.solvers import SolverFactory, SPDSolver, solver_usage
+from ..errors import FrictionConvergenceError
+from ..inexact import InexactRule
+from ..qp import check_vector
+from .fixed_point import solve_by_fixed_point
+from .kkt import FrictionProblem, friction_kkt
+from .result import INACTIVE, SLIP, STICK, FrictionResult, FrictionStep
+from .rule import (
     States,
     iteration_step,
     multipliers,
@@ -73,10 +70,7 @@ from .friction_rule import (
     states_key,
     update_states,
 )
-from .friction_system import CoupledSystem, SymmetricSystem, friction_system
-from .inexact import InexactRule
-from .qp import check_vector
-from .solvers import SolverFactory, SPDSolver, solver_usage
+from .system import CoupledSystem, SymmetricSystem, friction_system
 
 __all__ = ["INACTIVE", "SLIP", "STICK", "FrictionOptions", "solve_friction"]
 
@@ -97,7 +91,7 @@ class FrictionOptions:
     max_iter : int
         Bound on iterations (linear solves).
     kkt_tol : float
-        Largest relative KKT residual (:class:`~.friction_kkt.FrictionKKT`) accepted when the
+        Largest relative KKT residual (:class:`~.friction.kkt.FrictionKKT`) accepted when the
         states repeat.
     c : float, optional
         The positive constant of the update rule; default :data:`C_FACTOR` times the mean
@@ -148,7 +142,7 @@ def solve_friction(
     Parameters
     ----------
     problem : FrictionProblem
-        The checked data (:func:`~.friction_kkt.check_friction`): ``K``, ``F``, the normal
+        The checked data (:func:`~.friction.kkt.check_friction`): ``K``, ``F``, the normal
         and tangential DOFs, gaps, Dirichlet data, the laws per node and their weights, the
         reference of no slip.
     state0, direction0 : (m,) int arrays, optional
@@ -163,7 +157,7 @@ def solve_friction(
     solver : SPDSolver or SolverFactory, optional
         An :class:`SPDSolver` to use and keep (not closed): SPD when every law is symmetric,
         else LU. A factory (:class:`~.solvers.SolverFactory`, default
-        :func:`~.backends.auto_solver`) makes the kind the laws need for this call.
+        :func:`~.selection.auto_solver`) makes the kind the laws need for this call.
 
     Returns
     -------
@@ -176,7 +170,7 @@ def solve_friction(
     FrictionConvergenceError
         If the states cycle, ``max_iter`` is reached, or the KKT residuals exceed ``kkt_tol``
         when the states repeat; it carries the history.
-    signorini.algebra.solvers.FactorizationError
+    signorini.algebra.backends.solvers.FactorizationError
         If a system is singular.
     """
     t_start = time.perf_counter()
@@ -299,7 +293,7 @@ def _initial_states(
             return none[0], law.can_rub & law.everywhere, none[2]
         x = check_vector(x0, problem.qp.n, "x0")
         r = problem.qp.F - problem.qp.matvec(x)
-        return update_states(problem, rule, x, r[problem.normal], r[problem.tangent], none)
+        return update_states(problem, rule, x, r[problem.normal], r[problem.tangent_2d], none)
     state = np.asarray(state0)
     if state.shape != (m,) or not np.isin(state, (INACTIVE, STICK, SLIP)).all():
         raise ValueError(f"state0 must have shape ({m},) and hold INACTIVE, STICK or SLIP")

@@ -1,7 +1,9 @@
 """The discrete frictional contact problem in node frames: its data, checks and KKT residuals.
 
 At every frictional contact node ``i`` the system has a normal DOF ``normal[i]`` (``x = u·n``)
-and a tangential DOF ``tangent[i]`` (``x = u·t``). The multipliers are the residuals of these
+and ``d − 1`` tangential DOFs ``tangent[i]`` (``x = u·t_j``, the node frame
+``[n t_1 … t_{d−1}]``); in 2D one, ``tangent (m, 1)``, the DOF the 2D kernel reads as
+:attr:`FrictionProblem.tangent_2d` ``(m,)``. The multipliers are the residuals of these
 rows, ``Λ = F − K x`` (``Λ_n ≥ 0`` is the contact force; the obstacle acts on the body with
 ``−Λ``). The laws (docs/method.md, *Friction: the algebraic problem and its solver*):
 
@@ -12,7 +14,7 @@ rows, ``Λ = F − K x`` (``Λ_n ≥ 0`` is the contact force; the obstacle acts
   contact, or ``F Λ_n`` for Coulomb); laws may differ from node to node.
 
 :func:`check_friction` turns the problem's arrays and laws into the :class:`FrictionProblem`
-that :func:`~.friction.solve_friction` solves, or raises a :class:`ValueError` naming the
+that :func:`~.newton.solve_friction` solves, or raises a :class:`ValueError` naming the
 argument;
 :func:`friction_kkt` measures how far a point is from satisfying both laws.
 """
@@ -23,11 +25,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .kkt import contact_scale, force_scale, normal_law_columns
+from ..kkt import contact_scale, force_scale, normal_law_columns
+from ..qp import BoundQP, _index_array, check_qp, check_vector
+from ..ranks import Ranks
+from ..sparse import as_csr
 from .laws import LawGroups, check_laws
-from .qp import BoundQP, _index_array, check_qp, check_vector
-from .ranks import Ranks
-from .sparse import as_csr
 
 __all__ = ["FrictionKKT", "FrictionProblem", "check_friction", "friction_kkt"]
 
@@ -42,8 +44,10 @@ class FrictionProblem:
         ``K``, ``F`` and the Dirichlet data; its constrained DOFs are ``normal`` then
         ``tangent``, its bounds ``gap`` then ``reference`` (the values these DOFs take when
         held: in contact, and in stick).
-    normal, tangent : (m,) int64 arrays
-        The normal and tangential DOF of each frictional contact node.
+    normal : (m,) int64 array
+        The normal DOF of each frictional contact node.
+    tangent : (m, d − 1) int64 array
+        Its tangential DOFs, one per tangent ``t_j`` of the node frame (in 2D ``(m, 1)``).
     gap : (m,) float array
         ``g``: the bound ``x_n ≤ g``.
     reference : (m,) float array
@@ -58,6 +62,13 @@ class FrictionProblem:
     gap: np.ndarray
     reference: np.ndarray
     friction: LawGroups
+
+    @property
+    def tangent_2d(self) -> np.ndarray:
+        """``(m,)`` the one tangential DOF of each node, ``tangent[:, 0]``: the door of the 2D
+        kernel (the Tresca and Coulomb laws on a line, docs/method.md, *Friction: the
+        algebraic problem and its solver*)."""
+        return self.tangent[:, 0]
 
     @property
     def m(self) -> int:
@@ -103,9 +114,12 @@ def check_friction(
         DOFs rotated into their (normal, tangential) frames.
     F : (n,) float array
         Load vector (force units).
-    normal, tangent : (m,) int arrays or (n,) bool masks
-        The normal and the tangential DOF of each frictional contact node (as masks, nodes in
-        increasing DOF order).
+    normal : (m,) int array or (n,) bool mask
+        The normal DOF of each frictional contact node (as a mask, nodes in increasing DOF
+        order).
+    tangent : (m, d − 1) int array, or (m,) int array or (n,) bool mask (d = 2)
+        Its tangential DOFs, one column per tangent of the node frame ``[n t_1 … t_{d−1}]``;
+        a 1-D tangent is the one column of 2D. Only ``d = 2`` is solved today.
     gap : float or (m,) float array
         ``g``: the bound ``x_n ≤ g`` (length units).
     dirichlet : (n_d,) int array or (n,) bool mask, optional
@@ -129,22 +143,20 @@ def check_friction(
     ValueError
         Naming the argument: wrong shape or type, non-finite values, indices out of range or
         repeated, a DOF both normal and tangential or both contact and Dirichlet, a negative
-        weight, something else than friction laws, a law index out of range.
+        weight, something else than friction laws, a law index out of range, a tangent
+        that is not ``(m, d − 1)``.
+    NotImplementedError
+        For ``d − 1 > 1`` tangential DOFs per node (3D friction).
     """
     K = as_csr(K, "K")
     n = K.shape[0]
     normal = _index_array(normal, n, "normal")
-    tangent = _index_array(tangent, n, "tangent")
-    if tangent.size != normal.size:
-        raise ValueError(
-            f"tangent must name one DOF per contact node: {tangent.size} DOFs for "
-            f"{normal.size} normal DOFs"
-        )
-    _disjoint(normal, tangent, "normal", "tangent")
+    tangent = _tangent_basis(tangent, n, normal.size)
+    _disjoint(normal, tangent.ravel(), "normal", "tangent")
     if dirichlet is not None:
         d = _index_array(dirichlet, n, "dirichlet")
         _disjoint(normal, d, "normal", "dirichlet")
-        _disjoint(tangent, d, "tangent", "dirichlet")
+        _disjoint(tangent.ravel(), d, "tangent", "dirichlet")
     m = normal.size
     g = check_vector(gap, m, "gap", allow_scalar=True)
     ref = (
@@ -153,9 +165,36 @@ def check_friction(
         else check_vector(reference, m, "reference", allow_scalar=True)
     )
     friction = check_laws(laws, law_index, weight, m)
-    constrained = np.concatenate([normal, tangent])
+    constrained = np.concatenate([normal, tangent[:, 0]])
     qp = check_qp(K, F, constrained, np.concatenate([g, ref]), dirichlet, dirichlet_values)
     return FrictionProblem(qp, normal, tangent, g, ref, friction)
+
+
+def _tangent_basis(tangent: object, n: int, m: int) -> np.ndarray:
+    """The tangential DOFs ``(m, d − 1)`` of :func:`check_friction`: a 1-D ``tangent`` (indices
+    or a mask) is the one column of ``d = 2``; a 2-D one is taken as it is."""
+    if np.ndim(tangent) == 2:
+        tangent = np.asarray(tangent)
+        if tangent.shape[0] != m or tangent.shape[1] < 1:
+            raise ValueError(
+                f"tangent must be (m, d - 1) = ({m}, d - 1), one row of tangential DOFs per "
+                f"contact node, got {tangent.shape}"
+            )
+        columns = tangent.shape[1]
+        if columns > 1:
+            raise NotImplementedError(
+                f"tangent has {columns} tangential DOFs per node (d = {columns + 1}): the "
+                "frictional solver handles d = 2, one tangential DOF per node"
+            )
+        tangent = tangent[:, 0]
+    elif np.ndim(tangent) > 2:
+        raise ValueError(f"tangent must be (m,) or (m, d - 1), got shape {np.shape(tangent)}")
+    tangent = _index_array(tangent, n, "tangent")
+    if tangent.size != m:
+        raise ValueError(
+            f"tangent must name one DOF per contact node: {tangent.size} DOFs for {m} normal DOFs"
+        )
+    return tangent[:, None]
 
 
 def _disjoint(a: np.ndarray, b: np.ndarray, name_a: str, name_b: str) -> None:
@@ -244,7 +283,7 @@ def friction_kkt(
     FrictionKKT
     """
     qp = problem.qp
-    K, F, n_dof, t_dof = qp.K, qp.F, problem.normal, problem.tangent
+    K, F, n_dof, t_dof = qp.K, qp.F, problem.normal, problem.tangent_2d
     Kx = qp.matvec(x)
     r = F - Kx
     force = force_scale(K, F, x, Kx, ranks=qp.ranks)

@@ -1,4 +1,4 @@
-"""The update rule of the frictional active set method (:mod:`.friction`): the node states
+"""The update rule of the frictional active set method (:mod:`.friction.newton`): the node states
 of the next iteration from an iterate, and the records of an iteration.
 
 The states are ``(active, stick, direction)``: ``(m,)`` bool, bool and float (±1 where a
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction_kkt import FrictionProblem
-from .friction_result import INACTIVE, SLIP, STICK, FrictionStep
+from .kkt import FrictionProblem
+from .result import INACTIVE, SLIP, STICK, FrictionStep
 
 __all__ = [
     "States",
@@ -73,7 +73,7 @@ def update_states(
     new_active = np.where(np.abs(value_n) <= band_n, active, value_n > 0)
     s = p.slip_bound(value_n, new_active)
     acts = p.friction.everywhere | new_active
-    y = lam_t + c * (x[p.tangent] - p.reference)
+    y = lam_t + c * (x[p.tangent_2d] - p.reference)
     margin = np.abs(y) - s
     band_t = np.where(stick, band_force, band_disp)
     new_stick = np.where(np.abs(margin) <= band_t, stick, margin < 0) & acts
@@ -112,7 +112,7 @@ def multipliers(p: FrictionProblem, x: np.ndarray, states: States) -> tuple[np.n
     r = p.qp.F - p.qp.matvec(x)
     multiplier_n = np.where(active, r[p.normal], 0.0)
     imposed = direction * p.slip_bound(multiplier_n, active)
-    return multiplier_n, np.where(stick, r[p.tangent], imposed)
+    return multiplier_n, np.where(stick, r[p.tangent_2d], imposed)
 
 
 def one_change(states: States, new: States) -> States:
@@ -121,7 +121,7 @@ def one_change(states: States, new: States) -> States:
     force goes from one bound of ``[−s, s]`` to the other through the inside): the
     least-index rule of Murty's principal pivoting method, which cannot cycle on a P-matrix
     complementarity problem (Murty [1]_), used by the iteration once its states have cycled
-    (:func:`~.friction._iterate`). A fixed point of it is one of the rule.
+    (:func:`~.newton._iterate`). A fixed point of it is one of the rule.
 
     References
     ----------

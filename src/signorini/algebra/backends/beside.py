@@ -13,14 +13,14 @@ from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from typing import TypeVar
 
+from .mkl import mkl_threads_local, openmp_sleep_at_once
+
 __all__ = ["beside"]
 
 T = TypeVar("T")
 
 
 def _sleep_at_once() -> None:
-    from .mkl import openmp_sleep_at_once  # mkl imports solvers, which imports this module
-
     openmp_sleep_at_once()
 
 
@@ -45,8 +45,6 @@ def beside(work: Callable[..., T], *args: object, one_thread: bool = False) -> F
 
 
 def _one_thread(work: Callable[..., T], *args: object) -> T:
-    from .mkl import mkl_threads_local  # mkl imports solvers, which imports this module
-
     mkl_threads_local(1)
     try:
         return work(*args)

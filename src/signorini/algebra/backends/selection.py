@@ -8,14 +8,14 @@ backend by name (:func:`solver_name`).
 
 ``"pardiso"``
     :func:`~.pardiso.pardiso_solver`: MKL PARDISO, sparse Cholesky or LU with the symbolic
-    analysis done once per pattern; raises :class:`~.solvers.BackendUnavailableError` with
+    analysis done once per pattern; raises :class:`~.errors.BackendUnavailableError` with
     the reason where it cannot be used.
 ``"scipy"``
     :func:`~.superlu.superlu_solver`: SuperLU, always there, with no reuse of the analysis.
 ``"petsc"``
     :func:`~.petsc.petsc_solver`: MUMPS through PETSc (the optional extra ``signorini[mpi]``),
     serial or under ``mpiexec`` (docs/parallel.md); raises
-    :class:`~.solvers.BackendUnavailableError` naming the extra where petsc4py is missing.
+    :class:`~.errors.BackendUnavailableError` naming the extra where petsc4py is missing.
 ``"petsc-gamg"``
     :func:`~.petsc_gamg.petsc_gamg_solver`: CG preconditioned by PETSc's GAMG with the
     rigid-body near-nullspace (the extra ``signorini[mpi]``), an iterative solver with the
@@ -40,16 +40,16 @@ import numpy as np
 import scipy
 import scipy.sparse as sp
 
+from ..errors import BackendUnavailableError, SolverFallbackWarning
 from .mkl import mkl_version
 from .pardiso import pardiso_problem, pardiso_solver
-from .petsc import petsc_solver
+from .petsc import petsc_library, petsc_solver
 from .petsc_gamg import petsc_gamg_solver
-from .solvers import BackendUnavailableError, SolverFactory, SolverRequest, SPDSolver
+from .solvers import SolverFactory, SolverRequest, SPDSolver
 from .superlu import superlu_solver
 
 __all__ = [
     "SOLVERS",
-    "SolverFallbackWarning",
     "auto_solver",
     "available_backends",
     "make_solver",
@@ -58,11 +58,6 @@ __all__ = [
     "solver_name",
     "takes_ordering",
 ]
-
-
-class SolverFallbackWarning(RuntimeWarning):
-    """The ``"auto"`` backend could not load PARDISO and uses SuperLU (much slower at 10⁵+
-    unknowns)."""
 
 
 @cache
@@ -238,8 +233,6 @@ def solver_library(solver: object = None) -> str:
         if version is not None:
             return f"MKL PARDISO ({version})"
     if name in ("petsc", "petsc-gamg"):
-        from .petsc import petsc_library
-
         return petsc_library("MUMPS" if name == "petsc" else "GAMG (CG)")
     if name in ("auto", "pardiso", "scipy", "superlu"):
         return f"SuperLU (SciPy {scipy.__version__})"

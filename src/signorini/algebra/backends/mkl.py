@@ -17,7 +17,7 @@ from collections.abc import Callable
 from functools import cache, lru_cache
 from pathlib import Path
 
-from .solvers import BackendUnavailableError
+from ..errors import BackendUnavailableError
 
 __all__ = [
     "blas_for_libraries_loaded_later",

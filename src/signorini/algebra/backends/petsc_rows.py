@@ -22,9 +22,11 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .ranks import SERIAL, Ranks
-from .solvers import FactorizationError, SPDSolver
-from .sparse import diagonal_positions, list_indices
+from ..errors import FactorizationError
+from ..ranks import SERIAL, Ranks, world_ranks
+from ..sparse import diagonal_positions, list_indices
+from .petsc_import import petsc_module
+from .solvers import SPDSolver
 
 __all__ = ["PetscRows", "row_block"]
 
@@ -78,13 +80,11 @@ class PetscRows(SPDSolver):
         check_symmetry: bool = True,
         ordering: np.ndarray | None = None,
     ) -> None:
-        from .petsc import petsc_module
-
         self._PETSc = petsc_module()
         comm = self._PETSc.COMM_WORLD
         self.comm_size = comm.getSize()
         self._rank = comm.getRank()
-        self._ranks: Ranks = SERIAL if self.comm_size == 1 else _world_ranks()
+        self._ranks: Ranks = SERIAL if self.comm_size == 1 else world_ranks()
         self.split = False
         self._order: np.ndarray | None = None
         self._own: np.ndarray | slice = slice(0, 0)
@@ -221,7 +221,7 @@ class PetscRows(SPDSolver):
 
     def _set_up(self, failure: str) -> None:
         """Hand the written matrix to the KSP and set it up (MUMPS's factorization, GAMG's
-        hierarchy); a PETSc error raises :class:`~.solvers.FactorizationError` with the
+        hierarchy); a PETSc error raises :class:`~.errors.FactorizationError` with the
         message ``failure`` formatted with its ``ierr``."""
         self._ksp.setOperators(self._mat)
         try:
@@ -251,11 +251,3 @@ class PetscRows(SPDSolver):
         scale = self._ranks.max(float(np.abs(values).max(initial=0.0)))
         if not self._mat.isSymmetric(1e-12 * scale):
             raise ValueError("A is not symmetric: max|A - A^T| > 1e-12 max|A|")
-
-
-def _world_ranks() -> Ranks:
-    """``PETSC_COMM_WORLD``'s ranks (:func:`~.ranks.world_ranks`): the ranks the PETSc
-    backends' matrices are split over, their factories' ``ranks`` (:func:`~.ranks.solver_ranks`)."""
-    from .ranks import world_ranks
-
-    return world_ranks()

@@ -1,5 +1,5 @@
 """MKL PARDISO's LU factorization of general real matrices (``mtype = 11``): the
-non-symmetric systems of Coulomb friction (:mod:`.friction_system`), on the phases and
+non-symmetric systems of Coulomb friction (:mod:`.friction.system`), on the phases and
 settings of :class:`~.pardiso.PardisoSolver`."""
 
 from __future__ import annotations

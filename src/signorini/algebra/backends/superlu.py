@@ -6,8 +6,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .solvers import FactorizationError, SolverRequest, SPDSolver
-from .sparse import diagonal_positions
+from ..errors import FactorizationError
+from ..sparse import diagonal_positions
+from .solvers import SolverRequest, SPDSolver
 
 __all__ = ["PIVOT_RTOL", "SuperLULUSolver", "SuperLUSolver", "superlu_solver"]
 
