@@ -70,16 +70,16 @@ def contact_node_parts(
     friction), integrated along each edge's geometry (``curved (n_ce,)`` bool: quadratic);
     ``gap``, ``density`` ``(n_ce, 3)`` as :func:`~.terms.complementarity` reads them."""
     space, cs = result.space, result.contact
-    element = space.element
+    facet = space.element.facet
     parts6 = np.zeros(gap.shape)
     parts8 = np.zeros(gap.shape)
     for rows, edges in edge_groups(space.node_points[cs.edge_nodes], curved):
-        parts6[rows] = complementarity(gap[rows], density[rows], edges, None, element.hat_pieces)
+        parts6[rows] = complementarity(gap[rows], density[rows], edges, None, facet.hat_pieces)
         if friction is not None:
             slip, bound, p_t = friction.slip[rows], friction.bound[rows], friction.friction[rows]
-            parts8[rows] = friction_work(slip, p_t, bound, edges, None, element.node_parts)
-    n_edge = element.n_edge
-    return parts6[:, :n_edge], move_dirichlet_thirds(parts8, cs.edge_local)[:, :n_edge]
+            parts8[rows] = friction_work(slip, p_t, bound, edges, None, facet.node_parts)
+    n = facet.n_nodes
+    return parts6[:, :n], move_dirichlet_thirds(parts8, cs.edge_local)[:, :n]
 
 
 def edge_pressure(result: ContactResult) -> np.ndarray:

@@ -50,7 +50,8 @@ def friction_edges(result: ContactResult, unit: float = 1.0) -> FrictionEdges | 
     cs = result.contact
     if not cs.has_friction:
         return None
-    bound = cs.friction.slip_bound(result.contact_force, result.active) / cs.basis_integral
+    force = cs.friction.slip_bound(result.contact_force, result.active)  # s_z
+    bound = result.space.element.facet.pressure(force, cs.basis_integral)
     loc = cs.edge_local
     inside = loc >= 0
     row = np.maximum(loc, 0)

@@ -232,7 +232,7 @@ def estimate(
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells
     element = space.element  # P2, or P1 read as the P2 field it is (docs/method.md, *P1 ...*)
-    on_edge = element.edge_values  # nodal data of contact edges at [start, end, midpoint]
+    on_edge = element.facet.facet_values  # nodal data of contact edges at [start, end, midpoint]
     h_p = node_mesh_size(mesh.h, space.cell_nodes, result.dirichlet_nodes, n_nodes)
     cells, quadratic_edges = geometry(space)
 

@@ -334,7 +334,7 @@ def complementarity(
     density: np.ndarray,
     length: np.ndarray,
     points: np.ndarray | None = None,
-    pieces: tuple = P2.hat_pieces,
+    pieces: tuple = P2.facet.hat_pieces,
 ) -> np.ndarray:
     """``s_p d_p`` with ``d_p = ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p``, per contact edge node (η6).
 
@@ -350,7 +350,7 @@ def complementarity(
         Node points ``[start, end, midpoint]`` of quadratic edges: integrate along them
         (:func:`third_integrals`).
     pieces : tuple, optional
-        The element's γ̃_p and hats (:attr:`~signorini.fem.element.Element.hat_pieces`):
+        The element's γ̃_p and hats (:attr:`~signorini.fem.facet_element.FacetElement.hat_pieces`):
         P2's thirds (default), P1's halves.
 
     Returns
@@ -367,7 +367,7 @@ def friction_work(
     bound: np.ndarray,
     length: np.ndarray,
     points: np.ndarray | None = None,
-    parts: tuple = P2.node_parts,
+    parts: tuple = P2.facet.node_parts,
 ) -> np.ndarray:
     """``∫_{γ̃_p} (max(b_h, |p_t,h|) |u_t| − p_t,h u_t) ds`` per contact edge node (η8): the
     defect of the friction work ``p_t u_t = s |u_t|`` of the tangential law (docs/method.md,
