@@ -31,7 +31,7 @@ def third_integrals(
     points: np.ndarray | None = None,
     pieces: tuple = _HAT_PIECES,
 ) -> np.ndarray:
-    """∫ v⁺ φ_p over the thirds γ̃_p of each edge (docs/method.md, *Estimator*, paper (4.12)).
+    """∫ v⁺ φ_p over the thirds γ̃_p of each facet (docs/method.md, *Estimator*, paper (4.12)).
 
     Exact on straight edges: each linear piece of φ is cut at the roots of v, and on each
     sub-interval the product of the quadratic and the linear hat is integrated by a 3-point
