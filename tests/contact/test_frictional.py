@@ -23,7 +23,7 @@ from scipy.optimize import lsq_linear
 from signorini.algebra import FrictionResult
 from signorini.contact.contact_set import contact_set
 from signorini.contact.solution import INACTIVE, SLIP, STICK, solve
-from signorini.estimator.friction import friction_edges
+from signorini.estimator.friction import friction_facets
 from signorini.fem.material import Material
 from signorini.fem.space import P2Space
 from signorini.fem.stiffness import assemble_stiffness
@@ -221,10 +221,10 @@ def test_a_new_law_is_one_class():
     print(f"frozen cohesive bound: |u − u_ref|/|u| = {err_u:.1e}, Λ_n {err_n:.1e}, Λ_t {err_t:.1e}")
     assert err_u < 1e-8 and err_n < 1e-8 and err_t < 1e-8
     # the estimator asks the law too: its bound as a stress is s_z / w_z
-    edges = friction_edges(res)
+    facets = friction_facets(res)
     loc = res.contact.edge_local
     inside = loc >= 0
-    assert np.array_equal(edges.bound[inside], (s / res.contact.basis_integral)[loc[inside]])
+    assert np.array_equal(facets.bound[inside], (s / res.contact.basis_integral)[loc[inside]])
 
 
 def test_tresca_in_contact_only_is_tresca_with_the_bound_cut_to_the_contact_set():

@@ -13,9 +13,9 @@ from signorini.contact.solution import solve
 from signorini.estimator import residual
 from signorini.estimator.residual import contact_stress, estimate
 from signorini.estimator.terms import (
-    EdgeSet,
+    FacetSet,
     direction_field,
-    edge_traction,
+    facet_traction,
     tangential_stress,
     third_integrals,
 )
@@ -170,7 +170,7 @@ def test_tangential_stress_of_a_radial_field_vanishes_with_the_local_normal():
         space = P2Space(mesh)
         u = space.interpolate(lame)
         e = mesh.part_edges("outer")
-        edges = EdgeSet(e, space.edge_nodes(e), mesh.edge2cell[e], mesh.edge_length[e])
+        edges = FacetSet(e, space.edge_nodes(e), mesh.facet2cell[e], mesh.facet_measure[e])
         x = space.node_points[edges.nodes]
         direction = x / np.hypot(x[..., 0], x[..., 1])[..., None]  # the arc's normal n_z
         ab = mesh.points[mesh.oriented_boundary(e)]
@@ -183,10 +183,10 @@ def test_tangential_stress_of_a_radial_field_vanishes_with_the_local_normal():
         local.append(np.sqrt(J4.sum()))
         u_cell = space.cell_values(u)
         sigma = stress(material, p2.field_gradients(space.vertices, u_cell, p2.REFERENCE_NODES[:3]))
-        sn = edge_traction(
-            sigma, mesh.points, mesh.cells, edges.cells[:, 0], mesh.edge_local[e, 0], t
+        sn = facet_traction(
+            sigma, mesh.points, mesh.cells, edges.cells[:, 0], mesh.facet_local[e, 0], t
         )
-        chord.append(np.sqrt(tangential_stress(sn, normal, w, edges.length).sum()))
+        chord.append(np.sqrt(tangential_stress(sn, normal, w, edges.measure).sum()))
     r_local = np.log2(np.array(local[:-1]) / local[1:])
     r_chord = np.log2(np.array(chord[:-1]) / chord[1:])
     print(f"‖σ_t(I_h u)‖ on the arc: local normal {np.array(local)} (rates {r_local.round(2)})")
@@ -384,7 +384,9 @@ def test_adaptive_loop_on_a_half_disc_pressed_onto_a_rigid_plane():
     # acts along it), not along the body's normal, which is a/R off at the contact ends
     stresses = CellStress.of(res.space, res.u, res.problem.material, est.unit)
     cs, mesh = res.contact, res.mesh
-    edges = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
+    edges = FacetSet(
+        cs.edges, cs.edge_nodes, mesh.facet2cell[cs.edges], mesh.facet_measure[cs.edges]
+    )
     t, w = line_rule(7)
     body = res.space.node_points[cs.edge_nodes] - [0.0, 1.0]
     eta4 = {
@@ -426,7 +428,7 @@ def test_straight_contact_part_against_a_disc_splits_along_the_obstacle_directio
             res.space.vertices, res.space.cell_values(res.u), p2.REFERENCE_NODES[:3]
         ),
     )
-    sn = edge_traction(
+    sn = facet_traction(
         sigma, mesh.points, mesh.cells, mesh.edge2cell[cs.edges, 0], mesh.edge_local[cs.edges, 0], t
     )
     length = mesh.edge_length[cs.edges]
@@ -469,15 +471,15 @@ def test_a_gap_along_the_curve_normal_splits_along_the_body_normal():
         assert abs(est.eta2.sum() - est.eta**2) <= 1e-13 * est.eta**2
         assert 0 < res.active.sum() < res.contact.size
         cs = res.contact
-        edges = EdgeSet(
-            cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges]
+        edges = FacetSet(
+            cs.edges, cs.edge_nodes, mesh.facet2cell[cs.edges], mesh.facet_measure[cs.edges]
         )
         t, w = line_rule(7)
         stresses = CellStress.of(res.space, res.u, res.problem.material, est.unit)
         J4, _ = contact_stress(stresses, mesh, edges, cs.edge_normal, cs.edge_direction, t, w)
         # the paper's split: along the normal n(t) of the quadratic edges at each point
         e = cs.edges
-        ((_, sn, arc),) = stresses.on_edges(mesh.edge2cell[e, 0], mesh.edge_local[e, 0], t)
+        ((_, sn, arc),) = stresses.on_facets(mesh.facet2cell[e, 0], mesh.facet_local[e, 0], t)
         speed, normal = arc.speeds(t), arc.normals(t)
         J4n = tangential_stress(sn, normal, w, speed)
         diffs.append(abs(np.sqrt(J4.sum()) - np.sqrt(J4n.sum())) / np.sqrt(J4n.sum()))

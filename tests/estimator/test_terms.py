@@ -8,15 +8,15 @@ import pytest
 from scipy.integrate import quad
 
 from signorini.estimator.terms import (
-    EdgeSet,
+    FacetSet,
     boundary_cell_shares,
     complementarity,
-    edge_traction,
+    facet_traction,
     interior_residual,
     normal_stress,
     penetration,
     spread_cell_integrals,
-    spread_edge_integrals,
+    spread_facet_integrals,
     spread_node_parts,
     stress_jump,
     tangential_stress,
@@ -28,16 +28,16 @@ T, W = line_rule(7)
 
 
 # ---------------------------------------------------------------------------- distribution
-def test_spread_edge_integrals_weights_and_halves():
-    """An interior edge (cells 0, 1) and a boundary edge (cell 1) with J = 2 and 3."""
+def test_spread_facet_integrals_weights_and_halves():
+    """An interior facet (cells 0, 1) and a boundary facet (cell 1) with J = 2 and 3."""
     h_p = np.array([0.0, 1.0, 2.0, 4.0, 8.0, 16.0])  # node 0 a Dirichlet node
-    edges = EdgeSet(
+    edges = FacetSet(
         index=np.array([7, 9]),
         nodes=np.array([[0, 1, 4], [1, 2, 5]]),
         cells=np.array([[0, 1], [1, -1]]),
-        length=np.array([1.0, 1.0]),
+        measure=np.array([1.0, 1.0]),
     )
-    shares = spread_edge_integrals(edges, np.array([2.0, 3.0]), h_p, n_cells=3)
+    shares = spread_facet_integrals(edges, np.array([2.0, 3.0]), h_p, n_cells=3)
     np.testing.assert_array_equal(shares.node, [0, 2 * 1 + 3 * 1, 3 * 2, 0, 2 * 8, 3 * 16])
     total0, total1 = 2 * (0 + 1 + 8), 3 * (1 + 2 + 16)
     np.testing.assert_array_equal(shares.cell, [total0 / 2, total0 / 2 + total1, 0])
@@ -58,7 +58,7 @@ def test_spread_cell_integrals():
 
 
 def test_spread_node_parts_and_boundary_cells():
-    edges = EdgeSet(
+    edges = FacetSet(
         np.array([0, 1]), np.array([[0, 1, 3], [1, 2, 4]]), np.array([[2, -1], [0, -1]]), np.ones(2)
     )
     parts = np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]])
@@ -69,22 +69,22 @@ def test_spread_node_parts_and_boundary_cells():
 
 
 # ---------------------------------------------------------------------------- σ(u_h) n
-def test_edge_traction_of_a_constant_stress_uses_outward_normals():
+def test_facet_traction_of_a_constant_stress_uses_outward_normals():
     points = np.array([[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]])
     cells = np.array([[0, 1, 2]])
     sigma = np.array([[1.0, 0.5], [0.5, -2.0]])
     sigma_vertex = np.broadcast_to(sigma, (1, 3, 2, 2))
-    out = edge_traction(sigma_vertex, points, cells, np.zeros(3, int), np.arange(3), T)
+    out = facet_traction(sigma_vertex, points, cells, np.zeros(3, int), np.arange(3), T)
     normals = np.array([[0.0, -1.0], [1.0, 2.0] / np.sqrt(5.0), [-1.0, 0.0]])
     np.testing.assert_allclose(out, np.broadcast_to((normals @ sigma)[:, None], out.shape))
 
 
-def test_edge_traction_interpolates_linearly_along_the_edge():
+def test_facet_traction_interpolates_linearly_along_the_facet():
     points = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     cells = np.array([[0, 1, 2]])
     sigma_vertex = np.zeros((1, 3, 2, 2))
     sigma_vertex[0, 1] = np.eye(2)  # σ = λ_1 I: on edge 0 (from vertex 0 to 1) equal to t I
-    out = edge_traction(sigma_vertex, points, cells, np.array([0]), np.array([0]), T)
+    out = facet_traction(sigma_vertex, points, cells, np.array([0]), np.array([0]), T)
     np.testing.assert_allclose(out[0], T[:, None] * [0.0, -1.0], atol=1e-16)
 
 

@@ -35,8 +35,8 @@ def test_p1_pieces_of_a_contact_edge_are_its_halves():
     """γ̃_p of P1 is the half of the edge next to p with the P1 hat: ∫ 1·φ = 3/8 |e|; a
     linear v is cut at its root."""
     length = np.array([2.0, 1.0])
-    v = P1.edge_values(np.array([[1.0, 1.0], [1.0, -1.0]]))  # 1; 1 − 2t (root at 1/2)
-    out = third_integrals(v, length, None, P1.hat_pieces)
+    v = P1.facet.facet_values(np.array([[1.0, 1.0], [1.0, -1.0]]))  # 1; 1 − 2t (root at 1/2)
+    out = third_integrals(v, length, None, P1.facet.hat_pieces)
     # ∫_0^{1/2} (1 − 2t)(1 − t) dt = 5/24; on the end's half v < 0: nothing
     assert np.allclose(out, [[0.75, 0.75, 0.0], [5 / 24, 0.0, 0.0]], rtol=1e-14, atol=1e-15)
     work = friction_work_thirds(
@@ -45,7 +45,7 @@ def test_p1_pieces_of_a_contact_edge_are_its_halves():
         np.ones((1, 3)),
         np.array([1.0]),
         None,
-        P1.node_parts,
+        P1.facet.node_parts,
     )
     assert np.allclose(work, [[0.5, 0.5, 0.0]], rtol=1e-14)
 

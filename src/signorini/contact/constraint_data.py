@@ -104,8 +104,8 @@ def edge_weights(space: LagrangeSpace, edges: np.ndarray, edge_nodes: np.ndarray
     (the element's shares of the length), a Gauss rule along the quadratic edge on curved
     ones."""
     length = space.mesh.edge_length[edges]
-    hat = np.outer(length, space.element.hat_share)
-    basis = np.outer(length, space.element.basis_share)
+    hat = np.outer(length, space.element.facet.hat_share)
+    basis = np.outer(length, space.element.facet.basis_share)
     curved = np.flatnonzero(np.isin(edges, space.curved_edges))
     if curved.size:
         t, w = gauss_legendre(6)
@@ -183,7 +183,7 @@ def _integrator(space: LagrangeSpace, on_part: np.ndarray, edges: tuple, what: s
         if (s < 0).any():
             raise ProblemError(f"{what} must be >= 0; it is {s.min():.6g} somewhere")
         # ∫ s ψ_j |x'(t)| dt on each edge, j = start, end, midpoint
-        share = (s.reshape(-1, t.size) * speed * w) @ space.element.edge_basis(t)
+        share = (s.reshape(-1, t.size) * speed * w) @ space.element.facet.basis(t)
         loc = edge_local[sel].ravel()
         inside = loc >= 0
         return np.bincount(loc[inside], weights=share.ravel()[inside], minlength=k)

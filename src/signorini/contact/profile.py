@@ -122,7 +122,11 @@ def contact_profile(result: ContactResult, part: str | None = None) -> ContactPr
         chain=np.broadcast_to(chain[:, None], take.shape)[take],
         s=np.concatenate([[0.0], np.cumsum(step)]),
         points=points,
-        pressure=np.where(inside, force / cs.basis_integral[np.maximum(loc, 0)], np.nan),
+        pressure=np.where(
+            inside,
+            result.space.element.facet.pressure(force, cs.basis_integral[np.maximum(loc, 0)]),
+            np.nan,
+        ),
         contact_force=force,
         gap=gap,
         normal_displacement=un,

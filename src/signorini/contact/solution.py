@@ -173,12 +173,13 @@ class ContactResult:
     def pressure(self) -> np.ndarray:
         """Consistent nodal contact pressure ``p_z = Λ_z / w_z``, ``w_z = ∫ψ_z`` (docs/method.md,
         *Discrete problem*)."""
-        return self.contact_force / self.contact.basis_integral
+        return self.space.element.facet.pressure(self.contact_force, self.contact.basis_integral)
 
     @property
     def tangential_pressure(self) -> np.ndarray:
         """Consistent nodal friction stress ``p_t,z = Λ_t,z / w_z``."""
-        return self.tangential_force / self.contact.basis_integral
+        weight = self.contact.basis_integral
+        return self.space.element.facet.pressure(self.tangential_force, weight)
 
     @cached_property
     def master_side(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

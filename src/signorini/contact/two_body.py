@@ -203,7 +203,8 @@ def master_traction(
     f = master_forces(transfer.dofs, nodes, force[:, :2], space.n_nodes)[on]
     lam = np.zeros(space.n_nodes)
     np.add.at(lam, nodes, force[:, 2])
-    return on, f / w[on, None], (transfer.nodes.T @ lam)[on] / w[on]
+    pressure = space.element.facet.pressure  # nodal force -> consistent stress
+    return on, pressure(f, w[on, None]), pressure((transfer.nodes.T @ lam)[on], w[on])
 
 
 def pair_transfer(

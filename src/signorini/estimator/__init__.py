@@ -4,8 +4,8 @@
 - ``terms``: one function per term η1 … η7 and the helpers that distribute them to nodes
   and cells.
 - ``h_half_norm``: the H^{1/2}(Γ_C) norm of the penetration (η7).
-- ``contact_edges``: η4, η5, η6, η8 on the contact edges, and the nodal data they read.
-- ``owned``: the estimator on several MPI ranks (each integrates its own cells and edges).
+- ``contact_facets``: η4, η5, η6, η8 on the contact facets, and the nodal data they read.
+- ``owned``: the estimator on several MPI ranks (each integrates its own cells and facets).
 - ``marking``: Dörfler marking.
 - ``names``: the terms by name (:data:`TERMS`), from which the history columns and the
   figures' legends are derived.

@@ -1,9 +1,9 @@
-"""What the frictional extension of the estimator reads on the contact edges (docs/method.md,
-*Estimator*, "With friction").
+"""What the frictional extension of the estimator reads on the contact facets (edges in 2D;
+docs/method.md, *Estimator*, "With friction").
 
 With Tresca or Coulomb friction, η4 balances the tangential stress by the discrete friction
 stress, ``‖σ_t(u_h) + p_t,h‖``, and η8 measures the defect of the friction work,
-``∫ (max(b_h, |p_t,h|) |u_t| − p_t,h u_t)``. Both are quadratics on each contact edge through
+``∫ (max(b_h, |p_t,h|) |u_t| − p_t,h u_t)``. Both are quadratics on each contact facet through
 nodal values at ``[start, end, midpoint]``:
 
 - ``p_t,z = Λ_t,z / w_z``, the consistent friction stress (``ContactResult.tangential_pressure``;
@@ -18,8 +18,8 @@ nodal values at ``[start, end, midpoint]``:
   (``ContactResult.tangential_reference``: a load step's previous displacement, a moving
   obstacle's motion; 0 for one step at rest).
 
-At a Dirichlet end point of Γ_C the stresses are 0 and ``u_t = u_D·t``; its third of the edge
-is given to the edge's midpoint (Dirichlet nodes carry no term).
+At a Dirichlet end point of Γ_C the stresses are 0 and ``u_t = u_D·t``; its third of the facet
+is given to the facet's midpoint (Dirichlet nodes carry no term).
 """
 
 from __future__ import annotations
@@ -30,11 +30,11 @@ import numpy as np
 
 from ..contact.solution import ContactResult
 
-__all__ = ["FrictionEdges", "friction_edges", "move_dirichlet_thirds"]
+__all__ = ["FrictionFacets", "friction_facets", "move_dirichlet_thirds"]
 
 
-class FrictionEdges(NamedTuple):
-    """The frictional quantities at ``[start, end, midpoint]`` of each contact edge, each
+class FrictionFacets(NamedTuple):
+    """The frictional quantities at ``[start, end, midpoint]`` of each contact facet, each
     ``(n_ce, 3)``: ``friction`` p_t,z and ``bound`` b_z (stresses, divided by the estimator's
     stress unit), ``slip`` u_t (displacement)."""
 
@@ -43,14 +43,15 @@ class FrictionEdges(NamedTuple):
     slip: np.ndarray
 
 
-def friction_edges(result: ContactResult, unit: float = 1.0) -> FrictionEdges | None:
-    """The nodal inputs of η4 and η8 with friction on the contact edges, stresses divided by
+def friction_facets(result: ContactResult, unit: float = 1.0) -> FrictionFacets | None:
+    """The nodal inputs of η4 and η8 with friction on the contact facets, stresses divided by
     the stress unit ``unit``; ``None`` for a result without friction (then η4 is the paper's
     ``‖σ_t(u_h)‖`` and η8 = 0)."""
     cs = result.contact
     if not cs.has_friction:
         return None
-    bound = cs.friction.slip_bound(result.contact_force, result.active) / cs.basis_integral
+    force = cs.friction.slip_bound(result.contact_force, result.active)  # s_z
+    bound = result.space.element.facet.pressure(force, cs.basis_integral)
     loc = cs.edge_local
     inside = loc >= 0
     row = np.maximum(loc, 0)
@@ -59,7 +60,7 @@ def friction_edges(result: ContactResult, unit: float = 1.0) -> FrictionEdges | 
     # the law acts on the slip from the reference (a load step's previous one, the
     # obstacle's motion): so does the friction work
     slip = slip - np.where(inside, result.tangential_reference[row], 0.0)
-    return FrictionEdges(
+    return FrictionFacets(
         friction=np.where(inside, result.tangential_pressure[row], 0.0) / unit,
         bound=np.where(inside, bound[row], 0.0) / unit,
         slip=slip,
@@ -68,13 +69,13 @@ def friction_edges(result: ContactResult, unit: float = 1.0) -> FrictionEdges | 
 
 def move_dirichlet_thirds(parts: np.ndarray, edge_local: np.ndarray) -> np.ndarray:
     """Per-node parts ``(n_ce, 3)`` with the part of a Dirichlet end point (``edge_local``
-    ``-1``) added to the edge's midpoint, so that Dirichlet nodes carry none and the parts
-    still sum to the edge's integral. With P1's ``edge_local (n_ce, 2)`` (no midpoint node)
-    it goes to the edge's other end."""
+    ``-1``) added to the facet's midpoint, so that Dirichlet nodes carry none and the parts
+    still sum to the facet's integral. With P1's ``edge_local (n_ce, 2)`` (no midpoint node)
+    it goes to the facet's other end."""
     out = parts.copy()
     for col in (0, 1):
         at = edge_local[:, col] < 0
-        # P1 (two nodes an edge): to the edge's other end, unless that is a Dirichlet node too
+        # P1 (two nodes a facet): to the facet's other end, unless that is a Dirichlet node too
         other = 1 - col
         to = 2 if edge_local.shape[1] == 3 else other
         if to == other:

@@ -1,17 +1,17 @@
-"""The estimator on several ranks: each rank integrates its own cells and edges, and the
+"""The estimator on several ranks: each rank integrates its own cells and facets, and the
 integrals are summed over the ranks before they are spread to nodes and cells (docs/parallel.md,
 *The estimator on several ranks*).
 
-Every term of (5.1) is a sum of integrals over single cells (η1) and single edges (η2 … η6,
-η8), and η7's edge shares; :func:`~signorini.estimator.residual.estimate` spreads them to the
-nodes and cells (:mod:`.terms`). On a run of several ranks (the mesh, the space and the
-solution replicated on every rank, docs/parallel.md, *What is distributed*) rank r integrates
+Every term of (5.1) is a sum of integrals over single cells (η1) and single facets (edges in 2D; η2
+… η6, η8), and η7's facet shares; :func:`~signorini.estimator.residual.estimate` spreads them to the
+nodes and cells (:mod:`.terms`). On a run of several ranks (the mesh, the space and the solution
+replicated on every rank, docs/parallel.md, *What is distributed*) rank r integrates
 
 - η1 on its own cells (:attr:`~signorini.contact.partition.Partition.owned_cells`);
-- every edge term on the edges whose first cell (``edge2cell[:, 0]``) is its own: an interior
-  edge once, on one side's rank, with the stress of the neighbour across it (a ghost cell,
-  whose σ(u_h) it computes too), a boundary edge on its cell's rank;
-- the contact terms η4 … η8 on every contact edge, and keeps those of its own: Γ_C's data
+- every facet term on the facets whose first cell (``facet2cell[:, 0]``) is its own: an
+  interior facet once, on one side's rank, with the stress of the neighbour across it (a ghost
+  cell, whose σ(u_h) it computes too), a boundary facet on its cell's rank;
+- the contact terms η4 … η8 on every contact facet, and keeps those of its own: Γ_C's data
   (the gap, the pressure, the contact set, the friction stresses: O(√n) numbers) is
   replicated, η7 is a norm on Γ_C whole, and all of them together take under 1 % of the
   estimator's time (docs/parallel.md), less than splitting them would save.
@@ -49,25 +49,25 @@ class OwnPart:
     ranks : Ranks
         The processes of the run (their :meth:`~Ranks.sum` and :meth:`~Ranks.max`).
     cells : (n_cells,) bool array
-        This rank's cells: η1 on them, every edge term on the edges whose first cell is one.
+        This rank's cells: η1 on them, every facet term on the facets whose first cell is one.
     """
 
     ranks: Ranks
     cells: np.ndarray
 
-    def edges(self, edge2cell: np.ndarray) -> np.ndarray:
-        """``(k,)`` bool: which of the edges with cells ``edge2cell (k, 2)`` this rank
+    def facets(self, facet2cell: np.ndarray) -> np.ndarray:
+        """``(k,)`` bool: which of the facets with cells ``facet2cell (k, 2)`` this rank
         integrates (those whose first cell is its own)."""
-        return self.cells[edge2cell[:, 0]]
+        return self.cells[facet2cell[:, 0]]
 
-    def stressed_cells(self, edge2cell: np.ndarray, contact_edges: np.ndarray) -> np.ndarray:
+    def stressed_cells(self, facet2cell: np.ndarray, contact_facets: np.ndarray) -> np.ndarray:
         """The cells whose σ(u_h) this rank needs, ascending: its own, across its interior
-        edges their neighbours (``edge2cell`` of the mesh), and the cells of the contact
-        edges ``contact_edges`` (mesh edge numbers)."""
-        mine = self.cells[edge2cell[:, 0]] & (edge2cell[:, 1] >= 0)
+        facets their neighbours (``facet2cell`` of the mesh), and the cells of the contact
+        facets ``contact_facets`` (mesh facet numbers)."""
+        mine = self.cells[facet2cell[:, 0]] & (facet2cell[:, 1] >= 0)
         need = self.cells.copy()
-        need[edge2cell[mine, 1]] = True
-        need[edge2cell[contact_edges, 0]] = True
+        need[facet2cell[mine, 1]] = True
+        need[facet2cell[contact_facets, 0]] = True
         return np.flatnonzero(need)
 
     def sum(self, arrays: Sequence[np.ndarray]) -> list[np.ndarray]:

@@ -19,28 +19,28 @@ quadratic interpolant of the nodal friction stresses) and η8, the defect of the
 is added; without friction both are the frictionless values exactly (η8 = 0;
 docs/method.md, *Estimator*, "With friction").
 
-γ_{p,I}, γ_{p,N}, γ_{p,C} are the interior, Neumann and contact edges that contain p (as a
-vertex or as their midpoint): the only edges where the P2 basis function ψ_p is not zero.
-γ̃_p is made of the thirds of the contact edges that belong to p (outer thirds to the end
-vertices, the middle third to the midpoint). On contact edges ψ is replaced by its P2
-interpolant, so that (u_h·n − ψ) is a quadratic on each edge (exact for gaps that are
-piecewise quadratic with kinks at nodes, as in Example 6.2). A P1 solution is estimated by the
-same terms on its P2 form, the pieces γ̃_p and the edge layout taken from its element
-(docs/method.md, *P1 elements and their estimator*).
+γ_{p,I}, γ_{p,N}, γ_{p,C} are the interior, Neumann and contact facets (edges in 2D) that contain p
+(as a vertex or as their midpoint): the only facets where the P2 basis function ψ_p is not zero.
+γ̃_p is made of the thirds of the contact facets that belong to p (outer thirds to the end vertices,
+the middle third to the midpoint). On contact facets ψ is replaced by its P2 interpolant, so that
+(u_h·n − ψ) is a quadratic on each facet (exact for gaps that are piecewise quadratic with kinks at
+nodes, as in Example 6.2). A P1 solution is estimated by the same terms on its P2 form, the pieces
+γ̃_p and the facet layout taken from its facet element (docs/method.md, *P1 elements and their
+estimator*).
 
 Each term is one function of :mod:`signorini.estimator.terms` (arrays in, integrals out):
 η1 ``interior_residual``, η2 ``stress_jump``, η3 ``neumann_residual``,
 η4 ``tangential_stress``, η5 ``normal_stress``, η6 ``complementarity``,
 η7 ``penetration``, η8 ``friction_work``; :func:`estimate` is the table that feeds them, by
-name. Every node term is a sum of cell or edge integrals; each cell receives its share (edge
-terms split equally between the edge's cells, ``terms.spread_edge_integrals``), so the
+name. Every node term is a sum of cell or facet integrals; each cell receives its share (facet
+terms split equally between the facet's cells, ``terms.spread_facet_integrals``), so the
 element indicators sum exactly to η_h².
 
-Each integral is taken once, through the geometry of its cell or edge
+Each integral is taken once, through the geometry of its cell or facet
 (:mod:`signorini.fem.mapping`, :func:`geometry`): the closed forms of straight cells where
 the Jacobian is constant, the quadratic maps of the isoparametric cells along curved parts
-and their quadratic edges elsewhere; η4, η5 split the traction along the constraint direction
-field where n_z is not the edge's normal (docs/method.md, *Estimator*, "On curved
+and their quadratic facets elsewhere; η4, η5 split the traction along the constraint direction
+field where n_z is not the facet's normal (docs/method.md, *Estimator*, "On curved
 boundaries").
 """
 
@@ -60,13 +60,13 @@ from ..fem.quadrature import line_rule, triangle_rule
 from ..fem.space import LagrangeSpace
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
-from .contact_edges import contact_node_parts, contact_stress, edge_pressure, semi_contact_density
-from .friction import friction_edges
-from .held import further_traction_edges
+from .contact_facets import contact_node_parts, contact_stress, facet_pressure, semi_contact_density
+from .friction import friction_facets
+from .held import further_traction_facets
 from .names import TERMS
 from .owned import OwnPart, own_part, per_cell_of
 from .terms import (
-    EdgeSet,
+    FacetSet,
     TermShares,
     boundary_cell_shares,
     interior_residual,
@@ -74,7 +74,7 @@ from .terms import (
     node_mesh_size,
     penetration,
     spread_cell_integrals,
-    spread_edge_integrals,
+    spread_facet_integrals,
     spread_node_parts,
     stress_jump,
 )
@@ -95,7 +95,7 @@ __all__ = [
 ETA5_VARIANTS = ("consistent", "paper")
 #: the terms with node contributions (all but the global η7), the rows of ``Estimate.eta2_node``
 NODE_TERMS = tuple(name for name in TERMS if name != "eta_7")
-#: line quadrature degree for the polynomial edge terms η2, η4, η5 (σ(u_h) is linear)
+#: line quadrature degree for the polynomial facet terms η2, η4, η5 (σ(u_h) is linear)
 EDGE_DEGREE = 7
 #: line quadrature degree for the Neumann residual with non-polynomial data g: finer, so
 #: that quadrature stays far below the residual itself
@@ -210,7 +210,7 @@ def estimate(
         With friction η4 is ``‖σ_t(u_h) + p_t,h‖`` in both variants.
     ranks : Ranks, optional
         The processes of a run on several MPI ranks (:mod:`signorini.algebra.ranks`; default
-        one process): each integrates its own cells and edges, and the integrals are summed
+        one process): each integrates its own cells and facets, and the integrals are summed
         over them (:mod:`signorini.estimator.owned`); every rank returns the serial estimate.
     partition : Partition, optional
         Which cells are this rank's (:func:`signorini.contact.partition.partition`, built
@@ -228,15 +228,15 @@ def estimate(
     """
     if eta5_variant not in ETA5_VARIANTS:
         raise ValueError(f"eta5_variant must be one of {ETA5_VARIANTS}, got {eta5_variant!r}")
-    own = own_part(result, ranks, partition)  # None: one process, every cell and edge
+    own = own_part(result, ranks, partition)  # None: one process, every cell and facet
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells
     element = space.element  # P2, or P1 read as the P2 field it is (docs/method.md, *P1 ...*)
-    on_edge = element.edge_values  # nodal data of contact edges at [start, end, midpoint]
+    on_facet = element.facet.facet_values  # contact facets' nodal data: [start, end, midpoint]
     h_p = node_mesh_size(mesh.h, space.cell_nodes, result.dirichlet_nodes, n_nodes)
-    cells, quadratic_edges = geometry(space)
+    cells, quadratic_facets = geometry(space)
 
-    # what the terms integrate: the residual in the cells, σ(u_h) n on the edges, the gap
+    # what the terms integrate: the residual in the cells, σ(u_h) n on the facets, the gap
     # every stress-like input (σ(u_h), div σ(u_h), f, g, p_z, s_z) is divided by the stress
     # unit σ₀ (a power of 4, 1 for ordinary stresses): exact, and no square overflows;
     # Estimate puts σ₀ back (docs/method.md, *Estimator*, "Units")
@@ -244,50 +244,54 @@ def estimate(
     stresses = _cell_stress(result, cells, material, own)
     unit, u_cell = stresses.unit, stresses.u_cell
     t, w = line_rule(EDGE_DEGREE)
-    inner = _edge_set(space, np.flatnonzero(mesh.edge2cell[:, 1] >= 0))
+    inner = _facet_set(space, np.flatnonzero(mesh.facet2cell[:, 1] >= 0))
     t_n, w_n = line_rule(NEUMANN_DEGREE)
     # pairs' masters (the slave's traction) and rollers (their free traction) join η3: held.py
-    further, J3_further = further_traction_edges(result, stresses, t_n, w_n, unit)
-    neumann = _edge_set(space, np.concatenate([_part_edges(mesh, problem.neumann_parts), further]))
-    contact = EdgeSet(cs.edges, cs.edge_nodes, mesh.edge2cell[cs.edges], mesh.edge_length[cs.edges])
-    pressure = on_edge(edge_pressure(result)) / unit if eta5_variant == "consistent" else None
-    friction = friction_edges(result, unit)  # None without friction
+    further, J3_further = further_traction_facets(result, stresses, t_n, w_n, unit)
+    neumann = _facet_set(
+        space, np.concatenate([_part_facets(mesh, problem.neumann_parts), further])
+    )
+    contact = FacetSet(
+        cs.edges, cs.edge_nodes, mesh.facet2cell[cs.edges], mesh.facet_measure[cs.edges]
+    )
+    pressure = on_facet(facet_pressure(result)) / unit if eta5_variant == "consistent" else None
+    friction = friction_facets(result, unit)  # None without friction
     if friction is not None:
-        friction = type(friction)(*(on_edge(v) for v in friction))
+        friction = type(friction)(*(on_facet(v) for v in friction))
     p_t = None if friction is None else friction.friction
-    gap = on_edge(cs.edge_normal_gap(result.u))  # u_h·n − ψ_h at [start, end, midpoint]
-    density = on_edge(semi_contact_density(result)) / unit
+    gap = on_facet(cs.edge_normal_gap(result.u))  # u_h·n − ψ_h at [start, end, midpoint]
+    density = on_facet(semi_contact_density(result)) / unit
     x0, x1 = mesh.points[cs.edge_nodes[:, 0]], mesh.points[cs.edge_nodes[:, 1]]
     eta7_shares = penetration(x0, x1, gap, scale=float(np.abs(result.u).max(initial=0.0)))
 
-    # each integral once per cell or edge, through its own geometry (docs/method.md,
+    # each integral once per cell or facet, through its own geometry (docs/method.md,
     # *Estimator*, "On curved boundaries"); on several ranks, the rank's own (owned.py)
     R = _interior_residual(problem, material, cells, u_cell, unit, own)
     J2 = _stress_jumps(mesh, stresses, inner, t, w, own)
     J3 = np.concatenate([_neumann_integrals(problem, mesh, stresses, t_n, w_n, unit), J3_further])
-    direction = on_edge(cs.edge_direction)
-    # the contact terms on every contact edge, on every rank (Γ_C's data is replicated)
+    direction = on_facet(cs.edge_direction)
+    # the contact terms on every contact facet, on every rank (Γ_C's data is replicated)
     every = stresses.everywhere
     J4, J5 = contact_stress(every, mesh, contact, cs.edge_normal, direction, t, w, pressure, p_t)
-    curved = np.isin(cs.edges, quadratic_edges)
+    curved = np.isin(cs.edges, quadratic_facets)
     parts6, parts8 = contact_node_parts(result, gap, density, friction, curved)
     if own is not None:  # each integral from the one rank that owns it, summed over the ranks
-        mine = own.edges(contact.cells)
+        mine = own.facets(contact.cells)
         J4, J5, eta7_shares = (np.where(mine, a, 0.0) for a in (J4, J5, eta7_shares))
         parts6, parts8 = (np.where(mine[:, None], a, 0.0) for a in (parts6, parts8))
         R, J2, J3, J4, J5, parts6, parts8, eta7_shares = own.sum(
             [R, J2, J3, J4, J5, parts6, parts8, eta7_shares]
         )
 
-    def on_edges(edges: EdgeSet, J: np.ndarray) -> TermShares:
-        return spread_edge_integrals(edges, J, h_p, n_cells)
+    def on_facets(facets: FacetSet, J: np.ndarray) -> TermShares:
+        return spread_facet_integrals(facets, J, h_p, n_cells)
 
     shares = {
         "eta_1": spread_cell_integrals(R, space.cell_nodes, h_p),
-        "eta_2": on_edges(inner, J2),
-        "eta_3": on_edges(neumann, J3),
-        "eta_4": on_edges(contact, J4),
-        "eta_5": on_edges(contact, J5),
+        "eta_2": on_facets(inner, J2),
+        "eta_3": on_facets(neumann, J3),
+        "eta_4": on_facets(contact, J4),
+        "eta_5": on_facets(contact, J5),
         "eta_6": spread_node_parts(contact, parts6, n_nodes, n_cells),
         "eta_7": TermShares(None, boundary_cell_shares(contact, eta7_shares, n_cells)),
         "eta_8": spread_node_parts(contact, parts8, n_nodes, n_cells),
@@ -317,7 +321,7 @@ def stress_unit(sigma_max: float) -> float:
 
 
 def geometry(space: LagrangeSpace) -> tuple[CellMap, np.ndarray]:
-    """The cells' maps (:attr:`~signorini.fem.space.P2Space.mapping`) and the boundary edges
+    """The cells' maps (:attr:`~signorini.fem.space.P2Space.mapping`) and the boundary facets
     that are quadratics (those on parts carrying a curve other than a line; none in a P1
     space): the geometry every term integrates on."""
     return space.mapping, space.curved_edges
@@ -335,7 +339,7 @@ def _cell_stress(
         sigma = vertex_stress(cells, u_cell, material)
         unit = stress_unit(float(np.abs(sigma).max(initial=0.0)))
         return CellStress(cells, mesh.points, mesh.cells, u_cell, material, sigma / unit, unit)
-    stressed = own.stressed_cells(mesh.edge2cell, result.contact.edges)
+    stressed = own.stressed_cells(mesh.facet2cell, result.contact.edges)
     u_cell = np.zeros((mesh.n_cells, 12))
     values = np.asarray(result.u).reshape(-1)[space.cell_dofs[stressed]]  # as cell_values
     u_cell[stressed] = space.element.cell_coefficients(values)
@@ -383,55 +387,57 @@ def _interior_residual(
 
 
 def _stress_jumps(
-    mesh, stresses: CellStress, inner: EdgeSet, t: np.ndarray, w: np.ndarray, own: OwnPart | None
+    mesh, stresses: CellStress, inner: FacetSet, t: np.ndarray, w: np.ndarray, own: OwnPart | None
 ) -> np.ndarray:
-    """η2's ``‖⟦σ(u_h)⟧‖²_e`` on the interior edges ``inner``; with ``own`` on its edges only
-    (zero on the others)."""
+    """η2's ``‖⟦σ(u_h)⟧‖²_F`` on the interior facets ``inner``; with ``own`` on its facets
+    only (zero on the others)."""
     if own is None:
         return stress_jump(
-            *_from_both_sides(mesh, stresses.traction, inner.index, t), w, inner.length
+            *_from_both_sides(mesh, stresses.traction, inner.index, t), w, inner.measure
         )
     J = np.zeros(inner.index.size)
-    mine = np.flatnonzero(own.edges(inner.cells))
+    mine = np.flatnonzero(own.facets(inner.cells))
     jump = _from_both_sides(mesh, stresses.traction, inner.index[mine], t)
-    J[mine] = stress_jump(*jump, w, inner.length[mine])
+    J[mine] = stress_jump(*jump, w, inner.measure[mine])
     return J
 
 
 def _neumann_integrals(
     problem: ContactProblem, mesh, stresses: CellStress, t: np.ndarray, w: np.ndarray, unit: float
 ) -> np.ndarray:
-    """η3's ``‖σ(u_h) n − g‖²_e`` on the Neumann edges (part after part), g (divided by the
-    stress unit) at the points and with the normals of each edge's geometry."""
+    """η3's ``‖σ(u_h) n − g‖²_F`` on the Neumann facets (part after part), g (divided by the
+    stress unit) at the points and with the normals of each facet's geometry."""
     out = []
     for name in problem.neumann_parts:
         cond = problem.conditions[name]
-        e = mesh.part_edges(name)
+        e = mesh.part_facets(name)
         values = np.zeros(e.size)
-        for rows, sn, edges in stresses.on_edges(mesh.edge2cell[e, 0], mesh.edge_local[e, 0], t):
+        for rows, sn, facets in stresses.on_facets(
+            mesh.facet2cell[e, 0], mesh.facet_local[e, 0], t
+        ):
             if not cond.is_zero:
                 what = f"the traction of Neumann part {name!r}"
-                g = evaluate_field(cond.field(), edges.points(t), what, normal=edges.normals(t))
+                g = evaluate_field(cond.field(), facets.points(t), what, normal=facets.normals(t))
                 sn = sn - g / unit
-            values[rows] = neumann_residual(sn, w, edges.speeds(t))
+            values[rows] = neumann_residual(sn, w, facets.speeds(t))
         out.append(values)
     return np.concatenate(out) if out else np.zeros(0)
 
 
-def _part_edges(mesh, names) -> np.ndarray:
-    """Mesh edges of the named boundary parts, part after part."""
-    return np.concatenate([mesh.part_edges(p) for p in names] or [np.zeros(0, np.int64)])
+def _part_facets(mesh, names) -> np.ndarray:
+    """Mesh facets of the named boundary parts, part after part."""
+    return np.concatenate([mesh.part_facets(p) for p in names] or [np.zeros(0, np.int64)])
 
 
-def _edge_set(space: LagrangeSpace, e: np.ndarray) -> EdgeSet:
-    """Mesh edges ``e`` with their nodes ``[vertex, vertex, midpoint]`` (P1: the two
-    vertices) and cells."""
+def _facet_set(space: LagrangeSpace, e: np.ndarray) -> FacetSet:
+    """Mesh facets ``e`` with their nodes ``[vertex, vertex, midpoint]`` (P1: the two
+    vertices), cells and measures."""
     mesh = space.mesh
-    return EdgeSet(e, space.mesh_edge_nodes(e), mesh.edge2cell[e], mesh.edge_length[e])
+    return FacetSet(e, space.mesh_edge_nodes(e), mesh.facet2cell[e], mesh.facet_measure[e])
 
 
 def _from_both_sides(mesh, traction, e: np.ndarray, t: np.ndarray):
-    """σ(u_h) n of both cells of interior edges ``e`` at the same points, each with its
-    outward normal (the second cell runs the edge the other way)."""
-    c, k = mesh.edge2cell[e], mesh.edge_local[e]
+    """σ(u_h) n of both cells of interior facets ``e`` at the same points, each with its
+    outward normal (the second cell runs the facet the other way)."""
+    c, k = mesh.facet2cell[e], mesh.facet_local[e]
     return traction(c[:, 0], k[:, 0], t), traction(c[:, 1], k[:, 1], 1 - t)

@@ -1,23 +1,23 @@
 """The terms of the residual estimator (paper, Section 5, (5.1), and η8 with friction), one
 function each.
 
-Every term function takes arrays and returns the paper's integrals, one per cell (η1),
-per edge (η2–η5, η7) or per edge node (η6, η8); the distributing helpers turn them into node
-contributions ``η_{k,p}²`` and cell shares. :func:`signorini.estimator.residual.estimate`
-is the table that calls them; docs/method.md, *Estimator*, states the choices.
+Every term function takes arrays and returns the paper's integrals, one per cell (η1), per facet
+(η2–η5, η7; an edge in 2D) or per facet node (η6, η8); the distributing helpers turn them into node
+contributions ``η_{k,p}²`` and cell shares. :func:`signorini.estimator.residual.estimate` is the
+table that calls them; docs/method.md, *Estimator*, states the choices.
 
 ====  ===========================  ================================================
 term  function                     integral
 ====  ===========================  ================================================
 η1    :func:`interior_residual`    ``‖f + div σ(u_h)‖²_T`` per cell
-η2    :func:`stress_jump`          ``‖⟦σ(u_h)⟧‖²_e`` per interior edge
-η3    :func:`neumann_residual`     ``‖σ(u_h)n − g‖²_e`` per Neumann edge
-η4    :func:`tangential_stress`    ``‖σ_t(u_h) [+ p_t,h]‖²_e`` per contact edge
-η5    :func:`normal_stress`        ``‖σ_nn(u_h) [+ p_h]‖²_e`` per contact edge
-η6    :func:`complementarity`      ``s_p ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p`` per edge node
+η2    :func:`stress_jump`          ``‖⟦σ(u_h)⟧‖²_F`` per interior facet
+η3    :func:`neumann_residual`     ``‖σ(u_h)n − g‖²_F`` per Neumann facet
+η4    :func:`tangential_stress`    ``‖σ_t(u_h) [+ p_t,h]‖²_F`` per contact facet
+η5    :func:`normal_stress`        ``‖σ_nn(u_h) [+ p_h]‖²_F`` per contact facet
+η6    :func:`complementarity`      ``s_p ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p`` per facet node
 η7    :func:`penetration`          share of ``‖(u_h·n − ψ)⁺‖²_{H^{1/2}(Γ_C)}``
 η8    :func:`friction_work`        ``∫_{γ̃_p} (max(b_h, |p_t,h|)|u_t| − p_t,h u_t)``
-                                   per edge node
+                                   per facet node
 ====  ===========================  ================================================
 
 The functions carry the names of what they measure; ``estimate`` files their results under
@@ -32,15 +32,14 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..fem.element import P2
-from ..fem.p2 import edge_basis
 from .h_half_norm import hhalf_norm2_positive_part
 from .thirds import friction_work_thirds, third_integrals
-from .traction import direction_field, edge_traction
+from .traction import direction_field, facet_traction
 
 __all__ = [
-    "EdgeSet",
+    "FacetSet",
     "TermShares",
-    "edge_traction",
+    "facet_traction",
     "interior_residual",
     "stress_jump",
     "neumann_residual",
@@ -53,30 +52,31 @@ __all__ = [
     "direction_field",
     "boundary_cell_shares",
     "spread_cell_integrals",
-    "spread_edge_integrals",
+    "spread_facet_integrals",
     "spread_node_parts",
     "third_integrals",
 ]
 
 
-class EdgeSet(NamedTuple):
-    """The edges a term integrates over.
+class FacetSet(NamedTuple):
+    """The facets a term integrates over (edges in 2D).
 
     Attributes
     ----------
     index : (k,) int array
-        Mesh edge numbers.
+        Mesh facet numbers.
     nodes : (k, 3) int array
-        P2 nodes of each edge: its two vertices, then its midpoint.
+        P2 nodes of each facet: its two vertices, then its midpoint (P1: the two vertices).
     cells : (k, 2) int array
-        The edge's cells (``edge2cell`` rows, ``-1`` outside the domain).
-    length : (k,) float array
+        The facet's cells (``facet2cell`` rows, ``-1`` outside the domain).
+    measure : (k,) float array
+        The facets' measures ``|F|`` (lengths in 2D).
     """
 
     index: np.ndarray
     nodes: np.ndarray
     cells: np.ndarray
-    length: np.ndarray
+    measure: np.ndarray
 
 
 class TermShares(NamedTuple):
@@ -111,16 +111,16 @@ def spread_cell_integrals(R: np.ndarray, cell_nodes: np.ndarray, h_p: np.ndarray
     return TermShares(node, R * (h_p[cell_nodes] ** 2).sum(axis=1))
 
 
-def spread_edge_integrals(
-    edges: EdgeSet, J: np.ndarray, h_p: np.ndarray, n_cells: int
+def spread_facet_integrals(
+    facets: FacetSet, J: np.ndarray, h_p: np.ndarray, n_cells: int
 ) -> TermShares:
-    """Edge integrals ``J_e`` enter ``η_{k,p}²`` with weight ``h_p`` for each node p of e.
+    """Facet integrals ``J_F`` enter ``η_{k,p}²`` with weight ``h_p`` for each node p of F.
 
-    Each edge's total ``Σ_{p ∈ e} h_p J_e`` is split equally between its cells.
+    Each facet's total ``Σ_{p ∈ F} h_p J_F`` is split equally between its cells.
 
     Parameters
     ----------
-    edges : EdgeSet
+    facets : FacetSet
     J : (k,) float array
     h_p : (n_nodes,) float array
         Node mesh sizes, zero at Dirichlet nodes.
@@ -130,24 +130,26 @@ def spread_edge_integrals(
     -------
     TermShares
     """
-    node_part = h_p[edges.nodes] * J[:, None]
-    node = np.bincount(edges.nodes.ravel(), weights=node_part.ravel(), minlength=h_p.size)
+    node_part = h_p[facets.nodes] * J[:, None]
+    node = np.bincount(facets.nodes.ravel(), weights=node_part.ravel(), minlength=h_p.size)
     total = node_part.sum(axis=1)
-    c0, c1 = edges.cells[:, 0], edges.cells[:, 1]
+    c0, c1 = facets.cells[:, 0], facets.cells[:, 1]
     two = c1 >= 0
     cell = np.bincount(c0, weights=np.where(two, 0.5, 1.0) * total, minlength=n_cells)
     cell += np.bincount(c1[two], weights=0.5 * total[two], minlength=n_cells)
     return TermShares(node, cell)
 
 
-def spread_node_parts(edges: EdgeSet, parts: np.ndarray, n_nodes: int, n_cells: int) -> TermShares:
-    """Per-node parts ``(k, 3)`` of boundary edges to their nodes, each edge's total to its
+def spread_node_parts(
+    facets: FacetSet, parts: np.ndarray, n_nodes: int, n_cells: int
+) -> TermShares:
+    """Per-node parts ``(k, 3)`` of boundary facets to their nodes, each facet's total to its
     cell.
 
     Parameters
     ----------
-    edges : EdgeSet
-        Boundary edges (one cell each); ``parts`` columns follow ``edges.nodes``.
+    facets : FacetSet
+        Boundary facets (one cell each); ``parts`` columns follow ``facets.nodes``.
     parts : (k, 3) float array
     n_nodes, n_cells : int
 
@@ -155,13 +157,13 @@ def spread_node_parts(edges: EdgeSet, parts: np.ndarray, n_nodes: int, n_cells: 
     -------
     TermShares
     """
-    node = np.bincount(edges.nodes.ravel(), weights=parts.ravel(), minlength=n_nodes)
-    return TermShares(node, boundary_cell_shares(edges, parts.sum(axis=1), n_cells))
+    node = np.bincount(facets.nodes.ravel(), weights=parts.ravel(), minlength=n_nodes)
+    return TermShares(node, boundary_cell_shares(facets, parts.sum(axis=1), n_cells))
 
 
-def boundary_cell_shares(edges: EdgeSet, values: np.ndarray, n_cells: int) -> np.ndarray:
-    """Values ``(k,)`` of boundary edges to their cells: ``(n_cells,)``."""
-    return np.bincount(edges.cells[:, 0], weights=values, minlength=n_cells)
+def boundary_cell_shares(facets: FacetSet, values: np.ndarray, n_cells: int) -> np.ndarray:
+    """Values ``(k,)`` of boundary facets to their cells: ``(n_cells,)``."""
+    return np.bincount(facets.cells[:, 0], weights=values, minlength=n_cells)
 
 
 def _point_weights(w: np.ndarray, length: np.ndarray) -> np.ndarray:
@@ -223,12 +225,12 @@ def interior_residual(
 def stress_jump(
     traction_0: np.ndarray, traction_1: np.ndarray, w: np.ndarray, length: np.ndarray
 ) -> np.ndarray:
-    """``‖⟦σ(u_h)⟧‖²_e`` per interior edge (η2).
+    """``‖⟦σ(u_h)⟧‖²_F`` per interior facet (η2, an edge in 2D).
 
     Parameters
     ----------
     traction_0, traction_1 : (k, q, 2) float arrays
-        ``σ(u_h) n`` from each of the edge's cells with its own outward normal, at the same
+        ``σ(u_h) n`` from each of the facet's cells with its own outward normal, at the same
         points (so the jump is their sum).
     w : (q,) float array
         Weights on [0, 1].
@@ -239,9 +241,9 @@ def stress_jump(
 
 
 def neumann_residual(residual: np.ndarray, w: np.ndarray, length: np.ndarray) -> np.ndarray:
-    """``‖σ(u_h) n − g‖²_e`` per Neumann edge (η3), from ``residual (k, q, 2)`` at the
+    """``‖σ(u_h) n − g‖²_F`` per Neumann facet (η3), from ``residual (k, q, 2)`` at the
     points of the weights ``w (q,)``; ``length (k,)``, or ``|x'(t)|`` at each point ``(k, q)``
-    on a quadratic edge."""
+    on a quadratic facet."""
     length = _per_item(length, 2)
     if np.ndim(length) == 2:
         return np.einsum("eq,eqi,eqi->e", _point_weights(w, length), residual, residual)
@@ -256,7 +258,7 @@ def tangential_stress(
     t: np.ndarray | None = None,
     friction: np.ndarray | None = None,
 ) -> np.ndarray:
-    """``‖σ_t(u_h)‖²_e`` per contact edge (η4), or ``‖σ_t(u_h) + p_t,h‖²_e`` with friction.
+    """``‖σ_t(u_h)‖²_F`` per contact facet (η4), or ``‖σ_t(u_h) + p_t,h‖²_F`` with friction.
 
     Parameters
     ----------
@@ -282,7 +284,7 @@ def tangential_stress(
     if friction is not None:
         d = normal if normal.ndim == 3 else np.broadcast_to(normal[:, None, :], traction.shape)
         residual = traction[..., 1] * d[..., 0] - traction[..., 0] * d[..., 1]
-        residual = residual + friction @ edge_basis(t).T
+        residual = residual + friction @ P2.facet.basis(t).T
         return (_point_weights(w, length) * residual**2).sum(axis=1)
     if normal.ndim == 3:
         snn = np.einsum("eqi,eqi->eq", traction, normal)
@@ -301,7 +303,7 @@ def normal_stress(
     length: np.ndarray,
     pressure: np.ndarray | None = None,
 ) -> np.ndarray:
-    """``‖σ_nn(u_h)‖²_e`` (``paper``) or ``‖σ_nn(u_h) + p_h‖²_e`` (``consistent``) (η5).
+    """``‖σ_nn(u_h)‖²_F`` (``paper``) or ``‖σ_nn(u_h) + p_h‖²_F`` (``consistent``) (η5).
 
     Parameters
     ----------
@@ -323,7 +325,7 @@ def normal_stress(
     else:
         snn = np.einsum("eqi,ei->eq", traction, normal)
     if pressure is not None:
-        snn = snn + pressure @ edge_basis(t).T
+        snn = snn + pressure @ P2.facet.basis(t).T
     if normal.ndim == 3 or np.ndim(length) == 2:
         return (_point_weights(w, length) * snn**2).sum(axis=1)
     return length * (w * snn**2).sum(axis=1)
@@ -334,9 +336,9 @@ def complementarity(
     density: np.ndarray,
     length: np.ndarray,
     points: np.ndarray | None = None,
-    pieces: tuple = P2.hat_pieces,
+    pieces: tuple = P2.facet.hat_pieces,
 ) -> np.ndarray:
-    """``s_p d_p`` with ``d_p = ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p``, per contact edge node (η6).
+    """``s_p d_p`` with ``d_p = ∫_{γ̃_p} (ψ − u_h·n)⁺ φ_p``, per contact facet node (η6).
 
     Parameters
     ----------
@@ -350,13 +352,13 @@ def complementarity(
         Node points ``[start, end, midpoint]`` of quadratic edges: integrate along them
         (:func:`third_integrals`).
     pieces : tuple, optional
-        The element's γ̃_p and hats (:attr:`~signorini.fem.element.Element.hat_pieces`):
+        The element's γ̃_p and hats (:attr:`~signorini.fem.facet_element.FacetElement.hat_pieces`):
         P2's thirds (default), P1's halves.
 
     Returns
     -------
     (k, 3) float array
-        Each node's part from this edge.
+        Each node's part from this facet.
     """
     return density * third_integrals(-gap, length, points, pieces)
 
@@ -367,9 +369,9 @@ def friction_work(
     bound: np.ndarray,
     length: np.ndarray,
     points: np.ndarray | None = None,
-    parts: tuple = P2.node_parts,
+    parts: tuple = P2.facet.node_parts,
 ) -> np.ndarray:
-    """``∫_{γ̃_p} (max(b_h, |p_t,h|) |u_t| − p_t,h u_t) ds`` per contact edge node (η8): the
+    """``∫_{γ̃_p} (max(b_h, |p_t,h|) |u_t| − p_t,h u_t) ds`` per contact facet node (η8): the
     defect of the friction work ``p_t u_t = s |u_t|`` of the tangential law (docs/method.md,
     *Estimator*, "With friction").
 
@@ -390,7 +392,7 @@ def friction_work(
     Returns
     -------
     (k, 3) float array
-        The edge's integrals over the thirds of its start, end and midpoint nodes.
+        The facet's integrals over the thirds of its start, end and midpoint nodes.
     """
     return friction_work_thirds(slip, friction, bound, length, points, parts)
 
@@ -398,12 +400,12 @@ def friction_work(
 def penetration(
     x0: np.ndarray, x1: np.ndarray, gap: np.ndarray, scale: float | None = None
 ) -> np.ndarray:
-    """Each contact edge's share of ``η7² = ‖(u_h·n − ψ_h)⁺‖²_{H^{1/2}(Γ_C)}``.
+    """Each contact facet's share of ``η7² = ‖(u_h·n − ψ_h)⁺‖²_{H^{1/2}(Γ_C)}``.
 
     Parameters
     ----------
     x0, x1 : (k, 2) float arrays
-        Start and end points of the contact edges.
+        Start and end points of the contact facets (edges).
     gap : (k, 3) float array
         ``u_h·n − ψ_h`` at ``[start, end, midpoint]``.
     scale : float, optional

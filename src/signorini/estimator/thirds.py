@@ -21,8 +21,8 @@ CURVED_THIRD_POINTS = 5
 
 #: sub-intervals of [0, 1] where a half-edge hat φ of Q^h (3.6) is linear:
 #: ``(lo, hi, column, (φ(0), φ'))`` with column 0, 1, 2 = start, end, midpoint (P2's pieces;
-#: an element states its own, :class:`~signorini.fem.element.Element`)
-_HAT_PIECES = P2.hat_pieces
+#: an element states its own, :class:`~signorini.fem.facet_element.FacetElement`)
+_HAT_PIECES = P2.facet.hat_pieces
 
 
 def third_integrals(
@@ -31,7 +31,7 @@ def third_integrals(
     points: np.ndarray | None = None,
     pieces: tuple = _HAT_PIECES,
 ) -> np.ndarray:
-    """∫ v⁺ φ_p over the thirds γ̃_p of each edge (docs/method.md, *Estimator*, paper (4.12)).
+    """∫ v⁺ φ_p over the thirds γ̃_p of each facet (docs/method.md, *Estimator*, paper (4.12)).
 
     Exact on straight edges: each linear piece of φ is cut at the roots of v, and on each
     sub-interval the product of the quadratic and the linear hat is integrated by a 3-point
@@ -49,8 +49,8 @@ def third_integrals(
     points : (k, 3, 2) float array, optional
         Node points ``[start, end, midpoint]`` of quadratic edges ``x(t)``.
     pieces : tuple, optional
-        The pieces γ̃_p and hats of the element (:attr:`~signorini.fem.element.Element.
-        hat_pieces`): P2's thirds (default) or P1's halves (column 2 then stays 0).
+        The pieces γ̃_p and hats of the element (:attr:`~signorini.fem.facet_element.
+        FacetElement.hat_pieces`): P2's thirds (default) or P1's halves (column 2 then stays 0).
 
     Returns
     -------
@@ -81,7 +81,7 @@ def third_integrals(
 
 
 #: the thirds of [0, 1] as ``(lo, hi, column)``, column 0, 1, 2 = start, end, midpoint
-_THIRDS = P2.node_parts
+_THIRDS = P2.facet.node_parts
 
 
 def friction_work_thirds(
@@ -93,7 +93,7 @@ def friction_work_thirds(
     parts: tuple = _THIRDS,
 ) -> np.ndarray:
     """``∫ (max(b, |p_t|) |u_t| − p_t u_t) ds`` over each third of each edge (η8); over
-    each half with P1's ``parts`` (:attr:`~signorini.fem.element.Element.node_parts`).
+    each half with P1's ``parts`` (:attr:`~signorini.fem.facet_element.FacetElement.node_parts`).
 
     The three quadratics are given by their values at ``[start, end, midpoint]``. Each third
     is cut at the roots of ``u_t``, ``p_t − b`` and ``p_t + b``, so that on each piece the

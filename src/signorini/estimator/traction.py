@@ -1,6 +1,6 @@
-"""``σ(u_h) n`` on the edges of the cells, through each cell's map, and the direction field
-the contact terms split it along (docs/method.md, *Estimator*, "On curved boundaries"); used
-by the terms of :mod:`signorini.estimator.terms` (which re-exports ``edge_traction`` and
+"""``σ(u_h) n`` on the facets of the cells (edges in 2D), through each cell's map, and the direction
+field the contact terms split it along (docs/method.md, *Estimator*, "On curved boundaries"); used
+by the terms of :mod:`signorini.estimator.terms` (which re-exports ``facet_traction`` and
 ``direction_field``)."""
 
 from __future__ import annotations
@@ -9,14 +9,15 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from ..fem.element import P2
 from ..fem.mapping import AffineCells, CellMap, Cells, Edges
 from ..fem.material import CellMaterials, Material, on_cells, stress
-from ..fem.p2 import REFERENCE_NODES, edge_basis, edge_reference_points
+from ..fem.p2 import REFERENCE_NODES, edge_reference_points
 from ..mesh.geometry import segment_normals
 from ..mesh.reference import TRIANGLE
 from .owned import per_cell_of
 
-__all__ = ["CellStress", "direction_field", "edge_traction", "vertex_stress"]
+__all__ = ["CellStress", "direction_field", "facet_traction", "vertex_stress"]
 
 
 def vertex_stress(
@@ -41,11 +42,11 @@ def vertex_stress(
 
 
 class CellStress:
-    """σ(u_h) of a discrete solution in a stress unit, along the local edges of its cells.
+    """σ(u_h) of a discrete solution in a stress unit, along the local facets of its cells.
 
     On cells with a constant Jacobian σ(u_h) is linear (P2 displacements), so it is
-    interpolated from its vertex values (:func:`edge_traction`); on the isoparametric ones it
-    is taken through the quadratic map at each point, with the normal of the quadratic edge
+    interpolated from its vertex values (:func:`facet_traction`); on the isoparametric ones it
+    is taken through the quadratic map at each point, with the normal of the quadratic facet
     (docs/method.md, *Estimator*, "On curved boundaries").
 
     Parameters
@@ -60,7 +61,7 @@ class CellStress:
     unit : float
         The stress unit σ₀.
     owned : (n_cells,) bool array, optional
-        A rank's cells (:mod:`.owned`): :meth:`on_edges` then gives the edges of these
+        A rank's cells (:mod:`.owned`): :meth:`on_facets` then gives the facets of these
         cells only. ``None`` (the default): every cell's.
     """
 
@@ -84,7 +85,7 @@ class CellStress:
 
     @property
     def everywhere(self) -> CellStress:
-        """The same stresses, :meth:`on_edges` giving every edge (``owned`` dropped)."""
+        """The same stresses, :meth:`on_facets` giving every facet (``owned`` dropped)."""
         if self.owned is None:
             return self
         return CellStress(
@@ -92,40 +93,40 @@ class CellStress:
             self.sigma_vertex, self.unit,
         )  # fmt: skip
 
-    def _traction(self, group: Cells, slot, cell, k, t, edges: Edges | None) -> np.ndarray:
-        """σ(u_h) n on local edges ``k`` of ``cell`` (rows ``slot`` of ``group``); ``edges``
+    def _traction(self, group: Cells, slot, cell, k, t, facets: Edges | None) -> np.ndarray:
+        """σ(u_h) n on local facets ``k`` of ``cell`` (rows ``slot`` of ``group``); ``facets``
         their geometry where already built."""
         if isinstance(group, AffineCells):
-            return edge_traction(self.sigma_vertex, self.points, self.cell_vertices, cell, k, t)
-        edges = group.local_edges(slot, k) if edges is None else edges
+            return facet_traction(self.sigma_vertex, self.points, self.cell_vertices, cell, k, t)
+        facets = group.local_edges(slot, k) if facets is None else facets
         grad = group.rows(slot).field_gradients(self.u_cell[cell], edge_reference_points(k, t))
         sig = stress(on_cells(self.material, cell), grad) / self.unit
-        return np.einsum("eqij,eqj->eqi", sig, edges.normals(t))
+        return np.einsum("eqij,eqj->eqi", sig, facets.normals(t))
 
-    def on_edges(
+    def on_facets(
         self, cell: np.ndarray, k: np.ndarray, t: np.ndarray
     ) -> Iterator[tuple[slice | np.ndarray, np.ndarray, Edges]]:
-        """``σ(u_h) n`` along local edge ``k (e,)`` of each ``cell (e,)`` at parameters ``t
+        """``σ(u_h) n`` along local facet ``k (e,)`` of each ``cell (e,)`` at parameters ``t
         (q,)`` (counter-clockwise around the cell), n the outward normal, group by group:
-        ``(rows, traction (r, q, 2), edges)`` with the edges' geometry. With ``owned``, only
+        ``(rows, traction (r, q, 2), facets)`` with the facets' geometry. With ``owned``, only
         the rows whose cell is owned (none at all if there is no such row)."""
         if self.owned is not None:
             mine = np.flatnonzero(self.owned[cell])
             if mine.size == 0:
                 return
             if mine.size < len(cell):
-                for rows, traction, edges in self._on_edges(cell[mine], k[mine], t):
-                    yield mine[rows], traction, edges
+                for rows, traction, facets in self._on_facets(cell[mine], k[mine], t):
+                    yield mine[rows], traction, facets
                 return
-        yield from self._on_edges(cell, k, t)
+        yield from self._on_facets(cell, k, t)
 
-    def _on_edges(self, cell, k, t):
-        for rows, g, slot, edges in self.cells.local_edges(cell, k):
-            yield rows, self._traction(g, slot, cell[rows], k[rows], t, edges), edges
+    def _on_facets(self, cell, k, t):
+        for rows, g, slot, facets in self.cells.local_edges(cell, k):
+            yield rows, self._traction(g, slot, cell[rows], k[rows], t, facets), facets
 
     def traction(self, cell: np.ndarray, k: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """``σ(u_h) n`` ``(e, q, 2)`` along local edge ``k`` of each ``cell`` (as
-        :meth:`on_edges`, in one array, without the edges' geometry)."""
+        """``σ(u_h) n`` ``(e, q, 2)`` along local facet ``k`` of each ``cell`` (as
+        :meth:`on_facets`, in one array, without the facets' geometry)."""
         parts = list(self.cells.split(cell))
         if len(parts) == 1:
             _, g, slot = parts[0]
@@ -136,7 +137,7 @@ class CellStress:
         return out
 
 
-def edge_traction(
+def facet_traction(
     sigma_vertex: np.ndarray,
     points: np.ndarray,
     cells: np.ndarray,
@@ -144,7 +145,7 @@ def edge_traction(
     k: np.ndarray,
     t: np.ndarray,
 ) -> np.ndarray:
-    """``σ(u_h) n`` along local edge ``k`` of ``cell``, n the cell's outward normal.
+    """``σ(u_h) n`` along local facet ``k`` of ``cell`` (an edge), n the cell's outward normal.
 
     σ(u_h) is linear on each cell (P2 displacements), so it is interpolated from its
     values at the vertices.
@@ -155,19 +156,19 @@ def edge_traction(
         σ(u_h) of each cell at its vertices.
     points, cells : mesh arrays
     cell, k : (m,) int arrays
-        Cell and local edge of each edge.
+        Cell and local facet of each facet.
     t : (q,) float array
-        Parameters along the edge, in the cell's counter-clockwise direction.
+        Parameters along the facet, in the cell's counter-clockwise direction.
 
     Returns
     -------
     (m, q, 2) float array
     """
     # flat indices (one gather each, faster than indexing two axes)
-    v0, v1 = 3 * cell + TRIANGLE.edges[k, 0], 3 * cell + TRIANGLE.edges[k, 1]
+    v0, v1 = 3 * cell + TRIANGLE.facets[k, 0], 3 * cell + TRIANGLE.facets[k, 1]
     corners = cells.ravel()
     _, n = segment_normals(points[corners[v0]], points[corners[v1]])
-    # σ n at the edge's two vertices, then linear along it (σ is linear on the cell)
+    # σ n at the facet's two vertices, then linear along it (σ is linear on the cell)
     sigma = sigma_vertex.reshape(-1, 2, 2)
     a = np.einsum("eij,ej->ei", sigma[v0], n)
     b = np.einsum("eij,ej->ei", sigma[v1], n)
@@ -175,12 +176,12 @@ def edge_traction(
 
 
 def direction_field(direction: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """The constraint direction along contact edges: the normalised quadratic interpolant of
+    """The constraint direction along contact facets: the normalised quadratic interpolant of
     the nodal directions n_z ``(k, 3, 2)`` at ``[start, end, midpoint]``, at parameters
     ``t (q,)``: ``(k, q, 2)`` unit vectors (docs/method.md, *Estimator*, "On curved
     boundaries"). Where the interpolant vanishes (nodal directions opposed across one edge,
-    e.g. an edge spanning a slot of an obstacle) the midpoint node's direction is used."""
-    d = np.einsum("qa,kac->kqc", edge_basis(t), direction)
+    e.g. a facet spanning a slot of an obstacle) the midpoint node's direction is used."""
+    d = np.einsum("qa,kac->kqc", P2.facet.basis(t), direction)
     size = np.hypot(d[..., 0], d[..., 1])[..., None]
     small = size <= 1e-8
     if small.any():

@@ -103,5 +103,5 @@ def assemble_edge_load(
     x = edges.points(t)
     gx = np.broadcast_to(np.asarray(g(x, edges.normals(t)), dtype=np.float64), x.shape)
     ds = np.broadcast_to(edges.speeds(t) * w, x.shape[:2])
-    local = np.einsum("qa,kqc,kq->kac", element.edge_basis(t), gx, ds)
+    local = np.einsum("qa,kqc,kq->kac", element.facet.basis(t), gx, ds)
     return np.bincount(np.ravel(edge_dofs), weights=local.ravel(), minlength=n_dofs)

@@ -33,6 +33,7 @@ import numpy as np
 from ..mesh.reference import TRIANGLE
 
 __all__ = [
+    "GRAD_BARYCENTRIC",
     "REFERENCE_NODES",
     "barycentric",
     "basis",
@@ -58,8 +59,10 @@ REFERENCE_NODES = np.concatenate(
 )
 REFERENCE_NODES.setflags(write=False)
 
-# gradients of the barycentric coordinates l0, l1, l2 on the reference triangle
-_GRAD_L = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
+#: Gradients ``(3, 2)`` of the barycentric coordinates l0, l1, l2 on the reference triangle:
+#: the (constant) gradients of the P1 basis, from which those of the P2 basis are built.
+GRAD_BARYCENTRIC = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
+GRAD_BARYCENTRIC.setflags(write=False)
 # midpoint a = 3 + k lies on local edge k, joining vertices TRIANGLE.edges[k]
 _EDGE_VERTS = tuple(tuple(e) for e in TRIANGLE.edges.tolist())
 
@@ -142,9 +145,11 @@ def grad_basis(xi: np.ndarray) -> np.ndarray:
     bary = barycentric(xi)
     out = np.empty((bary.shape[0], 6, 2))
     for i in range(3):
-        out[:, i, :] = (4.0 * bary[:, i] - 1.0)[:, None] * _GRAD_L[i]
+        out[:, i, :] = (4.0 * bary[:, i] - 1.0)[:, None] * GRAD_BARYCENTRIC[i]
     for k, (a, b) in enumerate(_EDGE_VERTS):
-        out[:, 3 + k, :] = 4.0 * (bary[:, a, None] * _GRAD_L[b] + bary[:, b, None] * _GRAD_L[a])
+        out[:, 3 + k, :] = 4.0 * (
+            bary[:, a, None] * GRAD_BARYCENTRIC[b] + bary[:, b, None] * GRAD_BARYCENTRIC[a]
+        )
     return out
 
 
@@ -158,9 +163,9 @@ def hessian_basis() -> np.ndarray:
     """
     out = np.empty((6, 2, 2))
     for i in range(3):
-        out[i] = 4.0 * np.outer(_GRAD_L[i], _GRAD_L[i])
+        out[i] = 4.0 * np.outer(GRAD_BARYCENTRIC[i], GRAD_BARYCENTRIC[i])
     for k, (a, b) in enumerate(_EDGE_VERTS):
-        g = np.outer(_GRAD_L[a], _GRAD_L[b])
+        g = np.outer(GRAD_BARYCENTRIC[a], GRAD_BARYCENTRIC[b])
         out[3 + k] = 4.0 * (g + g.T)
     return out
 

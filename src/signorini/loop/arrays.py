@@ -85,9 +85,9 @@ def level_arrays(level: Level) -> dict[str, Any]:
 
 def _p2_edge(values: np.ndarray) -> np.ndarray:
     """Per-edge nodal data ``(e, 3, ...)`` at ``[start, end, midpoint]``; a P1 edge's ``(e, 2,
-    ...)`` with the mean of its ends at the midpoint (:meth:`~signorini.fem.element.Element.
-    edge_values`)."""
-    return values if values.shape[1] == 3 else P1.edge_values(values)
+    ...)`` with the mean of its ends at the midpoint (:meth:`~signorini.fem.facet_element.
+    FacetElement.facet_values`)."""
+    return values if values.shape[1] == 3 else P1.facet.facet_values(values)
 
 
 def _on_edges(ends: np.ndarray, m: int) -> np.ndarray:

@@ -1,0 +1,139 @@
+"""The facet elements: the trace of a Lagrange element on a facet of its cell (an edge in 2D),
+where boundary data, tractions and contact live (docs/method.md, *Discrete problem*, *P1
+elements and their estimator*).
+
+A :class:`FacetElement` holds what the contact boundary reads of an element: the basis on a
+facet, the number of nodes per facet, the contact weights (the shares ``m_z / |F|`` of the
+hats of the contact force density (4.1) and ``w_z / |F|`` of the basis functions on a straight
+facet), the pieces ``γ̃_p`` of a contact facet that belong to each of its nodes with their hats
+(η6) and without (η8), how per-facet nodal data are read as P2 data, and how a nodal force
+becomes the consistent nodal pressure (:meth:`FacetElement.pressure`). The cell's element
+(:class:`~signorini.fem.element.Element`) carries its facet element as ``Element.facet``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..mesh.reference import INTERVAL, ReferenceCell
+from . import p1, p2
+
+__all__ = ["FacetElement", "P1_INTERVAL", "P2_INTERVAL"]
+
+
+@dataclass(frozen=True, eq=False)
+class FacetElement:
+    """The facts of one Lagrange element on a facet of its cell.
+
+    Attributes
+    ----------
+    name : str
+        The cell element's name and the facet's reference cell, e.g. ``"P2 interval"``.
+    reference : ReferenceCell
+        The facet's reference cell (:data:`~signorini.mesh.reference.INTERVAL` in 2D, with
+        the parameter ``t`` in [0, 1] from the facet's start to its end).
+    n_nodes : int
+        Nodes per facet, ``[start, end]`` (P1) or ``[start, end, midpoint]`` (P2).
+    basis : callable
+        Values ``(q, n_nodes)`` of the facet's basis functions at ``t (q,)``.
+    hat_share, basis_share : tuples of n_nodes floats
+        ``∫_F φ_z ds / |F|`` (the hat of the contact force density s_z = Λ_z / m_z, (4.1):
+        the half-edge hats of Q^h (3.6) for P2, the P1 hat for P1) and ``∫_F ψ_z ds / |F|``
+        (the basis function, the consistent pressure's ``w_z``) of each facet node on a
+        straight facet.
+    hat_pieces : tuple of ``(lo, hi, column, (φ(0), φ'))``
+        The pieces ``γ̃_p`` of [0, 1] that belong to each facet node (``column``), with the
+        hat ``φ_p(t) = φ(0) + φ' t`` there (η6): the thirds for P2 (paper (4.12)), the halves
+        for P1.
+    node_parts : tuple of ``(lo, hi, column)``
+        The same pieces without the hat (η8).
+    """
+
+    name: str
+    reference: ReferenceCell
+    n_nodes: int
+    basis: Callable[[np.ndarray], np.ndarray]
+    hat_share: tuple[float, ...]
+    basis_share: tuple[float, ...]
+    hat_pieces: tuple
+    node_parts: tuple
+
+    def __repr__(self) -> str:
+        return self.name
+
+    def facet_values(self, values: np.ndarray) -> np.ndarray:
+        """Per-facet nodal data ``(k, n_nodes, ...)`` as ``(k, 3, ...)`` at ``[start, end,
+        midpoint]``: unchanged for P2; for P1 the midpoint gets the mean of the ends (so the
+        quadratic through the three is the linear interpolant)."""
+        values = np.asarray(values, dtype=np.float64)
+        if self.n_nodes == 3:
+            return values
+        mid = 0.5 * (values[:, 0] + values[:, 1])
+        return np.concatenate([values, mid[:, None]], axis=1)
+
+    def pressure(self, force: np.ndarray, weight: np.ndarray) -> np.ndarray:
+        """The consistent nodal pressure ``p_z = Λ_z / w_z`` of nodal forces ``Λ_z`` (docs/
+        method.md, *Discrete problem*).
+
+        ``w_z = ∫_{Γ_C} ψ_z ds`` is the integral of node z's basis function over its contact
+        facets (``ContactSet.basis_integral``): for a pressure p linear along the facets (P1:
+        constant), ``Λ_z = ∫ p ψ_z ds = p(z) w_z``, so ``p_z`` recovers p at the nodes. On an
+        interval every ``w_z`` is positive (P2: ``|F|/6`` at the ends, ``2|F|/3`` at the
+        midpoint; P1: ``|F|/2``), and this is the division, elementwise. It turns any nodal
+        force of the contact boundary into a stress: the friction force ``Λ_t,z``, the slip
+        bound ``s_z``, a master part's transferred force (``w_k`` over the master's facets).
+
+        The trap in three dimensions: on a P2 triangular face the vertex basis functions
+        integrate to zero, ``∫_F ψ_z = 0``, so ``w_z`` vanishes at a face's vertices and the
+        division is undefined there. A facet element of a 3D cell overrides this method
+        (e.g. with the weights of a dual or lumped basis) instead of dividing.
+
+        Parameters
+        ----------
+        force : (k,) or (k, c) float array
+            Nodal forces ``Λ_z`` (or ``c`` components of them).
+        weight : (k,) float array
+            The nodes' basis integrals ``w_z`` (``(k, 1)`` with a force ``(k, c)``).
+
+        Returns
+        -------
+        float array, the shape of ``force``
+            ``force / weight``.
+        """
+        return force / weight
+
+
+#: P2 on an edge: the half-edge hats of Q^h are linear on [0, 1/3] (start), [2/3, 1] (end)
+#: and on the two halves of the middle third (midpoint), paper (3.6), (4.12)
+P2_INTERVAL = FacetElement(
+    name="P2 interval",
+    reference=INTERVAL,
+    n_nodes=3,
+    basis=p2.edge_basis,
+    hat_share=(1 / 4, 1 / 4, 1 / 2),
+    basis_share=(1 / 6, 1 / 6, 2 / 3),
+    hat_pieces=(
+        (0.0, 1 / 3, 0, (1.0, -2.0)),
+        (2 / 3, 1.0, 1, (-1.0, 2.0)),
+        (1 / 3, 0.5, 2, (0.0, 2.0)),
+        (0.5, 2 / 3, 2, (2.0, -2.0)),
+    ),
+    node_parts=((0.0, 1 / 3, 0), (2 / 3, 1.0, 1), (1 / 3, 2 / 3, 2)),
+)
+
+#: P1 on an edge: the hat φ_z is the basis function (m_z = w_z = |e|/2 per edge at a vertex),
+#: γ̃_p the half of each contact edge next to p (Krause–Veeser–Walloth's choice for linear
+#: elements)
+P1_INTERVAL = FacetElement(
+    name="P1 interval",
+    reference=INTERVAL,
+    n_nodes=2,
+    basis=p1.edge_basis,
+    hat_share=(1 / 2, 1 / 2),
+    basis_share=(1 / 2, 1 / 2),
+    hat_pieces=((0.0, 0.5, 0, (1.0, -1.0)), (0.5, 1.0, 1, (0.0, 1.0))),
+    node_parts=((0.0, 0.5, 0), (0.5, 1.0, 1)),
+)
