@@ -111,7 +111,7 @@ def test_isoparametric_cells_give_the_optimal_rate_with_a_dirichlet_arc_and_chor
     iso_slope, iso_err = energy_slope()
     # straight chords: the same meshes, nodes and data (u_D taken on the arc), but every cell
     # assembled as the straight triangle of its vertices (as before isoparametric cells)
-    monkeypatch.setattr(iso, "curved_edges", lambda mesh: np.zeros(0, dtype=np.int64))
+    monkeypatch.setattr(iso, "curved_facets", lambda mesh: np.zeros(0, dtype=np.int64))
     chord_slope, chord_err = energy_slope()
     print(f"energy error vs Ndof: isoparametric slope {iso_slope:.3f} {iso_err}")
     print(f"energy error vs Ndof: straight chords slope {chord_slope:.3f} {chord_err}")

@@ -26,7 +26,7 @@ from .quadrature import triangle_rule
 
 __all__ = [
     "STIFFNESS_DEGREE",
-    "curved_edges",
+    "curved_facets",
     "curved_cells",
     "geometry",
     "folded",
@@ -42,18 +42,19 @@ __all__ = [
 STIFFNESS_DEGREE = 4
 
 
-def curved_edges(mesh: Mesh) -> np.ndarray:
-    """Sorted indices of the boundary edges on parts carrying a curve that is not a line."""
+def curved_facets(mesh: Mesh) -> np.ndarray:
+    """Sorted indices of the boundary facets (edges in 2D) on parts carrying a curve that is
+    not a line."""
     curved = [i for i, c in enumerate(mesh.curves) if c is not None and not isinstance(c, Line)]
     if not curved:
         return np.zeros(0, dtype=np.int64)
-    return np.flatnonzero(np.isin(mesh.edge_part, curved))
+    return np.flatnonzero(np.isin(mesh.facet_part, curved))
 
 
 def curved_cells(mesh: Mesh) -> np.ndarray:
-    """Sorted indices of the cells with an edge on a curved part (their isoparametric cells)."""
-    edges = curved_edges(mesh)
-    return np.unique(mesh.edge2cell[edges, 0])
+    """Sorted indices of the cells with a facet on a curved part (their isoparametric cells)."""
+    facets = curved_facets(mesh)
+    return np.unique(mesh.facet2cell[facets, 0])
 
 
 def geometry(nodes: np.ndarray, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
