@@ -29,7 +29,7 @@ from collections.abc import Callable, Iterator
 
 import numpy as np
 
-from ..mesh.geometry import segment_normals, spanned_normals
+from ..mesh.geometry import facet_normals, spanned_normals
 from ..mesh.jacobians import determinant, inverse_transpose
 from ..mesh.reference import TRIANGLE
 from . import iso, p2
@@ -66,7 +66,7 @@ class StraightEdges:
 
     def __init__(self, ends: np.ndarray) -> None:
         self.ends = np.asarray(ends, dtype=np.float64)
-        self.length, self._normal = segment_normals(self.ends[:, 0], self.ends[:, 1])
+        self.length, self._normal = facet_normals(self.ends)
 
     def __len__(self) -> int:
         return len(self.ends)
