@@ -65,7 +65,7 @@ def _rows(space: P2Space, slave: str, master: str, method: str):
         coupling = c.M
     else:  # node-to-segment: the slave node's projection (along n_j) onto the master edge
         x = space.node_points[c.slave_nodes]
-        edges = space.edge_nodes(space.mesh.part_edges(master))
+        edges = space.facet_nodes(space.mesh.part_facets(master))
         a, b = space.node_points[edges[:, 0]], space.node_points[edges[:, 1]]
         lo, hi = np.minimum(a[:, 0], b[:, 0]), np.maximum(a[:, 0], b[:, 0])
         inside = (x[:, None, 0] >= lo - 1e-14) & (x[:, None, 0] <= hi + 1e-14)
@@ -92,8 +92,8 @@ def pressure_deviation(n_upper: int, n_lower: int, slave: str, method: str) -> f
     mesh = space.mesh
     n = space.n_dofs
     K = assemble_stiffness(space.mapping, space.cell_dofs, n, Material.from_young(1.0, 0.3))
-    top = mesh.part_edges("up.top")
-    nodes = space.edge_nodes(top)
+    top = mesh.part_facets("up.top")
+    nodes = space.facet_nodes(top)
     dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1, 6)
     F = assemble_edge_load(
         StraightEdges(space.node_points[nodes[:, :2]]), dofs, n, lambda x, nu: np.array([0.0, -1.0])

@@ -111,7 +111,7 @@ def test_isoparametric_cells_give_the_optimal_rate_with_a_dirichlet_arc_and_chor
     iso_slope, iso_err = energy_slope()
     # straight chords: the same meshes, nodes and data (u_D taken on the arc), but every cell
     # assembled as the straight triangle of its vertices (as before isoparametric cells)
-    monkeypatch.setattr(iso, "curved_edges", lambda mesh: np.zeros(0, dtype=np.int64))
+    monkeypatch.setattr(iso, "curved_facets", lambda mesh: np.zeros(0, dtype=np.int64))
     chord_slope, chord_err = energy_slope()
     print(f"energy error vs Ndof: isoparametric slope {iso_slope:.3f} {iso_err}")
     print(f"energy error vs Ndof: straight chords slope {chord_slope:.3f} {chord_err}")
@@ -171,8 +171,8 @@ def test_curved_stiffness_is_symmetric_with_exactly_three_rigid_body_modes():
 def test_curved_cells_are_the_cells_touching_a_curved_arc():
     mesh = refine_uniform(curved_sector()).mesh
     cells = iso.curved_cells(mesh)
-    arcs = np.concatenate([mesh.part_edges("inner"), mesh.part_edges("outer")])
-    assert np.array_equal(cells, np.unique(mesh.edge2cell[arcs, 0]))
+    arcs = np.concatenate([mesh.part_facets("inner"), mesh.part_facets("outer")])
+    assert np.array_equal(cells, np.unique(mesh.facet2cell[arcs, 0]))
     assert cells.size == arcs.size  # no cell has two edges on the arcs here
     assert P2Space(annulus_sector()).curved is None
 
@@ -196,8 +196,8 @@ def test_curved_edge_load_integrates_along_the_arc():
     # a unit traction on the quarter circle of radius 1: total force = the arc length pi / 2
     mesh = curved_sector()
     space = P2Space(mesh)
-    edges = mesh.part_edges("inner")
-    nodes = space.edge_nodes(edges)
+    edges = mesh.part_facets("inner")
+    nodes = space.facet_nodes(edges)
     dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1, 6)
     one = lambda x, n: np.broadcast_to([1.0, 0.0], x.shape)  # noqa: E731
     ends = mesh.points[nodes[:, :2]]

@@ -8,7 +8,7 @@ from contact_problems import random_quadratic
 from fem_problems import SquareMesh
 
 from signorini.fem import p2
-from signorini.fem.loads import assemble_body_force, assemble_edge_load
+from signorini.fem.loads import assemble_body_force, assemble_facet_load
 from signorini.fem.material import Material
 from signorini.fem.stiffness import assemble_stiffness
 
@@ -61,7 +61,7 @@ def test_body_force_constant_broadcasts():
     assert np.allclose(F[1 : 2 * mesh.n_points : 2], 0.0, atol=1e-15)
 
 
-def test_edge_load_polynomial_exact_and_normals():
+def test_facet_load_polynomial_exact_and_normals():
     mesh = SquareMesh(3, RNG, perturb=0.3)
     ev, ed = mesh.bedge_vertices, mesh.bedge_dofs
 
@@ -69,7 +69,7 @@ def test_edge_load_polynomial_exact_and_normals():
         X, Y = x[..., 0], x[..., 1]
         return np.stack([X**3 + Y, X * Y**2], axis=-1) + 0 * normal
 
-    G = assemble_edge_load(ev, ed, mesh.n_dofs, g, degree=5)
+    G = assemble_facet_load(ev, ed, mesh.n_dofs, g, degree=5)
     # independent: 6-point Gauss-Legendre per edge, basis (start, end, mid)
     t, w = np.polynomial.legendre.leggauss(6)
     t, w = 0.5 * (t + 1), 0.5 * w
@@ -85,10 +85,10 @@ def test_edge_load_polynomial_exact_and_normals():
     assert G[0::2].sum() == pytest.approx(0.25 + 1.5 + 1.25 + 0.5, rel=1e-13)
     # the outward unit normals integrate to zero around the closed boundary, and
     # on each side to the side length times its normal
-    Gn = assemble_edge_load(ev, ed, mesh.n_dofs, lambda x, n: np.broadcast_to(n, x.shape))
+    Gn = assemble_facet_load(ev, ed, mesh.n_dofs, lambda x, n: np.broadcast_to(n, x.shape))
     assert np.allclose([Gn[0::2].sum(), Gn[1::2].sum()], 0.0, atol=1e-14)
     right = ev.mean(axis=1)[:, 0] > 1 - 1e-12
-    Gr = assemble_edge_load(ev[right], ed[right], mesh.n_dofs, lambda x, n: n + 0 * x)
+    Gr = assemble_facet_load(ev[right], ed[right], mesh.n_dofs, lambda x, n: n + 0 * x)
     assert Gr[0::2].sum() == pytest.approx(1.0, rel=1e-14)
     assert abs(Gr[1::2].sum()) < 1e-15
 
@@ -144,7 +144,7 @@ def test_patch_test_with_neumann_tractions(seed):
         seen_normals.append(normal)
         return np.einsum("kqij,kqj->kqi", u.stress(x, MAT), np.broadcast_to(normal, x.shape))
 
-    F = F + assemble_edge_load(ev[neu], mesh.bedge_dofs[neu], mesh.n_dofs, g)
+    F = F + assemble_facet_load(ev[neu], mesh.bedge_dofs[neu], mesh.n_dofs, g)
     normals = seen_normals[0][:, 0]
     expected = np.where(mid[neu, 0:1] > 1 - 1e-12, [[1.0, 0.0]], [[0.0, 1.0]])
     assert np.allclose(normals, expected)

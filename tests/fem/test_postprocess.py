@@ -7,7 +7,7 @@ from fem_problems import SquareMesh
 
 from signorini.fem import p2
 from signorini.fem.material import Material
-from signorini.fem.postprocess import cell_stress, div_stress, edge_traction, traction
+from signorini.fem.postprocess import cell_stress, div_stress, facet_traction, traction
 
 RNG = np.random.default_rng(5)
 MAT = Material.from_lame(1.3, 0.8)
@@ -34,7 +34,7 @@ def test_div_stress_traction_and_edge_traction_for_quadratic_field():
     t = np.array([0.0, 0.3, 1.0])
     for k in range(3):
         le = np.full(m, k)
-        trac, normal = edge_traction(mesh.vertices, u_cell, MAT, le, t)
+        trac, normal = facet_traction(mesh.vertices, u_cell, MAT, le, t)
         start, end = mesh.vertices[:, k], mesh.vertices[:, (k + 1) % 3]
         centroid = mesh.vertices.mean(axis=1)
         assert np.all(np.einsum("mi,mi->m", normal, 0.5 * (start + end) - centroid) > 0)
@@ -56,8 +56,8 @@ def test_stress_jump_vanishes_for_quadratic_and_not_for_cubic():
 
     def jump(field):
         u_cell = mesh.interpolate(field)[mesh.cell_dofs]
-        ta, na = edge_traction(mesh.vertices[[lower]], u_cell[[lower]], MAT, np.array([2]), t)
-        tb, nb = edge_traction(mesh.vertices[[upper]], u_cell[[upper]], MAT, np.array([0]), 1 - t)
+        ta, na = facet_traction(mesh.vertices[[lower]], u_cell[[lower]], MAT, np.array([2]), t)
+        tb, nb = facet_traction(mesh.vertices[[upper]], u_cell[[upper]], MAT, np.array([0]), 1 - t)
         assert np.allclose(na, -nb)
         return np.abs(ta + tb).max()
 

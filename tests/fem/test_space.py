@@ -95,8 +95,8 @@ def test_edge_nodes_counter_clockwise_with_outward_normals():
     space = P2Space(mesh)
     outward = {"bottom": (0, -1), "right": (1, 0), "top": (0, 1), "left": (-1, 0)}
     for name, n in outward.items():
-        edges = mesh.part_edges(name)
-        en = space.edge_nodes(edges)
+        edges = mesh.part_facets(name)
+        en = space.facet_nodes(edges)
         a, b = space.node_points[en[:, 0]], space.node_points[en[:, 1]]
         d = b - a
         normal = np.column_stack([d[:, 1], -d[:, 0]]) / np.hypot(d[:, 0], d[:, 1])[:, None]

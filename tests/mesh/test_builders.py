@@ -31,13 +31,13 @@ def test_counts_area_and_parts(pattern: str, nx: int, ny: int, box) -> None:
         ("left", y1 - y0, ny),
         ("right", y1 - y0, ny),
     ]:
-        assert m.part_length(name) == pytest.approx(length, rel=1e-13)
-        assert m.part_edges(name).size == count
+        assert m.part_measure(name) == pytest.approx(length, rel=1e-13)
+        assert m.part_facets(name).size == count
     mid = m.edge_midpoints
-    assert np.all(mid[m.part_edges("bottom"), 1] == y0)
-    assert np.all(mid[m.part_edges("top"), 1] == y1)
-    assert np.all(mid[m.part_edges("left"), 0] == x0)
-    assert np.all(mid[m.part_edges("right"), 0] == x1)
+    assert np.all(mid[m.part_facets("bottom"), 1] == y0)
+    assert np.all(mid[m.part_facets("top"), 1] == y1)
+    assert np.all(mid[m.part_facets("left"), 0] == x0)
+    assert np.all(mid[m.part_facets("right"), 0] == x1)
     # every grid square is covered exactly: the cells whose centroid lies in it fill it
     dx, dy = (x1 - x0) / nx, (y1 - y0) / ny
     centroid = m.points[m.cells].mean(axis=1)
@@ -163,5 +163,5 @@ def test_rectangle_accepts_integral_floats() -> None:
     m, ref = rectangle(nx=3.0, ny=2.0), rectangle(nx=3, ny=2)
     assert np.array_equal(m.points, ref.points) and np.array_equal(m.cells, ref.cells)
     assert np.array_equal(m.boundary_part, ref.boundary_part)
-    assert m.part_length("bottom") == pytest.approx(1.0, rel=1e-14)
-    assert m.part_edges("left").size == 2
+    assert m.part_measure("bottom") == pytest.approx(1.0, rel=1e-14)
+    assert m.part_facets("left").size == 2

@@ -25,7 +25,7 @@ def disc(k: int = 8, radius: float = 1.0, center=(0.0, 0.0)) -> Mesh:
 
 
 def on_circle_error(mesh: Mesh, part: str, center, radius) -> float:
-    v = np.unique(mesh.edges[mesh.part_edges(part)])
+    v = np.unique(mesh.edges[mesh.part_facets(part)])
     r = np.hypot(*(mesh.points[v] - center).T)
     return float(np.abs(r / radius - 1).max())
 
@@ -77,8 +77,8 @@ def test_a_quarter_disc_keeps_straight_sides_straight_and_its_arc_on_the_circle(
     for _ in range(4):
         mesh = refine_uniform(mesh).mesh
     assert on_circle_error(mesh, "arc", (0, 0), 1) <= 1e-14
-    assert np.all(mesh.points[np.unique(mesh.edges[mesh.part_edges("bottom")]), 1] == 0)
-    assert np.all(mesh.points[np.unique(mesh.edges[mesh.part_edges("left")]), 0] == 0)
+    assert np.all(mesh.points[np.unique(mesh.edges[mesh.part_facets("bottom")]), 1] == 0)
+    assert np.all(mesh.points[np.unique(mesh.edges[mesh.part_facets("left")]), 0] == 0)
 
 
 def test_a_straight_mesh_refines_exactly_as_without_curves():
@@ -99,7 +99,7 @@ def test_a_straight_mesh_refines_exactly_as_without_curves():
 def test_p2_edge_nodes_of_curved_edges_lie_on_the_curve_and_prolongation_follows_the_parent():
     mesh = disc(8).with_curve("arc", Circle((0, 0), 1))
     space = P2Space(mesh)
-    arc = mesh.part_edges("arc")
+    arc = mesh.part_facets("arc")
     mid = space.node_points[mesh.n_points + arc]
     assert np.abs(np.hypot(*mid.T) - 1).max() <= 1e-15
     inner = np.setdiff1d(np.arange(mesh.n_edges), arc)

@@ -32,8 +32,8 @@ def gmsh_square(mesh, *, order: int = 1, with_lines: bool = True):
     blocks = [(kinds[0], cells)]
     physical = [np.full(len(cells), 10)]
     if with_lines:
-        edges = [mesh.part_edges(n) for n in mesh.part_names]
-        lines = np.vstack([space.edge_nodes(e)[:, : order + 1] for e in edges])
+        edges = [mesh.part_facets(n) for n in mesh.part_names]
+        lines = np.vstack([space.facet_nodes(e)[:, : order + 1] for e in edges])
         tags = np.concatenate(
             [np.full(e.size, names[n]) for n, e in zip(mesh.part_names, edges, strict=True)]
         )
@@ -61,9 +61,9 @@ def test_read_mesh_from_gmsh_file(tmp_path, order, binary):
     assert np.all(mesh.area > 0) and mesh.area.sum() == pytest.approx(1.0, rel=1e-14)
     side = {"bottom": (1, 0.0), "right": (0, 1.0), "top": (1, 1.0), "left": (0, 0.0)}
     for name, (axis, value) in side.items():
-        pts = mesh.points[mesh.edges[mesh.part_edges(name)]]
+        pts = mesh.points[mesh.edges[mesh.part_facets(name)]]
         np.testing.assert_array_equal(pts[..., axis], value)
-        assert mesh.part_length(name) == pytest.approx(1.0, rel=1e-14)
+        assert mesh.part_measure(name) == pytest.approx(1.0, rel=1e-14)
     # the same problem on the mesh read back gives the same discrete solution
     again = dataclasses.replace(problem, mesh=mesh)
     eta_file, eta_orig = estimate(solve(again)).eta, estimate(solve(problem)).eta

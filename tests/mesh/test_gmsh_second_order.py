@@ -69,8 +69,8 @@ def gmsh_file(mesh: Mesh, order: int) -> meshio.Mesh:
     vertices; physical line groups name the parts."""
     space = P2Space(mesh)
     tags = {name: i + 1 for i, name in enumerate(mesh.part_names)}
-    edges = [mesh.part_edges(name) for name in mesh.part_names]
-    lines = np.vstack([space.edge_nodes(e)[:, : order + 1] for e in edges])
+    edges = [mesh.part_facets(name) for name in mesh.part_names]
+    lines = np.vstack([space.facet_nodes(e)[:, : order + 1] for e in edges])
     line_tags = np.concatenate([np.full(e.size, tags[n]) for n, e in zip(tags, edges, strict=True)])
     if order == 1:
         points, cells, kinds = mesh.points, mesh.cells, ("triangle", "line")
@@ -97,7 +97,7 @@ def radial_error(mesh: Mesh) -> float:
     """Largest distance of a vertex of the arc parts from its circle."""
     errors = []
     for name, rho in ARCS.items():
-        v = np.unique(mesh.edges[mesh.part_edges(name)])
+        v = np.unique(mesh.edges[mesh.part_facets(name)])
         errors.append(np.abs(np.hypot(*mesh.points[v].T) - rho).max())
     return float(max(errors))
 
@@ -124,11 +124,11 @@ def test_the_arc_parts_carry_the_files_quadratics_and_the_p2_nodes_are_the_files
     # every P2 node is the file's node: vertices, chord midpoints and the arc midpoints
     np.testing.assert_array_equal(space.node_points, written.points[:, :2])
     # the cells along the arcs are isoparametric, the others affine
-    arcs = np.concatenate([mesh.part_edges("inner"), mesh.part_edges("outer")])
-    np.testing.assert_array_equal(iso.curved_cells(mesh), np.unique(mesh.edge2cell[arcs, 0]))
+    arcs = np.concatenate([mesh.part_facets("inner"), mesh.part_facets("outer")])
+    np.testing.assert_array_equal(iso.curved_cells(mesh), np.unique(mesh.facet2cell[arcs, 0]))
     assert space.curved is not None and space.curved[0].size == arcs.size
     # the outward normal of the file's quadratics: towards the centre on the inner arc
-    x = space.node_points[mesh.n_points + mesh.part_edges("inner")]
+    x = space.node_points[mesh.n_points + mesh.part_facets("inner")]
     np.testing.assert_allclose(curves["inner"].normal(x), -x, atol=1e-15)
 
 
@@ -146,7 +146,7 @@ def test_refinement_stays_on_the_files_quadratics_and_keeps_every_cell_valid(tmp
         # boundary is those quadratics: the discrete domain keeps its area to round-off
         for name in ARCS:
             curve = second.curves[second.part_index(name)]
-            v = np.unique(second.edges[second.part_edges(name)])
+            v = np.unique(second.edges[second.part_facets(name)])
             assert np.abs(curve.project(second.points[v]) - second.points[v]).max() <= 1e-15
         assert abs(isoparametric_area(second) - area0) <= 1e-14 * area0
         errors.append(radial_error(second))
@@ -171,10 +171,10 @@ def test_adaptive_refinement_stays_on_the_files_quadratics(tmp_path):
         assert mesh.area.min() > 0 and iso.folded(P2Space(mesh).curved[1]).size == 0
     for name in ARCS:
         curve = mesh.curves[mesh.part_index(name)]
-        v = np.unique(mesh.edges[mesh.part_edges(name)])
+        v = np.unique(mesh.edges[mesh.part_facets(name)])
         assert np.abs(curve.project(mesh.points[v]) - mesh.points[v]).max() <= 1e-15
     change = abs(isoparametric_area(mesh) - area0) / area0
-    lengths = mesh.edge_length[mesh.part_edges("outer")]
+    lengths = mesh.edge_length[mesh.part_facets("outer")]
     print(
         f"outer arc edges from {lengths.min():.2e} to {lengths.max():.2e}; area change {change:.1e}"
     )
@@ -291,11 +291,11 @@ def test_with_curve_replaces_the_files_curve(tmp_path):
     assert isinstance(exact.curves[exact.part_index("outer")], Circle)
     assert isinstance(exact.curves[exact.part_index("inner")], QuadraticBoundary)
     # the circle's halfway points are the file's midpoints up to round-off
-    e = mesh.part_edges("outer")
+    e = mesh.part_facets("outer")
     assert np.abs(exact.curved_midpoints[e] - mesh.curved_midpoints[e]).max() <= 1e-15
     for _ in range(3):
         exact = refine_uniform(exact).mesh
-    v = np.unique(exact.edges[exact.part_edges("outer")])
+    v = np.unique(exact.edges[exact.part_facets("outer")])
     off = np.abs(np.hypot(*exact.points[v].T) - 2).max()
     print(f"outer arc with the exact circle after 3 refinements: radial error {off:.1e}")
     assert off <= 1e-14
@@ -336,9 +336,9 @@ def moved_midpoint(edge_of: str, shift) -> meshio.Mesh:
     mesh = sector(4)
     m = gmsh_file(mesh, order=2)
     if edge_of == "interior":
-        e = int(np.flatnonzero(mesh.edge2cell[:, 1] >= 0)[0])
+        e = int(np.flatnonzero(mesh.facet2cell[:, 1] >= 0)[0])
     else:
-        e = int(mesh.part_edges(edge_of)[0])
+        e = int(mesh.part_facets(edge_of)[0])
     a, b = mesh.points[mesh.edges[e]]
     m.points[mesh.n_points + e, :2] += shift(a, b)
     return m

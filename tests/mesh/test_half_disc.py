@@ -47,12 +47,12 @@ def test_parts_lengths_and_cells(rings: int):
     mesh = half_disc(radius, rings)
     assert mesh.n_cells == 3 * rings**2
     assert mesh.part_names == ("top", "arc")
-    assert mesh.part_length("top") == pytest.approx(2 * radius, rel=1e-14)
+    assert mesh.part_measure("top") == pytest.approx(2 * radius, rel=1e-14)
     n_arc = 3 * rings
-    assert mesh.part_edges("arc").size == n_arc
+    assert mesh.part_facets("arc").size == n_arc
     # the arc's chords: n_arc equal chords of the angle π / n_arc
     chord = 2 * radius * np.sin(np.pi / (2 * n_arc))
-    assert mesh.part_length("arc") == pytest.approx(n_arc * chord, rel=1e-13)
+    assert mesh.part_measure("arc") == pytest.approx(n_arc * chord, rel=1e-13)
     assert np.all(mesh.area > 0)
     assert mesh.min_angle() > np.radians(29.9), np.degrees(mesh.min_angle())
     curve = mesh.curves[mesh.part_index("arc")]

@@ -46,8 +46,8 @@ def test_edge_claimed_by_two_parts(mapping) -> None:
 def test_predicate_claims_only_unlisted_edges() -> None:
     m = Mesh.from_arrays(SQUARE_P, SQUARE_C, {"rest": everything, "contact": [[1, 0]]})
     assert m.part_names == ("rest", "contact")
-    assert m.part_length("contact") == pytest.approx(1.0, abs=1e-15)
-    assert m.part_length("rest") == pytest.approx(3.0, abs=1e-15)
+    assert m.part_measure("contact") == pytest.approx(1.0, abs=1e-15)
+    assert m.part_measure("rest") == pytest.approx(3.0, abs=1e-15)
 
 
 @pytest.mark.parametrize(
@@ -66,7 +66,7 @@ def test_bad_part_specs(spec, match) -> None:
 def test_unknown_part_name() -> None:
     m = rectangle()
     with pytest.raises(MeshError, match=r"no boundary part 'contact'; its parts are \['bottom'"):
-        m.part_edges("contact")
+        m.part_facets("contact")
 
 
 # ---------------------------------------------------------------------------- positive cases
@@ -81,11 +81,11 @@ def test_from_arrays_with_predicates() -> None:
     m = Mesh.from_arrays(p, c, parts)
     assert m.part_names == ("bottom", "right", "top", "left")
     for name in m.part_names:
-        assert m.part_length(name) == pytest.approx(1.0, rel=1e-14)
-        assert m.part_edges(name).size == 5  # 6 points per side
+        assert m.part_measure(name) == pytest.approx(1.0, rel=1e-14)
+        assert m.part_facets(name).size == 5  # 6 points per side
     mid = m.edge_midpoints
-    assert np.all(mid[m.part_edges("bottom"), 1] == 0.0)
-    assert np.all(mid[m.part_edges("left"), 0] == 0.0)
+    assert np.all(mid[m.part_facets("bottom"), 1] == 0.0)
+    assert np.all(mid[m.part_facets("left"), 0] == 0.0)
     assert m.area.sum() == pytest.approx(1.0, rel=1e-14)
 
 
@@ -95,16 +95,16 @@ def test_from_arrays_with_edge_lists() -> None:
     m = Mesh.from_arrays(p, c, {"south": [[1, 0]], "east": [1, 2], "rest": [[2, 3], [0, 3]]})
     expect = {"south": {0, 1}, "east": {1, 2}, "rest": {2, 3, 0}}
     for name, verts in expect.items():
-        e = m.edges[m.part_edges(name)]
+        e = m.edges[m.part_facets(name)]
         assert set(e.ravel().tolist()) == verts
-    assert m.part_length("rest") == pytest.approx(2.0, abs=1e-15)
-    assert m.edge_part[m.edge2cell[:, 1] >= 0].tolist() == [-1] * 4
-    assert sorted(m.edge_part[m.edge2cell[:, 1] < 0].tolist()) == [0, 1, 2, 2]
+    assert m.part_measure("rest") == pytest.approx(2.0, abs=1e-15)
+    assert m.facet_part[m.facet2cell[:, 1] >= 0].tolist() == [-1] * 4
+    assert sorted(m.facet_part[m.facet2cell[:, 1] < 0].tolist()) == [0, 1, 2, 2]
 
 
 def test_mesh_is_immutable() -> None:
     m = rectangle(nx=2, ny=2)
-    for a in (m.points, m.cells, m.boundary, m.boundary_part, m.edge_part):
+    for a in (m.points, m.cells, m.boundary, m.boundary_part, m.facet_part):
         with pytest.raises(ValueError, match="read-only"):
             a[0] = 0
 
@@ -132,12 +132,12 @@ def test_topology_matches_brute_force(name: str) -> None:
         occ = ref[frozenset(pair)]
         # cell2edge: local edge k of cell t is this edge for every occurrence (t, k)
         assert all(m.cell2edge[t, k] == e for t, k in occ)
-        cells = set(m.edge2cell[e].tolist()) - {-1}
+        cells = set(m.facet2cell[e].tolist()) - {-1}
         assert cells == {t for t, _ in occ}
         if len(occ) == 1:
-            assert m.edge2cell[e, 0] == occ[0][0] and m.edge2cell[e, 1] == -1
+            assert m.facet2cell[e, 0] == occ[0][0] and m.facet2cell[e, 1] == -1
         else:
-            assert len(occ) == 2 and m.edge2cell[e, 1] >= 0
+            assert len(occ) == 2 and m.facet2cell[e, 1] >= 0
     # Euler: V - E + F = 1 for a triangulated disc
     assert m.n_points - m.n_edges + m.n_cells == 1
 
@@ -157,11 +157,11 @@ def test_boundary_edges_have_one_cell(name: str) -> None:
     p, c = HAND_MESHES[name]()
     m = Mesh.from_arrays(p, c, ALL)
     counts = np.bincount(m.cell2edge.ravel(), minlength=m.n_edges)
-    on_boundary = m.edge2cell[:, 1] == -1
+    on_boundary = m.facet2cell[:, 1] == -1
     assert np.array_equal(on_boundary, counts == 1)
-    assert np.all(m.edge2cell[:, 0] >= 0)
-    assert np.array_equal(np.sort(m.boundary_edge), np.flatnonzero(on_boundary))
-    assert np.array_equal(m.edge_part >= 0, on_boundary)
+    assert np.all(m.facet2cell[:, 0] >= 0)
+    assert np.array_equal(np.sort(m.boundary_facet), np.flatnonzero(on_boundary))
+    assert np.array_equal(m.facet_part >= 0, on_boundary)
     # boundary_edges() gives each boundary edge once, in its cell's counter-clockwise order
     be = boundary_edges(m.cells)
     assert len(be) == on_boundary.sum()
@@ -175,13 +175,13 @@ def test_edge_local_is_the_index_of_the_edge_in_its_cells(name: str) -> None:
     m = Mesh.from_arrays(p, c, ALL)
     e = np.arange(m.n_edges)
     for side in range(2):
-        has = m.edge2cell[:, side] >= 0
-        cell, k = m.edge2cell[has, side], m.edge_local[has, side]
+        has = m.facet2cell[:, side] >= 0
+        cell, k = m.facet2cell[has, side], m.facet_local[has, side]
         assert np.array_equal(m.cell2edge[cell, k], e[has])
         # local edge k joins local vertices k and k + 1
         pair = np.sort(np.column_stack([m.cells[cell, k], m.cells[cell, (k + 1) % 3]]), axis=1)
         assert np.array_equal(pair, m.edges[has])
-    assert np.array_equal(m.edge_local[:, 1] < 0, m.edge2cell[:, 1] < 0)
+    assert np.array_equal(m.facet_local[:, 1] < 0, m.facet2cell[:, 1] < 0)
 
 
 def test_topology_is_computed_once() -> None:
@@ -209,12 +209,12 @@ def test_oriented_boundary_is_counter_clockwise() -> None:
     m = rectangle(-1.0, 2.0, 0.5, 1.5, nx=3, ny=2, pattern="crossed")
     outward = {"bottom": (0, -1), "right": (1, 0), "top": (0, 1), "left": (-1, 0)}
     for name, normal in outward.items():
-        pairs = m.oriented_boundary(m.part_edges(name))
+        pairs = m.oriented_boundary(m.part_facets(name))
         t = m.points[pairs[:, 1]] - m.points[pairs[:, 0]]
         n = np.column_stack([t[:, 1], -t[:, 0]]) / np.linalg.norm(t, axis=1)[:, None]
         assert np.allclose(n, normal, atol=1e-15)
     # the whole oriented boundary encloses the area positively (shoelace formula)
-    pairs = m.oriented_boundary(m.boundary_edge)
+    pairs = m.oriented_boundary(m.boundary_facet)
     a, b = m.points[pairs[:, 0]], m.points[pairs[:, 1]]
     assert 0.5 * np.sum(a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]) == pytest.approx(3.0, rel=1e-14)
 
@@ -223,10 +223,10 @@ def test_oriented_boundary_is_counter_clockwise() -> None:
 def test_oriented_boundary_keeps_cell_on_the_left(name: str) -> None:
     p, c = HAND_MESHES[name]()
     m = Mesh.from_arrays(p, c, ALL)
-    e = m.boundary_edge
+    e = m.boundary_facet
     pairs = m.oriented_boundary(e)
     assert np.array_equal(np.sort(pairs, axis=1), m.edges[e])
-    third = m.cells[m.edge2cell[e, 0]].sum(axis=1) - pairs.sum(axis=1)
+    third = m.cells[m.facet2cell[e, 0]].sum(axis=1) - pairs.sum(axis=1)
     a, b, x = m.points[pairs[:, 0]], m.points[pairs[:, 1]], m.points[third]
     cross = (b - a)[:, 0] * (x - a)[:, 1] - (b - a)[:, 1] * (x - a)[:, 0]
     assert np.all(cross > 0)
@@ -280,8 +280,8 @@ def test_long_boundary_validates(nx: int, ny: int) -> None:
     # 40 000 boundary edges: the hanging-node check must not compare all pairs
     m = rectangle(0, nx, 0, ny, nx=nx, ny=ny, pattern="left")
     assert len(m.boundary) == 2 * (nx + ny)
-    assert m.part_length("bottom") == pytest.approx(nx, rel=1e-12)
-    assert m.part_length("left") == pytest.approx(ny, rel=1e-12)
+    assert m.part_measure("bottom") == pytest.approx(nx, rel=1e-12)
+    assert m.part_measure("left") == pytest.approx(ny, rel=1e-12)
     assert m.area.sum() == pytest.approx(nx * ny, rel=1e-12)
 
 
@@ -315,7 +315,7 @@ def test_selectors_are_called_with_points_of_shape_n_2() -> None:
 
     m = Mesh.from_arrays(SQUARE_P, SQUARE_C, {"right": right, "rest": lambda x: x[:, 0] < 1})
     assert seen == [(4, 2)]
-    assert m.edges[m.part_edges("right")].tolist() == [[1, 2]]
+    assert m.edges[m.part_facets("right")].tolist() == [[1, 2]]
 
 
 def test_old_two_argument_selectors_warn_and_still_work() -> None:
@@ -329,7 +329,7 @@ def test_old_two_argument_selectors_warn_and_still_work() -> None:
         old = Mesh.from_arrays(SQUARE_P, SQUARE_C, {"right": lambda x, y: x > 0.5, **rest})
     assert len(record) == 1 and record[0].filename == __file__
     np.testing.assert_array_equal(old.boundary_part, new.boundary_part)
-    np.testing.assert_array_equal(old.part_edges("right"), new.part_edges("right"))
+    np.testing.assert_array_equal(old.part_facets("right"), new.part_facets("right"))
 
 
 def test_selector_that_raises_is_named() -> None:

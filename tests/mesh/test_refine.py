@@ -105,7 +105,7 @@ def check_refinement(old: Mesh, ref: Refinement, marked: np.ndarray | None) -> N
         np.bincount(parent, weights=new.area, minlength=old.n_cells), old.area, rtol=1e-12, atol=0
     )
     for name in old.part_names:
-        assert new.part_length(name) == pytest.approx(old.part_length(name), rel=1e-13)
+        assert new.part_measure(name) == pytest.approx(old.part_measure(name), rel=1e-13)
     # parts survive: each new boundary edge lies on an old boundary edge of the same part
     origin = np.full(new.n_points, -1, dtype=np.int64)  # old edge bisected at a new point
     origin[edge_point[bisected]] = np.flatnonzero(bisected)
@@ -118,7 +118,7 @@ def check_refinement(old: Mesh, ref: Refinement, marked: np.ndarray | None) -> N
     whole = np.sort(new.boundary[~from_split], axis=1)
     old_edge[~from_split] = np.searchsorted(keys, whole[:, 0] * old.n_points + whole[:, 1])
     assert np.array_equal(old.edges[old_edge[~from_split]], whole)
-    assert np.array_equal(new.boundary_part, old.edge_part[old_edge])
+    assert np.array_equal(new.boundary_part, old.facet_part[old_edge])
     # a cell with k bisected edges has k + 1 children; unrefined cells are kept as they are
     children = np.bincount(parent, minlength=old.n_cells)
     assert np.array_equal(children, 1 + cut.sum(axis=1))
@@ -282,7 +282,7 @@ def test_closure_propagates_along_a_chain() -> None:
     # in the "right" pattern every refinement edge is a diagonal; marking a leg of a cell
     # forces its diagonal, which is a whole cell's refinement edge on both sides
     m = rectangle(nx=4, ny=1, pattern="right")
-    bottom = m.part_edges("bottom")
+    bottom = m.part_facets("bottom")
     marked = np.zeros(m.n_edges, dtype=bool)
     marked[bottom[0]] = True
     closed = closure(m, marked)
@@ -340,7 +340,7 @@ def test_nvb_properties(mesh: Mesh, steps: int, fraction: float, seed: int) -> N
     classes = reachable_shapes(mesh.points[mesh.cells])
     bound = classes.min()
     area = mesh.area.sum()
-    lengths = {name: mesh.part_length(name) for name in mesh.part_names}
+    lengths = {name: mesh.part_measure(name) for name in mesh.part_names}
     for _ in range(steps):
         marked = rng.random(mesh.n_cells) < fraction
         if not marked.any():
@@ -352,7 +352,7 @@ def test_nvb_properties(mesh: Mesh, steps: int, fraction: float, seed: int) -> N
         assert mesh.min_angle() >= bound - 1e-9
     assert mesh.area.sum() == pytest.approx(area, rel=1e-12)
     for name, length in lengths.items():
-        assert mesh.part_length(name) == pytest.approx(length, rel=1e-12)
+        assert mesh.part_measure(name) == pytest.approx(length, rel=1e-12)
 
 
 @pytest.mark.parametrize(

@@ -108,7 +108,7 @@ def test_bisecting_one_cell_alone_leaves_a_hanging_node(pattern: str) -> None:
     # split each interior-edge cell in turn without touching its neighbour
     m = rectangle(0, 1, 0, 2, nx=3, ny=3, pattern=pattern)
     p = m.points @ np.array([[1.0, 0.4], [0.0, 1.0]]).T
-    interior = np.flatnonzero(m.edge2cell[m.cell2edge[:, 0], 1] >= 0)
+    interior = np.flatnonzero(m.facet2cell[m.cell2edge[:, 0], 1] >= 0)
     assert interior.size > 10
     for t in interior[::3]:
         a, b, c = m.cells[t]

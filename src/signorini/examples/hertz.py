@@ -164,7 +164,7 @@ def hertz_contact(result: ContactResult) -> dict[str, object]:
         "x": x,
         "a": float(2.0 * np.sqrt(force @ x**2 / total)),
         "p0": float(np.max(result.pressure)),
-        "radius": 0.5 * problem.mesh.part_length("top"),
+        "radius": 0.5 * problem.mesh.part_measure("top"),
     }
 
 

@@ -158,7 +158,7 @@ def partial_slip_pressure(result: ContactResult) -> PressureComparison:
         raise ValueError("partial-slip: the half-disc does not touch the plane (no contact force)")
     problem = result.problem
     coefficient = problem.conditions["arc"].friction.coefficient
-    radius = 0.5 * problem.mesh.part_length("top")
+    radius = 0.5 * problem.mesh.part_measure("top")
     a, p0 = hertz_solution(total, radius, problem.material)
     ratio = float(result.tangential_force.sum()) / (coefficient * total)
     c = a * np.sqrt(max(1.0 - abs(ratio), 0.0))

@@ -218,8 +218,8 @@ def stacked_blocks(
 def _pair_materials(result: ContactResult) -> tuple[float, float]:
     """The effective radius and the plane-strain modulus E* of :func:`two_cylinders`."""
     mesh = result.problem.mesh
-    r1 = 0.5 * mesh.part_length("upper.top")
-    r2 = 0.5 * mesh.part_length("lower.top")
+    r1 = 0.5 * mesh.part_measure("upper.top")
+    r2 = 0.5 * mesh.part_measure("lower.top")
     m = result.problem.material
     compliance = sum((1.0 - m[b].poisson ** 2) / m[b].young for b in ("upper", "lower"))
     return r1 * r2 / (r1 + r2), 1.0 / compliance

@@ -18,13 +18,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh.curves import Line
+from ..mesh.geometry import spanned_normals
+from ..mesh.jacobians import determinant, inverse
 from ..mesh.mesh import Mesh
 from . import p2
 from .quadrature import triangle_rule
 
 __all__ = [
     "STIFFNESS_DEGREE",
-    "curved_edges",
+    "curved_facets",
     "curved_cells",
     "geometry",
     "folded",
@@ -40,18 +42,19 @@ __all__ = [
 STIFFNESS_DEGREE = 4
 
 
-def curved_edges(mesh: Mesh) -> np.ndarray:
-    """Sorted indices of the boundary edges on parts carrying a curve that is not a line."""
+def curved_facets(mesh: Mesh) -> np.ndarray:
+    """Sorted indices of the boundary facets (edges in 2D) on parts carrying a curve that is
+    not a line."""
     curved = [i for i, c in enumerate(mesh.curves) if c is not None and not isinstance(c, Line)]
     if not curved:
         return np.zeros(0, dtype=np.int64)
-    return np.flatnonzero(np.isin(mesh.edge_part, curved))
+    return np.flatnonzero(np.isin(mesh.facet_part, curved))
 
 
 def curved_cells(mesh: Mesh) -> np.ndarray:
-    """Sorted indices of the cells with an edge on a curved part (their isoparametric cells)."""
-    edges = curved_edges(mesh)
-    return np.unique(mesh.edge2cell[edges, 0])
+    """Sorted indices of the cells with a facet on a curved part (their isoparametric cells)."""
+    facets = curved_facets(mesh)
+    return np.unique(mesh.facet2cell[facets, 0])
 
 
 def geometry(nodes: np.ndarray, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -67,8 +70,7 @@ def geometry(nodes: np.ndarray, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     nodes = np.asarray(nodes, dtype=np.float64)
     x = np.einsum("qa,mai->mqi", p2.basis(xi), nodes)
     J = np.einsum("qaj,mai->mqij", p2.grad_basis(xi), nodes)
-    det = J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
-    return x, J, det
+    return x, J, determinant(J)
 
 
 def folded(nodes: np.ndarray) -> np.ndarray:
@@ -94,8 +96,7 @@ def edge_geometry(
     dpsi = np.column_stack([4.0 * t - 3.0, 4.0 * t - 1.0, 4.0 - 8.0 * t])  # (q, 3)
     x = np.einsum("qa,kai->kqi", p2.edge_basis(t), nodes)
     dx = np.einsum("qa,kai->kqi", dpsi, nodes)
-    speed = np.hypot(dx[..., 0], dx[..., 1])
-    normal = np.stack([dx[..., 1], -dx[..., 0]], axis=-1) / speed[..., None]
+    speed, normal = spanned_normals(dx[..., None, :])
     return x, speed, normal
 
 
@@ -138,13 +139,7 @@ def field_derivatives(
     dphi_t = np.swapaxes(dphi, -1, -2)
     J = np.swapaxes(np.matmul(dphi_t, nodes[:, None]), -1, -2)
     Du = np.swapaxes(np.matmul(dphi_t, u[:, None]), -1, -2)
-    det = J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
-    Jinv = np.empty_like(J)
-    Jinv[..., 0, 0] = J[..., 1, 1]
-    Jinv[..., 0, 1] = -J[..., 0, 1]
-    Jinv[..., 1, 0] = -J[..., 1, 0]
-    Jinv[..., 1, 1] = J[..., 0, 0]
-    Jinv /= det[..., None, None]
+    Jinv = inverse(J)
     grad = np.matmul(Du, Jinv)
     d2phi = p2.hessian_basis().reshape(6, 4)  # constant: (a, kl)
     D2u = np.swapaxes(u, 1, 2) @ d2phi  # (m, 2, 4): [c, kl]

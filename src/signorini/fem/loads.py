@@ -15,7 +15,7 @@ from .element import P2, Element
 from .mapping import CellMap, Edges, QuadraticEdges, StraightEdges
 from .quadrature import line_rule, triangle_rule
 
-__all__ = ["assemble_body_force", "assemble_edge_load"]
+__all__ = ["assemble_body_force", "assemble_edge_load", "assemble_facet_load"]
 
 
 def assemble_body_force(
@@ -61,9 +61,9 @@ def assemble_body_force(
     return np.bincount(np.ravel(cell_dofs), weights=local.ravel(), minlength=n_dofs)
 
 
-def assemble_edge_load(
-    edges: Edges | np.ndarray,
-    edge_dofs: np.ndarray,
+def assemble_facet_load(
+    facets: Edges | np.ndarray,
+    facet_dofs: np.ndarray,
     n_dofs: int,
     g: Callable[[np.ndarray, np.ndarray], np.ndarray],
     degree: int = 6,
@@ -73,35 +73,39 @@ def assemble_edge_load(
 
     Parameters
     ----------
-    edges : StraightEdges, QuadraticEdges or ndarray of float, shape (k, 2, 2)
-        The boundary edges' geometry (:mod:`signorini.fem.mapping`): straight, or the
-        quadratics ``x(t)`` through start, midpoint (on the curve) and end; an array is
-        the (start, end) of straight edges. Start to end runs in the counter-clockwise
-        order of the edge's cell (so the normal is outward).
-    edge_dofs : ndarray of int, shape (k, 6)
-        Interleaved DOFs of the edge's P2 nodes in the order (start, end, midpoint).
+    facets : StraightEdges, QuadraticEdges or ndarray of float, shape (k, 2, 2)
+        The boundary facets' geometry (edges in 2D; :mod:`signorini.fem.mapping`):
+        straight, or the quadratics ``x(t)`` through start, midpoint (on the curve) and end;
+        an array is the (start, end) of straight edges. Start to end runs in the
+        counter-clockwise order of the facet's cell (so the normal is outward).
+    facet_dofs : ndarray of int, shape (k, 6)
+        Interleaved DOFs of the facet's P2 nodes in the order (start, end, midpoint).
     n_dofs : int
     g : callable
         ``g(x, normal)`` with points ``x (k, q, 2)`` and outward unit normals
         ``normal (k, 1, 2)`` on straight edges, ``(k, q, 2)`` on quadratic ones, returns the
         traction, shape ``(k, q, 2)`` (or broadcastable to it).
     degree : int, optional
-        Gauss-Legendre degree along each edge (exact for ``g`` polynomial of
+        Gauss-Legendre degree along each facet (exact for ``g`` polynomial of
         degree ``degree - 2`` on straight edges); the integral is
         ``int_0^1 g psi |x'(t)| dt``.
     element : Element, optional
-        The element of the DOFs (P2, the default, or P1 with ``edge_dofs (k, 4)`` of
-        ``(start, end)`` on straight edges).
+        The element of the DOFs (P2, the default, or P1 with ``facet_dofs (k, 4)``
+        of ``(start, end)`` on straight edges).
 
     Returns
     -------
     ndarray of float64, shape (n_dofs,)
     """
-    if not isinstance(edges, StraightEdges | QuadraticEdges):
-        edges = StraightEdges(edges)
+    if not isinstance(facets, StraightEdges | QuadraticEdges):
+        facets = StraightEdges(facets)
     t, w = line_rule(degree)
-    x = edges.points(t)
-    gx = np.broadcast_to(np.asarray(g(x, edges.normals(t)), dtype=np.float64), x.shape)
-    ds = np.broadcast_to(edges.speeds(t) * w, x.shape[:2])
+    x = facets.points(t)
+    gx = np.broadcast_to(np.asarray(g(x, facets.normals(t)), dtype=np.float64), x.shape)
+    ds = np.broadcast_to(facets.speeds(t) * w, x.shape[:2])
     local = np.einsum("qa,kqc,kq->kac", element.facet.basis(t), gx, ds)
-    return np.bincount(np.ravel(edge_dofs), weights=local.ravel(), minlength=n_dofs)
+    return np.bincount(np.ravel(facet_dofs), weights=local.ravel(), minlength=n_dofs)
+
+
+#: the former name, read by the contact layer's assembly
+assemble_edge_load = assemble_facet_load

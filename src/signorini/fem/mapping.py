@@ -29,7 +29,8 @@ from collections.abc import Callable, Iterator
 
 import numpy as np
 
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals, spanned_normals
+from ..mesh.jacobians import determinant, inverse_transpose
 from ..mesh.reference import TRIANGLE
 from . import iso, p2
 
@@ -46,21 +47,6 @@ __all__ = [
 EDGE_NODES = TRIANGLE.edge_nodes
 
 _ALL = slice(None)
-
-
-def _det(J: np.ndarray) -> np.ndarray:
-    return J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
-
-
-def _inverse_transpose(J: np.ndarray, det: np.ndarray) -> np.ndarray:
-    """``J^{-T}`` of 2x2 Jacobians ``(..., 2, 2)``."""
-    out = np.empty_like(J)
-    out[..., 0, 0] = J[..., 1, 1]
-    out[..., 0, 1] = -J[..., 1, 0]
-    out[..., 1, 0] = -J[..., 0, 1]
-    out[..., 1, 1] = J[..., 0, 0]
-    out /= det[..., None, None]
-    return out
 
 
 # --------------------------------------------------------------------------- edges
@@ -80,7 +66,7 @@ class StraightEdges:
 
     def __init__(self, ends: np.ndarray) -> None:
         self.ends = np.asarray(ends, dtype=np.float64)
-        self.length, self._normal = segment_normals(self.ends[:, 0], self.ends[:, 1])
+        self.length, self._normal = facet_normals(self.ends)
 
     def __len__(self) -> int:
         return len(self.ends)
@@ -148,7 +134,7 @@ class QuadraticEdges:
         nodes = self.nodes
         dx = (4 * t - 3) * nodes[:, None, 0] + (4 * t - 1) * nodes[:, None, 1]
         dx = dx + (4 - 8 * t) * nodes[:, None, 2]
-        return np.hypot(dx[..., 0], dx[..., 1])
+        return spanned_normals(dx[..., None, :])[0]
 
 
 Edges = StraightEdges | QuadraticEdges
@@ -297,12 +283,12 @@ class IsoparametricCells:
         J = x[:, :, 0] * g[:, :, 0]
         for a in range(1, g.shape[2]):  # a loop over the local basis functions
             J += x[:, :, a] * g[:, :, a]
-        return J, _det(J)
+        return J, determinant(J)
 
     def inverse_transpose(self, xi: np.ndarray) -> np.ndarray:
         """``J^{-T}`` ``(m, q, 2, 2)`` at each point."""
         J, det = self.jacobians(xi)
-        return _inverse_transpose(J, det)
+        return inverse_transpose(J, det)
 
     def measure(self, w: np.ndarray, xi: np.ndarray) -> np.ndarray:
         """``(m, q)`` the weights ``w_q det J(ξ_q)`` of a rule on the reference triangle."""

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..mesh import jacobians
 from ..mesh.reference import TRIANGLE
 
 __all__ = [
@@ -214,7 +215,8 @@ def edge_reference_points(local_edge: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 
 def jacobian(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Jacobians of the affine maps from the reference triangle.
+    """Jacobians of the affine maps from the reference triangle
+    (:func:`signorini.mesh.jacobians.affine_jacobian`).
 
     Parameters
     ----------
@@ -228,14 +230,12 @@ def jacobian(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     det : ndarray of float64, shape (m,)
         ``det J`` = twice the cell area (positive for counter-clockwise cells).
     """
-    v = np.asarray(vertices, dtype=np.float64)
-    J = np.stack([v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]], axis=2)
-    det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
-    return J, det
+    return jacobians.affine_jacobian(vertices)
 
 
 def inverse_transpose(J: np.ndarray, det: np.ndarray | None = None) -> np.ndarray:
-    """Inverse transposes ``J^{-T}`` of a batch of 2x2 Jacobians.
+    """Inverse transposes ``J^{-T}`` of a batch of affine Jacobians, the cofactors times
+    ``1 / det J`` (:func:`signorini.mesh.jacobians.inverse_transpose`).
 
     Parameters
     ----------
@@ -249,17 +249,7 @@ def inverse_transpose(J: np.ndarray, det: np.ndarray | None = None) -> np.ndarra
     ndarray of float64, shape (m, 2, 2)
         ``J^{-T}``; physical gradients are ``J^{-T} grad_xi``.
     """
-    J = np.asarray(J, dtype=np.float64)
-    if det is None:
-        det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
-    inv_det = 1.0 / det
-    out = np.empty_like(J)
-    # J^{-1} = [[d, -b], [-c, a]] / det ; J^{-T} = [[d, -c], [-b, a]] / det
-    out[:, 0, 0] = J[:, 1, 1] * inv_det
-    out[:, 0, 1] = -J[:, 1, 0] * inv_det
-    out[:, 1, 0] = -J[:, 0, 1] * inv_det
-    out[:, 1, 1] = J[:, 0, 0] * inv_det
-    return out
+    return jacobians.inverse_transpose(J, det, reciprocal=True)
 
 
 def physical_points(vertices: np.ndarray, xi: np.ndarray) -> np.ndarray:

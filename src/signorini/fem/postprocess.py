@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from ..mesh.reference import TRIANGLE
 from . import iso, p2
 from .mapping import CellMap
@@ -20,6 +20,7 @@ __all__ = [
     "cell_stress",
     "div_stress",
     "edge_traction",
+    "facet_traction",
     "nodal_stress",
     "stress_divergence",
     "traction",
@@ -92,20 +93,21 @@ def traction(
     return np.einsum("mqij,mqj->mqi", sig, np.broadcast_to(nrm, sig.shape[:-1]))
 
 
-def edge_traction(
+def facet_traction(
     vertices: np.ndarray,
     u_cell: np.ndarray,
     material: Material | CellMaterials,
-    local_edge: np.ndarray,
+    local_facet: np.ndarray,
     t: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Traction ``sigma(u_h) n`` along one local edge of each cell, ``n`` outward.
+    """Traction ``sigma(u_h) n`` along one local facet (an edge in 2D) of each cell, ``n``
+    outward.
 
-    Local edge ``k`` runs from local vertex ``k`` to ``k + 1`` mod 3 (``TRIANGLE.edges[k]``,
-    :mod:`signorini.mesh.reference`); ``t`` is the
-    parameter along it (0 at the start).  The neighbour across an interior edge
-    traverses it the other way: evaluate it at ``1 - t`` to get the same
-    physical points (its normal is the opposite one), e.g. for the jump
+    Local facet ``k`` runs from local vertex ``k`` to ``k + 1`` mod 3
+    (``TRIANGLE.facets[k]``, :mod:`signorini.mesh.reference`); ``t`` is the parameter along
+    it (0 at the start).  The neighbour across an interior facet traverses it the other
+    way: evaluate it at ``1 - t`` to get the same physical points (its normal is the
+    opposite one), e.g. for the jump
     ``[[sigma n]] = sigma_1 n_1 + sigma_2 n_2``.
 
     Parameters
@@ -113,23 +115,27 @@ def edge_traction(
     vertices : ndarray of float, shape (m, 3, 2)
     u_cell : ndarray of float, shape (m, 12)
     material : Material
-    local_edge : ndarray of int, shape (m,)
-        Which local edge of each cell, in {0, 1, 2} (e.g. :attr:`Mesh.edge_local`).
+    local_facet : ndarray of int, shape (m,)
+        Which local facet of each cell, in {0, 1, 2} (e.g. :attr:`Mesh.facet_local`).
     t : ndarray of float, shape (q,)
-        Edge parameters in [0, 1].
+        Parameters in [0, 1] along the facet.
 
     Returns
     -------
     traction : ndarray of float64, shape (m, q, 2)
     normal : ndarray of float64, shape (m, 2)
-        Outward unit normals of those edges.
+        Outward unit normals of those facets.
     """
     v = np.asarray(vertices, dtype=np.float64)
-    le = np.asarray(local_edge)
-    xi = p2.edge_reference_points(le, t)
+    lf = np.asarray(local_facet)
+    xi = p2.edge_reference_points(lf, t)
     rows = np.arange(v.shape[0])
-    _, normal = segment_normals(v[rows, TRIANGLE.edges[le, 0]], v[rows, TRIANGLE.edges[le, 1]])
+    _, normal = facet_normals(v[rows[:, None], TRIANGLE.facets[lf]])
     return traction(v, u_cell, material, xi, normal), normal
+
+
+#: the 2D name of :func:`facet_traction`
+edge_traction = facet_traction
 
 
 def div_stress(

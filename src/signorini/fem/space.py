@@ -3,8 +3,10 @@ interpolation, prolongation; :func:`space_of` chooses one by its element.
 
 Global P2 nodes are the mesh vertices (node index = point index) followed by the edge
 midpoints (node index = ``n_points + edge index``). Vector DOFs are interleaved:
-``dof = d * node + component``, ``d = mesh.dim``. Local node order on a cell: its vertices, then the
-midpoints of local edges 0, 1, 2 (the order of VTK's quadratic triangle / meshio ``triangle6``).
+``dof = d * node + component``, ``d = mesh.dim`` (:mod:`signorini.fem.dofs`, the layout;
+:mod:`signorini.fem.prolongation`, the interpolation on a refined mesh). Local node order on
+a cell: its vertices, then the midpoints of local edges 0, 1, 2 (the order of VTK's quadratic
+triangle / meshio ``triangle6``).
 Global P1 nodes are the mesh vertices; a P1 space is affine on every cell (a curved boundary
 part is approximated by its chords; docs/method.md, *P1 elements and their estimator*).
 """
@@ -20,31 +22,13 @@ from ..mesh.mesh import Mesh
 from ..mesh.reference import TRIANGLE
 from ..mesh.refine import Refinement
 from ..mesh.validation import MeshError
-from . import iso
+from . import dofs, iso
+from .dofs import node_dofs
 from .element import P1, P2, Element, element_of
 from .mapping import CellMap, QuadraticEdges, StraightEdges, edge_groups
-from .p2 import basis_barycentric
+from .prolongation import prolongate_p1, prolongate_p2
 
 __all__ = ["LagrangeSpace", "P1Space", "P2Space", "node_dofs", "space_of"]
-
-
-def node_dofs(nodes: np.ndarray, n_components: int) -> np.ndarray:
-    """The interleaved DOFs ``n_components * node + c`` of ``nodes``.
-
-    Parameters
-    ----------
-    nodes : (...) int array
-        Global nodes.
-    n_components : int
-        The components per node, ``d``.
-
-    Returns
-    -------
-    (..., d) int array
-        ``[d * node, d * node + 1, …, d * node + d − 1]`` per node, in the dtype of ``nodes``.
-    """
-    nodes = np.asarray(nodes)
-    return n_components * nodes[..., None] + np.arange(n_components, dtype=nodes.dtype)
 
 
 class LagrangeSpace:
@@ -79,8 +63,7 @@ class LagrangeSpace:
     def cell_dofs(self) -> np.ndarray:
         """``(n_cells, d n_local)`` interleaved global DOFs (local DOF ``d * node + component``,
         ``d = n_components``)."""
-        n = self.cell_nodes
-        return node_dofs(n, self.n_components).reshape(len(n), -1)
+        return dofs.cell_dofs(self.cell_nodes, self.n_components)
 
     @cached_property
     def mapping(self) -> CellMap:
@@ -178,19 +161,15 @@ class P2Space(LagrangeSpace):
         return cells, nodes
 
     @property
-    def curved_edges(self) -> np.ndarray:
-        """The boundary edges that are quadratics (on parts carrying a curve other than a
-        line; :func:`signorini.fem.iso.curved_edges`)."""
-        return iso.curved_edges(self.mesh)
+    def curved_facets(self) -> np.ndarray:
+        """The boundary facets (edges in 2D) that are quadratics (on parts carrying a curve
+        other than a line; :func:`signorini.fem.iso.curved_facets`)."""
+        return iso.curved_facets(self.mesh)
 
     def dof_order(self, vertex_order: np.ndarray) -> np.ndarray:
         """The order of the DOFs that extends an order of the mesh's vertices
-        (docs/method.md, *Ordering of the unknowns*): each edge's node right after the earlier
-        of its two vertices, the two DOFs of a node together.
-
-        A nested dissection of the vertex graph stays one of the P2 graph this way: the nodes
-        of a cell are its vertices and edges, and an edge's node goes where its earlier vertex
-        is, so no coupling crosses a separator.
+        (:func:`signorini.fem.dofs.vertex_dof_order`): each edge's node right after the
+        earlier of its two vertices, the ``d`` DOFs of a node together.
 
         Parameters
         ----------
@@ -202,40 +181,42 @@ class P2Space(LagrangeSpace):
         (n_dofs,) int64 array
             ``order[k]``: the DOF eliminated k-th.
         """
-        n_points = self.mesh.n_points
-        position = np.empty(n_points, dtype=np.int64)
-        position[vertex_order] = np.arange(n_points)
-        edges = self.mesh.edges
-        key = np.concatenate([2 * position, 2 * position[edges].min(axis=1) + 1])
-        nodes = np.argsort(key, kind="stable")
-        return node_dofs(nodes, self.n_components).ravel()
+        return dofs.vertex_dof_order(vertex_order, self.n_components, self.mesh.edges)
 
-    def edge_nodes(self, edge_index: np.ndarray) -> np.ndarray:
-        """``(k, 3)`` nodes ``[start, end, midpoint]`` of boundary edges, counter-clockwise."""
-        edge_index = np.asarray(edge_index, dtype=np.int64)
-        ab = self.mesh.oriented_boundary(edge_index)
-        return np.column_stack([ab, self.mesh.n_points + edge_index])
+    def facet_nodes(self, facet_index: np.ndarray) -> np.ndarray:
+        """``(k, 3)`` nodes ``[start, end, midpoint]`` of boundary facets (edges in 2D),
+        counter-clockwise around their cells."""
+        facet_index = np.asarray(facet_index, dtype=np.int64)
+        ab = self.mesh.oriented_boundary(facet_index)
+        return np.column_stack([ab, self.mesh.n_points + facet_index])  # 2D: the facet's edge
 
-    def mesh_edge_nodes(self, edge_index: np.ndarray) -> np.ndarray:
-        """``(k, 3)`` nodes ``[vertex, vertex, midpoint]`` of any mesh edges (as stored)."""
-        edge_index = np.asarray(edge_index, dtype=np.int64)
-        return np.column_stack([self.mesh.edges[edge_index], self.mesh.n_points + edge_index])
+    def mesh_facet_nodes(self, facet_index: np.ndarray) -> np.ndarray:
+        """``(k, 3)`` nodes ``[vertex, vertex, midpoint]`` of any mesh facets (as stored)."""
+        facet_index = np.asarray(facet_index, dtype=np.int64)
+        return np.column_stack([self.mesh.facets[facet_index], self.mesh.n_points + facet_index])
 
-    def boundary_edges(
-        self, edge_index: np.ndarray
+    def boundary_facets(
+        self, facet_index: np.ndarray
     ) -> Iterator[tuple[slice | np.ndarray, StraightEdges | QuadraticEdges]]:
-        """The geometry of boundary edges (:mod:`signorini.fem.mapping`), counter-clockwise
-        as :meth:`edge_nodes`: quadratic through the midpoint node on parts carrying a curve
-        other than a line, straight elsewhere; ``(rows, edges)`` per kind."""
-        edge_index = np.asarray(edge_index, dtype=np.int64)
-        points = self.node_points[self.edge_nodes(edge_index)]
-        return edge_groups(points, np.isin(edge_index, self.curved_edges))
+        """The geometry of boundary facets (edges in 2D; :mod:`signorini.fem.mapping`),
+        counter-clockwise as :meth:`facet_nodes`: quadratic through the midpoint node on parts
+        carrying a curve other than a line, straight elsewhere; ``(rows, facets)`` per kind."""
+        facet_index = np.asarray(facet_index, dtype=np.int64)
+        points = self.node_points[self.facet_nodes(facet_index)]
+        return edge_groups(points, np.isin(facet_index, self.curved_facets))
 
     def part_nodes(self, names: Iterable[str]) -> np.ndarray:
         """Sorted nodes on the closure of the named boundary parts (vertices and midpoints)."""
-        edges = np.concatenate([self.mesh.part_edges(n) for n in names] or [np.zeros(0, int)])
-        nodes = np.concatenate([self.mesh.edges[edges].ravel(), self.mesh.n_points + edges])
+        facets = np.concatenate([self.mesh.part_facets(n) for n in names] or [np.zeros(0, int)])
+        nodes = np.concatenate([self.mesh.facets[facets].ravel(), self.mesh.n_points + facets])
         return np.unique(nodes)
+
+    # the former edge names of the facet-sense methods, read by the contact layer and the
+    # estimator
+    edge_nodes = facet_nodes
+    mesh_edge_nodes = mesh_facet_nodes
+    boundary_edges = boundary_facets
+    curved_edges = curved_facets
 
     def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
         """Exact interpolation of a P2 field of this space on the refined mesh.
@@ -263,69 +244,7 @@ class P2Space(LagrangeSpace):
             If ``u`` does not have one row per node, or ``refinement`` is not a refinement of
             this space's mesh.
         """
-        u = np.asarray(u, dtype=np.float64)
-        if u.shape[0] != self.n_nodes:
-            raise ValueError(f"u has {u.shape[0]} nodes, the space has {self.n_nodes}")
-        fine = P2Space(refinement.mesh)
-        parent = np.asarray(refinement.parent)
-        if (
-            parent.shape != (fine.mesh.n_cells,)
-            or (parent.size and (parent.min() < 0 or parent.max() >= self.mesh.n_cells))
-            or np.shape(refinement.edge_point) != (self.mesh.n_edges,)
-            or fine.mesh.n_points < self.mesh.n_points
-        ):
-            raise ValueError(
-                "the refinement is not a refinement of this space's mesh (its parent "
-                f"cells do not index the {self.mesh.n_cells} cells, or its bisected edges or "
-                "points do not match the mesh's)"
-            )
-        coarse_cells, fine_cells = self.mesh.cells, fine.mesh.cells
-        coarse_nodes, fine_nodes = self.cell_nodes, fine.cell_nodes
-        out = np.empty((fine.n_nodes,) + u.shape[1:])
-        known = np.zeros(fine.n_nodes, dtype=bool)
-        # a cell that was not refined keeps its vertices, edges and local order: copy its nodes
-        same = np.flatnonzero((fine_cells == coarse_cells[parent]).all(axis=1))
-        out[fine_nodes[same]] = u[coarse_nodes[parent[same]]]
-        known[fine_nodes[same]] = True
-        # the old vertices keep their numbers; a bisection's new vertex is the old edge's node
-        n_old = self.mesh.n_points
-        out[:n_old] = u[:n_old]
-        split = np.flatnonzero(refinement.edge_point >= 0)
-        out[refinement.edge_point[split]] = u[n_old + split]
-        known[:n_old] = True
-        known[refinement.edge_point[split]] = True
-        # the other nodes (midpoints of new edges): the parent's quadratic where they lie
-        cell, local = np.nonzero(~known[fine_nodes])
-        if cell.size:
-            nodes = fine_nodes[cell, local]
-            P = self.vertices[parent[cell]]  # (k, 3, 2)
-            X = _reference_nodes(self.mesh, refinement, fine)[nodes]  # (k, 2)
-            J = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=-1)  # columns
-            xi = np.linalg.solve(J, (X - P[:, 0])[..., None])[..., 0]  # (k, 2)
-            bary = np.concatenate([1 - xi.sum(-1, keepdims=True), xi], axis=-1)
-            if bary.min(initial=0.0) < -1e-8:
-                raise ValueError(
-                    "the refinement is not a refinement of this space's mesh (a new "
-                    "cell is not inside its parent cell)"
-                )
-            phi = basis_barycentric(bary)  # (k, 6): the parent's local nodes
-            coarse = u[coarse_nodes[parent[cell]]]  # (k, 6) or (k, 6, 2)
-            out[nodes] = np.einsum("kj,kj...->k...", phi, coarse)
-        return out
-
-
-def _reference_nodes(coarse: Mesh, refinement: Refinement, fine: P2Space) -> np.ndarray:
-    """``(n_nodes_new, 2)`` where the new nodes lie in their parent cells: the fine node
-    points, except that a vertex placed on a curve counts at the chord midpoint of the edge
-    it bisected (its parent cells are straight-sided), and the edge nodes of the fine mesh at
-    the chord midpoints of these positions."""
-    if all(curve is None for curve in coarse.curves):
-        return fine.node_points
-    points = refinement.mesh.points.copy()
-    split = refinement.edge_point >= 0
-    points[refinement.edge_point[split]] = coarse.edge_midpoints[split]
-    e = refinement.mesh.edges
-    return np.vstack([points, 0.5 * (points[e[:, 0]] + points[e[:, 1]])])
+        return prolongate_p2(self, P2Space(refinement.mesh), u, refinement)
 
 
 class P1Space(LagrangeSpace):
@@ -357,8 +276,8 @@ class P1Space(LagrangeSpace):
         return self.mesh.points
 
     @property
-    def curved_edges(self) -> np.ndarray:
-        """No edge is a quadratic: every edge is its chord."""
+    def curved_facets(self) -> np.ndarray:
+        """No facet is a quadratic: every boundary edge is its chord."""
         return np.zeros(0, dtype=np.int64)
 
     @property
@@ -372,27 +291,32 @@ class P1Space(LagrangeSpace):
     def dof_order(self, vertex_order: np.ndarray) -> np.ndarray:
         """The order of the DOFs of an order of the vertices, the two DOFs of a node
         together (as :meth:`P2Space.dof_order`)."""
-        nodes = np.asarray(vertex_order, dtype=np.int64)
-        return node_dofs(nodes, self.n_components).ravel()
+        return dofs.vertex_dof_order(vertex_order, self.n_components)
 
-    def edge_nodes(self, edge_index: np.ndarray) -> np.ndarray:
-        """``(k, 2)`` nodes ``[start, end]`` of boundary edges, counter-clockwise."""
-        return self.mesh.oriented_boundary(np.asarray(edge_index, dtype=np.int64))
+    def facet_nodes(self, facet_index: np.ndarray) -> np.ndarray:
+        """``(k, 2)`` nodes ``[start, end]`` of boundary facets (edges in 2D),
+        counter-clockwise."""
+        return self.mesh.oriented_boundary(np.asarray(facet_index, dtype=np.int64))
 
-    def mesh_edge_nodes(self, edge_index: np.ndarray) -> np.ndarray:
-        """``(k, 2)`` the two vertices of any mesh edges (as stored)."""
-        return self.mesh.edges[np.asarray(edge_index, dtype=np.int64)]
+    def mesh_facet_nodes(self, facet_index: np.ndarray) -> np.ndarray:
+        """``(k, 2)`` the two vertices of any mesh facets (as stored)."""
+        return self.mesh.facets[np.asarray(facet_index, dtype=np.int64)]
 
-    def boundary_edges(
-        self, edge_index: np.ndarray
+    def boundary_facets(
+        self, facet_index: np.ndarray
     ) -> Iterator[tuple[slice | np.ndarray, StraightEdges | QuadraticEdges]]:
-        """The boundary edges as straight edges, counter-clockwise as :meth:`edge_nodes`."""
-        yield slice(None), StraightEdges(self.node_points[self.edge_nodes(edge_index)])
+        """The boundary facets as straight edges, counter-clockwise as :meth:`facet_nodes`."""
+        yield slice(None), StraightEdges(self.node_points[self.facet_nodes(facet_index)])
 
     def part_nodes(self, names: Iterable[str]) -> np.ndarray:
         """Sorted nodes (vertices) on the closure of the named boundary parts."""
-        edges = np.concatenate([self.mesh.part_edges(n) for n in names] or [np.zeros(0, int)])
-        return np.unique(self.mesh.edges[edges])
+        facets = np.concatenate([self.mesh.part_facets(n) for n in names] or [np.zeros(0, int)])
+        return np.unique(self.mesh.facets[facets])
+
+    edge_nodes = facet_nodes
+    mesh_edge_nodes = mesh_facet_nodes
+    boundary_edges = boundary_facets
+    curved_edges = curved_facets
 
     def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
         """Exact interpolation of a P1 field of this space on the refined mesh: the old
@@ -415,24 +339,7 @@ class P1Space(LagrangeSpace):
             If ``u`` does not have one row per node, or ``refinement`` is not a refinement
             of this space's mesh.
         """
-        u = np.asarray(u, dtype=np.float64)
-        if u.shape[0] != self.n_nodes:
-            raise ValueError(f"u has {u.shape[0]} nodes, the space has {self.n_nodes}")
-        n_old = self.mesh.n_points
-        edge_point = np.asarray(refinement.edge_point)
-        split = (
-            np.flatnonzero(edge_point >= 0) if edge_point.shape == (self.mesh.n_edges,) else None
-        )
-        if split is None or refinement.mesh.n_points != n_old + split.size:
-            raise ValueError(
-                "the refinement is not a refinement of this space's mesh (its bisected edges "
-                "or points do not match the mesh's)"
-            )
-        out = np.empty((refinement.mesh.n_points,) + u.shape[1:])
-        out[:n_old] = u
-        ends = self.mesh.edges[split]
-        out[edge_point[split]] = 0.5 * (u[ends[:, 0]] + u[ends[:, 1]])
-        return out
+        return prolongate_p1(self, u, refinement)
 
 
 def space_of(mesh: Mesh, element: str | Element = "P2") -> LagrangeSpace:

@@ -97,7 +97,7 @@ def union(bodies: Mapping[str, Mesh]) -> Mesh:
 def _check_apart(names: list[str], meshes: list[Mesh]) -> None:
     """No cell centroid of one body lies inside another (winding number of its boundary)."""
     for a, mesh in enumerate(meshes):  # a loop over bodies
-        segments = mesh.oriented_boundary(np.flatnonzero(mesh.edge2cell[:, 1] < 0))
+        segments = mesh.oriented_boundary(np.flatnonzero(mesh.facet2cell[:, 1] < 0))
         for b, other in enumerate(meshes):
             if a == b:
                 continue
@@ -123,7 +123,7 @@ def body_of_cells(mesh: Mesh) -> np.ndarray:
     union's order when each body is connected; the cells' order, which refinement changes,
     does not enter.
     """
-    e2c = mesh.edge2cell
+    e2c = mesh.facet2cell
     inner = e2c[:, 1] >= 0
     n = mesh.n_cells
     graph = sp.coo_matrix(

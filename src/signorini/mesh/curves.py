@@ -21,6 +21,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .geometry import spanned_normals
 from .validation import MeshError
 
 __all__ = ["Circle", "Curve", "Line", "ProjectedCurve", "QuadraticBoundary"]
@@ -400,8 +401,7 @@ class QuadraticBoundary(Curve):
 
     def _piece_normal(self, piece: np.ndarray, t: np.ndarray) -> np.ndarray:
         dX = self._B[piece] + 2.0 * t[:, None] * self._C[piece]
-        dX /= np.hypot(dX[:, 0], dX[:, 1])[:, None]
-        return np.column_stack([dX[:, 1], -dX[:, 0]])
+        return spanned_normals(dX[:, None, :])[1]
 
     def normal(self, x: np.ndarray) -> np.ndarray:
         piece, t = self._locate(x)

@@ -1,22 +1,80 @@
-"""Geometry of straight segments and triangles: lengths, unit normals, signed areas.
+"""Geometry of straight facets and simplices: facet measures and unit normals, signed
+measures of cells.
 
-The one place where an edge's normal is computed. For a segment traversed from ``a`` to
-``b`` the normal is the right-hand one, ``(d_y, −d_x) / |d|`` with ``d = b − a``: it points
-out of a counter-clockwise cell whose local edge runs from ``a`` to ``b``, so it is the
-outward normal of every boundary edge taken in its cell's counter-clockwise order.
+The one place where a straight facet's normal is computed (:func:`facet_normals`), chosen
+by the dimension:
+
+- d = 2, a segment traversed from ``a`` to ``b``: the right-hand normal
+  ``(d_y, −d_x) / |d|`` with ``d = b − a`` and ``|d|`` by ``np.hypot``. It points out of a
+  counter-clockwise cell whose local edge runs from ``a`` to ``b``, so it is the outward
+  normal of every boundary facet taken in its cell's counter-clockwise order.
+- d = 3, a triangle ``(a, b, c)``: ``n = (b − a) × (c − a) / |…|``, the measure half the
+  norm; outward for a face whose vertices run counter-clockwise seen from outside.
+
+:func:`spanned_normals` is the kernel under it, also read where the spanning vectors are a
+curve's tangent (a curved edge's line element and normal).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from .jacobians import affine_jacobian
 from .reference import TRIANGLE
 
-__all__ = ["min_angle", "segment_normals", "signed_area"]
+__all__ = ["facet_normals", "min_angle", "segment_normals", "signed_area", "spanned_normals"]
+
+
+def spanned_normals(spans: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Norms and unit normals of the parallelotopes spanned by ``d − 1`` vectors in R^d.
+
+    Parameters
+    ----------
+    spans : (..., d − 1, d) float array
+        d = 2: one vector ``t`` (a segment's direction or a curve's tangent); d = 3: two
+        vectors ``u, v``.
+
+    Returns
+    -------
+    element : (...) float array
+        d = 2: ``|t|`` (``np.hypot``); d = 3: ``|u × v|``.
+    normal : (..., d) float array
+        d = 2: ``(t_y, −t_x) / |t|``, the tangent turned clockwise; d = 3: ``u × v / |u × v|``.
+    """
+    spans = np.asarray(spans, dtype=np.float64)
+    if spans.shape[-1] == 2:
+        t = spans[..., 0, :]
+        element = np.hypot(t[..., 0], t[..., 1])
+        return element, np.stack([t[..., 1], -t[..., 0]], axis=-1) / element[..., None]
+    n = np.cross(spans[..., 0, :], spans[..., 1, :])
+    element = np.sqrt(np.einsum("...i,...i->...", n, n))
+    return element, n / element[..., None]
+
+
+def facet_normals(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Measures |F| and unit normals of straight facets given by their ``d`` vertices.
+
+    Parameters
+    ----------
+    corners : (..., d, d) float array
+        The facets' vertices in their cell's order (d = 2: ``(a, b)``; d = 3: ``(a, b, c)``).
+
+    Returns
+    -------
+    measure : (...) float array
+        d = 2: the length ``|b − a|``; d = 3: the area ``|(b − a) × (c − a)| / 2``.
+    normal : (..., d) float array
+        Outward for a positively oriented cell (module docstring).
+    """
+    corners = np.asarray(corners, dtype=np.float64)
+    element, normal = spanned_normals(corners[..., 1:, :] - corners[..., :1, :])
+    if corners.shape[-1] == 2:
+        return element, normal
+    return 0.5 * element, normal
 
 
 def segment_normals(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Lengths and right-hand unit normals of the segments ``a → b``.
+    """Lengths and right-hand unit normals of the segments ``a → b`` (2D facets).
 
     Parameters
     ----------
@@ -30,26 +88,24 @@ def segment_normals(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarra
         ``(d_y, −d_x) / |d|``, ``d = b − a``; outward for a counter-clockwise cell.
     """
     d = np.asarray(b, dtype=np.float64) - np.asarray(a, dtype=np.float64)
-    length = np.hypot(d[..., 0], d[..., 1])
-    normal = np.stack([d[..., 1], -d[..., 0]], axis=-1) / length[..., None]
-    return length, normal
+    return spanned_normals(d[..., None, :])
 
 
 def signed_area(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
-    """Signed areas of triangles, positive for counter-clockwise ones.
+    """Signed measures ``det J / d!`` of simplices (areas of triangles, positive for
+    counter-clockwise ones; volumes of tetrahedra).
 
     Parameters
     ----------
-    points : (n_points, 2) float array
-    cells : (n_cells, 3) int array
+    points : (n_points, d) float array
+    cells : (n_cells, d + 1) int array
 
     Returns
     -------
     (n_cells,) float array
     """
-    p0, p1, p2 = (points[cells[:, k]] for k in range(3))
-    d1, d2 = p1 - p0, p2 - p0
-    return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+    _, det = affine_jacobian(points[cells])
+    return 0.5 * det if points.shape[-1] == 2 else det / 6.0
 
 
 def min_angle(points: np.ndarray, cells: np.ndarray) -> float:

@@ -184,7 +184,7 @@ def _warn_if_polygonal(path: Path, mesh: Mesh) -> None:
     or more of their vertices stay polygonal, however the mesh is refined."""
     curved = []
     for index, name in enumerate(mesh.part_names):  # a loop over parts, not edges
-        ab = mesh.oriented_boundary(mesh.boundary_edge[mesh.boundary_part == index])
+        ab = mesh.oriented_boundary(mesh.boundary_facet[mesh.boundary_part == index])
         if len(ab) < 3:
             continue
         d = mesh.points[ab[:, 1]] - mesh.points[ab[:, 0]]
@@ -270,7 +270,7 @@ def _with_quadratic_boundaries(mesh: Mesh, given: tuple[np.ndarray, np.ndarray])
         )
     offset = np.hypot(*(mid - mesh.edge_midpoints).T)
     curved = offset > tol
-    inside = np.flatnonzero(curved & (mesh.edge2cell[:, 1] >= 0))
+    inside = np.flatnonzero(curved & (mesh.facet2cell[:, 1] >= 0))
     if inside.size:
         e = int(inside[0])
         raise MeshError(
@@ -284,7 +284,7 @@ def _with_quadratic_boundaries(mesh: Mesh, given: tuple[np.ndarray, np.ndarray])
         return mesh
     curves = {}
     for index, name in enumerate(mesh.part_names):  # a loop over parts, not edges
-        e = mesh.boundary_edge[mesh.boundary_part == index]
+        e = mesh.boundary_facet[mesh.boundary_part == index]
         if not curved[e].any():
             continue
         ends = mesh.points[mesh.oriented_boundary(e)]  # counter-clockwise: normals outward

@@ -75,7 +75,7 @@ def closure(mesh: Mesh, marked_edges: np.ndarray) -> np.ndarray:
         newly = ref[candidates[hit]]
         marked[newly] = True
         # only neighbours of newly marked edges can change next round
-        nb = mesh.edge2cell[newly].ravel()
+        nb = mesh.edge2cell[newly].ravel()  # edge sense: the cells around a marked edge
         candidates = np.unique(nb[nb >= 0])
 
 
@@ -170,7 +170,7 @@ def _bisect(mesh: Mesh, marked_edges: np.ndarray) -> Refinement:
     parent = np.concatenate([g[1] for g in groups])
 
     # boundary edges: a bisected one becomes two with the same part
-    be = mesh.boundary_edge
+    be = mesh.boundary_facet
     mid = edge_point[be]
     split = mid >= 0
     bnd = mesh.boundary
@@ -206,7 +206,7 @@ def _curved_bisected(mesh: Mesh, edge_point: np.ndarray) -> tuple[np.ndarray, np
     if not with_curve:
         return None
     rows = np.flatnonzero(np.isin(mesh.boundary_part, with_curve))
-    edge = mesh.boundary_edge[rows]
+    edge = mesh.boundary_facet[rows]
     split = edge_point[edge] >= 0
     return edge[split], mesh.boundary_part[rows[split]]
 
@@ -221,7 +221,7 @@ def _check_curved_cells(
     """Raise if a new vertex placed on a curve leaves a cell clockwise or degenerate (only
     the children of cells with such a vertex are looked at)."""
     moved = np.zeros(mesh.n_cells, dtype=bool)
-    moved[mesh.edge2cell[curved[0], 0]] = True
+    moved[mesh.facet2cell[curved[0], 0]] = True
     touched = np.flatnonzero(moved[parent])
     area = signed_area(points, cells[touched])
     bad = (area <= 0) | degenerate_cells(points, cells[touched], area)

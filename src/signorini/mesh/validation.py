@@ -212,7 +212,7 @@ def _check_part_labels(mesh: Mesh) -> None:
 
 def _check_boundary_labelled(mesh: Mesh, is_bnd: np.ndarray) -> None:
     """The listed boundary edges are exactly the edges with one cell, each listed once."""
-    be = mesh.boundary_edge  # raises for a listed pair that is not an edge
+    be = mesh.boundary_facet  # raises for a listed pair that is not an edge
     if np.any(~is_bnd[be]):
         bad = mesh.boundary[np.flatnonzero(~is_bnd[be])[0]]
         raise MeshError(
@@ -387,7 +387,7 @@ def _check_no_overlap(mesh: Mesh, is_bnd: np.ndarray) -> None:
     outgoing = np.bincount(segments[:, 0], minlength=mesh.n_points)
     pinch = np.flatnonzero(outgoing[segments[:, 0]] > 1)
     test = np.union1d(first, pinch)
-    cell = mesh.edge2cell[bnd[test], 0]
+    cell = mesh.facet2cell[bnd[test], 0]
     centroid = points[mesh.cells[cell]].mean(axis=1)
     covered = winding_numbers(points, segments, centroid)
     if np.any(covered != 1):
@@ -418,7 +418,7 @@ def validate_mesh(mesh: Mesh) -> None:
     check_orientation(points, cells)
     _check_points(points, cells)
     _check_part_labels(mesh)
-    is_bnd = mesh.edge2cell[:, 1] < 0  # building the topology raises on non-manifold edges
+    is_bnd = mesh.facet2cell[:, 1] < 0  # building the topology raises on non-manifold edges
     _check_opposite_traversal(mesh, is_bnd)
     _check_no_hanging_node(mesh, is_bnd)
     _check_no_overlap(mesh, is_bnd)

@@ -23,7 +23,7 @@ from matplotlib.transforms import offset_copy
 from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
-from ..mesh.topology import boundary_edges
+from ..mesh.topology import boundary_facets
 from .contact_line import contact_coordinate
 from .contact_stress import draw_states, draw_stresses, part_widths
 from .mesh import line_width, mesh_arrays
@@ -132,7 +132,7 @@ def _draw_body(
         )
     ax.add_collection(
         LineCollection(
-            p[boundary_edges(c)],
+            p[boundary_facets(c)],
             colors="0.4",
             linewidths=0.8,
             linestyles="--",

@@ -23,7 +23,7 @@ from matplotlib.patches import Rectangle
 from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
-from ..mesh.topology import boundary_edges
+from ..mesh.topology import boundary_facets
 from .style import RC, fit_title, new_figure, save_figure, trim_height
 
 __all__ = [
@@ -121,7 +121,7 @@ def boundary_groups(
         Group name -> vertex pairs of the boundary edges on it (the keys of ``segments``).
     """
     p, c = mesh_arrays(points, cells)
-    edges = boundary_edges(c)
+    edges = boundary_facets(c)
     mid = p[edges].mean(axis=1)  # (m, 2)
     size = float(np.ptp(p, axis=0).max()) if p.size else 1.0
     free = np.ones(edges.shape[0], dtype=bool)
