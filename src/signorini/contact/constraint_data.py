@@ -14,15 +14,15 @@ from ..algebra.laws import LawGroups
 from ..fem import iso, p2
 from ..fem.quadrature import gauss_legendre
 from ..fem.space import LagrangeSpace
-from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.normals import node_normals
-from ..problem.problem import ContactProblem
 
 if TYPE_CHECKING:
+    from .discrete_conditions import DiscreteConditions
     from .mortar import MortarCoupling
 
 __all__ = [
+    "body_normals",
     "directions_and_gaps",
     "edge_weights",
     "friction_data",
@@ -30,19 +30,25 @@ __all__ = [
 ]
 
 
-def _body_normals(
-    problem: ContactProblem, space: LagrangeSpace, name: str, nodes: np.ndarray, chord: np.ndarray
+def body_normals(
+    conditions: DiscreteConditions,
+    space: LagrangeSpace,
+    i: int,
+    nodes: np.ndarray,
+    chord: np.ndarray,
 ) -> np.ndarray:
-    """The body's outward unit normal at the nodes ``[start, end, midpoint]`` of one contact
-    part's edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``
-    (:func:`signorini.problem.normals.node_normals`; docs/method.md, *Contact directions*)."""
+    """The body's outward unit normal at the nodes ``[start, end, midpoint]`` of contact part
+    ``i``'s facets (edges in 2D; ``nodes (e, 3)``, chord normals ``(e, 2)``), shape
+    ``(e, 3, 2)``: the part's straight normal where it has one
+    (:attr:`DiscreteConditions.straight_normal`), else
+    :func:`signorini.problem.normals.node_normals` (docs/method.md, *Contact directions*)."""
     return node_normals(
         space.mesh,
-        name,
+        conditions.contact_parts[i],
         nodes,
         space.node_points[nodes],
         chord,
-        straight=problem.contact_normals.get(name),
+        straight=conditions.straight(i),
     )
 
 
@@ -56,45 +62,36 @@ def part_normals(
 
 
 def directions_and_gaps(
-    problem: ContactProblem,
+    conditions: DiscreteConditions,
     space: LagrangeSpace,
-    cs_edges: tuple,
+    cs_facets: tuple,
     chord: np.ndarray,
     couplings: Mapping[str, MortarCoupling],
 ) -> tuple[np.ndarray, np.ndarray]:
-    """n_z and ψ(z) at the nodes ``[start, end, midpoint]`` of the contact edges, part by part
-    (each part has its own obstacle), shapes ``(n_ce, 3, 2)`` and ``(n_ce, 3)``; on the slave
-    part of a contact pair the mortar direction and weighted gap ``g̃_z / D_zz`` of its
-    coupling (docs/method.md, *Two bodies*)."""
-    parts, edge_part, edge_nodes = cs_edges
-    direction = np.empty(edge_nodes.shape + (2,))
-    gap = np.empty(edge_nodes.shape)
+    """n_z and ψ(z) at the nodes ``[start, end, midpoint]`` of the contact facets (edges in
+    2D), part by part (each part has its own obstacle), shapes ``(n_cf, 3, 2)`` and
+    ``(n_cf, 3)``: a shape's direction and ψ, or the body's normal and the gap function's ψ,
+    from ``conditions``; on the slave part of a contact pair the mortar direction and
+    weighted gap ``g̃_z / D_zz`` of its coupling (docs/method.md, *Two bodies*)."""
+    parts, facet_part, facet_nodes = cs_facets
+    direction = np.empty(facet_nodes.shape + (2,))
+    gap = np.empty(facet_nodes.shape)
     for i, name in enumerate(parts):
-        sel = edge_part == i
-        cond: Contact = problem.conditions[name]
-        nodes, inverse = np.unique(edge_nodes[sel], return_inverse=True)
-        x = space.node_points[nodes]
+        sel = facet_part == i
+        nodes, inverse = np.unique(facet_nodes[sel], return_inverse=True)
+        on_part = conditions.gap_part == i  # the same nodes, sorted
         if name in couplings:
             c = couplings[name]
             loc = np.searchsorted(c.slave_nodes, nodes)
             psi = c.weighted_gap[loc] / c.D[loc]
             direction[sel] = c.normal[loc][inverse].reshape(-1, 3, 2)
-        elif cond.obstacle is not None:
-            try:
-                psi, n = cond.obstacle.gap_and_direction(x)
-            except ValueError as err:
-                raise ProblemError(f"the obstacle of contact part {name!r}: {err}") from err
-            except Exception as err:  # a shape of one's own that raises
-                raise ProblemError(
-                    f"the obstacle {cond.obstacle!r} of contact part {name!r} raised "
-                    f"{type(err).__name__} in gap_and_direction: {err}"
-                ) from err
-            direction[sel] = n[inverse].reshape(-1, edge_nodes.shape[1], 2)
+        elif conditions.is_shape[i]:
+            psi, n = conditions.gap[on_part], conditions.obstacle_direction[on_part]
+            direction[sel] = n[inverse].reshape(-1, facet_nodes.shape[1], 2)
         else:
-            what = f"the gap function of contact part {name!r}"
-            psi = evaluate_field(cond.gap_field(), x, what, shape=(), bounded=True)
-            direction[sel] = _body_normals(problem, space, name, edge_nodes[sel], chord[sel])
-        gap[sel] = psi[inverse].reshape(-1, edge_nodes.shape[1])
+            psi = conditions.gap[on_part]
+            direction[sel] = body_normals(conditions, space, i, facet_nodes[sel], chord[sel])
+        gap[sel] = psi[inverse].reshape(-1, facet_nodes.shape[1])
     return direction, gap
 
 
@@ -126,11 +123,11 @@ def edge_weights(space: LagrangeSpace, edges: np.ndarray, edge_nodes: np.ndarray
 
 
 def friction_data(
-    problem: ContactProblem,
+    conditions: DiscreteConditions,
     space: LagrangeSpace,
-    edge_part: np.ndarray,
-    edge_nodes: np.ndarray,
-    edge_local: np.ndarray,
+    facet_part: np.ndarray,
+    facet_nodes: np.ndarray,
+    facet_local: np.ndarray,
     part: np.ndarray,
     second: np.ndarray,
 ) -> LawGroups:
@@ -143,15 +140,15 @@ def friction_data(
     weight = np.zeros(k)
     laws = []
     corner = second | np.concatenate([second[1:], [False]])
-    for i, name in enumerate(problem.contact_parts):
-        law = problem.conditions[name].friction
+    for i, name in enumerate(conditions.contact_parts):
+        law = conditions.friction[i]
         if law is None:
             continue
         mine = (part == i) & ~corner
         what = f"the {type(law).__name__} bound of contact part {name!r}"
         values = np.asarray(
             law.nodal_weight(
-                _integrator(space, edge_part == i, (edge_nodes, edge_local), what, k), k
+                _integrator(space, facet_part == i, (facet_nodes, facet_local), what, k), k
             ),
             dtype=np.float64,
         )

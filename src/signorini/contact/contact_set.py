@@ -30,9 +30,9 @@ from ..algebra.laws import LawGroups
 from ..fem.space import LagrangeSpace
 from ..mesh.geometry import segment_normals
 from ..problem.fields import ProblemError
-from ..problem.problem import ContactProblem
 from .admissible import check_dirichlet_admissible, check_initial_overlap, check_obstacle_side
 from .constraint_data import directions_and_gaps, edge_weights, friction_data
+from .discrete_conditions import DiscreteConditions
 from .mortar import mortar_coupling
 from .rows import MIN_CORNER_ANGLE, SAME_DIRECTION, constraint_rows
 from .two_body import PairTransfer, pair_transfer
@@ -253,9 +253,10 @@ def _empty(parts: tuple[str, ...]) -> ContactSet:
     )
 
 
-def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
-    """Collect the constraints of ``space`` for ``problem`` (docs/method.md, *Discrete
-    problem* and *Contact directions*).
+def contact_set(conditions: DiscreteConditions, space: LagrangeSpace) -> ContactSet:
+    """Collect the constraints of ``space`` for a problem's ``conditions`` on it
+    (:func:`~.discrete_conditions.discrete_conditions`; docs/method.md, *Discrete problem*
+    and *Contact directions*).
 
     Raises
     ------
@@ -271,7 +272,7 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     """
     mesh = space.mesh
     d = space.n_components
-    parts = tuple(problem.contact_parts)
+    parts = conditions.contact_parts
     if not parts:
         return _empty(parts)
     edge_lists = [mesh.part_edges(p) for p in parts]
@@ -279,19 +280,19 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     edge_part = np.repeat(np.arange(len(parts)), [e.size for e in edge_lists])
     edge_nodes = space.edge_nodes(edges)
     _, chord = segment_normals(mesh.points[edge_nodes[:, 0]], mesh.points[edge_nodes[:, 1]])
-    for i, name in enumerate(parts):  # straight parts: exactly their normal
-        if name in problem.contact_normals:
-            chord[edge_part == i] = problem.contact_normals[name]
-    dirichlet = problem.dirichlet_nodes(space)
+    for i in range(len(parts)):  # straight parts: exactly their normal
+        if conditions.straight(i) is not None:
+            chord[edge_part == i] = conditions.straight_normal[i]
+    dirichlet = conditions.dirichlet_nodes
     couplings = {  # the slave's Dirichlet nodes carry no constraint
         s: mortar_coupling(space, s, m, constrained=np.setdiff1d(space.part_nodes([s]), dirichlet))
-        for s, m in problem.pairs.items()
+        for s, m in conditions.pairs.items()
     }
     direction, edge_gap = directions_and_gaps(
-        problem, space, (parts, edge_part, edge_nodes), chord, couplings
+        conditions, space, (parts, edge_part, edge_nodes), chord, couplings
     )
     cs_edges = (parts, edge_part, edge_nodes)
-    check_obstacle_side(problem, space, cs_edges, chord, (direction, edge_gap))
+    check_obstacle_side(conditions, space, cs_edges, chord, (direction, edge_gap))
 
     # candidates: one per (node, part), Dirichlet nodes left out
     n_parts = len(parts)
@@ -303,7 +304,7 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
         raise ProblemError("every node of the contact boundary is a Dirichlet node")
     held = np.flatnonzero(~free)
     check_dirichlet_admissible(
-        problem,
+        conditions,
         space,
         cand_node[held],
         (direction.reshape(-1, d)[first[held]], edge_gap.ravel()[first[held]]),
@@ -312,7 +313,7 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     )
     kept = np.flatnonzero(free)
     check_initial_overlap(
-        problem,
+        conditions,
         space,
         cand_node[kept],
         (direction.reshape(-1, d)[first[kept]], edge_gap.ravel()[first[kept]]),
@@ -340,7 +341,7 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     k = nodes.size
     part = ukey[lead] % n_parts
     normal = direction.reshape(-1, d)[first[lead]]
-    friction = friction_data(problem, space, edge_part, edge_nodes, edge_local, part, second)
+    friction = friction_data(conditions, space, edge_part, edge_nodes, edge_local, part, second)
     return ContactSet(
         nodes=nodes,
         normal=normal,
@@ -364,7 +365,7 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
             couplings,
             (nodes, part, second, normal, friction.index >= 0),
             parts,
-            tuple(problem.pairs[s] for s in couplings),
+            tuple(conditions.pairs[s] for s in couplings),
         ),
     )
 
