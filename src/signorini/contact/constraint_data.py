@@ -1,5 +1,5 @@
 """The data of each constraint before the rows are formed: directions n_z and gaps ψ(z) at
-the contact edges' nodes, the weights m_z, w_z per edge, and the friction data
+the contact facets' nodes (edges in 2D), the weights m_z, w_z per facet, and the friction data
 (docs/method.md, *Contact directions*, *Discrete problem*, *Friction in a ContactProblem*).
 """
 
@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 __all__ = [
     "body_normals",
     "directions_and_gaps",
-    "edge_weights",
+    "facet_weights",
     "friction_data",
     "part_normals",
 ]
@@ -95,20 +95,20 @@ def directions_and_gaps(
     return direction, gap
 
 
-def edge_weights(space: LagrangeSpace, edges: np.ndarray, edge_nodes: np.ndarray):
+def facet_weights(space: LagrangeSpace, facets: np.ndarray, facet_nodes: np.ndarray):
     """``∫ φ_z ds`` and ``∫ ψ_z ds`` of ``[start, end, midpoint]`` (P1: ``[start, end]``) on
-    each contact edge, ``(n_ce, 3)`` (``(n_ce, 2)``) each: closed forms on straight edges
-    (the element's shares of the length), a Gauss rule along the quadratic edge on curved
-    ones."""
-    length = space.mesh.edge_length[edges]
+    each contact facet (an edge in 2D), ``(n_cf, 3)`` (``(n_cf, 2)``) each: closed forms on
+    straight edges (the element's shares of the length), a Gauss rule along the quadratic
+    edge on curved ones."""
+    length = space.mesh.facet_measure[facets]
     hat = np.outer(length, space.element.hat_share)
     basis = np.outer(length, space.element.basis_share)
-    curved = np.flatnonzero(np.isin(edges, space.curved_edges))
+    curved = np.flatnonzero(np.isin(facets, space.curved_edges))
     if curved.size:
         t, w = gauss_legendre(6)
         halves = np.concatenate([t / 2, 0.5 + t / 2])  # φ_z is linear on each half-edge
         wh = np.concatenate([w, w]) / 2
-        points = space.node_points[edge_nodes[curved]]
+        points = space.node_points[facet_nodes[curved]]
         _, speed, _ = iso.edge_geometry(points[:, :2], points[:, 2], halves)
         phi = np.column_stack(
             [
@@ -160,16 +160,16 @@ def friction_data(
     return LawGroups(tuple(laws), index, weight)
 
 
-def _integrator(space: LagrangeSpace, on_part: np.ndarray, edges: tuple, what: str, k: int):
-    """``integrate(f)``: ``∫ f ψ_z ds`` over the edges ``on_part`` (of ``edges``, the contact
-    edges' nodes and constraint rows) per constraint ``(k,)``,
+def _integrator(space: LagrangeSpace, on_part: np.ndarray, facets: tuple, what: str, k: int):
+    """``integrate(f)``: ``∫ f ψ_z ds`` over the facets ``on_part`` (of ``facets``, the contact
+    facets' nodes and constraint rows; edges in 2D) per constraint ``(k,)``,
     by a 4-point Gauss rule along the (quadratic) edges; ``f`` must be ``≥ 0``."""
-    edge_nodes, edge_local = edges
+    facet_nodes, facet_local = facets
     t, w = gauss_legendre(4)
     sel = np.flatnonzero(on_part)
 
     def integrate(field) -> np.ndarray:
-        points = space.node_points[edge_nodes[sel]]
+        points = space.node_points[facet_nodes[sel]]
         if points.shape[1] == 2:  # P1: straight edges [start, end]
             d = points[:, 1] - points[:, 0]
             x = points[:, None, 0] + t[None, :, None] * d[:, None]
@@ -181,7 +181,7 @@ def _integrator(space: LagrangeSpace, on_part: np.ndarray, edges: tuple, what: s
             raise ProblemError(f"{what} must be >= 0; it is {s.min():.6g} somewhere")
         # ∫ s ψ_j |x'(t)| dt on each edge, j = start, end, midpoint
         share = (s.reshape(-1, t.size) * speed * w) @ space.element.edge_basis(t)
-        loc = edge_local[sel].ravel()
+        loc = facet_local[sel].ravel()
         inside = loc >= 0
         return np.bincount(loc[inside], weights=share.ravel()[inside], minlength=k)
 

@@ -223,9 +223,9 @@ class ContactResult:
     def classes(self) -> np.ndarray:
         """Full / semi / no contact class of every constrained node (paper, Section 4)."""
         cs = self.contact
-        loc = cs.edge_local
-        gap = cs.edge_normal_gap(self.u)
-        dirichlet_touch = gap >= -TOUCH_RTOL * round_off_scale(self.u, cs.edge_gap)
+        loc = cs.facet_local
+        gap = cs.facet_normal_gap(self.u)
+        dirichlet_touch = gap >= -TOUCH_RTOL * round_off_scale(self.u, cs.facet_gap)
         edge_in = np.where(loc >= 0, self.active[np.maximum(loc, 0)], dirichlet_touch)
         return node_classes(cs, self.active, edge_in)
 

@@ -231,15 +231,15 @@ def assemble(
         cond: Neumann = problem.conditions[name]
         if cond.is_zero:
             continue
-        edges = mesh.part_edges(name)
-        nodes = space.edge_nodes(edges)
+        facets = mesh.part_facets(name)
+        nodes = space.edge_nodes(facets)
         dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(len(nodes), -1)
         g = cond.field()
 
         def traction(x, n, g=g, name=name):
             return evaluate_field(g, x, f"the traction of Neumann part {name!r}", normal=n)
 
-        for rows, geometry in space.boundary_edges(edges):
+        for rows, geometry in space.boundary_edges(facets):
             g = assemble_edge_load(
                 geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE, element=space.element
             )
