@@ -320,3 +320,12 @@ def graded_half_disc(radius: float, h_contact: float, zone: float, grading: floa
         if not marked.any():
             return mesh
         mesh = refine_nvb(mesh, marked).mesh
+
+
+def problem_contact_set(problem: ContactProblem, space):
+    """The contact set of ``problem`` on ``space`` as the assembly builds it: the problem's
+    conditions resolved on the space once, then the constraints from them."""
+    from signorini.contact.contact_set import contact_set
+    from signorini.contact.discrete_conditions import discrete_conditions
+
+    return contact_set(discrete_conditions(problem, space), space)

@@ -10,13 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from contact_problems import contact_patch_field, patch_problem
+from contact_problems import contact_patch_field, patch_problem, problem_contact_set
 
 from signorini.contact.contact_set import (
     FULL_CONTACT,
     NO_CONTACT,
     SEMI_CONTACT,
-    contact_set,
     node_classes,
 )
 from signorini.contact.solution import solve
@@ -61,7 +60,7 @@ def block_problem(mesh: Mesh, gap=0.0) -> ContactProblem:
 def test_weights_on_a_uniform_mesh():
     mesh = rectangle(0, 1, 0, 1, nx=4, ny=4)
     space = P2Space(mesh)
-    cs = contact_set(block_problem(mesh, gap=lambda x: x[..., 0] ** 2), space)
+    cs = problem_contact_set(block_problem(mesh, gap=lambda x: x[..., 0] ** 2), space)
     x = space.node_points[cs.nodes]
     assert cs.size == 9 and np.allclose(x[:, 1], 0.0)
     assert np.array_equal(cs.is_vertex, cs.nodes < mesh.n_points)
@@ -78,7 +77,7 @@ def test_weights_on_a_uniform_mesh():
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_weights_sum_to_the_contact_length(seed):
     mesh = graded_mesh(seed)
-    cs = contact_set(block_problem(mesh), P2Space(mesh))
+    cs = problem_contact_set(block_problem(mesh), P2Space(mesh))
     lengths = mesh.edge_length[mesh.part_edges("bottom")]
     print(
         f"seed {seed}: {cs.size} constrained nodes, edge lengths "
@@ -107,7 +106,7 @@ def test_dirichlet_nodes_are_not_constrained():
             "bottom": Contact(gap=0.01),
         },
     )
-    cs = contact_set(pb, space)
+    cs = problem_contact_set(pb, space)
     x = space.node_points[cs.nodes]
     assert cs.size == 8  # 9 nodes on the bottom minus the corner (0, 0)
     assert np.all(x[:, 0] > 0.1) and np.allclose(x[:, 1], 0)
@@ -194,7 +193,7 @@ def classes_by_definition(cs, in_contact):
 def test_node_classes_follow_the_definition(seed):
     rng = np.random.default_rng(seed)
     mesh = graded_mesh(seed)
-    cs = contact_set(block_problem(mesh), P2Space(mesh))
+    cs = problem_contact_set(block_problem(mesh), P2Space(mesh))
     # random intervals of contact nodes plus isolated ones
     x = P2Space(mesh).node_points[cs.nodes, 0]
     a, b = np.sort(rng.uniform(0, 2, 2))
@@ -287,7 +286,7 @@ def test_contact_parts_meeting_at_a_corner_give_two_constraints():
         MATERIAL,
         {"left": Dirichlet(), "top": Neumann(), "bottom": Contact(), "right": Contact()},
     )
-    cs = contact_set(pb, P2Space(pb.mesh))
+    cs = problem_contact_set(pb, P2Space(pb.mesh))
     corner = np.flatnonzero(cs.nodes == 2)  # the vertex (1, 0)
     assert corner.size == 2 and cs.second[corner].tolist() == [False, True]
     assert {tuple(n) for n in cs.normal[corner]} == {(0.0, -1.0), (1.0, 0.0)}

@@ -13,10 +13,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.linalg as la
-from contact_problems import corner_problem
+from contact_problems import corner_problem, problem_contact_set
 from scipy.optimize import nnls
 
-from signorini.contact.contact_set import contact_set
 from signorini.contact.solution import solve
 from signorini.fem.loads import assemble_body_force
 from signorini.fem.material import Material
@@ -36,7 +35,7 @@ def reference_solution(pb: ContactProblem, mesh: Mesh | None = None):
     """u (n_nodes, 2) and λ (k,) of the discrete problem, by the dual QP and NNLS."""
     mesh = pb.mesh if mesh is None else mesh
     space = P2Space(mesh)
-    cs = contact_set(pb, space)
+    cs = problem_contact_set(pb, space)
     n = space.n_dofs
     K = assemble_stiffness(space.mapping, space.cell_dofs, n, pb.material).toarray()
     F = np.zeros(n)
@@ -149,7 +148,7 @@ def test_polygonal_part_takes_the_mean_of_its_edges_normals_at_a_vertex():
 
     pb = ContactProblem(mesh, MATERIAL, {"rest": Dirichlet(shear), "corner": Contact(gap=0.005)})
     space = P2Space(mesh)
-    cs = contact_set(pb, space)
+    cs = problem_contact_set(pb, space)
     x = space.node_points[cs.nodes]
     at_corner = np.all(np.abs(x - [1.0, 0.0]) < TOL, axis=1)
     assert at_corner.sum() == 1  # one part: one constraint, along the mean normal

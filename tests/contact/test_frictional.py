@@ -17,11 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 import scipy.linalg as la
-from contact_problems import corner_problem
+from contact_problems import corner_problem, problem_contact_set
 from scipy.optimize import lsq_linear
 
 from signorini.algebra import FrictionResult
-from signorini.contact.contact_set import contact_set
 from signorini.contact.solution import INACTIVE, SLIP, STICK, solve
 from signorini.estimator.friction import friction_facets
 from signorini.fem.material import Material
@@ -122,7 +121,7 @@ def tresca_reference(
     """u (n_nodes, 2), λ_n and λ_t of the Tresca problem by its dual over a box, with the
     nodal bounds ``bound (k,)`` (default the contact set's Tresca weights ∫ s ψ_z ds)."""
     space = P2Space(pb.mesh)
-    cs = contact_set(pb, space)
+    cs = problem_contact_set(pb, space)
     n = space.n_dofs
     K = assemble_stiffness(space.vertices, space.cell_dofs, n, pb.material).toarray()
     u_d = np.zeros((space.n_nodes, 2))

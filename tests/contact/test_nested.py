@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from contact_problems import problem_contact_set
 
 from signorini import adaptive
-from signorini.contact.contact_set import contact_set
 from signorini.contact.nested import NESTED_MAX_SHARE, NESTED_MIN_NDOF, coarse_mesh, transfer_active
 from signorini.contact.solution import solve
 from signorini.examples import example_6_2
@@ -63,8 +63,8 @@ def test_coarse_mesh_has_the_fine_cells_at_the_contact_part(fine):
     coarse = coarse_mesh(problem.mesh, mesh, problem.contact_parts)
     assert coarse is not None and coarse.n_cells <= NESTED_MAX_SHARE * mesh.n_cells
     # same contact nodes, at the same points
-    fine_cs = contact_set(problem, P2Space(mesh))
-    coarse_cs = contact_set(problem, P2Space(coarse))
+    fine_cs = problem_contact_set(problem, P2Space(mesh))
+    coarse_cs = problem_contact_set(problem, P2Space(coarse))
     fine_points = P2Space(mesh).node_points[fine_cs.nodes]
     coarse_points = P2Space(coarse).node_points[coarse_cs.nodes]
     order = np.lexsort(fine_points.T), np.lexsort(coarse_points.T)
@@ -115,7 +115,7 @@ def test_warm_starts_small_meshes_and_the_switch_leave_pdas_alone(fine, cold):
 def test_transfer_to_the_same_mesh_is_the_identity_also_at_a_corner():
     problem = punch(nx=8)
     space = P2Space(problem.mesh)
-    cs = contact_set(problem, space)
+    cs = problem_contact_set(problem, space)
     assert cs.second.any()  # the wall meets the top at a corner: two constraints
     rng = np.random.default_rng(0)
     for _ in range(5):

@@ -48,7 +48,7 @@ def test_profile_against_independent_computations(name, seed):
     normal = problem.contact_normals[part]
 
     # every P2 node of the part once, ordered along the counter-clockwise tangent
-    edges = mesh.part_edges(part)
+    edges = mesh.part_facets(part)
     expected_nodes = np.unique(np.concatenate([mesh.edges[edges].ravel(), mesh.n_points + edges]))
     np.testing.assert_array_equal(np.sort(prof.nodes), expected_nodes)
     along = prof.points @ np.array(tangent)
@@ -101,7 +101,7 @@ def two_chain_problem() -> ContactProblem:
     """The unit square pressed down by its top; the bottom touches the obstacle only on
     x < 1/4 and x > 3/4 (two pieces of one contact part), the middle is free."""
     base = rectangle(nx=8, ny=8)
-    pairs = {name: base.edges[base.part_edges(name)] for name in base.part_names}
+    pairs = {name: base.edges[base.part_facets(name)] for name in base.part_names}
     mid = base.points[pairs["bottom"]].mean(axis=1)[:, 0]
     inner = (mid > 0.25) & (mid < 0.75)
     pairs["free"] = pairs["bottom"][inner]

@@ -6,9 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from contact_problems import corner_problem
+from contact_problems import corner_problem, problem_contact_set
 
-from signorini.contact.contact_set import contact_set
 from signorini.contact.solution import solve
 from signorini.fem.material import Material
 from signorini.fem.space import P2Space
@@ -54,7 +53,7 @@ def bottom_contact(friction) -> ContactProblem:
 def test_tresca_bound_is_the_integral_of_s_times_the_basis_function():
     # s linear in x: the Gauss rule integrates s ψ_z exactly; s_z = ∫ s ψ_z ds
     pb = bottom_contact(Tresca(lambda x: 1.0 + 0.5 * x[:, 0]))
-    cs = contact_set(pb, P2Space(pb.mesh))
+    cs = problem_contact_set(pb, P2Space(pb.mesh))
     assert cs.friction.laws == (pb.conditions["bottom"].friction,)
     assert (cs.friction.index == 0).all()
     x = P2Space(pb.mesh).node_points[cs.nodes][:, 0]
@@ -79,14 +78,14 @@ def test_tresca_bound_is_the_integral_of_s_times_the_basis_function():
 
 def test_constant_tresca_bound_is_s_times_w_z_and_coulomb_coefficient_per_constraint():
     pb = bottom_contact(Tresca(0.3))
-    cs = contact_set(pb, P2Space(pb.mesh))
+    cs = problem_contact_set(pb, P2Space(pb.mesh))
     assert np.allclose(cs.friction.weight, 0.3 * cs.basis_integral, rtol=1e-14, atol=0)
     pb = bottom_contact(Coulomb(0.4))
-    cs = contact_set(pb, P2Space(pb.mesh))
+    cs = problem_contact_set(pb, P2Space(pb.mesh))
     assert cs.friction.laws == (Coulomb(0.4),) and (cs.friction.index == 0).all()
     assert (cs.friction.weight == 0.4).all()
     pb = bottom_contact(None)
-    cs = contact_set(pb, P2Space(pb.mesh))
+    cs = problem_contact_set(pb, P2Space(pb.mesh))
     assert (cs.friction.index == -1).all() and not cs.has_friction
 
 
@@ -95,7 +94,7 @@ def test_negative_bound_function_names_the_part():
     with pytest.raises(
         ProblemError, match="the Tresca bound of contact part 'bottom' must be >= 0"
     ):
-        contact_set(pb, P2Space(pb.mesh))
+        problem_contact_set(pb, P2Space(pb.mesh))
 
 
 @pytest.mark.parametrize("shapes", [False, True], ids=["gap", "shape"])

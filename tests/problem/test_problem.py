@@ -184,7 +184,7 @@ def _union(*meshes_and_parts) -> Mesh:
         points.append(mesh.points + np.asarray(shift, dtype=float))
         cells.append(mesh.cells + offset)
         for new, old in names.items():
-            pairs = mesh.oriented_boundary(mesh.part_edges(old)) + offset
+            pairs = mesh.oriented_boundary(mesh.part_facets(old)) + offset
             parts[new] = np.concatenate([parts[new], pairs]) if new in parts else pairs
         offset += mesh.n_points
     p = np.concatenate(points)
@@ -234,7 +234,7 @@ def test_a_bow_tie_is_two_components():
     corner = int(np.flatnonzero((sq.points == 1.0).all(axis=1))[0])
     n = sq.n_points
     wing = [[corner, n], [n, n + 1], [n + 1, corner]]
-    parts = {name: sq.oriented_boundary(sq.part_edges(name)) for name in sq.part_names}
+    parts = {name: sq.oriented_boundary(sq.part_facets(name)) for name in sq.part_names}
     mesh = Mesh.from_arrays(
         points, np.vstack([sq.cells, [[corner, n, n + 1]]]), {**parts, "wing": np.array(wing)}
     )

@@ -215,7 +215,7 @@ def test_oblique_roller_reproduces_an_affine_solution(bottom):
     space = result.space
     expected = np.zeros(space.n_nodes)
     for name in [p for p, c in conditions.items() if isinstance(c, Roller)]:
-        edges = mesh.part_edges(name)
+        edges = mesh.part_facets(name)
         nodes = space.edge_nodes(edges)
         length = mesh.edge_length[edges]
         ab = mesh.points[nodes[0, :2]]
@@ -425,7 +425,7 @@ def test_the_estimator_measures_the_free_traction_on_rollers():
         rows.append((r.ndof, r.errors()["error_energy"], estimate(r).eta, np.sqrt(J.sum())))
         mesh = refine_uniform(mesh).mesh
     ndof, error, eta, roller = (np.array(c) for c in zip(*rows, strict=True))
-    assert edges.size == sum(mesh.part_edges(n).size for n in ("inner", "start", "end")) // 2
+    assert edges.size == sum(mesh.part_facets(n).size for n in ("inner", "start", "end")) // 2
     efficiency = eta / error
     print(f"\nroller traction residual {roller}; η/‖e‖ {np.round(efficiency, 2)}")
     assert (roller > 0).all() and fitted_slope(ndof, roller, last=3) < -0.9

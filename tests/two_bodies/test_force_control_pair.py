@@ -71,7 +71,7 @@ def cartesian_system(problem):
     n_dofs = 2 * (n_points + mesh.n_edges)
     cell_dofs = (2 * cell_nodes[:, :, None] + np.arange(2)).reshape(-1, 12)
     K = assemble_stiffness(mesh.points[mesh.cells], cell_dofs, n_dofs, problem.material_on(mesh))
-    edges = mesh.part_edges("a.top")
+    edges = mesh.part_facets("a.top")
     ab = mesh.oriented_boundary(edges)
     nodes = np.column_stack([ab, n_points + edges])
     dofs = (2 * nodes[:, :, None] + np.arange(2)).reshape(-1, 6)

@@ -14,11 +14,10 @@ import numpy as np
 from ..algebra.ranks import Ranks
 from ..fem.space import LagrangeSpace
 from ..problem.fields import DATA_MAX, ProblemError
-from ..problem.problem import ContactProblem
-from ..problem.rollers import held_nodes
-from .constraint_data import _body_normals
+from .constraint_data import body_normals
 
 if TYPE_CHECKING:
+    from .discrete_conditions import DiscreteConditions
     from .mortar import MortarCoupling
 
 __all__ = [
@@ -45,9 +44,9 @@ SIDE_TOL = 1e-8
 
 
 def check_obstacle_side(
-    problem: ContactProblem,
+    conditions: DiscreteConditions,
     space: LagrangeSpace,
-    cs_edges: tuple,
+    cs_facets: tuple,
     chord: np.ndarray,
     constraint: tuple,
 ) -> None:
@@ -67,14 +66,15 @@ def check_obstacle_side(
 
     Parameters
     ----------
-    problem : ContactProblem
+    conditions : DiscreteConditions
+        The problem's conditions on ``space`` (:mod:`~.discrete_conditions`).
     space : LagrangeSpace
-    cs_edges : tuple of (tuple of str, (n_ce,) int array, (n_ce, m) int array)
-        The contact parts, the part of each contact edge and its nodes ``[start, end,
-        midpoint]`` (P1: ``[start, end]``).
-    chord : (n_ce, 2) float array
-        The outward unit normal of each edge (the part's own on a straight part).
-    constraint : tuple of (n_ce, m, 2) and (n_ce, m) float arrays
+    cs_facets : tuple of (tuple of str, (n_cf,) int array, (n_cf, m) int array)
+        The contact parts, the part of each contact facet (an edge in 2D) and its nodes
+        ``[start, end, midpoint]`` (P1: ``[start, end]``).
+    chord : (n_cf, 2) float array
+        The outward unit normal of each facet (the part's own on a straight part).
+    constraint : tuple of (n_cf, m, 2) and (n_cf, m) float arrays
         The direction n_z and the gap ψ(z) at those nodes.
 
     Raises
@@ -82,28 +82,27 @@ def check_obstacle_side(
     ProblemError
         Naming the part, its obstacle, the node, ψ, n_z, the body's normal and their product.
     """
-    parts, edge_part, edge_nodes = cs_edges
+    parts, facet_part, facet_nodes = cs_facets
     direction, gap = constraint
     pts = space.mesh.points
     depth_tol = DIRICHLET_POINT_TOL * float(np.abs(pts).max() + np.ptp(pts, axis=0).max())
     for i, name in enumerate(parts):  # a loop over parts
-        obstacle = problem.conditions[name].obstacle
-        if obstacle is None or name in problem.pairs:
+        if not conditions.is_shape[i] or name in conditions.pairs:
             continue
-        sel = np.flatnonzero(edge_part == i)
-        normal = _body_normals(problem, space, name, edge_nodes[sel], chord[sel])
+        sel = np.flatnonzero(facet_part == i)
+        normal = body_normals(conditions, space, i, facet_nodes[sel], chord[sel])
         along = np.einsum("ejc,ejc->ej", direction[sel], normal).ravel()
         inside = gap[sel].ravel() < -depth_tol
         bad = np.flatnonzero(inside & (along < -SIDE_TOL))
         if bad.size == 0:
             continue
         k = bad[np.argmin(along[bad])]
-        x = space.node_points[edge_nodes[sel].ravel()[k]]
+        x = space.node_points[facet_nodes[sel].ravel()[k]]
         n_z, n = direction[sel].reshape(-1, 2)[k] + 0.0, normal.reshape(-1, 2)[k] + 0.0
-        count = np.unique(edge_nodes[sel].ravel()[bad]).size
+        count = np.unique(facet_nodes[sel].ravel()[bad]).size
         raise ProblemError(
-            f"the obstacle {obstacle!r} of contact part {name!r} lies on the body's side of "
-            f"it: the node at ({x[0]:.12g}, {x[1]:.12g}) starts inside it (ψ = "
+            f"the obstacle {conditions.obstacles[i]!r} of contact part {name!r} lies on the "
+            f"body's side of it: the node at ({x[0]:.12g}, {x[1]:.12g}) starts inside it (ψ = "
             f"{gap[sel].ravel()[k]:.6g}), and its constraint direction n_z = ({n_z[0]:.6g}, "
             f"{n_z[1]:.6g}) (the obstacle's normal into it at its surface point nearest the node) "
             f"points into the "
@@ -124,7 +123,7 @@ DIRICHLET_POINT_TOL = 1e-12
 
 
 def check_dirichlet_admissible(
-    problem: ContactProblem,
+    conditions: DiscreteConditions,
     space: LagrangeSpace,
     nodes: np.ndarray,
     constraint: tuple,
@@ -149,10 +148,11 @@ def check_dirichlet_admissible(
 
     Parameters
     ----------
-    problem : ContactProblem
+    conditions : DiscreteConditions
+        The problem's conditions on ``space`` (:mod:`~.discrete_conditions`).
     space : P2Space
     nodes : (j,) int array
-        Dirichlet nodes on contact edges, one entry per (node, contact part).
+        Dirichlet nodes on contact facets, one entry per (node, contact part).
     constraint : tuple of (j, 2) and (j,) float arrays
         The constraint direction n_z and the gap ψ(z) of each entry.
     parts : tuple of (tuple of str, (j,) int array)
@@ -167,15 +167,16 @@ def check_dirichlet_admissible(
         (on a slave: the master's node and its u_D as well).
     """
     names, part = parts
-    value, owner = _dirichlet_values(problem, space, nodes)
+    value, owner = _dirichlet_values(conditions, nodes)
     direction, gap = (np.array(a, dtype=np.float64) for a in constraint)
     master = np.full(nodes.size, -1)  # the master's Dirichlet node at π(z), on a slave
     entry_part = np.asarray(names, dtype=object)[part]
-    keep = ~np.isin(entry_part, list(problem.pairs))
-    held = held_nodes(problem, space).values if couplings else None
+    keep = ~np.isin(entry_part, list(conditions.pairs))
+    held = conditions.held.values if couplings else None
     for slave, c in (couplings or {}).items():  # a loop over pairs
         on = np.flatnonzero(entry_part == slave)
-        k, gap_z = _held_master_node(problem, space, c, np.searchsorted(c.slave_nodes, nodes[on]))
+        row = np.searchsorted(c.slave_nodes, nodes[on])
+        k, gap_z = _held_master_node(conditions, space, c, row)
         on, k, gap_z = on[k >= 0], k[k >= 0], gap_z[k >= 0]
         master[on], gap[on], keep[on] = k, gap_z, True
         value[on] -= held[k]
@@ -200,7 +201,7 @@ def check_dirichlet_admissible(
         slave = parts[0][parts[1][i]]
         y, u_m = space.node_points[master[i]], held[master[i]]
         relative = (
-            f" relative to the node of master part {problem.pairs[slave]!r} facing it at "
+            f" relative to the node of master part {conditions.pairs[slave]!r} facing it at "
             f"({y[0]:.12g}, {y[1]:.12g}), held at u_D = ({u_m[0]:.6g}, {u_m[1]:.6g}),"
         )
     raise ProblemError(
@@ -215,7 +216,10 @@ def check_dirichlet_admissible(
 
 
 def _held_master_node(
-    problem: ContactProblem, space: LagrangeSpace, coupling: MortarCoupling, row: np.ndarray
+    conditions: DiscreteConditions,
+    space: LagrangeSpace,
+    coupling: MortarCoupling,
+    row: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
     """For the slave nodes ``coupling.slave_nodes[row]``: the master's Dirichlet node (held
     in both components) at their point π(z) on the master, within the round-off of a
@@ -223,7 +227,7 @@ def _held_master_node(
     x = space.node_points[coupling.slave_nodes[row]]
     pi, n = coupling.master_point[row], coupling.normal[row]
     master_nodes = space.part_nodes([coupling.master])
-    held = problem.dirichlet_nodes(space)
+    held = conditions.dirichlet_nodes
     candidates = master_nodes[np.isin(master_nodes, held)]
     k = np.full(row.size, -1)
     if candidates.size and row.size:
@@ -243,19 +247,17 @@ def _held_master_node(
 DEEP_OVERLAP = 0.25
 
 
-def _dirichlet_values(problem: ContactProblem, space: LagrangeSpace, nodes: np.ndarray):
+def _dirichlet_values(conditions: DiscreteConditions, nodes: np.ndarray):
     """``u_D`` at the Dirichlet nodes ``nodes (j,)`` (held in both components, from one part
     or two, a roller's among them: :func:`~signorini.problem.rollers.held_nodes`) and the
     Dirichlet or Roller part of each (the later one at a node on two)."""
-    value = held_nodes(problem, space).values[nodes]
-    owner = np.full(nodes.size, "", dtype=object)
-    for name in problem.dirichlet_parts:  # a loop over parts
-        owner[np.isin(nodes, space.part_nodes([name]))] = name
-    return value, owner
+    value = conditions.held.values[nodes]
+    names = np.asarray(("",) + conditions.held_parts, dtype=object)
+    return value, names[conditions.held_part[nodes] + 1]
 
 
 def check_initial_overlap(
-    problem: ContactProblem,
+    conditions: DiscreteConditions,
     space: LagrangeSpace,
     nodes: np.ndarray,
     constraint: tuple,
@@ -283,7 +285,8 @@ def check_initial_overlap(
 
     Parameters
     ----------
-    problem : ContactProblem
+    conditions : DiscreteConditions
+        The problem's conditions on ``space`` (:mod:`~.discrete_conditions`).
     space : P2Space
     nodes : (k,) int array
         The constrained nodes (not Dirichlet nodes), one entry per (node, contact part).
@@ -300,11 +303,10 @@ def check_initial_overlap(
     direction, gap = constraint
     pts = space.mesh.points
     size = float(np.hypot(*np.ptp(pts, axis=0)))
-    shape = np.array([problem.conditions[p].obstacle is not None for p in parts[0]])
-    deep = np.flatnonzero((-gap > DEEP_OVERLAP * size) & shape[parts[1]])
+    deep = np.flatnonzero((-gap > DEEP_OVERLAP * size) & conditions.is_shape[parts[1]])
     if deep.size == 0:
         return
-    value, _ = _dirichlet_values(problem, space, problem.dirichlet_nodes(space))
+    value, _ = _dirichlet_values(conditions, conditions.dirichlet_nodes)
     # (deep,) max_y u_D(y)·(−n_z); with no Dirichlet node (a body under force control) the
     # Dirichlet data move the body out by nothing
     moved = (value @ -direction[deep].T).max(axis=0) if len(value) else np.zeros(deep.size)

@@ -1,5 +1,5 @@
 """The data of each constraint before the rows are formed: directions n_z and gaps ψ(z) at
-the contact edges' nodes, the weights m_z, w_z per edge, and the friction data
+the contact facets' nodes (edges in 2D), the weights m_z, w_z per facet, and the friction data
 (docs/method.md, *Contact directions*, *Discrete problem*, *Friction in a ContactProblem*).
 """
 
@@ -14,35 +14,41 @@ from ..algebra.friction.laws import LawGroups
 from ..fem import iso, p2
 from ..fem.quadrature import gauss_legendre
 from ..fem.space import LagrangeSpace
-from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.normals import node_normals
-from ..problem.problem import ContactProblem
 
 if TYPE_CHECKING:
+    from .discrete_conditions import DiscreteConditions
     from .mortar import MortarCoupling
 
 __all__ = [
+    "body_normals",
     "directions_and_gaps",
-    "edge_weights",
+    "facet_weights",
     "friction_data",
     "part_normals",
 ]
 
 
-def _body_normals(
-    problem: ContactProblem, space: LagrangeSpace, name: str, nodes: np.ndarray, chord: np.ndarray
+def body_normals(
+    conditions: DiscreteConditions,
+    space: LagrangeSpace,
+    i: int,
+    nodes: np.ndarray,
+    chord: np.ndarray,
 ) -> np.ndarray:
-    """The body's outward unit normal at the nodes ``[start, end, midpoint]`` of one contact
-    part's edges (``nodes (e, 3)``, chord normals ``(e, 2)``), shape ``(e, 3, 2)``
-    (:func:`signorini.problem.normals.node_normals`; docs/method.md, *Contact directions*)."""
+    """The body's outward unit normal at the nodes ``[start, end, midpoint]`` of contact part
+    ``i``'s facets (edges in 2D; ``nodes (e, 3)``, chord normals ``(e, 2)``), shape
+    ``(e, 3, 2)``: the part's straight normal where it has one
+    (:attr:`DiscreteConditions.straight_normal`), else
+    :func:`signorini.problem.normals.node_normals` (docs/method.md, *Contact directions*)."""
     return node_normals(
         space.mesh,
-        name,
+        conditions.contact_parts[i],
         nodes,
         space.node_points[nodes],
         chord,
-        straight=problem.contact_normals.get(name),
+        straight=conditions.straight(i),
     )
 
 
@@ -56,62 +62,53 @@ def part_normals(
 
 
 def directions_and_gaps(
-    problem: ContactProblem,
+    conditions: DiscreteConditions,
     space: LagrangeSpace,
-    cs_edges: tuple,
+    cs_facets: tuple,
     chord: np.ndarray,
     couplings: Mapping[str, MortarCoupling],
 ) -> tuple[np.ndarray, np.ndarray]:
-    """n_z and ψ(z) at the nodes ``[start, end, midpoint]`` of the contact edges, part by part
-    (each part has its own obstacle), shapes ``(n_ce, 3, 2)`` and ``(n_ce, 3)``; on the slave
-    part of a contact pair the mortar direction and weighted gap ``g̃_z / D_zz`` of its
-    coupling (docs/method.md, *Two bodies*)."""
-    parts, edge_part, edge_nodes = cs_edges
-    direction = np.empty(edge_nodes.shape + (2,))
-    gap = np.empty(edge_nodes.shape)
+    """n_z and ψ(z) at the nodes ``[start, end, midpoint]`` of the contact facets (edges in
+    2D), part by part (each part has its own obstacle), shapes ``(n_cf, 3, 2)`` and
+    ``(n_cf, 3)``: a shape's direction and ψ, or the body's normal and the gap function's ψ,
+    from ``conditions``; on the slave part of a contact pair the mortar direction and
+    weighted gap ``g̃_z / D_zz`` of its coupling (docs/method.md, *Two bodies*)."""
+    parts, facet_part, facet_nodes = cs_facets
+    direction = np.empty(facet_nodes.shape + (2,))
+    gap = np.empty(facet_nodes.shape)
     for i, name in enumerate(parts):
-        sel = edge_part == i
-        cond: Contact = problem.conditions[name]
-        nodes, inverse = np.unique(edge_nodes[sel], return_inverse=True)
-        x = space.node_points[nodes]
+        sel = facet_part == i
+        nodes, inverse = np.unique(facet_nodes[sel], return_inverse=True)
+        on_part = conditions.gap_part == i  # the same nodes, sorted
         if name in couplings:
             c = couplings[name]
             loc = np.searchsorted(c.slave_nodes, nodes)
             psi = c.weighted_gap[loc] / c.D[loc]
             direction[sel] = c.normal[loc][inverse].reshape(-1, 3, 2)
-        elif cond.obstacle is not None:
-            try:
-                psi, n = cond.obstacle.gap_and_direction(x)
-            except ValueError as err:
-                raise ProblemError(f"the obstacle of contact part {name!r}: {err}") from err
-            except Exception as err:  # a shape of one's own that raises
-                raise ProblemError(
-                    f"the obstacle {cond.obstacle!r} of contact part {name!r} raised "
-                    f"{type(err).__name__} in gap_and_direction: {err}"
-                ) from err
-            direction[sel] = n[inverse].reshape(-1, edge_nodes.shape[1], 2)
+        elif conditions.is_shape[i]:
+            psi, n = conditions.gap[on_part], conditions.obstacle_direction[on_part]
+            direction[sel] = n[inverse].reshape(-1, facet_nodes.shape[1], 2)
         else:
-            what = f"the gap function of contact part {name!r}"
-            psi = evaluate_field(cond.gap_field(), x, what, shape=(), bounded=True)
-            direction[sel] = _body_normals(problem, space, name, edge_nodes[sel], chord[sel])
-        gap[sel] = psi[inverse].reshape(-1, edge_nodes.shape[1])
+            psi = conditions.gap[on_part]
+            direction[sel] = body_normals(conditions, space, i, facet_nodes[sel], chord[sel])
+        gap[sel] = psi[inverse].reshape(-1, facet_nodes.shape[1])
     return direction, gap
 
 
-def edge_weights(space: LagrangeSpace, edges: np.ndarray, edge_nodes: np.ndarray):
+def facet_weights(space: LagrangeSpace, facets: np.ndarray, facet_nodes: np.ndarray):
     """``∫ φ_z ds`` and ``∫ ψ_z ds`` of ``[start, end, midpoint]`` (P1: ``[start, end]``) on
-    each contact edge, ``(n_ce, 3)`` (``(n_ce, 2)``) each: closed forms on straight edges
-    (the element's shares of the length), a Gauss rule along the quadratic edge on curved
-    ones."""
-    length = space.mesh.edge_length[edges]
+    each contact facet (an edge in 2D), ``(n_cf, 3)`` (``(n_cf, 2)``) each: closed forms on
+    straight edges (the element's shares of the length), a Gauss rule along the quadratic
+    edge on curved ones."""
+    length = space.mesh.facet_measure[facets]
     hat = np.outer(length, space.element.facet.hat_share)
     basis = np.outer(length, space.element.facet.basis_share)
-    curved = np.flatnonzero(np.isin(edges, space.curved_edges))
+    curved = np.flatnonzero(np.isin(facets, space.curved_edges))
     if curved.size:
         t, w = gauss_legendre(6)
         halves = np.concatenate([t / 2, 0.5 + t / 2])  # φ_z is linear on each half-edge
         wh = np.concatenate([w, w]) / 2
-        points = space.node_points[edge_nodes[curved]]
+        points = space.node_points[facet_nodes[curved]]
         _, speed, _ = iso.edge_geometry(points[:, :2], points[:, 2], halves)
         phi = np.column_stack(
             [
@@ -126,11 +123,11 @@ def edge_weights(space: LagrangeSpace, edges: np.ndarray, edge_nodes: np.ndarray
 
 
 def friction_data(
-    problem: ContactProblem,
+    conditions: DiscreteConditions,
     space: LagrangeSpace,
-    edge_part: np.ndarray,
-    edge_nodes: np.ndarray,
-    edge_local: np.ndarray,
+    facet_part: np.ndarray,
+    facet_nodes: np.ndarray,
+    facet_local: np.ndarray,
     part: np.ndarray,
     second: np.ndarray,
 ) -> LawGroups:
@@ -143,15 +140,15 @@ def friction_data(
     weight = np.zeros(k)
     laws = []
     corner = second | np.concatenate([second[1:], [False]])
-    for i, name in enumerate(problem.contact_parts):
-        law = problem.conditions[name].friction
+    for i, name in enumerate(conditions.contact_parts):
+        law = conditions.friction[i]
         if law is None:
             continue
         mine = (part == i) & ~corner
         what = f"the {type(law).__name__} bound of contact part {name!r}"
         values = np.asarray(
             law.nodal_weight(
-                _integrator(space, edge_part == i, (edge_nodes, edge_local), what, k), k
+                _integrator(space, facet_part == i, (facet_nodes, facet_local), what, k), k
             ),
             dtype=np.float64,
         )
@@ -163,16 +160,16 @@ def friction_data(
     return LawGroups(tuple(laws), index, weight)
 
 
-def _integrator(space: LagrangeSpace, on_part: np.ndarray, edges: tuple, what: str, k: int):
-    """``integrate(f)``: ``∫ f ψ_z ds`` over the edges ``on_part`` (of ``edges``, the contact
-    edges' nodes and constraint rows) per constraint ``(k,)``,
+def _integrator(space: LagrangeSpace, on_part: np.ndarray, facets: tuple, what: str, k: int):
+    """``integrate(f)``: ``∫ f ψ_z ds`` over the facets ``on_part`` (of ``facets``, the contact
+    facets' nodes and constraint rows; edges in 2D) per constraint ``(k,)``,
     by a 4-point Gauss rule along the (quadratic) edges; ``f`` must be ``≥ 0``."""
-    edge_nodes, edge_local = edges
+    facet_nodes, facet_local = facets
     t, w = gauss_legendre(4)
     sel = np.flatnonzero(on_part)
 
     def integrate(field) -> np.ndarray:
-        points = space.node_points[edge_nodes[sel]]
+        points = space.node_points[facet_nodes[sel]]
         if points.shape[1] == 2:  # P1: straight edges [start, end]
             d = points[:, 1] - points[:, 0]
             x = points[:, None, 0] + t[None, :, None] * d[:, None]
@@ -184,7 +181,7 @@ def _integrator(space: LagrangeSpace, on_part: np.ndarray, edges: tuple, what: s
             raise ProblemError(f"{what} must be >= 0; it is {s.min():.6g} somewhere")
         # ∫ s ψ_j |x'(t)| dt on each edge, j = start, end, midpoint
         share = (s.reshape(-1, t.size) * speed * w) @ space.element.facet.basis(t)
-        loc = edge_local[sel].ravel()
+        loc = facet_local[sel].ravel()
         inside = loc >= 0
         return np.bincount(loc[inside], weights=share.ravel()[inside], minlength=k)
 

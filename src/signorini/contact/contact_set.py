@@ -30,9 +30,9 @@ from ..algebra.friction.laws import LawGroups
 from ..fem.space import LagrangeSpace
 from ..mesh.geometry import segment_normals
 from ..problem.fields import ProblemError
-from ..problem.problem import ContactProblem
 from .admissible import check_dirichlet_admissible, check_initial_overlap, check_obstacle_side
-from .constraint_data import directions_and_gaps, edge_weights, friction_data
+from .constraint_data import directions_and_gaps, facet_weights, friction_data
+from .discrete_conditions import DiscreteConditions
 from .mortar import mortar_coupling
 from .rows import MIN_CORNER_ANGLE, SAME_DIRECTION, constraint_rows
 from .two_body import PairTransfer, pair_transfer
@@ -57,7 +57,8 @@ class ContactSet:
 
     Arrays of length k are indexed by constraint, sorted by node; a corner node (two contact
     parts meeting at an angle) has two rows, the first bounding the DOF ``2z`` and the second
-    ``2z + 1`` of the node's frame. Arrays of length n_ce are indexed by contact edge.
+    ``2z + 1`` of the node's frame. Arrays of length n_cf are indexed by contact facet (an
+    edge in 2D).
     Consistent units: if lengths are in mm, gaps and weights are in mm (the weights are
     lengths: integrals of dimensionless basis functions along Γ_C).
 
@@ -83,25 +84,25 @@ class ContactSet:
         basis function; the consistent pressure is ``p_z = Λ_z / w_z``.
     is_vertex : (k,) bool array
         Whether the node is a mesh vertex (else an edge midpoint).
-    edges : (n_ce,) int array
-        Mesh edges of Γ_C, part after part.
-    edge_nodes : (n_ce, 3) int array
-        Global nodes ``[start, end, midpoint]`` (P1: ``(n_ce, 2)``, ``[start, end]``; the
-        other per-edge-node arrays likewise) of each contact edge, start to end in the
+    facets : (n_cf,) int array
+        Mesh facets of Γ_C (edges in 2D), part after part.
+    facet_nodes : (n_cf, 3) int array
+        Global nodes ``[start, end, midpoint]`` (P1: ``(n_cf, 2)``, ``[start, end]``; the
+        other per-facet-node arrays likewise) of each contact facet, start to end in the
         counter-clockwise direction of the boundary (Dirichlet nodes included).
-    edge_part : (n_ce,) int array
-        Index into ``parts`` of each contact edge.
+    facet_part : (n_cf,) int array
+        Index into ``parts`` of each contact facet.
     parts : tuple of str
         The contact parts, in the problem's order.
-    edge_gap : (n_ce, 3) float array
-        ψ at ``[start, end, midpoint]`` for the edge's part (also at Dirichlet end points).
-    edge_direction : (n_ce, 3, 2) float array
-        The constraint direction at ``[start, end, midpoint]`` for the edge's part.
-    edge_normal : (n_ce, 2) float array
-        Outward unit normal of each contact edge's chord.
-    edge_local : (n_ce, 3) int array
-        Row of the constraint of each contact edge's nodes (for the edge's part), ``-1`` at
-        Dirichlet nodes.
+    facet_gap : (n_cf, 3) float array
+        ψ at ``[start, end, midpoint]`` for the facet's part (also at Dirichlet end points).
+    facet_direction : (n_cf, 3, 2) float array
+        The constraint direction at ``[start, end, midpoint]`` for the facet's part.
+    facet_normal : (n_cf, 2) float array
+        Outward unit normal of each contact facet's chord.
+    facet_local : (n_cf, 3) int array
+        Row of the constraint of each contact facet's nodes (for the facet's part), ``-1``
+        at Dirichlet nodes.
     friction : LawGroups
         The friction laws of the frictional parts (:mod:`signorini.algebra.friction.laws`), the law
         of each constraint (``-1``: frictionless; a corner's constraints are frictionless)
@@ -113,7 +114,10 @@ class ContactSet:
         ``ũ = u − T_d u`` (:meth:`relative`); ``None`` without pairs (``ũ = u``).
 
     Derived: ``tangent`` (the tangent space of each constraint as a basis beside its
-    normal), ``edge_tangent``, ``frames``, ``has_friction``.
+    normal), ``facet_tangent``, ``frames``, ``has_friction``. The edge names of the facet
+    arrays (``edges``, ``edge_nodes``, ``edge_part``, ``edge_gap``, ``edge_direction``,
+    ``edge_normal``, ``edge_local``, ``edge_tangent``, ``edge_relative``,
+    ``edge_normal_gap``) are kept as aliases until no module reads them.
     """
 
     nodes: np.ndarray
@@ -124,14 +128,14 @@ class ContactSet:
     hat_integral: np.ndarray
     basis_integral: np.ndarray
     is_vertex: np.ndarray
-    edges: np.ndarray
-    edge_nodes: np.ndarray
-    edge_part: np.ndarray
+    facets: np.ndarray
+    facet_nodes: np.ndarray
+    facet_part: np.ndarray
     parts: tuple[str, ...]
-    edge_gap: np.ndarray
-    edge_direction: np.ndarray
-    edge_normal: np.ndarray
-    edge_local: np.ndarray
+    facet_gap: np.ndarray
+    facet_direction: np.ndarray
+    facet_normal: np.ndarray
+    facet_local: np.ndarray
     friction: LawGroups
     transfer: PairTransfer | None = None
 
@@ -151,10 +155,10 @@ class ContactSet:
         return _tangents(self.normal)
 
     @cached_property
-    def edge_tangent(self) -> np.ndarray:
-        """``(n_ce, 3, 1, 2)`` the tangent basis beside :attr:`edge_direction` at
-        ``[start, end, midpoint]`` of each contact edge."""
-        return _tangents(self.edge_direction)
+    def facet_tangent(self) -> np.ndarray:
+        """``(n_cf, 3, 1, 2)`` the tangent basis beside :attr:`facet_direction` at
+        ``[start, end, midpoint]`` of each contact facet."""
+        return _tangents(self.facet_direction)
 
     @property
     def constrained_dofs(self) -> np.ndarray:
@@ -199,19 +203,31 @@ class ContactSet:
         (:meth:`relative`)."""
         return np.einsum("kc,kc->k", self.relative(u)[self.nodes], self.normal)
 
-    def edge_relative(self, u: np.ndarray) -> np.ndarray:
+    def facet_relative(self, u: np.ndarray) -> np.ndarray:
         """The relative displacement ``u − T u`` at ``[start, end, midpoint]`` of each contact
-        edge ``(n_ce, 3, 2)``, Dirichlet end points of a pair's slave included (``u``
+        facet ``(n_cf, 3, 2)``, Dirichlet end points of a pair's slave included (``u``
         itself without pairs)."""
         u = np.asarray(u)
         if self.transfer is not None:
             u = u - (self.transfer.every_slave @ u.ravel()).reshape(u.shape)
-        return u[self.edge_nodes]
+        return u[self.facet_nodes]
 
-    def edge_normal_gap(self, u: np.ndarray) -> np.ndarray:
-        """``ũ·n_z − ψ`` at ``[start, end, midpoint]`` of each contact edge, ``(n_ce, 3)``."""
-        un = np.einsum("ejc,ejc->ej", self.edge_relative(u), self.edge_direction)
-        return un - self.edge_gap
+    def facet_normal_gap(self, u: np.ndarray) -> np.ndarray:
+        """``ũ·n_z − ψ`` at ``[start, end, midpoint]`` of each contact facet, ``(n_cf, 3)``."""
+        un = np.einsum("ejc,ejc->ej", self.facet_relative(u), self.facet_direction)
+        return un - self.facet_gap
+
+    # the edge names of the facet arrays, kept until no module reads them
+    edges = property(lambda self: self.facets)
+    edge_nodes = property(lambda self: self.facet_nodes)
+    edge_part = property(lambda self: self.facet_part)
+    edge_gap = property(lambda self: self.facet_gap)
+    edge_direction = property(lambda self: self.facet_direction)
+    edge_normal = property(lambda self: self.facet_normal)
+    edge_local = property(lambda self: self.facet_local)
+    edge_tangent = property(lambda self: self.facet_tangent)
+    edge_relative = facet_relative
+    edge_normal_gap = facet_normal_gap
 
 
 def _tangents(normal: np.ndarray) -> np.ndarray:
@@ -231,7 +247,7 @@ def _locate(sorted_keys: np.ndarray, query: np.ndarray, rows: np.ndarray | None 
 
 def _empty(parts: tuple[str, ...]) -> ContactSet:
     """The contact set of a problem without contact parts."""
-    no_int, no_edges = np.zeros(0, dtype=np.int64), np.zeros((0, 3), dtype=np.int64)
+    no_int, no_facets = np.zeros(0, dtype=np.int64), np.zeros((0, 3), dtype=np.int64)
     return ContactSet(
         nodes=no_int,
         normal=np.zeros((0, 2)),
@@ -241,21 +257,22 @@ def _empty(parts: tuple[str, ...]) -> ContactSet:
         hat_integral=np.zeros(0),
         basis_integral=np.zeros(0),
         is_vertex=np.zeros(0, dtype=bool),
-        edges=no_int,
-        edge_nodes=no_edges,
-        edge_part=no_int,
+        facets=no_int,
+        facet_nodes=no_facets,
+        facet_part=no_int,
         parts=parts,
-        edge_gap=np.zeros((0, 3)),
-        edge_direction=np.zeros((0, 3, 2)),
-        edge_normal=np.zeros((0, 2)),
-        edge_local=no_edges,
+        facet_gap=np.zeros((0, 3)),
+        facet_direction=np.zeros((0, 3, 2)),
+        facet_normal=np.zeros((0, 2)),
+        facet_local=no_facets,
         friction=LawGroups((), no_int, np.zeros(0)),
     )
 
 
-def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
-    """Collect the constraints of ``space`` for ``problem`` (docs/method.md, *Discrete
-    problem* and *Contact directions*).
+def contact_set(conditions: DiscreteConditions, space: LagrangeSpace) -> ContactSet:
+    """Collect the constraints of ``space`` for a problem's ``conditions`` on it
+    (:func:`~.discrete_conditions.discrete_conditions`; docs/method.md, *Discrete problem*
+    and *Contact directions*).
 
     Raises
     ------
@@ -271,31 +288,31 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
     """
     mesh = space.mesh
     d = space.n_components
-    parts = tuple(problem.contact_parts)
+    parts = conditions.contact_parts
     if not parts:
         return _empty(parts)
-    edge_lists = [mesh.part_edges(p) for p in parts]
-    edges = np.concatenate(edge_lists)
-    edge_part = np.repeat(np.arange(len(parts)), [e.size for e in edge_lists])
-    edge_nodes = space.edge_nodes(edges)
-    _, chord = segment_normals(mesh.points[edge_nodes[:, 0]], mesh.points[edge_nodes[:, 1]])
-    for i, name in enumerate(parts):  # straight parts: exactly their normal
-        if name in problem.contact_normals:
-            chord[edge_part == i] = problem.contact_normals[name]
-    dirichlet = problem.dirichlet_nodes(space)
+    facet_lists = [mesh.part_facets(p) for p in parts]
+    facets = np.concatenate(facet_lists)
+    facet_part = np.repeat(np.arange(len(parts)), [e.size for e in facet_lists])
+    facet_nodes = space.edge_nodes(facets)
+    _, chord = segment_normals(mesh.points[facet_nodes[:, 0]], mesh.points[facet_nodes[:, 1]])
+    for i in range(len(parts)):  # straight parts: exactly their normal
+        if conditions.straight(i) is not None:
+            chord[facet_part == i] = conditions.straight_normal[i]
+    dirichlet = conditions.dirichlet_nodes
     couplings = {  # the slave's Dirichlet nodes carry no constraint
         s: mortar_coupling(space, s, m, constrained=np.setdiff1d(space.part_nodes([s]), dirichlet))
-        for s, m in problem.pairs.items()
+        for s, m in conditions.pairs.items()
     }
-    direction, edge_gap = directions_and_gaps(
-        problem, space, (parts, edge_part, edge_nodes), chord, couplings
+    direction, facet_gap = directions_and_gaps(
+        conditions, space, (parts, facet_part, facet_nodes), chord, couplings
     )
-    cs_edges = (parts, edge_part, edge_nodes)
-    check_obstacle_side(problem, space, cs_edges, chord, (direction, edge_gap))
+    cs_facets = (parts, facet_part, facet_nodes)
+    check_obstacle_side(conditions, space, cs_facets, chord, (direction, facet_gap))
 
     # candidates: one per (node, part), Dirichlet nodes left out
     n_parts = len(parts)
-    key = (edge_nodes * n_parts + edge_part[:, None]).ravel()
+    key = (facet_nodes * n_parts + facet_part[:, None]).ravel()
     ukey, first, cand_of = np.unique(key, return_index=True, return_inverse=True)
     cand_node = ukey // n_parts
     free = ~np.isin(cand_node, dirichlet)
@@ -303,73 +320,75 @@ def contact_set(problem: ContactProblem, space: LagrangeSpace) -> ContactSet:
         raise ProblemError("every node of the contact boundary is a Dirichlet node")
     held = np.flatnonzero(~free)
     check_dirichlet_admissible(
-        problem,
+        conditions,
         space,
         cand_node[held],
-        (direction.reshape(-1, d)[first[held]], edge_gap.ravel()[first[held]]),
+        (direction.reshape(-1, d)[first[held]], facet_gap.ravel()[first[held]]),
         (parts, ukey[held] % n_parts),
         couplings,
     )
     kept = np.flatnonzero(free)
     check_initial_overlap(
-        problem,
+        conditions,
         space,
         cand_node[kept],
-        (direction.reshape(-1, d)[first[kept]], edge_gap.ravel()[first[kept]]),
+        (direction.reshape(-1, d)[first[kept]], facet_gap.ravel()[first[kept]]),
         (parts, ukey[kept] % n_parts),
     )
     row_of, starts = constraint_rows(
         cand_node[kept],
         direction.reshape(-1, d)[first[kept]],
-        edge_gap.ravel()[first[kept]],
+        facet_gap.ravel()[first[kept]],
         space.node_points,
         (parts, ukey[kept] % n_parts),
     )
     cand_row = np.full(ukey.size, -1)
     cand_row[kept] = row_of
-    edge_local = cand_row[cand_of].reshape(edge_nodes.shape)
+    facet_local = cand_row[cand_of].reshape(facet_nodes.shape)
     lead = kept[starts]
     nodes = cand_node[lead]
     if np.unique(nodes, return_counts=True)[1].max() > 2:
         raise ProblemError("a node lies on more than two contact parts with different directions")
     second = np.concatenate([[False], nodes[1:] == nodes[:-1]])
 
-    hat, basis = edge_weights(space, edges, edge_nodes)
-    loc = edge_local.ravel()
+    hat, basis = facet_weights(space, facets, facet_nodes)
+    loc = facet_local.ravel()
     inside = loc >= 0
     k = nodes.size
     part = ukey[lead] % n_parts
     normal = direction.reshape(-1, d)[first[lead]]
-    friction = friction_data(problem, space, edge_part, edge_nodes, edge_local, part, second)
+    friction = friction_data(conditions, space, facet_part, facet_nodes, facet_local, part, second)
     return ContactSet(
         nodes=nodes,
         normal=normal,
-        gap=edge_gap.ravel()[first[lead]],
+        gap=facet_gap.ravel()[first[lead]],
         part=part,
         second=second,
         hat_integral=np.bincount(loc[inside], weights=hat.ravel()[inside], minlength=k),
         basis_integral=np.bincount(loc[inside], weights=basis.ravel()[inside], minlength=k),
         is_vertex=nodes < mesh.n_points,
-        edges=edges,
-        edge_nodes=edge_nodes,
-        edge_part=edge_part,
+        facets=facets,
+        facet_nodes=facet_nodes,
+        facet_part=facet_part,
         parts=parts,
-        edge_gap=edge_gap,
-        edge_direction=direction,
-        edge_normal=chord,
-        edge_local=edge_local,
+        facet_gap=facet_gap,
+        facet_direction=direction,
+        facet_normal=chord,
+        facet_local=facet_local,
         friction=friction,
         transfer=pair_transfer(
             space,
             couplings,
             (nodes, part, second, normal, friction.index >= 0),
             parts,
-            tuple(problem.pairs[s] for s in couplings),
+            tuple(conditions.pairs[s] for s in couplings),
         ),
     )
 
 
-def node_classes(cs: ContactSet, in_contact: np.ndarray, edge_in_contact: np.ndarray) -> np.ndarray:
+def node_classes(
+    cs: ContactSet, in_contact: np.ndarray, facet_in_contact: np.ndarray
+) -> np.ndarray:
     """Full / semi / no contact class of each constrained node (paper, Section 4).
 
     Parameters
@@ -377,20 +396,21 @@ def node_classes(cs: ContactSet, in_contact: np.ndarray, edge_in_contact: np.nda
     cs : ContactSet
     in_contact : (k,) bool array
         Actual contact nodes (``u_h(z)·n = ψ(z)``).
-    edge_in_contact : (n_ce, 3) bool array
-        Whether each node ``[start, end, midpoint]`` of each contact edge is in contact
+    facet_in_contact : (n_cf, 3) bool array
+        Whether each node ``[start, end, midpoint]`` of each contact facet (an edge in 2D)
+        is in contact
         (for Dirichlet end points: whether ``u_D·n = ψ`` there).
 
     Returns
     -------
     (k,) int array of ``NO_CONTACT``, ``SEMI_CONTACT``, ``FULL_CONTACT``.
     """
-    edge_full = edge_in_contact.all(axis=1)
-    loc = cs.edge_local.ravel()
+    facet_full = facet_in_contact.all(axis=1)
+    loc = cs.facet_local.ravel()
     touching = loc >= 0
     broken = np.bincount(
         loc[touching],
-        weights=np.repeat(~edge_full, cs.edge_local.shape[1])[touching],
+        weights=np.repeat(~facet_full, cs.facet_local.shape[1])[touching],
         minlength=cs.size,
     )
     classes = np.full(cs.size, NO_CONTACT, dtype=np.int64)

@@ -16,9 +16,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import nnls
 
-from ..mesh.bodies import body_of_cells
 from ..problem.fields import DATA_MAX, ProblemError
-from ..problem.rigid import describe_motion, motion_field
+from ..problem.rigid import describe_motion
 from .node_frames import to_frames
 from .system import Assembled
 
@@ -32,35 +31,29 @@ LOAD_RTOL = 1e-10
 STRICT_RTOL = 1e-6
 
 
-def motion_fields(problem, assembled: Assembled) -> np.ndarray:
-    """The free rigid motions of ``problem`` at the P2 nodes of ``assembled``, ``(k,
+def motion_fields(assembled: Assembled) -> np.ndarray:
+    """The free rigid motions of the problem of ``assembled`` at its P2 nodes, ``(k,
     n_nodes, 2)``, as the unknowns the constraints bound: each zero off its body where the
-    problem has contact pairs (``problem.rigid_parts`` names a part of it), and then the
-    relative displacement ``ũ = (I − T_d) u`` of the pairs (docs/method.md, *Two bodies*), so
-    that ``r̃(z)·n_z`` is the motion's normal component at constraint ``z``, a master's
-    motion included, and the load's work ``F̃·r̃ = F·r``."""
-    space, cs = assembled.space, assembled.contact
-    r = motion_field(space.mesh, problem.rigid_motions, space.node_points)
-    if not problem.rigid_parts:
+    problem has contact pairs
+    (:attr:`~.discrete_conditions.DiscreteConditions.rigid_field`), and then the relative
+    displacement ``ũ = (I − T_d) u`` of the pairs (docs/method.md, *Two bodies*), so that
+    ``r̃(z)·n_z`` is the motion's normal component at constraint ``z``, a master's motion
+    included, and the load's work ``F̃·r̃ = F·r``."""
+    r, cs = assembled.conditions.rigid_field, assembled.contact
+    if cs.transfer is None:
         return r
-    mesh = space.mesh
-    cell_body = body_of_cells(mesh)
-    node_body = np.zeros(space.n_nodes, dtype=np.int64)
-    node_body[space.cell_nodes.ravel()] = np.repeat(cell_body, space.cell_nodes.shape[1])
-    first_cell = [mesh.edge2cell[mesh.part_edges(p)[0], 0] for p in problem.rigid_parts]
-    r = r * (node_body[None, :] == cell_body[first_cell][:, None])[..., None]
     return np.stack([cs.relative(ri) for ri in r])  # k ≤ 3 per body
 
 
-def check_load_carried(problem, assembled: Assembled) -> None:
-    """Refuse a load the contacts cannot carry along the free rigid motions of ``problem``.
+def check_load_carried(assembled: Assembled) -> None:
+    """Refuse a load the contacts cannot carry along the free rigid motions of the problem
+    of ``assembled``.
 
     Parameters
     ----------
-    problem : ContactProblem
-        With ``problem.rigid_motions (k, 3)``, ``k ≥ 1``.
     assembled : Assembled
-        Its algebraic problem on one mesh (rotated frames at the constrained nodes).
+        The algebraic problem on one mesh (rotated frames at the constrained nodes), whose
+        conditions have free rigid motions (``conditions.rigid_motions (k, 3)``, ``k ≥ 1``).
 
     Raises
     ------
@@ -70,8 +63,8 @@ def check_load_carried(problem, assembled: Assembled) -> None:
         contacts hold one way only), naming the motion, the contact parts and the load.
     """
     space, cs = assembled.space, assembled.contact
-    motions = problem.rigid_motions
-    r = motion_fields(problem, assembled)  # (k, n_nodes, 2)
+    motions = assembled.conditions.rigid_motions
+    r = motion_fields(assembled)  # (k, n_nodes, 2)
     nodes, frames = assembled.frame_nodes, assembled.frames
     y = np.stack([to_frames(ri.ravel(), nodes, frames) for ri in r])  # k ≤ 3
     # a load beyond DATA_MAX (E extreme, the loads with it) is divided by a power of 2 near
@@ -119,7 +112,7 @@ def check_load_carried(problem, assembled: Assembled) -> None:
                 )
 
 
-def initial_active_set(problem, assembled: Assembled) -> np.ndarray:
+def initial_active_set(assembled: Assembled) -> np.ndarray:
     """The first active set of PDAS for a semi-coercive body: the constraints of least gap
     (the first points of contact) if their directions hold every free rigid motion, else
     every constraint (the contact closed). Either makes the first system regular where
@@ -132,8 +125,8 @@ def initial_active_set(problem, assembled: Assembled) -> np.ndarray:
     cs = assembled.contact
     gap = cs.gap
     first = gap <= gap.min() + 1e-12 * max(np.abs(gap).max(), np.finfo(float).tiny)
-    motions = problem.rigid_motions
-    r = motion_fields(problem, assembled)[:, cs.nodes[first]]
+    motions = assembled.conditions.rigid_motions
+    r = motion_fields(assembled)[:, cs.nodes[first]]
     along = np.einsum("knc,nc->kn", r, cs.normal[first])
     s = np.linalg.svd(along, compute_uv=False)
     if s.size == motions.shape[0] and s.min() > 1e-9 * max(s.max(), 1.0):

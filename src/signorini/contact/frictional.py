@@ -33,7 +33,7 @@ from .contact_set import ContactSet
 from .node_frames import to_frames
 from .ordering import ordered_solver
 from .rigid_modes import system_rigid_modes
-from .system import Assembled, obstacle_displacement
+from .system import Assembled
 
 __all__ = [
     "Solved",
@@ -224,7 +224,7 @@ def solve_frictional(
     tangent = cs.tangent[:, 0]
     reference = np.einsum("kc,kc->k", assembled.obstacle_motion, tangent) + 0.0
     if previous is not None:
-        moved = obstacle_displacement(previous.problem, previous.contact)
+        moved = previous.obstacle_motion
         reference += slip_reference(previous, cs)
         if moved.any():
             reference -= np.einsum("kc,kc->k", moved, tangent)

@@ -152,7 +152,7 @@ def mesh_difference(a: Mesh, b: Mesh) -> str | None:
 
     def labels(m: Mesh) -> np.ndarray:
         names = np.array([*m.part_names, ""], dtype=object)
-        return names[m.edge_part]  # -1 (interior) -> ""
+        return names[m.facet_part]  # -1 (interior) -> ""
 
     la, lb = labels(a), labels(b)
     if set(a.part_names) != set(b.part_names):
@@ -174,7 +174,7 @@ def mesh_difference(a: Mesh, b: Mesh) -> str | None:
         if (ca is None) != (cb is None):
             which = "has a curve" if ca is not None else "has no curve"
             return f"{which} on part {name!r}, unlike problems[0]"
-        x = a.edge_midpoints[a.part_edges(name)]
+        x = a.edge_midpoints[a.part_facets(name)]
         same = np.abs(ca.project(x) - cb.project(x)).max() <= SAME_CURVE_TOL * extent
         if same and (ca.has_normal or cb.has_normal):
             same = ca.has_normal == cb.has_normal and np.allclose(

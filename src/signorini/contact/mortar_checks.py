@@ -24,7 +24,7 @@ def _bodies(space: P2Space) -> np.ndarray:
     """``(n_cells,)`` the body of each cell: components of the cells joined through interior
     edges (as :class:`~signorini.problem.ContactProblem` finds them)."""
     mesh = space.mesh
-    e2c = mesh.edge2cell
+    e2c = mesh.facet2cell
     inner = e2c[:, 1] >= 0
     graph = sp.coo_matrix(
         (np.ones(int(inner.sum()), dtype=np.int8), (e2c[inner, 0], e2c[inner, 1])),
@@ -56,7 +56,7 @@ def check_pair(space: P2Space, slave: str, master: str, pair: str) -> tuple:
     label = _bodies(space)
     found = []
     for role, name in (("slave", slave), ("master", master)):
-        owner = np.unique(label[mesh.edge2cell[mesh.part_edges(name), 0]])
+        owner = np.unique(label[mesh.facet2cell[mesh.part_facets(name), 0]])
         if owner.size > 1:
             raise ProblemError(
                 f"{pair}: the {role} part {name!r} runs over {owner.size} bodies (components "

@@ -59,7 +59,7 @@ def side(space: P2Space, name: str) -> Side:
     at their nodes (as contact parts compute them: the curve's, else the mean of the part's
     edges' normals at a vertex); curved where the part carries a curve."""
     mesh = space.mesh
-    edges = mesh.part_edges(name)
+    edges = mesh.part_facets(name)
     nodes = space.edge_nodes(edges)
     points = space.node_points[nodes]
     _, chord = segment_normals(points[:, 0], points[:, 1])

@@ -182,14 +182,14 @@ def transfer_active(
 
 
 def nested_active_set(
-    problem, space: LagrangeSpace, cs: ContactSet, solve_coarse: Callable[[Mesh], object]
+    initial: Mesh, space: LagrangeSpace, cs: ContactSet, solve_coarse: Callable[[Mesh], object]
 ) -> np.ndarray | None:
-    """The initial active set of a cold solve of ``problem`` on ``space`` (contact set
-    ``cs``) from the solve ``solve_coarse(mesh)`` (a
+    """The initial active set of a cold solve on ``space`` (contact set ``cs``) of a problem
+    posed on the mesh ``initial`` from the solve ``solve_coarse(mesh)`` (a
     :class:`~signorini.contact.ContactResult`) on the coarse mesh of :func:`coarse_mesh`,
     or None where there is no coarse mesh or its PDAS fails (the fine PDAS then starts
     empty)."""
-    coarse = coarse_mesh(problem.mesh, space.mesh, problem.contact_parts)
+    coarse = coarse_mesh(initial, space.mesh, list(cs.parts))
     if coarse is None:
         return None
     try:

@@ -98,24 +98,24 @@ def contact_profile(result: ContactResult, part: str | None = None) -> ContactPr
             f"part: {part!r} is not a contact part of {result.problem.name!r}; its contact "
             f"parts are {list(cs.parts)}"
         )
-    mine = np.flatnonzero(cs.edge_part == cs.parts.index(part))
-    order, chain_end, chain = _walk(cs.edge_nodes[mine], result.space.node_points)
+    mine = np.flatnonzero(cs.facet_part == cs.parts.index(part))
+    order, chain_end, chain = _walk(cs.facet_nodes[mine], result.space.node_points)
     edges = mine[order]
     # per ordered edge: start, midpoint (P2; P1 edges have none), and the end vertex where a
     # chain ends
-    inner = [np.ones(edges.size, bool)] * (cs.edge_nodes.shape[1] - 1)
+    inner = [np.ones(edges.size, bool)] * (cs.facet_nodes.shape[1] - 1)
     take = np.column_stack([*inner, chain_end])
-    order_of = np.array([0, 2, 1]) if cs.edge_nodes.shape[1] == 3 else np.array([0, 1])
+    order_of = np.array([0, 2, 1]) if cs.facet_nodes.shape[1] == 3 else np.array([0, 1])
     column = np.broadcast_to(order_of, take.shape)[take]
     row = np.broadcast_to(edges[:, None], take.shape)[take]
-    nodes = cs.edge_nodes[row, column]
+    nodes = cs.facet_nodes[row, column]
     points = result.space.node_points[nodes]
     step = np.sqrt((np.diff(points, axis=0) ** 2).sum(axis=1))
-    loc = cs.edge_local[row, column]
+    loc = cs.facet_local[row, column]
     inside = loc >= 0
     force = np.where(inside, result.contact_force[np.maximum(loc, 0)], np.nan)
-    gap = cs.edge_gap[row, column]
-    un = np.einsum("kc,kc->k", result.u[nodes], cs.edge_direction[row, column])
+    gap = cs.facet_gap[row, column]
+    un = np.einsum("kc,kc->k", result.u[nodes], cs.facet_direction[row, column])
     return ContactProfile(
         part=part,
         nodes=nodes,

@@ -117,6 +117,10 @@ class ContactResult:
         On a run of several MPI ranks, which rank owns which nodes and cells and the ranks
         themselves (:attr:`~.system.Assembled.partition`); None on one process. Everything
         else is the same on every rank.
+    obstacle_motion : (k, 2) float array or None
+        The prescribed displacement of the obstacle of each constraint
+        (:attr:`~.system.Assembled.obstacle_motion`), which the next load step's slip is
+        measured against (docs/method.md, *Obstacle motion*).
     tangential_force : (k,) float array
         Nodal friction forces Λ_t,z (along the constraint's tangent ``contact.tangent``,
         ``t = (−n_y, n_x)``; the obstacle acts on the body with ``−Λ_t t``); 0 without
@@ -154,6 +158,7 @@ class ContactResult:
     roller_nodes: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     roller_force: np.ndarray = field(default_factory=lambda: np.zeros(0))
     partition: Partition | None = None
+    obstacle_motion: np.ndarray | None = None
 
     @property
     def mesh(self) -> Mesh:
@@ -219,9 +224,9 @@ class ContactResult:
     def classes(self) -> np.ndarray:
         """Full / semi / no contact class of every constrained node (paper, Section 4)."""
         cs = self.contact
-        loc = cs.edge_local
-        gap = cs.edge_normal_gap(self.u)
-        dirichlet_touch = gap >= -TOUCH_RTOL * round_off_scale(self.u, cs.edge_gap)
+        loc = cs.facet_local
+        gap = cs.facet_normal_gap(self.u)
+        dirichlet_touch = gap >= -TOUCH_RTOL * round_off_scale(self.u, cs.facet_gap)
         edge_in = np.where(loc >= 0, self.active[np.maximum(loc, 0)], dirichlet_touch)
         return node_classes(cs, self.active, edge_in)
 
@@ -323,8 +328,8 @@ def solve(
         assembled.partition.check_ranks(solver_ranks(solver))
     ranks = assembled.ranks
     space, cs = assembled.space, assembled.contact
-    if problem.rigid_motions.size:
-        check_load_carried(problem, assembled)
+    if assembled.conditions.rigid_motions.size:
+        check_load_carried(assembled)
     if previous is not None:
         check_previous(previous, space, cs)
         if u0 is None and not cs.has_friction:
@@ -353,17 +358,17 @@ def solve(
         and problem.free_ndof(space) >= NESTED_MIN_NDOF
     ):
         active0 = nested_active_set(
-            problem, space, cs,
+            problem.mesh, space, cs,
             lambda coarse: solve(
                 problem, coarse, solver=solver, max_iter=max_iter, fallback=fallback,
                 element=space.element,
             ),
         )  # fmt: skip
         timings["nested"] = time.perf_counter() - t0
-    if active0 is None and problem.rigid_motions.size:
+    if active0 is None and assembled.conditions.rigid_motions.size:
         # semi-coercive: the empty active set leaves the free rigid motions singular; start
         # from the first points of contact (docs/method.md, *Force control*)
-        active0 = initial_active_set(problem, assembled)
+        active0 = initial_active_set(assembled)
     solved = _solve_system(
         assembled, (K, F), u0=u0, active0=active0, previous=previous,
         options=PDASOptions(max_iter=max_iter, fallback=fallback), solver=ahead or solver,
@@ -398,6 +403,7 @@ def solve(
         roller_nodes=assembled.rollers.nodes,
         roller_force=assembled.rollers.force(assembled.K, assembled.F, solved.x, ranks),
         partition=assembled.partition,
+        obstacle_motion=assembled.obstacle_motion,
     )
 
 

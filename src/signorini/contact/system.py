@@ -19,13 +19,13 @@ from ..fem.loads import assemble_body_force, assemble_edge_load
 from ..fem.space import LagrangeSpace, space_of
 from ..fem.stiffness import assemble_stiffness
 from ..mesh.mesh import Mesh
-from ..problem.conditions import Neumann, Roller
+from ..problem.conditions import Neumann
 from ..problem.fields import ProblemError, evaluate_field
-from ..problem.normals import straight_normal
 from ..problem.problem import ContactProblem
-from ..problem.rollers import HeldNodes, held_nodes
+from ..problem.rollers import HeldNodes
 from .admissible import check_load_size
 from .contact_set import ContactSet, contact_set
+from .discrete_conditions import DiscreteConditions, discrete_conditions
 from .node_frames import frame_matrices, rotate_frames
 from .ordering import Ordering
 from .partition import Partition, partition
@@ -95,6 +95,10 @@ class Assembled:
     rollers : RollerDofs
         The held DOF of each roller node off the contact boundary and its roller's normal
         there, to recover the roller's force (:func:`roller_dofs`).
+    conditions : DiscreteConditions
+        The problem's conditions resolved on :attr:`space`, once
+        (:func:`~.discrete_conditions.discrete_conditions`): what every helper below the
+        assembly reads instead of the problem (force control among them).
     partition : Partition or None
         On a run of several MPI ranks, which rank owns which nodes and cells
         (:func:`~.partition.partition`) and the ranks (``partition.ranks``); None on one.
@@ -117,6 +121,7 @@ class Assembled:
     frame_nodes: np.ndarray
     frames: np.ndarray
     rollers: RollerDofs
+    conditions: DiscreteConditions
     partition: Partition | None = None
     ordering: Ordering | None = None
 
@@ -137,6 +142,10 @@ def assemble(
     on_pattern: Callable[[sp.csr_matrix, ContactSet, Ordering], None] | None = None,
 ) -> Assembled:
     """Stiffness, load and constraints of ``problem`` on ``mesh`` (paper, Section 3).
+
+    The problem's boundary conditions are resolved once on the nodes of the space
+    (:class:`~.discrete_conditions.DiscreteConditions`, :attr:`Assembled.conditions`); the
+    contact set, the held DOFs and the rollers' DOFs are built from that record.
 
     The two DOFs of every constrained node are transformed into its frame (normal and
     tangential components; a corner's two constraint directions) so that each constraint
@@ -174,7 +183,8 @@ def assemble(
             "coupling of docs/method.md, *Two bodies*) are built for P2 only"
         )
     n_dofs = space.n_dofs
-    cs = contact_set(problem, space)
+    conditions = discrete_conditions(problem, space)
+    cs = contact_set(conditions, space)
     coupling = None if cs.transfer is None else cs.transfer.nodes
     ordering = Ordering(space, coupling, prefetch=prefetch_ordering and ranks.size == 1)
     part, rows = None, None
@@ -221,15 +231,15 @@ def assemble(
         cond: Neumann = problem.conditions[name]
         if cond.is_zero:
             continue
-        edges = mesh.part_edges(name)
-        nodes = space.edge_nodes(edges)
+        facets = mesh.part_facets(name)
+        nodes = space.edge_nodes(facets)
         dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(len(nodes), -1)
         g = cond.field()
 
         def traction(x, n, g=g, name=name):
             return evaluate_field(g, x, f"the traction of Neumann part {name!r}", normal=n)
 
-        for rows, geometry in space.boundary_edges(edges):
+        for rows, geometry in space.boundary_edges(facets):
             g = assemble_edge_load(
                 geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE, element=space.element
             )
@@ -243,7 +253,7 @@ def assemble(
             K = part.own_rows(K)
     if on_pattern is not None:
         on_pattern(K, cs, ordering)
-    held = held_nodes(problem, space)
+    held = conditions.held
     frame_nodes, frames = system_frames(cs, held)
     K, F = rotate_frames(K, F, frame_nodes, frames, copy=False, validate=False)
     dirichlet, d_values = _dirichlet_dofs(held, space, cs)
@@ -256,10 +266,11 @@ def assemble(
         d_values,
         time.perf_counter() - t0,
         np.flatnonzero(held.components.all(axis=1)),
-        obstacle_displacement(problem, cs),
+        obstacle_displacement(conditions, cs),
         frame_nodes,
         frames,
-        roller_dofs(problem, space, held, cs),
+        roller_dofs(conditions, cs),
+        conditions,
         part,
         ordering,
     )
@@ -299,34 +310,25 @@ class RollerDofs:
         return self.sign * (F[self.dofs] - ranks.sum(K[self.dofs] @ y))
 
 
-def roller_dofs(
-    problem: ContactProblem, space: LagrangeSpace, held: HeldNodes, cs: ContactSet
-) -> RollerDofs:
-    """The :class:`RollerDofs` of ``problem`` on ``space``: the roller nodes in frames
-    (``held.roller_nodes`` off the contact boundary) and the nodes of rollers along an axis
-    that hold one Cartesian component there."""
+def roller_dofs(conditions: DiscreteConditions, cs: ContactSet) -> RollerDofs:
+    """The :class:`RollerDofs` of a problem's ``conditions`` on a space: the roller nodes in
+    frames (``held.roller_nodes`` off the contact boundary) and the nodes of rollers along an
+    axis (:attr:`~.discrete_conditions.DiscreteConditions.axis_normal`) that hold one
+    Cartesian component there."""
+    held = conditions.held
     off = cs.local(held.roller_nodes) < 0
-    nodes, dofs = [held.roller_nodes[off]], [2 * held.roller_nodes[off]]
-    sign, normal = [np.ones(int(off.sum()))], [held.roller_normal[off]]
     partial = held.components.sum(axis=1) == 1
-    for name in problem.held:  # a loop over parts
-        if not isinstance(problem.conditions[name], Roller):
-            continue
-        z = space.part_nodes([name])
-        z = z[partial[z] & (cs.local(z) < 0)]
-        n = straight_normal(space.mesh, name)
-        c = int(np.argmax(np.abs(n)))
-        nodes.append(z)
-        dofs.append(2 * z + c)
-        sign.append(np.full(z.size, np.sign(n[c])))
-        normal.append(np.broadcast_to(np.eye(2)[c] * np.sign(n[c]), (z.size, 2)))
-    nodes = np.concatenate(nodes)
-    first = np.unique(nodes, return_index=True)[1]  # a node on two axis rollers: once
+    axis = conditions.axis_normal
+    z = np.flatnonzero(partial & axis.any(axis=1))
+    z = z[cs.local(z) < 0]
+    c = np.argmax(np.abs(axis[z]), axis=1)
+    nodes = np.concatenate([held.roller_nodes[off], z])
+    order = np.argsort(nodes)  # the two sets are apart: an axis roller holds a component
     return RollerDofs(
-        nodes[first],
-        np.concatenate(dofs)[first],
-        np.concatenate(sign)[first],
-        np.concatenate(normal)[first],
+        nodes[order],
+        np.concatenate([2 * held.roller_nodes[off], 2 * z + c])[order],
+        np.concatenate([np.ones(int(off.sum())), axis[z, c]])[order],
+        np.concatenate([held.roller_normal[off], axis[z]])[order],
     )
 
 
@@ -346,16 +348,12 @@ def system_frames(cs: ContactSet, held: HeldNodes) -> tuple[np.ndarray, np.ndarr
     return nodes[order], frames[order]
 
 
-def obstacle_displacement(problem: ContactProblem, cs: ContactSet) -> np.ndarray:
+def obstacle_displacement(conditions: DiscreteConditions, cs: ContactSet) -> np.ndarray:
     """``(k, 2)`` the prescribed displacement of the obstacle of each constraint of ``cs``
-    (docs/method.md, *Obstacle motion*): ``Obstacle.displacement`` of its part's obstacle,
-    0 for a part with a gap function."""
-    by_part = np.zeros((len(cs.parts), 2))
-    for i, name in enumerate(cs.parts):  # a loop over contact parts
-        obstacle = problem.conditions[name].obstacle
-        if obstacle is not None:
-            by_part[i] = obstacle.displacement
-    return by_part[cs.part] if cs.size else np.zeros((0, 2))
+    (docs/method.md, *Obstacle motion*): ``Obstacle.displacement`` of its part's obstacle
+    (:attr:`~.discrete_conditions.DiscreteConditions.obstacle_motion`), 0 for a part with a
+    gap function."""
+    return conditions.obstacle_motion[cs.part] if cs.size else np.zeros((0, 2))
 
 
 def _dirichlet_dofs(

@@ -32,7 +32,7 @@ import scipy.sparse as sp
 from ..algebra.sparse import concatenated_ranges
 from ..fem.space import P2Space
 from ..problem.fields import ProblemError
-from .constraint_data import edge_weights
+from .constraint_data import facet_weights
 from .mortar import MortarCoupling
 
 __all__ = [
@@ -193,13 +193,13 @@ def master_traction(
     ``(m,)`` ``Σ_j T_jk Λ_j / w_k``; ``nodes (k,)`` and ``force (k, 3)`` the slave
     constraints' nodes and their ``(f_x, f_y, Λ)`` (the force on the slave and the normal
     contact force)."""
-    edges = np.concatenate([space.mesh.part_edges(m) for m in transfer.masters])
-    edge_nodes = space.edge_nodes(edges)
+    facets = np.concatenate([space.mesh.part_facets(m) for m in transfer.masters])
+    facet_nodes = space.edge_nodes(facets)
     w = np.bincount(
-        edge_nodes.ravel(), weights=edge_weights(space, edges, edge_nodes)[1].ravel(),
+        facet_nodes.ravel(), weights=facet_weights(space, facets, facet_nodes)[1].ravel(),
         minlength=space.n_nodes,
     )  # fmt: skip
-    on = np.unique(edge_nodes)
+    on = np.unique(facet_nodes)
     f = master_forces(transfer.dofs, nodes, force[:, :2], space.n_nodes)[on]
     lam = np.zeros(space.n_nodes)
     np.add.at(lam, nodes, force[:, 2])

@@ -33,7 +33,7 @@ def _part_direction(problem: ContactProblem, name: str, vertex: np.ndarray) -> n
     if name in problem.contact_normals:
         return np.broadcast_to(problem.contact_normals[name], x.shape)
     mesh = problem.mesh
-    ab = mesh.oriented_boundary(mesh.part_edges(name))
+    ab = mesh.oriented_boundary(mesh.part_facets(name))
     _, chord = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
     total = np.zeros((mesh.n_points, 2))
     np.add.at(total, ab.ravel(), np.repeat(chord, 2, axis=0))
@@ -60,7 +60,7 @@ def check_corner_friction(problem: ContactProblem) -> None:
     """
     mesh = problem.mesh
     parts = problem.contact_parts
-    ends = {p: np.unique(mesh.edges[mesh.part_edges(p)]) for p in parts}
+    ends = {p: np.unique(mesh.facets[mesh.part_facets(p)]) for p in parts}
     for i, a in enumerate(parts):
         for b in parts[i + 1 :]:
             fa, fb = problem.conditions[a].friction, problem.conditions[b].friction

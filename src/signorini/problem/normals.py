@@ -36,7 +36,7 @@ def straight_normal(mesh: Mesh, name: str) -> np.ndarray | None:
     """``(2,)`` the outward unit normal of part ``name`` if it is straight (its edges'
     normals agree within :data:`STRAIGHT_RTOL` and it carries no curve other than a
     :class:`~signorini.mesh.curves.Line`), else ``None``."""
-    ab = mesh.oriented_boundary(mesh.part_edges(name))
+    ab = mesh.oriented_boundary(mesh.part_facets(name))
     _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
     mean = n.mean(axis=0)
     mean /= np.linalg.norm(mean)

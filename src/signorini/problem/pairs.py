@@ -93,8 +93,8 @@ def pair_rigid_motions(
     """
     body = body_of_cells(mesh)
     edge_body = np.full(mesh.n_edges, -1)
-    edge_body[mesh.edge_part >= 0] = body[mesh.edge2cell[mesh.edge_part >= 0, 0]]
-    part_body = {p: int(edge_body[mesh.part_edges(p)[0]]) for p in mesh.part_names}
+    edge_body[mesh.facet_part >= 0] = body[mesh.facet2cell[mesh.facet_part >= 0, 0]]
+    part_body = {p: int(edge_body[mesh.part_facets(p)[0]]) for p in mesh.part_names}
     masters = set(pairs.values())
 
     def parts_of(b: int) -> list[str]:

@@ -258,7 +258,7 @@ class ContactProblem:
         given = self.conditions[name].normal
         if self.conditions[name].obstacle is not None or name in self.pairs:
             return None
-        ab = mesh.oriented_boundary(mesh.part_edges(name))
+        ab = mesh.oriented_boundary(mesh.part_facets(name))
         _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
         mean = n.mean(axis=0)
         mean /= np.linalg.norm(mean)
@@ -326,14 +326,14 @@ def _check_components(mesh: Mesh, dirichlet_parts: list[str], contact_parts: lis
         Naming each component without a Dirichlet edge by its cells, bounding box and
         boundary parts (the first few, and how many more).
     """
-    e2c = mesh.edge2cell
+    e2c = mesh.facet2cell
     label = body_of_cells(mesh)
     n_comp = int(label.max(initial=0)) + 1
     if n_comp == 1:
         return
     held = np.zeros(n_comp, dtype=bool)
     for name in dirichlet_parts:
-        held[label[e2c[mesh.part_edges(name), 0]]] = True
+        held[label[e2c[mesh.part_facets(name), 0]]] = True
     floating = np.flatnonzero(~held)
     if floating.size == 0:
         return
@@ -344,8 +344,8 @@ def _check_components(mesh: Mesh, dirichlet_parts: list[str], contact_parts: lis
     hi = np.full((n_comp, mesh.dim), -np.inf)
     np.minimum.at(lo, label, xy.min(axis=1))
     np.maximum.at(hi, label, xy.max(axis=1))
-    be = np.flatnonzero(mesh.edge_part >= 0)
-    pairs = np.unique(np.column_stack([label[e2c[be, 0]], mesh.edge_part[be]]), axis=0)
+    be = np.flatnonzero(mesh.facet_part >= 0)
+    pairs = np.unique(np.column_stack([label[e2c[be, 0]], mesh.facet_part[be]]), axis=0)
     lines = []
     for c in floating[:_NAMED_COMPONENTS]:
         parts = [mesh.part_names[p] for p in pairs[pairs[:, 0] == c, 1]]

@@ -81,7 +81,7 @@ def motion_conditions(
     centre, size = _frame(mesh)
     rows = [np.zeros((0, 3))]
     for name, cond in held.items():  # a loop over parts
-        e = mesh.part_edges(name)
+        e = mesh.part_facets(name)
         v = np.unique(mesh.edges[e if on_edges is None else e[on_edges[e]]])
         d = (mesh.points[v] - centre) / size
         one, zero = np.ones(v.size), np.zeros(v.size)
@@ -91,7 +91,7 @@ def motion_conditions(
         )
         rows += [by_component[c] for c in range(2) if cond.components[c]]
     for name, (x, n) in (rollers or {}).items():  # a loop over parts
-        if on_edges is None or on_edges[mesh.part_edges(name)[0]]:
+        if on_edges is None or on_edges[mesh.part_facets(name)[0]]:
             d = (x - centre) / size  # r·n = a n_x + b n_y + c (d_x n_y − d_y n_x)
             rows.append(np.column_stack([n[:, 0], n[:, 1], d[:, 0] * n[:, 1] - d[:, 1] * n[:, 0]]))
     return np.concatenate(rows)
@@ -129,7 +129,7 @@ def free_rigid_motions(
         return free
     normals, mids = [], []
     for name in contact_parts:  # a loop over parts
-        ab = mesh.oriented_boundary(mesh.part_edges(name))
+        ab = mesh.oriented_boundary(mesh.part_facets(name))
         _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
         normals.append(n)
         mids.append(0.5 * (mesh.points[ab[:, 0]] + mesh.points[ab[:, 1]]))

@@ -44,7 +44,7 @@ PARALLEL = 1e-8
 def roller_normals(mesh: Mesh, name: str) -> tuple[np.ndarray, np.ndarray]:
     """The P2 nodes ``[start, end, midpoint]`` of roller part ``name``'s edges ``(e, 3)`` and
     the outward unit normal at each ``(e, 3, 2)`` (:func:`~.normals.node_normals`)."""
-    edges = mesh.part_edges(name)
+    edges = mesh.part_facets(name)
     ab = mesh.oriented_boundary(edges)
     nodes = np.column_stack([ab, mesh.n_points + edges])
     points = np.concatenate(
@@ -70,7 +70,7 @@ def check_roller_part(mesh: Mesh, name: str) -> None:
     curve = mesh.curves[mesh.part_index(name)]
     if straight_normal(mesh, name) is not None or (curve is not None and curve.has_normal):
         return
-    ab = mesh.oriented_boundary(mesh.part_edges(name))
+    ab = mesh.oriented_boundary(mesh.part_facets(name))
     _, chord = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
     total = np.zeros((mesh.n_points, 2))
     count = np.zeros(mesh.n_points)
