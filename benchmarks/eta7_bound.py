@@ -39,7 +39,7 @@ PROBLEMS = {"example-6.1": example_6_1, "example-6.2": example_6_2, "hertz": her
 def contact_trace(result):
     """The edges of Γ_C and ``u_h·n − ψ_h`` on them, as the estimator's η7 reads them."""
     mesh, cs = result.mesh, result.contact
-    gap = result.space.element.edge_values(cs.edge_normal_gap(result.u))
+    gap = result.space.element.facet.facet_values(cs.facet_normal_gap(result.u))
     x0, x1 = mesh.points[cs.edge_nodes[:, 0]], mesh.points[cs.edge_nodes[:, 1]]
     origin = x0.min(axis=0)
     return x0 - origin, x1 - origin, gap, float(np.abs(result.u).max(initial=0.0))

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..algebra.laws import FrictionLaw
+from ..algebra.friction.laws import FrictionLaw
 from ..fem.space import LagrangeSpace
 from ..mesh.bodies import body_of_cells
 from ..problem.conditions import Contact, Roller
