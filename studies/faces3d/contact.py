@@ -68,7 +68,9 @@ def assemble(mesh: CubeMesh, exact: Manufactured) -> ContactProblem:
     for axis, value in [(0, 0.0), (0, 1.0), (1, 0.0), (1, 1.0)]:
         normal = np.zeros(3)
         normal[axis] = 1.0 if value else -1.0
-        F += face_load(mesh, mesh.boundary_faces(axis, value), lambda p: exact.stress(p) @ normal)
+        F += face_load(
+            mesh, mesh.boundary_faces(axis, value), lambda p, nrm=normal: exact.stress(p) @ nrm
+        )
     faces = mesh.boundary_faces(2, 0.0)
     tangential = np.array([1.0, 1.0, 0.0])
     F += face_load(mesh, faces, lambda p: -exact.stress(p)[..., :, 2] * tangential)
@@ -162,7 +164,7 @@ def solve_pdas(problem: ContactProblem, alpha: float = 0.0, max_iter: int = 50) 
     x = np.zeros(n)
     x[problem.fixed] = problem.u_fixed
     active = np.ones(C.size, bool)
-    for it in range(1, max_iter + 1):
+    for it in range(1, max_iter + 1):  # noqa: B007 (the count is reported)
         x[C[active]] = lower[active]
         held = np.zeros(n, bool)
         held[problem.fixed] = True
