@@ -227,11 +227,6 @@ def solve_dual_nnls(problem: ContactProblem, alpha: float = 0.0) -> np.ndarray:
     KiBt = np.linalg.solve(Kff, B.T)
     L = np.linalg.cholesky(B @ KiBt)
     rhs = np.linalg.solve(L, B @ np.linalg.solve(Kff, Ff) - b)
-    lam, _ = so.nnls(L.T, rhs, maxiter=50 * lam_size(B))
+    lam, _ = so.nnls(L.T, rhs, maxiter=50 * B.shape[0])
     u[free] = np.linalg.solve(Kff, Ff - B.T @ lam)
     return u.reshape(-1, 3)
-
-
-def lam_size(B: np.ndarray) -> int:
-    """Number of constraints (rows of B)."""
-    return B.shape[0]
