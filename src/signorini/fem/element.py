@@ -20,11 +20,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..mesh.reference import TRIANGLE, ReferenceCell
-from . import p1, p2
-from .facet_element import P1_INTERVAL, P2_INTERVAL, FacetElement
+from ..mesh.reference import TETRAHEDRON, TRIANGLE, ReferenceCell
+from . import p1, p2, p2_tet
+from .facet_element import P1_INTERVAL, P2_INTERVAL, P2_TRIANGLE, FacetElement
 
-__all__ = ["ELEMENTS", "Element", "FacetElement", "P1", "P2", "element_of"]
+__all__ = ["ELEMENTS", "Element", "FacetElement", "P1", "P2", "P2_TET", "element_of"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -39,7 +39,8 @@ class Element:
         The polynomial degree k: 2 for P2, 1 for P1. The energy error of a smooth solution
         (and η_h with it) decays at best like ``h^k``, i.e. ``N_dof^{-k/2}`` in 2D.
     reference : ReferenceCell
-        The reference cell the element lives on (:data:`~signorini.mesh.reference.TRIANGLE`).
+        The reference cell the element lives on (:data:`~signorini.mesh.reference.TRIANGLE`,
+        or :data:`~signorini.mesh.reference.TETRAHEDRON` for :data:`P2_TET`).
     n_local : int
         Nodes per cell (the vertices, then for P2 the midpoints of the local edges in the
         order of ``reference.edges``).
@@ -48,7 +49,7 @@ class Element:
         dim)``.
     reference_nodes : (n_local, dim) float array
     vtk_cell : str
-        meshio's cell type: ``"triangle6"`` or ``"triangle"``.
+        meshio's cell type: ``"triangle6"``, ``"triangle"`` or ``"tetra10"``.
     facet : FacetElement
         The element on a facet of the cell: its basis, nodes per facet, contact weights,
         pieces γ̃_p and nodal force → pressure.
@@ -111,22 +112,53 @@ P1 = Element(
     facet=P1_INTERVAL,
 )
 
-#: the elements by name
+#: P2 on the tetrahedron (VTK's tetra10: 4 vertices, then the midpoints of
+#: ``TETRAHEDRON.edges``), its facet element the P2 triangle of a face
+P2_TET = Element(
+    name="P2",
+    degree=2,
+    reference=TETRAHEDRON,
+    n_local=10,
+    basis=p2_tet.basis,
+    grad_basis=p2_tet.grad_basis,
+    reference_nodes=p2_tet.REFERENCE_NODES,
+    vtk_cell=TETRAHEDRON.vtk_p2_name,
+    facet=P2_TRIANGLE,
+)
+
+#: the elements by name (on the triangle)
 ELEMENTS: dict[str, Element] = {"P1": P1, "P2": P2}
 
+#: the elements by reference cell, then name: one record per element *and* cell
+ELEMENTS_ON: dict[str, dict[str, Element]] = {
+    TRIANGLE.name: ELEMENTS,
+    TETRAHEDRON.name: {"P2": P2_TET},
+}
 
-def element_of(element: str | Element, argument: str = "element") -> Element:
-    """The :class:`Element` named ``element`` (``"P1"`` or ``"P2"``, any case), or the element
-    itself.
+
+def element_of(
+    element: str | Element, argument: str = "element", reference: ReferenceCell = TRIANGLE
+) -> Element:
+    """The :class:`Element` named ``element`` (``"P1"`` or ``"P2"``, any case) on the
+    reference cell ``reference`` (a mesh's ``mesh.reference``; the triangle by default), or
+    the element itself.
 
     Raises
     ------
     ValueError
-        Naming ``argument`` and the choices, for anything else.
+        Naming ``argument`` and the choices, for anything else, and for an element given as a
+        record that lives on another cell than ``reference``.
     """
+    table = ELEMENTS_ON[reference.name]
     if isinstance(element, Element):
+        if element.reference is not reference:
+            raise ValueError(
+                f"{argument} {element!r} lives on the {element.reference.name}, not on the "
+                f"{reference.name}"
+            )
         return element
     key = element.upper() if isinstance(element, str) else None
-    if key not in ELEMENTS:
-        raise ValueError(f"{argument} must be one of {tuple(ELEMENTS)}, got {element!r}")
-    return ELEMENTS[key]
+    if key not in table:
+        on = "" if reference is TRIANGLE else f" on the {reference.name}"
+        raise ValueError(f"{argument} must be one of {tuple(table)}{on}, got {element!r}")
+    return table[key]

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..mesh.reference import INTERVAL, ReferenceCell
+from ..mesh.reference import INTERVAL, TRIANGLE, ReferenceCell
 from . import p1, p2
 
-__all__ = ["FacetElement", "P1_INTERVAL", "P2_INTERVAL"]
+__all__ = ["FaceElement", "FacetElement", "P1_INTERVAL", "P2_INTERVAL", "P2_TRIANGLE"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -136,4 +136,78 @@ P1_INTERVAL = FacetElement(
     basis_share=(1 / 2, 1 / 2),
     hat_pieces=((0.0, 0.5, 0, (1.0, -1.0)), (0.5, 1.0, 1, (0.0, 1.0))),
     node_parts=((0.0, 0.5, 0), (0.5, 1.0, 1)),
+)
+
+
+def _contact_on_faces(what: str) -> property:
+    """A property that refuses: the contact facts of a face are the 3D contact issue's."""
+
+    def refuse(self: FaceElement) -> None:
+        raise NotImplementedError(
+            f"{self.name}: {what} of a triangular face is not defined yet -- the discrete "
+            "contact condition on P2 faces is the subject of issue 38 (three dimensions, part "
+            "2: frictionless contact on faces); on a flat P2 triangle the vertex basis "
+            "functions integrate to zero, so the 2D shares do not carry over"
+        )
+
+    return property(refuse)
+
+
+class FaceElement(FacetElement):
+    """The trace of a 3D cell's element on a triangular face: its basis, nodes per face and
+    basis integrals; the contact facts (``hat_share``, ``hat_pieces``, ``node_parts``,
+    :meth:`pressure`) refuse with ``NotImplementedError`` until the 3D contact condition is
+    chosen (issue 38).
+
+    Parameters
+    ----------
+    name : str
+    reference : ReferenceCell
+        :data:`~signorini.mesh.reference.TRIANGLE`.
+    n_nodes : int
+        Nodes per face (6 for P2: the vertices, then the midpoints of its sides).
+    basis : callable
+        Values ``(q, n_nodes)`` at triangle reference points ``s (q, 2)``.
+    basis_share : tuple of n_nodes floats
+        ``∫_F ψ_z ds / |F|`` on a flat face: ``(0, 0, 0, 1/3, 1/3, 1/3)`` for P2.
+    """
+
+    def __init__(
+        self,
+        name: str,
+        reference: ReferenceCell,
+        n_nodes: int,
+        basis: Callable[[np.ndarray], np.ndarray],
+        basis_share: tuple[float, ...],
+    ) -> None:
+        for key, value in (
+            ("name", name),
+            ("reference", reference),
+            ("n_nodes", n_nodes),
+            ("basis", basis),
+            ("basis_share", basis_share),
+        ):
+            object.__setattr__(self, key, value)
+
+    hat_share = _contact_on_faces("the contact weights m_z / |F| (hat_share)")
+    hat_pieces = _contact_on_faces("the pieces γ̃_p of a contact face (hat_pieces)")
+    node_parts = _contact_on_faces("the pieces γ̃_p of a contact face (node_parts)")
+
+    def facet_values(self, values: np.ndarray) -> np.ndarray:
+        """Per-face nodal data ``(k, 6, ...)``, unchanged (P2)."""
+        return np.asarray(values, dtype=np.float64)
+
+    def pressure(self, force: np.ndarray, weight: np.ndarray) -> np.ndarray:
+        """Refused: ``w_z = 0`` at a P2 face's vertices (see :meth:`FacetElement.pressure`)."""
+        _contact_on_faces("the nodal pressure Λ_z / w_z").fget(self)
+
+
+#: P2 on a triangular face of a tetrahedron: the P2 triangle's basis; the vertex functions
+#: integrate to zero, the midpoint functions to |F|/3
+P2_TRIANGLE = FaceElement(
+    name="P2 triangle",
+    reference=TRIANGLE,
+    n_nodes=6,
+    basis=p2.basis,
+    basis_share=(0.0, 0.0, 0.0, 1 / 3, 1 / 3, 1 / 3),
 )

@@ -333,7 +333,13 @@ class CellMap:
     curved : (cells (k,), nodes (k, 6, d)), optional
         The isoparametric cells and their node points
         (:attr:`~signorini.fem.space.P2Space.curved`); ``None``: every cell is affine.
+
+    The group classes are the class attributes :attr:`affine` and :attr:`isoparametric`
+    (tetrahedra: :class:`signorini.fem.mapping3d.TetrahedronMap`).
     """
+
+    affine: type = AffineCells
+    isoparametric: type = IsoparametricCells
 
     def __init__(
         self, vertices: np.ndarray, curved: tuple[np.ndarray, np.ndarray] | None = None
@@ -343,7 +349,7 @@ class CellMap:
         self.group = np.zeros(0, dtype=np.int8)  # which group each cell is in (if several)
         self.slot = np.zeros(0, dtype=np.int64)  # its row in that group
         if curved is None or len(curved[0]) == 0:
-            self.groups: tuple[Cells, ...] = (AffineCells(vertices),)
+            self.groups: tuple[Cells, ...] = (self.affine(vertices),)
             return
         cells, nodes = curved
         self.group = np.zeros(self.n_cells, dtype=np.int8)
@@ -353,10 +359,10 @@ class CellMap:
         self.slot[affine] = np.arange(affine.size)
         self.slot[cells] = np.arange(len(cells))
         if affine.size == 0:  # every cell is isoparametric (a coarse mesh of a curved body)
-            self.groups = (IsoparametricCells(nodes),)
+            self.groups = (self.isoparametric(nodes),)
             self.group, self.slot = np.zeros(0, dtype=np.int8), np.zeros(0, dtype=np.int64)
             return
-        self.groups = (AffineCells(vertices[affine], affine), IsoparametricCells(nodes, cells))
+        self.groups = (self.affine(vertices[affine], affine), self.isoparametric(nodes, cells))
 
     def per_cell(self, func: Callable[[Cells], np.ndarray]) -> np.ndarray:
         """``func(group)`` of every group, in mesh order ``(n_cells, ...)``."""

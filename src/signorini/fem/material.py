@@ -11,6 +11,12 @@ modulus, and ``lam* = lam`` in plane strain, ``lam* = 2 lam mu / (lam + 2 mu)`` 
 stress (:attr:`Material.lam_eff`; docs/method.md, *Plane stress*). Several materials, one per
 cell region, are a :class:`CellMaterials`; the functions here take either. Gradients are stored
 last-axis-is-derivative: ``grad_u[..., i, j] = d u_i / d x_j``.
+
+In three dimensions (gradients ``(..., 3, 3)``) the law is the isotropic Hooke's law itself,
+``sigma = lam tr(eps) I + 2 mu eps`` with the material's own ``lam`` and ``mu``
+(:func:`lame_parameters` with ``dim = 3``): plane strain is the 3D law restricted to
+``eps_zz = 0``, so a plane-strain material is the same body in 3D, while plane stress is a
+2D reduction only and is refused there.
 """
 
 from __future__ import annotations
@@ -21,7 +27,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CellMaterials", "Material", "on_cells", "strain", "stress", "stress_zz"]
+__all__ = [
+    "CellMaterials",
+    "Material",
+    "lame_parameters",
+    "on_cells",
+    "strain",
+    "stress",
+    "stress_zz",
+    "von_mises",
+]
 
 _PLANES = ("strain", "stress")
 
@@ -243,21 +258,21 @@ def strain(grad_u: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
-    grad_u : array_like of float, shape (..., 2, 2)
+    grad_u : array_like of float, shape (..., d, d), d = 2 or 3
         ``grad_u[..., i, j] = d u_i / d x_j``.
 
     Returns
     -------
-    ndarray of float64, shape (..., 2, 2)
+    ndarray of float64, shape (..., d, d)
 
     Raises
     ------
     ValueError
-        If the last two axes are not ``(2, 2)``.
+        If the last two axes are not ``(2, 2)`` or ``(3, 3)``.
     """
     g = np.asarray(grad_u, dtype=np.float64)
-    if g.ndim < 2 or g.shape[-2:] != (2, 2):
-        raise ValueError(f"grad_u must have shape (..., 2, 2), got {g.shape}")
+    if g.ndim < 2 or g.shape[-2:] not in ((2, 2), (3, 3)):
+        raise ValueError(f"grad_u must have shape (..., 2, 2) or (..., 3, 3), got {g.shape}")
     return 0.5 * (g + np.swapaxes(g, -1, -2))
 
 
@@ -274,9 +289,17 @@ def stress(material: Material, grad_u: np.ndarray) -> np.ndarray:
     Returns
     -------
     ndarray of float64, shape (..., 2, 2)
-        Symmetric stress tensors (the in-plane ones, with ``lam_eff`` in plane stress).
+        Symmetric stress tensors (the in-plane ones, with ``lam_eff`` in plane stress);
+        ``(..., 3, 3)`` for gradients ``(..., 3, 3)``, the 3D law (:func:`lame_parameters`).
     """
     eps = strain(grad_u)
+    if eps.shape[-1] == 3:
+        lam, mu = lame_parameters(material, 3)
+        sig = 2.0 * _per_cell(mu, eps.ndim) * eps
+        tr = _per_cell(lam, eps.ndim - 2) * np.trace(eps, axis1=-2, axis2=-1)
+        for i in range(3):
+            sig[..., i, i] += tr
+        return sig
     sig = 2.0 * _per_cell(material.mu, eps.ndim) * eps
     tr = _per_cell(material.lam_eff, eps.ndim - 2) * (eps[..., 0, 0] + eps[..., 1, 1])
     sig[..., 0, 0] += tr
@@ -296,3 +319,46 @@ def stress_zz(material: Material | CellMaterials, grad_u: np.ndarray) -> np.ndar
     else:
         lam = material.lam if material.plane == "strain" else 0.0
     return _per_cell(lam, g.ndim - 2) * (g[..., 0, 0] + g[..., 1, 1])
+
+
+def lame_parameters(
+    material: Material | CellMaterials, dim: int
+) -> tuple[float | np.ndarray, float | np.ndarray]:
+    """The ``(lam, mu)`` of Hooke's law in ``dim`` dimensions, the dimension explicit.
+
+    ``dim = 2``: ``(lam_eff, mu)``, plane strain or plane stress (:attr:`Material.lam_eff`).
+    ``dim = 3``: ``(lam, mu)``, the isotropic law ``sigma = lam tr(eps) I + 2 mu eps`` of the
+    same (E, nu) or (lam, mu); arrays ``(n_cells,)`` for a :class:`CellMaterials`.
+
+    Raises
+    ------
+    ValueError
+        In 3D for a plane-stress material (a thin-plate reduction of the 2D solver, with no
+        meaning for a 3D body), naming the remedy; for a ``dim`` other than 2 or 3.
+    """
+    if dim == 2:
+        return material.lam_eff, material.mu
+    if dim != 3:
+        raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+    planes = (
+        [m.plane for m in material.materials]
+        if isinstance(material, CellMaterials)
+        else [material.plane]
+    )
+    if "stress" in planes:
+        raise ValueError(
+            'plane="stress" is a 2D reduction (a thin plate, sigma_zz = 0) and has no meaning '
+            "for a 3D body: build the material without it, Material.from_young(E, nu) or "
+            "Material(lam=..., mu=...), for the full 3D law"
+        )
+    return material.lam, material.mu
+
+
+def von_mises(sigma: np.ndarray) -> np.ndarray:
+    """The von Mises stress ``sqrt(3/2 s : s)``, ``s = sigma - tr(sigma) I / 3``, of 3D stress
+    tensors ``sigma (..., 3, 3)``; shape ``(...)``."""
+    sigma = np.asarray(sigma, dtype=np.float64)
+    if sigma.shape[-2:] != (3, 3):
+        raise ValueError(f"sigma must have shape (..., 3, 3), got {sigma.shape}")
+    s = sigma - np.trace(sigma, axis1=-2, axis2=-1)[..., None, None] / 3.0 * np.eye(3)
+    return np.sqrt(1.5 * np.einsum("...ij,...ij->...", s, s))

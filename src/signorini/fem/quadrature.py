@@ -1,4 +1,4 @@
-"""Quadrature rules on the reference triangle and on the unit interval.
+"""Quadrature rules on the reference triangle, the reference tetrahedron and the unit interval.
 
 The one owner of Gauss-Legendre points on [0, 1]: :func:`gauss_legendre` by number of
 points, :func:`line_rule` by polynomial degree.
@@ -14,6 +14,13 @@ into a Gauss-Jacobi rule in ``s``, with a Gauss-Legendre rule in ``t``.  With
 ``n`` points per direction the collapsed rule integrates every polynomial of
 total degree ``<= 2 n - 1`` exactly; all its weights are positive and all its
 points lie strictly inside ``T``.
+
+The reference tetrahedron is ``{x, y, z >= 0, x + y + z <= 1}`` (volume 1/6,
+:data:`~signorini.mesh.reference.TETRAHEDRON`): the centroid rule (degree 1), the symmetric
+four-point rule (degree 2, the stiffness of affine P2 cells), and above those the collapsed
+(conical product) rules ``(s, t, r) -> (s, t (1 - s), r (1 - s)(1 - t))`` with Gauss-Jacobi
+rules of weights ``(1 - s)²`` and ``(1 - t)`` and Gauss-Legendre in ``r``: ``n³`` points,
+exact to degree ``2 n - 1``, positive weights, points strictly inside (Stroud [3]).
 
 The returned arrays are cached and read-only; copy them before modifying.
 
@@ -34,7 +41,7 @@ from functools import cache, lru_cache
 import numpy as np
 from scipy.special import roots_jacobi
 
-__all__ = ["exact_degree", "gauss_legendre", "line_rule", "triangle_rule"]
+__all__ = ["exact_degree", "gauss_legendre", "line_rule", "tetrahedron_rule", "triangle_rule"]
 
 
 def _check_integer(degree: int, what: str = "quadrature degree", minimum: int = 0) -> int:
@@ -202,3 +209,53 @@ def line_rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
         If ``degree`` is not a non-negative integer.
     """
     return _gauss_legendre(_check_integer(degree) // 2 + 1)
+
+
+@lru_cache(maxsize=32)
+def _tetrahedron_rule(deg: int) -> tuple[np.ndarray, np.ndarray]:
+    if deg <= 1:
+        xi = np.full((1, 3), 0.25)
+        w = np.array([1.0 / 6.0])
+    elif deg == 2:
+        a = (5.0 - np.sqrt(5.0)) / 20.0
+        b = 1.0 - 3.0 * a
+        xi = np.full((4, 3), a)
+        xi[1:, :][np.arange(3), np.arange(3)] = b
+        w = np.full(4, 1.0 / 24.0)
+    else:
+        n = deg // 2 + 1  # 2 n - 1 >= deg
+        xs, ws = roots_jacobi(n, 2.0, 0.0)  # weight (1 - s)² on [0, 1]
+        xt, wt = roots_jacobi(n, 1.0, 0.0)  # weight (1 - t)
+        r, wr = _gauss_legendre(n)
+        s, t = 0.5 * (1.0 + xs), 0.5 * (1.0 + xt)
+        S, T, R = np.meshgrid(s, t, r, indexing="ij")
+        xi = np.column_stack(
+            [S.ravel(), (T * (1.0 - S)).ravel(), (R * (1.0 - S) * (1.0 - T)).ravel()]
+        )
+        w = np.einsum("i,j,k->ijk", ws / 8.0, wt / 4.0, wr).ravel()
+    return _frozen(np.ascontiguousarray(xi, dtype=np.float64), np.asarray(w, dtype=np.float64))
+
+
+def tetrahedron_rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """Quadrature rule on the reference tetrahedron (0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1).
+
+    Parameters
+    ----------
+    degree : int
+        Every polynomial of total degree ``<= degree`` is integrated exactly: 1 point for
+        degree 1, 4 for degree 2, ``n³`` with ``n = degree // 2 + 1`` above (exact to
+        ``2 n - 1``).
+
+    Returns
+    -------
+    xi : ndarray of float64, shape (q, 3)
+        Points, strictly inside the tetrahedron.
+    w : ndarray of float64, shape (q,)
+        Positive weights, summing to 1/6 (the volume).
+
+    Raises
+    ------
+    ValueError
+        If ``degree`` is not a non-negative integer.
+    """
+    return _tetrahedron_rule(_check_integer(degree))

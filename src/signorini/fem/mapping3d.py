@@ -1,0 +1,296 @@
+"""The geometry of a tetrahedral mesh: the maps from the reference tetrahedron to its cells
+and from the reference triangle to its faces (docs/method.md, *Three dimensions*).
+
+The same objects as :mod:`signorini.fem.mapping`, one dimension up, with the same methods,
+so an integrand is written once and the geometry decides what is constant:
+
+- :class:`AffineTetrahedra`: ``x(ξ) = v0 + J ξ``, ``J = [v1 − v0, v2 − v0, v3 − v0]``
+  (:mod:`signorini.mesh.jacobians`, d = 3): ``J``, ``det J``, ``J⁻ᵀ`` constant per cell
+  (a point axis of length 1).
+- :class:`IsoparametricTetrahedra`: ``x(ξ) = Σ_a x_a φ_a(ξ)`` through the ten P2 node points
+  (:mod:`signorini.fem.p2_tet`): the cells with an edge node moved onto a curved surface.
+- :class:`TetrahedronMap`: a mesh's tetrahedra as such groups (:class:`~signorini.fem.
+  mapping.CellMap` with these group classes).
+- :class:`FlatFaces`, :class:`QuadraticFaces`: points, unit normals and the area element
+  ``|∂x/∂s₁ × ∂x/∂s₂|`` of triangular faces (reference triangle, area 1/2), their vertices
+  in their cell's face order (outward normal).
+
+Points are ``(..., 3)``; reference points of cells ``(q, 3)``, of faces ``(q, 2)``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..mesh.geometry import facet_normals, spanned_normals
+from ..mesh.jacobians import affine_jacobian, determinant, inverse_transpose
+from . import p2, p2_tet
+from .mapping import CellMap
+
+__all__ = [
+    "AffineTetrahedra",
+    "FlatFaces",
+    "IsoparametricTetrahedra",
+    "QuadraticFaces",
+    "TetrahedronMap",
+    "face_groups",
+]
+
+_ALL = slice(None)
+
+
+def _coefficients(u_cell: np.ndarray) -> np.ndarray:
+    """Interleaved cell coefficients ``(m, 30)`` as ``(m, 10, 3)``."""
+    return np.asarray(u_cell, dtype=np.float64).reshape(-1, 10, 3)
+
+
+class AffineTetrahedra:
+    """Straight tetrahedra ``x(ξ) = v0 + J ξ`` (constant ``J``).
+
+    Parameters
+    ----------
+    vertices : (m, 4, 3) float array
+        Positively oriented (``det J > 0``).
+    cells : (m,) int array or slice
+        Their rows in the mesh (``slice(None)``: all cells, in order).
+    """
+
+    order = 1
+
+    def __init__(self, vertices: np.ndarray, cells: np.ndarray | slice = _ALL) -> None:
+        self.vertices = np.asarray(vertices, dtype=np.float64)
+        self.cells = cells
+
+    def __len__(self) -> int:
+        return len(self.vertices)
+
+    def points(self, xi: np.ndarray) -> np.ndarray:
+        """``(m, q, 3)`` images of the reference points ``xi (q, 3)``."""
+        v = self.vertices
+        xi = np.atleast_2d(np.asarray(xi, dtype=np.float64))
+        return v[:, None, 0] + np.einsum("qk,mki->mqi", xi, v[:, 1:] - v[:, :1])
+
+    def jacobians(self, xi: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``J (m, 1, 3, 3)`` and ``det J (m, 1)``: one per cell, for every point."""
+        J, det = affine_jacobian(self.vertices)
+        return J[:, None], det[:, None]
+
+    def inverse_transpose(self, xi: np.ndarray | None = None) -> np.ndarray:
+        """``J⁻ᵀ`` ``(m, 1, 3, 3)``: physical gradients are ``J⁻ᵀ ∇̂``."""
+        J, det = affine_jacobian(self.vertices)
+        return inverse_transpose(J, det, reciprocal=True)[:, None]
+
+    def measure(self, w: np.ndarray, xi: np.ndarray | None = None) -> np.ndarray:
+        """``(m, q)`` the weights ``w_q det J`` of a rule on the reference tetrahedron."""
+        return affine_jacobian(self.vertices)[1][:, None] * w
+
+    def basis_gradients(self, xi: np.ndarray) -> np.ndarray:
+        """``(m, q, 10, 3)`` physical gradients of the ten P2 basis functions."""
+        jit = self.inverse_transpose()[:, 0]
+        return np.einsum("mij,qaj->mqai", jit, p2_tet.grad_basis(xi))
+
+    def field_values(self, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
+        """``(m, q, 3)`` a P2 field with interleaved coefficients ``u_cell (m, 30)`` at the
+        reference points ``xi (q, 3)``."""
+        return np.einsum("qa,mai->mqi", p2_tet.basis(xi), _coefficients(u_cell))
+
+    def field_gradients(self, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
+        """``(m, q, 3, 3)`` ``∂u_i/∂x_j`` of a P2 field at reference points ``xi (q, 3)``."""
+        return np.einsum("mai,mqaj->mqij", _coefficients(u_cell), self.basis_gradients(xi))
+
+    def gradient_field(self, u_cell: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+        """The physical gradient of a P2 field as a function of reference points."""
+        return lambda xi: self.field_gradients(u_cell, xi)
+
+    def field_hessians(self, u_cell: np.ndarray, xi: np.ndarray | None = None) -> np.ndarray:
+        """``(m, 1, 3, 3, 3)`` ``∂²u_i/∂x_j∂x_k`` of a P2 field (constant on each cell)."""
+        jit = self.inverse_transpose()[:, 0]
+        href = np.einsum("mai,ars->mirs", _coefficients(u_cell), p2_tet.hessian_basis())
+        return np.einsum("mjr,mirs,mks->mijk", jit, href, jit)[:, None]
+
+    def rows(self, slot: np.ndarray) -> AffineTetrahedra:
+        """The cells at rows ``slot`` of this group, as a group."""
+        cells = slot if isinstance(self.cells, slice) else self.cells[slot]
+        return AffineTetrahedra(self.vertices[slot], cells)
+
+
+class IsoparametricTetrahedra:
+    """Tetrahedra mapped by the quadratic ``x(ξ) = Σ_a x_a φ_a(ξ)`` through their ten P2 node
+    points: Jacobians vary from point to point.
+
+    Parameters
+    ----------
+    nodes : (m, 10, 3) float array
+        Node points in local node order (:mod:`signorini.fem.p2_tet`).
+    cells : (m,) int array or slice
+        Their rows in the mesh.
+    """
+
+    order = 2
+
+    def __init__(self, nodes: np.ndarray, cells: np.ndarray | slice = _ALL) -> None:
+        self.nodes = np.asarray(nodes, dtype=np.float64)
+        self.cells = cells
+
+    def __len__(self) -> int:
+        return len(self.nodes)
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """``(m, 4, 3)`` the vertices."""
+        return self.nodes[:, :4]
+
+    def points(self, xi: np.ndarray) -> np.ndarray:
+        """``(m, q, 3)`` images of the reference points ``xi (q, 3)``."""
+        return np.einsum("qa,mai->mqi", p2_tet.basis(xi), self.nodes)
+
+    def jacobians(self, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``J (m, q, 3, 3)`` and ``det J (m, q)`` at each point, ``J = Σ_a x_a ⊗ ∇φ_a(ξ)``
+        summed in the order a = 0 … 9 (a cell's Jacobians depend on its nodes alone)."""
+        g = p2_tet.grad_basis(xi)[None, :, :, None, :]  # (1, q, 10, 1, 3)
+        x = self.nodes[:, None, :, :, None]  # (m, 1, 10, 3, 1)
+        J = x[:, :, 0] * g[:, :, 0]
+        for a in range(1, g.shape[2]):  # a loop over the local basis functions
+            J += x[:, :, a] * g[:, :, a]
+        return J, determinant(J)
+
+    def inverse_transpose(self, xi: np.ndarray) -> np.ndarray:
+        """``J⁻ᵀ`` ``(m, q, 3, 3)`` at each point."""
+        J, det = self.jacobians(xi)
+        return inverse_transpose(J, det)
+
+    def measure(self, w: np.ndarray, xi: np.ndarray) -> np.ndarray:
+        """``(m, q)`` the weights ``w_q det J(ξ_q)``."""
+        return self.jacobians(xi)[1] * w
+
+    def basis_gradients(self, xi: np.ndarray) -> np.ndarray:
+        """``(m, q, 10, 3)`` physical gradients of the ten P2 basis functions."""
+        jit = self.inverse_transpose(xi)
+        return np.einsum("mqij,qaj->mqai", jit, p2_tet.grad_basis(xi))
+
+    def field_values(self, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
+        """``(m, q, 3)`` a P2 field at the reference points ``xi (q, 3)``."""
+        return np.einsum("qa,mai->mqi", p2_tet.basis(xi), _coefficients(u_cell))
+
+    def field_gradients(self, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
+        """``(m, q, 3, 3)`` ``∂u_i/∂x_j`` of a P2 field at reference points ``xi``."""
+        return np.einsum("mai,mqaj->mqij", _coefficients(u_cell), self.basis_gradients(xi))
+
+    def gradient_field(self, u_cell: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+        """As :meth:`AffineTetrahedra.gradient_field`, through the quadratic map."""
+        return lambda xi: self.field_gradients(u_cell, xi)
+
+    def rows(self, slot: np.ndarray) -> IsoparametricTetrahedra:
+        """The cells at rows ``slot`` of this group, as a group."""
+        cells = slot if isinstance(self.cells, slice) else self.cells[slot]
+        return IsoparametricTetrahedra(self.nodes[slot], cells)
+
+
+class TetrahedronMap(CellMap):
+    """The tetrahedra of a mesh as groups of one geometry: affine, then isoparametric.
+
+    Parameters
+    ----------
+    vertices : (n_cells, 4, 3) float array
+    curved : (cells (k,), nodes (k, 10, 3)), optional
+        The isoparametric cells and their node points; ``None``: every cell is affine.
+    """
+
+    affine = AffineTetrahedra
+    isoparametric = IsoparametricTetrahedra
+
+
+# --------------------------------------------------------------------------- faces
+
+
+class FlatFaces:
+    """Flat triangular faces ``x(s) = a + s₁ (b − a) + s₂ (c − a)``: constant unit normal and
+    area element ``2 |F|``.
+
+    Parameters
+    ----------
+    corners : (k, 3, 3) float array
+        ``(a, b, c)`` of each face in its cell's face order (outward normal).
+    """
+
+    order = 1
+
+    def __init__(self, corners: np.ndarray) -> None:
+        self.corners = np.asarray(corners, dtype=np.float64)
+        self.area, self._normal = facet_normals(self.corners)
+
+    def __len__(self) -> int:
+        return len(self.corners)
+
+    def points(self, s: np.ndarray) -> np.ndarray:
+        """``(k, q, 3)`` the points ``x(s)`` of triangle reference points ``s (q, 2)``."""
+        c = self.corners
+        return c[:, None, 0] + np.einsum("qk,fki->fqi", s, c[:, 1:] - c[:, :1])
+
+    def normals(self, s: np.ndarray | None = None) -> np.ndarray:
+        """``(k, 1, 3)`` outward unit normals (constant on each face)."""
+        return self._normal[:, None, :]
+
+    def speeds(self, s: np.ndarray | None = None) -> np.ndarray:
+        """``(k, 1)`` the area element ``|∂x/∂s₁ × ∂x/∂s₂| = 2 |F|`` (constant)."""
+        return 2.0 * self.area[:, None]
+
+
+class QuadraticFaces:
+    """Faces ``x(s) = Σ_a x_a ψ_a(s)`` through their six P2 node points (the P2 triangle's
+    basis, :func:`signorini.fem.p2_tet.face_basis`): normal and area element vary.
+
+    Parameters
+    ----------
+    nodes : (k, 6, 3) float array
+        The face's vertices in its cell's face order, then its side midpoints.
+    """
+
+    order = 2
+
+    def __init__(self, nodes: np.ndarray) -> None:
+        self.nodes = np.asarray(nodes, dtype=np.float64)
+
+    def __len__(self) -> int:
+        return len(self.nodes)
+
+    @property
+    def area(self) -> np.ndarray:
+        """``(k,)`` the areas of the flat triangles of the vertices."""
+        return facet_normals(self.nodes[:, :3])[0]
+
+    def points(self, s: np.ndarray) -> np.ndarray:
+        """``(k, q, 3)`` the points ``x(s)``."""
+        return np.einsum("qa,fai->fqi", p2_tet.face_basis(s), self.nodes)
+
+    def _tangents(self, s: np.ndarray) -> np.ndarray:
+        """``(k, q, 2, 3)`` the tangents ``∂x/∂s₁``, ``∂x/∂s₂``."""
+        return np.einsum("qar,fai->fqri", p2.grad_basis(s), self.nodes)
+
+    def normals(self, s: np.ndarray) -> np.ndarray:
+        """``(k, q, 3)`` unit normals at ``s``, outward as the cell's face order."""
+        return spanned_normals(self._tangents(s))[1]
+
+    def speeds(self, s: np.ndarray) -> np.ndarray:
+        """``(k, q)`` the area element ``|∂x/∂s₁ × ∂x/∂s₂|``."""
+        return spanned_normals(self._tangents(s))[0]
+
+
+Faces = FlatFaces | QuadraticFaces
+
+
+def face_groups(nodes: np.ndarray, quadratic: np.ndarray):
+    """The faces with node points ``nodes (k, 6, 3)`` as groups of one kind: ``(rows,
+    faces)`` for the flat ones, then the ``quadratic (k,) bool`` ones."""
+    quadratic = np.asarray(quadratic, dtype=bool)
+    if not quadratic.any():
+        yield _ALL, FlatFaces(nodes[:, :3])
+        return
+    if quadratic.all():
+        yield _ALL, QuadraticFaces(nodes)
+        return
+    flat, rows = np.flatnonzero(~quadratic), np.flatnonzero(quadratic)
+    yield flat, FlatFaces(nodes[flat, :3])
+    yield rows, QuadraticFaces(nodes[rows])
