@@ -12,6 +12,10 @@ negative orientation along the path and are listed with their vertices 1 and 2 s
 (:mod:`signorini.mesh.tetrahedra`): a cell's Kuhn path is ``cells[c]`` for even ``σ`` and
 ``cells[c, [0, 2, 1, 3]]`` for odd ``σ`` (:func:`kuhn_paths`).
 
+The curved meshes map a Kuhn grid of the unit cube (square) onto the eighth ball (quarter
+disc) by :func:`round_corner`, which keeps the cells shape-regular (smallest dihedral angle
+above 30° for every ``n`` tried) and the symmetry planes in place.
+
 References
 ----------
 Kuhn, H. W. (1960). Some combinatorial lemmas in topology. *IBM J. Res. Dev.* 4, 518–524.
@@ -27,9 +31,10 @@ import numpy as np
 from .mesh import Mesh, MeshError
 from .reference import TETRAHEDRON
 from .regions import RegionSpec
+from .surfaces import Cylinder, Sphere
 from .topology import boundary_facets
 
-__all__ = ["BOX_PARTS", "box", "kuhn_grid", "kuhn_paths"]
+__all__ = ["BOX_PARTS", "box", "eighth_ball", "kuhn_grid", "kuhn_paths", "quarter_cylinder"]
 
 #: The six faces of a box, as parts: ``x0``/``x1`` at the lower/upper x, and so on.
 BOX_PARTS = ("x0", "x1", "y0", "y1", "z0", "z1")
@@ -64,11 +69,13 @@ def kuhn_grid(nx: int, ny: int, nz: int) -> tuple[np.ndarray, np.ndarray]:
     return grid, cells
 
 
-def kuhn_paths(cells: np.ndarray) -> np.ndarray:
+def kuhn_paths(cells: np.ndarray, *, mirrored: bool = False) -> np.ndarray:
     """The Kuhn paths ``(n_cells, 4)`` of the cells of :func:`kuhn_grid` (and of
-    :func:`box`, :func:`eighth_ball`, :func:`quarter_cylinder`, whose cells keep its order):
-    the tagged vertex order ``x0 … x3`` of bisection's initial condition."""
-    odd = np.tile(_ODD, cells.shape[0] // 6)
+    :func:`box` and :func:`quarter_cylinder`, whose cells keep its order; of
+    :func:`eighth_ball` with ``mirrored``, whose cells are its mirror image, all with their
+    vertices 1 and 2 swapped): the tagged vertex order ``x0 … x3`` of bisection's initial
+    condition."""
+    odd = np.tile(_ODD != mirrored, cells.shape[0] // 6)
     out = np.array(cells, dtype=np.int64)
     out[odd] = out[odd][:, [0, 2, 1, 3]]
     return out
@@ -133,3 +140,116 @@ def box(
     points = lo + (hi - lo) * (grid / n)
     parts = _face_parts(grid, boundary_facets(cells, TETRAHEDRON.facets), n)
     return Mesh.from_arrays(points, cells, parts, regions=regions)
+
+
+def round_corner(p: np.ndarray) -> np.ndarray:
+    """Map the unit cube (square) ``[0, 1]^k`` onto the unit ball's (disc's) positive
+    orthant: ``p ↦ p ((1 − w) + w |p|_∞ / |p|_2)`` with ``w = |p|_∞``.
+
+    Each ray from the origin maps into itself, with the radial factor ``r ↦ r (1 − r (1 −
+    c))``, ``c = 1 / |d|_2 ≥ 1/√k`` for the ray's point ``d`` on ``|d|_∞ = 1``: increasing
+    (its derivative ``1 − 2 r (1 − c) ≥ 2/√3 − 1 > 0`` for k ≤ 3), so the map is one to one;
+    it is the identity near the origin and radial (``|p|_∞ = 1`` onto the sphere) at the
+    far sides, and a coordinate that is 0 stays 0 (the symmetry planes stay put).
+
+    Parameters
+    ----------
+    p : (n, k) float array
+        Points of ``[0, 1]^k``.
+
+    Returns
+    -------
+    (n, k) float array
+        Their images; those with ``|p|_∞ = 1`` on the unit sphere to round-off.
+    """
+    w = np.abs(p).max(axis=1)
+    norm = np.sqrt(np.einsum("ij,ij->i", p, p))
+    ratio = np.divide(w, norm, out=np.ones_like(w), where=norm > 0)
+    return p * ((1.0 - w) + w * ratio)[:, None]
+
+
+def _curved(points: np.ndarray, cells: np.ndarray, parts: dict, part: str, surface: object) -> Mesh:
+    """The mesh of the arrays with ``part`` carrying ``surface``, its vertices put onto it
+    exactly (the map leaves them within round-off of it)."""
+    on = np.unique(parts[part])
+    points[on] = surface.project(points[on])  # type: ignore[attr-defined]
+    return Mesh.from_arrays(points, cells, parts).with_curve(part, surface)  # type: ignore[arg-type]
+
+
+def eighth_ball(
+    n: int, *, radius: float = 1.0, center: tuple[float, float, float] = (0.0, 0.0, 0.0)
+) -> Mesh:
+    """The eighth of the ball of ``radius`` R about ``center`` c below it, ``x ≥ c_x``,
+    ``y ≥ c_y``, ``z ≤ c_z``: the Hertz sphere's symmetric model, its pole ``c − (0, 0, R)``
+    the point where contact starts.
+
+    A Kuhn grid of ``n³`` cubes of ``[0, 1]³`` mapped by :func:`round_corner` and mirrored
+    in z (so the cells are those of :func:`kuhn_grid`, each with its vertices 1 and 2
+    swapped: :func:`kuhn_paths` with ``mirrored``). Boundary parts: ``"x0"`` (``x = c_x``)
+    and ``"y0"`` (``y = c_y``), the symmetry planes through the pole; ``"z1"`` (``z =
+    c_z``, the equatorial plane, where the load goes); ``"sphere"``, which carries
+    ``Sphere(c, R)`` (:meth:`Mesh.with_curve`), its vertices on the sphere to round-off.
+
+    Parameters
+    ----------
+    n : int
+        Cubes per direction of the grid, positive (``6 n³`` cells).
+    radius : float
+        R, positive.
+    center : (3,) float
+        The centre c.
+
+    Returns
+    -------
+    Mesh
+        Its volume converges to π R³ / 6 like ``h²``.
+    """
+    sphere = Sphere(center, radius)
+    grid, cells = kuhn_grid(n, n, n)
+    mirror = np.array([1.0, 1.0, -1.0])
+    points = sphere.center + sphere.radius * mirror * round_corner(grid / n)
+    cells = cells[:, [0, 2, 1, 3]]  # positive after the mirror
+    sides = _face_parts(grid, boundary_facets(cells, TETRAHEDRON.facets), np.array([n, n, n]))
+    parts = {"x0": sides["x0"], "y0": sides["y0"], "z1": sides["z0"]}
+    parts["sphere"] = np.concatenate([sides["x1"], sides["y1"], sides["z1"]])
+    return _curved(points, cells, parts, "sphere", sphere)
+
+
+def quarter_cylinder(
+    n: int,
+    nz: int | None = None,
+    *,
+    radius: float = 1.0,
+    length: float = 1.0,
+    center: tuple[float, float, float] = (0.0, 0.0, 0.0),
+) -> Mesh:
+    """The quarter of the cylinder of ``radius`` R and ``length`` L along z, ``x ≥ c_x``,
+    ``y ≥ c_y``, ``c_z ≤ z ≤ c_z + L``, about the axis through ``center`` c.
+
+    A Kuhn grid of ``n × n × nz`` cuboids of ``[0, 1]² × [0, L]``, its cross-section mapped
+    by :func:`round_corner`. Boundary parts: ``"x0"``, ``"y0"`` (the symmetry planes through
+    the axis), ``"z0"``, ``"z1"`` (the ends) and ``"cylinder"``, which carries
+    ``Cylinder(c, (0, 0, 1), R)``.
+
+    Parameters
+    ----------
+    n, nz : int
+        Cuboids across the radius and along the axis, positive; by default ``nz`` makes
+        them about as long as wide (``round(n L / R)``, at least 1).
+    radius, length : float
+        R and L, positive.
+    center : (3,) float
+        The point c of the axis at the lower end.
+    """
+    if not (np.isfinite(length) and length > 0):
+        raise MeshError(f"quarter_cylinder: length must be a positive number, got {length!r}")
+    cylinder = Cylinder(center, (0.0, 0.0, 1.0), radius)
+    if nz is None:
+        nz = max(1, round(n * length / cylinder.radius))
+    grid, cells = kuhn_grid(n, n, nz)
+    section = round_corner(grid[:, :2] / n) * cylinder.radius
+    points = cylinder.point + np.column_stack([section, grid[:, 2] * (length / nz)])
+    sides = _face_parts(grid, boundary_facets(cells, TETRAHEDRON.facets), np.array([n, n, nz]))
+    parts = {name: sides[name] for name in ("x0", "y0", "z0", "z1")}
+    parts["cylinder"] = np.concatenate([sides["x1"], sides["y1"]])
+    return _curved(points, cells, parts, "cylinder", cylinder)

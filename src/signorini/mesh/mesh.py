@@ -62,7 +62,7 @@ from .validation import (
     nondegenerate_area,
     validate_mesh,
 )
-from .validation3d import nondegenerate_volume
+from .validation3d import check_on_surface, nondegenerate_volume
 
 __all__ = ["Mesh", "MeshError", "boundary_edges"]
 
@@ -236,8 +236,8 @@ class Mesh(MeshGeometry):
             mesh.reoriented = _frozen(flipped)
         return mesh
 
-    def with_curve(self, part: str, curve: Curve, *, rtol: float = 1e-8) -> Mesh:
-        """A new mesh whose boundary part ``part`` carries ``curve``.
+    def with_curve(self, part: str, curve: Curve | Surface, *, rtol: float = 1e-8) -> Mesh:
+        """A new mesh whose boundary part ``part`` carries ``curve`` (in 3D a surface).
 
         Refinement then puts the new vertex of a bisected edge of the part at the curve's
         halfway point (:meth:`Curve.halfway`) instead of the chord midpoint, and the P2
@@ -251,7 +251,9 @@ class Mesh(MeshGeometry):
             A boundary part of the mesh.
         curve : Curve
             E.g. :class:`~signorini.mesh.curves.Circle` or
-            :class:`~signorini.mesh.curves.Line`; replaces any curve the part had.
+            :class:`~signorini.mesh.curves.Line`; replaces any curve the part had. In 3D a
+            :class:`~signorini.mesh.surfaces.Surface` (``Sphere``, ``Cylinder``), moving the
+            midpoints of the edges of the part's faces.
         rtol : float
             Every vertex of the part must lie within ``rtol`` times the mesh's diameter
             (the diagonal of its bounding box) of the curve.
@@ -263,13 +265,15 @@ class Mesh(MeshGeometry):
             part is off the curve (naming the vertex and its distance).
         """
         index = self.part_index(part)
-        if not isinstance(curve, Curve):
+        kind = "Curve (Line, Circle, ProjectedCurve)" if self.dim == 2 else "Surface (Sphere, …)"
+        if not isinstance(curve, Curve if self.dim == 2 else Surface):
             raise MeshError(
-                f"with_curve: the curve of part {part!r} must be a Curve (Line, Circle, "
-                f"ProjectedCurve), got {type(curve).__name__}"
+                f"with_curve: the curve of part {part!r} must be a {kind}, got "
+                f"{type(curve).__name__}"
             )
         vertices = np.unique(self.boundary[self.boundary_part == index])
-        check_on_curve(self.points, vertices, curve, part, rtol)
+        check = check_on_curve if self.dim == 2 else check_on_surface
+        check(self.points, vertices, curve, part, rtol)
         curves = list(self.curves)
         curves[index] = curve
         mesh = Mesh(

@@ -38,10 +38,12 @@ from .validation import (
 
 if TYPE_CHECKING:
     from .mesh import Mesh
+    from .surfaces import Surface
 
 __all__ = [
     "SLIVER_ANGLE",
     "SliverWarning",
+    "check_on_surface",
     "dihedral_angles",
     "nondegenerate_volume",
     "validate_tetrahedra",
@@ -265,3 +267,27 @@ def validate_tetrahedra(mesh: Mesh) -> None:
     _check_sides(mesh, is_bnd)
     _check_no_hanging_node(mesh, is_bnd)
     _check_boundary_labelled(mesh, is_bnd)
+
+
+def check_on_surface(
+    points: np.ndarray, vertices: np.ndarray, surface: Surface, part: str, rtol: float
+) -> None:
+    """Check that the ``vertices`` of boundary part ``part`` lie on ``surface``: within
+    ``rtol`` times the diameter of ``points`` (the diagonal of their bounding box); the 3D
+    :func:`~signorini.mesh.validation.check_on_curve`.
+
+    Raises
+    ------
+    MeshError
+        Naming the vertex farthest off the surface and its distance.
+    """
+    x = points[vertices]
+    distance = np.linalg.norm(surface.project(x) - x, axis=1)
+    diameter = float(np.linalg.norm(np.ptp(points, axis=0)))
+    if np.any(distance > rtol * diameter):
+        k = int(np.argmax(distance))
+        raise MeshError(
+            f"with_curve: vertex {vertices[k]} {x[k].tolist()} of part {part!r} lies "
+            f"{distance[k]:.3g} from {surface!r}, more than rtol * diameter = "
+            f"{rtol * diameter:.3g}"
+        )
