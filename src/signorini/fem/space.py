@@ -344,14 +344,22 @@ class P1Space(LagrangeSpace):
 
 def space_of(mesh: Mesh, element: str | Element = "P2") -> LagrangeSpace:
     """The space of ``element`` (``"P2"``, the default, or ``"P1"``) on ``mesh``: the one
-    place where a caller's choice of element becomes a space.
+    place where a caller's choice of element becomes a space. The element is looked up on
+    the mesh's reference cell (``mesh.reference``): on a tetrahedral mesh ``"P2"`` is the P2
+    tetrahedron (:class:`~signorini.fem.space3d.P2TetSpace`).
 
     Raises
     ------
     ValueError
-        If ``element`` is not one of :data:`~signorini.fem.element.ELEMENTS`.
+        If ``element`` is not one of the elements of ``mesh.reference``
+        (:data:`~signorini.fem.element.ELEMENTS_ON`).
     """
-    return _SPACES[element_of(element).name](mesh)
+    chosen = element_of(element, reference=mesh.reference)
+    if mesh.dim == 3:
+        from .space3d import P2TetSpace  # the 3D space builds on P2Space (this module)
+
+        return P2TetSpace(mesh)
+    return _SPACES[chosen.name](mesh)
 
 
 _SPACES = {"P1": P1Space, "P2": P2Space}
