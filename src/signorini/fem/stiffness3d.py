@@ -11,7 +11,8 @@ the physical basis gradients and ``W_q = w_q det J(ξ_q)`` at the points of the 
     K[(a, i), (b, j)] = λ B[a, i, b, j] + μ B[a, j, b, i] + μ δ_ij Σ_k B[a, k, b, k],
 
 formed by elementwise products and sums over the points in turn (a loop over quadrature
-points, never over cells): each cell's matrix depends on that cell's data alone, bit for bit,
+points, never over cells), for the components ``i ≤ j`` (``K[(b, j), (a, i)]`` is their
+transpose): each cell's matrix depends on that cell's data alone, bit for bit,
 whatever cells are computed beside it (the property :mod:`signorini.fem.fixed_order` gives
 the 2D products). On affine cells the integrand is of degree 2 and the four-point rule makes
 it exact; on the quadratic maps of isoparametric cells the degree-4 rule (degree 2k − 2 + 2
@@ -42,6 +43,9 @@ __all__ = ["assemble_stiffness_3d", "element_stiffness_3d"]
 _CHUNK = 256
 
 _Tetrahedra = AffineTetrahedra | IsoparametricTetrahedra
+
+#: the block components ``i <= j`` that are computed (the others are their transposes)
+_UPPER = tuple((i, j) for i in range(3) for j in range(i, 3))
 
 
 def _per_cell(value: float | np.ndarray, rows: slice) -> float | np.ndarray:
@@ -88,21 +92,21 @@ def component_blocks(
         G = np.ascontiguousarray(part.basis_gradients(xi).transpose(3, 1, 0, 2))  # (3, q, k, 10)
         Gw = G * part.measure(w, xi).T[None, :, :, None]  # W_q ∂_i φ_a
         B = np.empty((3, 3, G.shape[2], 10, 10))
-        for i in range(3):
-            for j in range(3):
-                b = B[i, j]
-                np.multiply(Gw[i, 0, :, :, None], G[j, 0, :, None, :], out=b)
-                for q in range(1, G.shape[1]):  # a loop over quadrature points
-                    b += Gw[i, q, :, :, None] * G[j, q, :, None, :]
+        for i, j in _UPPER:  # B[j, i] is B[i, j] with a and b swapped
+            b = B[i, j]
+            np.multiply(Gw[i, 0, :, :, None], G[j, 0, :, None, :], out=b)
+            for q in range(1, G.shape[1]):  # a loop over quadrature points
+                b += Gw[i, q, :, :, None] * G[j, q, :, None, :]
         lam_k, mu_k = _per_cell(lam, rows), _per_cell(mu, rows)
         trace = mu_k * (B[0, 0] + B[1, 1] + B[2, 2])  # μ ∫ ∇φ_a · ∇φ_b
-        for i in range(3):
-            for j in range(3):
-                K = out[i, j, rows]
-                np.multiply(lam_k, B[i, j], out=K)
-                K += mu_k * B[j, i]
-                if i == j:
-                    K += trace
+        for i, j in _UPPER:
+            K = out[i, j, rows]
+            np.multiply(lam_k, B[i, j], out=K)
+            K += mu_k * np.swapaxes(B[i, j], -1, -2)
+            if i == j:
+                K += trace
+            else:  # K[(b, j), (a, i)] = K[(a, i), (b, j)]: the symmetric block
+                out[j, i, rows] = np.swapaxes(K, -1, -2)
     return out
 
 
