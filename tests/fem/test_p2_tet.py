@@ -212,3 +212,15 @@ def test_curved_part_gives_isoparametric_cells_closer_to_the_ball():
     assert abs(iso_volume - exact) < 0.2 * abs(flat_volume - exact)
     faces = [f for _, f in V.boundary_facets(V.curved_facets)]
     assert all(isinstance(f, QuadraticFaces) for f in faces)
+
+
+def test_interior_face_nodes_and_prolongation_left_to_the_bisection():
+    V = space_of(box(2, 2, 2))
+    interior = np.flatnonzero(V.mesh.facet2cell[:, 1] >= 0)[:5]
+    nodes = V.mesh_facet_nodes(interior)
+    x = V.node_points[nodes]
+    assert nodes.shape == (5, 6)
+    assert np.allclose(x[:, 3:], 0.5 * (x[:, [0, 1, 2]] + x[:, [1, 2, 0]]), atol=1e-15)
+    assert np.array_equal(np.sort(nodes[:, :3], axis=1), V.mesh.facets[interior])
+    with pytest.raises(NotImplementedError, match="3D bisection"):
+        V.prolongate(np.zeros((V.n_nodes, 3)), None)

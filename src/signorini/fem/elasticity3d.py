@@ -12,6 +12,7 @@ with ``np.bincount``. User functions take points ``x (..., 3)`` and return ``(..
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,6 +20,9 @@ from .dofs import node_dofs
 from .material import CellMaterials, Material, lame_parameters, on_cells, stress, von_mises
 from .p2_tet import basis, face_basis
 from .quadrature import tetrahedron_rule, triangle_rule
+
+if TYPE_CHECKING:
+    from .space3d import P2TetSpace
 
 __all__ = [
     "assemble_body_force_3d",
@@ -41,7 +45,7 @@ def _summed(dofs: np.ndarray, values: np.ndarray, n_dofs: int) -> np.ndarray:
     return np.bincount(dofs.ravel(), weights=values.ravel(), minlength=n_dofs)
 
 
-def assemble_body_force_3d(space, f: Field, degree: int = LOAD_DEGREE) -> np.ndarray:
+def assemble_body_force_3d(space: P2TetSpace, f: Field, degree: int = LOAD_DEGREE) -> np.ndarray:
     """The load vector ``F[3 z + i] = ∫_Ω f_i φ_z dx`` of a body force density ``f``.
 
     Parameters
@@ -68,7 +72,7 @@ def assemble_body_force_3d(space, f: Field, degree: int = LOAD_DEGREE) -> np.nda
 
 
 def assemble_face_load_3d(
-    space, facet_index: np.ndarray, g: Field, degree: int = LOAD_DEGREE
+    space: P2TetSpace, facet_index: np.ndarray, g: Field, degree: int = LOAD_DEGREE
 ) -> np.ndarray:
     """The load vector ``G[3 z + i] = ∫_Γ g_i φ_z ds`` of a traction ``g`` on boundary faces
     (Neumann data).
@@ -106,7 +110,7 @@ def assemble_face_load_3d(
 
 
 def cell_stress_3d(
-    space, material: Material | CellMaterials, u: np.ndarray, xi: np.ndarray
+    space: P2TetSpace, material: Material | CellMaterials, u: np.ndarray, xi: np.ndarray
 ) -> np.ndarray:
     """Stresses ``σ(u_h) (n_cells, q, 3, 3)`` of the field with nodal values ``u (n_nodes,
     3)`` at the reference points ``xi (q, 3)`` of every cell (Hooke's law in 3D)."""
@@ -119,14 +123,15 @@ def cell_stress_3d(
 
 
 def von_mises_3d(
-    space, material: Material | CellMaterials, u: np.ndarray, xi: np.ndarray
+    space: P2TetSpace, material: Material | CellMaterials, u: np.ndarray, xi: np.ndarray
 ) -> np.ndarray:
     """The von Mises stress ``(n_cells, q)`` of :func:`cell_stress_3d`."""
     return von_mises(cell_stress_3d(space, material, u, xi))
 
 
 def _integrated(space, density: Callable, degree: int) -> float:
-    """``Σ_cells ∫ density(group, rows, x, xi)`` with the degree-``degree`` rule."""
+    """``Σ_cells ∫ density(group, x, xi)`` with the degree-``degree`` rule, ``x`` the images
+    ``(m, q, 3)`` of the rule's points ``xi`` in the group's cells."""
     xi, w = tetrahedron_rule(degree)
     total = 0.0
     for g in space.mapping.groups:
@@ -135,7 +140,7 @@ def _integrated(space, density: Callable, degree: int) -> float:
 
 
 def energy_error2_3d(
-    space,
+    space: P2TetSpace,
     u: np.ndarray,
     grad_exact: Field,
     material: Material | CellMaterials,
@@ -169,7 +174,7 @@ def energy_error2_3d(
 
 
 def h1_seminorm_error2_3d(
-    space, u: np.ndarray, grad_exact: Field, degree: int = LOAD_DEGREE
+    space: P2TetSpace, u: np.ndarray, grad_exact: Field, degree: int = LOAD_DEGREE
 ) -> float:
     """``|u − u_h|²_{H¹} = ∫ |∇(u − u_h)|²`` (Frobenius), arguments as
     :func:`energy_error2_3d`."""
@@ -182,7 +187,9 @@ def h1_seminorm_error2_3d(
     return _integrated(space, density, degree)
 
 
-def l2_error2_3d(space, u: np.ndarray, u_exact: Field, degree: int = LOAD_DEGREE) -> float:
+def l2_error2_3d(
+    space: P2TetSpace, u: np.ndarray, u_exact: Field, degree: int = LOAD_DEGREE
+) -> float:
     """``‖u − u_h‖²_{L²}`` against ``u_exact(x (..., 3)) -> (..., 3)``."""
     u_cell = space.cell_values(u)
 

@@ -20,7 +20,7 @@ Points are ``(..., 3)``; reference points of cells ``(q, 3)``, of faces ``(q, 2)
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
@@ -281,7 +281,9 @@ class QuadraticFaces:
 Faces = FlatFaces | QuadraticFaces
 
 
-def face_groups(nodes: np.ndarray, quadratic: np.ndarray):
+def face_groups(
+    nodes: np.ndarray, quadratic: np.ndarray
+) -> Iterator[tuple[slice | np.ndarray, FlatFaces | QuadraticFaces]]:
     """The faces with node points ``nodes (k, 6, 3)`` as groups of one kind: ``(rows,
     faces)`` for the flat ones, then the ``quadratic (k,) bool`` ones."""
     quadratic = np.asarray(quadratic, dtype=bool)
