@@ -73,7 +73,7 @@ class LagrangeSpace:
 
     @cached_property
     def vertices(self) -> np.ndarray:
-        """``(n_cells, 3, 2)`` vertex coordinates of each cell."""
+        """``(n_cells, d + 1, d)`` vertex coordinates of each cell."""
         return self.mesh.points[self.mesh.cells]
 
     def interpolate(self, func: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
