@@ -24,7 +24,7 @@ from ..mesh.reference import TETRAHEDRON, TRIANGLE, ReferenceCell
 from . import p1, p2, p2_tet
 from .facet_element import P1_INTERVAL, P2_INTERVAL, P2_TRIANGLE, FacetElement
 
-__all__ = ["ELEMENTS", "Element", "FacetElement", "P1", "P2", "P2_TET", "element_of"]
+__all__ = ["ELEMENTS", "ELEMENTS_ON", "Element", "FacetElement", "P1", "P2", "P2_TET", "element_of"]
 
 
 @dataclass(frozen=True, eq=False)
