@@ -21,18 +21,18 @@ of the numerator, as in 2D).
 Assembly
 --------
 The element matrices are 3 × 3 node blocks (DOFs ``3 node + component``,
-:mod:`signorini.fem.dofs`) kept by block component (:func:`component_blocks`,
-``(3, 3, m, 10, 10)``). The sum over cells sorts the ``m · 100`` node pairs once
-(:func:`_assemble_node_blocks`) and sums each component with one gather and one
-``np.add.reduceat``, written straight into the CSR arrays: sorted indices, the node-block
-pattern (rows ``3z … 3z + 2`` share their columns), int32 indices while they fit. A scalar
-COO → CSR conversion would sort the 900 entries of each cell instead of its 100 node pairs;
-the complex packing of the 2D assembly is a d = 2 trick and is not used.
+:mod:`signorini.fem.dofs`), ``(m, 10, 10, 3, 3)`` (:func:`node_blocks`). The sum over cells
+sorts the ``m · 100`` node pairs once (:func:`_assemble_node_blocks`) and adds each pair's
+blocks in one sparse product with the 0/1 matrix of the sort's runs, written straight into
+the CSR arrays: sorted indices, the node-block pattern (rows ``3z … 3z + 2`` share their
+columns), int32 indices while they fit. A scalar COO → CSR conversion would sort the 900
+entries of each cell instead of its 100 node pairs; the complex packing of the 2D assembly
+is a d = 2 trick and is not used.
 
 Measured on a shared two-core machine (``benchmarks/assembly3d.py``, Kuhn cube):
 0.1–0.2 × 10⁶ unknowns per second of wall time, 10–24 times scikit-fem's ``asm`` on the same
 mesh in the same run; about 0.2 × 10⁶ per second of CPU time at 1.1 × 10⁵ unknowns (element
-matrices 0.19 s, summation 0.34 s). The issue's target of 0.5 × 10⁶ is not reached yet.
+matrices 0.21 s, summation 0.29 s). The issue's target of 0.5 × 10⁶ is not reached yet.
 """
 
 from __future__ import annotations
@@ -64,15 +64,15 @@ def _per_cell(value: float | np.ndarray, rows: slice) -> float | np.ndarray:
     return np.asarray(value)[rows, None, None]
 
 
-def component_blocks(
+def node_blocks(
     cells: _Tetrahedra,
     material: Material | CellMaterials,
     degree: int | None = None,
     out: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Element stiffness of a group of tetrahedra by block component, ``(3, 3, m, 10, 10)``:
-    ``[i, j, c, a, b] = a(φ_b e_j, φ_a e_i)`` on cell ``c`` (module docstring), the layout the
-    assembly sums (each component's entries contiguous).
+    """Element stiffness of a group of tetrahedra as node blocks, ``(m, 10, 10, 3, 3)``:
+    ``[c, a, b, i, j] = a(φ_b e_j, φ_a e_i)`` on cell ``c`` (module docstring), the layout the
+    assembly sums (the nine entries of a node pair's block together).
 
     Parameters
     ----------
@@ -83,18 +83,18 @@ def component_blocks(
         :class:`CellMaterials` of the group's cells in its order.
     degree : int, optional
         The rule's degree, ``2 * cells.order`` by default (exact on affine cells).
-    out : (3, 3, m, 10, 10) float array, optional
+    out : (m, 10, 10, 3, 3) float array, optional
         Receives the result.
 
     Returns
     -------
-    (3, 3, m, 10, 10) float64 array
+    (m, 10, 10, 3, 3) float64 array
     """
     lam, mu = lame_parameters(material, 3)
     degree = 2 * cells.order if degree is None else degree
     xi, w = tetrahedron_rule(degree)
     m = len(cells)
-    out = np.empty((3, 3, m, 10, 10)) if out is None else out
+    out = np.empty((m, 10, 10, 3, 3)) if out is None else out
     for start in range(0, m, _CHUNK):  # chunks of cells bound the temporaries
         rows = slice(start, min(start + _CHUNK, m))
         part = cells.rows(np.arange(rows.start, rows.stop))
@@ -109,13 +109,13 @@ def component_blocks(
         lam_k, mu_k = _per_cell(lam, rows), _per_cell(mu, rows)
         trace = mu_k * (B[0, 0] + B[1, 1] + B[2, 2])  # μ ∫ ∇φ_a · ∇φ_b
         for i, j in _UPPER:
-            K = out[i, j, rows]
+            K = out[rows, :, :, i, j]
             np.multiply(lam_k, B[i, j], out=K)
             K += mu_k * np.swapaxes(B[i, j], -1, -2)
             if i == j:
                 K += trace
             else:  # K[(b, j), (a, i)] = K[(a, i), (b, j)]: the symmetric block
-                out[j, i, rows] = np.swapaxes(K, -1, -2)
+                out[rows, :, :, j, i] = np.swapaxes(K, -1, -2)
     return out
 
 
@@ -124,7 +124,7 @@ def element_stiffness_3d(
 ) -> np.ndarray:
     """Element stiffness matrices of a group of tetrahedra, ``(m, 30, 30)`` in interleaved
     local DOF order: ``K[c, 3 a + i, 3 b + j] = a(φ_b e_j, φ_a e_i)`` on cell ``c``
-    (:func:`component_blocks`, laid out by DOF).
+    (:func:`node_blocks`, laid out by DOF).
 
     Parameters
     ----------
@@ -138,8 +138,8 @@ def element_stiffness_3d(
     (m, 30, 30) float64 array
         Symmetric positive semidefinite, six zero eigenvalues (the rigid motions).
     """
-    comp = component_blocks(cells, material, degree)
-    return comp.transpose(2, 3, 0, 4, 1).reshape(-1, 30, 30)
+    blocks = node_blocks(cells, material, degree)
+    return blocks.transpose(0, 1, 3, 2, 4).reshape(-1, 30, 30)
 
 
 def _cell_nodes(cell_dofs: np.ndarray) -> np.ndarray:
@@ -173,12 +173,12 @@ def assemble_stiffness_3d(
     mapping = cells if isinstance(cells, CellMap) else TetrahedronMap(cells)
     nodes = _cell_nodes(cell_dofs)
     m = mapping.n_cells
-    blocks = np.empty((3, 3, m, 10, 10))
+    blocks = np.empty((m, 10, 10, 3, 3))
     order = []
     start = 0
     for g in mapping.groups:  # group after group into one array, the cells in that order
         rows = slice(start, start + len(g))
-        component_blocks(g, on_cells(material, g.cells), out=blocks[:, :, rows])
+        node_blocks(g, on_cells(material, g.cells), out=blocks[rows])
         order.append(np.arange(m)[g.cells])
         start += len(g)
     if len(mapping.groups) > 1:
@@ -192,19 +192,20 @@ def _assemble_node_blocks(
     """Sum per-cell 3 × 3 node blocks into a CSR matrix with the node-block pattern.
 
     The ``(m, 10, 10)`` node pairs ``(z_a, z_b)`` of the cells are sorted once by their key
-    ``z_a n_nodes + z_b`` (a stable sort: the duplicates of a pair stay in cell order, so each
-    entry is summed in the same order on every run); the pattern is the distinct keys, and
-    each of the nine block components is one gather and one ``np.add.reduceat`` of a
-    contiguous array, written straight to its places in the CSR data (row ``3 z + i`` holds
-    node ``z``'s blocks' row ``i``). The sort handles 100 keys per cell, not the 900 scalar
-    entries a scalar COO → CSR conversion sorts.
+    ``z_a n_nodes + z_b`` (a stable sort: the duplicates of a pair stay in cell order); the
+    pattern is the distinct keys, and the summation is one product ``S @ blocks`` with the
+    0/1 matrix ``S (n_pairs, m · 100)`` whose row p holds the sorted run of pair p (its CSR
+    arrays are the sort's run starts and order, built without a conversion): SciPy's loop
+    reads each block's nine entries where they lie and adds them in cell order. The blocks
+    are then written straight to their places in the CSR arrays (row ``3 z + i`` holds node
+    ``z``'s blocks' row ``i``).
 
     Parameters
     ----------
     cell_nodes : (m, 10) int array
     n_nodes : int
-    blocks : (3, 3, m, 10, 10) float array
-        :func:`component_blocks` of the cells, in the order of ``cell_nodes``.
+    blocks : (m, 10, 10, 3, 3) float array
+        :func:`node_blocks` of the cells, in the order of ``cell_nodes``.
 
     Returns
     -------
@@ -215,10 +216,18 @@ def _assemble_node_blocks(
     key = (z[:, :, None] * n_nodes + z[:, None, :]).reshape(-1)
     order = np.argsort(key, kind="stable")
     key = key[order]
-    new = np.empty(key.size, dtype=bool)
-    new[:1] = True
-    np.not_equal(key[1:], key[:-1], out=new[1:])
-    start = np.flatnonzero(new)
+    new = np.empty(key.size + 1, dtype=bool)
+    new[0] = new[-1] = True
+    np.not_equal(key[1:], key[:-1], out=new[1:-1])
+    run = np.flatnonzero(new)  # run p of equal keys: order[run[p] : run[p + 1]]
+    start = run[:-1]
+    index = np.int32 if key.size < 2**31 else np.int64
+    S = sp.csr_matrix(
+        (np.ones(key.size), order.astype(index), run.astype(index)),
+        shape=(start.size, key.size),
+        copy=False,
+    )
+    summed = S @ np.ascontiguousarray(blocks).reshape(-1, 9)  # (n_pairs, 9)
     row, col = np.divmod(key[start], n_nodes)
     count = np.bincount(row, minlength=n_nodes)  # blocks per block row
     first = np.zeros(n_nodes + 1, dtype=np.int64)
@@ -229,18 +238,18 @@ def _assemble_node_blocks(
     stride = 3 * count[row]
     data = np.empty(9 * row.size)
     indices = np.empty(9 * row.size, dtype=np.int32 if 3 * n_nodes < 2**31 else np.int64)
-    comp = blocks.reshape(9, -1)
     for c in range(9):  # a loop over the nine components of a block
         i, j = divmod(c, 3)
         at = base + i * stride + j
-        data[at] = np.add.reduceat(comp[c][order], start)
+        data[at] = summed[:, c]
         indices[at] = 3 * col + j
     indptr = np.empty(3 * n_nodes + 1, dtype=np.int64)
     indptr[0] = 0
     np.cumsum(np.repeat(3 * count, 3), out=indptr[1:])
-    idx = indices.dtype
     out = sp.csr_matrix(
-        (data, indices, indptr.astype(idx)), shape=(3 * n_nodes, 3 * n_nodes), copy=False
+        (data, indices, indptr.astype(indices.dtype)),
+        shape=(3 * n_nodes, 3 * n_nodes),
+        copy=False,
     )
     out.has_sorted_indices = True
     return out
