@@ -4,19 +4,21 @@ P2 tetrahedra (:mod:`signorini.fem.p2_tet`, 30 DOFs per cell).
 
 Element matrices
 ----------------
-One integrand for every geometry (:mod:`signorini.fem.mapping3d`): with ``G_q (m, 10, 3)``
-the physical basis gradients and ``W_q = w_q det J(ξ_q)`` at the points of the rule,
+One integrand for every geometry (:mod:`signorini.fem.mapping3d`). With the physical
+gradients ``∇φ_a = J⁻ᵀ ∇̂φ_a`` and the weights ``w_p det J(ξ_p)`` of the rule,
 
-    B[a, i, b, j] = Σ_q W_q ∂_i φ_a ∂_j φ_b,
-    K[(a, i), (b, j)] = λ B[a, i, b, j] + μ B[a, j, b, i] + μ δ_ij Σ_k B[a, k, b, k],
+    B_ij[a, b] = ∫ ∂_i φ_a ∂_j φ_b = Σ_p Σ_kl P_p[ij, kl] R_p[kl, ab],
+    P_p[ij, kl] = det J J⁻ᵀ[i, k] J⁻ᵀ[j, l] at ξ_p,   R_p[kl, ab] = w_p ∂_k φ̂_a ∂_l φ̂_b,
+    K[(a, i), (b, j)] = λ B_ij[a, b] + μ B_ji[a, b] + μ δ_ij Σ_k B_kk[a, b],
 
-formed by elementwise products and sums over the points in turn (a loop over quadrature
-points, never over cells), for the components ``i ≤ j`` (``K[(b, j), (a, i)]`` is their
-transpose): each cell's matrix depends on that cell's data alone, bit for bit,
-whatever cells are computed beside it (the property :mod:`signorini.fem.fixed_order` gives
-the 2D products). On affine cells the integrand is of degree 2 and the four-point rule makes
-it exact; on the quadratic maps of isoparametric cells the degree-4 rule (degree 2k − 2 + 2
-of the numerator, as in 2D).
+with ``B_ji = B_ijᵀ`` (in a, b), so only ``i ≤ j`` are formed and ``K[(b, j), (a, i)]`` is
+copied from ``K[(a, i), (b, j)]``. Where ``J`` is constant (affine cells) ``P`` has one point
+and ``R`` is summed over the rule first, ``(9, 100)``: one product of the ``(6 m, 9)``
+factors with it per chunk of cells, :func:`~signorini.fem.fixed_order.rows_times` (no BLAS),
+so each cell's matrix depends on that cell's data alone, bit for bit, whatever cells are
+computed beside it. On affine cells the integrand is of degree 2 and the four-point rule
+makes it exact; on the quadratic maps of isoparametric cells ``P`` varies and the degree-4
+rule is used (as in 2D).
 
 Assembly
 --------
@@ -29,17 +31,22 @@ columns), int32 indices while they fit. A scalar COO → CSR conversion would so
 entries of each cell instead of its 100 node pairs; the complex packing of the 2D assembly
 is a d = 2 trick and is not used.
 
-Measured on a shared two-core machine (``benchmarks/assembly3d.py``, Kuhn cube):
-0.1–0.2 × 10⁶ unknowns per second of wall time, 10–24 times scikit-fem's ``asm`` on the same
-mesh in the same run; about 0.2 × 10⁶ per second of CPU time at 1.1 × 10⁵ unknowns (element
-matrices 0.21 s, summation 0.29 s). The issue's target of 0.5 × 10⁶ is not reached yet.
+Measured on a shared two-core machine (``benchmarks/assembly3d.py``, Kuhn cube, load 3–5):
+0.13–0.32 × 10⁶ unknowns per second of wall time, 14–31 times scikit-fem's ``asm`` on the
+same mesh in the same run; 0.32 × 10⁶ per second of CPU time at 1.1 × 10⁵ unknowns (element
+matrices 0.12 s, the sum 0.22 s, of which 0.10 s places the summed blocks in the CSR
+arrays). The issue's target of 0.5 × 10⁶ is not reached yet.
 """
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 import scipy.sparse as sp
 
+from . import p2_tet
+from .fixed_order import rows_times
 from .mapping import CellMap
 from .mapping3d import AffineTetrahedra, IsoparametricTetrahedra, TetrahedronMap
 from .material import CellMaterials, Material, lame_parameters, on_cells
@@ -47,8 +54,8 @@ from .quadrature import tetrahedron_rule
 
 __all__ = ["assemble_stiffness_3d", "element_stiffness_3d"]
 
-#: cells per chunk of the element matrices: their (256, 10, 10) temporaries stay in the
-#: cache (measured: 4096 took 2-3 times as long)
+#: cells per chunk of the element matrices: the temporaries stay in the cache (measured:
+#: 4096 took twice as long)
 _CHUNK = 256
 
 _Tetrahedra = AffineTetrahedra | IsoparametricTetrahedra
@@ -62,6 +69,19 @@ def _per_cell(value: float | np.ndarray, rows: slice) -> float | np.ndarray:
     if np.ndim(value) == 0:
         return value
     return np.asarray(value)[rows, None, None]
+
+
+@lru_cache(maxsize=16)
+def _reference_products(degree: int, per_point: bool) -> np.ndarray:
+    """``R[(p, k, l), (a, b)] = w_p ∂_k φ̂_a(ξ_p) ∂_l φ̂_b(ξ_p)`` on the reference tetrahedron
+    for the points of the degree-``degree`` rule, ``(q · 9, 100)``; summed over the points,
+    ``(9, 100)``, unless ``per_point`` (Jacobians that vary from point to point)."""
+    xi, w = tetrahedron_rule(degree)
+    g = p2_tet.grad_basis(xi)
+    R = np.einsum("q,qak,qbl->qklab", w, g, g)
+    R = R.reshape(len(w) * 9, 100) if per_point else R.sum(axis=0).reshape(9, 100)
+    R.setflags(write=False)
+    return R
 
 
 def node_blocks(
@@ -95,17 +115,19 @@ def node_blocks(
     xi, w = tetrahedron_rule(degree)
     m = len(cells)
     out = np.empty((m, 10, 10, 3, 3)) if out is None else out
+    J, det = cells.jacobians(xi)  # (m, p, 3, 3), p = 1 (affine) or q
+    jit = cells.inverse_transpose(xi)
+    R = _reference_products(degree, det.shape[1] > 1)  # (p · 9, 100)
     for start in range(0, m, _CHUNK):  # chunks of cells bound the temporaries
         rows = slice(start, min(start + _CHUNK, m))
-        part = cells.rows(np.arange(rows.start, rows.stop))
-        G = np.ascontiguousarray(part.basis_gradients(xi).transpose(3, 1, 0, 2))  # (3, q, k, 10)
-        Gw = G * part.measure(w, xi).T[None, :, :, None]  # W_q ∂_i φ_a
-        B = np.empty((3, 3, G.shape[2], 10, 10))
-        for i, j in _UPPER:  # B[j, i] is B[i, j] with a and b swapped
-            b = B[i, j]
-            np.multiply(Gw[i, 0, :, :, None], G[j, 0, :, None, :], out=b)
-            for q in range(1, G.shape[1]):  # a loop over quadrature points
-                b += Gw[i, q, :, :, None] * G[j, q, :, None, :]
+        # P[c, (i, j), p, k, l] = det J J⁻ᵀ[i, k] J⁻ᵀ[j, l] at point p, for i <= j
+        d, t = det[rows], jit[rows]
+        P = np.empty((len(d), len(_UPPER), d.shape[1], 3, 3))
+        for u, (i, j) in enumerate(_UPPER):
+            np.multiply(t[:, :, i, :, None], t[:, :, j, None, :], out=P[:, u])
+            P[:, u] *= d[:, :, None, None]
+        B = rows_times(P.reshape(-1, R.shape[0]), R).reshape(len(d), len(_UPPER), 10, 10)
+        B = {ij: B[:, u] for u, ij in enumerate(_UPPER)}
         lam_k, mu_k = _per_cell(lam, rows), _per_cell(mu, rows)
         trace = mu_k * (B[0, 0] + B[1, 1] + B[2, 2])  # μ ∫ ∇φ_a · ∇φ_b
         for i, j in _UPPER:
