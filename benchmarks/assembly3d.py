@@ -8,6 +8,8 @@ ElementVector(ElementTetP2())))`` on the same points and cells, in one run: the 
 ``--repeat`` runs each, the ratio of the two, and the two matrices' difference after
 matching the DOF order (scikit-fem numbers its DOFs by component blocks of its own edge
 order, so the check compares ``x^T K x`` for the interpolants of random quadratic fields).
+Freed memory is kept for reuse as the command line keeps it
+(:func:`signorini.runtime.retain_freed_memory`).
 
     python benchmarks/assembly3d.py                 # n = 8, 12, 16
     python benchmarks/assembly3d.py --sizes 20 24 --repeat 2
@@ -24,6 +26,7 @@ from signorini.fem.material import Material
 from signorini.fem.space import space_of
 from signorini.fem.stiffness3d import assemble_stiffness_3d
 from signorini.mesh.builders3d import box
+from signorini.runtime import retain_freed_memory
 
 MATERIAL = Material.from_young(1.0, 0.3)
 
@@ -64,6 +67,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--no-peer", action="store_true", help="skip scikit-fem")
     args = parser.parse_args()
+    retain_freed_memory()  # as the command line does: freed pages reused, not faulted in anew
     rng = np.random.default_rng(0)
     print(
         f"{'n':>4s} {'unknowns':>10s} {'ours s':>8s} {'ours 1e6/s':>10s} {'skfem s':>8s} "

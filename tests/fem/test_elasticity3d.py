@@ -162,6 +162,11 @@ def test_global_matrix_symmetric_block_pattern_and_rigid_kernel():
     V = space_of(distorted_box(2))
     K = assemble_stiffness_3d(V.mapping, V.cell_dofs, V.n_dofs, MATERIAL)
     assert abs(K - K.T).max() < 1e-14 * abs(K).max()
+    assert isinstance(K, sp.csr_matrix) and K.has_sorted_indices
+    resorted = K.copy()
+    resorted.has_sorted_indices = False
+    resorted.sort_indices()
+    assert np.array_equal(resorted.indices, K.indices) and np.array_equal(resorted.data, K.data)
     indptr = K.indptr
     lengths = np.diff(indptr).reshape(-1, 3)
     assert (lengths == lengths[:, :1]).all() and (lengths % 3 == 0).all()

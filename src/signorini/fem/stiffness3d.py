@@ -25,17 +25,17 @@ Assembly
 The element matrices are 3 × 3 node blocks (DOFs ``3 node + component``,
 :mod:`signorini.fem.dofs`), ``(m, 10, 10, 3, 3)`` (:func:`node_blocks`). The sum over cells
 sorts the ``m · 100`` node pairs once (:func:`_assemble_node_blocks`) and adds each pair's
-blocks in one sparse product with the 0/1 matrix of the sort's runs, written straight into
-the CSR arrays: sorted indices, the node-block pattern (rows ``3z … 3z + 2`` share their
-columns), int32 indices while they fit. A scalar COO → CSR conversion would sort the 900
-entries of each cell instead of its 100 node pairs; the complex packing of the 2D assembly
-is a d = 2 trick and is not used.
+blocks in one sparse product with the 0/1 matrix of the sort's runs; the summed blocks are a
+BSR matrix (blocksize 3) as they stand, converted to CSR once: sorted indices, the
+node-block pattern (rows ``3z … 3z + 2`` share their columns), int32 indices while they fit.
+A scalar COO → CSR conversion would sort the 900 entries of each cell instead of its 100
+node pairs; the complex packing of the 2D assembly is a d = 2 trick and is not used.
 
-Measured on a shared two-core machine (``benchmarks/assembly3d.py``, Kuhn cube, load 3–5):
-0.13–0.32 × 10⁶ unknowns per second of wall time, 14–31 times scikit-fem's ``asm`` on the
-same mesh in the same run; 0.32 × 10⁶ per second of CPU time at 1.1 × 10⁵ unknowns (element
-matrices 0.12 s, the sum 0.22 s, of which 0.10 s places the summed blocks in the CSR
-arrays). The issue's target of 0.5 × 10⁶ is not reached yet.
+Measured on a shared two-core machine (``benchmarks/assembly3d.py``, Kuhn cube): 0.30–0.52 ×
+10⁶ unknowns per second of wall time from 1.5 × 10⁴ to 3.5 × 10⁵ unknowns, 24–38 times
+scikit-fem's ``asm`` on the same mesh in the same run; at 1.1 × 10⁵ unknowns 0.12 s of CPU
+for the element matrices and 0.15 s for the sum (the sort of the node pairs the largest
+part, 0.27 s of 0.55 at 3.5 × 10⁵). The issue's 0.5 × 10⁶ is reached on small meshes only.
 """
 
 from __future__ import annotations
@@ -218,9 +218,10 @@ def _assemble_node_blocks(
     pattern is the distinct keys, and the summation is one product ``S @ blocks`` with the
     0/1 matrix ``S (n_pairs, m · 100)`` whose row p holds the sorted run of pair p (its CSR
     arrays are the sort's run starts and order, built without a conversion): SciPy's loop
-    reads each block's nine entries where they lie and adds them in cell order. The blocks
-    are then written straight to their places in the CSR arrays (row ``3 z + i`` holds node
-    ``z``'s blocks' row ``i``).
+    reads each block's nine entries where they lie and adds them in cell order. The summed
+    blocks, in the sort's order, are a BSR matrix as they stand (block row z, its columns
+    sorted), and SciPy's BSR → CSR loop lays them out (row ``3 z + i`` holds row ``i`` of node
+    ``z``'s blocks).
 
     Parameters
     ----------
@@ -243,35 +244,22 @@ def _assemble_node_blocks(
     np.not_equal(key[1:], key[:-1], out=new[1:-1])
     run = np.flatnonzero(new)  # run p of equal keys: order[run[p] : run[p + 1]]
     start = run[:-1]
-    index = np.int32 if key.size < 2**31 else np.int64
+    runs = np.int32 if key.size < 2**31 else np.int64
     S = sp.csr_matrix(
-        (np.ones(key.size), order.astype(index), run.astype(index)),
+        (np.ones(key.size), order.astype(runs), run.astype(runs)),
         shape=(start.size, key.size),
         copy=False,
     )
     summed = S @ np.ascontiguousarray(blocks).reshape(-1, 9)  # (n_pairs, 9)
     row, col = np.divmod(key[start], n_nodes)
-    count = np.bincount(row, minlength=n_nodes)  # blocks per block row
-    first = np.zeros(n_nodes + 1, dtype=np.int64)
-    np.cumsum(count, out=first[1:])
-    # block p of node row z, entry (i, j): CSR position 9 first[z] + 3 i count[z] + 3 (p -
-    # first[z]) + j
-    base = 9 * first[row] + 3 * (np.arange(row.size) - first[row])
-    stride = 3 * count[row]
-    data = np.empty(9 * row.size)
-    indices = np.empty(9 * row.size, dtype=np.int32 if 3 * n_nodes < 2**31 else np.int64)
-    for c in range(9):  # a loop over the nine components of a block
-        i, j = divmod(c, 3)
-        at = base + i * stride + j
-        data[at] = summed[:, c]
-        indices[at] = 3 * col + j
-    indptr = np.empty(3 * n_nodes + 1, dtype=np.int64)
-    indptr[0] = 0
-    np.cumsum(np.repeat(3 * count, 3), out=indptr[1:])
-    out = sp.csr_matrix(
-        (data, indices, indptr.astype(indices.dtype)),
+    first = np.zeros(n_nodes + 1, dtype=np.int64)  # the block rows' starts
+    np.cumsum(np.bincount(row, minlength=n_nodes), out=first[1:])
+    index = np.int32 if summed.size < 2**31 else np.int64
+    bsr = sp.bsr_matrix(
+        (summed.reshape(-1, 3, 3), col.astype(index), first.astype(index)),
         shape=(3 * n_nodes, 3 * n_nodes),
         copy=False,
     )
+    out = bsr.tocsr()  # SciPy's loop lays each block row out as three CSR rows
     out.has_sorted_indices = True
     return out
