@@ -135,11 +135,6 @@ class P2TetSpace(P2Space):
         facets = np.concatenate([self.mesh.part_facets(n) for n in names] or [np.zeros(0, int)])
         return np.unique(self.facet_nodes(facets))
 
-    edge_nodes = facet_nodes
-    mesh_edge_nodes = mesh_facet_nodes
-    boundary_edges = boundary_facets
-    curved_edges = curved_facets
-
     def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
         """Not yet: the P2 prolongation onto a bisected tetrahedral mesh comes with the 3D
         bisection (issue 37, *3D refinement with tags*)."""
