@@ -27,7 +27,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from signorini.contact.mortar import mortar_coupling
-from signorini.fem.loads import assemble_edge_load
+from signorini.fem.loads import assemble_facet_load
 from signorini.fem.mapping import StraightEdges
 from signorini.fem.material import Material
 from signorini.fem.space import P2Space
@@ -95,7 +95,7 @@ def pressure_deviation(n_upper: int, n_lower: int, slave: str, method: str) -> f
     top = mesh.part_facets("up.top")
     nodes = space.facet_nodes(top)
     dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1, 6)
-    F = assemble_edge_load(
+    F = assemble_facet_load(
         StraightEdges(space.node_points[nodes[:, :2]]), dofs, n, lambda x, nu: np.array([0.0, -1.0])
     )
     held = np.concatenate(

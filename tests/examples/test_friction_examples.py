@@ -60,7 +60,7 @@ def transitions(result, axis: int) -> tuple[np.ndarray, np.ndarray]:
 
 def contact_edges(result, axis: int) -> tuple[np.ndarray, np.ndarray]:
     """Midpoint coordinate ``axis`` and length of every contact edge."""
-    mesh, edges = result.mesh, result.contact.edges
+    mesh, edges = result.mesh, result.contact.facets
     ends = mesh.points[mesh.edges[edges]]
     return ends[:, :, axis].mean(axis=1), mesh.edge_length[edges]
 

@@ -60,7 +60,7 @@ def side(space: P2Space, name: str) -> Side:
     edges' normals at a vertex); curved where the part carries a curve."""
     mesh = space.mesh
     edges = mesh.part_facets(name)
-    nodes = space.edge_nodes(edges)
+    nodes = space.facet_nodes(edges)
     points = space.node_points[nodes]
     _, chord = segment_normals(points[:, 0], points[:, 1])
     curve = mesh.curves[mesh.part_index(name)]

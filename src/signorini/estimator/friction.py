@@ -13,8 +13,8 @@ nodal values at ``[start, end, midpoint]``:
   so ``b_z = s_z / w_z``; Coulomb ``F Λ_z``, so ``b_z = F p_z``): ``|p_t,z| ≤ b_z`` is the
   solver's nodal law ``|Λ_t,z| ≤ s_z`` divided by ``w_z``; 0 on frictionless parts;
 - ``u_t(z) = ũ_h(z)·t_z − u_t,ref(z)``, ``t_z`` the constraint's tangent
-  (``ContactSet.edge_tangent``), ``ũ_h`` relative to the master with two bodies
-  (``ContactSet.edge_relative``), ``u_t,ref`` the reference the law's slip starts from
+  (``ContactSet.facet_tangent``), ``ũ_h`` relative to the master with two bodies
+  (``ContactSet.facet_relative``), ``u_t,ref`` the reference the law's slip starts from
   (``ContactResult.tangential_reference``: a load step's previous displacement, a moving
   obstacle's motion; 0 for one step at rest).
 
@@ -52,11 +52,11 @@ def friction_facets(result: ContactResult, unit: float = 1.0) -> FrictionFacets 
         return None
     force = cs.friction.slip_bound(result.contact_force, result.active)  # s_z
     bound = result.space.element.facet.pressure(force, cs.basis_integral)
-    loc = cs.edge_local
+    loc = cs.facet_local
     inside = loc >= 0
     row = np.maximum(loc, 0)
-    tangent = cs.edge_tangent[..., 0, :]
-    slip = np.einsum("ejc,ejc->ej", cs.edge_relative(result.u), tangent)
+    tangent = cs.facet_tangent[..., 0, :]
+    slip = np.einsum("ejc,ejc->ej", cs.facet_relative(result.u), tangent)
     # the law acts on the slip from the reference (a load step's previous one, the
     # obstacle's motion): so does the friction work
     slip = slip - np.where(inside, result.tangential_reference[row], 0.0)

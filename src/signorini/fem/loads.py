@@ -15,7 +15,7 @@ from .element import P2, Element
 from .mapping import CellMap, Edges, QuadraticEdges, StraightEdges
 from .quadrature import line_rule, triangle_rule
 
-__all__ = ["assemble_body_force", "assemble_edge_load", "assemble_facet_load"]
+__all__ = ["assemble_body_force", "assemble_facet_load"]
 
 
 def assemble_body_force(
@@ -105,7 +105,3 @@ def assemble_facet_load(
     ds = np.broadcast_to(facets.speeds(t) * w, x.shape[:2])
     local = np.einsum("qa,kqc,kq->kac", element.facet.basis(t), gx, ds)
     return np.bincount(np.ravel(facet_dofs), weights=local.ravel(), minlength=n_dofs)
-
-
-#: the former name, read by the contact layer's assembly
-assemble_edge_load = assemble_facet_load

@@ -211,13 +211,6 @@ class P2Space(LagrangeSpace):
         nodes = np.concatenate([self.mesh.facets[facets].ravel(), self.mesh.n_points + facets])
         return np.unique(nodes)
 
-    # the former edge names of the facet-sense methods, read by the contact layer and the
-    # estimator
-    edge_nodes = facet_nodes
-    mesh_edge_nodes = mesh_facet_nodes
-    boundary_edges = boundary_facets
-    curved_edges = curved_facets
-
     def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
         """Exact interpolation of a P2 field of this space on the refined mesh.
 
@@ -312,11 +305,6 @@ class P1Space(LagrangeSpace):
         """Sorted nodes (vertices) on the closure of the named boundary parts."""
         facets = np.concatenate([self.mesh.part_facets(n) for n in names] or [np.zeros(0, int)])
         return np.unique(self.mesh.facets[facets])
-
-    edge_nodes = facet_nodes
-    mesh_edge_nodes = mesh_facet_nodes
-    boundary_edges = boundary_facets
-    curved_edges = curved_facets
 
     def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
         """Exact interpolation of a P1 field of this space on the refined mesh: the old
