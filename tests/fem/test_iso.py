@@ -11,7 +11,7 @@ from fem_problems import GradientField, stress_of
 from signorini.contact.system import assemble
 from signorini.fem import iso
 from signorini.fem.loads import assemble_body_force, assemble_facet_load
-from signorini.fem.mapping import IsoparametricCells, QuadraticEdges
+from signorini.fem.mapping import IsoparametricCells, QuadraticFacets
 from signorini.fem.material import Material
 from signorini.fem.norms import energy_error2
 from signorini.fem.space import P2Space
@@ -201,7 +201,7 @@ def test_curved_edge_load_integrates_along_the_arc():
     dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1, 6)
     one = lambda x, n: np.broadcast_to([1.0, 0.0], x.shape)  # noqa: E731
     ends = mesh.points[nodes[:, :2]]
-    arc = QuadraticEdges(space.node_points[nodes])
+    arc = QuadraticFacets(space.node_points[nodes])
     G = assemble_facet_load(arc, dofs, space.n_dofs, one, 8)
     chord = assemble_facet_load(ends, dofs, space.n_dofs, one, 8)
     print(f"arc length {G[0::2].sum()}, chords {chord[0::2].sum()}, exact {np.pi / 2}")

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..algebra.friction.laws import LawGroups
 from ..fem.space import LagrangeSpace
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from ..problem.fields import ProblemError
 from .admissible import check_dirichlet_admissible, check_initial_overlap, check_obstacle_side
 from .constraint_data import directions_and_gaps, facet_weights, friction_data
@@ -280,7 +280,7 @@ def contact_set(conditions: DiscreteConditions, space: LagrangeSpace) -> Contact
     facets = np.concatenate(facet_lists)
     facet_part = np.repeat(np.arange(len(parts)), [e.size for e in facet_lists])
     facet_nodes = space.facet_nodes(facets)
-    _, chord = segment_normals(mesh.points[facet_nodes[:, 0]], mesh.points[facet_nodes[:, 1]])
+    _, chord = facet_normals(mesh.points[facet_nodes[:, :2]])
     for i in range(len(parts)):  # straight parts: exactly their normal
         if conditions.straight(i) is not None:
             chord[facet_part == i] = conditions.straight_normal[i]

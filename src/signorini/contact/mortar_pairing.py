@@ -17,7 +17,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..fem.space import P2Space
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from .constraint_data import part_normals
 
 __all__ = [
@@ -62,7 +62,7 @@ def side(space: P2Space, name: str) -> Side:
     edges = mesh.part_facets(name)
     nodes = space.facet_nodes(edges)
     points = space.node_points[nodes]
-    _, chord = segment_normals(points[:, 0], points[:, 1])
+    _, chord = facet_normals(points[:, :2])
     curve = mesh.curves[mesh.part_index(name)]
     curved = np.full(edges.size, curve is not None, dtype=bool)
     return Side(nodes, points, part_normals(space, name, nodes, chord), curved)

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..contact.contact_set import SEMI_CONTACT
 from ..contact.solution import ContactResult
-from ..fem.mapping import edge_groups
+from ..fem.mapping import facet_groups
 from .friction import FrictionFacets, move_dirichlet_thirds
 from .terms import FacetSet, complementarity, friction_work, normal_stress, tangential_stress
 from .traction import CellStress, direction_field
@@ -73,7 +73,7 @@ def contact_node_parts(
     facet = space.element.facet
     parts6 = np.zeros(gap.shape)
     parts8 = np.zeros(gap.shape)
-    for rows, facets in edge_groups(space.node_points[cs.facet_nodes], curved):
+    for rows, facets in facet_groups(space.node_points[cs.facet_nodes], curved):
         parts6[rows] = complementarity(gap[rows], density[rows], facets, None, facet.hat_pieces)
         if friction is not None:
             slip, bound, p_t = friction.slip[rows], friction.bound[rows], friction.friction[rows]

@@ -346,7 +346,7 @@ def complementarity(
         ``u_h·n − ψ_h`` at ``[start, end, midpoint]``.
     density : (k, 3) float array
         ``s_p`` at the same nodes where p is a semi-contact node, else 0.
-    length : (k,) float array or StraightEdges or QuadraticEdges
+    length : (k,) float array or StraightFacets or QuadraticFacets
         Edge lengths, or the edges' geometry (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
         Node points ``[start, end, midpoint]`` of quadratic edges: integrate along them
@@ -384,7 +384,7 @@ def friction_work(
     bound : (k, 3) float array
         The nodal slip bounds ``b_z`` (Tresca ``s_z / w_z``, Coulomb ``F p_z``; 0 at
         Dirichlet nodes and on frictionless parts).
-    length : (k,) float array or StraightEdges or QuadraticEdges
+    length : (k,) float array or StraightFacets or QuadraticFacets
         Edge lengths, or the edges' geometry (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
         Node points of quadratic edges: integrate along them.

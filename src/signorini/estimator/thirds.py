@@ -10,7 +10,7 @@ import numpy as np
 
 from ..fem.edge_trace import evaluate, monomial_coefficients, roots_in_unit_interval
 from ..fem.element import P2
-from ..fem.mapping import Edges, QuadraticEdges, StraightEdges
+from ..fem.mapping import Facets, QuadraticFacets, StraightFacets
 from ..fem.quadrature import gauss_legendre
 
 __all__ = ["CURVED_THIRD_POINTS", "friction_work_thirds", "third_integrals"]
@@ -43,7 +43,7 @@ def third_integrals(
     ----------
     v : (k, 3) float array
         A quadratic on each edge, by its values at ``[start, end, midpoint]``.
-    length : (k,) float array or StraightEdges or QuadraticEdges
+    length : (k,) float array or StraightFacets or QuadraticFacets
         Edge lengths (not used with ``points``), or the edges' geometry
         (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
@@ -109,7 +109,7 @@ def friction_work_thirds(
         ``p_t`` (stress).
     bound : (k, 3) float array
         ``b``, the slip bound (stress).
-    length : (k,) float array or StraightEdges or QuadraticEdges
+    length : (k,) float array or StraightFacets or QuadraticFacets
         Edge lengths (not used with ``points``), or the edges' geometry
         (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
@@ -145,18 +145,18 @@ def friction_work_thirds(
 
 
 def _geometry(
-    length: np.ndarray | Edges, points: np.ndarray | None
-) -> tuple[np.ndarray | None, QuadraticEdges | None]:
+    length: np.ndarray | Facets, points: np.ndarray | None
+) -> tuple[np.ndarray | None, QuadraticFacets | None]:
     """``(lengths, None)`` for straight edges (their constant ``|x'(t)|`` multiplies the
     integrals once), ``(None, edges)`` for quadratic ones (``|x'(t)|`` at every point)."""
-    if isinstance(length, StraightEdges):
+    if isinstance(length, StraightFacets):
         return length.length, None
-    if isinstance(length, QuadraticEdges):
+    if isinstance(length, QuadraticFacets):
         return None, length
-    return (length, None) if points is None else (None, QuadraticEdges(points))
+    return (length, None) if points is None else (None, QuadraticFacets(points))
 
 
-def _points(edges: QuadraticEdges | None) -> int:
+def _points(edges: QuadraticFacets | None) -> int:
     """Gauss points per piece: 3 (exact) on straight edges, ``CURVED_THIRD_POINTS`` along
     quadratic ones, where ``|x'(t)|`` makes the integrand non-polynomial."""
     return 3 if edges is None else CURVED_THIRD_POINTS

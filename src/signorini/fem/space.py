@@ -25,7 +25,7 @@ from ..mesh.validation import MeshError
 from . import dofs, iso
 from .dofs import node_dofs
 from .element import P1, P2, Element, element_of
-from .mapping import CellMap, QuadraticEdges, StraightEdges, edge_groups
+from .mapping import CellMap, QuadraticFacets, StraightFacets, facet_groups
 from .prolongation import prolongate_p1, prolongate_p2
 
 __all__ = ["LagrangeSpace", "P1Space", "P2Space", "node_dofs", "space_of"]
@@ -197,13 +197,13 @@ class P2Space(LagrangeSpace):
 
     def boundary_facets(
         self, facet_index: np.ndarray
-    ) -> Iterator[tuple[slice | np.ndarray, StraightEdges | QuadraticEdges]]:
+    ) -> Iterator[tuple[slice | np.ndarray, StraightFacets | QuadraticFacets]]:
         """The geometry of boundary facets (edges in 2D; :mod:`signorini.fem.mapping`),
         counter-clockwise as :meth:`facet_nodes`: quadratic through the midpoint node on parts
         carrying a curve other than a line, straight elsewhere; ``(rows, facets)`` per kind."""
         facet_index = np.asarray(facet_index, dtype=np.int64)
         points = self.node_points[self.facet_nodes(facet_index)]
-        return edge_groups(points, np.isin(facet_index, self.curved_facets))
+        return facet_groups(points, np.isin(facet_index, self.curved_facets))
 
     def part_nodes(self, names: Iterable[str]) -> np.ndarray:
         """Sorted nodes on the closure of the named boundary parts (vertices and midpoints)."""
@@ -297,9 +297,9 @@ class P1Space(LagrangeSpace):
 
     def boundary_facets(
         self, facet_index: np.ndarray
-    ) -> Iterator[tuple[slice | np.ndarray, StraightEdges | QuadraticEdges]]:
+    ) -> Iterator[tuple[slice | np.ndarray, StraightFacets | QuadraticFacets]]:
         """The boundary facets as straight edges, counter-clockwise as :meth:`facet_nodes`."""
-        yield slice(None), StraightEdges(self.node_points[self.facet_nodes(facet_index)])
+        yield slice(None), StraightFacets(self.node_points[self.facet_nodes(facet_index)])
 
     def part_nodes(self, names: Iterable[str]) -> np.ndarray:
         """Sorted nodes (vertices) on the closure of the named boundary parts."""

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh.curves import Line
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from ..mesh.mesh import Mesh
 from ..mesh.validation import MeshError
 from .fields import ProblemError
@@ -37,7 +37,7 @@ def straight_normal(mesh: Mesh, name: str) -> np.ndarray | None:
     normals agree within :data:`STRAIGHT_RTOL` and it carries no curve other than a
     :class:`~signorini.mesh.curves.Line`), else ``None``."""
     ab = mesh.oriented_boundary(mesh.part_facets(name))
-    _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+    _, n = facet_normals(mesh.points[ab])
     mean = n.mean(axis=0)
     mean /= np.linalg.norm(mean)
     curve = mesh.curves[mesh.part_index(name)]

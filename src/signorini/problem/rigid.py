@@ -15,7 +15,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from ..mesh.mesh import Mesh
 from .fields import ProblemError
 
@@ -130,7 +130,7 @@ def free_rigid_motions(
     normals, mids = [], []
     for name in contact_parts:  # a loop over parts
         ab = mesh.oriented_boundary(mesh.part_facets(name))
-        _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+        _, n = facet_normals(mesh.points[ab])
         normals.append(n)
         mids.append(0.5 * (mesh.points[ab[:, 0]] + mesh.points[ab[:, 1]]))
     if normals:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..fem.space import P2Space
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from ..mesh.mesh import Mesh
 from .fields import ProblemError, evaluate_field
 from .normals import node_normals, straight_normal
@@ -50,7 +50,7 @@ def roller_normals(mesh: Mesh, name: str) -> tuple[np.ndarray, np.ndarray]:
     points = np.concatenate(
         [mesh.points[ab], mesh.curved_midpoints[edges][:, None, :]], axis=1
     )  # (e, 3, 2)
-    _, chord = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+    _, chord = facet_normals(mesh.points[ab])
     normals = node_normals(
         mesh, name, nodes, points, chord, straight=straight_normal(mesh, name), what="roller part"
     )
@@ -71,7 +71,7 @@ def check_roller_part(mesh: Mesh, name: str) -> None:
     if straight_normal(mesh, name) is not None or (curve is not None and curve.has_normal):
         return
     ab = mesh.oriented_boundary(mesh.part_facets(name))
-    _, chord = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+    _, chord = facet_normals(mesh.points[ab])
     total = np.zeros((mesh.n_points, 2))
     count = np.zeros(mesh.n_points)
     np.add.at(total, ab.ravel(), np.repeat(chord, 2, axis=0))
