@@ -22,7 +22,7 @@ from scipy.optimize import lsq_linear
 
 from signorini.algebra import FrictionResult
 from signorini.contact.solution import INACTIVE, SLIP, STICK, solve
-from signorini.estimator.friction import friction_facets
+from signorini.estimator.friction_facets import friction_facets
 from signorini.fem.material import Material
 from signorini.fem.space import P2Space
 from signorini.fem.stiffness import assemble_stiffness

@@ -20,7 +20,7 @@ from signorini.mesh.bodies import union
 from signorini.mesh.builders import rectangle
 from signorini.mesh.mesh import Mesh
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
-from signorini.problem.friction import Coulomb
+from signorini.problem.friction_laws import Coulomb
 
 X0, X1 = 0.2, 0.8  # the block's width; the support is [0, 1] x [0, 1]
 MATERIALS = {"a": Material.from_young(1.0, 0.3), "b": Material.from_young(4.0, 0.25)}

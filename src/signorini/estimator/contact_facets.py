@@ -11,7 +11,7 @@ import numpy as np
 from ..contact.contact_set import SEMI_CONTACT
 from ..contact.solution import ContactResult
 from ..fem.mapping import facet_groups
-from .friction import FrictionFacets, move_dirichlet_thirds
+from .friction_facets import FrictionFacets, move_dirichlet_thirds
 from .terms import FacetSet, complementarity, friction_work, normal_stress, tangential_stress
 from .traction import CellStress, direction_field
 

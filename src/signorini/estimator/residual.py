@@ -61,7 +61,7 @@ from ..fem.space import LagrangeSpace
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_facets import contact_node_parts, contact_stress, facet_pressure, semi_contact_density
-from .friction import friction_facets
+from .friction_facets import friction_facets
 from .held import further_traction_facets
 from .names import TERMS
 from .owned import OwnPart, own_part, per_cell_of
