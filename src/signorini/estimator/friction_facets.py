@@ -67,19 +67,19 @@ def friction_facets(result: ContactResult, unit: float = 1.0) -> FrictionFacets 
     )
 
 
-def move_dirichlet_thirds(parts: np.ndarray, edge_local: np.ndarray) -> np.ndarray:
-    """Per-node parts ``(n_ce, 3)`` with the part of a Dirichlet end point (``edge_local``
+def move_dirichlet_thirds(parts: np.ndarray, facet_local: np.ndarray) -> np.ndarray:
+    """Per-node parts ``(n_ce, 3)`` with the part of a Dirichlet end point (``facet_local``
     ``-1``) added to the facet's midpoint, so that Dirichlet nodes carry none and the parts
-    still sum to the facet's integral. With P1's ``edge_local (n_ce, 2)`` (no midpoint node)
+    still sum to the facet's integral. With P1's ``facet_local (n_ce, 2)`` (no midpoint node)
     it goes to the facet's other end."""
     out = parts.copy()
     for col in (0, 1):
-        at = edge_local[:, col] < 0
+        at = facet_local[:, col] < 0
         # P1 (two nodes a facet): to the facet's other end, unless that is a Dirichlet node too
         other = 1 - col
-        to = 2 if edge_local.shape[1] == 3 else other
+        to = 2 if facet_local.shape[1] == 3 else other
         if to == other:
-            at &= edge_local[:, other] >= 0
+            at &= facet_local[:, other] >= 0
         out[at, to] += out[at, col]
         out[at, col] = 0.0
     return out
