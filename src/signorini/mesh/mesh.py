@@ -1,4 +1,4 @@
-"""Conforming triangular meshes with labelled boundary edges.
+"""Conforming triangular meshes with labelled boundary facets (edges in 2D).
 
 Conventions (fixed for the whole package)
 -----------------------------------------
@@ -9,9 +9,11 @@ Conventions (fixed for the whole package)
   bisection and ``cells[:, 2]`` the newest vertex. :meth:`Mesh.from_arrays` puts the longest
   edge first; refinement keeps the convention.
 - ``edges (n_edges, 2)`` store each undirected edge once, as ``(min, max)`` vertex pair.
-  ``cell2edge (n_cells, 3)`` gives the edge of local edge ``k``; ``edge2cell (n_edges, 2)`` the
-  two cells of an edge, ``-1`` outside the domain (boundary edges have their cell in column 0).
-- The boundary is split into named *parts* (``part_names``); every boundary edge carries the
+  ``cell2edge (n_cells, 3)`` gives the edge of local edge ``k``. The *facets* (where parts,
+  tractions, jumps and contact live; a triangle's facets are its edges, the same arrays in
+  2D): ``facet2cell (n_facets, 2)`` the two cells of a facet, ``-1`` outside the domain
+  (boundary facets have their cell in column 0).
+- The boundary is split into named *parts* (``part_names``); every boundary facet carries the
   index of its part in ``boundary_part``. What a part means (Dirichlet, Neumann, contact) is the
   business of :mod:`signorini.problem`, not of the mesh. Parts survive refinement.
 - Cells carry a *region* (``region_names``, ``cell_region``: e.g. one per material,
@@ -39,7 +41,7 @@ from .parts import check_parts, part_indices
 from .reference import TRIANGLE, ReferenceCell
 from .regions import RegionSpec, checked_regions, region_labels
 from .topology import (
-    boundary_edges,
+    boundary_facets,
     entity_topology,
     facet_local,
     longest_edge_first,
@@ -54,7 +56,7 @@ from .validation import (
     validate_mesh,
 )
 
-__all__ = ["Mesh", "MeshError", "boundary_edges"]
+__all__ = ["Mesh", "MeshError", "boundary_facets"]
 
 logger = logging.getLogger(__name__)
 
@@ -206,7 +208,7 @@ class Mesh:
                 cells.shape[0],
             )
         cells = longest_edge_first(points, cells)
-        bnd = boundary_edges(cells)
+        bnd = boundary_facets(cells)
         part_of = part_indices(points, bnd, parts, names)
         region, region_names = region_labels(regions, points[cells].mean(axis=1))
         mesh = cls(
@@ -368,13 +370,6 @@ class Mesh:
         local = self.reference.facets[self.facet_local[facet_index, 0]]
         return self.cells[cell[:, None], local]
 
-    # the 2D names of the facet arrays (a triangle's facets are its edges)
-    edge2cell = facet2cell
-    edge_local = property(lambda self: self.facet_local, doc="The 2D name of facet_local.")
-    boundary_edge = property(lambda self: self.boundary_facet, doc="The 2D name.")
-    edge_part = property(lambda self: self.facet_part, doc="The 2D name of facet_part.")
-    part_edges = part_facets
-
     # ------------------------------------------------------------------ geometry
     @cached_property
     def area(self) -> np.ndarray:
@@ -410,7 +405,7 @@ class Mesh:
         if all(c is None for c in self.curves):
             return self.edge_midpoints
         mid = self.edge_midpoints.copy()
-        part = self.edge_part
+        part = self.facet_part  # 2D: an edge is a facet (3D: an edge's part from its faces)
         for index, curve in enumerate(self.curves):  # a loop over parts, not edges
             if curve is None:
                 continue
@@ -434,8 +429,6 @@ class Mesh:
     def part_measure(self, name: str) -> float:
         """Total measure of boundary part ``name`` (its length in 2D)."""
         return float(self.facet_measure[self.part_facets(name)].sum())
-
-    part_length = part_measure
 
     def __repr__(self) -> str:
         parts = list(self.part_names)
