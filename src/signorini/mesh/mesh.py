@@ -133,7 +133,6 @@ class Mesh(MeshGeometry):
         if validate:  # argument kinds first: a clear error instead of NumPy's
             points = as_points(points)
             cells = as_cells(cells, len(points), width=points.shape[1] + 1)
-            reference_of(points, cells)
         self.points = np.ascontiguousarray(points, dtype=np.float64)
         self.cells = np.ascontiguousarray(cells, dtype=np.int64)
         boundary = np.asarray(boundary, dtype=np.int64)
