@@ -75,7 +75,9 @@ def closure(mesh: Mesh, marked_edges: np.ndarray) -> np.ndarray:
         newly = ref[candidates[hit]]
         marked[newly] = True
         # only neighbours of newly marked edges can change next round
-        nb = mesh.edge2cell[newly].ravel()  # edge sense: the cells around a marked edge
+        # edge sense: the cells around a marked edge. In 2D an edge's cells are its facet's
+        # cells (facet2cell); in 3D this needs an edge -> cells map
+        nb = mesh.facet2cell[newly].ravel()
         candidates = np.unique(nb[nb >= 0])
 
 
