@@ -1,8 +1,14 @@
-"""Conforming triangular meshes with labelled boundary edges.
+"""Conforming simplicial meshes (triangles, tetrahedra) with labelled boundary facets.
 
 Conventions (fixed for the whole package)
 -----------------------------------------
-- ``points (n_points, 2)`` float64, ``cells (n_cells, 3)`` int64, counter-clockwise.
+- ``points (n_points, 2)`` float64, ``cells (n_cells, 3)`` int64, counter-clockwise; or, in
+  3D, ``points (n_points, 3)``, ``cells (n_cells, 4)`` with ``det[x1 − x0, x2 − x0, x3 − x0]
+  > 0``, so that local face ``k`` (opposite vertex ``k``) of ``TETRAHEDRON`` is outward
+  (:mod:`signorini.mesh.tetrahedra`). The cells' width sets :attr:`Mesh.reference` and
+  :attr:`Mesh.dim`. In 3D the facets are the faces (``boundary (n_b, 3)``) and the edges
+  (six per cell) carry the P2 nodes; the cells keep their vertex order
+  (:func:`~signorini.mesh.tetrahedra.initial_vertex_order`).
 - Local edge ``k`` of a cell joins its local vertices ``TRIANGLE.edges[k]``, ``k`` and ``k + 1``
   mod 3 (:mod:`signorini.mesh.reference`, the one owner of local topology).
 - Local edge 0 (``cells[:, 0]``–``cells[:, 1]``) is the *refinement edge* of newest vertex
@@ -34,12 +40,15 @@ from functools import cached_property
 import numpy as np
 
 from .curves import Curve
-from .geometry import min_angle, signed_area
+from .mesh_geometry import MeshGeometry
 from .parts import check_parts, part_indices
-from .reference import TRIANGLE, ReferenceCell
+from .reference import ReferenceCell
 from .regions import RegionSpec, checked_regions, region_labels
+from .surfaces import Surface
+from .tetrahedra import REFERENCES, initial_vertex_order, reference_of, reoriented
 from .topology import (
     boundary_edges,
+    boundary_facets,
     entity_topology,
     facet_local,
     longest_edge_first,
@@ -53,6 +62,7 @@ from .validation import (
     nondegenerate_area,
     validate_mesh,
 )
+from .validation3d import check_on_surface, nondegenerate_volume
 
 __all__ = ["Mesh", "MeshError", "boundary_edges"]
 
@@ -62,7 +72,7 @@ _NO_CELLS = np.zeros(0, dtype=np.int64)
 _NO_CELLS.flags.writeable = False
 
 
-class Mesh:
+class Mesh(MeshGeometry):
     """An immutable conforming triangulation with named boundary parts.
 
     Parameters
@@ -122,12 +132,14 @@ class Mesh:
     ) -> None:
         if validate:  # argument kinds first: a clear error instead of NumPy's
             points = as_points(points)
-            cells = as_cells(cells, len(points))
+            cells = as_cells(cells, len(points), width=points.shape[1] + 1)
+            reference_of(points, cells)
         self.points = np.ascontiguousarray(points, dtype=np.float64)
         self.cells = np.ascontiguousarray(cells, dtype=np.int64)
         boundary = np.asarray(boundary, dtype=np.int64)
-        if boundary.ndim == 1 and boundary.size % 2 == 0:  # flat list of pairs, or empty
-            boundary = boundary.reshape(-1, 2)
+        width = self.cells.shape[1] - 1  # a facet's vertices
+        if boundary.ndim == 1 and boundary.size % width == 0:  # flat list of facets, or empty
+            boundary = boundary.reshape(-1, width)
         self.boundary = np.ascontiguousarray(boundary)
         self.boundary_part = np.ascontiguousarray(boundary_part, dtype=np.int64).reshape(-1)
         self.part_names = tuple(str(p) for p in part_names)
@@ -135,11 +147,11 @@ class Mesh:
             curves = (None,) * len(self.part_names)
         self.curves = tuple(curves)
         if len(self.curves) != len(self.part_names) or not all(
-            c is None or isinstance(c, Curve) for c in self.curves
+            c is None or isinstance(c, (Curve, Surface)) for c in self.curves
         ):
             raise MeshError(
-                f"curves needs one Curve or None per part ({len(self.part_names)}), got "
-                f"{self.curves!r}"
+                f"curves needs one Curve or None per part ({len(self.part_names)}) (in 3D a "
+                f"Surface), got {self.curves!r}"
             )
         self.cell_region, self.region_names = checked_regions(
             cell_region, region_names, self.cells.shape[0]
@@ -159,22 +171,25 @@ class Mesh:
         *,
         regions: RegionSpec | None = None,
     ) -> Mesh:
-        """Build a mesh from user arrays, putting each cell's longest edge first.
+        """Build a mesh from user arrays, putting each triangle's longest edge first.
 
         Cells may come in either orientation (other tools mix them): clockwise cells are
-        listed counter-clockwise; their indices are kept in :attr:`reoriented` and their
-        number is logged (``logging.INFO``). Only degenerate cells are refused.
+        listed counter-clockwise (negative tetrahedra positively); their indices are kept in
+        :attr:`reoriented` and their number is logged (``logging.INFO``). Only degenerate
+        cells are refused. Tetrahedra keep their vertex order
+        (:func:`~signorini.mesh.tetrahedra.initial_vertex_order`).
 
         Parameters
         ----------
-        points : (n_points, 2) float array
-        cells : (n_cells, 3) int array
-            Triangles, in either orientation.
+        points : (n_points, d) float array
+            d = 2, or d = 3 for tetrahedra.
+        cells : (n_cells, d + 1) int array
+            Triangles or tetrahedra, in either orientation.
         parts : mapping from part name (str) to either
-            - a ``(k, 2)`` int array of boundary vertex pairs, or
-            - a selector ``f(x) -> (n,) bool array``, called with the boundary edge
-              midpoints ``x`` of shape ``(n, 2)`` (``x[:, 0]`` and ``x[:, 1]`` are the
-              coordinates). A selector written ``f(x, y)`` still works, with a
+            - a ``(k, d)`` int array of boundary facets' vertices (pairs, or face triples),
+            - or a selector ``f(x) -> (n,) bool array``, called with the boundary facet
+              centroids ``x`` of shape ``(n, d)`` (edge midpoints in 2D; ``x[:, 0]`` …
+              are the coordinates). A 2D selector written ``f(x, y)`` still works, with a
               ``DeprecationWarning``.
 
             Selectors claim only the edges no list names; a boundary edge claimed by two
@@ -182,7 +197,7 @@ class Mesh:
         regions : array or mapping, optional
             The cells' regions (e.g. one per material): an ``(n_cells,)`` array of int or str
             labels, or a mapping region name -> selector ``f(x) -> (n,) bool`` of the cell
-            centroids ``x (n, 2)`` claiming every cell once
+            centroids ``x (n, d)`` claiming every cell once
             (:func:`~signorini.mesh.regions.region_labels`). By default one region, ``"body"``.
 
         Raises
@@ -194,19 +209,24 @@ class Mesh:
         """
         names = check_parts(parts)
         points = as_points(points)
-        cells = as_cells(cells, len(points))
-        area = nondegenerate_area(points, cells)
-        flipped = np.flatnonzero(area < 0)
+        cells = as_cells(cells, len(points), width=points.shape[1] + 1)
+        reference = reference_of(points, cells)
+        if reference.dim == 2:
+            measure = nondegenerate_area(points, cells)
+        else:
+            measure = nondegenerate_volume(points, cells)
+        cells, flipped = reoriented(cells, measure)
         if flipped.size:
-            cells = cells.copy()
-            cells[flipped] = cells[flipped][:, [0, 2, 1]]
             logger.info(
                 "Mesh.from_arrays: %d of %d cells were clockwise and were reoriented",
                 flipped.size,
                 cells.shape[0],
             )
-        cells = longest_edge_first(points, cells)
-        bnd = boundary_edges(cells)
+        if reference.dim == 2:
+            cells = longest_edge_first(points, cells)
+        else:
+            cells = initial_vertex_order(points, cells)
+        bnd = boundary_facets(cells, reference.facets)
         part_of = part_indices(points, bnd, parts, names)
         region, region_names = region_labels(regions, points[cells].mean(axis=1))
         mesh = cls(
@@ -216,8 +236,8 @@ class Mesh:
             mesh.reoriented = _frozen(flipped)
         return mesh
 
-    def with_curve(self, part: str, curve: Curve, *, rtol: float = 1e-8) -> Mesh:
-        """A new mesh whose boundary part ``part`` carries ``curve``.
+    def with_curve(self, part: str, curve: Curve | Surface, *, rtol: float = 1e-8) -> Mesh:
+        """A new mesh whose boundary part ``part`` carries ``curve`` (in 3D a surface).
 
         Refinement then puts the new vertex of a bisected edge of the part at the curve's
         halfway point (:meth:`Curve.halfway`) instead of the chord midpoint, and the P2
@@ -231,7 +251,9 @@ class Mesh:
             A boundary part of the mesh.
         curve : Curve
             E.g. :class:`~signorini.mesh.curves.Circle` or
-            :class:`~signorini.mesh.curves.Line`; replaces any curve the part had.
+            :class:`~signorini.mesh.curves.Line`; replaces any curve the part had. In 3D a
+            :class:`~signorini.mesh.surfaces.Surface` (``Sphere``, ``Cylinder``), moving the
+            midpoints of the edges of the part's faces.
         rtol : float
             Every vertex of the part must lie within ``rtol`` times the mesh's diameter
             (the diagonal of its bounding box) of the curve.
@@ -243,13 +265,15 @@ class Mesh:
             part is off the curve (naming the vertex and its distance).
         """
         index = self.part_index(part)
-        if not isinstance(curve, Curve):
+        kind = "Curve (Line, Circle, ProjectedCurve)" if self.dim == 2 else "Surface (Sphere, …)"
+        if not isinstance(curve, Curve if self.dim == 2 else Surface):
             raise MeshError(
-                f"with_curve: the curve of part {part!r} must be a Curve (Line, Circle, "
-                f"ProjectedCurve), got {type(curve).__name__}"
+                f"with_curve: the curve of part {part!r} must be a {kind}, got "
+                f"{type(curve).__name__}"
             )
         vertices = np.unique(self.boundary[self.boundary_part == index])
-        check_on_curve(self.points, vertices, curve, part, rtol)
+        check = check_on_curve if self.dim == 2 else check_on_surface
+        check(self.points, vertices, curve, part, rtol)
         curves = list(self.curves)
         curves[index] = curve
         mesh = Mesh(
@@ -269,13 +293,13 @@ class Mesh:
     # ------------------------------------------------------------------ sizes
     @property
     def reference(self) -> ReferenceCell:
-        """The reference cell of the cells, :data:`~signorini.mesh.reference.TRIANGLE`: the
-        one owner of their local topology (edges, facets, VTK names)."""
-        return TRIANGLE
+        """The reference cell of the cells, ``TRIANGLE`` for ``cells (n, 3)``, ``TETRAHEDRON``
+        for ``(n, 4)``: the one owner of their local topology (edges, facets, VTK names)."""
+        return REFERENCES[self.cells.shape[1]]
 
     @property
     def dim(self) -> int:
-        """The dimension of the cells and the points, ``(n_points, dim)``: 2 (a triangle's)."""
+        """The dimension of the cells and the points, ``(n_points, dim)``: 2 or 3."""
         return self.reference.dim
 
     @property
@@ -297,18 +321,25 @@ class Mesh:
     # ------------------------------------------------------------------ topology
     @cached_property
     def _topology(self) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-        return entity_topology(self.cells, self.n_points, self.reference.edges)
+        """The facets: in 2D the edges (one ``np.unique``), in 3D the faces."""
+        return entity_topology(self.cells, self.n_points, self.reference.facets)
+
+    @cached_property
+    def _edge_topology(self) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        if self.dim == 2:
+            return self._topology
+        return entity_topology(self.cells, self.n_points, self.reference.edges, facets=False)
 
     @property
     def edges(self) -> np.ndarray:
         """``(n_edges, 2)`` vertex pairs, ``min`` first: the carriers of the P2 edge nodes."""
-        return self._topology[0]
+        return self._edge_topology[0]
 
     @property
     def cell2edge(self) -> np.ndarray:
         """``(n_cells, n_edges of the cell)`` edge index of local edge ``k``
         (``reference.edges[k]``)."""
-        return self._topology[1]
+        return self._edge_topology[1]
 
     @property
     def facets(self) -> np.ndarray:
@@ -375,54 +406,7 @@ class Mesh:
     edge_part = property(lambda self: self.facet_part, doc="The 2D name of facet_part.")
     part_edges = part_facets
 
-    # ------------------------------------------------------------------ geometry
-    @cached_property
-    def area(self) -> np.ndarray:
-        """``(n_cells,)`` signed areas (positive for counter-clockwise cells)."""
-        return _frozen(signed_area(self.points, self.cells))
-
-    @cached_property
-    def edge_length(self) -> np.ndarray:
-        """``(n_edges,)`` lengths."""
-        d = self.points[self.edges[:, 1]] - self.points[self.edges[:, 0]]
-        return _frozen(np.hypot(d[:, 0], d[:, 1]))
-
-    @property
-    def facet_measure(self) -> np.ndarray:
-        """``(n_facets,)`` the facets' measures |F|: :attr:`edge_length` in 2D."""
-        return self.edge_length
-
-    @cached_property
-    def h(self) -> np.ndarray:
-        """``(n_cells,)`` diameters ``h_T`` (longest edge)."""
-        return _frozen(self.edge_length[self.cell2edge].max(axis=1))
-
-    @cached_property
-    def edge_midpoints(self) -> np.ndarray:
-        """``(n_edges, 2)`` midpoints."""
-        return _frozen(0.5 * (self.points[self.edges[:, 0]] + self.points[self.edges[:, 1]]))
-
-    @cached_property
-    def curved_midpoints(self) -> np.ndarray:
-        """``(n_edges, 2)`` edge midpoints, on the curve for edges of a part that carries one
-        (:meth:`Curve.halfway` of the edge's ends): where refinement puts new vertices and the
-        P2 space its edge nodes; :attr:`edge_midpoints` when no part carries a curve."""
-        if all(c is None for c in self.curves):
-            return self.edge_midpoints
-        mid = self.edge_midpoints.copy()
-        part = self.edge_part
-        for index, curve in enumerate(self.curves):  # a loop over parts, not edges
-            if curve is None:
-                continue
-            e = np.flatnonzero(part == index)
-            ends = self.edges[e]
-            mid[e] = curve.halfway(self.points[ends[:, 0]], self.points[ends[:, 1]])
-        return _frozen(mid)
-
-    def min_angle(self) -> float:
-        """Smallest interior angle (radians) over all cells."""
-        return min_angle(self.points, self.cells)
-
+    # ------------------------------------------------------------------ geometry (MeshGeometry)
     def region_cells(self, name: str) -> np.ndarray:
         """Indices of the cells of region ``name``."""
         if name not in self.region_names:

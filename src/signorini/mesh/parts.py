@@ -1,7 +1,7 @@
 """Boundary parts named by the user (:meth:`Mesh.from_arrays <signorini.mesh.Mesh.from_arrays>`):
-each part given as a list of boundary vertex pairs or as a selector ``f(x)`` of the edge
-midpoints ``x (n, 2)``, checked before any work and resolved to one part index per boundary
-edge.
+each part given as a list of boundary vertex pairs (face triples in 3D) or as a selector
+``f(x)`` of the edge midpoints ``x (n, 2)`` (face centroids ``(n, 3)``), checked before any
+work and resolved to one part index per boundary facet.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from .topology import edge_keys
+from .topology import entity_keys
 from .validation import MeshError, as_cells
 
 __all__ = ["check_parts", "part_indices"]
@@ -62,10 +62,10 @@ def _takes_x_and_y(f: Callable) -> bool:
 
 
 def _select(name: str, f: Callable, mid: np.ndarray) -> np.ndarray:
-    """The selector of part ``name`` at the edge midpoints ``mid (n, 2)``: a ``(n,)`` bool
-    array, or a :class:`MeshError` naming the part."""
+    """The selector of part ``name`` at the edge midpoints ``mid (n, 2)`` (face centroids
+    ``(n, 3)``): a ``(n,)`` bool array, or a :class:`MeshError` naming the part."""
     try:
-        if _takes_x_and_y(f):
+        if mid.shape[1] == 2 and _takes_x_and_y(f):
             warnings.warn(
                 f"the selector of boundary part {name!r} takes (x, y); selectors take the "
                 "points x of shape (n, 2): write `lambda x: ...` with x[:, 0] and x[:, 1] "
@@ -95,9 +95,9 @@ def part_indices(
     parts: Mapping[str, np.ndarray | Callable[[np.ndarray], np.ndarray]],
     names: list[str],
 ) -> np.ndarray:
-    """``(n_boundary,)`` the index into ``names`` of the part that claims each boundary edge
-    ``bnd (n_boundary, 2)`` (``-1`` for none): the edges a part lists, then the edges its
-    selector picks among those no list names (see :meth:`Mesh.from_arrays
+    """``(n_boundary,)`` the index into ``names`` of the part that claims each boundary facet
+    ``bnd (n_boundary, d)`` (edges, or faces in 3D; ``-1`` for none): the facets a part
+    lists, then the facets its selector picks among those no list names (see :meth:`Mesh.from_arrays
     <signorini.mesh.Mesh.from_arrays>`).
 
     Raises
@@ -106,7 +106,9 @@ def part_indices(
         If a listed pair is not a boundary edge, or two parts claim one edge.
     """
     part_of = np.full(len(bnd), -1, dtype=np.int64)
-    keys = edge_keys(bnd, len(points))
+    width = bnd.shape[1]
+    what = "edge" if width == 2 else "face"
+    keys = entity_keys(bnd, len(points))
     order = np.argsort(keys)
     listed = None  # edges named by an explicit list; predicates only claim the others
     for index in sorted(range(len(names)), key=lambda i: callable(parts[names[i]])):
@@ -115,7 +117,10 @@ def part_indices(
         if callable(spec):
             if listed is None:
                 listed = part_of >= 0
-            mid = 0.5 * (points[bnd[:, 0]] + points[bnd[:, 1]])
+            if width == 2:
+                mid = 0.5 * (points[bnd[:, 0]] + points[bnd[:, 1]])
+            else:
+                mid = points[bnd].mean(axis=1)  # the face centroids
             hit = _select(name, spec, mid)
             where = np.flatnonzero(hit & ~listed)
         else:
@@ -123,18 +128,18 @@ def part_indices(
             if pairs.size == 0:
                 where = np.zeros(0, dtype=np.int64)
             else:
-                if pairs.ndim == 1 and pairs.size % 2 == 0:
-                    pairs = pairs.reshape(-1, 2)
-                pairs = as_cells(pairs, len(points), what="boundary edges")
-                k = edge_keys(pairs, len(points))
+                if pairs.ndim == 1 and pairs.size % width == 0:
+                    pairs = pairs.reshape(-1, width)
+                pairs = as_cells(pairs, len(points), what=f"boundary {what}s", width=width)
+                k = entity_keys(pairs, len(points))
                 pos = np.searchsorted(keys, k, sorter=order)
                 pos = np.minimum(pos, len(keys) - 1)
                 found = keys[order[pos]] == k
                 if not found.all():
                     bad = pairs[~found][0]
                     raise MeshError(
-                        f"boundary part {name!r}: ({bad[0]}, {bad[1]}) is not a "
-                        "boundary edge of the mesh"
+                        f"boundary part {name!r}: {tuple(int(v) for v in bad)} is not a "
+                        f"boundary {what} of the mesh"
                     )
                 where = order[pos]
         taken = where[part_of[where] >= 0]
@@ -142,7 +147,7 @@ def part_indices(
             other = names[part_of[taken[0]]]
             bad = bnd[taken[0]]
             raise MeshError(
-                f"boundary edge ({bad[0]}, {bad[1]}) is claimed by both parts "
+                f"boundary {what} {tuple(int(v) for v in bad)} is claimed by both parts "
                 f"{other!r} and {name!r}"
             )
         part_of[where] = index

@@ -77,21 +77,21 @@ def _as_number_array(value: object, what: str, expected: str, kinds: str) -> np.
 
 
 def as_points(points: np.ndarray) -> np.ndarray:
-    """``points`` as a finite ``(n_points, 2)`` float64 array, or a :class:`MeshError`."""
+    """``points`` as a finite ``(n_points, d)`` float64 array, d = 2 or 3, or a MeshError."""
     p = _as_number_array(points, "points", "an (n_points, 2) array of numbers", "iuf")
     p = p.astype(np.float64, copy=False)
-    if p.ndim != 2 or p.shape[1] != 2:
-        raise MeshError(f"points must have shape (n_points, 2), got {p.shape}")
+    if p.ndim != 2 or p.shape[1] not in (2, 3):
+        raise MeshError(f"points must have shape (n_points, 2), got {p.shape} (3D: (n_points, 3))")
     if not np.isfinite(p).all():
         bad = np.flatnonzero(~np.isfinite(p).all(1))
         raise MeshError(f"point(s) {format_indices(bad)} have non-finite coordinates")
     return p
 
 
-def as_cells(cells: np.ndarray, n_points: int, what: str = "cells") -> np.ndarray:
-    """Integer point indices ``(n, 3)`` (``(n, 2)`` for boundary edges) in ``0..n_points - 1``
-    as int64, or a :class:`MeshError`."""
-    width = 3 if what == "cells" else 2
+def as_cells(cells: np.ndarray, n_points: int, what: str = "cells", width: int = 0) -> np.ndarray:
+    """Integer point indices ``(n, width)`` (by default ``(n, 3)``, ``(n, 2)`` for boundary
+    edges) in ``0..n_points - 1`` as int64, or a :class:`MeshError`."""
+    width = width or (3 if what == "cells" else 2)
     c = _as_number_array(cells, what, f"an (n, {width}) array of point indices", "iuf")
     if c.ndim != 2 or c.shape[1] != width:
         raise MeshError(f"{what} must have shape (n, {width}), got {c.shape}")
@@ -401,17 +401,18 @@ def _check_no_overlap(mesh: Mesh, is_bnd: np.ndarray) -> None:
 
 
 def validate_mesh(mesh: Mesh) -> None:
-    """Check that ``mesh`` is a valid conforming triangulation with labelled boundary.
-
-    Parameters
-    ----------
-    mesh : Mesh
+    """Check that ``mesh`` is a valid conforming triangulation with labelled boundary (in 3D
+    the tetrahedral checks, :func:`~signorini.mesh.validation3d.validate_tetrahedra`).
 
     Raises
     ------
     MeshError
         At the first violation, naming the offending cells, edges or points.
     """
+    if mesh.dim == 3:
+        from .validation3d import validate_tetrahedra  # it builds on this module
+
+        return validate_tetrahedra(mesh)
     points = as_points(mesh.points)
     cells = as_cells(mesh.cells, len(points))
     as_cells(mesh.boundary, len(points), what="boundary edges")
