@@ -1,0 +1,125 @@
+"""The REFINE step on tetrahedral meshes: tagged-simplex bisection
+(:mod:`signorini.mesh.bisect3d`) behind :func:`signorini.mesh.refine.refine_nvb` and
+:func:`~signorini.mesh.refine.refine_uniform`, which dispatch here on ``mesh.dim == 3``
+(docs/method.md, *Three dimensions: bisection*).
+
+The refined mesh carries its cells' tags (:func:`~signorini.mesh.tags3d.tags_of`), so the
+next refinement continues the bisection sequence; boundary faces are read from the face
+tags, parts and regions go to the children, and new vertices of edges of a part that carries
+a :class:`~signorini.mesh.surfaces.Surface` are placed by its ``halfway``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .bisect3d import bisect_tagged, boundary_of, edge_key
+from .mesh import Mesh
+from .surfaces import Surface
+from .tags3d import ATTRIBUTE, Tags, mesh_cells, tags_of, with_face_parts
+from .validation import MeshError
+
+__all__ = ["UNIFORM_BISECTIONS", "bisect_mesh", "tagged"]
+
+#: Bisections of every cell per level of uniform refinement in 3D: ``h`` halves and the
+#: number of cells grows eightfold (the children of a Kuhn cell after three bisections are
+#: Kuhn cells of half the size).
+UNIFORM_BISECTIONS = 3
+
+
+def bisect_mesh(
+    mesh: Mesh, marked: np.ndarray, bisections: int = 1
+) -> tuple[Mesh, np.ndarray, np.ndarray]:
+    """Bisect the marked cells of a tetrahedral mesh ``bisections`` times each (the children
+    of a marked cell are marked for the next bisection), with closure.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        ``dim == 3``.
+    marked : (n_cells,) bool array
+    bisections : int
+        1 for ``refine_nvb``, :data:`UNIFORM_BISECTIONS` for a uniform level.
+
+    Returns
+    -------
+    mesh : Mesh
+        The refined mesh (old points keep their indices; new points follow), tagged.
+    parent : (n_cells_new,) int64 array
+        The old cell that contains each new cell.
+    edge_point : (n_edges_old,) int64 array
+        The new vertex at the midpoint of each bisected old edge, ``-1`` elsewhere.
+
+    Raises
+    ------
+    MeshError
+        If a new vertex placed on a surface turns a cell inside out or flat.
+    """
+    old = edge_key(mesh.edges[:, 0], mesh.edges[:, 1])
+    edge_point = np.full(old.size, -1, dtype=np.int64)
+    parent = np.arange(mesh.n_cells, dtype=np.int64)
+    marked = np.asarray(marked, dtype=bool)
+    for _ in range(bisections):  # a loop over bisections, not cells
+        mesh, step, split_key, split_point = _bisect_once(mesh, marked[parent])
+        parent = parent[step]
+        if split_key.size:
+            pos = np.minimum(np.searchsorted(split_key, old), split_key.size - 1)
+            hit = (split_key[pos] == old) & (edge_point < 0)
+            edge_point[hit] = split_point[pos[hit]]
+    return mesh, parent, edge_point
+
+
+def _bisect_once(mesh: Mesh, marked: np.ndarray) -> tuple[Mesh, np.ndarray, np.ndarray, np.ndarray]:
+    """One :func:`~signorini.mesh.bisect3d.bisect_tagged` of a Mesh: the tagged child mesh,
+    the parent map and the bisected edges' keys and new vertices."""
+    tags = tags_of(mesh)
+    curved = np.array([isinstance(c, Surface) for c in mesh.curves], dtype=bool)
+
+    def halfway(part: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return mesh.curves[part].halfway(a, b)
+
+    result = bisect_tagged(
+        mesh.points, tags, marked, curved=curved if curved.any() else None, halfway=halfway
+    )
+    cells = mesh_cells(result.tags)
+    if curved.any():
+        _check_volumes(result.points, cells, mesh.n_points)
+    boundary, part = boundary_of(cells, result.tags)
+    refined = Mesh(
+        result.points,
+        cells,
+        boundary,
+        part,
+        mesh.part_names,
+        validate=False,
+        curves=mesh.curves,
+        cell_region=mesh.cell_region[result.parent],  # a child takes its parent's region
+        region_names=mesh.region_names,
+    )
+    setattr(refined, ATTRIBUTE, result.tags)
+    return refined, result.parent, result.split_key, result.split_point
+
+
+def _check_volumes(points: np.ndarray, cells: np.ndarray, n_old: int) -> None:
+    """Raise if a cell with a new vertex (index ``>= n_old``) is not positively oriented."""
+    touched = np.flatnonzero((cells >= n_old).any(axis=1))
+    p = points[cells[touched]]
+    det = np.linalg.det(p[:, 1:] - p[:, :1])
+    if np.any(det <= 0):
+        bad = cells[touched[np.flatnonzero(det <= 0)[0]]]
+        raise MeshError(
+            f"refinement: placing new vertices on a surface turns cell {bad.tolist()} inside "
+            "out or flat: the initial mesh is too coarse for the surface"
+        )
+
+
+def tagged(mesh: Mesh, order: np.ndarray, gamma: np.ndarray | None = None) -> Mesh:
+    """``mesh`` with the tag order ``order (n_cells, 4)`` (e.g. the Kuhn paths a builder
+    knows, :func:`~signorini.mesh.builders3d.kuhn_paths`) and types ``gamma`` (0 by default)
+    attached for bisection; returns ``mesh``."""
+    gamma = np.zeros(mesh.n_cells, np.int8) if gamma is None else gamma
+    tags: Tags = with_face_parts(mesh.points, order, gamma, mesh.boundary, mesh.boundary_part)
+    if not np.array_equal(np.sort(order, axis=1), np.sort(mesh.cells, axis=1)):
+        raise MeshError("tagged: the order must list each cell's own vertices")
+    setattr(mesh, ATTRIBUTE, tags)
+    return mesh
