@@ -187,3 +187,29 @@ def test_an_arbitrary_numbering_terminates_and_conforms():
     faces = np.sort(cells[:, TETRAHEDRON.facets].reshape(-1, 3), axis=1)
     u, count = np.unique(faces, axis=0, return_counts=True)
     np.testing.assert_array_equal(u[count == 1], np.unique(np.sort(bnd, axis=1), axis=0))
+
+
+def test_handed_topology_equals_the_global_one():
+    from functools import cached_property
+
+    from signorini.mesh.mesh import Mesh
+    from signorini.mesh.refine3d import EDGE_CACHE, FACET_CACHE
+    from signorini.mesh.topology import entity_topology
+
+    assert isinstance(Mesh.__dict__[EDGE_CACHE], cached_property)
+    assert isinstance(Mesh.__dict__[FACET_CACHE], cached_property)
+    rng = np.random.default_rng(11)
+    mesh = box(2, 2, 2)
+    for step in range(8):
+        ref = (
+            refine_uniform(mesh) if step == 2 else refine_nvb(mesh, rng.random(mesh.n_cells) < 0.1)
+        )
+        child = ref.mesh
+        assert EDGE_CACHE in child.__dict__ and FACET_CACHE in child.__dict__
+        edges = entity_topology(child.cells, child.n_points, TETRAHEDRON.edges, facets=False)
+        faces = entity_topology(child.cells, child.n_points, TETRAHEDRON.facets)
+        for handed, computed in zip(child.__dict__[EDGE_CACHE][:2], edges[:2], strict=True):
+            np.testing.assert_array_equal(handed, computed)
+        for handed, computed in zip(child.__dict__[FACET_CACHE], faces, strict=True):
+            np.testing.assert_array_equal(handed, computed)
+        mesh = child

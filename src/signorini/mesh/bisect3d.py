@@ -55,7 +55,7 @@ Halfway = Callable[[int, np.ndarray, np.ndarray], np.ndarray]
 
 def edge_key(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The key ``min * 2**31 + max`` of the undirected edges ``a–b`` (int64 arrays)."""
-    return np.minimum(a, b).astype(np.int64) * KEY_BASE + np.maximum(a, b)
+    return np.minimum(a, b) * KEY_BASE + np.maximum(a, b)
 
 
 @dataclass(frozen=True)
@@ -74,6 +74,8 @@ class Bisection:
         The key of each bisected edge (sorted, :func:`edge_key`) and its new vertex.
     rounds : int
         The number of closure rounds.
+    touched : (n_cells_new,) bool array
+        The cells that are not old cells kept in their row (the children).
     """
 
     points: np.ndarray
@@ -82,6 +84,7 @@ class Bisection:
     split_key: np.ndarray
     split_point: np.ndarray
     rounds: int
+    touched: np.ndarray
 
 
 def _cell_edge_keys(order: np.ndarray) -> np.ndarray:
@@ -166,6 +169,8 @@ def bisect_tagged(
     pieces = [np.asarray(points, dtype=np.float64)]
     n_points = pieces[0].shape[0]
     todo = np.flatnonzero(marked)
+    touched = np.zeros(order.shape[0], dtype=bool)
+    endpoint = np.zeros(n_points, dtype=bool)  # the vertices of bisected edges
     any_curved = curved is not None and bool(np.any(curved))
     rounds = 0
     while todo.size:
@@ -198,6 +203,9 @@ def bisect_tagged(
                 mid[mine] = halfway(int(part), everything[lo[mine]], everything[hi[mine]])
         pieces.append(mid)
         n_points += new_key.size
+        endpoint = np.concatenate([endpoint, np.zeros(new_key.size, dtype=bool)])
+        endpoint[lo] = True
+        endpoint[hi] = True
         merged = np.concatenate([split_key, new_key])
         by_key = np.argsort(merged, kind="stable")
         split_key = merged[by_key]
@@ -215,11 +223,21 @@ def bisect_tagged(
             one.face_part,
         )
         parent = np.concatenate([parent, parent[todo]])
-        _, hanging = _lookup(split_key, _cell_edge_keys(order))
-        todo = np.flatnonzero(hanging.any(axis=1))
+        touched = np.concatenate([touched, np.ones(todo.size, dtype=bool)])
+        touched[todo] = True
+        # a hanging vertex: a cell with a bisected edge (two of its vertices ends of one)
+        near = np.flatnonzero(endpoint[order].sum(axis=1) >= 2)
+        _, hanging = _lookup(split_key, _cell_edge_keys(order[near]))
+        todo = near[hanging.any(axis=1)]
     points_new = np.concatenate(pieces) if len(pieces) > 1 else pieces[0]
     return Bisection(
-        points_new, Tags(order, gamma, sign, face_part), parent, split_key, split_point, rounds
+        points_new,
+        Tags(order, gamma, sign, face_part),
+        parent,
+        split_key,
+        split_point,
+        rounds,
+        touched,
     )
 
 

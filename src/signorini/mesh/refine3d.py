@@ -17,6 +17,7 @@ from .bisect3d import bisect_tagged, boundary_of, edge_key
 from .mesh import Mesh
 from .surfaces import Surface
 from .tags3d import ATTRIBUTE, Tags, mesh_cells, tags_of, with_face_parts
+from .topology3d import refined_topology
 from .validation import MeshError
 
 __all__ = ["UNIFORM_BISECTIONS", "bisect_mesh", "tagged"]
@@ -25,6 +26,10 @@ __all__ = ["UNIFORM_BISECTIONS", "bisect_mesh", "tagged"]
 #: number of cells grows eightfold (the children of a Kuhn cell after three bisections are
 #: Kuhn cells of half the size).
 UNIFORM_BISECTIONS = 3
+
+#: The cached properties of :class:`Mesh` that hold its edge and facet topology; a refined
+#: mesh receives them from :func:`~signorini.mesh.topology3d.refined_topology`.
+EDGE_CACHE, FACET_CACHE = "_edge_topology", "_topology"
 
 
 def bisect_mesh(
@@ -97,6 +102,18 @@ def _bisect_once(mesh: Mesh, marked: np.ndarray) -> tuple[Mesh, np.ndarray, np.n
         region_names=mesh.region_names,
     )
     setattr(refined, ATTRIBUTE, result.tags)
+    if np.array_equal(mesh.cells, mesh_cells(tags)):  # kept rows keep their local order
+        known = refined_topology(
+            mesh.edges,
+            mesh.cell2edge,
+            mesh.facets,
+            mesh.cell2facet,
+            cells,
+            result.touched,
+            result.split_key,
+        )
+        if known is not None:  # hand the child its topology (Mesh's cached properties)
+            refined.__dict__[EDGE_CACHE], refined.__dict__[FACET_CACHE] = known
     return refined, result.parent, result.split_key, result.split_point
 
 

@@ -1,0 +1,148 @@
+"""Tagged-simplex bisection of tetrahedra: speed and shape regularity.
+
+    python benchmarks/bisect3d.py            # rates, then 30 levels towards a vertex, an
+                                             # edge and a face, and the curved sphere part
+    python benchmarks/bisect3d.py --quick    # smaller sizes
+
+Speed: uniform refinement of a Kuhn box (three bisections of every cell) and local
+refinement (the cells within a ball about a corner) up to about 10⁶ P2 unknowns
+(``3 (n_points + n_edges)``); each time includes the child mesh's topology (``edges``,
+``cell2edge``, ``facets``, ``facet2cell``, ``boundary_facet``). Shape: per level the cells,
+the smallest dihedral angle, and the number of similarity classes, up to similarity
+(translation, scaling, rotation, reflection) and up to translation and scaling only
+(:func:`~signorini.mesh.quality3d.similarity_classes`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from signorini.mesh.builders3d import box, eighth_ball, kuhn_paths
+from signorini.mesh.quality3d import min_dihedral_angle, similarity_classes
+from signorini.mesh.refine import refine_nvb, refine_uniform
+from signorini.mesh import refine3d
+from signorini.mesh.refine3d import tagged
+
+
+def p2_unknowns(mesh) -> int:
+    return 3 * (mesh.n_points + mesh.n_edges)
+
+
+def topology(mesh) -> None:
+    """Touch the child mesh's topology, as the next SOLVE reads it."""
+    mesh.edges, mesh.cell2edge, mesh.facets, mesh.facet2cell, mesh.boundary_facet  # noqa: B018
+
+
+def timed(step, mesh, *args, repeat: int = 3):
+    """The refined mesh and the best of ``repeat`` times of the step and of its topology
+    (the machine is shared)."""
+    best = (np.inf, np.inf)
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        ref = step(mesh, *args)
+        t1 = time.perf_counter()
+        topology(ref.mesh)
+        t2 = time.perf_counter()
+        best = min(best, (t1 - t0, t2 - t1), key=sum)
+    return ref.mesh, *best
+
+
+def rates(n: int, levels: int) -> None:
+    print("uniform: level  cells  P2 unknowns  bisect s  topology s  cells/s  unknowns/s")
+    mesh = box(n, n, n)
+    topology(mesh)
+    for level in range(levels):
+        mesh, tb, tt = timed(refine_uniform, mesh)
+        u = p2_unknowns(mesh)
+        print(
+            f"  {level:2d} {mesh.n_cells:9d} {u:11d} {tb:9.3f} {tt:10.3f} "
+            f"{mesh.n_cells / (tb + tt):9.3g} {u / (tb + tt):9.3g}"
+        )
+    print(
+        "local (the 10% of cells nearest a corner): level  cells  P2 unknowns  bisect s  "
+        "topology s  unknowns/s"
+    )
+    mesh = box(n, n, n)
+    topology(mesh)
+    level = 0
+    while p2_unknowns(mesh) < 1.1e6:
+        distance = np.linalg.norm(mesh.points[mesh.cells].mean(axis=1), axis=1)
+        marked = distance <= np.quantile(distance, 0.1)
+        mesh, tb, tt = timed(refine_nvb, mesh, marked)
+        u = p2_unknowns(mesh)
+        if level % 4 == 3:
+            print(
+                f"  {level:2d} {mesh.n_cells:9d} {u:11d} {tb:9.3f} {tt:10.3f} {u / (tb + tt):9.3g}"
+            )
+        level += 1
+    compare_topology(mesh, marked)
+
+
+def compare_topology(mesh, marked) -> None:
+    """The same step with the child's topology handed over and computed by a global
+    ``np.unique`` of all edges and faces."""
+    handed = refine3d.refined_topology
+    for name, known in (("handed", handed), ("global np.unique", lambda *a: None)):
+        refine3d.refined_topology = known
+        try:
+            child, tb, tt = timed(refine_nvb, mesh, marked)
+        finally:
+            refine3d.refined_topology = handed
+        u = p2_unknowns(child)
+        print(f"  topology {name}: bisect {tb:.3f} s, topology {tt:.3f} s, {u / (tb + tt):.3g}/s")
+
+
+def towards(where: str, levels: int, budget: int) -> None:
+    print(f"towards a {where}: level  cells  min dihedral  classes  (translation+scaling)")
+    mesh = box(1, 1, 1)
+    for level in range(levels):
+        p = mesh.points[mesh.cells]
+        zero = np.abs(p) < 1e-12
+        if where == "vertex":
+            marked = zero.all(-1).any(1)
+        elif where == "edge":
+            marked = (zero[..., 1] & zero[..., 2]).sum(1) >= 2
+        else:  # the face z = 0, within x < 1/4 as cells shrink
+            marked = (zero[..., 2].sum(1) >= 3) & (p[..., 0].min(1) < 0.25)
+        if mesh.n_cells > budget:
+            break
+        mesh = refine_nvb(mesh, marked).mesh
+        print(
+            f"  {level:2d} {mesh.n_cells:8d} {min_dihedral_angle(mesh.points, mesh.cells):8.3f} "
+            f"{similarity_classes(mesh.points, mesh.cells):4d} "
+            f"({similarity_classes(mesh.points, mesh.cells, rotations=False)})"
+        )
+
+
+def towards_sphere(levels: int, budget: int) -> None:
+    print("towards the curved sphere part of an eighth ball: level  cells  min dihedral  classes")
+    mesh = eighth_ball(2)
+    mesh = tagged(mesh, kuhn_paths(mesh.cells, mirrored=True))
+    for level in range(levels):
+        if mesh.n_cells > budget:
+            break
+        marked = np.zeros(mesh.n_cells, dtype=bool)
+        marked[mesh.facet2cell[mesh.part_facets("sphere"), 0]] = True
+        mesh = refine_nvb(mesh, marked).mesh
+        print(
+            f"  {level:2d} {mesh.n_cells:8d} {min_dihedral_angle(mesh.points, mesh.cells):8.3f} "
+            f"{similarity_classes(mesh.points, mesh.cells):6d}"
+        )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args()
+    rates(4, 3 if args.quick else 4)
+    budget = 30_000 if args.quick else 300_000
+    for where in ("vertex", "edge", "face"):
+        towards(where, 30, budget)
+    towards_sphere(30, budget)
+
+
+if __name__ == "__main__":
+    main()
