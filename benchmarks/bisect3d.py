@@ -139,7 +139,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     args = parser.parse_args()
     rates(4, 2 if args.quick else 3)
-    budget = 30_000 if args.quick else 300_000
+    budget = 20_000 if args.quick else 100_000
     for where in ("vertex", "edge", "face"):
         towards(where, 30, budget)
     towards_sphere(30, budget)
