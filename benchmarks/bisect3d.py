@@ -134,6 +134,54 @@ def towards_sphere(levels: int, budget: int) -> None:
         )
 
 
+def arbitrary(levels: int, budget: int) -> None:
+    """A Delaunay mesh of a grid and random points (slivers included), tagged by the global
+    vertex order (no matching condition): rounds, smallest dihedral angle, classes."""
+    from scipy.spatial import Delaunay
+
+    from signorini.mesh.bisect3d import bisect_tagged
+    from signorini.mesh.reference import TETRAHEDRON
+    from signorini.mesh.tags3d import mesh_cells, sorted_tags, with_face_parts
+    from signorini.mesh.topology import boundary_facets
+
+    rng = np.random.default_rng(1)
+    g = np.linspace(0.0, 1.0, 4)
+    grid = np.stack(np.meshgrid(g, g, g), axis=-1).reshape(-1, 3)
+    points = np.vstack([grid, 0.1 + 0.8 * rng.random((60, 3))])
+    cells = Delaunay(points).simplices.astype(np.int64)
+    p = points[cells]
+    det = np.linalg.det(p[:, 1:] - p[:, :1])
+    cells = cells[np.abs(det) > 1e-10]
+    det = det[np.abs(det) > 1e-10]
+    cells[det < 0] = cells[det < 0][:, [0, 2, 1, 3]]
+    boundary = boundary_facets(cells, TETRAHEDRON.facets)
+    tags = with_face_parts(
+        points,
+        sorted_tags(cells),
+        np.zeros(len(cells), np.int8),
+        boundary,
+        np.zeros(len(boundary), np.int64),
+    )
+    print(
+        f"arbitrary (Delaunay, {len(cells)} cells, global vertex order): level  cells  rounds  "
+        f"min dihedral  classes; initially {min_dihedral_angle(points, cells):.2f}°"
+    )
+    for level in range(levels):
+        cells = mesh_cells(tags)
+        if cells.shape[0] > budget:
+            break
+        x = points[cells]
+        marked = (np.abs(x).sum(-1) < 1e-12).any(1)  # towards the corner 0
+        marked |= np.linalg.norm(x.mean(1) - 0.5, axis=1) < 0.5 ** (level / 3 + 2)
+        result = bisect_tagged(points, tags, marked)
+        points, tags = result.points, result.tags
+        cells = mesh_cells(tags)
+        print(
+            f"  {level:2d} {cells.shape[0]:8d} {result.rounds:3d} "
+            f"{min_dihedral_angle(points, cells):8.3f} {similarity_classes(points, cells):6d}"
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
@@ -143,6 +191,7 @@ def main() -> None:
     for where in ("vertex", "edge", "face"):
         towards(where, 30, budget)
     towards_sphere(30, budget)
+    arbitrary(30, budget)
 
 
 if __name__ == "__main__":
