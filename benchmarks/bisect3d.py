@@ -21,10 +21,9 @@ import time
 import numpy as np
 
 from signorini.mesh import refine3d
-from signorini.mesh.builders3d import box, eighth_ball, kuhn_paths
+from signorini.mesh.builders3d import box, eighth_ball
 from signorini.mesh.quality3d import min_dihedral_angle, similarity_classes
 from signorini.mesh.refine import refine_nvb, refine_uniform
-from signorini.mesh.refine3d import tagged
 
 
 def p2_unknowns(mesh) -> int:
@@ -120,8 +119,7 @@ def towards(where: str, levels: int, budget: int) -> None:
 
 def towards_sphere(levels: int, budget: int) -> None:
     print("towards the curved sphere part of an eighth ball: level  cells  min dihedral  classes")
-    mesh = eighth_ball(2)
-    mesh = tagged(mesh, kuhn_paths(mesh.cells, mirrored=True))
+    mesh = eighth_ball(2)  # tagged by its Kuhn paths (refine3d.tags_of)
     for level in range(levels):
         if mesh.n_cells > budget:
             break

@@ -11,8 +11,8 @@ from signorini.mesh.builders3d import BOX_PARTS, box, eighth_ball, kuhn_paths
 from signorini.mesh.quality3d import min_dihedral_angle, similarity_classes
 from signorini.mesh.reference import TETRAHEDRON
 from signorini.mesh.refine import refine_nvb, refine_uniform
-from signorini.mesh.refine3d import tagged
-from signorini.mesh.tags3d import kuhn_tags, mesh_cells, sorted_tags, tags_of, with_face_parts
+from signorini.mesh.refine3d import matches, tagged, tags_of
+from signorini.mesh.tags3d import kuhn_tags, mesh_cells, sorted_tags, with_face_parts
 
 
 def six_volumes(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
@@ -152,9 +152,29 @@ def test_boundary_faces_are_outward():
     np.testing.assert_allclose(area_normal.sum(0), 0.0, atol=1e-14)
 
 
+def test_mapped_kuhn_grids_are_tagged_by_their_paths():
+    mesh = eighth_ball(2)
+    tags = tags_of(mesh)
+    np.testing.assert_array_equal(tags.order, kuhn_paths(mesh.cells, mirrored=True))
+    assert matches(mesh.points, tags)
+    # the global vertex order of a grid numbering is the Kuhn paths' order; of a random
+    # numbering it breaks the matching condition
+    np.testing.assert_array_equal(sorted_tags(mesh.cells), tags.order)
+    box_mesh = box(2, 2, 2)
+    perm = np.random.default_rng(0).permutation(box_mesh.n_points)
+    inverse = np.argsort(perm)
+    shuffled = with_face_parts(
+        box_mesh.points[perm],
+        sorted_tags(inverse[box_mesh.cells]),
+        np.zeros(box_mesh.n_cells, np.int8),
+        inverse[box_mesh.boundary],
+        box_mesh.boundary_part,
+    )
+    assert not matches(box_mesh.points[perm], shuffled)
+
+
 def test_sphere_vertices_stay_on_the_sphere():
     mesh = eighth_ball(2, radius=2.0)
-    mesh = tagged(mesh, kuhn_paths(mesh.cells, mirrored=True))
     sphere = mesh.part_index("sphere")
     for _ in range(6):
         on = np.zeros(mesh.n_cells, dtype=bool)
@@ -213,3 +233,13 @@ def test_handed_topology_equals_the_global_one():
         for handed, computed in zip(child.__dict__[FACET_CACHE], faces, strict=True):
             np.testing.assert_array_equal(handed, computed)
         mesh = child
+
+
+def test_tagged_attaches_a_builders_order_and_refuses_foreign_vertices():
+    from signorini.mesh.mesh import MeshError
+
+    mesh = tagged(box(1, 1, 2), kuhn_paths(box(1, 1, 2).cells))
+    np.testing.assert_array_equal(tags_of(mesh).order, kuhn_tags(mesh.points, mesh.cells))
+    wrong = kuhn_paths(mesh.cells)[::-1]
+    with pytest.raises(MeshError, match="own vertices"):
+        tagged(box(1, 1, 2), wrong)

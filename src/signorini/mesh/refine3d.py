@@ -3,7 +3,7 @@
 :func:`~signorini.mesh.refine.refine_uniform`, which dispatch here on ``mesh.dim == 3``
 (docs/method.md, *Three dimensions: bisection*).
 
-The refined mesh carries its cells' tags (:func:`~signorini.mesh.tags3d.tags_of`), so the
+The refined mesh carries its cells' tags (:func:`tags_of`), so the
 next refinement continues the bisection sequence; boundary faces are read from the face
 tags, parts and regions go to the children, and new vertices of edges of a part that carries
 a :class:`~signorini.mesh.surfaces.Surface` are placed by its ``halfway``.
@@ -14,13 +14,21 @@ from __future__ import annotations
 import numpy as np
 
 from .bisect3d import bisect_tagged, boundary_of, edge_key
+from .builders3d import kuhn_paths
 from .mesh import Mesh
 from .surfaces import Surface
-from .tags3d import ATTRIBUTE, Tags, mesh_cells, tags_of, with_face_parts
+from .tags3d import (
+    ATTRIBUTE,
+    Tags,
+    kuhn_tags,
+    mesh_cells,
+    sorted_tags,
+    with_face_parts,
+)
 from .topology3d import refined_topology
 from .validation import MeshError
 
-__all__ = ["UNIFORM_BISECTIONS", "bisect_mesh", "tagged"]
+__all__ = ["UNIFORM_BISECTIONS", "bisect_mesh", "matches", "tagged", "tags_of"]
 
 #: Bisections of every cell per level of uniform refinement in 3D: ``h`` halves and the
 #: number of cells grows eightfold (the children of a Kuhn cell after three bisections are
@@ -140,3 +148,45 @@ def tagged(mesh: Mesh, order: np.ndarray, gamma: np.ndarray | None = None) -> Me
         raise MeshError("tagged: the order must list each cell's own vertices")
     setattr(mesh, ATTRIBUTE, tags)
     return mesh
+
+
+def matches(points: np.ndarray, tags: Tags) -> bool:
+    """Whether :data:`UNIFORM_BISECTIONS` bisections of every cell each need one round, no
+    closure: a consequence of Stevenson's matching condition (a check, not a proof)."""
+    for _ in range(UNIFORM_BISECTIONS):  # a loop over bisections, not cells
+        result = bisect_tagged(points, tags, np.ones(tags.order.shape[0], dtype=bool))
+        if result.rounds != 1:
+            return False
+        points, tags = result.points, result.tags
+    return True
+
+
+def tags_of(mesh: Mesh) -> Tags:
+    """The :class:`~signorini.mesh.tags3d.Tags` of a tetrahedral mesh, attached to it: those
+    refinement (or :func:`tagged`) attached; else the Kuhn paths of an axis-aligned Kuhn mesh
+    (:func:`~signorini.mesh.tags3d.kuhn_tags`); else the Kuhn paths of a mapped Kuhn grid in
+    the builders' cell order (:func:`~signorini.mesh.builders3d.kuhn_paths`, plain or
+    mirrored) if they pass :func:`matches`; else the global vertex order
+    (:func:`~signorini.mesh.tags3d.sorted_tags`, no matching condition: docs/method.md)."""
+    tags = getattr(mesh, ATTRIBUTE, None)
+    if tags is not None:
+        return tags
+    gamma = np.zeros(mesh.n_cells, np.int8)
+
+    def tags_in(order: np.ndarray) -> Tags:
+        return with_face_parts(mesh.points, order, gamma, mesh.boundary, mesh.boundary_part)
+
+    try:
+        tags = tags_in(kuhn_tags(mesh.points, mesh.cells))
+    except MeshError:
+        tags = None
+    if tags is None and mesh.n_cells % 6 == 0:
+        for mirrored in (False, True):
+            candidate = tags_in(kuhn_paths(mesh.cells, mirrored=mirrored))
+            if matches(mesh.points, candidate):
+                tags = candidate
+                break
+    if tags is None:
+        tags = tags_in(sorted_tags(mesh.cells))
+    setattr(mesh, ATTRIBUTE, tags)
+    return tags

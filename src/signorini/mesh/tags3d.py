@@ -20,8 +20,9 @@ with the smallest coordinates along the common diagonal direction, ``x1 = x0 + h
 every shared face), type 0: bisection then stays conforming and terminates on the meshes
 tested, but the matching condition, hence the bound on similarity classes and the closure
 estimate, is not guaranteed (Diening, Gehring, Storn [5]_ give an initialisation for any
-conforming mesh; it is not implemented). :func:`matching_defects` checks the condition's
-consequence that three rounds of bisecting every cell stay conforming.
+conforming mesh; it is not implemented). :func:`signorini.mesh.refine3d.tags_of` checks the
+condition's consequence that three bisections of every cell need no closure before it takes
+the Kuhn paths of a mapped Kuhn grid.
 
 References
 ----------
@@ -47,10 +48,10 @@ from .reference import TETRAHEDRON
 from .topology import entity_keys
 from .validation import MeshError
 
-__all__ = ["Tags", "kuhn_tags", "mesh_cells", "sorted_tags", "tags_of", "with_face_parts"]
+__all__ = ["Tags", "kuhn_tags", "mesh_cells", "sorted_tags", "with_face_parts"]
 
 #: The attribute of a 3D Mesh that carries its :class:`Tags` (set by refinement and by
-#: :func:`tags_of`).
+#: :func:`signorini.mesh.refine3d.tags_of`).
 ATTRIBUTE = "bisection_tags"
 
 
@@ -165,20 +166,3 @@ def sorted_tags(cells: np.ndarray) -> np.ndarray:
     """The tag order ``(n, 4)`` of any conforming mesh: each cell's vertices in increasing
     global number, type 0 (no guarantee of the matching condition, see the module notes)."""
     return np.sort(np.asarray(cells, dtype=np.int64), axis=1)
-
-
-def tags_of(mesh) -> Tags:
-    """The :class:`Tags` of a 3D mesh: those refinement attached, else a Kuhn tagging when
-    every cell is a Kuhn simplex, else :func:`sorted_tags`; attached to the mesh."""
-    tags = getattr(mesh, ATTRIBUTE, None)
-    if tags is not None:
-        return tags
-    try:
-        order = kuhn_tags(mesh.points, mesh.cells)
-    except MeshError:
-        order = sorted_tags(mesh.cells)
-    tags = with_face_parts(
-        mesh.points, order, np.zeros(mesh.n_cells, np.int8), mesh.boundary, mesh.boundary_part
-    )
-    setattr(mesh, ATTRIBUTE, tags)
-    return tags
