@@ -2,7 +2,7 @@
 in 3D; docs/method.md, *Three dimensions: bisection*).
 
 A tagged cell ``(x0, x1, x2, x3)_gamma`` (:mod:`signorini.mesh.tags3d`) is bisected at the
-midpoint ``z`` of its refinement edge ``x0–x3`` into (Stevenson [1]_, Sect. 2, with ``n =
+midpoint ``z`` of its refinement edge ``x0–x3`` into (Stevenson [1]_, with ``n =
 3``; Maubach [2]_, Traxler [3]_)::
 
     (x0, z, x1, x2)_{gamma+1 mod 3}
@@ -19,7 +19,7 @@ cells of an edge (one vertex per edge key, ``min * 2**31 + max``), children repl
 parents (the first child in the parent's row, the second appended), and the cells that still
 contain a bisected edge (a hanging vertex) form the next round's set, until none does. Under
 the matching condition the number of rounds is bounded by the level differences the marking
-creates (the closure estimate of [1]_, Thm. 5.1); a loop over rounds, never over cells.
+creates (the closure estimate of [1]_); a loop over rounds, never over cells.
 
 References
 ----------

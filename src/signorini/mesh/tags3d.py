@@ -15,7 +15,7 @@ as the vertices.
 Initial condition. Stevenson's matching condition holds for a Kuhn (Freudenthal) mesh of a
 box ordered along the path of each simplex, type 0 (:func:`kuhn_tags`): ``x0`` the corner
 with the smallest coordinates along the common diagonal direction, ``x1 = x0 + h_i e_i``,
-``x2 = x1 + h_j e_j``, ``x3 = x2 + h_k e_k`` ([3]_, Sect. 4; [4]_). For an arbitrary mesh
+``x2 = x1 + h_j e_j``, ``x3 = x2 + h_k e_k`` ([3]_, [4]_). For an arbitrary mesh
 :func:`sorted_tags` orders each cell by its global vertex numbers (a consistent order on
 every shared face), type 0: bisection then stays conforming and terminates on the meshes
 tested, but the matching condition, hence the bound on similarity classes and the closure
