@@ -27,7 +27,7 @@ own METIS analysis; the loop orders the unknowns by
 :func:`signorini.contact.ordering.dof_ordering`.
 
 With ``--friction coulomb`` (or ``tresca``) the same run solves Example 6.2 with friction on
-its contact part (``signorini.examples.friction``: F = 0.3, or s = 30) by the semismooth
+its contact part (``signorini.examples.paper_friction``: F = 0.3, or s = 30) by the semismooth
 Newton method; the table gains ``iters``, its iterations per level, and the floor stays the
 same: one complete direct (Cholesky) solve of the level's stiffness matrix.
 

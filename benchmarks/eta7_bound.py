@@ -40,7 +40,7 @@ def contact_trace(result):
     """The edges of Γ_C and ``u_h·n − ψ_h`` on them, as the estimator's η7 reads them."""
     mesh, cs = result.mesh, result.contact
     gap = result.space.element.facet.facet_values(cs.facet_normal_gap(result.u))
-    x0, x1 = mesh.points[cs.edge_nodes[:, 0]], mesh.points[cs.edge_nodes[:, 1]]
+    x0, x1 = mesh.points[cs.facet_nodes[:, 0]], mesh.points[cs.facet_nodes[:, 1]]
     origin = x0.min(axis=0)
     return x0 - origin, x1 - origin, gap, float(np.abs(result.u).max(initial=0.0))
 

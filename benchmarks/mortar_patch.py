@@ -27,8 +27,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from signorini.contact.mortar import mortar_coupling
-from signorini.fem.loads import assemble_edge_load
-from signorini.fem.mapping import StraightEdges
+from signorini.fem.loads import assemble_facet_load
+from signorini.fem.mapping import StraightFacets
 from signorini.fem.material import Material
 from signorini.fem.space import P2Space
 from signorini.fem.stiffness import assemble_stiffness
@@ -95,8 +95,11 @@ def pressure_deviation(n_upper: int, n_lower: int, slave: str, method: str) -> f
     top = mesh.part_facets("up.top")
     nodes = space.facet_nodes(top)
     dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1, 6)
-    F = assemble_edge_load(
-        StraightEdges(space.node_points[nodes[:, :2]]), dofs, n, lambda x, nu: np.array([0.0, -1.0])
+    F = assemble_facet_load(
+        StraightFacets(space.node_points[nodes[:, :2]]),
+        dofs,
+        n,
+        lambda x, nu: np.array([0.0, -1.0]),
     )
     held = np.concatenate(
         [2 * space.part_nodes(["up.left", "low.left"]), 2 * space.part_nodes(["low.bottom"]) + 1]

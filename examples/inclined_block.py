@@ -83,7 +83,7 @@ def main() -> None:
         mesh.points,
         mesh.cells,
         args.out / "mesh",
-        highlight=mesh.edges[cs.edges],
+        highlight=mesh.edges[cs.facets],
         title="adaptive mesh",
     )
     plots.plot_deformed(

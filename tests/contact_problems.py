@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from signorini.fem.loads import assemble_body_force, assemble_edge_load
+from signorini.fem.loads import assemble_body_force, assemble_facet_load
 from signorini.fem.material import Material
 from signorini.fem.stiffness import assemble_stiffness
 from signorini.mesh.builders import rectangle
@@ -173,7 +173,7 @@ def independent_system(problem: ContactProblem, mesh: Mesh) -> System:
         F += assemble_body_force(vertices, cell_dofs, n_dofs, problem.body_force, degree=8)
 
     def part_nodes(name):
-        edges = mesh.part_edges(name)
+        edges = mesh.part_facets(name)
         ab = mesh.oriented_boundary(edges)
         return edges, np.column_stack([ab, n_points + edges])
 
@@ -181,7 +181,7 @@ def independent_system(problem: ContactProblem, mesh: Mesh) -> System:
         _, nodes = part_nodes(name)
         g = problem.conditions[name].field()
         dofs = (2 * nodes[:, :, None] + np.arange(2)).reshape(-1, 6)
-        F += assemble_edge_load(mesh.points[nodes[:, :2]], dofs, n_dofs, g, degree=8)
+        F += assemble_facet_load(mesh.points[nodes[:, :2]], dofs, n_dofs, g, degree=8)
     d_nodes = np.unique(np.concatenate([part_nodes(p)[1].ravel() for p in problem.dirichlet_parts]))
     d_vals = np.zeros((d_nodes.size, 2))
     for name in problem.dirichlet_parts:

@@ -68,5 +68,5 @@ def affine_copy(mesh: Mesh, matrix: np.ndarray, shift: np.ndarray) -> Mesh:
     """The image of ``mesh`` under ``x -> matrix @ x + shift``, parts given as edge lists."""
     assert np.linalg.det(matrix) > 0
     points = mesh.points @ np.asarray(matrix).T + shift
-    parts = {name: mesh.edges[mesh.part_edges(name)] for name in mesh.part_names}
+    parts = {name: mesh.facets[mesh.part_facets(name)] for name in mesh.part_names}
     return Mesh.from_arrays(points, mesh.cells, parts)

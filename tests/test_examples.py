@@ -245,7 +245,7 @@ def test_initial_mesh_size(example):
             flipped = (mesh.points - 0.5) * mirror + 0.5
             assert cells_as_points(flipped, mesh.cells) == cells
         for name in ("left", "right", "top", "bottom"):
-            assert mesh.part_edges(name).size == nx
+            assert mesh.part_facets(name).size == nx
         assert pb.material == default.material and pb.conditions.keys() == default.conditions.keys()
 
 

@@ -69,7 +69,7 @@ def run(s: float, t, marks: list[np.ndarray] | None = None):
     marked cells of each step (taken from ``marks`` when given)."""
     t = np.asarray(t, dtype=float)
     m0 = example_6_2().mesh
-    parts = {name: m0.edges[m0.part_edges(name)] for name in m0.part_names}
+    parts = {name: m0.facets[m0.part_facets(name)] for name in m0.part_names}
     mesh = Mesh.from_arrays(m0.points * s + t, m0.cells, parts)
     used = []
     for step in range(STEPS + 1):

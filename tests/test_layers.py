@@ -54,6 +54,71 @@ DOORS: dict[str, frozenset[str]] = {
 }
 
 
+#: The rooms of ``algebra`` and the rooms each may import besides itself: ``errors`` (the
+#: module ``algebra/errors.py``, every error and warning) is the bottom; ``core`` (the
+#: top-level modules of ``algebra/``: CSR helpers, ranks, the QP and its KKT residuals, the
+#: active set iterations) imports only the errors; the SPD solvers of ``backends/`` build on
+#: the core's CSR helpers and ranks; the frictional solver of ``friction/`` on the core's QP,
+#: KKT and active systems. ``__init__`` (``algebra/__init__.py``) is the subpackage's door
+#: and re-exports every room.
+ROOMS: dict[str, frozenset[str]] = {
+    "errors": frozenset(),
+    "core": frozenset({"errors"}),
+    "backends": frozenset({"errors", "core"}),
+    "friction": frozenset({"errors", "core"}),
+    "__init__": frozenset({"errors", "core", "backends", "friction"}),
+}
+
+#: Single modules of another room that a room of ``algebra`` may import, each with its
+#: reason. The core's door to the backends is the solver interface and its selection: the
+#: active set iterations factor SPD systems through the interface ``SPDSolver`` and pick the
+#: backend by name (``make_solver``), and the ranks' collectives find petsc4py where the
+#: PETSc backends find it (one import of petsc4py, asked for only under MPI). The frictional
+#: solver factors its systems through the same door. No backend imports the frictional
+#: solver.
+ROOM_DOORS: dict[str, dict[str, str]] = {
+    "core": {
+        "backends.solvers": "SPDSolver, SolverFactory: the interface the iterations factor with",
+        "backends.selection": "make_solver: a backend chosen by name (PDAS's solver=)",
+        "backends.petsc_import": "petsc_module: the ranks' communicator under MPI",
+    },
+    "friction": {
+        "backends.solvers": "SPDSolver, SolverFactory: the interface Newton's systems factor with",
+        "backends.selection": "make_solver: a backend chosen by name (solve_friction's solver=)",
+    },
+}
+
+
+def room_of(name: str) -> str:
+    """The room of ``algebra`` of a module given by its dotted name under ``algebra``
+    (``algebra.backends.mkl`` -> ``backends``, ``algebra.errors`` -> ``errors``,
+    ``algebra.pdas`` -> ``core``, ``algebra`` -> ``__init__``)."""
+    parts = name.split(".")[1:]
+    if not parts or parts == ["__init__"]:
+        return "__init__"
+    if parts[0] in ("backends", "friction", "errors"):
+        return parts[0]
+    return "core"
+
+
+def forbidden_room_imports(root: Path = PACKAGE) -> list[str]:
+    """Every import between the rooms of ``algebra`` under ``root`` that :data:`ROOMS` and
+    :data:`ROOM_DOORS` do not allow."""
+    found = []
+    for path in sorted((root / "algebra").rglob("*.py")):
+        dotted = ".".join(path.relative_to(root).with_suffix("").parts)
+        own = room_of(dotted)
+        doors = ROOM_DOORS.get(own, {})
+        for name in sorted(imported_modules(path, root)):
+            if name.split(".")[0] != "algebra":
+                continue
+            room = room_of(name)
+            door = any(name == "algebra." + d for d in doors)
+            if room != own and room not in ROOMS[own] and not door:
+                found.append(f"{path.relative_to(root)} ({own}) imports {name} ({room})")
+    return found
+
+
 def layer_of(path: Path, root: Path = PACKAGE) -> str:
     return path.relative_to(root).parts[0].removesuffix(".py")
 
@@ -152,6 +217,22 @@ def test_the_errors_of_the_linear_algebra_are_its_bottom():
     assert ranks == {"algebra.backends.petsc_import", "algebra.errors"}
 
 
+def test_the_rooms_of_the_linear_algebra_import_only_what_their_row_allows():
+    found = forbidden_room_imports()
+    assert not found, "imports the rooms' table does not allow: " + "; ".join(found)
+
+
+def test_every_room_door_has_its_reason_and_exists():
+    for own, doors in ROOM_DOORS.items():
+        for door, reason in doors.items():
+            assert reason, (own, door)
+            path = PACKAGE.joinpath("algebra", *door.split(".")).with_suffix(".py")
+            assert path.is_file(), door
+            assert room_of("algebra." + door) not in ROOMS[own] | {own}, (own, door)
+    assert ROOMS["errors"] == frozenset()
+    assert "friction" not in ROOMS["backends"] and "friction" not in ROOMS["core"]
+
+
 def test_the_import_reader_sees_every_kind_of_relative_import():
     """``from ..x import``, ``from .x import`` at the top and ``from . import`` inside a layer."""
     solution = imported_layers(PACKAGE / "contact" / "solution.py")
@@ -201,6 +282,35 @@ def test_a_forbidden_import_is_reported(package, layer, source, reported):
     (package / layer / "probe.py").write_text(source)
     found = forbidden_imports(package)
     assert len(found) == 1 and reported in found[0], found
+
+
+@pytest.mark.parametrize(
+    "room, source, reported",
+    [
+        ("errors.py", "from .sparse import csr\n", "algebra/errors.py (errors) imports algebra"),
+        ("probe.py", "from .backends import pardiso\n", "imports algebra.backends.pardiso"),
+        ("probe.py", "def f():\n    from .friction import kkt\n", "imports algebra.friction.kkt"),
+        ("backends/probe.py", "from ..friction.laws import LawGroups\n", "(friction)"),
+        ("friction/probe.py", "from ..backends.superlu import superlu_solver\n", "superlu"),
+        ("backends/probe.py", "from .. import pdas\nimport signorini.algebra\n", "(__init__)"),
+    ],
+)
+def test_a_forbidden_room_import_is_reported(package, room, source, reported):
+    assert forbidden_room_imports(package) == []
+    (package / "algebra" / room).write_text(source)
+    found = forbidden_room_imports(package)
+    assert len(found) == 1 and reported in found[0], found
+
+
+def test_room_doors_and_allowed_rooms_are_not_reported(package):
+    (package / "algebra" / "probe.py").write_text(
+        "from .errors import ConvergenceError\nfrom .backends.solvers import SPDSolver\n"
+    )
+    (package / "algebra" / "friction" / "probe.py").write_text(
+        "from ..backends.selection import make_solver\nfrom ..qp import BoundQP\n"
+    )
+    (package / "algebra" / "backends" / "probe.py").write_text("from ..sparse import csr\n")
+    assert forbidden_room_imports(package) == []
 
 
 def test_allowed_imports_and_doors_are_not_reported(package):

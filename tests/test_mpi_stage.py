@@ -1,4 +1,4 @@
-"""The MPI stage: the ``"petsc"`` backend's tests (``tests/algebra/test_petsc.py``) and the
+"""The MPI stage: the ``"petsc"`` backend's tests (``tests/algebra/backends/test_petsc.py``) and the
 invariance runs under ``mpiexec -n 1, 2, 3`` (``tests/parallel``), run by the Python that has
 the ``[mpi]`` extra (PETSc, MUMPS and MPICH wheels need Python >= 3.12; docs/parallel.md).
 
@@ -38,7 +38,7 @@ def test_the_petsc_backend_and_the_mpi_runs_pass():
     env = {**os.environ, "SIGNORINI_REQUIRE_PETSC": "1", "MPLBACKEND": "Agg", **ONE_THREAD}
     done = subprocess.run(
         [MPI_PYTHON, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-m", "", "tests/parallel",
-         "tests/algebra/test_petsc.py", f"--ignore={SERIAL_ONLY}"],
+         "tests/algebra/backends/test_petsc.py", f"--ignore={SERIAL_ONLY}"],
         cwd=ROOT, env=env, capture_output=True, text=True, timeout=1200,
     )  # fmt: skip
     summary = done.stdout.strip().splitlines()[-1] if done.stdout.strip() else ""

@@ -24,7 +24,7 @@ from signorini.algebra.backends.superlu import SuperLUSolver
 from signorini.algebra.friction.kkt import check_friction
 from signorini.algebra.friction.newton import FrictionOptions, solve_friction
 from signorini.algebra.inexact import CONFIRM_RTOL, KKT_RTOL
-from signorini.problem.friction import Tresca
+from signorini.problem.friction_laws import Tresca
 
 LOOSE = 1e-6
 

@@ -78,7 +78,7 @@ def test_weights_on_a_uniform_mesh():
 def test_weights_sum_to_the_contact_length(seed):
     mesh = graded_mesh(seed)
     cs = problem_contact_set(block_problem(mesh), P2Space(mesh))
-    lengths = mesh.edge_length[mesh.part_edges("bottom")]
+    lengths = mesh.edge_length[mesh.part_facets("bottom")]
     print(
         f"seed {seed}: {cs.size} constrained nodes, edge lengths "
         f"{lengths.min():.4f}..{lengths.max():.4f}, Σm = {cs.hat_integral.sum():.15f}, "
@@ -112,7 +112,7 @@ def test_dirichlet_nodes_are_not_constrained():
     assert np.all(x[:, 0] > 0.1) and np.allclose(x[:, 1], 0)
     # the corner's share of the first edge is missing from m_z
     assert cs.hat_integral.sum() == pytest.approx(1 - 0.25 / 4, rel=1e-14)
-    assert cs.edge_gap.shape == (4, 3) and np.allclose(cs.edge_gap, 0.01)
+    assert cs.facet_gap.shape == (4, 3) and np.allclose(cs.facet_gap, 0.01)
 
 
 # --------------------------------------------------------------------------- s_z and p_z
@@ -179,12 +179,12 @@ def classes_by_definition(cs, in_contact):
     """Paper, Section 4, written out edge by edge (plain loops; small meshes only)."""
     where = {int(z): k for k, z in enumerate(cs.nodes)}
     full_edge = [
-        all(z in where and in_contact[where[z]] for z in map(int, e)) for e in cs.edge_nodes
+        all(z in where and in_contact[where[z]] for z in map(int, e)) for e in cs.facet_nodes
     ]
     out = np.full(cs.size, NO_CONTACT)
     for k, z in enumerate(cs.nodes):
         if in_contact[k]:
-            edges = [i for i, e in enumerate(cs.edge_nodes) if z in e]
+            edges = [i for i, e in enumerate(cs.facet_nodes) if z in e]
             out[k] = FULL_CONTACT if all(full_edge[i] for i in edges) else SEMI_CONTACT
     return out
 
@@ -198,7 +198,7 @@ def test_node_classes_follow_the_definition(seed):
     x = P2Space(mesh).node_points[cs.nodes, 0]
     a, b = np.sort(rng.uniform(0, 2, 2))
     in_contact = ((x >= a) & (x <= b)) | (rng.random(cs.size) < 0.15)
-    edge_in = np.isin(cs.edge_nodes, cs.nodes[in_contact])
+    edge_in = np.isin(cs.facet_nodes, cs.nodes[in_contact])
     got = node_classes(cs, in_contact, edge_in)
     expect = classes_by_definition(cs, in_contact)
     print(f"seed {seed}: {np.bincount(got, minlength=3)} (no, semi, full)")

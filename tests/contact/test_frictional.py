@@ -22,7 +22,7 @@ from scipy.optimize import lsq_linear
 
 from signorini.algebra import FrictionResult
 from signorini.contact.solution import INACTIVE, SLIP, STICK, solve
-from signorini.estimator.friction import friction_facets
+from signorini.estimator.friction_facets import friction_facets
 from signorini.fem.material import Material
 from signorini.fem.space import P2Space
 from signorini.fem.stiffness import assemble_stiffness
@@ -221,7 +221,7 @@ def test_a_new_law_is_one_class():
     assert err_u < 1e-8 and err_n < 1e-8 and err_t < 1e-8
     # the estimator asks the law too: its bound as a stress is s_z / w_z
     facets = friction_facets(res)
-    loc = res.contact.edge_local
+    loc = res.contact.facet_local
     inside = loc >= 0
     assert np.array_equal(facets.bound[inside], (s / res.contact.basis_integral)[loc[inside]])
 

@@ -131,7 +131,7 @@ def cylinders(Q: np.ndarray | None = None) -> P2Space:
 
 def partner(space: P2Space, c, points: np.ndarray) -> np.ndarray:
     """The master node at each of ``points``."""
-    master = np.unique(space.edge_nodes(space.mesh.part_facets(c.master)))
+    master = np.unique(space.facet_nodes(space.mesh.part_facets(c.master)))
     dist, k = cKDTree(space.node_points[master]).query(points)
     assert dist.max() < 1e-14
     return master[k]
@@ -210,7 +210,7 @@ def test_partly_covered_nodes_and_the_constrained_ones():
     space = blocks(5, 6, width=(0.3, 1.5))
     with pytest.raises(ProblemError, match=r"too short.*node at \(0\.[0-4]\d*, 0\).*swap"):
         mortar_coupling(space, "up.bottom", "low.top")
-    nodes = np.unique(space.edge_nodes(space.mesh.part_facets("up.bottom")))
+    nodes = np.unique(space.facet_nodes(space.mesh.part_facets("up.bottom")))
     full = space.node_points[nodes, 0] > 0.45
     c = mortar_coupling(space, "up.bottom", "low.top", constrained=nodes[full])
     xs = space.node_points[c.slave_nodes]
@@ -271,7 +271,7 @@ def test_D_is_the_weight_of_the_consistent_pressure(which):
     }[which]
     c = mortar_coupling(space, slave, master)
     edges = space.mesh.part_facets(slave)
-    nodes = space.edge_nodes(edges)
+    nodes = space.facet_nodes(edges)
     _, w = facet_weights(space, edges, nodes)
     D = np.bincount(np.searchsorted(c.slave_nodes, nodes.ravel()), weights=w.ravel())
     np.testing.assert_allclose(c.D, D, rtol=4e-15)
@@ -349,8 +349,8 @@ def brute_force_mortar(space: P2Space, c) -> np.ndarray:
     """``M`` by a plain loop over (slave edge, master edge): the segment ends by root finding
     on the slave edge, ``π(ξ)`` by root finding per point inside adaptive quadrature."""
     xp = space.node_points
-    s_nodes = space.edge_nodes(space.mesh.part_facets(c.slave))
-    m_nodes = space.edge_nodes(space.mesh.part_facets(c.master))
+    s_nodes = space.facet_nodes(space.mesh.part_facets(c.slave))
+    m_nodes = space.facet_nodes(space.mesh.part_facets(c.master))
     row = {n: i for i, n in enumerate(c.slave_nodes)}
     out = np.zeros((c.slave_nodes.size, space.n_nodes))
     for sn in s_nodes:

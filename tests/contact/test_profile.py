@@ -101,7 +101,7 @@ def two_chain_problem() -> ContactProblem:
     """The unit square pressed down by its top; the bottom touches the obstacle only on
     x < 1/4 and x > 3/4 (two pieces of one contact part), the middle is free."""
     base = rectangle(nx=8, ny=8)
-    pairs = {name: base.edges[base.part_facets(name)] for name in base.part_names}
+    pairs = {name: base.facets[base.part_facets(name)] for name in base.part_names}
     mid = base.points[pairs["bottom"]].mean(axis=1)[:, 0]
     inner = (mid > 0.25) & (mid < 0.75)
     pairs["free"] = pairs["bottom"][inner]

@@ -19,7 +19,7 @@ from signorini.contact.solution import solve
 from signorini.fem.material import Material
 from signorini.mesh.builders import rectangle
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, SlenderBodyWarning
-from signorini.problem.friction import Coulomb, Tresca
+from signorini.problem.friction_laws import Coulomb, Tresca
 
 BACKENDS = available_backends()
 E, NU, H, LOAD = 1000.0, 0.3, 1.0, 1e-3

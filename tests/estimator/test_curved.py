@@ -148,7 +148,7 @@ def lame_mesh(n: int) -> Mesh:
     base = rectangle(1.0, 2.0, 0.0, np.pi / 2, nx=n, ny=2 * n)
     r, t = base.points[:, 0], base.points[:, 1]
     points = np.column_stack([r * np.cos(t), r * np.sin(t)])
-    outer = base.edges[base.part_edges("right")]
+    outer = base.facets[base.part_facets("right")]
     mesh = Mesh.from_arrays(points, base.cells, {"outer": outer, "rest": lambda x: x[:, 0] > -1})
     return mesh.with_curve("outer", Circle((0, 0), 2.0))
 
@@ -169,8 +169,8 @@ def test_tangential_stress_of_a_radial_field_vanishes_with_the_local_normal():
         mesh = lame_mesh(n)
         space = P2Space(mesh)
         u = space.interpolate(lame)
-        e = mesh.part_edges("outer")
-        edges = FacetSet(e, space.edge_nodes(e), mesh.facet2cell[e], mesh.facet_measure[e])
+        e = mesh.part_facets("outer")
+        edges = FacetSet(e, space.facet_nodes(e), mesh.facet2cell[e], mesh.facet_measure[e])
         x = space.node_points[edges.nodes]
         direction = x / np.hypot(x[..., 0], x[..., 1])[..., None]  # the arc's normal n_z
         ab = mesh.points[mesh.oriented_boundary(e)]
@@ -292,7 +292,7 @@ def test_the_estimator_is_invariant_under_rotation_on_a_curved_mesh():
     def rotated(f):
         return lambda x, *n: f(x @ R) @ R.T
 
-    parts = {name: base.edges[base.part_edges(name)] for name in base.part_names}
+    parts = {name: base.facets[base.part_facets(name)] for name in base.part_names}
     mesh = Mesh.from_arrays(base.points @ R.T, base.cells, parts)
     mesh = mesh.with_curve("inner", Circle((0, 0), 1)).with_curve("outer", Circle((0, 0), 2))
     pb = problem(mesh, rotated(exact_u), lambda x: R @ exact_grad(x @ R) @ R.T, rotated(body_force))
@@ -385,13 +385,13 @@ def test_adaptive_loop_on_a_half_disc_pressed_onto_a_rigid_plane():
     stresses = CellStress.of(res.space, res.u, res.problem.material, est.unit)
     cs, mesh = res.contact, res.mesh
     edges = FacetSet(
-        cs.edges, cs.edge_nodes, mesh.facet2cell[cs.edges], mesh.facet_measure[cs.edges]
+        cs.facets, cs.facet_nodes, mesh.facet2cell[cs.facets], mesh.facet_measure[cs.facets]
     )
     t, w = line_rule(7)
-    body = res.space.node_points[cs.edge_nodes] - [0.0, 1.0]
+    body = res.space.node_points[cs.facet_nodes] - [0.0, 1.0]
     eta4 = {
-        name: np.sqrt(contact_stress(stresses, mesh, edges, cs.edge_normal, d, t, w)[0].sum())
-        for name, d in (("n_z", cs.edge_direction), ("body normal", body))
+        name: np.sqrt(contact_stress(stresses, mesh, edges, cs.facet_normal, d, t, w)[0].sum())
+        for name, d in (("n_z", cs.facet_direction), ("body normal", body))
     }
     print(f"‖σ_t(u_h)‖ on Γ_C at Ndof {ndof[-1]}: {eta4}")
     assert eta4["n_z"] < 0.5 * eta4["body normal"], eta4
@@ -429,14 +429,19 @@ def test_straight_contact_part_against_a_disc_splits_along_the_obstacle_directio
         ),
     )
     sn = facet_traction(
-        sigma, mesh.points, mesh.cells, mesh.edge2cell[cs.edges, 0], mesh.edge_local[cs.edges, 0], t
+        sigma,
+        mesh.points,
+        mesh.cells,
+        mesh.facet2cell[cs.facets, 0],
+        mesh.facet_local[cs.facets, 0],
+        t,
     )
-    length = mesh.edge_length[cs.edges]
+    length = mesh.edge_length[cs.facets]
     eta4 = {
         "n_z": np.sqrt(
-            tangential_stress(sn, direction_field(cs.edge_direction, t), w, length).sum()
+            tangential_stress(sn, direction_field(cs.facet_direction, t), w, length).sum()
         ),
-        "edge normal": np.sqrt(tangential_stress(sn, cs.edge_normal, w, length).sum()),
+        "edge normal": np.sqrt(tangential_stress(sn, cs.facet_normal, w, length).sum()),
     }
     print(f"η_h slope over the last 6 levels {s:.3f} (Ndof {ndof[-6:]})")
     print(f"‖σ_t(u_h)‖ on Γ_C at Ndof {ndof[-1]}: {eta4}")
@@ -472,13 +477,13 @@ def test_a_gap_along_the_curve_normal_splits_along_the_body_normal():
         assert 0 < res.active.sum() < res.contact.size
         cs = res.contact
         edges = FacetSet(
-            cs.edges, cs.edge_nodes, mesh.facet2cell[cs.edges], mesh.facet_measure[cs.edges]
+            cs.facets, cs.facet_nodes, mesh.facet2cell[cs.facets], mesh.facet_measure[cs.facets]
         )
         t, w = line_rule(7)
         stresses = CellStress.of(res.space, res.u, res.problem.material, est.unit)
-        J4, _ = contact_stress(stresses, mesh, edges, cs.edge_normal, cs.edge_direction, t, w)
+        J4, _ = contact_stress(stresses, mesh, edges, cs.facet_normal, cs.facet_direction, t, w)
         # the paper's split: along the normal n(t) of the quadratic edges at each point
-        e = cs.edges
+        e = cs.facets
         ((_, sn, arc),) = stresses.on_facets(mesh.facet2cell[e, 0], mesh.facet_local[e, 0], t)
         speed, normal = arc.speeds(t), arc.normals(t)
         J4n = tangential_stress(sn, normal, w, speed)

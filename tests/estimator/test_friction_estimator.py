@@ -161,7 +161,7 @@ def test_manufactured_stick_slip_estimator_and_error_decay_alike():
     for _, _, _, _, r in rows[1:]:
         est = estimate(r)
         top = int(np.argmax(est.eta2_node[k8]))
-        x_top, h = r.space.node_points[top, 0], r.mesh.edge_length[r.contact.edges].max()
+        x_top, h = r.space.node_points[top, 0], r.mesh.edge_length[r.contact.facets].max()
         print(f"largest η8 node contribution at x = {x_top:.4f} (c = {C}, h = {h:.4f})")
         assert abs(x_top - C) < 2 * h, (x_top, h)
     # the discrete solution has both zones: stick nodes left of c, slip nodes right of it
@@ -295,8 +295,10 @@ def test_adaptive_coulomb_rate_and_where_it_refines():
     last = levels[-1].result
     x, points = _transitions(last)
     mesh, cs = last.mesh, last.contact
-    length = mesh.edge_length[cs.edges]
-    mid = 0.5 * (mesh.points[mesh.edges[cs.edges, 0], 0] + mesh.points[mesh.edges[cs.edges, 1], 0])
+    length = mesh.edge_length[cs.facets]
+    mid = 0.5 * (
+        mesh.points[mesh.edges[cs.facets, 0], 0] + mesh.points[mesh.edges[cs.facets, 1], 0]
+    )
     finest = mid[np.argsort(length)[:12]]
     print("contact ends and stick–slip transitions at x =", np.round(points, 4))
     print(

@@ -228,7 +228,7 @@ def reference_eta6(result) -> np.ndarray:
     cond = problem.conditions[name]
     gap = cond.gap if callable(cond.gap) else (lambda x, g=cond.gap: np.full(x.shape[:-1], g))
     normal = problem.contact_normals[name]
-    for ia, ib, im in cs.edge_nodes:
+    for ia, ib, im in cs.facet_nodes:
         a, b = X[ia], X[ib]
         length = np.linalg.norm(b - a)
         ua, ub, um = (result.u[i] @ normal for i in (ia, ib, im))
@@ -306,7 +306,7 @@ def test_indicator_bookkeeping(name, seed):
     np.testing.assert_array_equal(est.eta2_node[ROW["eta_6"], ~semi], 0.0)
     # η7 lives on the cells along Γ_C
     touching = np.zeros(mesh.n_cells, dtype=bool)
-    touching[mesh.edge2cell[cs.edges, 0]] = True
+    touching[mesh.facet2cell[cs.facets, 0]] = True
     np.testing.assert_array_equal(est.eta2_cell[ROW["eta_7"], ~touching], 0.0)
     print(f"{name} seed {seed}: eta = {est.eta:.6e}, terms = {np.round(est.eta_terms, 6)}")
 
@@ -406,7 +406,7 @@ def test_eta7_from_independently_built_edge_data():
         total, share = hhalf_norm2_positive_part(x0, x1, w)
         eta7_2 = est.eta2_terms[ROW["eta_7"]]
         cells = np.zeros(result.mesh.n_cells)
-        np.add.at(cells, result.mesh.edge2cell[edges, 0], share)
+        np.add.at(cells, result.mesh.facet2cell[edges, 0], share)
         l2 = 0.0
         max_w = 0.0
         for (wa, wb, wm), xa, xb in zip(w, x0, x1, strict=True):

@@ -198,8 +198,8 @@ def test_solution_and_estimator_under_scaling_and_translation(a, shift):
     )
     assert np.array_equal(r.active, r0.active) and np.array_equal(r.classes, r0.classes)
     cs = r0.contact
-    x0, x1 = r0.mesh.points[cs.edge_nodes[:, 0]], r0.mesh.points[cs.edge_nodes[:, 1]]
-    v = cs.edge_normal_gap(r0.u)
+    x0, x1 = r0.mesh.points[cs.facet_nodes[:, 0]], r0.mesh.points[cs.facet_nodes[:, 1]]
+    v = cs.facet_normal_gap(r0.u)
     l2 = l2_norm2_positive_part(x0, x1, v)
     semi = hhalf_seminorm2_positive_part(x0, x1, v)
     l2, semi = (q[0] if isinstance(q, tuple) else q for q in (l2, semi))

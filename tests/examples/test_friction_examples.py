@@ -1,5 +1,5 @@
 """The friction examples through the adaptive loop: Example 6.2 with Coulomb friction and the
-partial-slip cylinder (signorini.examples.friction, signorini.examples.partial_slip).
+partial-slip cylinder (signorini.examples.paper_friction, signorini.examples.partial_slip).
 
 Each must converge at the optimal rate (η_h like Ndof⁻¹), refine at the stick–slip
 transition points, and meet the KKT conditions of both laws on every level; the partial-slip
@@ -60,7 +60,7 @@ def transitions(result, axis: int) -> tuple[np.ndarray, np.ndarray]:
 
 def contact_edges(result, axis: int) -> tuple[np.ndarray, np.ndarray]:
     """Midpoint coordinate ``axis`` and length of every contact edge."""
-    mesh, edges = result.mesh, result.contact.edges
+    mesh, edges = result.mesh, result.contact.facets
     ends = mesh.points[mesh.edges[edges]]
     return ends[:, :, axis].mean(axis=1), mesh.edge_length[edges]
 
@@ -172,7 +172,7 @@ def test_example_6_2_friction_laws_give_the_stated_stick_and_slip_zones():
     """On the initial mesh refined three times (2 048 cells, h = 1/32 on Γ_C): Coulomb F = 0.3
     sticks around the kink y = 1/2 and slips towards the ends of the contact zone; Tresca
     s = 30 slips around the kink (but at it) and sticks at the ends; both have about the
-    frictionless contact zone y ≈ 0.19 … 0.81, to an edge (examples/friction.py)."""
+    frictionless contact zone y ≈ 0.19 … 0.81, to an edge (examples/paper_friction.py)."""
     from signorini import solve
     from signorini.contact.solution import SLIP, STICK
     from signorini.examples import example_6_2, example_6_2_tresca

@@ -190,10 +190,10 @@ def test_mesh_figure_finds_the_arc_of_a_refined_mesh():
     def key(segments):
         return sorted(tuple(sorted(map(tuple, np.round(s, 12)))) for s in segments)
 
-    assert len(arc) > 2 * initial.part_edges("arc").size
+    assert len(arc) > 2 * initial.part_facets("arc").size
     assert key(found) == key(arc)
     top = part_segments(initial, "top", mesh.points, mesh.cells)
-    assert np.array_equal(top, initial.points[initial.edges[initial.part_edges("top")]])
+    assert np.array_equal(top, initial.points[initial.facets[initial.part_facets("top")]])
 
 
 def test_resumed_run_gives_the_hertz_columns_of_the_uninterrupted_run(tmp_path, monkeypatch):

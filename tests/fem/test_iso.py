@@ -10,8 +10,8 @@ from fem_problems import GradientField, stress_of
 
 from signorini.contact.system import assemble
 from signorini.fem import iso
-from signorini.fem.loads import assemble_body_force, assemble_edge_load
-from signorini.fem.mapping import IsoparametricCells, QuadraticEdges
+from signorini.fem.loads import assemble_body_force, assemble_facet_load
+from signorini.fem.mapping import IsoparametricCells, QuadraticFacets
 from signorini.fem.material import Material
 from signorini.fem.norms import energy_error2
 from signorini.fem.space import P2Space
@@ -201,15 +201,15 @@ def test_curved_edge_load_integrates_along_the_arc():
     dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1, 6)
     one = lambda x, n: np.broadcast_to([1.0, 0.0], x.shape)  # noqa: E731
     ends = mesh.points[nodes[:, :2]]
-    arc = QuadraticEdges(space.node_points[nodes])
-    G = assemble_edge_load(arc, dofs, space.n_dofs, one, 8)
-    chord = assemble_edge_load(ends, dofs, space.n_dofs, one, 8)
+    arc = QuadraticFacets(space.node_points[nodes])
+    G = assemble_facet_load(arc, dofs, space.n_dofs, one, 8)
+    chord = assemble_facet_load(ends, dofs, space.n_dofs, one, 8)
     print(f"arc length {G[0::2].sum()}, chords {chord[0::2].sum()}, exact {np.pi / 2}")
     assert abs(G[0::2].sum() - np.pi / 2) < 2e-4
     assert abs(chord[0::2].sum() - np.pi / 2) > 1e-2
     # the normal passed to the traction is the arc's outward normal (towards the origin)
     seen = []
-    assemble_edge_load(arc, dofs, space.n_dofs, lambda x, n: seen.append((x, n)) or 0 * x, 8)
+    assemble_facet_load(arc, dofs, space.n_dofs, lambda x, n: seen.append((x, n)) or 0 * x, 8)
     x, n = seen[0]
     assert np.abs(np.hypot(*x.reshape(-1, 2).T) - 1).max() < 1e-3
     assert np.abs(n + x / np.hypot(x[..., 0], x[..., 1])[..., None]).max() < 2e-2

@@ -12,9 +12,9 @@ from signorini.fem.mapping import (
     AffineCells,
     CellMap,
     IsoparametricCells,
-    QuadraticEdges,
-    StraightEdges,
-    edge_groups,
+    QuadraticFacets,
+    StraightFacets,
+    facet_groups,
 )
 from signorini.fem.material import Material, stress
 from signorini.fem.postprocess import cell_stress
@@ -139,7 +139,7 @@ def test_area_of_a_disc_sector_and_length_of_an_arc_converge_at_the_expected_rat
     for n in (2, 4, 8, 16):
         nodes = sector_nodes(n)
         area.append(abs(IsoparametricCells(nodes).measure(w, xi).sum() - np.pi / 4))
-        arc = QuadraticEdges(nodes[:, [1, 2, 4]])
+        arc = QuadraticFacets(nodes[:, [1, 2, 4]])
         length.append(abs((arc.speeds(t) * wt).sum() - np.pi / 2))
     rate_area = np.log2(np.array(area[:-1]) / area[1:])
     rate_length = np.log2(np.array(length[:-1]) / length[1:])
@@ -148,25 +148,25 @@ def test_area_of_a_disc_sector_and_length_of_an_arc_converge_at_the_expected_rat
     # the error's mean over each edge one order smaller)
     assert np.all(rate_area > 3.9) and np.all(rate_length > 3.9)
     # straight chords: O(h^2)
-    chords = StraightEdges(sector_nodes(16)[:, [1, 2]])
+    chords = StraightFacets(sector_nodes(16)[:, [1, 2]])
     assert abs(chords.length.sum() - np.pi / 2) > 100 * length[-1]
 
 
 def test_edges_straight_and_quadratic():
     ends = np.array([[[0.0, 0.0], [3.0, 4.0]], [[1.0, 1.0], [1.0, -1.0]]])
-    straight = StraightEdges(ends)
+    straight = StraightFacets(ends)
     np.testing.assert_array_equal(straight.length, [5.0, 2.0])
     np.testing.assert_allclose(straight.normals()[:, 0], [[0.8, -0.6], [-1.0, 0.0]])
     t = np.array([0.0, 0.25, 1.0])
     np.testing.assert_allclose(straight.points(t)[0], [[0, 0], [0.75, 1.0], [3, 4]])
     # a quadratic edge with its midpoint on the chord is the straight edge
-    flat = QuadraticEdges(np.concatenate([ends, ends.mean(axis=1, keepdims=True)], axis=1))
+    flat = QuadraticFacets(np.concatenate([ends, ends.mean(axis=1, keepdims=True)], axis=1))
     assert np.abs(flat.points(t) - straight.points(t)).max() < 1e-15
     assert np.abs(flat.normals(t) - straight.normals(t)).max() < 1e-15
     assert np.abs(flat.speeds(t) - straight.speeds(t)).max() < 1e-14
     assert np.abs(flat.speed_at(np.tile(t, (2, 1))) - straight.length[:, None]).max() < 1e-14
-    groups = list(edge_groups(flat.nodes, np.array([False, True])))
-    assert [type(g).__name__ for _, g in groups] == ["StraightEdges", "QuadraticEdges"]
+    groups = list(facet_groups(flat.nodes, np.array([False, True])))
+    assert [type(g).__name__ for _, g in groups] == ["StraightFacets", "QuadraticFacets"]
     assert [list(r) for r, _ in groups] == [[0], [1]]
 
 

@@ -13,7 +13,7 @@ RNG = np.random.default_rng(5)
 MAT = Material.from_lame(1.3, 0.8)
 
 
-def test_div_stress_traction_and_edge_traction_for_quadratic_field():
+def test_div_stress_traction_and_facet_traction_for_quadratic_field():
     mesh = SquareMesh(3, RNG, perturb=0.3)
     u = random_quadratic(RNG)
     u_cell = mesh.interpolate(u.value)[mesh.cell_dofs]

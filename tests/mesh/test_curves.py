@@ -25,7 +25,7 @@ def disc(k: int = 8, radius: float = 1.0, center=(0.0, 0.0)) -> Mesh:
 
 
 def on_circle_error(mesh: Mesh, part: str, center, radius) -> float:
-    v = np.unique(mesh.edges[mesh.part_facets(part)])
+    v = np.unique(mesh.facets[mesh.part_facets(part)])
     r = np.hypot(*(mesh.points[v] - center).T)
     return float(np.abs(r / radius - 1).max())
 
@@ -77,8 +77,8 @@ def test_a_quarter_disc_keeps_straight_sides_straight_and_its_arc_on_the_circle(
     for _ in range(4):
         mesh = refine_uniform(mesh).mesh
     assert on_circle_error(mesh, "arc", (0, 0), 1) <= 1e-14
-    assert np.all(mesh.points[np.unique(mesh.edges[mesh.part_facets("bottom")]), 1] == 0)
-    assert np.all(mesh.points[np.unique(mesh.edges[mesh.part_facets("left")]), 0] == 0)
+    assert np.all(mesh.points[np.unique(mesh.facets[mesh.part_facets("bottom")]), 1] == 0)
+    assert np.all(mesh.points[np.unique(mesh.facets[mesh.part_facets("left")]), 0] == 0)
 
 
 def test_a_straight_mesh_refines_exactly_as_without_curves():

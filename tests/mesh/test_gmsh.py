@@ -61,7 +61,7 @@ def test_read_mesh_from_gmsh_file(tmp_path, order, binary):
     assert np.all(mesh.area > 0) and mesh.area.sum() == pytest.approx(1.0, rel=1e-14)
     side = {"bottom": (1, 0.0), "right": (0, 1.0), "top": (1, 1.0), "left": (0, 0.0)}
     for name, (axis, value) in side.items():
-        pts = mesh.points[mesh.edges[mesh.part_facets(name)]]
+        pts = mesh.points[mesh.facets[mesh.part_facets(name)]]
         np.testing.assert_array_equal(pts[..., axis], value)
         assert mesh.part_measure(name) == pytest.approx(1.0, rel=1e-14)
     # the same problem on the mesh read back gives the same discrete solution

@@ -97,7 +97,7 @@ def radial_error(mesh: Mesh) -> float:
     """Largest distance of a vertex of the arc parts from its circle."""
     errors = []
     for name, rho in ARCS.items():
-        v = np.unique(mesh.edges[mesh.part_facets(name)])
+        v = np.unique(mesh.facets[mesh.part_facets(name)])
         errors.append(np.abs(np.hypot(*mesh.points[v].T) - rho).max())
     return float(max(errors))
 
@@ -146,7 +146,7 @@ def test_refinement_stays_on_the_files_quadratics_and_keeps_every_cell_valid(tmp
         # boundary is those quadratics: the discrete domain keeps its area to round-off
         for name in ARCS:
             curve = second.curves[second.part_index(name)]
-            v = np.unique(second.edges[second.part_facets(name)])
+            v = np.unique(second.facets[second.part_facets(name)])
             assert np.abs(curve.project(second.points[v]) - second.points[v]).max() <= 1e-15
         assert abs(isoparametric_area(second) - area0) <= 1e-14 * area0
         errors.append(radial_error(second))
@@ -171,7 +171,7 @@ def test_adaptive_refinement_stays_on_the_files_quadratics(tmp_path):
         assert mesh.area.min() > 0 and iso.folded(P2Space(mesh).curved[1]).size == 0
     for name in ARCS:
         curve = mesh.curves[mesh.part_index(name)]
-        v = np.unique(mesh.edges[mesh.part_facets(name)])
+        v = np.unique(mesh.facets[mesh.part_facets(name)])
         assert np.abs(curve.project(mesh.points[v]) - mesh.points[v]).max() <= 1e-15
     change = abs(isoparametric_area(mesh) - area0) / area0
     lengths = mesh.edge_length[mesh.part_facets("outer")]
@@ -295,7 +295,7 @@ def test_with_curve_replaces_the_files_curve(tmp_path):
     assert np.abs(exact.curved_midpoints[e] - mesh.curved_midpoints[e]).max() <= 1e-15
     for _ in range(3):
         exact = refine_uniform(exact).mesh
-    v = np.unique(exact.edges[exact.part_facets("outer")])
+    v = np.unique(exact.facets[exact.part_facets("outer")])
     off = np.abs(np.hypot(*exact.points[v].T) - 2).max()
     print(f"outer arc with the exact circle after 3 refinements: radial error {off:.1e}")
     assert off <= 1e-14

@@ -17,7 +17,7 @@ from mesh_problems import (
 )
 
 from signorini.mesh.builders import rectangle
-from signorini.mesh.mesh import Mesh, MeshError, boundary_edges
+from signorini.mesh.mesh import Mesh, MeshError, boundary_facets
 
 
 # ---------------------------------------------------------------------------- boundary parts
@@ -95,7 +95,7 @@ def test_from_arrays_with_edge_lists() -> None:
     m = Mesh.from_arrays(p, c, {"south": [[1, 0]], "east": [1, 2], "rest": [[2, 3], [0, 3]]})
     expect = {"south": {0, 1}, "east": {1, 2}, "rest": {2, 3, 0}}
     for name, verts in expect.items():
-        e = m.edges[m.part_facets(name)]
+        e = m.facets[m.part_facets(name)]
         assert set(e.ravel().tolist()) == verts
     assert m.part_measure("rest") == pytest.approx(2.0, abs=1e-15)
     assert m.facet_part[m.facet2cell[:, 1] >= 0].tolist() == [-1] * 4
@@ -162,8 +162,8 @@ def test_boundary_edges_have_one_cell(name: str) -> None:
     assert np.all(m.facet2cell[:, 0] >= 0)
     assert np.array_equal(np.sort(m.boundary_facet), np.flatnonzero(on_boundary))
     assert np.array_equal(m.facet_part >= 0, on_boundary)
-    # boundary_edges() gives each boundary edge once, in its cell's counter-clockwise order
-    be = boundary_edges(m.cells)
+    # boundary_facets() gives each boundary facet once, in its cell's counter-clockwise order
+    be = boundary_facets(m.cells)
     assert len(be) == on_boundary.sum()
     directed = {(cell[k], cell[(k + 1) % 3]) for cell in m.cells.tolist() for k in range(3)}
     assert all(tuple(e) in directed for e in be.tolist())
@@ -186,7 +186,7 @@ def test_edge_local_is_the_index_of_the_edge_in_its_cells(name: str) -> None:
 
 def test_topology_is_computed_once() -> None:
     m = rectangle(nx=3, ny=2)
-    for name in ("edges", "cell2edge", "edge2cell", "edge_local", "boundary_edge", "edge_part"):
+    for name in ("edges", "cell2edge", "facet2cell", "facet_local", "boundary_facet", "facet_part"):
         assert getattr(m, name) is getattr(m, name), name
 
 
@@ -290,14 +290,14 @@ def test_cached_arrays_are_read_only():
     for name in (
         "edges",
         "cell2edge",
-        "edge2cell",
-        "edge_local",
+        "facet2cell",
+        "facet_local",
         "area",
         "edge_length",
         "h",
         "edge_midpoints",
-        "boundary_edge",
-        "edge_part",
+        "boundary_facet",
+        "facet_part",
         "points",
         "cells",
     ):
@@ -315,7 +315,7 @@ def test_selectors_are_called_with_points_of_shape_n_2() -> None:
 
     m = Mesh.from_arrays(SQUARE_P, SQUARE_C, {"right": right, "rest": lambda x: x[:, 0] < 1})
     assert seen == [(4, 2)]
-    assert m.edges[m.part_facets("right")].tolist() == [[1, 2]]
+    assert m.facets[m.part_facets("right")].tolist() == [[1, 2]]
 
 
 def test_old_two_argument_selectors_warn_and_still_work() -> None:

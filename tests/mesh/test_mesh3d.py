@@ -155,3 +155,33 @@ def test_constructor_refuses_negative_cells_and_mismatched_shapes():
         Mesh.from_arrays(CUBE_POINTS, CUBE_CELLS[:, :3], {"a": lambda x: x[:, 0] > -1})
     with pytest.raises(MeshError, match=r"cells must have shape \(n, 3\)"):
         Mesh.from_arrays(CUBE_POINTS[:, :2], CUBE_CELLS, {"a": lambda x: x[:, 0] > -1})
+
+
+@pytest.mark.parametrize("n", [1, 3])
+def test_box_matches_the_independent_cube_of_studies_faces3d(n):
+    """The Kuhn cube of the independent study code: the same points, cells (as vertex
+    sets), edges and boundary faces."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "studies"))
+    from faces3d.mesh import cube_mesh
+
+    cube, mesh = cube_mesh(n), box(n, n, n)
+    np.testing.assert_allclose(mesh.points, cube.points[: cube.n_vertices], atol=1e-15)
+
+    def rows(a):
+        return {tuple(r) for r in np.sort(a, axis=1).tolist()}
+
+    assert rows(mesh.cells) == rows(cube.tets[:, :4])
+    assert np.array_equal(mesh.edges, cube.edges)
+    for axis in range(3):
+        for side, value in ((0, 0.0), (1, 1.0)):
+            faces = cube.boundary_faces(axis, value)[:, :3]
+            name = BOX_PARTS[2 * axis + side]
+            assert rows(mesh.facets[mesh.part_facets(name)]) == rows(faces)
+            # the study orients its faces outward too: the same normals
+            ours = mesh.oriented_boundary(mesh.part_facets(name))
+            n_ours = facet_normals(mesh.points[ours])[1]
+            n_theirs = facet_normals(cube.points[faces])[1]
+            np.testing.assert_allclose(n_ours.sum(0), n_theirs.sum(0), atol=1e-12)

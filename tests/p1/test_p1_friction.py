@@ -8,7 +8,7 @@ from signorini.contact.nested import NESTED_MIN_NDOF
 from signorini.contact.solution import solve
 from signorini.estimator.residual import estimate
 from signorini.examples import example_6_2
-from signorini.examples.friction import example_6_2_coulomb, example_6_2_tresca
+from signorini.examples.paper_friction import example_6_2_coulomb, example_6_2_tresca
 from signorini.examples.punch import punch
 from signorini.mesh.refine import refine_uniform
 

@@ -151,7 +151,7 @@ def test_p1_contact_patch_test(angle):
         f"{2 * p:.12g}; KKT {kkt}"
     )
     assert r.contact.size >= 9 and r.contact.is_vertex.all() and r.active.all()
-    assert r.contact.edge_nodes.shape[1] == 2
+    assert r.contact.facet_nodes.shape[1] == 2
     assert err < 1e-12
     assert density_err < 1e-10
     assert abs(r.total_contact_force - 2 * p) < 1e-10 * p

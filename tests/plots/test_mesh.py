@@ -15,7 +15,7 @@ from .figure_checks import check_written, png_size
 
 def test_mesh_figure_highlights_the_given_edges(tmp_path, captured):
     mesh = rectangle(nx=6, ny=6)
-    bottom = mesh.edges[mesh.part_facets("bottom")]
+    bottom = mesh.facets[mesh.part_facets("bottom")]
     written = plot_mesh(mesh.points, mesh.cells, tmp_path / "mesh", title="mesh", highlight=bottom)
     check_written(written, tmp_path / "mesh")
     (info,) = captured
@@ -31,7 +31,7 @@ def test_mesh_figure_highlights_the_given_edges(tmp_path, captured):
 
 def test_mesh_figure_with_several_groups(tmp_path, captured):
     mesh = rectangle(nx=3, ny=3)
-    groups = {name: mesh.edges[mesh.part_facets(name)] for name in ("left", "right")}
+    groups = {name: mesh.facets[mesh.part_facets(name)] for name in ("left", "right")}
     groups["none"] = np.zeros((0, 2), dtype=int)  # empty groups are left out
     plot_mesh(mesh.points, mesh.cells, tmp_path / "m", highlight=groups)
     (info,) = captured
@@ -66,16 +66,16 @@ def test_boundary_groups_of_a_refined_mesh_follow_the_coarse_parts():
     coarse = rectangle(nx=2, ny=2)
     fine = refine_uniform(refine_uniform(coarse).mesh).mesh
     segments = {
-        "D": coarse.points[coarse.edges[coarse.part_facets("top")]],
+        "D": coarse.points[coarse.facets[coarse.part_facets("top")]],
         "C": np.concatenate(
-            [coarse.points[coarse.edges[coarse.part_facets(n)]] for n in ("bottom", "right")]
+            [coarse.points[coarse.facets[coarse.part_facets(n)]] for n in ("bottom", "right")]
         ),
         "none": np.zeros((0, 2, 2)),
     }
     groups = boundary_groups(fine.points, fine.cells, segments)
     assert list(groups) == ["D", "C", "none"] and groups["none"].shape == (0, 2)
     for name, parts in (("D", ["top"]), ("C", ["bottom", "right"])):
-        expected = np.concatenate([fine.edges[fine.part_facets(n)] for n in parts])
+        expected = np.concatenate([fine.facets[fine.part_facets(n)] for n in parts])
         assert sorted(map(tuple, np.sort(groups[name], axis=1))) == sorted(map(tuple, expected))
 
 
@@ -106,7 +106,7 @@ def test_mesh_figure_height_follows_a_wide_body(tmp_path, captured):
 
 def test_mesh_figure_with_a_zoom(tmp_path, captured):
     mesh = refine_uniform(rectangle(nx=4, ny=4)).mesh
-    right = mesh.edges[mesh.part_facets("right")]
+    right = mesh.facets[mesh.part_facets("right")]
     plot_mesh(
         mesh.points,
         mesh.cells,

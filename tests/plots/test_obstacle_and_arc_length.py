@@ -126,10 +126,10 @@ def test_arc_lengths_on_a_closed_chain_start_at_its_first_edge():
     corners = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     mids = 0.5 * (corners + np.roll(corners, -1, axis=0))
     points = np.vstack([corners, mids])
-    edge_nodes = np.column_stack([np.arange(4), (np.arange(4) + 1) % 4, 4 + np.arange(4)])
+    facet_nodes = np.column_stack([np.arange(4), (np.arange(4) + 1) % 4, 4 + np.arange(4)])
     local = np.column_stack([np.arange(4), (np.arange(4) + 1) % 4, 4 + np.arange(4)])
     cs = SimpleNamespace(
-        parts=("loop",), edge_part=np.zeros(4, int), edge_nodes=edge_nodes, edge_local=local
+        parts=("loop",), facet_part=np.zeros(4, int), facet_nodes=facet_nodes, facet_local=local
     )
     rows, s = arc_lengths(cs, points)["loop"]
     np.testing.assert_array_equal(rows, [0, 4, 1, 5, 2, 6, 3, 7])

@@ -216,7 +216,7 @@ def test_oblique_roller_reproduces_an_affine_solution(bottom):
     expected = np.zeros(space.n_nodes)
     for name in [p for p, c in conditions.items() if isinstance(c, Roller)]:
         edges = mesh.part_facets(name)
-        nodes = space.edge_nodes(edges)
+        nodes = space.facet_nodes(edges)
         length = mesh.edge_length[edges]
         ab = mesh.points[nodes[0, :2]]
         normal = np.array([ab[1, 1] - ab[0, 1], ab[0, 0] - ab[1, 0]]) / length[0]

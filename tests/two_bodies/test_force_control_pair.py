@@ -13,14 +13,14 @@ import pytest
 from scipy.spatial import cKDTree
 
 from signorini.contact import solve
-from signorini.fem.loads import assemble_edge_load
+from signorini.fem.loads import assemble_facet_load
 from signorini.fem.material import Material
 from signorini.fem.stiffness import assemble_stiffness
 from signorini.mesh.bodies import union
 from signorini.mesh.builders import rectangle
 from signorini.mesh.mesh import Mesh
 from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
-from signorini.problem.friction import Coulomb
+from signorini.problem.friction_laws import Coulomb
 
 X0, X1 = 0.2, 0.8  # the block's width; the support is [0, 1] x [0, 1]
 MATERIALS = {"a": Material.from_young(1.0, 0.3), "b": Material.from_young(4.0, 0.25)}
@@ -76,7 +76,7 @@ def cartesian_system(problem):
     nodes = np.column_stack([ab, n_points + edges])
     dofs = (2 * nodes[:, :, None] + np.arange(2)).reshape(-1, 6)
     g = problem.conditions["a.top"].field()
-    F = assemble_edge_load(mesh.points[nodes[:, :2]], dofs, n_dofs, g, degree=8)
+    F = assemble_facet_load(mesh.points[nodes[:, :2]], dofs, n_dofs, g, degree=8)
     return K, F
 
 

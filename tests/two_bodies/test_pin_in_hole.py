@@ -28,7 +28,7 @@ from signorini.contact.system import assemble
 from signorini.examples.pin import pin_in_hole
 from signorini.loop import AdaptiveOptions, adaptive
 from signorini.mesh.refine import refine_uniform
-from signorini.problem.friction import Tresca
+from signorini.problem.friction_laws import Tresca
 
 COEFFICIENT = 0.2
 

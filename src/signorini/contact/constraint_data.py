@@ -103,7 +103,7 @@ def facet_weights(space: LagrangeSpace, facets: np.ndarray, facet_nodes: np.ndar
     length = space.mesh.facet_measure[facets]
     hat = np.outer(length, space.element.facet.hat_share)
     basis = np.outer(length, space.element.facet.basis_share)
-    curved = np.flatnonzero(np.isin(facets, space.curved_edges))
+    curved = np.flatnonzero(np.isin(facets, space.curved_facets))
     if curved.size:
         t, w = gauss_legendre(6)
         halves = np.concatenate([t / 2, 0.5 + t / 2])  # φ_z is linear on each half-edge

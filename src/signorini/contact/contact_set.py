@@ -28,7 +28,7 @@ import numpy as np
 
 from ..algebra.friction.laws import LawGroups
 from ..fem.space import LagrangeSpace
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from ..problem.fields import ProblemError
 from .admissible import check_dirichlet_admissible, check_initial_overlap, check_obstacle_side
 from .constraint_data import directions_and_gaps, facet_weights, friction_data
@@ -114,10 +114,7 @@ class ContactSet:
         ``ũ = u − T_d u`` (:meth:`relative`); ``None`` without pairs (``ũ = u``).
 
     Derived: ``tangent`` (the tangent space of each constraint as a basis beside its
-    normal), ``facet_tangent``, ``frames``, ``has_friction``. The edge names of the facet
-    arrays (``edges``, ``edge_nodes``, ``edge_part``, ``edge_gap``, ``edge_direction``,
-    ``edge_normal``, ``edge_local``, ``edge_tangent``, ``edge_relative``,
-    ``edge_normal_gap``) are kept as aliases until no module reads them.
+    normal), ``facet_tangent``, ``frames``, ``has_friction``.
     """
 
     nodes: np.ndarray
@@ -217,18 +214,6 @@ class ContactSet:
         un = np.einsum("ejc,ejc->ej", self.facet_relative(u), self.facet_direction)
         return un - self.facet_gap
 
-    # the edge names of the facet arrays, kept until no module reads them
-    edges = property(lambda self: self.facets)
-    edge_nodes = property(lambda self: self.facet_nodes)
-    edge_part = property(lambda self: self.facet_part)
-    edge_gap = property(lambda self: self.facet_gap)
-    edge_direction = property(lambda self: self.facet_direction)
-    edge_normal = property(lambda self: self.facet_normal)
-    edge_local = property(lambda self: self.facet_local)
-    edge_tangent = property(lambda self: self.facet_tangent)
-    edge_relative = facet_relative
-    edge_normal_gap = facet_normal_gap
-
 
 def _tangents(normal: np.ndarray) -> np.ndarray:
     """``(..., 1, 2)`` the tangent ``(−n_y, n_x)`` of unit normals ``(..., 2)``, as a basis."""
@@ -294,8 +279,8 @@ def contact_set(conditions: DiscreteConditions, space: LagrangeSpace) -> Contact
     facet_lists = [mesh.part_facets(p) for p in parts]
     facets = np.concatenate(facet_lists)
     facet_part = np.repeat(np.arange(len(parts)), [e.size for e in facet_lists])
-    facet_nodes = space.edge_nodes(facets)
-    _, chord = segment_normals(mesh.points[facet_nodes[:, 0]], mesh.points[facet_nodes[:, 1]])
+    facet_nodes = space.facet_nodes(facets)
+    _, chord = facet_normals(mesh.points[facet_nodes[:, :2]])
     for i in range(len(parts)):  # straight parts: exactly their normal
         if conditions.straight(i) is not None:
             chord[facet_part == i] = conditions.straight_normal[i]

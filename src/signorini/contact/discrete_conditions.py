@@ -177,7 +177,7 @@ def _gaps(space: LagrangeSpace, parts: tuple, conditions: list, pairs: Mapping) 
     (NaN where the part has none: a gap function's direction, a slave's mortar data)."""
     nodes, gaps, directions = [], [], []
     for name, cond in zip(parts, conditions, strict=True):  # a loop over parts
-        z = np.unique(space.edge_nodes(space.mesh.part_facets(name)))
+        z = np.unique(space.facet_nodes(space.mesh.part_facets(name)))
         x = space.node_points[z]
         psi, n = np.full(z.size, np.nan), np.full((z.size, 2), np.nan)
         if name in pairs:

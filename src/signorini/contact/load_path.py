@@ -160,7 +160,7 @@ def mesh_difference(a: Mesh, b: Mesh) -> str | None:
     moved = np.flatnonzero(la != lb)
     if moved.size:
         e = moved[0]
-        x = a.points[a.edges[e]]
+        x = a.points[a.facets[e]]
         return (
             f"labels {moved.size} boundary edge(s) with other parts (the edge "
             f"({x[0, 0]:.12g}, {x[0, 1]:.12g})–({x[1, 0]:.12g}, {x[1, 1]:.12g}) is on part "

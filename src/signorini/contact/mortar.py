@@ -37,9 +37,9 @@ from .mortar_pairing import (
     Side,
     candidate_pairs,
     directions,
-    edge_basis,
+    facet_basis,
     master_parameter,
-    on_edge,
+    on_facet,
     segments,
     side,
 )
@@ -103,8 +103,8 @@ def _dual_basis(slave: Side) -> tuple[np.ndarray, np.ndarray]:
     weights ``D_e = ∫_e φ_a ds = Σ_b (M_e)_ab`` ``(e, 3)`` and the coefficients ``A_e = D_e
     M_e⁻¹`` ``(e, 3, 3)`` of the dual basis ``ψ_a = Σ_b (A_e)_ab φ_b``."""
     t, w = gauss_legendre(MASS_POINTS)
-    phi, _ = edge_basis(t)
-    _, dx = on_edge(slave.points, np.broadcast_to(t, (len(slave.points), t.size)))
+    phi, _ = facet_basis(t)
+    _, dx = on_facet(slave.points, np.broadcast_to(t, (len(slave.points), t.size)))
     ws = w * np.hypot(dx[..., 0], dx[..., 1])  # (e, q)
     mass = np.einsum("eq,qa,qb->eab", ws, phi, phi)
     weight = mass.sum(axis=2)
@@ -129,14 +129,14 @@ def _mortar_entries(slave: Side, master: Side, seg: tuple, N: np.ndarray, coef: 
         t, w = gauss_legendre(points)
         length = hi[g] - lo[g]
         xi = lo[g, None] + length[:, None] * t  # (S, q)
-        xs, dxs = on_edge(slave.points[e[g]], xi)
-        n, _ = on_edge(N[e[g]], xi)
+        xs, dxs = on_facet(slave.points[e[g]], xi)
+        n, _ = on_facet(N[e[g]], xi)
         eta, _ = master_parameter(master.points[f[g]], xs, n)
-        nm, _ = on_edge(master.normals[f[g]], eta[:, points // 2])
+        nm, _ = on_facet(master.normals[f[g]], eta[:, points // 2])
         faces[g] = np.einsum("pi,pi->p", n[:, points // 2], nm) < 0
         ws = length[:, None] * w * np.hypot(dxs[..., 0], dxs[..., 1])
-        psi = np.einsum("sqb,sab->sqa", edge_basis(xi)[0], coef[e[g]])
-        out[g] = np.einsum("sq,sqa,sqb->sab", ws, psi, edge_basis(eta)[0])
+        psi = np.einsum("sqb,sab->sqa", facet_basis(xi)[0], coef[e[g]])
+        out[g] = np.einsum("sq,sqa,sqb->sab", ws, psi, facet_basis(eta)[0])
     return out, faces
 
 

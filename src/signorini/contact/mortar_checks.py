@@ -22,12 +22,12 @@ COVERAGE_TOL = 1e-12
 
 def _bodies(space: P2Space) -> np.ndarray:
     """``(n_cells,)`` the body of each cell: components of the cells joined through interior
-    edges (as :class:`~signorini.problem.ContactProblem` finds them)."""
+    facets (as :class:`~signorini.problem.ContactProblem` finds them)."""
     mesh = space.mesh
-    e2c = mesh.facet2cell
-    inner = e2c[:, 1] >= 0
+    f2c = mesh.facet2cell
+    inner = f2c[:, 1] >= 0
     graph = sp.coo_matrix(
-        (np.ones(int(inner.sum()), dtype=np.int8), (e2c[inner, 0], e2c[inner, 1])),
+        (np.ones(int(inner.sum()), dtype=np.int8), (f2c[inner, 0], f2c[inner, 1])),
         shape=(mesh.n_cells, mesh.n_cells),
     )
     return connected_components(graph, directed=False)[1]

@@ -1,10 +1,11 @@
-"""The geometry of a mortar contact pair (:mod:`signorini.contact.mortar`): the parts' edges
-and normals, the P2 edge maps, the projections between slave and master, the candidate
-edge pairs, the constraint directions and the slave edges' segments over the master
-(docs/method.md, *Two bodies: the dual mortar coupling*). Vectorized over edges and pairs; the
+"""The geometry of a mortar contact pair (:mod:`signorini.contact.mortar`): the parts' facets
+(edges in 2D: the pairing projects along curves, a 2D kernel; 3D faces get their own)
+and normals, the P2 facet maps, the projections between slave and master, the candidate
+facet pairs, the constraint directions and the slave facets' segments over the master
+(docs/method.md, *Two bodies: the dual mortar coupling*). Vectorized over facets and pairs; the
 loops are over Newton steps.
 
-Arrays: an edge's nodes are ``[start, end, midpoint]`` (counter-clockwise around its cell)
+Arrays: a facet's nodes are ``[start, end, midpoint]`` (counter-clockwise around its cell)
 and its map ``x(t) = Σ_a x_a φ_a(t)``, ``t ∈ [0, 1]``.
 """
 
@@ -17,7 +18,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..fem.space import P2Space
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from .constraint_data import part_normals
 
 __all__ = [
@@ -25,18 +26,18 @@ __all__ = [
     "candidate_pairs",
     "cross",
     "directions",
-    "edge_basis",
+    "facet_basis",
     "master_parameter",
-    "on_edge",
+    "on_facet",
     "segments",
     "side",
 ]
 
-#: a projected master vertex within ``SNAP · eps · max|x| / h`` of a slave edge's end (the
+#: a projected master vertex within ``SNAP · eps · max|x| / h`` of a slave facet's end (the
 #: round-off of the projection) is put on the end
 SNAP = 64
 #: Newton steps of the projections (quadratic convergence; a straight master needs one),
-#: stopped once every step in the edge parameter is at most ``NEWTON_TOL``: the error after
+#: stopped once every step in the facet parameter is at most ``NEWTON_TOL``: the error after
 #: it is of its square, below round-off
 NEWTON_STEPS = 30
 NEWTON_TOL = 1e-13
@@ -44,7 +45,7 @@ NEWTON_TOL = 1e-13
 
 @dataclass(frozen=True)
 class Side:
-    """One part's edges: ``nodes (e, 3)`` global, ``points (e, 3, 2)``, outward nodal
+    """One part's facets: ``nodes (e, 3)`` global, ``points (e, 3, 2)``, outward nodal
     ``normals (e, 3, 2)`` (:func:`~signorini.contact.constraint_data.part_normals`),
     ``curved (e,)``."""
 
@@ -55,35 +56,35 @@ class Side:
 
 
 def side(space: P2Space, name: str) -> Side:
-    """The edges of boundary part ``name``, their node points and the body's outward normals
+    """The facets of boundary part ``name``, their node points and the body's outward normals
     at their nodes (as contact parts compute them: the curve's, else the mean of the part's
-    edges' normals at a vertex); curved where the part carries a curve."""
+    facets' normals at a vertex); curved where the part carries a curve."""
     mesh = space.mesh
-    edges = mesh.part_facets(name)
-    nodes = space.edge_nodes(edges)
+    facets = mesh.part_facets(name)
+    nodes = space.facet_nodes(facets)
     points = space.node_points[nodes]
-    _, chord = segment_normals(points[:, 0], points[:, 1])
+    _, chord = facet_normals(points[:, :2])
     curve = mesh.curves[mesh.part_index(name)]
-    curved = np.full(edges.size, curve is not None, dtype=bool)
+    curved = np.full(facets.size, curve is not None, dtype=bool)
     return Side(nodes, points, part_normals(space, name, nodes, chord), curved)
 
 
-# --------------------------------------------------------------------------- edge kernels
+# --------------------------------------------------------------------------- facet kernels
 
 
-def edge_basis(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """P2 edge basis ``[start, end, midpoint]`` and its derivative at ``t (...)``: ``(..., 3)``
+def facet_basis(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """P2 facet basis ``[start, end, midpoint]`` and its derivative at ``t (...)``: ``(..., 3)``
     each."""
     phi = np.stack([(1 - t) * (1 - 2 * t), t * (2 * t - 1), 4 * t * (1 - t)], axis=-1)
     dphi = np.stack([4 * t - 3, 4 * t - 1, 4 - 8 * t], axis=-1)
     return phi, dphi
 
 
-def on_edge(X: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def on_facet(X: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``Σ_a X_a φ_a(t)`` and its t-derivative for nodal values ``X (p, 3, 2)`` at ``t (p,)``
     or ``(p, q)``: ``(p, 2)`` or ``(p, q, 2)`` each. Written on ``X_a − X_0`` (``Σ_a φ_a = 1``,
-    ``Σ_a φ_a' = 0``), so a short edge far from the origin keeps its digits."""
-    phi, dphi = edge_basis(t)
+    ``Σ_a φ_a' = 0``), so a short facet far from the origin keeps its digits."""
+    phi, dphi = facet_basis(t)
     rel = X[:, 1:] - X[:, :1]
     if t.ndim == 1:
         x = X[:, 0] + np.einsum("pa,pai->pi", phi[..., 1:], rel)
@@ -120,9 +121,9 @@ def newton(residual, t: np.ndarray, lo: float, hi: float) -> np.ndarray:
 
 
 def master_parameter(X: np.ndarray, x: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, ...]:
-    """η where the line ``x + t n`` meets the master edges ``X (p, 3, 2)`` (``x, n (p, 2)`` or
+    """η where the line ``x + t n`` meets the master facets ``X (p, 3, 2)`` (``x, n (p, 2)`` or
     ``(p, q, 2)``): Newton on ``(x_m(η) − x) × n = 0`` from the chord's intersection (exact
-    for a straight edge), kept within ``[−1, 2]``. Returns ``η`` and whether it converged."""
+    for a straight facet), kept within ``[−1, 2]``. Returns ``η`` and whether it converged."""
     shape = x.shape[:-1]
     rows = np.repeat(np.arange(len(X)), x[0, ..., 0].size)
     x, n = x.reshape(-1, 2), n.reshape(-1, 2)
@@ -132,18 +133,18 @@ def master_parameter(X: np.ndarray, x: np.ndarray, n: np.ndarray) -> tuple[np.nd
     eta = np.clip(np.nan_to_num(eta, nan=0.5), -1.0, 2.0)
 
     def residual(t, live):
-        xm, dxm = on_edge(X[rows[live]], t)
+        xm, dxm = on_facet(X[rows[live]], t)
         return cross(xm - x[live], n[live]), cross(dxm, n[live])
 
     eta = newton(residual, eta, -1.0, 2.0)
-    xm, _ = on_edge(X[rows], eta)
+    xm, _ = on_facet(X[rows], eta)
     scale = np.hypot(*(b - a).T) * np.hypot(n[:, 0], n[:, 1])
     ok = np.abs(cross(xm - x, n)) <= 1e-12 * scale
     return eta.reshape(shape), ok.reshape(shape)
 
 
 def slave_parameter(X: np.ndarray, N: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """ξ where the slave edge ``X (p, 3, 2)`` with the normal field ``n(ξ) = Σ N_a φ_a(ξ)``
+    """ξ where the slave facet ``X (p, 3, 2)`` with the normal field ``n(ξ) = Σ N_a φ_a(ξ)``
     projects onto the points ``y (p, 2)``: ``(x_s(ξ) − y) × n(ξ) = 0``, Newton from the
     projection onto the chord, kept within ``[−1, 2]``."""
     a, b = X[:, 0], X[:, 1]
@@ -151,8 +152,8 @@ def slave_parameter(X: np.ndarray, N: np.ndarray, y: np.ndarray) -> np.ndarray:
     xi = np.clip(np.einsum("pi,pi->p", y - a, d) / np.einsum("pi,pi->p", d, d), -1.0, 2.0)
 
     def residual(t, live):
-        xs, dxs = on_edge(X[live], t)
-        n, dn = on_edge(N[live], t)
+        xs, dxs = on_facet(X[live], t)
+        n, dn = on_facet(N[live], t)
         return cross(xs - y[live], n), cross(dxs, n) + cross(xs - y[live], dn)
 
     return newton(residual, xi, -1.0, 2.0)
@@ -164,16 +165,16 @@ def slave_parameter(X: np.ndarray, N: np.ndarray, y: np.ndarray) -> np.ndarray:
 def candidate_pairs(
     slave: Side, master: Side, mix: tuple, wide: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Slave and master edges ``(e, f)`` that may face each other, by a k-d tree of the
-    master edges' centres: f is a candidate of e if its centre is within ``ρ_e + r_f`` of a
-    centre ``c_e`` (``r`` an edge's radius about its centre).
+    """Slave and master facets ``(e, f)`` that may face each other, by a k-d tree of the
+    master facets' centres: f is a candidate of e if its centre is within ``ρ_e + r_f`` of a
+    centre ``c_e`` (``r`` a facet's radius about its centre).
 
     By default (*near*): each node x of e is sent along the direction estimated from the
     master's normal ``n_q`` at its nearest master node q (:func:`direction`) to the master's
     tangent line at q, at p; ``c_e`` is the mean of its nodes' p and ``ρ_e = r_e + max |p −
-    c_e| + 2 max |p − q|``: a few master edges per slave edge, whatever the gap. For the
-    slave edges ``wide`` (where the near search left a node unpaired or the edge not
-    covered, :func:`~signorini.contact.mortar.mortar_coupling`): ``c_e`` the edge's centre
+    c_e| + 2 max |p − q|``: a few master facets per slave facet, whatever the gap. For the
+    slave facets ``wide`` (where the near search left a node unpaired or the facet not
+    covered, :func:`~signorini.contact.mortar.mortar_coupling`): ``c_e`` the facet's centre
     and ``ρ_e = 3 r_e + 2 d_e``, ``d_e`` the largest distance from a node of e to the nearest
     master node: a master point reached from a point of e (within ``d_e + r_e`` of the
     master) along a direction within 60° of the master's normal lies within twice that."""
@@ -238,7 +239,7 @@ def angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def paired_points(
     master: Side, f: np.ndarray, x: np.ndarray, ns: np.ndarray, mix: tuple
 ) -> tuple[np.ndarray, np.ndarray]:
-    """η on master edges ``f (p,)`` where ``x_m(η) − x`` is along ``d(η)``, the direction of
+    """η on master facets ``f (p,)`` where ``x_m(η) − x`` is along ``d(η)``, the direction of
     :func:`direction` from n_s and ``n_m(η)`` (the normalised interpolant of the master's
     nodal normals): Newton on ``(x_m(η) − x) × d(η) = 0`` from the chord's intersection along
     ``d(1/2)``, kept within ``[−1/2, 3/2]``; ``d'`` by the chain rule through the angle of
@@ -253,8 +254,8 @@ def paired_points(
     share = mix[1] / (mix[0] + mix[1])
 
     def residual(t, live):
-        xm, dxm = on_edge(X[live], t)
-        m, dm = on_edge(N[live], t)
+        xm, dxm = on_facet(X[live], t)
+        m, dm = on_facet(N[live], t)
         size = np.hypot(m[:, 0], m[:, 1])
         nm = m / size[:, None]
         turn = cross(nm, dm) / size  # d(angle of n_m)/dη
@@ -264,8 +265,8 @@ def paired_points(
         return cross(r, d), cross(dxm, d) + cross(r, dd)
 
     eta = newton(residual, eta, -0.5, 1.5)
-    xm, _ = on_edge(X, eta)
-    d = direction(ns, unit(on_edge(N, eta)[0]), xm - x, mix)
+    xm, _ = on_facet(X, eta)
+    d = direction(ns, unit(on_facet(N, eta)[0]), xm - x, mix)
     scale = np.hypot(*(B - A).T) + np.hypot(*(xm - x).T)
     return eta, np.abs(cross(xm - x, d)) <= 1e-12 * scale
 
@@ -275,9 +276,9 @@ def directions(master: Side, pairs: tuple, x: np.ndarray, ns: np.ndarray, mix: t
     nodes ``x (s, 2)`` with outward normals ``ns (s, 2)`` (``mix = (a, b)``: ``(1, 1)`` the
     averaged normal, ``(1, 0)`` the slave's, ``(0, 1)`` the master's), π_j the point where
     the line ``x_j + t n_j`` meets the master: n_j and π_j depend on each other, so π_j is
-    sought on the master, as the point η of a candidate edge (the node's index ``pairs[2]
+    sought on the master, as the point η of a candidate facet (the node's index ``pairs[2]
     (e, 3)``) with ``x_m(η) − x_j`` along ``a n_s − b n_m(η)`` (:func:`paired_points`), the
-    nearest one where several edges have one. A node whose line meets no candidate takes
+    nearest one where several facets have one. A node whose line meets no candidate takes
     the master's normal at its nearest node. Returns ``n (s, 2)``, ``π (s, 2)`` (NaN where
     none)."""
     e, f, index = pairs
@@ -286,14 +287,14 @@ def directions(master: Side, pairs: tuple, x: np.ndarray, ns: np.ndarray, mix: t
     eta, ok = paired_points(master, f, x[j], ns[j], mix)
     ok &= (eta >= -1e-12) & (eta <= 1 + 1e-12)
     eta = np.clip(eta, 0.0, 1.0)
-    xm, _ = on_edge(master.points[f], eta)
+    xm, _ = on_facet(master.points[f], eta)
     order = np.lexsort((np.hypot(*(xm - x[j]).T), j))
     order = order[ok[order]]
     node, first = np.unique(j[order], return_index=True)
     best = order[first]
     _, k = cKDTree(master.points.reshape(-1, 2)).query(x)
     nm = master.normals.reshape(-1, 2)[k]
-    nm[node] = unit(on_edge(master.normals[f[best]], eta[best])[0])
+    nm[node] = unit(on_facet(master.normals[f[best]], eta[best])[0])
     toward = master.points.reshape(-1, 2)[k] - x
     toward[node] = xm[best] - x[node]
     point = np.full_like(x, np.nan)
@@ -302,14 +303,14 @@ def directions(master: Side, pairs: tuple, x: np.ndarray, ns: np.ndarray, mix: t
 
 
 def segments(slave: Side, master: Side, pairs: tuple, N: np.ndarray, paired: np.ndarray):
-    """The pieces ``[lo, hi] ⊂ [0, 1]`` of slave edges ``e`` over master edges ``f``: the
-    master edge's ends projected onto the slave edge along ``n(ξ) = Σ N_a φ_a(ξ)`` (``N (e_s,
-    3, 2)`` the slave edges' nodal directions). Returns ``e, f, lo, hi`` of non-empty ones.
+    """The pieces ``[lo, hi] ⊂ [0, 1]`` of slave facets ``e`` over master facets ``f``: the
+    master facet's ends projected onto the slave facet along ``n(ξ) = Σ N_a φ_a(ξ)`` (``N (e_s,
+    3, 2)`` the slave facets' nodal directions). Returns ``e, f, lo, hi`` of non-empty ones.
 
-    Each (slave edge, master vertex) is projected once, so the pieces of a slave edge tile
-    it exactly. A cut within round-off of the edge's end (:data:`SNAP` times the ratio of
-    the coordinates to the edge's length) is put on it, and so is the cut of a master vertex
-    that is the paired point π_j of the edge's end node (``paired (e_s, 2, 2)``, NaN where
+    Each (slave facet, master vertex) is projected once, so the pieces of a slave facet tile
+    it exactly. A cut within round-off of the facet's end (:data:`SNAP` times the ratio of
+    the coordinates to the facet's length) is put on it, and so is the cut of a master vertex
+    that is the paired point π_j of the facet's end node (``paired (e_s, 2, 2)``, NaN where
     none; within :data:`SNAP` eps times the coordinates): matching ends leave no sliver, even
     where the direction grazes the surfaces (the ends of two half-discs)."""
     e, f = pairs
@@ -320,16 +321,16 @@ def segments(slave: Side, master: Side, pairs: tuple, N: np.ndarray, paired: np.
     which = np.column_stack([np.repeat(f, 2), np.tile([0, 1], f.size)])[
         np.unique(inverse.ravel(), return_index=True)[1]
     ]
-    edge = key[:, 0]
-    X = slave.points[edge]
-    xi = slave_parameter(X, N[edge], master.points[which[:, 0], which[:, 1]])
+    facet = key[:, 0]
+    X = slave.points[facet]
+    xi = slave_parameter(X, N[facet], master.points[which[:, 0], which[:, 1]])
     length = np.hypot(*(X[:, 1] - X[:, 0]).T)
     tol = SNAP * np.finfo(float).eps * np.abs(X).max(axis=(1, 2)) / length
     xi = np.where(np.abs(xi) <= tol, 0.0, np.where(np.abs(xi - 1) <= tol, 1.0, xi))
     y = master.points[which[:, 0], which[:, 1]]
     near = SNAP * np.finfo(float).eps * np.abs(X).max(axis=(1, 2))
     for end in (0, 1):
-        at = np.hypot(*(paired[edge, end] - y).T) <= near  # NaN compares False
+        at = np.hypot(*(paired[facet, end] - y).T) <= near  # NaN compares False
         xi[at] = float(end)
     xi0, xi1 = xi[inverse.reshape(-1, 2)].T
     lo = np.clip(np.minimum(xi0, xi1), 0.0, 1.0)

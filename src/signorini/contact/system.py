@@ -15,7 +15,7 @@ import scipy.sparse as sp
 
 from ..algebra.ranks import SERIAL, Ranks
 from ..fem.element import Element
-from ..fem.loads import assemble_body_force, assemble_edge_load
+from ..fem.loads import assemble_body_force, assemble_facet_load
 from ..fem.space import LagrangeSpace, space_of
 from ..fem.stiffness import assemble_stiffness
 from ..mesh.mesh import Mesh
@@ -232,15 +232,15 @@ def assemble(
         if cond.is_zero:
             continue
         facets = mesh.part_facets(name)
-        nodes = space.edge_nodes(facets)
+        nodes = space.facet_nodes(facets)
         dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(len(nodes), -1)
         g = cond.field()
 
         def traction(x, n, g=g, name=name):
             return evaluate_field(g, x, f"the traction of Neumann part {name!r}", normal=n)
 
-        for rows, geometry in space.boundary_edges(facets):
-            g = assemble_edge_load(
+        for rows, geometry in space.boundary_facets(facets):
+            g = assemble_facet_load(
                 geometry, dofs[rows], n_dofs, traction, degree=LOAD_DEGREE, element=space.element
             )
             F += g

@@ -174,7 +174,7 @@ class PairTransfer:
     every_slave : (n_dofs, n_dofs) scipy.sparse CSR matrix
         Blocks ``T_jk I`` at every slave node, Dirichlet nodes included: the relative
         displacement ``u − T u`` along the whole slave part, which the estimator reads
-        (:meth:`~.contact_set.ContactSet.edge_normal_gap`); at a constrained node its normal
+        (:meth:`~.contact_set.ContactSet.facet_normal_gap`); at a constrained node its normal
         component is the basis unknown's.
     """
 
@@ -194,7 +194,7 @@ def master_traction(
     constraints' nodes and their ``(f_x, f_y, Λ)`` (the force on the slave and the normal
     contact force)."""
     facets = np.concatenate([space.mesh.part_facets(m) for m in transfer.masters])
-    facet_nodes = space.edge_nodes(facets)
+    facet_nodes = space.facet_nodes(facets)
     w = np.bincount(
         facet_nodes.ravel(), weights=facet_weights(space, facets, facet_nodes)[1].ravel(),
         minlength=space.n_nodes,

@@ -10,8 +10,8 @@ import numpy as np
 
 from ..contact.contact_set import SEMI_CONTACT
 from ..contact.solution import ContactResult
-from ..fem.mapping import edge_groups
-from .friction import FrictionFacets, move_dirichlet_thirds
+from ..fem.mapping import facet_groups
+from .friction_facets import FrictionFacets, move_dirichlet_thirds
 from .terms import FacetSet, complementarity, friction_work, normal_stress, tangential_stress
 from .traction import CellStress, direction_field
 
@@ -73,19 +73,19 @@ def contact_node_parts(
     facet = space.element.facet
     parts6 = np.zeros(gap.shape)
     parts8 = np.zeros(gap.shape)
-    for rows, facets in edge_groups(space.node_points[cs.edge_nodes], curved):
+    for rows, facets in facet_groups(space.node_points[cs.facet_nodes], curved):
         parts6[rows] = complementarity(gap[rows], density[rows], facets, None, facet.hat_pieces)
         if friction is not None:
             slip, bound, p_t = friction.slip[rows], friction.bound[rows], friction.friction[rows]
             parts8[rows] = friction_work(slip, p_t, bound, facets, None, facet.node_parts)
     n = facet.n_nodes
-    return parts6[:, :n], move_dirichlet_thirds(parts8, cs.edge_local)[:, :n]
+    return parts6[:, :n], move_dirichlet_thirds(parts8, cs.facet_local)[:, :n]
 
 
 def facet_pressure(result: ContactResult) -> np.ndarray:
     """The nodal pressures ``p_z`` at ``[start, end, midpoint]`` of each contact facet
     ``(n_ce, 3)``, 0 at Dirichlet end points."""
-    loc = result.contact.edge_local
+    loc = result.contact.facet_local
     return np.where(loc >= 0, result.pressure[np.maximum(loc, 0)], 0.0)
 
 
@@ -93,7 +93,7 @@ def semi_contact_density(result: ContactResult) -> np.ndarray:
     """The density ``s_p`` (4.1) at ``[start, end, midpoint]`` of each contact facet where p is
     a semi-contact node, else 0: ``(n_ce, 3)``. A negative Λ_p is round-off (the solver's
     KKT check bounds it) and counts as 0: η6² = s_p d_p must not turn negative."""
-    loc = result.contact.edge_local
+    loc = result.contact.facet_local
     semi = result.classes == SEMI_CONTACT
     use = (loc >= 0) & semi[np.maximum(loc, 0)]
     return np.where(use, np.maximum(result.density[np.maximum(loc, 0)], 0.0), 0.0)

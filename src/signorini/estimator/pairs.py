@@ -43,7 +43,7 @@ def master_integrals(
     g = np.zeros((space.n_nodes, 2))
     g[nodes] = traction / unit
     # at [start, end, midpoint], counter-clockwise around the facet's cell as the traction's t
-    g_nodes = g[space.edge_nodes(e)]
+    g_nodes = g[space.facet_nodes(e)]
     phi = P2.facet.basis(t)  # (q, 3)
     for rows, sn, facets in stresses.on_facets(mesh.facet2cell[e, 0], mesh.facet_local[e, 0], t):
         g_h = np.einsum("qa,eac->eqc", phi, g_nodes[rows])

@@ -61,7 +61,7 @@ from ..fem.space import LagrangeSpace
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_facets import contact_node_parts, contact_stress, facet_pressure, semi_contact_density
-from .friction import friction_facets
+from .friction_facets import friction_facets
 from .held import further_traction_facets
 from .names import TERMS
 from .owned import OwnPart, own_part, per_cell_of
@@ -252,16 +252,16 @@ def estimate(
         space, np.concatenate([_part_facets(mesh, problem.neumann_parts), further])
     )
     contact = FacetSet(
-        cs.edges, cs.edge_nodes, mesh.facet2cell[cs.edges], mesh.facet_measure[cs.edges]
+        cs.facets, cs.facet_nodes, mesh.facet2cell[cs.facets], mesh.facet_measure[cs.facets]
     )
     pressure = on_facet(facet_pressure(result)) / unit if eta5_variant == "consistent" else None
     friction = friction_facets(result, unit)  # None without friction
     if friction is not None:
         friction = type(friction)(*(on_facet(v) for v in friction))
     p_t = None if friction is None else friction.friction
-    gap = on_facet(cs.edge_normal_gap(result.u))  # u_h·n − ψ_h at [start, end, midpoint]
+    gap = on_facet(cs.facet_normal_gap(result.u))  # u_h·n − ψ_h at [start, end, midpoint]
     density = on_facet(semi_contact_density(result)) / unit
-    x0, x1 = mesh.points[cs.edge_nodes[:, 0]], mesh.points[cs.edge_nodes[:, 1]]
+    x0, x1 = mesh.points[cs.facet_nodes[:, 0]], mesh.points[cs.facet_nodes[:, 1]]
     eta7_shares = penetration(x0, x1, gap, scale=float(np.abs(result.u).max(initial=0.0)))
 
     # each integral once per cell or facet, through its own geometry (docs/method.md,
@@ -269,11 +269,11 @@ def estimate(
     R = _interior_residual(problem, material, cells, u_cell, unit, own)
     J2 = _stress_jumps(mesh, stresses, inner, t, w, own)
     J3 = np.concatenate([_neumann_integrals(problem, mesh, stresses, t_n, w_n, unit), J3_further])
-    direction = on_facet(cs.edge_direction)
+    direction = on_facet(cs.facet_direction)
     # the contact terms on every contact facet, on every rank (Γ_C's data is replicated)
     every = stresses.everywhere
-    J4, J5 = contact_stress(every, mesh, contact, cs.edge_normal, direction, t, w, pressure, p_t)
-    curved = np.isin(cs.edges, quadratic_facets)
+    J4, J5 = contact_stress(every, mesh, contact, cs.facet_normal, direction, t, w, pressure, p_t)
+    curved = np.isin(cs.facets, quadratic_facets)
     parts6, parts8 = contact_node_parts(result, gap, density, friction, curved)
     if own is not None:  # each integral from the one rank that owns it, summed over the ranks
         mine = own.facets(contact.cells)
@@ -324,7 +324,7 @@ def geometry(space: LagrangeSpace) -> tuple[CellMap, np.ndarray]:
     """The cells' maps (:attr:`~signorini.fem.space.P2Space.mapping`) and the boundary facets
     that are quadratics (those on parts carrying a curve other than a line; none in a P1
     space): the geometry every term integrates on."""
-    return space.mapping, space.curved_edges
+    return space.mapping, space.curved_facets
 
 
 def _cell_stress(
@@ -339,7 +339,7 @@ def _cell_stress(
         sigma = vertex_stress(cells, u_cell, material)
         unit = stress_unit(float(np.abs(sigma).max(initial=0.0)))
         return CellStress(cells, mesh.points, mesh.cells, u_cell, material, sigma / unit, unit)
-    stressed = own.stressed_cells(mesh.facet2cell, result.contact.edges)
+    stressed = own.stressed_cells(mesh.facet2cell, result.contact.facets)
     u_cell = np.zeros((mesh.n_cells, 12))
     values = np.asarray(result.u).reshape(-1)[space.cell_dofs[stressed]]  # as cell_values
     u_cell[stressed] = space.element.cell_coefficients(values)
@@ -433,7 +433,7 @@ def _facet_set(space: LagrangeSpace, e: np.ndarray) -> FacetSet:
     """Mesh facets ``e`` with their nodes ``[vertex, vertex, midpoint]`` (P1: the two
     vertices), cells and measures."""
     mesh = space.mesh
-    return FacetSet(e, space.mesh_edge_nodes(e), mesh.facet2cell[e], mesh.facet_measure[e])
+    return FacetSet(e, space.mesh_facet_nodes(e), mesh.facet2cell[e], mesh.facet_measure[e])
 
 
 def _from_both_sides(mesh, traction, e: np.ndarray, t: np.ndarray):

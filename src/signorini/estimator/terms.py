@@ -166,10 +166,10 @@ def boundary_cell_shares(facets: FacetSet, values: np.ndarray, n_cells: int) -> 
     return np.bincount(facets.cells[:, 0], weights=values, minlength=n_cells)
 
 
-def _point_weights(w: np.ndarray, length: np.ndarray) -> np.ndarray:
-    """``(k, q)`` quadrature weights along edges: ``w`` times the edge length ``(k,)`` or
+def _point_weights(w: np.ndarray, measure: np.ndarray) -> np.ndarray:
+    """``(k, q)`` quadrature weights along facets: ``w`` times the facet measure ``(k,)`` or
     times ``|x'(t)|`` at each point ``(k, q)``."""
-    return w * (length[:, None] if np.ndim(length) == 1 else length)
+    return w * (measure[:, None] if np.ndim(measure) == 1 else measure)
 
 
 def _per_item(a: np.ndarray | None, ndim: int) -> np.ndarray | None:
@@ -223,7 +223,7 @@ def interior_residual(
 
 
 def stress_jump(
-    traction_0: np.ndarray, traction_1: np.ndarray, w: np.ndarray, length: np.ndarray
+    traction_0: np.ndarray, traction_1: np.ndarray, w: np.ndarray, measure: np.ndarray
 ) -> np.ndarray:
     """``‖⟦σ(u_h)⟧‖²_F`` per interior facet (η2, an edge in 2D).
 
@@ -234,27 +234,27 @@ def stress_jump(
         points (so the jump is their sum).
     w : (q,) float array
         Weights on [0, 1].
-    length : (k,) float array
+    measure : (k,) float array
     """
     jump = traction_0 + traction_1
-    return length * np.einsum("q,eqi,eqi->e", w, jump, jump)
+    return measure * np.einsum("q,eqi,eqi->e", w, jump, jump)
 
 
-def neumann_residual(residual: np.ndarray, w: np.ndarray, length: np.ndarray) -> np.ndarray:
+def neumann_residual(residual: np.ndarray, w: np.ndarray, measure: np.ndarray) -> np.ndarray:
     """``‖σ(u_h) n − g‖²_F`` per Neumann facet (η3), from ``residual (k, q, 2)`` at the
-    points of the weights ``w (q,)``; ``length (k,)``, or ``|x'(t)|`` at each point ``(k, q)``
+    points of the weights ``w (q,)``; ``measure (k,)``, or ``|x'(t)|`` at each point ``(k, q)``
     on a quadratic facet."""
-    length = _per_item(length, 2)
-    if np.ndim(length) == 2:
-        return np.einsum("eq,eqi,eqi->e", _point_weights(w, length), residual, residual)
-    return length * np.einsum("q,eqi,eqi->e", w, residual, residual)
+    measure = _per_item(measure, 2)
+    if np.ndim(measure) == 2:
+        return np.einsum("eq,eqi,eqi->e", _point_weights(w, measure), residual, residual)
+    return measure * np.einsum("q,eqi,eqi->e", w, residual, residual)
 
 
 def tangential_stress(
     traction: np.ndarray,
     normal: np.ndarray,
     w: np.ndarray,
-    length: np.ndarray,
+    measure: np.ndarray,
     t: np.ndarray | None = None,
     friction: np.ndarray | None = None,
 ) -> np.ndarray:
@@ -268,8 +268,9 @@ def tangential_stress(
         The contact part's outward unit normal, or ``(k, q, 2)`` the direction the traction
         is split along at each point (:func:`direction_field`).
     w : (q,) float array
-    length : (k,) float array
-        Edge lengths; ``|x'(t)|`` at each point ``(k, q)`` on a quadratic edge.
+    measure : (k,) float array
+        Facet measures h_F = |F| (edge lengths in 2D); ``|x'(t)|`` at each point ``(k, q)``
+        on a quadratic facet.
     t : (q,) float array, optional
         The quadrature points on [0, 1] (needed with ``friction``).
     friction : (k, 3) float array, optional
@@ -278,21 +279,21 @@ def tangential_stress(
         is the scalar ``σ(u_h) n · τ + p_t,h`` with ``τ = (−d_y, d_x)`` for the direction d
         (docs/method.md, *Estimator*, "With friction"). ``None`` without friction.
     """
-    length, normal = _per_item(length, 2), _per_item(normal, 3)
-    if normal.ndim == 2 and np.ndim(length) == 2:
+    measure, normal = _per_item(measure, 2), _per_item(normal, 3)
+    if normal.ndim == 2 and np.ndim(measure) == 2:
         normal = np.broadcast_to(normal[:, None, :], traction.shape)
     if friction is not None:
         d = normal if normal.ndim == 3 else np.broadcast_to(normal[:, None, :], traction.shape)
         residual = traction[..., 1] * d[..., 0] - traction[..., 0] * d[..., 1]
         residual = residual + friction @ P2.facet.basis(t).T
-        return (_point_weights(w, length) * residual**2).sum(axis=1)
+        return (_point_weights(w, measure) * residual**2).sum(axis=1)
     if normal.ndim == 3:
         snn = np.einsum("eqi,eqi->eq", traction, normal)
         st = traction - snn[..., None] * normal
-        return np.einsum("eq,eqi,eqi->e", _point_weights(w, length), st, st)
+        return np.einsum("eq,eqi,eqi->e", _point_weights(w, measure), st, st)
     snn = np.einsum("eqi,ei->eq", traction, normal)
     st = traction - snn[..., None] * normal[:, None, :]
-    return length * np.einsum("q,eqi,eqi->e", w, st, st)
+    return measure * np.einsum("q,eqi,eqi->e", w, st, st)
 
 
 def normal_stress(
@@ -300,7 +301,7 @@ def normal_stress(
     normal: np.ndarray,
     t: np.ndarray,
     w: np.ndarray,
-    length: np.ndarray,
+    measure: np.ndarray,
     pressure: np.ndarray | None = None,
 ) -> np.ndarray:
     """``‖σ_nn(u_h)‖²_F`` (``paper``) or ``‖σ_nn(u_h) + p_h‖²_F`` (``consistent``) (η5).
@@ -313,28 +314,28 @@ def normal_stress(
         Or ``(k, q, 2)``, the direction at each point (:func:`direction_field`).
     t, w : (q,) float arrays
         Quadrature points and weights on [0, 1], in the edge's counter-clockwise direction.
-    length : (k,) float array
+    measure : (k,) float array
         ``(k, q)``: ``|x'(t)|`` at each point of a quadratic edge.
     pressure : (k, 3) float array, optional
         The nodal pressures ``p_z`` at ``[start, end, midpoint]`` (0 at Dirichlet nodes);
         ``p_h`` is their quadratic interpolant. ``None`` for the ``paper`` variant.
     """
-    length, normal = _per_item(length, 2), _per_item(normal, 3)
+    measure, normal = _per_item(measure, 2), _per_item(normal, 3)
     if normal.ndim == 3:
         snn = np.einsum("eqi,eqi->eq", traction, normal)
     else:
         snn = np.einsum("eqi,ei->eq", traction, normal)
     if pressure is not None:
         snn = snn + pressure @ P2.facet.basis(t).T
-    if normal.ndim == 3 or np.ndim(length) == 2:
-        return (_point_weights(w, length) * snn**2).sum(axis=1)
-    return length * (w * snn**2).sum(axis=1)
+    if normal.ndim == 3 or np.ndim(measure) == 2:
+        return (_point_weights(w, measure) * snn**2).sum(axis=1)
+    return measure * (w * snn**2).sum(axis=1)
 
 
 def complementarity(
     gap: np.ndarray,
     density: np.ndarray,
-    length: np.ndarray,
+    measure: np.ndarray,
     points: np.ndarray | None = None,
     pieces: tuple = P2.facet.hat_pieces,
 ) -> np.ndarray:
@@ -346,8 +347,9 @@ def complementarity(
         ``u_h·n − ψ_h`` at ``[start, end, midpoint]``.
     density : (k, 3) float array
         ``s_p`` at the same nodes where p is a semi-contact node, else 0.
-    length : (k,) float array or StraightEdges or QuadraticEdges
-        Edge lengths, or the edges' geometry (:mod:`signorini.fem.mapping`).
+    measure : (k,) float array or StraightFacets or QuadraticFacets
+        Facet measures h_F = |F| (edge lengths in 2D), or the facets' geometry
+        (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
         Node points ``[start, end, midpoint]`` of quadratic edges: integrate along them
         (:func:`third_integrals`).
@@ -360,14 +362,14 @@ def complementarity(
     (k, 3) float array
         Each node's part from this facet.
     """
-    return density * third_integrals(-gap, length, points, pieces)
+    return density * third_integrals(-gap, measure, points, pieces)
 
 
 def friction_work(
     slip: np.ndarray,
     friction: np.ndarray,
     bound: np.ndarray,
-    length: np.ndarray,
+    measure: np.ndarray,
     points: np.ndarray | None = None,
     parts: tuple = P2.facet.node_parts,
 ) -> np.ndarray:
@@ -384,8 +386,9 @@ def friction_work(
     bound : (k, 3) float array
         The nodal slip bounds ``b_z`` (Tresca ``s_z / w_z``, Coulomb ``F p_z``; 0 at
         Dirichlet nodes and on frictionless parts).
-    length : (k,) float array or StraightEdges or QuadraticEdges
-        Edge lengths, or the edges' geometry (:mod:`signorini.fem.mapping`).
+    measure : (k,) float array or StraightFacets or QuadraticFacets
+        Facet measures h_F = |F| (edge lengths in 2D), or the facets' geometry
+        (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
         Node points of quadratic edges: integrate along them.
 
@@ -394,7 +397,7 @@ def friction_work(
     (k, 3) float array
         The facet's integrals over the thirds of its start, end and midpoint nodes.
     """
-    return friction_work_thirds(slip, friction, bound, length, points, parts)
+    return friction_work_thirds(slip, friction, bound, measure, points, parts)
 
 
 def penetration(

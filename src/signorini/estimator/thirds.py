@@ -1,8 +1,8 @@
-"""Integrals over the thirds of contact edges: η6's ``∫_{γ̃_p} v⁺ φ_p ds`` (paper (4.12);
-docs/method.md, *Estimator*) and η8's friction work defect ``∫_{γ̃_p} (max(b, |p_t|) |u_t| −
-p_t u_t) ds`` (docs/method.md, *Estimator*, "With friction"), on straight edges exactly and
-along quadratic edges with ``|x'(t)|``
-(docs/method.md, *Estimator*, "On curved boundaries")."""
+"""Integrals over the thirds of contact facets (edges in 2D): η6's ``∫_{γ̃_p} v⁺ φ_p ds``
+(paper (4.12); docs/method.md, *Estimator*) and η8's friction work defect ``∫_{γ̃_p} (max(b,
+|p_t|) |u_t| − p_t u_t) ds`` (docs/method.md, *Estimator*, "With friction"), on straight
+facets exactly and along quadratic facets with ``|x'(t)|`` (docs/method.md, *Estimator*, "On
+curved boundaries")."""
 
 from __future__ import annotations
 
@@ -10,12 +10,12 @@ import numpy as np
 
 from ..fem.edge_trace import evaluate, monomial_coefficients, roots_in_unit_interval
 from ..fem.element import P2
-from ..fem.mapping import Edges, QuadraticEdges, StraightEdges
+from ..fem.mapping import Facets, QuadraticFacets, StraightFacets
 from ..fem.quadrature import gauss_legendre
 
 __all__ = ["CURVED_THIRD_POINTS", "friction_work_thirds", "third_integrals"]
 
-#: Gauss points per sub-interval of η6's integrals along a quadratic edge, where ``|x'(t)|``
+#: Gauss points per sub-interval of η6's integrals along a quadratic facet, where ``|x'(t)|``
 #: makes the integrand non-polynomial (it is nearly constant: 5 points, degree 9)
 CURVED_THIRD_POINTS = 5
 
@@ -27,27 +27,28 @@ _HAT_PIECES = P2.facet.hat_pieces
 
 def third_integrals(
     v: np.ndarray,
-    length: np.ndarray,
+    measure: np.ndarray,
     points: np.ndarray | None = None,
     pieces: tuple = _HAT_PIECES,
 ) -> np.ndarray:
     """∫ v⁺ φ_p over the thirds γ̃_p of each facet (docs/method.md, *Estimator*, paper (4.12)).
 
-    Exact on straight edges: each linear piece of φ is cut at the roots of v, and on each
+    Exact on straight facets: each linear piece of φ is cut at the roots of v, and on each
     sub-interval the product of the quadratic and the linear hat is integrated by a 3-point
-    Gauss rule (degree 5 ≥ 3). Along quadratic edges (``points`` given) the integrand also
+    Gauss rule (degree 5 ≥ 3). Along quadratic facets (``points`` given) the integrand also
     carries ``|x'(t)|`` (the square root of a quadratic, not a polynomial) and
     ``CURVED_THIRD_POINTS`` Gauss points are used on each sub-interval.
 
     Parameters
     ----------
     v : (k, 3) float array
-        A quadratic on each edge, by its values at ``[start, end, midpoint]``.
-    length : (k,) float array or StraightEdges or QuadraticEdges
-        Edge lengths (not used with ``points``), or the edges' geometry
+        A quadratic on each facet, by its values at ``[start, end, midpoint]``.
+    measure : (k,) float array or StraightFacets or QuadraticFacets
+        Facet measures h_F = |F| (edge lengths in 2D; not used with ``points``), or the
+        facets' geometry
         (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
-        Node points ``[start, end, midpoint]`` of quadratic edges ``x(t)``.
+        Node points ``[start, end, midpoint]`` of quadratic facets ``x(t)``.
     pieces : tuple, optional
         The pieces γ̃_p and hats of the element (:attr:`~signorini.fem.facet_element.
         FacetElement.hat_pieces`): P2's thirds (default) or P1's halves (column 2 then stays 0).
@@ -59,10 +60,10 @@ def third_integrals(
         where φ are the half-edge hats of Q^h (3.6).
     """
     v = np.asarray(v, dtype=np.float64)
-    length, edges = _geometry(length, points)
+    measure, facets = _geometry(measure, points)
     coef = monomial_coefficients(v)
     roots = roots_in_unit_interval(coef)  # (k, 2), NaN where none
-    gt, gw = gauss_legendre(_points(edges))
+    gt, gw = gauss_legendre(_points(facets))
     out = np.zeros(v.shape)
     for lo, hi, col, (p0, p1) in pieces:
         r = np.where(np.isnan(roots), lo, np.clip(roots, lo, hi))
@@ -72,12 +73,12 @@ def third_integrals(
             tq = x0 + (x1 - x0) * gt
             vq = evaluate(coef, tq)
             hat = p0 + p1 * tq
-            if edges is not None:
-                hat = hat * edges.speed_at(tq)
+            if facets is not None:
+                hat = hat * facets.speed_at(tq)
             out[:, col] += (x1 - x0)[:, 0] * (gw * np.maximum(vq, 0.0) * hat).sum(axis=1)
-    if edges is not None:
+    if facets is not None:
         return out
-    return out * np.asarray(length)[:, None]
+    return out * np.asarray(measure)[:, None]
 
 
 #: the thirds of [0, 1] as ``(lo, hi, column)``, column 0, 1, 2 = start, end, midpoint
@@ -88,17 +89,17 @@ def friction_work_thirds(
     slip: np.ndarray,
     force: np.ndarray,
     bound: np.ndarray,
-    length: np.ndarray,
+    measure: np.ndarray,
     points: np.ndarray | None = None,
     parts: tuple = _THIRDS,
 ) -> np.ndarray:
-    """``∫ (max(b, |p_t|) |u_t| − p_t u_t) ds`` over each third of each edge (η8); over
+    """``∫ (max(b, |p_t|) |u_t| − p_t u_t) ds`` over each third of each facet (η8); over
     each half with P1's ``parts`` (:attr:`~signorini.fem.facet_element.FacetElement.node_parts`).
 
     The three quadratics are given by their values at ``[start, end, midpoint]``. Each third
     is cut at the roots of ``u_t``, ``p_t − b`` and ``p_t + b``, so that on each piece the
     integrand is one polynomial of degree 4 and the 3-point Gauss rule (degree 5) is exact.
-    Along quadratic edges (``points`` given) the integrand carries ``|x'(t)|`` and
+    Along quadratic facets (``points`` given) the integrand carries ``|x'(t)|`` and
     ``CURVED_THIRD_POINTS`` Gauss points are used on each piece.
 
     Parameters
@@ -109,11 +110,12 @@ def friction_work_thirds(
         ``p_t`` (stress).
     bound : (k, 3) float array
         ``b``, the slip bound (stress).
-    length : (k,) float array or StraightEdges or QuadraticEdges
-        Edge lengths (not used with ``points``), or the edges' geometry
+    measure : (k,) float array or StraightFacets or QuadraticFacets
+        Facet measures h_F = |F| (edge lengths in 2D; not used with ``points``), or the
+        facets' geometry
         (:mod:`signorini.fem.mapping`).
     points : (k, 3, 2) float array, optional
-        Node points ``[start, end, midpoint]`` of quadratic edges ``x(t)``.
+        Node points ``[start, end, midpoint]`` of quadratic facets ``x(t)``.
 
     Returns
     -------
@@ -121,12 +123,12 @@ def friction_work_thirds(
         The integrals over the start, end and middle thirds: each ``≥ 0`` (the integrand
         is, pointwise).
     """
-    length, edges = _geometry(length, points)
+    measure, facets = _geometry(measure, points)
     cu, cp, cb = (
         monomial_coefficients(np.asarray(v, dtype=np.float64)) for v in (slip, force, bound)
     )
     roots = np.column_stack([roots_in_unit_interval(c) for c in (cu, cp - cb, cp + cb)])
-    gt, gw = gauss_legendre(_points(edges))
+    gt, gw = gauss_legendre(_points(facets))
     out = np.zeros(cu.shape)
     for lo, hi, col in parts:
         r = np.where(np.isnan(roots), lo, np.clip(roots, lo, hi))
@@ -136,27 +138,27 @@ def friction_work_thirds(
             tq = x0 + (x1 - x0) * gt
             u, p, b = evaluate(cu, tq), evaluate(cp, tq), evaluate(cb, tq)
             work = np.maximum(np.maximum(b, np.abs(p)) * np.abs(u) - p * u, 0.0)
-            if edges is not None:
-                work = work * edges.speed_at(tq)
+            if facets is not None:
+                work = work * facets.speed_at(tq)
             out[:, col] += (x1 - x0)[:, 0] * (gw * work).sum(axis=1)
-    if edges is not None:
+    if facets is not None:
         return out
-    return out * np.asarray(length)[:, None]
+    return out * np.asarray(measure)[:, None]
 
 
 def _geometry(
-    length: np.ndarray | Edges, points: np.ndarray | None
-) -> tuple[np.ndarray | None, QuadraticEdges | None]:
-    """``(lengths, None)`` for straight edges (their constant ``|x'(t)|`` multiplies the
-    integrals once), ``(None, edges)`` for quadratic ones (``|x'(t)|`` at every point)."""
-    if isinstance(length, StraightEdges):
-        return length.length, None
-    if isinstance(length, QuadraticEdges):
-        return None, length
-    return (length, None) if points is None else (None, QuadraticEdges(points))
+    measure: np.ndarray | Facets, points: np.ndarray | None
+) -> tuple[np.ndarray | None, QuadraticFacets | None]:
+    """``(lengths, None)`` for straight facets (their constant ``|x'(t)|`` multiplies the
+    integrals once), ``(None, facets)`` for quadratic ones (``|x'(t)|`` at every point)."""
+    if isinstance(measure, StraightFacets):
+        return measure.length, None
+    if isinstance(measure, QuadraticFacets):
+        return None, measure
+    return (measure, None) if points is None else (None, QuadraticFacets(points))
 
 
-def _points(edges: QuadraticEdges | None) -> int:
-    """Gauss points per piece: 3 (exact) on straight edges, ``CURVED_THIRD_POINTS`` along
+def _points(facets: QuadraticFacets | None) -> int:
+    """Gauss points per piece: 3 (exact) on straight facets, ``CURVED_THIRD_POINTS`` along
     quadratic ones, where ``|x'(t)|`` makes the integrand non-polynomial."""
-    return 3 if edges is None else CURVED_THIRD_POINTS
+    return 3 if facets is None else CURVED_THIRD_POINTS

@@ -10,10 +10,10 @@ from collections.abc import Iterator
 import numpy as np
 
 from ..fem.element import P2
-from ..fem.mapping import AffineCells, CellMap, Cells, Edges
+from ..fem.mapping import AffineCells, CellMap, Cells, Facets
 from ..fem.material import CellMaterials, Material, on_cells, stress
 from ..fem.p2 import REFERENCE_NODES, edge_reference_points
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from ..mesh.reference import TRIANGLE
 from .owned import per_cell_of
 
@@ -93,19 +93,19 @@ class CellStress:
             self.sigma_vertex, self.unit,
         )  # fmt: skip
 
-    def _traction(self, group: Cells, slot, cell, k, t, facets: Edges | None) -> np.ndarray:
+    def _traction(self, group: Cells, slot, cell, k, t, facets: Facets | None) -> np.ndarray:
         """σ(u_h) n on local facets ``k`` of ``cell`` (rows ``slot`` of ``group``); ``facets``
         their geometry where already built."""
         if isinstance(group, AffineCells):
             return facet_traction(self.sigma_vertex, self.points, self.cell_vertices, cell, k, t)
-        facets = group.local_edges(slot, k) if facets is None else facets
+        facets = group.local_facets(slot, k) if facets is None else facets
         grad = group.rows(slot).field_gradients(self.u_cell[cell], edge_reference_points(k, t))
         sig = stress(on_cells(self.material, cell), grad) / self.unit
         return np.einsum("eqij,eqj->eqi", sig, facets.normals(t))
 
     def on_facets(
         self, cell: np.ndarray, k: np.ndarray, t: np.ndarray
-    ) -> Iterator[tuple[slice | np.ndarray, np.ndarray, Edges]]:
+    ) -> Iterator[tuple[slice | np.ndarray, np.ndarray, Facets]]:
         """``σ(u_h) n`` along local facet ``k (e,)`` of each ``cell (e,)`` at parameters ``t
         (q,)`` (counter-clockwise around the cell), n the outward normal, group by group:
         ``(rows, traction (r, q, 2), facets)`` with the facets' geometry. With ``owned``, only
@@ -121,7 +121,7 @@ class CellStress:
         yield from self._on_facets(cell, k, t)
 
     def _on_facets(self, cell, k, t):
-        for rows, g, slot, facets in self.cells.local_edges(cell, k):
+        for rows, g, slot, facets in self.cells.local_facets(cell, k):
             yield rows, self._traction(g, slot, cell[rows], k[rows], t, facets), facets
 
     def traction(self, cell: np.ndarray, k: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -167,7 +167,7 @@ def facet_traction(
     # flat indices (one gather each, faster than indexing two axes)
     v0, v1 = 3 * cell + TRIANGLE.facets[k, 0], 3 * cell + TRIANGLE.facets[k, 1]
     corners = cells.ravel()
-    _, n = segment_normals(points[corners[v0]], points[corners[v1]])
+    _, n = facet_normals(points[corners[np.stack([v0, v1], axis=-1)]])
     # σ n at the facet's two vertices, then linear along it (σ is linear on the cell)
     sigma = sigma_vertex.reshape(-1, 2, 2)
     a = np.einsum("eij,ej->ei", sigma[v0], n)

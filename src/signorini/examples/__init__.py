@@ -4,7 +4,7 @@ curved geometry.
 - :mod:`.paper`: the paper's numerical experiments (Section 6);
 - :mod:`.hertz`: an elastic half-disc pressed onto a rigid plane, with the Hertz solution;
 - :mod:`.punch`: a rigid punch with rounded corners pressed into a block held against a wall;
-- :mod:`.friction.newton`: Example 6.2 with Tresca or Coulomb friction on its contact part;
+- :mod:`.paper_friction`: Example 6.2 with Tresca or Coulomb friction on its contact part;
 - :mod:`.partial_slip`: the Hertz half-disc pressed on a plane with Coulomb friction, then
   pulled sideways (Cattaneo–Mindlin), a load path of two steps;
 - :mod:`.two_bodies`: contact between two elastic bodies: two cylinders (Hertz), two
@@ -22,10 +22,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..problem import ContactProblem
-from .friction import example_6_2_coulomb, example_6_2_tresca
 from .hertz import HERTZ_METRICS, hertz
 from .metrics import Metrics, PressureComparison
 from .paper import example_6_1, example_6_2
+from .paper_friction import example_6_2_coulomb, example_6_2_tresca
 from .partial_slip import PARTIAL_SLIP_METRICS, partial_slip, partial_slip_path
 from .punch import punch
 from .two_bodies import BLOCKS_METRICS, CYLINDERS_METRICS, hertz_pair, stacked_blocks, two_cylinders

@@ -20,7 +20,7 @@ from ..mesh.bodies import union
 from ..mesh.curves import Circle
 from ..mesh.mesh import Mesh
 from ..problem import Contact, ContactProblem, Dirichlet, Neumann
-from ..problem.friction import Coulomb
+from ..problem.friction_laws import Coulomb
 
 __all__ = ["annulus", "pin_in_hole"]
 

@@ -2,11 +2,15 @@
 
 An edge is parametrised by ``t ∈ [0, 1]`` (``t = 0`` its start, ``t = 1`` its end). A P2
 function restricted to it is the quadratic through its values at the edge's three nodes,
-taken in the package's edge-node order ``[start, end, midpoint]`` (``P2Space.edge_nodes``,
-``ContactSet.edge_nodes``, :func:`signorini.fem.p2.edge_basis`, meshio ``line3``; docs/method.md,
-*Data conventions*). This module is the one owner of that quadratic's monomial form, its
-values, its maximum on [0, 1] and its sign-changing roots in (0, 1); the estimator's η6 and
-η7 (paper, Section 5) work with nothing else.
+taken in the package's edge-node order ``[start, end, midpoint]`` (``P2Space.facet_nodes``,
+``ContactSet.facet_nodes``, :func:`signorini.fem.p2.edge_basis`, meshio ``line3``;
+docs/method.md, *Data conventions*). This module is the one owner of that quadratic's monomial
+form, its values, its maximum on [0, 1] and its sign-changing roots in (0, 1); the estimator's
+η6 and η7 (paper, Section 5) work with nothing else.
+
+It keeps the edge's name: it is a 2D kernel, a univariate quadratic on one edge parameter
+(a 2D facet is an edge). A 3D face carries a bivariate quadratic on two parameters, which
+gets its own module rather than a door here.
 """
 
 from __future__ import annotations

@@ -12,10 +12,10 @@ from collections.abc import Callable
 import numpy as np
 
 from .element import P2, Element
-from .mapping import CellMap, Edges, QuadraticEdges, StraightEdges
+from .mapping import CellMap, Facets, QuadraticFacets, StraightFacets
 from .quadrature import line_rule, triangle_rule
 
-__all__ = ["assemble_body_force", "assemble_edge_load", "assemble_facet_load"]
+__all__ = ["assemble_body_force", "assemble_facet_load"]
 
 
 def assemble_body_force(
@@ -62,7 +62,7 @@ def assemble_body_force(
 
 
 def assemble_facet_load(
-    facets: Edges | np.ndarray,
+    facets: Facets | np.ndarray,
     facet_dofs: np.ndarray,
     n_dofs: int,
     g: Callable[[np.ndarray, np.ndarray], np.ndarray],
@@ -73,7 +73,7 @@ def assemble_facet_load(
 
     Parameters
     ----------
-    facets : StraightEdges, QuadraticEdges or ndarray of float, shape (k, 2, 2)
+    facets : StraightFacets, QuadraticFacets or ndarray of float, shape (k, 2, 2)
         The boundary facets' geometry (edges in 2D; :mod:`signorini.fem.mapping`):
         straight, or the quadratics ``x(t)`` through start, midpoint (on the curve) and end;
         an array is the (start, end) of straight edges. Start to end runs in the
@@ -97,15 +97,11 @@ def assemble_facet_load(
     -------
     ndarray of float64, shape (n_dofs,)
     """
-    if not isinstance(facets, StraightEdges | QuadraticEdges):
-        facets = StraightEdges(facets)
+    if not isinstance(facets, StraightFacets | QuadraticFacets):
+        facets = StraightFacets(facets)
     t, w = line_rule(degree)
     x = facets.points(t)
     gx = np.broadcast_to(np.asarray(g(x, facets.normals(t)), dtype=np.float64), x.shape)
     ds = np.broadcast_to(facets.speeds(t) * w, x.shape[:2])
     local = np.einsum("qa,kqc,kq->kac", element.facet.basis(t), gx, ds)
     return np.bincount(np.ravel(facet_dofs), weights=local.ravel(), minlength=n_dofs)
-
-
-#: the former name, read by the contact layer's assembly
-assemble_edge_load = assemble_facet_load

@@ -1,5 +1,6 @@
 """The geometry of a mesh: the maps from the reference triangle to its cells and from the
-reference edge [0, 1] to its edges (docs/method.md, *Curved boundaries*).
+reference facet (in 2D the interval [0, 1]) to its facets (docs/method.md, *Curved
+boundaries*).
 
 Every integral of the package (stiffness, loads, error norms, the estimator's terms) is
 written once against these objects; the geometry decides what is constant:
@@ -15,8 +16,11 @@ written once against these objects; the geometry decides what is constant:
   the mesh (``cells``, a slice for all cells). :meth:`CellMap.per_cell` evaluates an integrand
   group by group and returns one array in mesh order: each row is computed once, by its own
   geometry.
-- :class:`StraightEdges`, :class:`QuadraticEdges`: points, unit normals and the line element
-  ``|x'(t)|`` of edges, constant along straight ones (arrays with a point axis of length 1).
+- :class:`StraightFacets`, :class:`QuadraticFacets`: the geometry of 2D facets (line
+  segments, straight or quadratic through their midpoint node): points, unit normals and the
+  line element ``|x'(t)|``, constant along straight ones (arrays with a point axis of length
+  1). A 3D face geometry (a triangle's map and area element) will come beside them with
+  the same methods.
 
 Adding a geometry (a cubic map, a cell of another shape) means one more group class with the
 same methods; the integrands do not change. Points are ``(..., d)`` arrays; the Jacobian
@@ -38,9 +42,9 @@ __all__ = [
     "AffineCells",
     "CellMap",
     "IsoparametricCells",
-    "QuadraticEdges",
-    "StraightEdges",
-    "edge_groups",
+    "QuadraticFacets",
+    "StraightFacets",
+    "facet_groups",
 ]
 
 #: local nodes ``[start, end, midpoint]`` of local edge k = 0, 1, 2 of a P2 cell
@@ -49,11 +53,12 @@ EDGE_NODES = TRIANGLE.edge_nodes
 _ALL = slice(None)
 
 
-# --------------------------------------------------------------------------- edges
+# --------------------------------------------------------------------------- facets (2D: segments)
 
 
-class StraightEdges:
-    """Edges ``x(t) = a + t (b − a)``: constant unit normal and line element ``|b − a|``.
+class StraightFacets:
+    """Straight 2D facets (segments) ``x(t) = a + t (b − a)``: constant unit normal and line
+    element ``|b − a|``.
 
     Parameters
     ----------
@@ -89,9 +94,10 @@ class StraightEdges:
         return self.length[:, None]
 
 
-class QuadraticEdges:
-    """Edges ``x(t) = x_s ψ_0 + x_e ψ_1 + x_m ψ_2`` through ``[start, end, midpoint]`` (the
-    midpoint node on the curve): normal and line element vary along the edge.
+class QuadraticFacets:
+    """Quadratic 2D facets ``x(t) = x_s ψ_0 + x_e ψ_1 + x_m ψ_2`` through ``[start, end,
+    midpoint]`` (the midpoint node on the curve): normal and line element vary along the
+    facet.
 
     Parameters
     ----------
@@ -137,26 +143,26 @@ class QuadraticEdges:
         return spanned_normals(dx[..., None, :])[0]
 
 
-Edges = StraightEdges | QuadraticEdges
+Facets = StraightFacets | QuadraticFacets
 
 
-def edge_groups(
+def facet_groups(
     nodes: np.ndarray, quadratic: np.ndarray
-) -> Iterator[tuple[slice | np.ndarray, Edges]]:
-    """The edges with node points ``nodes (k, 3, d)`` ``[start, end, midpoint]`` as groups of
-    one kind: ``(rows, edges)`` for the straight ones, then the ``quadratic (k,) bool`` ones
-    (``rows`` a slice when one kind holds every edge)."""
+) -> Iterator[tuple[slice | np.ndarray, Facets]]:
+    """The 2D facets with node points ``nodes (k, 3, d)`` ``[start, end, midpoint]`` as
+    groups of one kind: ``(rows, facets)`` for the straight ones, then the ``quadratic (k,)
+    bool`` ones (``rows`` a slice when one kind holds every facet)."""
     quadratic = np.asarray(quadratic, dtype=bool)
     if not quadratic.any():
-        yield _ALL, StraightEdges(nodes[:, :2])
+        yield _ALL, StraightFacets(nodes[:, :2])
         return
     if quadratic.all():
-        yield _ALL, QuadraticEdges(nodes)
+        yield _ALL, QuadraticFacets(nodes)
         return
     straight = np.flatnonzero(~quadratic)
     rows = np.flatnonzero(quadratic)
-    yield straight, StraightEdges(nodes[straight, :2])
-    yield rows, QuadraticEdges(nodes[rows])
+    yield straight, StraightFacets(nodes[straight, :2])
+    yield rows, QuadraticFacets(nodes[rows])
 
 
 # --------------------------------------------------------------------------- cells
@@ -235,11 +241,11 @@ class AffineCells:
         cells = slot if isinstance(self.cells, slice) else self.cells[slot]
         return AffineCells(self.vertices[slot], cells)
 
-    def local_edges(self, slot: np.ndarray, k: np.ndarray) -> StraightEdges:
-        """Local edge ``k`` of the cells at rows ``slot`` of this group."""
+    def local_facets(self, slot: np.ndarray, k: np.ndarray) -> StraightFacets:
+        """Local facet ``k`` (an edge in 2D) of the cells at rows ``slot`` of this group."""
         flat = self.vertices.reshape(-1, self.vertices.shape[-1])
         start, end = 3 * slot + TRIANGLE.edges[k, 0], 3 * slot + TRIANGLE.edges[k, 1]
-        return StraightEdges(np.stack([flat[start], flat[end]], 1))
+        return StraightFacets(np.stack([flat[start], flat[end]], 1))
 
 
 class IsoparametricCells:
@@ -315,9 +321,10 @@ class IsoparametricCells:
         cells = slot if isinstance(self.cells, slice) else self.cells[slot]
         return IsoparametricCells(self.nodes[slot], cells)
 
-    def local_edges(self, slot: np.ndarray, k: np.ndarray) -> QuadraticEdges:
-        """Local edge ``k`` of the cells at rows ``slot``: the map restricted to it."""
-        return QuadraticEdges(self.nodes[slot[:, None], EDGE_NODES[k]])
+    def local_facets(self, slot: np.ndarray, k: np.ndarray) -> QuadraticFacets:
+        """Local facet ``k`` (an edge in 2D) of the cells at rows ``slot``: the map
+        restricted to it."""
+        return QuadraticFacets(self.nodes[slot[:, None], EDGE_NODES[k]])
 
 
 Cells = AffineCells | IsoparametricCells
@@ -393,10 +400,10 @@ class CellMap:
             if rows.size:
                 yield rows, g, self.slot[cell[rows]]
 
-    def local_edges(
+    def local_facets(
         self, cell: np.ndarray, k: np.ndarray
-    ) -> Iterator[tuple[slice | np.ndarray, Cells, np.ndarray, Edges]]:
-        """Local edge ``k (e,)`` of each ``cell (e,)`` by group: ``(rows, group, slots,
-        edges)``, the edges being the group's map restricted to them."""
+    ) -> Iterator[tuple[slice | np.ndarray, Cells, np.ndarray, Facets]]:
+        """Local facet ``k (e,)`` (an edge in 2D) of each ``cell (e,)`` by group: ``(rows,
+        group, slots, facets)``, the facets being the group's map restricted to them."""
         for rows, g, slot in self.split(cell):
-            yield rows, g, slot, g.local_edges(slot, k[rows])
+            yield rows, g, slot, g.local_facets(slot, k[rows])

@@ -19,7 +19,6 @@ from .material import CellMaterials, Material, _per_cell, on_cells, stress, stre
 __all__ = [
     "cell_stress",
     "div_stress",
-    "edge_traction",
     "facet_traction",
     "nodal_stress",
     "stress_divergence",
@@ -132,10 +131,6 @@ def facet_traction(
     rows = np.arange(v.shape[0])
     _, normal = facet_normals(v[rows[:, None], TRIANGLE.facets[lf]])
     return traction(v, u_cell, material, xi, normal), normal
-
-
-#: the 2D name of :func:`facet_traction`
-edge_traction = facet_traction
 
 
 def div_stress(

@@ -25,7 +25,7 @@ from ..mesh.validation import MeshError
 from . import dofs, iso
 from .dofs import node_dofs
 from .element import P1, P2, Element, element_of
-from .mapping import CellMap, QuadraticEdges, StraightEdges, edge_groups
+from .mapping import CellMap, QuadraticFacets, StraightFacets, facet_groups
 from .prolongation import prolongate_p1, prolongate_p2
 
 __all__ = ["LagrangeSpace", "P1Space", "P2Space", "node_dofs", "space_of"]
@@ -197,26 +197,19 @@ class P2Space(LagrangeSpace):
 
     def boundary_facets(
         self, facet_index: np.ndarray
-    ) -> Iterator[tuple[slice | np.ndarray, StraightEdges | QuadraticEdges]]:
+    ) -> Iterator[tuple[slice | np.ndarray, StraightFacets | QuadraticFacets]]:
         """The geometry of boundary facets (edges in 2D; :mod:`signorini.fem.mapping`),
         counter-clockwise as :meth:`facet_nodes`: quadratic through the midpoint node on parts
         carrying a curve other than a line, straight elsewhere; ``(rows, facets)`` per kind."""
         facet_index = np.asarray(facet_index, dtype=np.int64)
         points = self.node_points[self.facet_nodes(facet_index)]
-        return edge_groups(points, np.isin(facet_index, self.curved_facets))
+        return facet_groups(points, np.isin(facet_index, self.curved_facets))
 
     def part_nodes(self, names: Iterable[str]) -> np.ndarray:
         """Sorted nodes on the closure of the named boundary parts (vertices and midpoints)."""
         facets = np.concatenate([self.mesh.part_facets(n) for n in names] or [np.zeros(0, int)])
         nodes = np.concatenate([self.mesh.facets[facets].ravel(), self.mesh.n_points + facets])
         return np.unique(nodes)
-
-    # the former edge names of the facet-sense methods, read by the contact layer and the
-    # estimator
-    edge_nodes = facet_nodes
-    mesh_edge_nodes = mesh_facet_nodes
-    boundary_edges = boundary_facets
-    curved_edges = curved_facets
 
     def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
         """Exact interpolation of a P2 field of this space on the refined mesh.
@@ -304,19 +297,14 @@ class P1Space(LagrangeSpace):
 
     def boundary_facets(
         self, facet_index: np.ndarray
-    ) -> Iterator[tuple[slice | np.ndarray, StraightEdges | QuadraticEdges]]:
+    ) -> Iterator[tuple[slice | np.ndarray, StraightFacets | QuadraticFacets]]:
         """The boundary facets as straight edges, counter-clockwise as :meth:`facet_nodes`."""
-        yield slice(None), StraightEdges(self.node_points[self.facet_nodes(facet_index)])
+        yield slice(None), StraightFacets(self.node_points[self.facet_nodes(facet_index)])
 
     def part_nodes(self, names: Iterable[str]) -> np.ndarray:
         """Sorted nodes (vertices) on the closure of the named boundary parts."""
         facets = np.concatenate([self.mesh.part_facets(n) for n in names] or [np.zeros(0, int)])
         return np.unique(self.mesh.facets[facets])
-
-    edge_nodes = facet_nodes
-    mesh_edge_nodes = mesh_facet_nodes
-    boundary_edges = boundary_facets
-    curved_edges = curved_facets
 
     def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
         """Exact interpolation of a P1 field of this space on the refined mesh: the old

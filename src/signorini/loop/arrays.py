@@ -83,14 +83,14 @@ def level_arrays(level: Level) -> dict[str, Any]:
     return arrays
 
 
-def _p2_edge(values: np.ndarray) -> np.ndarray:
+def _p2_facet(values: np.ndarray) -> np.ndarray:
     """Per-edge nodal data ``(e, 3, ...)`` at ``[start, end, midpoint]``; a P1 edge's ``(e, 2,
     ...)`` with the mean of its ends at the midpoint (:meth:`~signorini.fem.facet_element.
     FacetElement.facet_values`)."""
     return values if values.shape[1] == 3 else P1.facet.facet_values(values)
 
 
-def _on_edges(ends: np.ndarray, m: int) -> np.ndarray:
+def _on_facets(ends: np.ndarray, m: int) -> np.ndarray:
     """``(e, m, ...)`` values at ``m`` equispaced points of each edge, interpolated
     quadratically from ``ends (e, 3, ...)`` at ``[start, end, midpoint]`` (the P2 edge)."""
     t = np.linspace(0.0, 1.0, m)
@@ -158,19 +158,19 @@ def obstacle_offset(
     for i, name in enumerate(cs.parts):  # a loop over the contact parts
         if getattr(conditions[name], "master", None) is not None:
             continue  # the other body is drawn itself
-        sel = cs.edge_part == i
+        sel = cs.facet_part == i
         out = np.full((int(sel.sum()), m + 1, 2), np.nan)
         obstacle = conditions[name].obstacle
-        x = _on_edges(_p2_edge(node_points[cs.edge_nodes[sel]]), m).reshape(-1, 2)
+        x = _on_facets(_p2_facet(node_points[cs.facet_nodes[sel]]), m).reshape(-1, 2)
         if obstacle is not None:
             g, n = obstacle.gap_and_direction(x)
             out[:, :m] = (x + g[:, None] * n).reshape(-1, m, 2)
             psi = g.reshape(-1, m)
         else:
-            ends = node_points[cs.edge_nodes[sel]]
-            ends = _p2_edge(ends + cs.edge_gap[sel][..., None] * cs.edge_direction[sel])
-            out[:, :m] = _on_edges(ends, m)
-            psi = _on_edges(_p2_edge(cs.edge_gap[sel]), m)
+            ends = node_points[cs.facet_nodes[sel]]
+            ends = _p2_facet(ends + cs.facet_gap[sel][..., None] * cs.facet_direction[sel])
+            out[:, :m] = _on_facets(ends, m)
+            psi = _on_facets(_p2_facet(cs.facet_gap[sel]), m)
         out[:, :m][np.abs(psi) > OUTLINE_REACH * size] = np.nan
         offset = out.copy()
         offset[:, :m] -= x.reshape(-1, m, 2)
@@ -183,7 +183,7 @@ def arc_lengths(
 ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Each contact part's constraints and their arc length along the part.
 
-    The part's edges (oriented counter-clockwise, ``cs.edge_nodes``) form chains; the arc
+    The part's edges (oriented counter-clockwise, ``cs.facet_nodes``) form chains; the arc
     length of a vertex is its distance along the chain from the chain's first vertex
     (shortest paths on the directed chain graph, each edge weighted by its length through its
     midpoint), a midpoint's that of its edge's start plus the half-edge.
@@ -197,12 +197,12 @@ def arc_lengths(
     """
     along = {}
     for i, name in enumerate(cs.parts):  # a loop over the contact parts
-        sel = cs.edge_part == i
-        en, local = cs.edge_nodes[sel], cs.edge_local[sel]
+        sel = cs.facet_part == i
+        en, local = cs.facet_nodes[sel], cs.facet_local[sel]
         if en.shape[0] == 0:
             along[name] = (np.zeros(0, np.int64), np.zeros(0))
             continue
-        x = _p2_edge(node_points[en])
+        x = _p2_facet(node_points[en])
         half = np.hypot(*(x[:, 2] - x[:, 0]).T), np.hypot(*(x[:, 1] - x[:, 2]).T)
         vertices, ends = np.unique(en[:, :2], return_inverse=True)
         ends = ends.reshape(-1, 2)

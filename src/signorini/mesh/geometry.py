@@ -22,7 +22,7 @@ import numpy as np
 from .jacobians import affine_jacobian
 from .reference import TRIANGLE
 
-__all__ = ["facet_normals", "min_angle", "segment_normals", "signed_area", "spanned_normals"]
+__all__ = ["facet_normals", "min_angle", "signed_area", "spanned_normals"]
 
 
 def spanned_normals(spans: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -71,24 +71,6 @@ def facet_normals(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if corners.shape[-1] == 2:
         return element, normal
     return 0.5 * element, normal
-
-
-def segment_normals(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Lengths and right-hand unit normals of the segments ``a → b`` (2D facets).
-
-    Parameters
-    ----------
-    a, b : (..., 2) float arrays
-        Start and end points.
-
-    Returns
-    -------
-    length : (...) float array
-    normal : (..., 2) float array
-        ``(d_y, −d_x) / |d|``, ``d = b − a``; outward for a counter-clockwise cell.
-    """
-    d = np.asarray(b, dtype=np.float64) - np.asarray(a, dtype=np.float64)
-    return spanned_normals(d[..., None, :])
 
 
 def signed_area(points: np.ndarray, cells: np.ndarray) -> np.ndarray:

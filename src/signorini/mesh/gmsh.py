@@ -6,15 +6,16 @@ import contextlib
 import io as _io
 import logging
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
 from .curves import QuadraticBoundary
 from .mesh import Mesh, MeshError
-from .reference import INTERVAL, TRIANGLE
+from .reference import INTERVAL, TETRAHEDRON, TRIANGLE
 from .regions import DEFAULT_REGION
+from .surfaces import Surface
 from .topology import edge_keys
 
 __all__ = ["read_mesh"]
@@ -36,8 +37,19 @@ STRAIGHT_TOL = 1e-12
 CURVED_TURN = np.radians(40.0)
 
 
-def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Mesh:
-    """Read a triangular mesh with named boundary parts from a file (e.g. Gmsh ``.msh``).
+def read_mesh(
+    path: str | os.PathLike,
+    parts: Sequence[str] | None = None,
+    *,
+    surfaces: Mapping[str, Surface] | None = None,
+) -> Mesh:
+    """Read a triangular (or tetrahedral) mesh with named boundary parts from a file (e.g.
+    Gmsh ``.msh``).
+
+    A file with ``tetra`` or ``tetra10`` elements is read as a 3D mesh, its physical surface
+    groups the parts and its physical volume groups the regions, second-order midpoints off
+    their chords allowed on the parts given an exact surface in ``surfaces``
+    (:func:`signorini.mesh.gmsh3d.read_tetrahedra`). What follows is the 2D reading.
 
     Triangles (``triangle`` or ``triangle6``) make the cells; line elements (``line`` or
     ``line3``) tagged with physical groups make the boundary parts, named after the groups
@@ -67,6 +79,7 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
     ----------
     path : file readable by meshio
     parts : names of the parts to keep (default: all named line groups)
+    surfaces : mapping part name -> Surface, optional (3D files only)
 
     Returns
     -------
@@ -97,6 +110,12 @@ def read_mesh(path: str | os.PathLike, parts: Sequence[str] | None = None) -> Me
     except (Exception, SystemExit) as exc:  # meshio raises many types for foreign files
         detail = " ".join(said.getvalue().split()) if isinstance(exc, SystemExit) else exc
         raise MeshError(f"{path} is not a mesh file meshio can read: {detail}") from None
+    if any(b.type in (TETRAHEDRON.vtk_name, TETRAHEDRON.vtk_p2_name) for b in m.cells):
+        from .gmsh3d import read_tetrahedra  # it builds on this module
+
+        return read_tetrahedra(path, m, parts, surfaces)
+    if surfaces:
+        raise MeshError(f"{path} holds no tetrahedra: surfaces are for 3D meshes")
     names = (TRIANGLE.vtk_name, TRIANGLE.vtk_p2_name)
     tri = [(i, b) for i, b in enumerate(m.cells) if b.type in names]
     if not tri:

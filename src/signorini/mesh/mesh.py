@@ -1,4 +1,5 @@
-"""Conforming simplicial meshes (triangles, tetrahedra) with labelled boundary facets.
+"""Conforming simplicial meshes (triangles, tetrahedra) with labelled boundary facets (edges
+in 2D, faces in 3D).
 
 Conventions (fixed for the whole package)
 -----------------------------------------
@@ -15,9 +16,11 @@ Conventions (fixed for the whole package)
   bisection and ``cells[:, 2]`` the newest vertex. :meth:`Mesh.from_arrays` puts the longest
   edge first; refinement keeps the convention.
 - ``edges (n_edges, 2)`` store each undirected edge once, as ``(min, max)`` vertex pair.
-  ``cell2edge (n_cells, 3)`` gives the edge of local edge ``k``; ``edge2cell (n_edges, 2)`` the
-  two cells of an edge, ``-1`` outside the domain (boundary edges have their cell in column 0).
-- The boundary is split into named *parts* (``part_names``); every boundary edge carries the
+  ``cell2edge (n_cells, 3)`` gives the edge of local edge ``k``. The *facets* (where parts,
+  tractions, jumps and contact live; a triangle's facets are its edges, the same arrays in
+  2D): ``facet2cell (n_facets, 2)`` the two cells of a facet, ``-1`` outside the domain
+  (boundary facets have their cell in column 0).
+- The boundary is split into named *parts* (``part_names``); every boundary facet carries the
   index of its part in ``boundary_part``. What a part means (Dirichlet, Neumann, contact) is the
   business of :mod:`signorini.problem`, not of the mesh. Parts survive refinement.
 - Cells carry a *region* (``region_names``, ``cell_region``: e.g. one per material,
@@ -47,7 +50,6 @@ from .regions import RegionSpec, checked_regions, region_labels
 from .surfaces import Surface
 from .tetrahedra import REFERENCES, initial_vertex_order, reference_of, reoriented
 from .topology import (
-    boundary_edges,
     boundary_facets,
     entity_topology,
     facet_local,
@@ -64,7 +66,7 @@ from .validation import (
 )
 from .validation3d import check_on_surface, nondegenerate_volume
 
-__all__ = ["Mesh", "MeshError", "boundary_edges"]
+__all__ = ["Mesh", "MeshError", "boundary_facets"]
 
 logger = logging.getLogger(__name__)
 
@@ -133,7 +135,6 @@ class Mesh(MeshGeometry):
         if validate:  # argument kinds first: a clear error instead of NumPy's
             points = as_points(points)
             cells = as_cells(cells, len(points), width=points.shape[1] + 1)
-            reference_of(points, cells)
         self.points = np.ascontiguousarray(points, dtype=np.float64)
         self.cells = np.ascontiguousarray(cells, dtype=np.int64)
         boundary = np.asarray(boundary, dtype=np.int64)
@@ -399,13 +400,6 @@ class Mesh(MeshGeometry):
         local = self.reference.facets[self.facet_local[facet_index, 0]]
         return self.cells[cell[:, None], local]
 
-    # the 2D names of the facet arrays (a triangle's facets are its edges)
-    edge2cell = facet2cell
-    edge_local = property(lambda self: self.facet_local, doc="The 2D name of facet_local.")
-    boundary_edge = property(lambda self: self.boundary_facet, doc="The 2D name.")
-    edge_part = property(lambda self: self.facet_part, doc="The 2D name of facet_part.")
-    part_edges = part_facets
-
     # ------------------------------------------------------------------ geometry (MeshGeometry)
     def region_cells(self, name: str) -> np.ndarray:
         """Indices of the cells of region ``name``."""
@@ -418,8 +412,6 @@ class Mesh(MeshGeometry):
     def part_measure(self, name: str) -> float:
         """Total measure of boundary part ``name`` (its length in 2D)."""
         return float(self.facet_measure[self.part_facets(name)].sum())
-
-    part_length = part_measure
 
     def __repr__(self) -> str:
         parts = list(self.part_names)

@@ -15,16 +15,11 @@ import numpy as np
 
 from .geometry import min_angle, signed_area
 from .tetrahedra import edge_lengths, facet_edges, facet_measures
+from .topology import _frozen
 from .validation import MeshError
 from .validation3d import dihedral_angles
 
 __all__ = ["MeshGeometry"]
-
-
-def _frozen(a: np.ndarray) -> np.ndarray:
-    """Mark a cached array read-only (a Mesh is immutable)."""
-    a.flags.writeable = False
-    return a
 
 
 class MeshGeometry:
@@ -93,17 +88,19 @@ class MeshGeometry:
         if all(c is None for c in self.curves):
             return self.edge_midpoints
         mid = self.edge_midpoints.copy()
-        part = self.facet_part
         for index, curve in enumerate(self.curves):  # a loop over parts, not edges
             if curve is None:
                 continue
-            e = self.part_edge_indices(index) if self.dim == 3 else np.flatnonzero(part == index)
+            e = self.part_edge_indices(index)
             ends = self.edges[e]
             mid[e] = curve.halfway(self.points[ends[:, 0]], self.points[ends[:, 1]])
         return _frozen(mid)
 
     def part_edge_indices(self, index: int) -> np.ndarray:
-        """The sorted edge indices of the faces of the part of index ``index`` (3D)."""
+        """The sorted indices of the edges of the part of index ``index``: its facets in 2D,
+        the edges of its faces in 3D (their midpoints move onto the part's surface)."""
+        if self.dim == 2:
+            return np.flatnonzero(self.facet_part == index)
         faces = self.facets[self.facet_part == index]
         return np.unique(facet_edges(self.edges, faces, self.n_points))
 

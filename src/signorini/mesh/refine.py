@@ -1,4 +1,5 @@
-"""Newest vertex bisection (NVB) with closure, vectorized over the whole mesh.
+"""Newest vertex bisection (NVB) with closure, vectorized over the whole mesh (triangles; tetrahedra
+dispatch to the tagged-simplex bisection of :mod:`signorini.mesh.refine3d`).
 
 A cell ``[a, b, c]`` has refinement edge ``a–b`` and newest vertex ``c`` (see
 :mod:`signorini.mesh`). Bisecting it at the midpoint ``m`` of ``a–b`` gives the children
@@ -23,6 +24,7 @@ import numpy as np
 
 from .geometry import signed_area
 from .mesh import Mesh
+from .refine3d import UNIFORM_BISECTIONS, bisect_mesh
 from .validation import MeshError, degenerate_cells
 
 __all__ = ["Refinement", "refine_nvb", "refine_uniform", "closure"]
@@ -75,7 +77,9 @@ def closure(mesh: Mesh, marked_edges: np.ndarray) -> np.ndarray:
         newly = ref[candidates[hit]]
         marked[newly] = True
         # only neighbours of newly marked edges can change next round
-        nb = mesh.edge2cell[newly].ravel()  # edge sense: the cells around a marked edge
+        # edge sense: the cells around a marked edge. In 2D an edge's cells are its facet's
+        # cells (facet2cell); in 3D this needs an edge -> cells map
+        nb = mesh.facet2cell[newly].ravel()
         candidates = np.unique(nb[nb >= 0])
 
 
@@ -95,6 +99,8 @@ def refine_nvb(mesh: Mesh, marked: np.ndarray) -> Refinement:
     Refinement
     """
     marked = _as_cell_mask(mesh, marked)
+    if mesh.dim == 3:  # tagged-simplex bisection, docs/method.md "Three dimensions"
+        return Refinement(*bisect_mesh(mesh, marked))
     edges = np.zeros(mesh.n_edges, dtype=bool)
     edges[mesh.cell2edge[marked, 0]] = True
     return _bisect(mesh, closure(mesh, edges))
@@ -104,8 +110,13 @@ def refine_uniform(mesh: Mesh) -> Refinement:
     """Bisect every edge once: each cell splits into four similar-by-NVB children.
 
     This is NVB with all edges marked (three bisections per cell), so the mesh size halves
-    and the sequence stays within the NVB family of shapes.
+    and the sequence stays within the NVB family of shapes. In 3D, three bisections of every
+    cell (:data:`~signorini.mesh.refine3d.UNIFORM_BISECTIONS`): ``h`` halves and the number
+    of cells grows eightfold.
     """
+    if mesh.dim == 3:
+        marked = np.ones(mesh.n_cells, dtype=bool)
+        return Refinement(*bisect_mesh(mesh, marked, UNIFORM_BISECTIONS))
     return _bisect(mesh, np.ones(mesh.n_edges, dtype=bool))
 
 

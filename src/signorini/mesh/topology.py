@@ -18,10 +18,8 @@ from .reference import TRIANGLE
 from .validation import MeshError, format_indices
 
 __all__ = [
-    "boundary_edges",
     "boundary_facets",
     "edge_keys",
-    "edge_topology",
     "entity_keys",
     "entity_topology",
     "facet_local",
@@ -83,12 +81,6 @@ def boundary_facets(cells: np.ndarray, local: np.ndarray = TRIANGLE.facets) -> n
     return tuples[first[counts == 1]]
 
 
-def boundary_edges(cells: np.ndarray) -> np.ndarray:
-    """The boundary edges ``(n_boundary, 2)`` of counter-clockwise triangles ``cells (n_cells,
-    3)``, counter-clockwise: :func:`boundary_facets` of the triangle."""
-    return boundary_facets(cells, TRIANGLE.facets)
-
-
 def entity_topology(
     cells: np.ndarray, n_points: int, local: np.ndarray, *, facets: bool = True
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
@@ -125,15 +117,6 @@ def entity_topology(
     second[first] = False
     entity2cell[inverse[second], 1] = owner[second]
     return _frozen(entities), _frozen(cell2entity), _frozen(entity2cell)
-
-
-def edge_topology(cells: np.ndarray, n_points: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``edges (n_edges, 2)``, ``cell2edge (n_cells, 3)`` and ``edge2cell (n_edges, 2)`` of
-    triangles ``cells (n_cells, 3)``: :func:`entity_topology` of :attr:`TRIANGLE.edges`, the
-    triangle's facets."""
-    edges, cell2edge, edge2cell = entity_topology(cells, n_points, TRIANGLE.edges)
-    assert edge2cell is not None
-    return edges, cell2edge, edge2cell
 
 
 def facet_local(cell2facet: np.ndarray, facet2cell: np.ndarray) -> np.ndarray:

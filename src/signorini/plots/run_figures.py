@@ -175,7 +175,7 @@ def part_segments(initial: Mesh, part: str, points: np.ndarray, cells: np.ndarra
     part carrying a curve (whose new points lie on the curve, off the initial chords) the
     drawn mesh's own boundary edges with both ends on the curve, near the part's initial
     chords (within their largest distance from the curve)."""
-    chords = initial.points[initial.edges[initial.part_facets(part)]]
+    chords = initial.points[initial.facets[initial.part_facets(part)]]
     curve = initial.curves[initial.part_index(part)]
     if curve is None or isinstance(curve, Line):
         return chords

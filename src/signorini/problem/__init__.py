@@ -5,7 +5,7 @@ are evaluated and checked (``fields``)."""
 
 from .conditions import Contact, Dirichlet, ExactSolution, Neumann, Roller
 from .fields import ProblemError
-from .friction import Coulomb, Tresca
+from .friction_laws import Coulomb, Tresca
 from .obstacles import Disc, HalfPlane, Obstacle, Polyline, SignedDistance
 from .problem import ContactProblem, SlenderBodyWarning
 

@@ -36,7 +36,7 @@ from .fields import (
     check_numbers,
     constant_field,
 )
-from .friction import LAW_MEMBERS, Friction
+from .friction_laws import LAW_MEMBERS, Friction
 from .obstacles import Obstacle
 
 __all__ = ["Condition", "Contact", "Dirichlet", "ExactSolution", "Neumann", "Roller"]
@@ -225,7 +225,7 @@ class Contact:
         :class:`~signorini.problem.obstacles.Polyline` or
         :class:`~signorini.problem.obstacles.SignedDistance`.
     friction : Tresca, Coulomb, another friction law, or None
-        The friction law on the part (:mod:`signorini.problem.friction`, or any object of the
+        The friction law on the part (:mod:`signorini.problem.friction_laws`, or any object of the
         protocol :class:`signorini.algebra.friction.laws.FrictionLaw`); ``None`` for frictionless
         contact.
     master : str or None
@@ -275,7 +275,7 @@ class Contact:
         if friction is not None and not all(hasattr(friction, a) for a in LAW_MEMBERS):
             raise ProblemError(
                 "Contact(friction=...) must be None, Tresca(bound) or Coulomb(coefficient) "
-                "from signorini.problem.friction, or a friction law with "
+                "from signorini.problem.friction_laws, or a friction law with "
                 f"{', '.join(LAW_MEMBERS)}, got {self.friction!r}"
             )
         if callable(self.gap):

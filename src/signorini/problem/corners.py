@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from .conditions import Contact
 from .fields import ProblemError
 
@@ -34,7 +34,7 @@ def _part_direction(problem: ContactProblem, name: str, vertex: np.ndarray) -> n
         return np.broadcast_to(problem.contact_normals[name], x.shape)
     mesh = problem.mesh
     ab = mesh.oriented_boundary(mesh.part_facets(name))
-    _, chord = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+    _, chord = facet_normals(mesh.points[ab])
     total = np.zeros((mesh.n_points, 2))
     np.add.at(total, ab.ravel(), np.repeat(chord, 2, axis=0))
     n = total[vertex] / np.hypot(*total[vertex].T)[:, None]

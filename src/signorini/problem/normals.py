@@ -2,13 +2,13 @@
 directions of contact parts (docs/method.md, *Contact directions*) and of rollers
 (docs/method.md, *Rollers and components*).
 
-At a node ``z`` of a part's edge the normal ``n_z`` is
+At a node ``z`` of a part's facet the normal ``n_z`` is
 
 - the part's normal on a straight part;
 - the exact normal of the part's curve where the mesh carries a curve that has one
   (:meth:`~signorini.mesh.mesh.Mesh.with_curve`), oriented outwards;
-- otherwise the edge chord's normal at a midpoint, and the normalised mean of the normals of
-  the part's (one or two) edges at a vertex.
+- otherwise the facet chord's normal at a midpoint, and the normalised mean of the normals of
+  the part's (one or two) facets at a vertex (edges in 2D).
 """
 
 from __future__ import annotations
@@ -16,28 +16,28 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh.curves import Line
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from ..mesh.mesh import Mesh
 from ..mesh.validation import MeshError
 from .fields import ProblemError
 
 __all__ = ["CURVE_NORMAL_ANGLE", "STRAIGHT_RTOL", "node_normals", "straight_normal"]
 
-#: a curve's normal at a node of a part's edge may differ from the edge chord's normal by at
-#: most this angle (radians, 60°): the curve turns by about h / R over an edge, far less on
+#: a curve's normal at a node of a part's facet may differ from the facet chord's normal by at
+#: most this angle (radians, 60°): the curve turns by about h / R over a facet, far less on
 #: any mesh that resolves it; a normal along the boundary (the tangent) is 90° off
 CURVE_NORMAL_ANGLE = np.pi / 3
-#: a part is straight when its edges' outward unit normals differ from their mean by at most
+#: a part is straight when its facets' outward unit normals differ from their mean by at most
 #: this much (and it carries no curve other than a line)
 STRAIGHT_RTOL = 1e-8
 
 
 def straight_normal(mesh: Mesh, name: str) -> np.ndarray | None:
-    """``(2,)`` the outward unit normal of part ``name`` if it is straight (its edges'
+    """``(2,)`` the outward unit normal of part ``name`` if it is straight (its facets'
     normals agree within :data:`STRAIGHT_RTOL` and it carries no curve other than a
     :class:`~signorini.mesh.curves.Line`), else ``None``."""
     ab = mesh.oriented_boundary(mesh.part_facets(name))
-    _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+    _, n = facet_normals(mesh.points[ab])
     mean = n.mean(axis=0)
     mean /= np.linalg.norm(mean)
     curve = mesh.curves[mesh.part_index(name)]
@@ -56,7 +56,7 @@ def node_normals(
     straight: np.ndarray | None = None,
     what: str = "contact part",
 ) -> np.ndarray:
-    """The outward unit normal at the nodes ``[start, end, midpoint]`` of one part's edges.
+    """The outward unit normal at the nodes ``[start, end, midpoint]`` of one part's facets.
 
     Parameters
     ----------
@@ -64,12 +64,12 @@ def node_normals(
     name : str
         The part.
     nodes : (e, 3) int array
-        Global P2 nodes ``[start, end, midpoint]`` of the part's edges (vertices first in
+        Global P2 nodes ``[start, end, midpoint]`` of the part's facets (vertices first in
         the P2 numbering, so ``nodes[:, :2]`` are mesh vertices).
     points : (e, 3, 2) float array
         Their coordinates (the midpoint on the part's curve).
     chord : (e, 2) float array
-        The outward unit normal of each edge's chord.
+        The outward unit normal of each facet's chord.
     straight : (2,) float array, optional
         The part's normal where it is straight (:func:`straight_normal`): every node takes it.
     what : str
@@ -83,7 +83,7 @@ def node_normals(
     ------
     ProblemError
         If the part's curve cannot give its normal at a node, or gives one more than
-        :data:`CURVE_NORMAL_ANGLE` away from the edge's normal (a tangent, not a normal).
+        :data:`CURVE_NORMAL_ANGLE` away from the facet's normal (a tangent, not a normal).
     """
     if straight is not None:
         return np.broadcast_to(straight, nodes.shape + (2,)).copy()
@@ -107,7 +107,7 @@ def node_normals(
 
 def _check_across(part: str, cos: np.ndarray, x: np.ndarray) -> None:
     """Refuse a curve normal that runs along the boundary rather than across it: ``cos (e, 3)``
-    of its angle to the chord's normal at the nodes ``x (3 e, 2)`` of a part's edges."""
+    of its angle to the chord's normal at the nodes ``x (3 e, 2)`` of a part's facets."""
     bad = np.flatnonzero(np.abs(cos).ravel() < np.cos(CURVE_NORMAL_ANGLE))
     if bad.size:
         i = bad[0]

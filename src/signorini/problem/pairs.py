@@ -92,9 +92,9 @@ def pair_rigid_motions(
         each other), or if a free motion is tangential to every contact part of its body.
     """
     body = body_of_cells(mesh)
-    edge_body = np.full(mesh.n_edges, -1)
-    edge_body[mesh.facet_part >= 0] = body[mesh.facet2cell[mesh.facet_part >= 0, 0]]
-    part_body = {p: int(edge_body[mesh.part_facets(p)[0]]) for p in mesh.part_names}
+    facet_body = np.full(mesh.n_facets, -1)
+    facet_body[mesh.facet_part >= 0] = body[mesh.facet2cell[mesh.facet_part >= 0, 0]]
+    part_body = {p: int(facet_body[mesh.part_facets(p)[0]]) for p in mesh.part_names}
     masters = set(pairs.values())
 
     def parts_of(b: int) -> list[str]:
@@ -103,7 +103,7 @@ def pair_rigid_motions(
     free = {}
     for b in range(int(body.max(initial=-1)) + 1):  # a loop over bodies
         own = [p for p in parts_of(b) if p in contact_parts or p in masters]
-        free[b] = free_rigid_motions(mesh, held, own, rollers, on_edges=edge_body == b)
+        free[b] = free_rigid_motions(mesh, held, own, rollers, on_facets=facet_body == b)
     for slave, master in pairs.items():  # a loop over pairs
         a, b = part_body[slave], part_body[master]
         for loose, other in ((a, b), (b, a)):

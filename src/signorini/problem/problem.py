@@ -25,7 +25,7 @@ from ..fem.material import CellMaterials, Material
 from ..fem.space import LagrangeSpace, P2Space
 from ..mesh.bodies import body_of_cells
 from ..mesh.curves import Line
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from ..mesh.mesh import Mesh
 from .conditions import Condition, Contact, Dirichlet, ExactSolution, Neumann, Roller
 from .corners import check_corner_friction
@@ -259,7 +259,7 @@ class ContactProblem:
         if self.conditions[name].obstacle is not None or name in self.pairs:
             return None
         ab = mesh.oriented_boundary(mesh.part_facets(name))
-        _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+        _, n = facet_normals(mesh.points[ab])
         mean = n.mean(axis=0)
         mean /= np.linalg.norm(mean)
         curve = mesh.curves[mesh.part_index(name)]

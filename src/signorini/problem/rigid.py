@@ -5,8 +5,9 @@ A plane rigid motion is ``r(x) = (a − c (y − y_c) / L, b + c (x − x_c) / L
 ``(a, b, c)`` in a basis scaled by the body's centre ``(x_c, y_c)`` and size ``L`` so that the
 three columns are alike. A held component ``u_c`` at a vertex is a linear condition on
 ``(a, b, c)``; the null space of all of them is the free motions. Frictionless contact acts
-along the contact directions only, so a free motion tangential to every contact edge (zero
-``r(x_e)·n_e`` at every contact edge's midpoint ``x_e``) is held by nothing.
+along the contact directions only, so a free motion tangential to every contact facet (zero
+``r(x_e)·n_e`` at every contact facet's midpoint ``x_e``; facets are edges in 2D) is held by
+nothing.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from ..mesh.mesh import Mesh
 from .fields import ProblemError
 
@@ -71,18 +72,18 @@ def motion_conditions(
     mesh: Mesh,
     held: Mapping[str, object],
     rollers: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
-    on_edges: np.ndarray | None = None,
+    on_facets: np.ndarray | None = None,
 ) -> np.ndarray:
     """The linear conditions ``(n, 3)`` on a rigid motion's coefficients ``(a, b, c)`` that
     the held components of ``held`` and the roller normals of ``rollers`` (as in
-    :func:`free_rigid_motions`) impose at their parts' vertices; with ``on_edges`` (a bool
-    mask of the mesh's edges) only the held parts' edges in it and the roller parts that
+    :func:`free_rigid_motions`) impose at their parts' vertices; with ``on_facets`` (a bool
+    mask of the mesh's facets) only the held parts' facets in it and the roller parts that
     start in it (one body of a union)."""
     centre, size = _frame(mesh)
     rows = [np.zeros((0, 3))]
     for name, cond in held.items():  # a loop over parts
         e = mesh.part_facets(name)
-        v = np.unique(mesh.edges[e if on_edges is None else e[on_edges[e]]])
+        v = np.unique(mesh.facets[e if on_facets is None else e[on_facets[e]]])
         d = (mesh.points[v] - centre) / size
         one, zero = np.ones(v.size), np.zeros(v.size)
         by_component = (
@@ -91,7 +92,7 @@ def motion_conditions(
         )
         rows += [by_component[c] for c in range(2) if cond.components[c]]
     for name, (x, n) in (rollers or {}).items():  # a loop over parts
-        if on_edges is None or on_edges[mesh.part_facets(name)[0]]:
+        if on_facets is None or on_facets[mesh.part_facets(name)[0]]:
             d = (x - centre) / size  # r·n = a n_x + b n_y + c (d_x n_y − d_y n_x)
             rows.append(np.column_stack([n[:, 0], n[:, 1], d[:, 0] * n[:, 1] - d[:, 1] * n[:, 0]]))
     return np.concatenate(rows)
@@ -108,15 +109,15 @@ def free_rigid_motions(
     held: Mapping[str, object],
     contact_parts: list[str],
     rollers: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
-    on_edges: np.ndarray | None = None,
+    on_facets: np.ndarray | None = None,
 ) -> np.ndarray:
     """The rigid motions ``(k, 3)`` (orthonormal coefficients, ``k ≤ 3``) that the held
     components of ``held`` (part name → :class:`~.conditions.Dirichlet`) and the normal
     components held by ``rollers`` (part name → its vertices ``(m, 2)`` and the normals
     ``n (m, 2)`` there: ``r·n = 0``) leave free. A roller on an oblique straight part holds
     the translation along its normal; on a circular arc it leaves the rotation about the
-    centre free. With ``on_edges`` (a bool mask of the edges), the motions of one body of a
-    union: only its held parts' edges and rollers count (:func:`motion_conditions`).
+    centre free. With ``on_facets`` (a bool mask of the facets), the motions of one body
+    of a union: only its held parts' facets and rollers count (:func:`motion_conditions`).
 
     Raises
     ------
@@ -124,13 +125,13 @@ def free_rigid_motions(
         If a free motion is tangential to every contact part (or there is none): nothing
         holds it. The message names the motion.
     """
-    free = null_motions(motion_conditions(mesh, held, rollers, on_edges))
+    free = null_motions(motion_conditions(mesh, held, rollers, on_facets))
     if free.shape[0] == 0:
         return free
     normals, mids = [], []
     for name in contact_parts:  # a loop over parts
         ab = mesh.oriented_boundary(mesh.part_facets(name))
-        _, n = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+        _, n = facet_normals(mesh.points[ab])
         normals.append(n)
         mids.append(0.5 * (mesh.points[ab[:, 0]] + mesh.points[ab[:, 1]]))
     if normals:

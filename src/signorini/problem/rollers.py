@@ -5,7 +5,7 @@ A Dirichlet part, or a roller on a part along x or y, holds Cartesian components
 A roller on an oblique straight part or on a curved part holds ``u(z)·n_z = value`` at each
 node ``z`` of the part, ``n_z`` the outward unit normal there
 (:func:`~signorini.problem.normals.node_normals`: the part's normal on a straight part, the
-curve's exact normal where the mesh carries one, else the normalised mean of the edges'
+curve's exact normal where the mesh carries one, else the normalised mean of the facets'
 normals at a vertex). Per node the held directions combine:
 
 - one roller direction alone: the node is a *roller node*; the assembly gives it the frame
@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..fem.space import P2Space
-from ..mesh.geometry import segment_normals
+from ..mesh.geometry import facet_normals
 from ..mesh.mesh import Mesh
 from .fields import ProblemError, evaluate_field
 from .normals import node_normals, straight_normal
@@ -42,15 +42,17 @@ PARALLEL = 1e-8
 
 
 def roller_normals(mesh: Mesh, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """The P2 nodes ``[start, end, midpoint]`` of roller part ``name``'s edges ``(e, 3)`` and
-    the outward unit normal at each ``(e, 3, 2)`` (:func:`~.normals.node_normals`)."""
-    edges = mesh.part_facets(name)
-    ab = mesh.oriented_boundary(edges)
-    nodes = np.column_stack([ab, mesh.n_points + edges])
+    """The P2 nodes ``[start, end, midpoint]`` of roller part ``name``'s facets (edges in
+    2D) ``(e, 3)`` and the outward unit normal at each ``(e, 3, 2)``
+    (:func:`~.normals.node_normals`)."""
+    facets = mesh.part_facets(name)
+    ab = mesh.oriented_boundary(facets)
+    # 2D: a facet is an edge, its P2 node the edge's (n_points + edge index)
+    nodes = np.column_stack([ab, mesh.n_points + facets])
     points = np.concatenate(
-        [mesh.points[ab], mesh.curved_midpoints[edges][:, None, :]], axis=1
+        [mesh.points[ab], mesh.curved_midpoints[facets][:, None, :]], axis=1
     )  # (e, 3, 2)
-    _, chord = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+    _, chord = facet_normals(mesh.points[ab])
     normals = node_normals(
         mesh, name, nodes, points, chord, straight=straight_normal(mesh, name), what="roller part"
     )
@@ -59,8 +61,8 @@ def roller_normals(mesh: Mesh, name: str) -> tuple[np.ndarray, np.ndarray]:
 
 def check_roller_part(mesh: Mesh, name: str) -> None:
     """Refuse a roller part whose normal is not defined at a vertex: a corner of the part
-    (two of its edges turning by more than :data:`MAX_ROLLER_TURN`) where no curve gives
-    the normal.
+    (two of its facets, edges in 2D, turning by more than :data:`MAX_ROLLER_TURN`) where no
+    curve gives the normal.
 
     Raises
     ------
@@ -71,7 +73,7 @@ def check_roller_part(mesh: Mesh, name: str) -> None:
     if straight_normal(mesh, name) is not None or (curve is not None and curve.has_normal):
         return
     ab = mesh.oriented_boundary(mesh.part_facets(name))
-    _, chord = segment_normals(mesh.points[ab[:, 0]], mesh.points[ab[:, 1]])
+    _, chord = facet_normals(mesh.points[ab])
     total = np.zeros((mesh.n_points, 2))
     count = np.zeros(mesh.n_points)
     np.add.at(total, ab.ravel(), np.repeat(chord, 2, axis=0))

@@ -12,7 +12,7 @@ from .pardiso import PardisoSolver
 __all__ = ["REFINEMENT_STEPS", "PardisoLUSolver"]
 
 #: Steps of iterative refinement in the solves of a factor with perturbed pivots: on a matrix
-#: whose last pivot PARDISO perturbed (tests/algebra/test_lu_solvers.py) the residual is
+#: whose last pivot PARDISO perturbed (tests/algebra/backends/test_lu_solvers.py) the residual is
 #: 8.5e-13 without and 5.6e-16 with them.
 REFINEMENT_STEPS = 2
 

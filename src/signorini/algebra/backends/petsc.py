@@ -73,9 +73,9 @@ __all__ = [
 
 #: Steps of iterative refinement MUMPS does in each LU solve (``ICNTL(10) = -2``): without
 #: them an LU solve of a non-symmetric system left a relative residual of 1.7e-12, with them
-#: below 1e-12 as PARDISO (tests/algebra/test_lu_solvers.py). The Cholesky solves go without:
-#: refinement made MUMPS keep the matrix and took 1.6 x the refactorization and 6 x the solve
-#: at 132 000 unknowns, for no gain on the symmetric positive definite systems.
+#: below 1e-12 as PARDISO (tests/algebra/backends/test_lu_solvers.py). The Cholesky solves go
+#: without: refinement made MUMPS keep the matrix and took 1.6 x the refactorization and 6 x
+#: the solve at 132 000 unknowns, for no gain on the symmetric positive definite systems.
 REFINEMENT_STEPS = 2
 
 #: MUMPS's ordering for its Cholesky's analysis (``ICNTL(7)``), which PETSc does not hand an

@@ -20,6 +20,12 @@ backend by name (:func:`solver_name`).
     :func:`~.petsc_gamg.petsc_gamg_solver`: CG preconditioned by PETSc's GAMG with the
     rigid-body near-nullspace (the extra ``signorini[mpi]``), an iterative solver with the
     inexact active set stopping rule of :mod:`.inexact`; MUMPS LU for non-symmetric systems.
+``"amg"``
+    :func:`~.amg.amg_solver`: CG preconditioned by pyamg's smoothed aggregation with the
+    rigid-body near-nullspace, in the default install; iterative, with the inexact active
+    set stopping rule of :mod:`.inexact`; SuperLU's LU for non-symmetric systems. Only when
+    asked for: ``"auto"`` stays direct (docs/method.md, *Three dimensions: the linear solver
+    (measured)*, gives the rule by size for 3D).
 ``"auto"``
     :func:`auto_solver`, the default everywhere: PARDISO when it loads and solves a small test
     system; otherwise SuperLU, and a :class:`SolverFallbackWarning` says why (once per reason
@@ -41,6 +47,7 @@ import scipy
 import scipy.sparse as sp
 
 from ..errors import BackendUnavailableError, SolverFallbackWarning
+from .amg import amg_solver
 from .mkl import mkl_version
 from .pardiso import pardiso_problem, pardiso_solver
 from .petsc import petsc_library, petsc_solver
@@ -103,6 +110,7 @@ SOLVERS: dict[str, SolverFactory] = {
     "scipy": superlu_solver,
     "petsc": petsc_solver,
     "petsc-gamg": petsc_gamg_solver,
+    "amg": amg_solver,
 }
 
 
@@ -234,6 +242,10 @@ def solver_library(solver: object = None) -> str:
             return f"MKL PARDISO ({version})"
     if name in ("petsc", "petsc-gamg"):
         return petsc_library("MUMPS" if name == "petsc" else "GAMG (CG)")
+    if name == "amg":
+        from .amg import _pyamg
+
+        return f"pyamg {_pyamg().__version__} (CG + smoothed aggregation)"
     if name in ("auto", "pardiso", "scipy", "superlu"):
         return f"SuperLU (SciPy {scipy.__version__})"
     return f"{name} (SciPy {scipy.__version__} installed)"

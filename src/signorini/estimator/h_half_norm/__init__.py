@@ -20,6 +20,11 @@ at ``[start, end, midpoint]``, the package's P2 edge-node order); ``v = max(w, 0
 Nothing else about the mesh is needed. The edges may lie on several straight segments,
 connected or not, but must not cross or overlap (that is detected and reported).
 
+The package keeps the edges' names here: this is the exact algorithm for a 1D curve Γ_C (a
+2D problem's contact boundary, whose facets are edges), with panels, pair rules and
+subdivision in one arc parameter. A 3D contact boundary is a surface and gets its own
+algorithm; nothing here is a door for it.
+
 Method (exact up to quadrature round-off, cost driven by the support of v):
 
 * :mod:`.pieces`: every edge is cut at the real roots of its quadratic, so that v is a

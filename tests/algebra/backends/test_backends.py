@@ -60,13 +60,13 @@ def test_auto_takes_pardiso_when_mkl_is_installed():
     assert solver.backend == "pardiso" and solver.reuses_analysis
     assert available_backends() == ("pardiso", "scipy", *PETSC)
     gamg = ("petsc-gamg",) if PETSC else ()  # iterative: listed only when asked for
-    assert available_backends(iterative=True) == ("pardiso", "scipy", *PETSC, *gamg)
+    assert available_backends(iterative=True) == ("pardiso", "scipy", *PETSC, *gamg, "amg")
 
 
 def test_unknown_backend_lists_valid():
     with pytest.raises(ValueError, match="unknown backend 'mumps'.*auto, pardiso, scipy, petsc"):
         solver_factory("mumps")
-    assert tuple(SOLVERS) == ("auto", "pardiso", "scipy", "petsc", "petsc-gamg")
+    assert tuple(SOLVERS) == ("auto", "pardiso", "scipy", "petsc", "petsc-gamg", "amg")
 
 
 def test_the_registry_names_each_factory_once():

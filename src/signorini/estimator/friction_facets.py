@@ -13,8 +13,8 @@ nodal values at ``[start, end, midpoint]``:
   so ``b_z = s_z / w_z``; Coulomb ``F Λ_z``, so ``b_z = F p_z``): ``|p_t,z| ≤ b_z`` is the
   solver's nodal law ``|Λ_t,z| ≤ s_z`` divided by ``w_z``; 0 on frictionless parts;
 - ``u_t(z) = ũ_h(z)·t_z − u_t,ref(z)``, ``t_z`` the constraint's tangent
-  (``ContactSet.edge_tangent``), ``ũ_h`` relative to the master with two bodies
-  (``ContactSet.edge_relative``), ``u_t,ref`` the reference the law's slip starts from
+  (``ContactSet.facet_tangent``), ``ũ_h`` relative to the master with two bodies
+  (``ContactSet.facet_relative``), ``u_t,ref`` the reference the law's slip starts from
   (``ContactResult.tangential_reference``: a load step's previous displacement, a moving
   obstacle's motion; 0 for one step at rest).
 
@@ -52,11 +52,11 @@ def friction_facets(result: ContactResult, unit: float = 1.0) -> FrictionFacets 
         return None
     force = cs.friction.slip_bound(result.contact_force, result.active)  # s_z
     bound = result.space.element.facet.pressure(force, cs.basis_integral)
-    loc = cs.edge_local
+    loc = cs.facet_local
     inside = loc >= 0
     row = np.maximum(loc, 0)
-    tangent = cs.edge_tangent[..., 0, :]
-    slip = np.einsum("ejc,ejc->ej", cs.edge_relative(result.u), tangent)
+    tangent = cs.facet_tangent[..., 0, :]
+    slip = np.einsum("ejc,ejc->ej", cs.facet_relative(result.u), tangent)
     # the law acts on the slip from the reference (a load step's previous one, the
     # obstacle's motion): so does the friction work
     slip = slip - np.where(inside, result.tangential_reference[row], 0.0)
@@ -67,19 +67,19 @@ def friction_facets(result: ContactResult, unit: float = 1.0) -> FrictionFacets 
     )
 
 
-def move_dirichlet_thirds(parts: np.ndarray, edge_local: np.ndarray) -> np.ndarray:
-    """Per-node parts ``(n_ce, 3)`` with the part of a Dirichlet end point (``edge_local``
+def move_dirichlet_thirds(parts: np.ndarray, facet_local: np.ndarray) -> np.ndarray:
+    """Per-node parts ``(n_ce, 3)`` with the part of a Dirichlet end point (``facet_local``
     ``-1``) added to the facet's midpoint, so that Dirichlet nodes carry none and the parts
-    still sum to the facet's integral. With P1's ``edge_local (n_ce, 2)`` (no midpoint node)
+    still sum to the facet's integral. With P1's ``facet_local (n_ce, 2)`` (no midpoint node)
     it goes to the facet's other end."""
     out = parts.copy()
     for col in (0, 1):
-        at = edge_local[:, col] < 0
+        at = facet_local[:, col] < 0
         # P1 (two nodes a facet): to the facet's other end, unless that is a Dirichlet node too
         other = 1 - col
-        to = 2 if edge_local.shape[1] == 3 else other
+        to = 2 if facet_local.shape[1] == 3 else other
         if to == other:
-            at &= edge_local[:, other] >= 0
+            at &= facet_local[:, other] >= 0
         out[at, to] += out[at, col]
         out[at, col] = 0.0
     return out

@@ -32,7 +32,7 @@ from signorini.algebra.errors import FrictionConvergenceError
 from signorini.algebra.friction.kkt import check_friction
 from signorini.algebra.friction.newton import INACTIVE, SLIP, STICK, FrictionOptions, solve_friction
 from signorini.algebra.friction.system import CoupledSystem
-from signorini.problem.friction import Coulomb, Tresca
+from signorini.problem.friction_laws import Coulomb, Tresca
 
 #: The laws as the solver asks them; each node's data is its weight (Tresca: the bound s,
 #: Coulomb: the coefficient F), so the data the objects were built with is not used here.

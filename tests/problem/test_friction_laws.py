@@ -1,4 +1,4 @@
-"""Friction laws (signorini.problem.friction): their data checks, and the per-constraint
+"""Friction laws (signorini.problem.friction_laws): their data checks, and the per-constraint
 friction data of the contact set (law, its weight: Tresca bound s_z = ∫ s ψ_z ds, Coulomb
 coefficient)."""
 

@@ -24,7 +24,7 @@ from __future__ import annotations
 import dataclasses
 
 from ..problem import ContactProblem, Coulomb, Tresca
-from ..problem.friction import Friction
+from ..problem.friction_laws import Friction
 from .paper import example_6_2
 
 __all__ = [

@@ -32,7 +32,7 @@ from signorini.algebra.friction.newton import (
 from signorini.algebra.friction.result import SLIP, STICK
 from signorini.algebra.friction.system import CoupledSystem
 from signorini.algebra.inexact import InexactRule
-from signorini.problem.friction import Coulomb, Tresca
+from signorini.problem.friction_laws import Coulomb, Tresca
 
 COEFFICIENT = 0.2
 
