@@ -16,6 +16,8 @@ from signorini.fem.space3d import P2TetSpace
 from signorini.mesh.builders3d import box, eighth_ball
 from signorini.mesh.jacobians import affine_jacobian
 from signorini.mesh.reference import TETRAHEDRON, TRIANGLE
+from signorini.mesh.refine import Refinement
+from signorini.mesh.refine3d import bisect_mesh
 
 RNG = np.random.default_rng(20261202)
 
@@ -214,7 +216,7 @@ def test_curved_part_gives_isoparametric_cells_closer_to_the_ball():
     assert all(isinstance(f, QuadraticFaces) for f in faces)
 
 
-def test_interior_face_nodes_and_prolongation_left_to_the_bisection():
+def test_interior_face_nodes():
     V = space_of(box(2, 2, 2))
     interior = np.flatnonzero(V.mesh.facet2cell[:, 1] >= 0)[:5]
     nodes = V.mesh_facet_nodes(interior)
@@ -222,5 +224,21 @@ def test_interior_face_nodes_and_prolongation_left_to_the_bisection():
     assert nodes.shape == (5, 6)
     assert np.allclose(x[:, 3:], 0.5 * (x[:, [0, 1, 2]] + x[:, [1, 2, 0]]), atol=1e-15)
     assert np.array_equal(np.sort(nodes[:, :3], axis=1), V.mesh.facets[interior])
-    with pytest.raises(NotImplementedError, match="3D bisection"):
-        V.prolongate(np.zeros((V.n_nodes, 3)), None)
+
+
+@pytest.mark.parametrize("bisections", [1, 3])
+def test_prolongation_onto_a_bisected_mesh_is_exact_for_quadratics(bisections):
+    mesh = distorted_box(2, seed=7)
+    marked = np.zeros(mesh.n_cells, dtype=bool)
+    marked[::5] = True
+    fine, parent, edge_point = bisect_mesh(mesh, marked, bisections)
+    coarse_space, fine_space = space_of(mesh), space_of(fine)
+    A = RNG.normal(size=(3, 3, 3))
+
+    def field(x):
+        return np.einsum("ijk,...j,...k->...i", A, x, x) + x
+
+    u = coarse_space.interpolate(field)
+    v = coarse_space.prolongate(u, Refinement(fine, parent, edge_point))
+    assert v.shape == (fine_space.n_nodes, 3)
+    assert np.abs(v - fine_space.interpolate(field)).max() < 1e-13

@@ -16,6 +16,7 @@ import numpy as np
 from ..mesh.jacobians import affine_jacobian
 from ..mesh.mesh import Mesh
 from ..mesh.refine import Refinement
+from . import p2_tet
 from .p2 import basis_barycentric
 
 if TYPE_CHECKING:
@@ -96,7 +97,8 @@ def prolongate_p2(
                 "the refinement is not a refinement of this space's mesh (a new "
                 "cell is not inside its parent cell)"
             )
-        phi = basis_barycentric(bary)  # (k, 6): the parent's local nodes
+        tet = bary.shape[-1] == 4  # the P2 tetrahedron's ten nodes, else the triangle's six
+        phi = (p2_tet.basis_barycentric if tet else basis_barycentric)(bary)  # (k, n_local)
         parent_values = u[coarse_nodes[parent[cell]]]  # (k, 6) or (k, 6, d)
         out[nodes] = np.einsum("kj,kj...->k...", phi, parent_values)
     return out

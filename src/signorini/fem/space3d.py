@@ -32,6 +32,7 @@ from .mapping3d import (
     face_groups,
 )
 from .p2_tet import FACE_EDGES, REFERENCE_NODES
+from .prolongation import prolongate_p2
 from .quadrature import tetrahedron_rule
 from .space import P2Space
 
@@ -136,8 +137,19 @@ class P2TetSpace(P2Space):
         return np.unique(self.facet_nodes(facets))
 
     def prolongate(self, u: np.ndarray, refinement: Refinement) -> np.ndarray:
-        """Not yet: the P2 prolongation onto a bisected tetrahedral mesh comes with the 3D
-        bisection (issue 37, *3D refinement with tags*)."""
-        raise NotImplementedError(
-            "the P2 prolongation on tetrahedra comes with the 3D bisection (issue 37)"
-        )
+        """Exact interpolation of a P2 field of this space on the bisected mesh
+        (:func:`~signorini.fem.prolongation.prolongate_p2`, the parent's quadratic at each
+        new node): P2 fields are reproduced exactly.
+
+        Parameters
+        ----------
+        u : (n_nodes, 3) or (n_nodes,) array
+        refinement : Refinement
+            ``Refinement(mesh, parent, edge_point)`` of ``self.mesh``
+            (:func:`signorini.mesh.refine3d.bisect_mesh`).
+
+        Returns
+        -------
+        (n_nodes_new, 3) or (n_nodes_new,) array
+        """
+        return prolongate_p2(self, P2TetSpace(refinement.mesh), u, refinement)
