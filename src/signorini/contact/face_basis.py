@@ -115,6 +115,7 @@ def face_edges(faces: np.ndarray, face_part: np.ndarray, row_of, n_rows: int, al
     triples = faces[:, _SIDES].reshape(-1, 3)  # (3 n_f, 3): midpoint, start, end
     rows = row_of(triples, np.repeat(face_part, 3)[:, None])
     rows = rows[(rows >= 0).all(axis=1)]
+    rows[:, 1:] = np.sort(rows[:, 1:], axis=1)  # a side shared by two faces runs both ways
     rows = np.unique(rows, axis=0) if rows.size else np.zeros((0, 3), np.int64)
     return FaceEdges(n_rows, float(alpha), rows[:, 0], rows[:, 1], rows[:, 2])
 

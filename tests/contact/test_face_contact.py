@@ -1,0 +1,165 @@
+"""3D frictionless contact on P2 faces: conditions (a) and (b) by the package's blocks and
+``algebra.solve_pdas``, against the independent study code (studies/faces3d) on the Kuhn
+cube; the constant-pressure patch test; the frames."""
+
+from __future__ import annotations
+
+import sys
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+from face_problems import full_contact, patch, transition
+
+from signorini.algebra.pdas import solve_pdas
+from signorini.contact.face_contact import face_contact_set
+from signorini.contact.node_frames3d import row_frames, tangent_completion
+from signorini.fem.elasticity3d import assemble_body_force_3d, assemble_face_load_3d
+from signorini.fem.material import Material
+from signorini.fem.space3d import P2TetSpace
+from signorini.fem.stiffness3d import assemble_stiffness_3d
+from signorini.mesh.builders3d import box
+from signorini.problem.conditions import Contact
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "studies"))
+
+from faces3d import contact as study  # noqa: E402
+from faces3d import manufactured as study_data  # noqa: E402
+from faces3d.mesh import cube_mesh  # noqa: E402
+
+PROBLEMS = {"full": full_contact, "transition": transition, "patch": patch}
+STUDY = {"full": study_data.full_contact, "transition": study_data.transition}
+
+
+@cache
+def assembled(name: str, n: int):
+    """The package's stiffness, loads and held data of a manufactured problem on box(n)."""
+    exact = PROBLEMS[name]()
+    space = P2TetSpace(box(n, n, n))
+    material = Material.from_lame(exact.lam, exact.mu)
+    K = assemble_stiffness_3d(space.mapping, space.cell_dofs, space.n_dofs, material)
+    F = assemble_body_force_3d(space, exact.f, degree=7)
+    sides = np.concatenate([space.mesh.part_facets(p) for p in ("x0", "x1", "y0", "y1")])
+    F += assemble_face_load_3d(
+        space, sides, lambda p, nrm: np.einsum("...ij,...j->...i", exact.stress(p), nrm), degree=8
+    )
+    tangential = np.array([1.0, 1.0, 0.0])
+    F += assemble_face_load_3d(
+        space,
+        space.mesh.part_facets("z0"),
+        lambda p: -exact.stress(p)[..., :, 2] * tangential,
+        degree=8,
+    )
+    held = np.zeros((space.n_nodes, 3), dtype=bool)
+    top = space.part_nodes(["z1"])
+    held[top] = True
+    values = np.zeros((space.n_nodes, 3))
+    values[top] = exact.u(space.node_points[top])
+    return exact, space, K, F, held, values
+
+
+def solved(name: str, n: int, alpha: float, F: np.ndarray | None = None):
+    """The package's solution of condition α: ``(contact set, PDAS result, u, Λ)``; the loads
+    ``F`` when given (the study's, renumbered), else the package's own."""
+    exact, space, K, F_own, held, values = assembled(name, n)
+    F = F_own if F is None else F
+    contact = {"z0": Contact(gap=lambda x: exact.psi(x))}
+    cs = face_contact_set(space, contact, held, values, alpha=alpha)
+    Kt, Ft = cs.system(K, F)
+    result = solve_pdas(Kt, Ft, cs.dof, cs.bound, cs.held_dofs, cs.held_values)
+    u = cs.displacement(result.x)
+    return cs, result, u, cs.force(K, F, u)
+
+
+def _matched(points: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """``(n,)`` the index in ``reference`` of each point (the same node sets)."""
+    key = np.round(points * 1e9).astype(np.int64)
+    ref = np.round(reference * 1e9).astype(np.int64)
+    a, b = np.lexsort(key.T[::-1]), np.lexsort(ref.T[::-1])
+    out = np.empty(points.shape[0], dtype=np.int64)
+    out[a] = b
+    assert np.array_equal(key, ref[out])
+    return out
+
+
+@cache
+def study_solution(name: str, n: int, alpha: float):
+    mesh = cube_mesh(n)
+    problem = study.assemble(mesh, STUDY[name]())
+    return mesh, problem, study.solve_pdas(problem, alpha)
+
+
+@pytest.mark.parametrize("name", ["full", "transition"])
+@pytest.mark.parametrize("alpha", [0.0, 0.2], ids=["a-nodal", "b-transformed"])
+def test_conditions_a_and_b_equal_the_independent_study(name, alpha):
+    n = 2
+    mesh, problem, ref = study_solution(name, n, alpha)
+    space, F_own = assembled(name, n)[1:4:2]
+    to_study = _matched(space.node_points, mesh.points)
+    # the same discrete problem: the study's loads (its quadrature) in the package's numbering
+    F = problem.F.reshape(-1, 3)[to_study].ravel()
+    if name == "full":  # smooth data: the two quadratures agree (the transition's f is C⁰)
+        np.testing.assert_allclose(F_own, F, atol=1e-4 * np.abs(F).max())
+    cs, result, u, force = solved(name, n, alpha, F)
+    np.testing.assert_array_equal(to_study[cs.node].size, problem.nodes.size)
+    row = np.searchsorted(problem.nodes, to_study[cs.node])
+    assert np.array_equal(problem.nodes[row], to_study[cs.node])
+    scale = np.abs(ref.u).max()
+    np.testing.assert_allclose(u.reshape(-1, 3), ref.u[to_study], atol=1e-12 * scale, rtol=0)
+    assert np.array_equal(result.active, ref.active[row])
+    f_scale = np.abs(ref.force).max()
+    np.testing.assert_allclose(force, ref.force[row], atol=1e-11 * f_scale, rtol=0)
+    np.testing.assert_allclose(result.multiplier, ref.multiplier[row], atol=1e-11 * f_scale, rtol=0)
+    assert result.kkt.max <= 1e-10
+    if alpha > 0:  # (b): every multiplier positive where active, Λ̃ = T Λ
+        np.testing.assert_allclose(cs.edges.transformed(force), result.multiplier, atol=1e-13)
+
+
+@pytest.mark.parametrize("alpha", [0.0, 0.2, 0.3], ids=["a", "b", "b-0.3"])
+def test_constant_pressure_patch_test_is_exact(alpha):
+    exact, space, *_ = assembled("patch", 2)
+    cs, result, u, force = solved("patch", 2, alpha)
+    u_exact = exact.u(space.node_points).ravel()
+    np.testing.assert_allclose(u, u_exact, atol=1e-13 * np.abs(u_exact).max())
+    np.testing.assert_allclose(cs.recovered_pressure(force), 0.1, rtol=1e-11)
+    if alpha > 0:
+        np.testing.assert_allclose(cs.pressure(force), 0.1, rtol=1e-11)
+        assert (cs.transformed_integral > 0).all()
+    else:
+        with pytest.raises(ValueError, match="integrate to zero"):
+            cs.pressure(force)
+    # the weights: w = Σ_F ∫ ψ_z, the transformed ones T w = Σ_F shares |F|, all of Γ_C
+    area = space.mesh.part_measure("z0")
+    assert np.isclose(cs.basis_integral.sum(), area) and np.isclose(cs.hat_integral.sum(), area)
+    assert np.isclose(cs.transformed_integral.sum(), area)
+    vertex = cs.node < space.mesh.n_points
+    np.testing.assert_allclose(cs.basis_integral[vertex], 0.0, atol=1e-15)
+
+
+def test_frames_are_right_handed_rotations():
+    rng = np.random.default_rng(3)
+    n = rng.normal(size=(200, 3))
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    for pole in range(3):
+        Q = tangent_completion(n, pole)
+        np.testing.assert_allclose(
+            Q.transpose(0, 2, 1) @ Q, np.broadcast_to(np.eye(3), Q.shape), atol=1e-14
+        )
+        np.testing.assert_allclose(np.linalg.det(Q), 1.0, atol=1e-14)
+        np.testing.assert_array_equal(Q[:, :, 0], n)
+    # continuity: a small turn of n away from the equator n_k = 0 turns the frame by as much
+    m = n + 1e-7 * rng.normal(size=n.shape)
+    m /= np.linalg.norm(m, axis=1)[:, None]
+    far = np.abs(n[:, 2]) > 0.1
+    jump = np.abs(tangent_completion(m) - tangent_completion(n)).max(axis=(1, 2))
+    assert jump[far].max() < 1e-4
+    # a flat part normal to -e_z: the tangents are axes
+    np.testing.assert_array_equal(
+        tangent_completion(np.array([[0.0, 0.0, -1.0]]))[0], [[0, 1, 0], [0, 0, -1], [-1, 0, 0]]
+    )
+    # two rows: y = A u with rows n, m, (n × m)/|n × m|
+    rows = np.zeros((1, 3, 3))
+    rows[0, 0], rows[0, 1] = [0.0, 0.0, -1.0], [-1.0, 0.0, 0.0]
+    Q = row_frames(rows, np.array([2]), np.array([2]))
+    np.testing.assert_allclose(np.linalg.inv(Q[0])[:2], rows[0, :2], atol=1e-15)
