@@ -21,6 +21,7 @@ from signorini.fem.space3d import P2TetSpace
 from signorini.fem.stiffness3d import assemble_stiffness_3d
 from signorini.mesh.builders3d import box
 from signorini.problem.conditions import Contact
+from signorini.problem.obstacles3d import HalfSpace
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "studies"))
 
@@ -163,3 +164,48 @@ def test_frames_are_right_handed_rotations():
     rows[0, 0], rows[0, 1] = [0.0, 0.0, -1.0], [-1.0, 0.0, 0.0]
     Q = row_frames(rows, np.array([2]), np.array([2]))
     np.testing.assert_allclose(np.linalg.inv(Q[0])[:2], rows[0, :2], atol=1e-15)
+
+
+def test_rows_at_corners_held_nodes_and_shapes():
+    """Two contact parts meeting at an edge, a roller beside them, a shape's directions; the
+    cube pressed into both half-spaces solves with KKT ≤ 1e-10 and pushes at the corner."""
+    space = P2TetSpace(box(2, 2, 2))
+    x = space.node_points
+    held = np.zeros((space.n_nodes, 3), dtype=bool)
+    values = np.zeros((space.n_nodes, 3))
+    top = space.part_nodes(["z1"])
+    held[top] = True
+    values[top] = [-0.01, 0.0, -0.02]
+    held[space.part_nodes(["y0"]), 1] = True  # a roller u_y = 0 on y = 0
+    contact = {
+        "z0": Contact(obstacle=HalfSpace([0.0, 0.0, 0.0], [0.0, 0.0, 1.0])),
+        "x0": Contact(obstacle=HalfSpace([0.0, 0.0, 0.0], [1.0, 0.0, 0.0])),
+    }
+    cs = face_contact_set(space, contact, held, values, alpha=0.2)
+    on = np.isclose(x[cs.node], 0.0)
+    corner = on[:, 0] & on[:, 2]
+    nodes, count = np.unique(cs.node[corner], return_counts=True)
+    assert (count == 2).all() and nodes.size == 5  # 3 vertices, 2 midpoints of the edge
+    np.testing.assert_array_equal(cs.direction[cs.part == 0], np.tile([0, 0, -1.0], (25, 1)))
+    assert not np.isin(cs.node, top).any()  # Dirichlet nodes: no row
+    Q = dict(zip(cs.frame_nodes.tolist(), cs.frames, strict=True))
+    roller = cs.frame_nodes[np.isclose(x[cs.frame_nodes, 1], 0.0)]
+    for z in roller:  # rows (contact..., e_y): the held DOF is the frame's last row
+        A = np.linalg.inv(Q[int(z)])
+        assert np.isin(3 * z + np.flatnonzero(np.abs(A[:, 1]) == 1.0), cs.held_dofs).all()
+    K = assemble_stiffness_3d(
+        space.mapping, space.cell_dofs, space.n_dofs, Material.from_young(1.0, 0.3)
+    )
+    Kt, Ft = cs.system(K, np.zeros(space.n_dofs))
+    result = solve_pdas(Kt, Ft, cs.dof, cs.bound, cs.held_dofs, cs.held_values)
+    assert result.kkt.max <= 1e-10
+    u = cs.displacement(result.x).reshape(-1, 3)
+    np.testing.assert_allclose(u[top], values[top], atol=1e-15)
+    np.testing.assert_allclose(u[space.part_nodes(["y0"]), 1], 0.0, atol=1e-15)
+    assert (u[cs.node[cs.part == 0], 2] >= -1e-14).all()  # no penetration of z ≥ 0 (ψ = z)
+    force = cs.force(K, np.zeros(space.n_dofs), cs.displacement(result.x))
+    assert result.active[corner].all() and (cs.edges.transformed(force)[corner] > 0).all()
+    # a roller along the normal holds u·n: no row there
+    held[space.part_nodes(["z0"]), 2] = True
+    again = face_contact_set(space, {"z0": contact["z0"]}, held, values)
+    assert again.node.size == 0
