@@ -20,6 +20,7 @@ from signorini.fem.material import Material
 from signorini.fem.space3d import P2TetSpace
 from signorini.fem.stiffness3d import assemble_stiffness_3d
 from signorini.mesh.builders3d import box
+from signorini.mesh.mesh import Mesh
 from signorini.problem.conditions import Contact
 from signorini.problem.obstacles3d import HalfSpace
 
@@ -209,3 +210,43 @@ def test_rows_at_corners_held_nodes_and_shapes():
     held[space.part_nodes(["z0"]), 2] = True
     again = face_contact_set(space, {"z0": contact["z0"]}, held, values)
     assert again.node.size == 0
+
+
+def _pressed(R: np.ndarray, alpha: float):
+    """The cube of box(2) rotated by ``R``, pressed into two half-spaces (faces z0, x0) by
+    u_D on z1: (Cartesian u (n_nodes, 3), Λ, active set)."""
+    base = box(2, 2, 2)
+    parts = {p: base.facets[base.part_facets(p)] for p in ("x0", "x1", "y0", "y1", "z0", "z1")}
+    mesh = Mesh.from_arrays(base.points @ R.T, base.cells, parts)
+    space = P2TetSpace(mesh)
+    held = np.zeros((space.n_nodes, 3), dtype=bool)
+    values = np.zeros((space.n_nodes, 3))
+    top = space.part_nodes(["z1"])
+    held[top] = True
+    values[top] = R @ np.array([-0.01, 0.003, -0.02])
+    contact = {
+        "z0": Contact(obstacle=HalfSpace([0.0, 0.0, 0.0], R @ [0.0, 0.0, 1.0])),
+        "x0": Contact(obstacle=HalfSpace([0.0, 0.0, 0.0], R @ [1.0, 0.0, 0.0])),
+    }
+    cs = face_contact_set(space, contact, held, values, alpha=alpha)
+    K = assemble_stiffness_3d(
+        space.mapping, space.cell_dofs, space.n_dofs, Material.from_young(1.0, 0.3)
+    )
+    Kt, Ft = cs.system(K, np.zeros(space.n_dofs))
+    result = solve_pdas(Kt, Ft, cs.dof, cs.bound, cs.held_dofs, cs.held_values)
+    assert result.kkt.max <= 1e-10
+    u = cs.displacement(result.x)
+    return u.reshape(-1, 3), cs.force(K, np.zeros(space.n_dofs), u), result.active
+
+
+@pytest.mark.parametrize("alpha", [0.0, 0.2], ids=["a", "b"])
+def test_oblique_contact_is_the_axis_aligned_one_rotated(alpha):
+    c, s = np.cos(0.7), np.sin(0.7)
+    R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ np.array(
+        [[1.0, 0.0, 0.0], [0.0, c, s], [0.0, -s, c]]
+    )
+    u, force, active = _pressed(np.eye(3), alpha)
+    u_rot, force_rot, active_rot = _pressed(R, alpha)
+    assert active.any() and np.array_equal(active, active_rot)
+    np.testing.assert_allclose(u_rot, u @ R.T, atol=1e-13 * np.abs(u).max())
+    np.testing.assert_allclose(force_rot, force, atol=1e-12 * np.abs(force).max())
