@@ -19,9 +19,11 @@ from signorini.fem.elasticity3d import assemble_body_force_3d, assemble_face_loa
 from signorini.fem.material import Material
 from signorini.fem.space3d import P2TetSpace
 from signorini.fem.stiffness3d import assemble_stiffness_3d
-from signorini.mesh.builders3d import box
+from signorini.mesh.builders3d import box, eighth_ball
 from signorini.mesh.mesh import Mesh
 from signorini.problem.conditions import Contact
+from signorini.problem.fields import ProblemError
+from signorini.problem.obstacles import Disc
 from signorini.problem.obstacles3d import HalfSpace
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "studies"))
@@ -250,3 +252,31 @@ def test_oblique_contact_is_the_axis_aligned_one_rotated(alpha):
     assert active.any() and np.array_equal(active, active_rot)
     np.testing.assert_allclose(u_rot, u @ R.T, atol=1e-13 * np.abs(u).max())
     np.testing.assert_allclose(force_rot, force, atol=1e-12 * np.abs(force).max())
+
+
+def test_gap_function_on_a_curved_part_takes_the_surface_normal():
+    """The eighth ball's sphere part with a gap function: the outward radial normal at every
+    node (midpoints on the sphere too); the symmetry rollers u_x = 0, u_y = 0 beside it add
+    their held rows; the Hertz plane below as a shape gives the direction −e_z everywhere."""
+    space = P2TetSpace(eighth_ball(2))
+    x = space.node_points
+    held = np.zeros((space.n_nodes, 3), dtype=bool)
+    held[space.part_nodes(["x0"]), 0] = True
+    held[space.part_nodes(["y0"]), 1] = True
+    values = np.zeros((space.n_nodes, 3))
+    cs = face_contact_set(space, {"sphere": Contact(gap=0.01)}, held, values)
+    normal = x[cs.node] / np.linalg.norm(x[cs.node], axis=1)[:, None]
+    np.testing.assert_allclose(cs.direction, normal, atol=1e-12)
+    np.testing.assert_allclose(cs.gap, 0.01)
+    both = held[cs.node].sum(axis=1) == 2  # the rim's pole end: on both symmetry planes
+    assert both.any()
+    for z, Q in zip(cs.frame_nodes, cs.frames, strict=True):
+        A = np.linalg.inv(Q)
+        h = np.flatnonzero(held[z])
+        np.testing.assert_allclose(A[1 : 1 + h.size], np.eye(3)[h], atol=1e-15)
+    plane = HalfSpace([0.0, 0.0, -1.05], [0.0, 0.0, 1.0])
+    shaped = face_contact_set(space, {"sphere": Contact(obstacle=plane)}, held, values)
+    np.testing.assert_array_equal(shaped.direction, np.tile([0.0, 0.0, -1.0], (cs.n_rows, 1)))
+    np.testing.assert_allclose(shaped.gap, x[shaped.node, 2] + 1.05)
+    with pytest.raises(ProblemError, match="plane shape"):
+        face_contact_set(space, {"sphere": Contact(obstacle=Disc([0, 0], 1.0))}, held, values)
