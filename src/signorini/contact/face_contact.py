@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -29,6 +30,9 @@ from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
 from .face_basis import DEFAULT_ALPHA, FaceEdges, change_of_variables, face_edges
 from .node_frames3d import frame_operator, row_frames
+
+if TYPE_CHECKING:
+    from ..fem.space3d import P2TetSpace
 
 __all__ = ["SAME_DIRECTION", "FaceContactSet", "face_contact_set"]
 
@@ -190,7 +194,7 @@ def _part_rows(space, name: str, cond: Contact) -> tuple[np.ndarray, np.ndarray,
 
 
 def face_contact_set(
-    space,
+    space: P2TetSpace,
     contact: Mapping[str, Contact],
     held: np.ndarray,
     held_values: np.ndarray,
@@ -227,6 +231,7 @@ def face_contact_set(
     direction = np.concatenate([f[1] for f in found])
     gap = np.concatenate([f[2] for f in found])
     held = np.asarray(held, dtype=bool)
+    held_values = np.asarray(held_values, dtype=np.float64)
     free_normal = np.abs(np.where(held[node], 0.0, direction)).max(axis=1) > SAME_DIRECTION
     order = np.lexsort((part, node))
     order = order[free_normal[order]]
@@ -266,9 +271,15 @@ def _assembled(space, parts, node, part, direction, gap, row_of_part, held, valu
     rows[f, position[f, c], c] = 1.0
     mean = np.array([np.abs(direction[part == i].sum(axis=0)) for i in range(len(parts))])
     pole = np.argmax(mean, axis=1)[part[start]] if k else np.zeros(0, np.int64)
-    Q = row_frames(rows, total, pole)
+    try:
+        Q = row_frames(rows, total, pole)
+    except np.linalg.LinAlgError:
+        Q = np.full(rows.shape, np.nan)
     if not np.isfinite(Q).all():
-        raise ProblemError("the constraint directions at a contact node are dependent")
+        raise ProblemError(
+            "the constraint and held directions at a contact node are dependent (a contact "
+            "direction along a held axis beside another part's)"
+        )
     rotated = np.zeros(space.n_nodes, dtype=bool)
     rotated[frame_nodes] = True
     cartesian = np.flatnonzero((held & ~rotated[:, None]).ravel())
