@@ -319,7 +319,8 @@ def solve(
     ahead = None
     if assembled is None:
         serial = not solver_ranks(solver).distributed
-        ahead = SolverAhead(solver) if serial and takes_ordering(solver) else None
+        # 3D: no analysis ahead, the solver is chosen by the system's size (auto_solver)
+        ahead = SolverAhead(solver) if serial and takes_ordering(solver) and mesh.dim == 2 else None
         assembled = assemble(
             problem, mesh, element=element, ranks=solver_ranks(solver),
             prefetch_ordering=ahead is not None, on_pattern=ahead and ahead.start,
@@ -337,8 +338,8 @@ def solve(
     active0 = None
     if u0 is not None:
         u0 = np.asarray(u0, dtype=np.float64)
-        if u0.shape != (space.n_nodes, 2):
-            raise ValueError(f"u0 must have shape ({space.n_nodes}, 2), got {u0.shape}")
+        if u0.shape != (space.n_nodes, mesh.dim):
+            raise ValueError(f"u0 must have shape ({space.n_nodes}, {mesh.dim}), got {u0.shape}")
         if not np.isfinite(u0).all():
             raise ValueError("u0 contains NaN or inf")
         active0 = warm_active_set(cs, u0)
@@ -386,10 +387,7 @@ def solve(
     return ContactResult(
         problem=problem,
         space=space,
-        u=physical(
-            to_cartesian(solved.x, assembled.frame_nodes, assembled.frames).reshape(-1, 2),
-            cs.transfer,
-        ),
+        u=_cartesian(solved.x, assembled),
         contact=cs,
         contact_force=solved.normal_force if unit == 1.0 else solved.normal_force * unit,
         active=solved.state != INACTIVE,
@@ -405,6 +403,16 @@ def solve(
         partition=assembled.partition,
         obstacle_motion=assembled.obstacle_motion,
     )
+
+
+def _cartesian(x: np.ndarray, assembled: Assembled) -> np.ndarray:
+    """``(n_nodes, d)`` the Cartesian nodal displacements of the system's unknowns ``x``: out
+    of the node frames, and with contact pairs back from the relative displacement; in 3D
+    (no frames, no pairs) ``x`` itself."""
+    if assembled.space.mesh.dim == 3:
+        return x.reshape(-1, 3)
+    y = to_cartesian(x, assembled.frame_nodes, assembled.frames).reshape(-1, 2)
+    return physical(y, assembled.contact.transfer)
 
 
 def _solve_system(
