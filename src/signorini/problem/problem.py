@@ -163,7 +163,7 @@ class ContactProblem:
             self, "rollers", {k: self.conditions[k] for k, v in held.items() if v is None}
         )
         if mesh.dim == 3:  # 3D elasticity without contact (docs/method.md, *Three dimensions*)
-            check_problem_3d(mesh, self.held, self.rollers, self.body_force)
+            check_problem_3d(mesh, self.held, self.rollers)
             object.__setattr__(self, "rigid_motions", np.zeros((0, 6)))
             object.__setattr__(self, "rigid_parts", ())
             object.__setattr__(self, "contact_normals", {})

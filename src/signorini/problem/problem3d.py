@@ -9,7 +9,7 @@ here, before any work, and so is an oblique roller (its node frames are part 2's
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -68,7 +68,6 @@ def check_problem_3d(
     mesh: Mesh,
     held: Mapping[str, Dirichlet],
     rollers: Mapping[str, object],
-    body_force: Callable | None,
 ) -> None:
     """The checks of a 3D problem beyond the 2D ones that hold as they are.
 
@@ -80,12 +79,12 @@ def check_problem_3d(
         The Dirichlet parts and the axis rollers as Dirichlet conditions.
     rollers : mapping part -> Roller
         The rollers not along an axis (refused).
-    body_force : callable or None
 
     Raises
     ------
     ProblemError
-        For an oblique or non-planar roller, or rigid motions the held components leave free (the matrix would be singular).
+        For an oblique or non-planar roller, or rigid motions the held components leave
+        free (the matrix would be singular).
     """
     if rollers:
         raise ProblemError(
