@@ -41,13 +41,13 @@ from .nested import (
     round_off_scale,
     warm_active_set,
 )
-from .node_frames import to_cartesian
 from .ordering import SolverAhead, ordered_solver
 from .partition import Partition
 from .profile import ContactProfile, contact_profile
 from .rigid_modes import system_rigid_modes
+from .solution3d import cartesian_displacement, errors_3d
 from .system import Assembled, assemble
-from .two_body import master_traction, physical
+from .two_body import master_traction
 
 __all__ = [
     "ContactProfile",
@@ -236,10 +236,13 @@ class ContactResult:
         return contact_profile(self, part)
 
     def errors(self, degree: int = ERROR_DEGREE) -> dict[str, float]:
-        """Energy-norm ``a(e,e)^{1/2}`` and H¹-seminorm errors against the exact solution."""
+        """Energy-norm ``a(e,e)^{1/2}`` and H¹-seminorm errors against the exact solution
+        (3D: also the L² error, :func:`~.solution3d.errors_3d`)."""
         exact = self.problem.exact
         if exact is None:
             raise ValueError(f"{self.problem.name} has no exact solution")
+        if self.mesh.dim == 3:
+            return errors_3d(self)
         u_cell = self.space.field_coefficients(self.u)
 
         def gradient(x: np.ndarray) -> np.ndarray:
@@ -319,7 +322,6 @@ def solve(
     ahead = None
     if assembled is None:
         serial = not solver_ranks(solver).distributed
-        # 3D: no analysis ahead, the solver is chosen by the system's size (auto_solver)
         ahead = SolverAhead(solver) if serial and takes_ordering(solver) and mesh.dim == 2 else None
         assembled = assemble(
             problem, mesh, element=element, ranks=solver_ranks(solver),
@@ -387,7 +389,7 @@ def solve(
     return ContactResult(
         problem=problem,
         space=space,
-        u=_cartesian(solved.x, assembled),
+        u=cartesian_displacement(solved.x, assembled),
         contact=cs,
         contact_force=solved.normal_force if unit == 1.0 else solved.normal_force * unit,
         active=solved.state != INACTIVE,
@@ -403,16 +405,6 @@ def solve(
         partition=assembled.partition,
         obstacle_motion=assembled.obstacle_motion,
     )
-
-
-def _cartesian(x: np.ndarray, assembled: Assembled) -> np.ndarray:
-    """``(n_nodes, d)`` the Cartesian nodal displacements of the system's unknowns ``x``: out
-    of the node frames, and with contact pairs back from the relative displacement; in 3D
-    (no frames, no pairs) ``x`` itself."""
-    if assembled.space.mesh.dim == 3:
-        return x.reshape(-1, 3)
-    y = to_cartesian(x, assembled.frame_nodes, assembled.frames).reshape(-1, 2)
-    return physical(y, assembled.contact.transfer)
 
 
 def _solve_system(
