@@ -22,13 +22,13 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..problem import ContactProblem
+from .elasticity3d import ELASTICITY_3D_METRICS, elasticity_3d
 from .hertz import HERTZ_METRICS, hertz
 from .metrics import Metrics, PressureComparison
 from .paper import example_6_1, example_6_2
 from .paper_friction import example_6_2_coulomb, example_6_2_tresca
 from .partial_slip import PARTIAL_SLIP_METRICS, partial_slip, partial_slip_path
 from .punch import punch
-from .elasticity3d import ELASTICITY_3D_METRICS, elasticity_3d
 from .two_bodies import BLOCKS_METRICS, CYLINDERS_METRICS, hertz_pair, stacked_blocks, two_cylinders
 
 __all__ = [
