@@ -1,0 +1,110 @@
+"""The checks of a :class:`~signorini.problem.problem.ContactProblem` on a tetrahedral mesh
+(docs/method.md, *Three dimensions: solving elasticity*): 3D elasticity without contact.
+
+A 3D problem holds Dirichlet parts (all or some of ``(u_x, u_y, u_z)``), rollers on planar
+parts normal to an axis (one Cartesian component held) and Neumann parts. Contact on faces
+is the work of issue 38 (three dimensions, part 2): a contact part on a 3D mesh is refused
+here, before any work, and so is an oblique roller (its node frames are part 2's too).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..mesh.mesh import Mesh
+from .conditions import Condition, Contact, Dirichlet, Neumann
+from .fields import ProblemError
+
+__all__ = ["check_dimension", "check_problem_3d", "rigid_modes_3d"]
+
+#: the relative size of a singular value of the held rigid motions' matrix below which a
+#: rigid motion counts as free
+RIGID_RTOL = 1e-8
+
+
+def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
+    """Refuse contact parts on a tetrahedral ``mesh``, and constant data with another number
+    of components than the mesh has dimensions.
+
+    Raises
+    ------
+    ProblemError
+        Naming the contact parts and the issue that builds 3D contact, or the part whose
+        data have the wrong number of components.
+    """
+    contact = [name for name, cond in conditions.items() if isinstance(cond, Contact)]
+    if mesh.dim == 3 and contact:
+        raise ProblemError(
+            f"contact part(s) {contact} on a 3D (tetrahedral) mesh: contact on faces in three "
+            "dimensions is not built yet (issue 38, three dimensions part 2); a 3D problem "
+            "takes Dirichlet, axis Roller and Neumann parts (3D elasticity without contact)"
+        )
+    for name, cond in conditions.items():  # a loop over parts
+        if not isinstance(cond, Dirichlet | Neumann):
+            continue
+        value = cond.value if isinstance(cond, Dirichlet) else cond.traction
+        if not callable(value) and np.size(value) != mesh.dim:
+            raise ProblemError(
+                f"the condition of part {name!r} gives {np.size(value)} components "
+                f"{value!r} on a {mesh.dim}D mesh: give {mesh.dim}, "
+                f"{('(x, y)', '(x, y, z)')[mesh.dim - 2]} (None for a free Dirichlet component)"
+            )
+
+
+def rigid_modes_3d(x: np.ndarray) -> np.ndarray:
+    """``(n, 3, 6)`` the rigid motions at points ``x (n, 3)``: the translations ``e_k`` and
+    the rotations ``e_k × x`` (k = 0, 1, 2)."""
+    n = x.shape[0]
+    modes = np.zeros((n, 3, 6))
+    modes[:, [0, 1, 2], [0, 1, 2]] = 1.0
+    eye = np.eye(3)
+    modes[:, :, 3:] = np.cross(eye[None, :, :], x[:, None, :]).transpose(0, 2, 1)
+    return modes
+
+
+def check_problem_3d(
+    mesh: Mesh,
+    held: Mapping[str, Dirichlet],
+    rollers: Mapping[str, object],
+) -> None:
+    """The checks of a 3D problem beyond the 2D ones that hold as they are.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        Tetrahedral.
+    held : mapping part -> Dirichlet
+        The Dirichlet parts and the axis rollers as Dirichlet conditions.
+    rollers : mapping part -> Roller
+        The rollers not along an axis (refused).
+
+    Raises
+    ------
+    ProblemError
+        For an oblique or non-planar roller, or rigid motions the held components leave
+        free (the matrix would be singular).
+    """
+    if rollers:
+        raise ProblemError(
+            f"roller part(s) {list(rollers)} on a 3D mesh are not planar faces normal to the "
+            "x, y or z axis: in 3D a Roller holds one Cartesian component of a plane "
+            "x, y or z = const (oblique and curved rollers need the node frames of issue 38)"
+        )
+    # the held components at the held parts' vertices against the six rigid motions
+    rows = []
+    for name, cond in held.items():  # a loop over parts
+        vertices = np.unique(mesh.facets[mesh.part_facets(name)])
+        comp = np.resize(np.asarray(cond.components), 3)
+        rows.append(rigid_modes_3d(mesh.points[vertices])[:, comp, :].reshape(-1, 6))
+    if not rows:
+        return
+    scale = 1.0 + np.abs(mesh.points).max()
+    s = np.linalg.svd(np.concatenate(rows) / scale, compute_uv=False)
+    free = 6 - int((s > RIGID_RTOL * s.max(initial=0.0)).sum()) if s.size else 6
+    if free > 0:
+        raise ProblemError(
+            f"the Dirichlet and Roller parts {list(held)} leave {free} rigid motion(s) of the "
+            "body free: hold more components (e.g. one part with Dirichlet((0, 0, 0)))"
+        )
