@@ -71,7 +71,7 @@ def solved(name: str, n: int, alpha: float, F: np.ndarray | None = None):
     contact = {"z0": Contact(gap=lambda x: exact.psi(x))}
     cs = face_contact_set(space, contact, held, values, alpha=alpha)
     Kt, Ft = cs.system(K, F)
-    result = solve_pdas(Kt, Ft, cs.dof, cs.bound, cs.held_dofs, cs.held_values)
+    result = solve_pdas(Kt, Ft, cs.dof, cs.gap, cs.held_dofs, cs.held_values)
     u = cs.displacement(result.x)
     return cs, result, u, cs.force(K, F, u)
 
@@ -200,7 +200,7 @@ def test_rows_at_corners_held_nodes_and_shapes():
         space.mapping, space.cell_dofs, space.n_dofs, Material.from_young(1.0, 0.3)
     )
     Kt, Ft = cs.system(K, np.zeros(space.n_dofs))
-    result = solve_pdas(Kt, Ft, cs.dof, cs.bound, cs.held_dofs, cs.held_values)
+    result = solve_pdas(Kt, Ft, cs.dof, cs.gap, cs.held_dofs, cs.held_values)
     assert result.kkt.max <= 1e-10
     u = cs.displacement(result.x).reshape(-1, 3)
     np.testing.assert_allclose(u[top], values[top], atol=1e-15)
@@ -235,7 +235,7 @@ def _pressed(R: np.ndarray, alpha: float):
         space.mapping, space.cell_dofs, space.n_dofs, Material.from_young(1.0, 0.3)
     )
     Kt, Ft = cs.system(K, np.zeros(space.n_dofs))
-    result = solve_pdas(Kt, Ft, cs.dof, cs.bound, cs.held_dofs, cs.held_values)
+    result = solve_pdas(Kt, Ft, cs.dof, cs.gap, cs.held_dofs, cs.held_values)
     assert result.kkt.max <= 1e-10
     u = cs.displacement(result.x)
     return u.reshape(-1, 3), cs.force(K, np.zeros(space.n_dofs), u), result.active
@@ -267,7 +267,7 @@ def test_gap_function_on_a_curved_part_takes_the_surface_normal():
     cs = face_contact_set(space, {"sphere": Contact(gap=0.01)}, held, values)
     normal = x[cs.node] / np.linalg.norm(x[cs.node], axis=1)[:, None]
     np.testing.assert_allclose(cs.direction, normal, atol=1e-12)
-    np.testing.assert_allclose(cs.gap, 0.01)
+    np.testing.assert_allclose(cs.psi, 0.01)
     both = held[cs.node].sum(axis=1) == 2  # the rim's pole end: on both symmetry planes
     assert both.any()
     for z, Q in zip(cs.frame_nodes, cs.frames, strict=True):
@@ -277,6 +277,38 @@ def test_gap_function_on_a_curved_part_takes_the_surface_normal():
     plane = HalfSpace([0.0, 0.0, -1.05], [0.0, 0.0, 1.0])
     shaped = face_contact_set(space, {"sphere": Contact(obstacle=plane)}, held, values)
     np.testing.assert_array_equal(shaped.direction, np.tile([0.0, 0.0, -1.0], (cs.n_rows, 1)))
-    np.testing.assert_allclose(shaped.gap, x[shaped.node, 2] + 1.05)
+    np.testing.assert_allclose(shaped.psi, x[shaped.node, 2] + 1.05)
     with pytest.raises(ProblemError, match="plane shape"):
         face_contact_set(space, {"sphere": Contact(obstacle=Disc([0, 0], 1.0))}, held, values)
+
+
+def test_solve_runs_3d_contact_as_the_blocks_do():
+    """``solve()`` on a ContactProblem with two contact parts of half-spaces equals the
+    blocks' solution (condition (b), the default), and its pressure is the transformed one."""
+    from signorini.contact.solution import solve
+    from signorini.problem.conditions import Dirichlet, Neumann
+    from signorini.problem.problem import ContactProblem
+
+    mesh = box(2, 2, 2)
+    conditions = {name: Neumann((0.0, 0.0, 0.0)) for name in mesh.part_names}
+    conditions.update(
+        z1=Dirichlet((-0.01, 0.003, -0.02)),
+        z0=Contact(obstacle=HalfSpace([0.0, 0.0, 0.0], [0.0, 0.0, 1.0])),
+        x0=Contact(obstacle=HalfSpace([0.0, 0.0, 0.0], [1.0, 0.0, 0.0])),
+    )
+    result = solve(ContactProblem(mesh, Material.from_young(1.0, 0.3), conditions))
+    u, force, active = _pressed(np.eye(3), 0.2)
+    assert result.report.kkt.max <= 1e-10
+    cs = result.contact
+    assert cs.parts == ("x0", "z0")  # the problem's order: at the corner the rows swap places
+    assert active.all() == result.active.all() and active.sum() == result.active.sum()
+    np.testing.assert_allclose(result.u, u, atol=1e-13 * np.abs(u).max())
+    np.testing.assert_allclose(  # the same forces, two of them swapped at each corner node
+        np.sort(result.contact_force), np.sort(force), atol=1e-12 * np.abs(force).max()
+    )
+    np.testing.assert_allclose(result.total_contact_force, force.sum(), rtol=1e-12)
+    np.testing.assert_allclose(
+        result.pressure,
+        cs.edges.transformed(result.contact_force) / cs.transformed_integral,
+        rtol=1e-12,
+    )

@@ -89,6 +89,16 @@ class FaceEdges:
         np.add.at(out, self.end, self.alpha * f)
         return out
 
+    def untransformed(self, force: np.ndarray) -> np.ndarray:
+        """``T^{-1} Λ̃ (k,)``: forces on the φ̃ back to those on the P2 functions,
+        ``Λ_e = Λ̃_e / (1 − 2α)``, ``Λ_v = Λ̃_v − α Σ_{e ∋ v} Λ_e``."""
+        out = np.array(force, dtype=np.float64)
+        f = out[self.mid] / (1.0 - 2 * self.alpha)
+        out[self.mid] = f
+        np.add.at(out, self.start, -self.alpha * f)
+        np.add.at(out, self.end, -self.alpha * f)
+        return out
+
 
 def face_edges(faces: np.ndarray, face_part: np.ndarray, row_of, n_rows: int, alpha: float):
     """The :class:`FaceEdges` of contact faces.

@@ -52,8 +52,9 @@ class FaceContactSet:
     parts : tuple of str
     direction : (k, 3) float array
         ``n_z``, unit.
-    gap : (k,) float array
-        ``ψ(z)``.
+    psi : (k,) float array
+        ``ψ(z)``, the gap along ``n_z`` (the bounds of the solver's variables are
+        :attr:`gap`).
     dof : (k,) int array
         The frame DOF the row bounds, ``3 z + j``.
     frame_nodes : (m,) int array
@@ -80,7 +81,7 @@ class FaceContactSet:
     part: np.ndarray
     parts: tuple[str, ...]
     direction: np.ndarray
-    gap: np.ndarray
+    psi: np.ndarray
     dof: np.ndarray
     frame_nodes: np.ndarray
     frames: np.ndarray
@@ -101,9 +102,10 @@ class FaceContactSet:
         return (Q @ change_of_variables(self.n_dofs, self.dof, self.edges)).tocsr()
 
     @property
-    def bound(self) -> np.ndarray:
-        """``(k,)`` ψ̃ = T^{-T} ψ: the bounds ``ỹ_dof ≤ ψ̃`` of the solver's variables."""
-        return self.edges.coefficients(self.gap)
+    def gap(self) -> np.ndarray:
+        """``(k,)`` ψ̃ = T^{-T} ψ: the bounds ``ỹ_dof ≤ ψ̃`` of the solver's variables (ψ
+        itself for condition (a))."""
+        return self.edges.coefficients(self.psi)
 
     @property
     def transformed_integral(self) -> np.ndarray:
@@ -113,7 +115,7 @@ class FaceContactSet:
     def system(self, K: sp.spmatrix, F: np.ndarray) -> tuple[sp.csr_matrix, np.ndarray]:
         """``(Rᵀ K R, Rᵀ F)`` with ``R`` = :attr:`operator`: the bound-constrained system of
         :func:`~signorini.algebra.pdas.solve_pdas` (constrained ``dof``, bounds
-        :attr:`bound`, Dirichlet ``held_dofs`` at ``held_values``)."""
+        :attr:`gap`, Dirichlet ``held_dofs`` at ``held_values``)."""
         R = self.operator
         return (R.T @ K @ R).tocsr(), R.T @ np.asarray(F, dtype=np.float64)
 
@@ -148,7 +150,18 @@ class FaceContactSet:
 
     @property
     def n_rows(self) -> int:
+        """The number of rows ``k``."""
         return self.node.size
+
+    # what the solve reads of a contact set (as of the 2D ContactSet)
+    size = n_rows
+    has_friction = False
+    transfer = None
+
+    @property
+    def constrained_dofs(self) -> np.ndarray:
+        """``(k,)`` the bounded DOFs of the solver's variables (``dof``)."""
+        return self.dof
 
 
 def _body_normals(space, name: str, facets: np.ndarray, z: np.ndarray) -> np.ndarray:
@@ -300,7 +313,7 @@ def _assembled(space, parts, node, part, direction, gap, row_of_part, held, valu
         part=part,
         parts=parts,
         direction=direction,
-        gap=gap,
+        psi=gap,
         dof=3 * node + j,
         frame_nodes=frame_nodes,
         frames=Q,

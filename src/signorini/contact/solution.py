@@ -45,7 +45,7 @@ from .ordering import SolverAhead, ordered_solver
 from .partition import Partition
 from .profile import ContactProfile, contact_profile
 from .rigid_modes import system_rigid_modes
-from .solution3d import cartesian_displacement, errors_3d
+from .solution3d import cartesian_displacement, contact_force, errors_3d, nodal_pressure
 from .system import Assembled, assemble
 from .two_body import master_traction
 
@@ -177,8 +177,8 @@ class ContactResult:
     @property
     def pressure(self) -> np.ndarray:
         """Consistent nodal contact pressure ``p_z = Λ_z / w_z``, ``w_z = ∫ψ_z`` (docs/method.md,
-        *Discrete problem*)."""
-        return self.space.element.facet.pressure(self.contact_force, self.contact.basis_integral)
+        *Discrete problem*; on faces :func:`~.solution3d.nodal_pressure`)."""
+        return nodal_pressure(self)
 
     @property
     def tangential_pressure(self) -> np.ndarray:
@@ -356,6 +356,7 @@ def solve(
         nested
         and active0 is None
         and mesh is not problem.mesh
+        and mesh.dim == 2
         and cs.size > 0
         and not cs.has_friction
         and problem.free_ndof(space) >= NESTED_MIN_NDOF
@@ -391,7 +392,7 @@ def solve(
         space=space,
         u=cartesian_displacement(solved.x, assembled),
         contact=cs,
-        contact_force=solved.normal_force if unit == 1.0 else solved.normal_force * unit,
+        contact_force=contact_force(cs, solved.normal_force * unit),
         active=solved.state != INACTIVE,
         report=report,
         dirichlet_nodes=assembled.dirichlet_nodes,

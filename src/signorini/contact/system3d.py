@@ -5,10 +5,12 @@
 :func:`~signorini.fem.stiffness3d.assemble_stiffness_3d`'s, the load the body force and the
 Neumann tractions of :mod:`signorini.fem.elasticity3d`; the held DOFs are the Dirichlet
 parts' components and the axis rollers' (one Cartesian component each,
-:func:`~signorini.problem.rollers.held_nodes`), interleaved ``3 node + c``. There are no
-constrained nodes (the contact set is empty: :class:`~signorini.problem.problem.ContactProblem`
-refuses a contact part on a 3D mesh) and no node frames, so the system is ``K u = F`` with
-Cartesian unknowns and the solution needs no rotation back.
+:func:`~signorini.problem.rollers.held_nodes`), interleaved ``3 node + c``. Without contact
+parts there are no node frames, so the system is ``K u = F`` with Cartesian unknowns. With
+contact parts the contact set on faces (:func:`~.face_contact.face_contact_set`, condition
+(b) with ``DEFAULT_ALPHA``) gives the system ``Rᵀ K R ỹ = Rᵀ F``, ``u = R ỹ`` (node frames,
+then the transformed face basis), its bounds and its held DOFs (docs/method.md, *Three
+dimensions: contact on faces*).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..algebra.ranks import SERIAL
 from ..fem.elasticity3d import assemble_body_force_3d, assemble_face_load_3d
@@ -30,6 +33,7 @@ from ..problem.rollers import held_nodes
 from .admissible import check_load_size
 from .contact_set import _empty
 from .discrete_conditions import DiscreteConditions
+from .face_contact import face_contact_set
 from .ordering import Ordering
 from .system import Assembled, RollerDofs
 
@@ -142,6 +146,8 @@ def assemble_3d(problem: ContactProblem, mesh: Mesh) -> Assembled:
     check_load_size(K, F, loads, SERIAL)
     conditions = discrete_conditions_3d(problem, space)
     held = conditions.held
+    if problem.contact_parts:
+        return _with_contact(problem, space, K, F, conditions, time.perf_counter() - t0)
     dirichlet = np.flatnonzero(held.components.ravel())
     return Assembled(
         space,
@@ -156,6 +162,44 @@ def assemble_3d(problem: ContactProblem, mesh: Mesh) -> Assembled:
         np.zeros(0, dtype=np.int64),
         np.zeros((0, 3, 3)),
         _roller_dofs_3d(conditions),
+        conditions,
+        None,
+        Ordering(space),
+    )
+
+
+def _with_contact(
+    problem: ContactProblem,
+    space: P2TetSpace,
+    K: sp.csr_matrix,
+    F: np.ndarray,
+    conditions: DiscreteConditions,
+    seconds: float,
+) -> Assembled:
+    """The :class:`Assembled` of a 3D problem with contact parts: the system in the solver's
+    variables (:meth:`~.face_contact.FaceContactSet.system`), its held DOFs sorted, the
+    rollers off the contact nodes."""
+    t0 = time.perf_counter()
+    held = conditions.held
+    contact = {name: problem.conditions[name] for name in problem.contact_parts}
+    cs = face_contact_set(space, contact, held.components, held.values)
+    K_rot, F_rot = cs.system(K, F)
+    order = np.argsort(cs.held_dofs)
+    rollers = _roller_dofs_3d(conditions)
+    off = ~np.isin(rollers.nodes, cs.frame_nodes)
+    return Assembled(
+        space,
+        cs,
+        K_rot,
+        F_rot,
+        cs.held_dofs[order],
+        cs.held_values[order],
+        seconds + time.perf_counter() - t0,
+        conditions.dirichlet_nodes,
+        np.zeros((cs.n_rows, 3)),
+        cs.frame_nodes,
+        cs.frames,
+        RollerDofs(rollers.nodes[off], rollers.dofs[off], rollers.sign[off], rollers.normal[off]),
         conditions,
         None,
         Ordering(space),

@@ -2,9 +2,10 @@
 (docs/method.md, *Three dimensions: solving elasticity*): 3D elasticity without contact.
 
 A 3D problem holds Dirichlet parts (all or some of ``(u_x, u_y, u_z)``), rollers on planar
-parts normal to an axis (one Cartesian component held) and Neumann parts. Contact on faces
-is the work of issue 38 (three dimensions, part 2): a contact part on a 3D mesh is refused
-here, before any work, and so is an oblique roller (its node frames are part 2's too).
+parts normal to an axis (one Cartesian component held), Neumann parts and frictionless
+contact parts against a gap function or a shape of space (docs/method.md, *Three
+dimensions: contact on faces*); friction, contact pairs, plane shapes and oblique rollers are
+refused here, before any work.
 """
 
 from __future__ import annotations
@@ -25,22 +26,18 @@ RIGID_RTOL = 1e-8
 
 
 def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
-    """Refuse contact parts on a tetrahedral ``mesh``, and constant data with another number
-    of components than the mesh has dimensions.
+    """Refuse on a tetrahedral ``mesh`` what 3D contact does not build (friction, pairs,
+    plane shapes), and constant data with another number of components than the mesh has
+    dimensions.
 
     Raises
     ------
     ProblemError
-        Naming the contact parts and the issue that builds 3D contact, or the part whose
-        data have the wrong number of components.
+        Naming the contact part and what it asks for, or the part whose data have the wrong
+        number of components.
     """
-    contact = [name for name, cond in conditions.items() if isinstance(cond, Contact)]
-    if mesh.dim == 3 and contact:
-        raise ProblemError(
-            f"contact part(s) {contact} on a 3D (tetrahedral) mesh: contact on faces in three "
-            "dimensions is not built yet (issue 38, three dimensions part 2); a 3D problem "
-            "takes Dirichlet, axis Roller and Neumann parts (3D elasticity without contact)"
-        )
+    if mesh.dim == 3:
+        _check_contact_3d(conditions)
     for name, cond in conditions.items():  # a loop over parts
         if not isinstance(cond, Dirichlet | Neumann):
             continue
@@ -51,6 +48,28 @@ def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
                 f"{value!r} on a {mesh.dim}D mesh: give {mesh.dim}, "
                 f"{('(x, y)', '(x, y, z)')[mesh.dim - 2]} (None for a free Dirichlet component)"
             )
+
+
+def _check_contact_3d(conditions: Mapping[str, Condition]) -> None:
+    """Refuse what 3D contact on faces does not build yet: friction, contact pairs, a plane
+    shape (dim 2) as the obstacle, a given normal that is not three numbers."""
+    for name, cond in conditions.items():  # a loop over parts
+        if not isinstance(cond, Contact):
+            continue
+        what = None
+        if cond.friction is not None:
+            what = "friction on faces is not built yet (frictionless contact only)"
+        elif cond.master is not None:
+            what = "contact pairs between bodies are not built in 3D yet"
+        elif cond.obstacle is not None and cond.obstacle.dim != 3:
+            what = (
+                f"the obstacle {cond.obstacle!r} is a plane shape: use a shape of space "
+                "(signorini.problem.obstacles3d: HalfSpace, Ball, Cylinder, SignedDistance3D)"
+            )
+        elif cond.normal is not None and np.size(cond.normal) != 3:
+            what = f"the normal {cond.normal!r} must be three numbers on a 3D mesh"
+        if what is not None:
+            raise ProblemError(f"contact part {name!r} on a 3D (tetrahedral) mesh: {what}")
 
 
 def rigid_modes_3d(x: np.ndarray) -> np.ndarray:
