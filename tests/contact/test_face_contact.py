@@ -282,7 +282,8 @@ def test_gap_function_on_a_curved_part_takes_the_surface_normal():
         face_contact_set(space, {"sphere": Contact(obstacle=Disc([0, 0], 1.0))}, held, values)
 
 
-def test_solve_runs_3d_contact_as_the_blocks_do():
+@pytest.mark.parametrize("alpha", [None, 0.0], ids=["b-default", "a"])
+def test_solve_runs_3d_contact_as_the_blocks_do(alpha):
     """``solve()`` on a ContactProblem with two contact parts of half-spaces equals the
     blocks' solution (condition (b), the default), and its pressure is the transformed one."""
     from signorini.contact.solution import solve
@@ -293,11 +294,11 @@ def test_solve_runs_3d_contact_as_the_blocks_do():
     conditions = {name: Neumann((0.0, 0.0, 0.0)) for name in mesh.part_names}
     conditions.update(
         z1=Dirichlet((-0.01, 0.003, -0.02)),
-        z0=Contact(obstacle=HalfSpace([0.0, 0.0, 0.0], [0.0, 0.0, 1.0])),
-        x0=Contact(obstacle=HalfSpace([0.0, 0.0, 0.0], [1.0, 0.0, 0.0])),
+        z0=Contact(obstacle=HalfSpace([0, 0, 0], [0, 0, 1.0]), face_alpha=alpha),
+        x0=Contact(obstacle=HalfSpace([0, 0, 0], [1.0, 0, 0]), face_alpha=alpha),
     )
     result = solve(ContactProblem(mesh, Material.from_young(1.0, 0.3), conditions))
-    u, force, active = _pressed(np.eye(3), 0.2)
+    u, force, active = _pressed(np.eye(3), 0.2 if alpha is None else alpha)
     assert result.report.kkt.max <= 1e-10
     cs = result.contact
     assert cs.parts == ("x0", "z0")  # the problem's order: at the corner the rows swap places
@@ -307,6 +308,12 @@ def test_solve_runs_3d_contact_as_the_blocks_do():
         np.sort(result.contact_force), np.sort(force), atol=1e-12 * np.abs(force).max()
     )
     np.testing.assert_allclose(result.total_contact_force, force.sum(), rtol=1e-12)
+    assert cs.edges.alpha == (0.2 if alpha is None else alpha)
+    assert np.isfinite(cs.recovered_pressure(result.contact_force)).all()
+    if alpha == 0.0:  # (a): no nodal pressure at the vertices
+        with pytest.raises(ValueError, match="integrate to zero"):
+            _ = result.pressure
+        return
     np.testing.assert_allclose(
         result.pressure,
         cs.edges.transformed(result.contact_force) / cs.transformed_integral,

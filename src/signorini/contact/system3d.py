@@ -7,10 +7,10 @@ Neumann tractions of :mod:`signorini.fem.elasticity3d`; the held DOFs are the Di
 parts' components and the axis rollers' (one Cartesian component each,
 :func:`~signorini.problem.rollers.held_nodes`), interleaved ``3 node + c``. Without contact
 parts there are no node frames, so the system is ``K u = F`` with Cartesian unknowns. With
-contact parts the contact set on faces (:func:`~.face_contact.face_contact_set`, condition
-(b) with ``DEFAULT_ALPHA``) gives the system ``Rᵀ K R ỹ = Rᵀ F``, ``u = R ỹ`` (node frames,
-then the transformed face basis), its bounds and its held DOFs (docs/method.md, *Three
-dimensions: contact on faces*).
+contact parts the contact set on faces (:func:`~.face_contact.face_contact_set`; condition
+(b) with ``DEFAULT_ALPHA`` unless the parts give ``face_alpha``) gives the system
+``Rᵀ K R ỹ = Rᵀ F``, ``u = R ỹ`` (node frames, then the transformed face basis), its bounds
+and its held DOFs (docs/method.md, *Three dimensions: contact on faces*).
 """
 
 from __future__ import annotations
@@ -33,6 +33,7 @@ from ..problem.rollers import held_nodes
 from .admissible import check_load_size
 from .contact_set import _empty
 from .discrete_conditions import DiscreteConditions
+from .face_basis import DEFAULT_ALPHA
 from .face_contact import face_contact_set
 from .ordering import Ordering
 from .system import Assembled, RollerDofs
@@ -182,7 +183,9 @@ def _with_contact(
     t0 = time.perf_counter()
     held = conditions.held
     contact = {name: problem.conditions[name] for name in problem.contact_parts}
-    cs = face_contact_set(space, contact, held.components, held.values)
+    alpha = next(iter(contact.values())).face_alpha  # one for all parts (problem3d)
+    alpha = DEFAULT_ALPHA if alpha is None else alpha
+    cs = face_contact_set(space, contact, held.components, held.values, alpha)
     K_rot, F_rot = cs.system(K, F)
     order = np.argsort(cs.held_dofs)
     rollers = _roller_dofs_3d(conditions)

@@ -247,6 +247,10 @@ class Contact:
         bodies*). The constraint is the dual mortar one, the gap and the direction come from
         the two surfaces; the master part takes no condition of its own. Not with ``gap``,
         ``normal`` or ``obstacle``.
+    face_alpha : float or None
+        On a 3D mesh, the α of the transformed face basis, in [0, 1/2): None for the default
+        1/5 (condition (b)), 0 for the nodal constraints at all P2 nodes (condition (a));
+        docs/method.md, *Three dimensions: contact on faces*. Not on a 2D mesh.
 
     Raises
     ------
@@ -262,9 +266,13 @@ class Contact:
     obstacle: Obstacle | None = None
     friction: Friction | None = None
     master: str | None = None
+    face_alpha: float | None = None
 
     def __post_init__(self) -> None:
         friction = self.friction
+        alpha = self.face_alpha
+        if alpha is not None and not (isinstance(alpha, int | float) and 0 <= alpha < 0.5):
+            raise ProblemError(f"Contact(face_alpha=...) must be in [0, 1/2), got {alpha!r}")
         if self.master is not None:
             if not isinstance(self.master, str) or not self.master:
                 raise ProblemError(

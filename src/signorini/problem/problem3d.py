@@ -38,6 +38,14 @@ def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
     """
     if mesh.dim == 3:
         _check_contact_3d(conditions)
+    alpha = [
+        n for n, c in conditions.items() if isinstance(c, Contact) and c.face_alpha is not None
+    ]
+    if mesh.dim == 2 and alpha:
+        raise ProblemError(
+            f"contact part(s) {alpha} give face_alpha on a 2D mesh: the transformed face basis "
+            "is the 3D contact condition on P2 faces"
+        )
     for name, cond in conditions.items():  # a loop over parts
         if not isinstance(cond, Dirichlet | Neumann):
             continue
@@ -52,7 +60,7 @@ def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
 
 def _check_contact_3d(conditions: Mapping[str, Condition]) -> None:
     """Refuse what 3D contact on faces does not build yet: friction, contact pairs, a plane
-    shape (dim 2) as the obstacle, a given normal that is not three numbers."""
+    shape (dim 2) as the obstacle; and contact parts with different ``face_alpha``."""
     for name, cond in conditions.items():  # a loop over parts
         if not isinstance(cond, Contact):
             continue
@@ -66,10 +74,14 @@ def _check_contact_3d(conditions: Mapping[str, Condition]) -> None:
                 f"the obstacle {cond.obstacle!r} is a plane shape: use a shape of space "
                 "(signorini.problem.obstacles3d: HalfSpace, Ball, Cylinder, SignedDistance3D)"
             )
-        elif cond.normal is not None and np.size(cond.normal) != 3:
-            what = f"the normal {cond.normal!r} must be three numbers on a 3D mesh"
         if what is not None:
             raise ProblemError(f"contact part {name!r} on a 3D (tetrahedral) mesh: {what}")
+    alphas = {c.face_alpha for c in conditions.values() if isinstance(c, Contact)}
+    if len(alphas) > 1:
+        raise ProblemError(
+            f"the contact parts give different face_alpha {sorted(alphas, key=str)}: one "
+            "discrete contact condition on all of Γ_C"
+        )
 
 
 def rigid_modes_3d(x: np.ndarray) -> np.ndarray:
