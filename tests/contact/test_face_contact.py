@@ -30,6 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "studies"))
 
 from faces3d import contact as study  # noqa: E402
 from faces3d import manufactured as study_data  # noqa: E402
+from faces3d import measures as study_measures  # noqa: E402
 from faces3d.mesh import cube_mesh  # noqa: E402
 
 PROBLEMS = {"full": full_contact, "transition": transition, "patch": patch}
@@ -116,8 +117,17 @@ def test_conditions_a_and_b_equal_the_independent_study(name, alpha):
     np.testing.assert_allclose(force, ref.force[row], atol=1e-11 * f_scale, rtol=0)
     np.testing.assert_allclose(result.multiplier, ref.multiplier[row], atol=1e-11 * f_scale, rtol=0)
     assert result.kkt.max <= 1e-10
-    if alpha > 0:  # (b): every multiplier positive where active, Λ̃ = T Λ
+    # the pressures: the P1-lumped one at the vertices, (b)'s own p̃ at every node
+    vertex = cs.node < space.mesh.n_points
+    p_scale = np.abs(STUDY[name]().pressure(space.node_points[cs.node])).max()
+    p1 = study_measures.recovered_pressure(problem, ref.force, 0.5)[row]
+    np.testing.assert_allclose(
+        cs.recovered_pressure(force)[vertex], p1[vertex], atol=1e-10 * p_scale, rtol=0
+    )
+    if alpha > 0:  # (b): Λ̃ = T Λ is the multiplier
         np.testing.assert_allclose(cs.edges.transformed(force), result.multiplier, atol=1e-13)
+        own = study_measures.recovered_pressure(problem, ref.force, alpha)[row]
+        np.testing.assert_allclose(cs.pressure(force), own, atol=1e-10 * p_scale, rtol=0)
 
 
 @pytest.mark.parametrize("alpha", [0.0, 0.2, 0.3], ids=["a", "b", "b-0.3"])
