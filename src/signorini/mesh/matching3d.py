@@ -15,10 +15,10 @@ Stevenson [2]_, who shows that such a subdivision of an arbitrary conforming par
 satisfies it). The type and the order of ``x1, x2`` are those that the package's
 check :func:`~signorini.mesh.refine3d.matches` accepts (as do ``(a, c_T, c_F, b)`` and
 type 1) and that keep the fewest similarity classes and the largest dihedral angles under
-uniform bisection of a regular tetrahedron (3 classes and 22.2° against up to 8 and 17.0°
-for the other three). For types 1 and 2 the tagged simplices ``(x0, x1, x2, x3)_gamma``
-and ``(x3, x1, x2, x0)_gamma`` have the same children, so which end of ``a–b`` comes first
-does not matter (the smaller vertex number is taken).
+uniform bisection of a regular tetrahedron (nine bisections: at most 6 classes and 22.2°,
+against 7–8 classes and 17.0–19.1° for the other three). For types 1 and 2 the tagged simplices
+``(x0, x1, x2, x3)_gamma`` and ``(x3, x1, x2, x0)_gamma`` have the same children, so which
+end of ``a–b`` comes first does not matter (the smaller vertex number is taken).
 
 Face barycentres are shared by the two cells of a face; those of a boundary face of a part
 that carries a :class:`~signorini.mesh.surfaces.Surface` are projected onto it. Each
