@@ -78,7 +78,7 @@ def matching_subdivision(
     volume6 : (12 n,) float64 array
         ``det[b - a, c_T - a, c_F - a]`` with ``a, b`` in the order of the outward face
         ``F``: six times the sub-tetrahedron's volume, positive for every sub-cell of a
-        valid subdivision (``c_T`` lies inside ``F``'s half-space).
+        valid subdivision (``c_T`` lies on the inner side of ``F``).
     """
     n_points, n = points.shape[0], cells.shape[0]
     face = cells[:, TETRAHEDRON.facets]  # (n, 4, 3), outward
