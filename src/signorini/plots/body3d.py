@@ -4,7 +4,7 @@ Mises stress (docs/method.md, *Three dimensions: solving elasticity*).
 Drawn with matplotlib's ``Poly3DCollection`` (one collection of the faces' corner points,
 no loop over faces): the boundary faces only, which grow like ``N^{2/3}``; beyond
 :data:`MAX_FACES` the faces turned away from the viewer are left out, then every k-th face
-of the rest, and the figure says what was drawn. With the optional ``[3d]`` extra
+of the rest, and the title says what was drawn. With the optional ``[3d]`` extra
 (PyVista) :func:`render_body_3d` renders the same surface off screen.
 """
 
@@ -68,8 +68,8 @@ def shown_faces(
     rows = rows[normal @ eye > 0]
     step = -(-rows.size // max_faces)
     rows = rows[::step]
-    thinned = f", every {step}th of them" if step > 1 else ""
-    return rows, f"drawn: {rows.size} of {k} boundary faces (those facing the viewer{thinned})"
+    thinned = f", 1 in {step}" if step > 1 else ""
+    return rows, f"drawn: {rows.size} of {k} boundary faces (facing the viewer{thinned})"
 
 
 def plot_body_3d(
@@ -112,7 +112,7 @@ def plot_body_3d(
     tri = np.asarray(faces, dtype=np.int64)
     scale = displacement_scale(x, u)
     corners = (x + scale * u)[tri]  # (k, 3, 3)
-    rows, note = shown_faces(corners)
+    rows, note = shown_faces(corners, VIEW, MAX_FACES)
     value = face_colours(tri, von_mises(np.asarray(stress, dtype=np.float64)))
     norm = colors.Normalize(float(value.min()), float(value.max()) or 1.0)
     fig = new_figure(5.6, 4.8)
@@ -132,9 +132,7 @@ def plot_body_3d(
     ax.view_init(*VIEW)
     fig.colorbar(cm.ScalarMappable(norm, "viridis"), ax=ax, shrink=0.7, label="von Mises")
     head = f"{title}: " if title else ""
-    ax.set_title(f"{head}deformed body, displacement × {scale:g}")
-    if note:
-        fig.text(0.02, 0.02, note, fontsize=8)
+    ax.set_title(f"{head}deformed body, displacement × {scale:g}" + (f"\n{note}" if note else ""))
     return save_figure(fig, path)
 
 
