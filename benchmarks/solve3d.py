@@ -9,8 +9,8 @@ by ``signorini.contact.solution.solve(..., assembled=...)`` with each solver **a
 as the spread of one solver's times on the same matrix. Printed per system: the unknowns,
 each solver's best time (set-up and solve: analysis, factorization or hierarchy, and the
 solves of the active set loop, here one system) and its spread (max/min), the peak memory
-of the solve above the memory before it (``VmHWM`` after resetting it through
-``/proc/self/clear_refs``, Linux), and amg's CG iterations.
+of the solve above the memory before it (``VmHWM`` after returning freed memory to the system
+and resetting the mark through ``/proc/self/clear_refs``, Linux), and amg's CG iterations.
 
 Graded meshes: the same cube refined by the package's 3D bisection (``refine_nvb``) towards
 the vertex ``(0, 0, 0)`` or the edge ``x = y = 0``: each local level bisects the cells that
@@ -23,6 +23,8 @@ touch it, ``--levels`` times; amg's iterations on them show whether they stay bo
 from __future__ import annotations
 
 import argparse
+import ctypes
+import gc
 import time
 
 import numpy as np
@@ -36,7 +38,6 @@ from signorini.mesh.mesh import Mesh
 from signorini.mesh.refine import refine_nvb
 from signorini.problem.conditions import Dirichlet, Neumann
 from signorini.problem.problem import ContactProblem
-from signorini.runtime import retain_freed_memory
 
 MATERIAL = Material.from_young(1.0, 0.3)
 
@@ -45,7 +46,8 @@ def cantilever(mesh: Mesh) -> ContactProblem:
     """Clamped on ``x0``, the body force ``(0, 0.3, −1)``, traction-free elsewhere."""
     conditions = {name: Neumann((0.0, 0.0, 0.0)) for name in mesh.part_names}
     conditions["x0"] = Dirichlet((0.0, 0.0, 0.0))
-    return ContactProblem(mesh, MATERIAL, conditions, body_force=(0.0, 0.3, -1.0))
+    force = np.array([0.0, 0.3, -1.0])
+    return ContactProblem(mesh, MATERIAL, conditions, body_force=lambda x: force)
 
 
 def graded(n: int, towards: str, levels: int) -> Mesh:
@@ -59,6 +61,14 @@ def graded(n: int, towards: str, levels: int) -> Mesh:
     return mesh
 
 
+def _trim() -> None:
+    """Return glibc's freed memory to the system (``malloc_trim``; nothing elsewhere)."""
+    try:
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+
+
 def _peak_kb() -> tuple[int, int]:
     """``VmRSS`` and ``VmHWM`` of this process, kB."""
     status = dict(line.split(":", 1) for line in open("/proc/self/status"))
@@ -68,11 +78,13 @@ def _peak_kb() -> tuple[int, int]:
 def timed_solve(problem: ContactProblem, assembled, solver: str) -> tuple[float, float, int]:
     """Seconds of one solve (set-up included), its peak memory above the memory before it
     (MB), and the CG iterations (0 for a direct solver)."""
+    _trim()  # freed memory back to the system, so that the peak is this solve's own
     try:
         with open("/proc/self/clear_refs", "w") as fh:
             fh.write("5")  # resets VmHWM to the current RSS
     except OSError:
         pass
+    gc.collect()
     before = _peak_kb()[0]
     t0 = time.perf_counter()
     result = solve(problem, assembled.space.mesh, solver=SOLVERS[solver], assembled=assembled)
@@ -113,7 +125,6 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--levels", type=int, default=15)
     parser.add_argument("--repeat", type=int, default=2)
     args = parser.parse_args(argv)
-    retain_freed_memory()
     direct = ["pardiso"] if "pardiso" in available_backends() else ["scipy"]
     print(f"{'mesh':>16s} {'ndof':>9s} {'cells':>9s}   solver best (max/min) peak [its]")
     for n in args.sizes:
