@@ -233,8 +233,7 @@ COLUMNS_3D: dict[str, str] = {
     "node on a Dirichlet part (one per fixed component on a roller)",
     "ndof_total": "all scalar P2 unknowns, 3 × (vertices + edges), Dirichlet ones included",
     "n_cells": "tetrahedra of the mesh",
-    "error_energy": "energy norm of u − u_h (only with an exact solution, else nan), "
-    "unit √energy",
+    "error_energy": "energy norm of u − u_h (only with an exact solution, else nan), unit √energy",
     "pdas_iterations": "iterations of the solve, one linear system each (without contact the "
     "active set is empty: one, or a second with an iterative solver's tightened tolerance)",
     "linear_iterations": "CG iterations of an iterative solver (amg), summed over the level's "
