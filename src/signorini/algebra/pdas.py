@@ -195,6 +195,7 @@ def solve_pdas(
         solver = make_solver(solver)
 
     before = solver_usage(solver)
+    its_before = len(getattr(solver, "iterations", ()))  # an iterative solver's counts
     try:
         system = ActiveSetSystem(qp, solver, max_update=options.max_update)
         history: list[PDASStep] = []
@@ -212,6 +213,7 @@ def solve_pdas(
     finally:
         used = {key: value - before[key] for key, value in solver_usage(solver).items()}
         backend_name = solver.backend
+        linear_iterations = tuple(int(k) for k in getattr(solver, "iterations", ())[its_before:])
         if own_solver:
             solver.close()
 
@@ -248,6 +250,7 @@ def solve_pdas(
         c_scale=c_scale,
         times=times,
         n_updates=system.n_updates,
+        linear_iterations=linear_iterations,
     )
 
 

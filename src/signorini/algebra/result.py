@@ -91,6 +91,10 @@ class SolveReport:
         The constant ``c`` of the active set rule.
     times : dict of str to float
         Seconds, e.g. ``analysis``, ``factorization``, ``solve``, ``total``.
+    linear_iterations : tuple of int
+        The iterations of each solve of an iterative linear solver (its ``iterations``,
+        e.g. :attr:`AmgSolver.iterations <.backends.amg.AmgSolver.iterations>`) during this
+        call; empty with a direct one.
     """
 
     x: np.ndarray
@@ -104,6 +108,7 @@ class SolveReport:
     backend: str
     c_scale: float
     times: dict[str, float] = field(default_factory=dict)
+    linear_iterations: tuple[int, ...] = ()
 
     #: the attributes that are forces (multiplied by :meth:`scaled`'s unit)
     FORCES: ClassVar[tuple[str, ...]] = ()

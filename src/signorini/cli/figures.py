@@ -23,17 +23,21 @@ def figures(
     last: Level | None = None,
     name: str | None = None,
     element: str | None = None,
+    dim: int | None = None,
 ) -> list[Path]:
     """The run's figures (:func:`signorini.plots.run_figures.run_figures`), titled with the
-    problem's ``name``, the reference slopes of its ``element`` (default: the last level's
-    problem's and element)."""
+    problem's ``name``, the reference slopes of its ``element`` in dimension ``dim`` (default:
+    the last level's problem's, element and mesh's); a 3D level as the arrays of its body
+    (:func:`~signorini.loop.arrays.body_arrays`)."""
     from ..fem.element import element_of
-    from ..loop.arrays import level_arrays
+    from ..loop.arrays import body_arrays, level_arrays
     from ..plots.run_figures import run_figures
 
-    arrays = None if last is None else level_arrays(last)
+    arrays = None
+    if last is not None:
+        arrays = body_arrays(last) if last.result.mesh.dim == 3 else level_arrays(last)
     degree = None if element is None else element_of(element).degree
-    return run_figures(example, out, arrays, name, degree)
+    return run_figures(example, out, arrays, name, degree, dim)
 
 
 def figures_command(name: str, out: Path, status) -> list[Path]:
@@ -51,7 +55,8 @@ def figures_command(name: str, out: Path, status) -> list[Path]:
     job = load(name)
     options = AdaptiveOptions.from_record(recorded_arguments(folder.manifest, folder.file))
     check_problem(folder, name, job, options, f"figures {name} {out}")
-    return figures(label(name), folder.path, name=job.problem.name, element=options.element)
+    drawn = {"name": job.problem.name, "element": options.element, "dim": job.problem.mesh.dim}
+    return figures(label(name), folder.path, **drawn)
 
 
 def pressure_figure(example: str, out: Path, last: Level, metrics: Metrics) -> list[Path]:
@@ -71,10 +76,13 @@ def draw_figures(
     """Announce, draw and record the figures of a run whose last level is ``last`` (None:
     the convergence figures of its history only)."""
     out = folder.path
+    three = last is not None and last.result.mesh.dim == 3  # no contact figures in 3D
     kinds = "convergence history, mesh, deformed body" if last else "convergence history"
+    if three:
+        kinds = "convergence history, deformed body"
     say(f"drawing the figures of {label} ({kinds}) ...")
     written = figures(label, out, last)
-    if last is not None and metrics is not None and metrics.pressure is not None:
+    if last is not None and not three and metrics is not None and metrics.pressure is not None:
         written += pressure_figure(label, out, last, metrics)
     folder.add_files(*(str(p.relative_to(out)) for p in written))
     say(f"figures: {', '.join(str(p.name) for p in written)}")

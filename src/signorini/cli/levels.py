@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..loop import AdaptiveOptions, Level, roundoff_text
+from ..loop.record import ElasticityRecord
 from ..output import HistoryWriter, write_vtu
 from ..output.run import RunFolder
 from ..output.vtu import write_pvd
@@ -24,9 +25,20 @@ __all__ = ["Clock", "Printer", "Status", "progress", "write_levels"]
 LONG_RUN_SECONDS = 10.0
 
 
+#: The errors a level's line shows without an estimator: (shown as, column, its rate's column).
+ERRORS_SHOWN = (
+    ("error", "error_energy", "rate_energy"),
+    ("h1", "error_h1", "rate_h1"),
+    ("l2", "error_l2", "rate_l2"),
+)
+
+
 def progress(level: Level) -> str:
-    """The progress line of a finished level."""
+    """The progress line of a finished level (:func:`elasticity_progress` for a level without
+    an estimator and without contact)."""
     r = level.record
+    if isinstance(r, ElasticityRecord):
+        return elasticity_progress(r)
     line = f"level {r.level:3d}  ndof {r.ndof:9d}  cells {r.n_cells:8d}  eta {r.eta:.4e}"
     if not np.isnan(r.error_energy):
         line += f"  error {r.error_energy:.4e}  eff {r.efficiency:.3f}"
@@ -35,6 +47,25 @@ def progress(level: Level) -> str:
         f"  [{r.t_assemble + r.t_solve + r.t_estimate + r.t_mark + r.t_refine:.2f}s]"
     )
     return line
+
+
+def elasticity_progress(r: ElasticityRecord) -> str:
+    """The progress line of a level without an estimator and without contact (3D): its
+    unknowns and cells, the errors it knows with their observed rates (the history's
+    ``rate_*`` columns, when the problem measures them), the solver and, if iterative, its
+    iterations, the seconds of its steps."""
+    row = {"error_energy": r.error_energy, "error_h1": r.error_h1, **r.extra}
+    line = f"level {r.level:3d}  ndof {r.ndof:9d}  cells {r.n_cells:8d}"
+    for shown, column, rate in ERRORS_SHOWN:
+        value = float(row.get(column, math.nan))
+        if math.isfinite(value):
+            line += f"  {shown} {value:.4e}"
+            if math.isfinite(float(row.get(rate, math.nan))):
+                line += f" ({float(row[rate]):+.2f})"
+    line += f"  {r.backend}"
+    if "linear_iterations" in r.extra:
+        line += f" {r.extra['linear_iterations']} its"
+    return line + f"  [{r.t_assemble + r.t_solve + r.t_estimate + r.t_mark + r.t_refine:.2f}s]"
 
 
 class Clock:

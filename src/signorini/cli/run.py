@@ -17,6 +17,7 @@ from pathlib import Path
 
 from ..algebra.backends.selection import solver_library, solver_name
 from ..loop import COLUMNS, Level, adaptive
+from ..loop.record import COLUMNS_3D
 from ..output import HistoryWriter, write_columns
 from ..output.check import CHECK, write_check
 from ..output.environment import environment
@@ -192,10 +193,11 @@ def _solve_levels(work: _Run, status: Status) -> Level | None:
     out, state, options, say = work.folder.path, work.state, work.settings.options, work.say
     job = work.job
     work.folder.add_files("history.csv", "history.md")
+    three = job.problem.mesh.dim == 3  # no estimator, no contact: their columns left out
     write_columns(
         out / "history.md",
         {
-            **COLUMNS,
+            **(COLUMNS_3D if three else COLUMNS),
             **(job.metrics.columns if job.metrics else {}),
             "t_output": "seconds spent writing the level's VTU file and recording it",
         },
@@ -206,10 +208,8 @@ def _solve_levels(work: _Run, status: Status) -> Level | None:
         write_fields(out / "fields.md", job.problem.mesh)  # its regions' and bodies' names
     history = HistoryWriter(out / "history.csv", rows=state.history_rows if state else ())
     mode = "uniform" if options.uniform else f"adaptive, theta={options.theta}"
-    say(
-        f"{job.problem.name}: {mode}, eta5={options.eta5_variant}, "
-        f"max_ndof={options.max_ndof} -> {out}"
-    )
+    eta5 = "" if three else f", eta5={options.eta5_variant}"
+    say(f"{job.problem.name}: {mode}{eta5}, max_ndof={options.max_ndof} -> {out}")
     loop = {"metrics": job.metrics, "path": job.path}
     status.phase = "at level 0" if state is None else f"at level {state.level + 1}"
     if state is not None and state.final:

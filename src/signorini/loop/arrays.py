@@ -18,13 +18,40 @@ from ..fem.element import P1
 if TYPE_CHECKING:
     from . import Level
 
-__all__ = ["arc_lengths", "level_arrays", "obstacle_offset", "obstacle_outline"]
+__all__ = ["arc_lengths", "body_arrays", "level_arrays", "obstacle_offset", "obstacle_outline"]
 
 #: Points sampled along each contact edge where the obstacle's outline is drawn.
 OUTLINE_SAMPLES = 9
 #: The outline is left out where the obstacle is farther than this fraction of the body's size
 #: from the contact part (a shape far from most of a curved part, e.g. the plane under a disc).
 OUTLINE_REACH = 0.25
+
+
+def body_arrays(level: Level) -> dict[str, Any]:
+    """What the picture of a 3D level's body needs (``plots.run_figures.body_figures``), as
+    plain arrays at the mesh's vertices.
+
+    Returns
+    -------
+    dict
+        ``level`` (int); ``points (n, 3)``, the vertices; ``faces (k, 3)``, the boundary
+        faces' vertices in outward order (the space's
+        :meth:`~signorini.fem.space3d.P2TetSpace.facet_nodes`); ``displacement (n, 3)`` and
+        the nodal Cauchy stress ``stress (n, 3, 3)`` at the vertices; ``name``, the
+        problem's; ``degree``, the element's; ``dim`` 3.
+    """
+    res = level.result
+    mesh, n = res.mesh, res.mesh.points.shape[0]
+    return {
+        "level": level.record.level,
+        "points": mesh.points,
+        "faces": res.space.facet_nodes(mesh.boundary_facet)[:, :3],
+        "displacement": res.u[:n],
+        "stress": res.nodal_stress[:n],
+        "name": res.problem.name,
+        "degree": res.space.element.degree,
+        "dim": mesh.dim,
+    }
 
 
 def level_arrays(level: Level) -> dict[str, Any]:

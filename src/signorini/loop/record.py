@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -14,7 +15,7 @@ from ..contact.solution import SLIP, STICK, ContactResult
 from ..estimator.names import TERM_TABLE, TERMS
 from ..estimator.residual import Estimate
 
-__all__ = ["COLUMNS", "LevelRecord", "level_record"]
+__all__ = ["COLUMNS", "COLUMNS_3D", "ElasticityRecord", "LevelRecord", "level_record"]
 
 #: What each :class:`LevelRecord` field (= each column of a run's ``history.csv``) means,
 #: with its unit. Units are those of the problem's data ("consistent units": if E is in MPa
@@ -190,12 +191,56 @@ class LevelRecord:
     t_refine: float = 0.0
     extra: dict = field(default_factory=dict)
 
+    #: the fields a row leaves out (none here; :class:`ElasticityRecord`)
+    LEFT_OUT: ClassVar[tuple[str, ...]] = ()
+
     def row(self) -> dict:
-        """Flat dict for a CSV row."""
+        """Flat dict for a CSV row (without the fields of :attr:`LEFT_OUT`)."""
         d = asdict(self)
         extra = d.pop("extra")
         d.update(extra)
+        for name in self.LEFT_OUT:
+            del d[name]
         return d
+
+
+#: The columns of a level without an estimator (the estimator's, NaN there) and without
+#: contact (the contact's, zero or NaN there).
+NO_ESTIMATE_COLUMNS = ("eta", *TERMS, "efficiency", "eta_roundoff")
+NO_CONTACT_COLUMNS = (
+    "n_active", "n_constrained", "n_full_contact", "n_semi_contact", "n_no_contact",
+    "n_stick", "n_slip", "contact_force", "kkt_primal", "kkt_dual", "kkt_complementarity",
+    "kkt_tangential_bound", "kkt_tangential_complementarity",
+)  # fmt: skip
+
+
+@dataclass
+class ElasticityRecord(LevelRecord):
+    """The record of a level of elasticity without an estimator and without contact (3D,
+    docs/method.md, *Three dimensions: solving elasticity*): its row leaves out the
+    estimator's and the contact's columns, which hold nothing there (NaN, zero); the
+    attributes stay (NaN, zero), so code reading a record reads either kind. An iterative
+    solve adds ``linear_iterations`` to :attr:`extra`."""
+
+    LEFT_OUT: ClassVar[tuple[str, ...]] = NO_ESTIMATE_COLUMNS + NO_CONTACT_COLUMNS
+
+
+#: The columns of a 3D elasticity run's history (:class:`ElasticityRecord`), with their
+#: meaning in 3D.
+COLUMNS_3D: dict[str, str] = {
+    **{k: v for k, v in COLUMNS.items() if k not in ElasticityRecord.LEFT_OUT},
+    "ndof": "free scalar unknowns, 3 × (vertices + edges) of the P2 tetrahedra minus 3 per "
+    "node on a Dirichlet part (one per fixed component on a roller)",
+    "ndof_total": "all scalar P2 unknowns, 3 × (vertices + edges), Dirichlet ones included",
+    "n_cells": "tetrahedra of the mesh",
+    "error_energy": "energy norm of u − u_h (only with an exact solution, else nan), unit √energy",
+    "pdas_iterations": "iterations of the solve, one linear system each (without contact the "
+    "active set is empty: one, or a second with an iterative solver's tightened tolerance)",
+    "linear_iterations": "CG iterations of an iterative solver (amg), summed over the level's "
+    "solves; absent with a direct solver",
+    "backend": "sparse solver backend used (pardiso, scipy or amg)",
+    "t_estimate": "seconds spent computing the estimator (0: none in 3D yet)",
+}
 
 
 @dataclass(frozen=True)
@@ -210,12 +255,14 @@ _NO_ESTIMATE = _NoEstimate()
 
 
 def level_record(level: int, result: ContactResult, est: Estimate | None) -> LevelRecord:
-    """The record of one level; without an estimate (3D) η and its terms are NaN."""
+    """The record of one level; without an estimate (3D) η and its terms are NaN, and
+    without contact as well an :class:`ElasticityRecord`, whose row leaves them out."""
     if est is None:
         est = _NO_ESTIMATE
     classes = result.classes if result.contact.size else np.zeros(0, dtype=np.int64)
     report = result.report
-    rec = LevelRecord(
+    elasticity = est is _NO_ESTIMATE and not result.contact.size
+    rec = (ElasticityRecord if elasticity else LevelRecord)(
         level=level,
         ndof=result.ndof,
         ndof_total=result.space.n_dofs,
@@ -240,6 +287,8 @@ def level_record(level: int, result: ContactResult, est: Estimate | None) -> Lev
         t_assemble=result.timings["assemble"],
         t_solve=result.timings["solve"],
     )
+    if elasticity and report.linear_iterations:
+        rec.extra["linear_iterations"] = int(sum(report.linear_iterations))
     if result.problem.exact is not None:
         err = result.errors()
         rec.error_energy, rec.error_h1 = err["error_energy"], err["error_h1"]

@@ -4,7 +4,8 @@
   (:func:`plot_error_and_estimator`); Fig. 6.1(b): the efficiency index
   ``η_h / ‖u − u_h‖_a`` (:func:`plot_efficiency`);
 - Figs. 6.2 and 6.4: the contributions ``η_1 … η_7`` of (5.1) (:func:`plot_contributions`);
-- Fig. 6.3(a): the estimator alone (:func:`plot_estimator`);
+- Fig. 6.3(a): the estimator alone (:func:`plot_estimator`); without an estimator (3D)
+  the errors against ``N_dof`` (:func:`plot_errors`);
 - several runs of one quantity on one plot (:func:`plot_adaptive_vs_uniform`).
 
 All five share one frame (:func:`~signorini.plots.frame.convergence_figure`): log ``N_dof``
@@ -41,6 +42,7 @@ __all__ = [
     "plot_efficiency",
     "plot_contributions",
     "plot_estimator",
+    "plot_errors",
     "plot_adaptive_vs_uniform",
 ]
 
@@ -109,6 +111,47 @@ def plot_error_and_estimator(
         title=title,
         reference_slope=reference_slope,
         note=fit_note([ndof], last),
+    )
+
+
+def plot_errors(
+    history: HistoryLike,
+    path: str | os.PathLike,
+    title: str | None = None,
+    reference_slope: float = -2.0 / 3.0,
+) -> list[Path]:
+    """The errors against ``N_dof`` of a run without an estimator (3D, docs/method.md,
+    *Three dimensions: solving elasticity*): the energy error, and where the history has
+    them the H¹ seminorm and L² errors, each with its fitted slope, and a triangle of slope
+    ``reference_slope`` (:func:`~signorini.plots.slopes.optimal_slope`; −2/3 for P2 in 3D).
+
+    Parameters
+    ----------
+    history : mapping of str to (n_levels,) array, or path of a CSV history
+        Needs ``ndof`` and ``error_energy``; ``error_h1`` and ``error_l2`` are drawn if present.
+    path : str or os.PathLike
+        Output path without extension.
+    title : str, optional
+        Axes title.
+    reference_slope : float
+        Slope of the reference triangle.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The PNG and PDF files written.
+    """
+    h = history_columns(history, ("ndof", "error_energy"), ("error_h1", "error_l2"))
+    ndof = h["ndof"]
+    keys = [k for k in ("error_energy", "error_h1", "error_l2") if k in h]
+    curves = [Curve.of(k, ndof, h[k]) for k in keys]
+    return convergence_figure(
+        path,
+        curves,
+        "error",
+        title=title,
+        reference_slope=reference_slope,
+        note=fit_note([ndof], None),
     )
 
 

@@ -63,15 +63,17 @@ def displacement_scale(points: ArrayLike, displacement: ArrayLike) -> float:
 
     Parameters
     ----------
-    points : (n, 2) float array
-        Reference coordinates.
-    displacement : (n, 2) float array
+    points : (n, d) float array
+        Reference coordinates (d = 2, or 3 given as an ``(n, 3)`` array).
+    displacement : (n, d) float array
         The displacement at ``points``.
     """
-    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-    u = np.asarray(displacement, dtype=np.float64).reshape(-1, 2)
+    p = np.asarray(points, dtype=np.float64)
+    d = 3 if p.ndim == 2 and p.shape[1] == 3 else 2
+    p = p.reshape(-1, d)
+    u = np.asarray(displacement, dtype=np.float64).reshape(-1, d)
     size = float(np.ptp(p, axis=0).max()) if p.size else 0.0
-    u_max = float(np.max(np.hypot(u[:, 0], u[:, 1]))) if u.size else 0.0
+    u_max = float(np.max(np.hypot.reduce(u, axis=1))) if u.size else 0.0
     if not (np.isfinite(size) and np.isfinite(u_max)):
         raise ValueError("points and displacement must be finite")
     if size == 0.0 or u_max == 0.0:

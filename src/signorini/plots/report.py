@@ -14,6 +14,7 @@ from .convergence import (
     plot_contributions,
     plot_efficiency,
     plot_error_and_estimator,
+    plot_errors,
     plot_estimator,
 )
 from .slopes import optimal_slope
@@ -33,12 +34,24 @@ def has_known_values(history: Mapping[str, np.ndarray], column: str) -> bool:
     return bool(np.any(np.isfinite(values) & (values > 0)))
 
 
+def _estimated(history: Mapping[str, np.ndarray]) -> bool:
+    """Whether the history has an estimator: an ``eta`` column with a finite value (a 3D
+    run has none)."""
+    if "eta" not in history:
+        return False
+    try:
+        return bool(np.isfinite(np.asarray(history["eta"], dtype=np.float64)).any())
+    except ValueError:  # an all-empty column reads as text
+        return False
+
+
 def make_figures(
     history_path: str | os.PathLike,
     out_dir: str | os.PathLike,
     example_name: str,
     title: str | None = None,
     degree: int = 2,
+    dim: int = 2,
 ) -> list[Path]:
     """The convergence figures of one run, drawn from its ``history.csv``.
 
@@ -47,6 +60,9 @@ def make_figures(
       estimator alone (Fig. 6.3(a)).
     - Estimator contributions ``eta_1`` … ``eta_7`` in the history: their figure (Figs. 6.2,
       6.4), where a term that vanishes on every level is listed as ``≡ 0`` instead of drawn.
+
+    - Without an estimator (a 3D run: no finite ``eta``) and with a known error: the errors
+      alone (:func:`~.convergence.plot_errors`).
 
     Meshes and deformed bodies need more than the history; callers draw them with
     :func:`~signorini.plots.plot_mesh` and :func:`~signorini.plots.plot_deformed`.
@@ -65,6 +81,8 @@ def make_figures(
     degree : {2, 1}
         The degree of the run's element: the reference triangles have its optimal slope
         (:func:`~signorini.plots.slopes.optimal_slope`: −1 for P2, −1/2 for P1).
+    dim : {2, 3}
+        The mesh's dimension, which the optimal slope depends on (3D P2: −2/3).
 
     Returns
     -------
@@ -75,7 +93,9 @@ def make_figures(
     slug = re.sub(r"[^A-Za-z0-9._-]+", "_", str(example_name)).strip("_.") or "example"
     out = Path(out_dir)
     written: list[Path] = []
-    drawn = {"title": title, "reference_slope": optimal_slope(degree)}
+    drawn = {"title": title, "reference_slope": optimal_slope(degree, dim)}
+    if not _estimated(history) and has_known_values(history, "error_energy"):
+        return plot_errors(history, out / f"{slug}_errors", **drawn)
     if has_known_values(history, "error_energy"):
         written += plot_error_and_estimator(history, out / f"{slug}_error_estimator", **drawn)
         written += plot_efficiency(history, out / f"{slug}_efficiency", title=title)

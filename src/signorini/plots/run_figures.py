@@ -10,6 +10,7 @@ pressure as a record of arrays (:class:`KnownPressure`).
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Protocol
@@ -20,10 +21,20 @@ from .. import plots
 from ..mesh.curves import Line
 from ..mesh.mesh import Mesh
 from ..output import read_history
+from .body3d import plot_body_3d, render_body_3d
 from .contact_line import free_boundary_ends
 from .mesh import boundary_groups
 
-__all__ = ["KnownPressure", "mesh_title", "part_segments", "pressure_figure", "run_figures"]
+__all__ = [
+    "KnownPressure",
+    "body_figures",
+    "mesh_title",
+    "part_segments",
+    "pressure_figure",
+    "run_figures",
+]
+
+log = logging.getLogger(__name__)
 
 #: How the figure of the mesh labels the parts of each kind (``last["parts"]``' keys).
 PART_LABELS = {
@@ -51,8 +62,10 @@ def run_figures(
     last: Mapping[str, Any] | None = None,
     name: str | None = None,
     degree: int | None = None,
+    dim: int | None = None,
 ) -> list[Path]:
-    """The run's convergence figures; with its last level also the mesh and the deformed body.
+    """The run's convergence figures; with its last level also the mesh and the deformed body
+    (in 3D the deformed body's boundary faces, :func:`body_figures`).
 
     The mesh figure shows the finest level of at most ``plots.READABLE_CELLS`` cells (read back
     from its ``level_NNN.vtu``; the last level when that file is missing or holds another
@@ -88,13 +101,21 @@ def run_figures(
     degree : {2, 1}, optional
         The degree of the run's element, whose optimal rate the reference triangles show;
         default ``last["degree"]``, else 2 (P2).
+    dim : {2, 3}, optional
+        The mesh's dimension; default ``last["dim"]``, else 2. A 3D level (the arrays of
+        :func:`signorini.loop.arrays.body_arrays`) gets its convergence history and the
+        picture of its body; the figures of contact are 2D only.
     """
     known = {} if last is None else last
     name = str(known.get("name", example)) if name is None else name
     degree = int(known.get("degree", 2)) if degree is None else degree
-    written = list(plots.make_figures(out / "history.csv", out, example, title=name, degree=degree))
+    dim = int(known.get("dim", 2)) if dim is None else dim
+    drawn = {"title": name, "degree": degree, "dim": dim}
+    written = list(plots.make_figures(out / "history.csv", out, example, **drawn))
     if last is None:
         return written
+    if dim == 3:
+        return written + body_figures(example, out, last, name)
     # the level the mesh figure shows
     history = read_history(out / "history.csv")
     k = plots.readable_level(history["n_cells"])
@@ -152,6 +173,20 @@ def run_figures(
         scale=1.0 if last.get("pairs") else "auto",
     )
     return written
+
+
+def body_figures(example: str, out: Path, last: Mapping[str, Any], name: str) -> list[Path]:
+    """The picture of a 3D level's body (``<example>_body``,
+    :func:`~.body3d.plot_body_3d`) and, with PyVista installed (the ``[3d]`` extra), its
+    off-screen rendering (``<example>_body_pyvista.png``); without it one line in the log.
+    ``last`` holds ``points (n, 3)``, ``faces (k, 3)``, ``displacement (n, 3)`` and ``stress
+    (n, 3, 3)`` at the vertices (:func:`signorini.loop.arrays.body_arrays`)."""
+    body = (last["points"], last["faces"], last["displacement"], last["stress"])
+    written = plot_body_3d(*body, out / f"{example}_body", title=name)
+    rendered, note = render_body_3d(*body, out / f"{example}_body_pyvista")
+    if note:
+        log.info(note)
+    return written + rendered
 
 
 def mesh_title(example: str, level: int, n_cells: int, last_level: int) -> str:

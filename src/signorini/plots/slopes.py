@@ -29,13 +29,16 @@ __all__ = [
 ]
 
 
-def optimal_slope(degree: int = 2) -> float:
-    """The slope of the reference triangle: the optimal rate ``N_dof^{-k/2}`` of the energy
-    error of elements of degree k in 2D (−1 for P2, −1/2 for P1; :attr:`Element.degree
-    <signorini.fem.element.Element.degree>`)."""
+def optimal_slope(degree: int = 2, dim: int = 2) -> float:
+    """The slope of the reference triangle: the optimal rate ``N_dof^{-k/d}`` of the energy
+    error of elements of degree k in dimension d (``h^k`` with ``N_dof ~ h^{-d}``): in 2D
+    −1 for P2, −1/2 for P1 (:attr:`Element.degree <signorini.fem.element.Element.degree>`);
+    in 3D −2/3 for P2."""
     if isinstance(degree, bool) or degree not in (1, 2):
         raise ValueError(f"degree must be 1 (P1) or 2 (P2), got {degree!r}")
-    return -int(degree) / 2.0
+    if isinstance(dim, bool) or dim not in (2, 3):
+        raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+    return -int(degree) / float(dim)
 
 
 def fit_start(ndof: ArrayLike) -> float:

@@ -74,6 +74,7 @@ TERM_LOOKS: tuple[tuple[str, str], ...] = (
 STYLES: dict[str, dict[str, str]] = {
     "error_energy": {"color": "#1f77b4", "marker": "o", "label": r"$\|u-u_h\|_a$"},
     "error_h1": {"color": "#17becf", "marker": "x", "label": r"$|u-u_h|_{H^1}$"},
+    "error_l2": {"color": "#9467bd", "marker": "^", "label": r"$\|u-u_h\|_{L^2}$"},
     "eta": {"color": "#d62728", "marker": "s", "label": r"$\eta_h$"},
     "efficiency": {"color": "#222222", "marker": "o", "label": r"$\eta_h/\|u-u_h\|_a$"},
     **{

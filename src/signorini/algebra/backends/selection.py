@@ -79,8 +79,8 @@ def _warn_fallback(reason: str) -> None:
 
 
 #: from this many unknowns on, ``"auto"`` takes ``"amg"`` for a symmetric 3D system
-#: (docs/method.md, *Three dimensions: the linear solver (measured)*)
-AMG_FROM_3D = 60_000
+#: (measured: docs/method.md, *Three dimensions: solving elasticity*)
+AMG_FROM_3D = 150_000
 
 
 def auto_solver(request: SolverRequest) -> SPDSolver:

@@ -1,0 +1,176 @@
+"""The picture of a 3D body: the boundary faces of its deformed mesh, coloured by the von
+Mises stress (docs/method.md, *Three dimensions: solving elasticity*).
+
+Drawn with matplotlib's ``Poly3DCollection`` (one collection of the faces' corner points,
+no loop over faces): the boundary faces only, which grow like ``N^{2/3}``; beyond
+:data:`MAX_FACES` the faces turned away from the viewer are left out, then every k-th face
+of the rest, and the title says what was drawn. With the optional ``[3d]`` extra
+(PyVista) :func:`render_body_3d` renders the same surface off screen.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..output.vtu import von_mises
+from .deformed import displacement_scale
+from .style import new_figure, save_figure
+
+__all__ = ["MAX_FACES", "VIEW", "face_colours", "plot_body_3d", "render_body_3d", "shown_faces"]
+
+log = logging.getLogger(__name__)
+
+#: Most boundary faces one picture draws (beyond: back faces out, then every k-th face).
+MAX_FACES = 30_000
+#: The view ``(elevation, azimuth)`` in degrees (matplotlib's ``view_init``).
+VIEW = (25.0, -55.0)
+
+
+def face_colours(faces: np.ndarray, nodal: np.ndarray) -> np.ndarray:
+    """``(k,)`` the value of each face: the mean of ``nodal (n,)`` at its corners
+    ``faces (k, 3)``."""
+    return nodal[faces].mean(axis=1)
+
+
+def shown_faces(
+    corners: np.ndarray, view: tuple[float, float] = VIEW, max_faces: int = MAX_FACES
+) -> tuple[np.ndarray, str]:
+    """The faces a picture draws and what it says of them.
+
+    Parameters
+    ----------
+    corners : (k, 3, 3) float array
+        Each boundary face's corner points, in outward order (the right-hand normal
+        ``(x1 − x0) × (x2 − x0)`` points out of the body).
+    view, max_faces
+        The viewer's direction (elevation, azimuth in degrees) and the most faces drawn.
+
+    Returns
+    -------
+    rows : (j,) int array
+        All faces if ``k ≤ max_faces``; else the faces whose outward normal has a positive
+        component towards the viewer, and of those every ``⌈j₀ / max_faces⌉``-th.
+    note : str
+        Empty when every face is drawn, else what was drawn (the figure's footnote).
+    """
+    k = corners.shape[0]
+    rows = np.arange(k)
+    if k <= max_faces:
+        return rows, ""
+    elev, azim = np.radians(view)
+    eye = np.array([np.cos(elev) * np.cos(azim), np.cos(elev) * np.sin(azim), np.sin(elev)])
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    rows = rows[normal @ eye > 0]
+    step = -(-rows.size // max_faces)
+    rows = rows[::step]
+    thinned = f", 1 in {step}" if step > 1 else ""
+    return rows, f"drawn: {rows.size} of {k} boundary faces (facing the viewer{thinned})"
+
+
+def plot_body_3d(
+    points: ArrayLike,
+    faces: ArrayLike,
+    displacement: ArrayLike,
+    stress: ArrayLike,
+    path: str | os.PathLike,
+    title: str | None = None,
+) -> list[Path]:
+    """The deformed body's boundary faces coloured by the von Mises stress, magnified by
+    :func:`~.deformed.displacement_scale` (stated in the title).
+
+    Parameters
+    ----------
+    points : (n, 3) float array
+        The mesh's vertices.
+    faces : (k, 3) int array
+        The boundary faces' vertices, in outward order.
+    displacement : (n, 3) float array
+        ``u_h`` at the vertices.
+    stress : (n, 3, 3) float array
+        The nodal Cauchy stress at the vertices; a face's colour is the mean von Mises
+        stress of its corners.
+    path : str or os.PathLike
+        Output path without extension (``.png`` and ``.pdf`` are written).
+    title : str, optional
+        The first line of the title.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
+    from matplotlib import cm, colormaps, colors
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    x = np.asarray(points, dtype=np.float64)
+    u = np.asarray(displacement, dtype=np.float64)
+    tri = np.asarray(faces, dtype=np.int64)
+    scale = displacement_scale(x, u)
+    corners = (x + scale * u)[tri]  # (k, 3, 3)
+    rows, note = shown_faces(corners, VIEW, MAX_FACES)
+    value = face_colours(tri, von_mises(np.asarray(stress, dtype=np.float64)))
+    norm = colors.Normalize(float(value.min()), float(value.max()) or 1.0)
+    fig = new_figure(5.6, 4.8)
+    ax = fig.add_subplot(projection="3d")
+    ax.add_collection3d(
+        Poly3DCollection(
+            corners[rows],
+            facecolors=colormaps["viridis"](norm(value[rows])),
+            edgecolors="k",
+            linewidths=0.1 if rows.size > 2000 else 0.3,
+        )
+    )
+    low, high = corners.reshape(-1, 3).min(axis=0), corners.reshape(-1, 3).max(axis=0)
+    ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]))
+    ax.set(xlabel="x", ylabel="y", zlabel="z")
+    ax.set_box_aspect(np.maximum(high - low, 1e-3 * (high - low).max()))
+    ax.view_init(*VIEW)
+    fig.colorbar(cm.ScalarMappable(norm, "viridis"), ax=ax, shrink=0.7, label="von Mises")
+    head = f"{title}: " if title else ""
+    ax.set_title(f"{head}deformed body, displacement × {scale:g}" + (f"\n{note}" if note else ""))
+    return save_figure(fig, path)
+
+
+def render_body_3d(
+    points: ArrayLike,
+    faces: ArrayLike,
+    displacement: ArrayLike,
+    stress: ArrayLike,
+    path: str | os.PathLike,
+) -> tuple[list[Path], str]:
+    """The picture of :func:`plot_body_3d` rendered off screen by PyVista (the optional
+    ``[3d]`` extra) as ``<path>.png``, all boundary faces, the same magnification.
+
+    Returns
+    -------
+    written : list of pathlib.Path
+        ``[<path>.png]``, or empty when PyVista is not installed or cannot render here.
+    note : str
+        Empty when written, else the one line for the run's log saying why not.
+    """
+    try:
+        import pyvista
+    except ImportError:
+        return [], "pyvista not installed (the [3d] extra): no PyVista rendering"
+    x = np.asarray(points, dtype=np.float64)
+    u = np.asarray(displacement, dtype=np.float64)
+    tri = np.asarray(faces, dtype=np.int64)
+    scale = displacement_scale(x, u)
+    cells = np.hstack([np.full((tri.shape[0], 1), 3), tri]).ravel()
+    surface = pyvista.PolyData(x + scale * u, cells)
+    surface.cell_data["von Mises"] = face_colours(tri, von_mises(np.asarray(stress, float)))
+    out = Path(f"{os.fspath(path)}.png")
+    try:
+        plotter = pyvista.Plotter(off_screen=True, window_size=(1200, 1000))
+        plotter.add_mesh(surface, scalars="von Mises", show_edges=True, cmap="viridis")
+        plotter.add_text(f"displacement × {scale:g}", font_size=10)
+        plotter.screenshot(os.fspath(out))
+        plotter.close()
+    except Exception as exc:  # no off-screen context on this machine
+        return [], f"pyvista could not render off screen ({type(exc).__name__}: {exc})"
+    return [out], ""
