@@ -213,7 +213,9 @@ def level_record(level: int, result: ContactResult, est: Estimate | None) -> Lev
     """The record of one level; without an estimate (3D) η and its terms are NaN."""
     if est is None:
         est = _NO_ESTIMATE
-    classes = result.classes if result.contact.size else np.zeros(0, dtype=np.int64)
+    # the node classes of Section 4 are not built on faces (3D): their counts stay 0
+    has_classes = result.contact.size and result.mesh.dim == 2
+    classes = result.classes if has_classes else np.zeros(0, dtype=np.int64)
     report = result.report
     rec = LevelRecord(
         level=level,
