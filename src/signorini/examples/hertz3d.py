@@ -24,8 +24,9 @@ recovered_pressure`), for either discrete contact condition.
 
 The initial mesh is graded toward the pole (:func:`graded_eighth_ball`): cells of
 :func:`~signorini.mesh.builders3d.eighth_ball` are bisected (:func:`~signorini.mesh.refine.
-refine_nvb`) until each is no longer than ``h_contact + grading · d``, d its distance from the
-pole, so that the contact disc of radius a ≈ 0.1 R is resolved before the run refines.
+refine_nvb`) until each is no longer than ``h_contact + grading · max(d − patch, 0)``, d its
+distance from the pole, so that the contact disc of radius a ≈ 0.1 R is resolved before the
+run refines (defaults: h_contact = 0.1 R, grading 0.5, patch = 0.15 R).
 """
 
 from __future__ import annotations
@@ -65,14 +66,18 @@ MAX_GRADING_STEPS = 60
 
 
 def graded_eighth_ball(
-    n: int = 2, radius: float = 1.0, h_contact: float = 0.1, grading: float = 0.5
+    n: int = 2,
+    radius: float = 1.0,
+    h_contact: float = 0.1,
+    grading: float = 0.5,
+    patch: float = 0.0,
 ) -> Mesh:
     """The eighth ball of :func:`hertz_3d`, graded toward its pole.
 
     Starting from ``eighth_ball(n, radius=R, center=(0, 0, R))``, every cell whose longest
-    edge exceeds ``h_contact + grading · d`` (d the distance from the pole, the origin, to the
-    cell's bounding box) is bisected once (:func:`~signorini.mesh.refine.refine_nvb` with its
-    closure), until none does.
+    edge exceeds ``h_contact + grading · max(d − patch, 0)`` (d the distance from the pole,
+    the origin, to the cell's bounding box) is bisected once
+    (:func:`~signorini.mesh.refine.refine_nvb` with its closure), until none does.
 
     Parameters
     ----------
@@ -84,6 +89,9 @@ def graded_eighth_ball(
         The longest edge wanted at the pole (length units).
     grading : float
         How fast the wanted edge grows with the distance from the pole (no unit).
+    patch : float
+        The distance from the pole within which the wanted edge is ``h_contact`` (length
+        units): about the contact radius, so that the whole contact disc is resolved.
 
     Returns
     -------
@@ -95,7 +103,7 @@ def graded_eighth_ball(
         p = mesh.points[mesh.cells]  # (n_cells, 4, 3)
         distance = np.linalg.norm(np.clip(0.0, p.min(axis=1), p.max(axis=1)), axis=1)
         longest = np.linalg.norm(p[:, :, None] - p[:, None], axis=-1).max(axis=(1, 2))
-        marked = longest > h_contact + grading * distance
+        marked = longest > h_contact + grading * np.maximum(distance - patch, 0.0)
         if not marked.any():
             return mesh
         mesh = refine_nvb(mesh, marked).mesh
@@ -111,6 +119,7 @@ def hertz_3d(
     n: int = 2,
     h_contact: float | None = None,
     grading: float = 0.5,
+    patch: float | None = None,
     face_alpha: float | None = None,
 ) -> ContactProblem:
     """The 3D Hertz problem: the eighth of an elastic ball pressed by its flat top onto a rigid
@@ -128,9 +137,10 @@ def hertz_3d(
         default ``DEPTH_3D * radius``.
     young, poisson : float
         E (stress units) and ν of the body.
-    n, h_contact, grading : optional
-        The initial mesh, :func:`graded_eighth_ball` ``(n, radius, h_contact, grading)``;
-        ``h_contact`` defaults to ``0.1 R``.
+    n, h_contact, grading, patch : optional
+        The initial mesh, :func:`graded_eighth_ball` ``(n, radius, h_contact, grading,
+        patch)``; ``h_contact`` defaults to ``0.1 R``, ``patch`` to ``0.15 R`` (the
+        default contact radius is about 0.102 R).
     face_alpha : float, optional
         The discrete contact condition (:class:`~signorini.problem.Contact`): None for (b),
         the transformed face basis with α = 1/5; 0 for (a), nodal constraints at all P2
@@ -144,7 +154,8 @@ def hertz_3d(
     """
     depth = DEPTH_3D * radius if depth is None else depth
     h_contact = 0.1 * radius if h_contact is None else h_contact
-    mesh = graded_eighth_ball(n, radius, h_contact, grading)
+    patch = 0.15 * radius if patch is None else patch
+    mesh = graded_eighth_ball(n, radius, h_contact, grading, patch)
     plane = HalfSpace([0.0, 0.0, 0.0], [0.0, 0.0, 1.0])
     return ContactProblem(
         mesh=mesh,
