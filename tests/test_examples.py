@@ -218,6 +218,7 @@ def test_get_example():
         "stacked-blocks",
         "hertz-pair",
         "elasticity-3d",
+        "hertz-3d",
     }
     for name in EXAMPLES:
         assert get_example(name).name == name

@@ -82,7 +82,7 @@ def draw_figures(
         kinds = "convergence history, deformed body"
     say(f"drawing the figures of {label} ({kinds}) ...")
     written = figures(label, out, last)
-    if last is not None and not three and metrics is not None and metrics.pressure is not None:
+    if last is not None and metrics is not None and metrics.pressure is not None:
         written += pressure_figure(label, out, last, metrics)
     folder.add_files(*(str(p.relative_to(out)) for p in written))
     say(f"figures: {', '.join(str(p.name) for p in written)}")

@@ -15,6 +15,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..contact.face_contact import FaceContactSet
 from ..contact.system import assemble
 from ..loop import AdaptiveOptions, adaptive
 from ..output.check import CHECK, MESH_ARRAYS, differences, read_check
@@ -93,14 +94,17 @@ def _step_data(problem: ContactProblem, mesh, k: int) -> dict[str, np.ndarray]:
     system = assemble(problem, mesh)
     cs = system.contact
     probe = np.sin(1.0 + np.arange(system.K.shape[0]))  # no zero entry, no symmetry
+    if isinstance(cs, FaceContactSet):  # on faces (3D): the rows' directions, no friction
+        normal, nodes, friction = cs.direction, cs.node, np.zeros(0)
+    else:
+        normal, nodes = cs.normal, cs.nodes
+        friction = np.concatenate([cs.friction.index, cs.friction.weight])
     return {
         f"dirichlet.{k}": system.dirichlet_values,
         f"contact.{k}.gap": cs.gap,
-        f"contact.{k}.normal": cs.normal,
-        f"contact.{k}.nodes": cs.nodes.astype(np.float64),
-        f"contact.{k}.friction": np.concatenate([cs.friction.index, cs.friction.weight]).astype(
-            np.float64
-        ),
+        f"contact.{k}.normal": normal,
+        f"contact.{k}.nodes": nodes.astype(np.float64),
+        f"contact.{k}.friction": friction.astype(np.float64),
         f"loads.{k}": system.F,
         f"material.{k}": system.K @ probe,
     }

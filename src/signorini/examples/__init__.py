@@ -7,6 +7,8 @@ curved geometry.
 - :mod:`.paper_friction`: Example 6.2 with Tresca or Coulomb friction on its contact part;
 - :mod:`.partial_slip`: the Hertz half-disc pressed on a plane with Coulomb friction, then
   pulled sideways (Cattaneo–Mindlin), a load path of two steps;
+- :mod:`.hertz3d`: the eighth of an elastic ball pressed onto a rigid plane (3D), with the
+  Hertz solution;
 - :mod:`.two_bodies`: contact between two elastic bodies: two cylinders (Hertz), two
   mirror-image half-discs, two blocks with non-matching meshes (the contact patch test).
 
@@ -24,6 +26,7 @@ from dataclasses import dataclass
 from ..problem import ContactProblem
 from .elasticity3d import ELASTICITY_3D_METRICS, elasticity_3d
 from .hertz import HERTZ_METRICS, hertz
+from .hertz3d import HERTZ_3D_METRICS, hertz_3d
 from .metrics import Metrics, PressureComparison
 from .paper import example_6_1, example_6_2
 from .paper_friction import example_6_2_coulomb, example_6_2_tresca
@@ -45,6 +48,7 @@ __all__ = [
     "elasticity_3d",
     "get_example",
     "hertz",
+    "hertz_3d",
     "partial_slip",
     "partial_slip_path",
     "punch",
@@ -103,6 +107,7 @@ EXAMPLES: dict[str, Example] = {
         Example("stacked-blocks", stacked_blocks, metrics=BLOCKS_METRICS),
         Example("hertz-pair", hertz_pair),
         Example("elasticity-3d", elasticity_3d, metrics=ELASTICITY_3D_METRICS),
+        Example("hertz-3d", hertz_3d, metrics=HERTZ_3D_METRICS),
     )
 }
 

@@ -259,7 +259,9 @@ def level_record(level: int, result: ContactResult, est: Estimate | None) -> Lev
     without contact as well an :class:`ElasticityRecord`, whose row leaves them out."""
     if est is None:
         est = _NO_ESTIMATE
-    classes = result.classes if result.contact.size else np.zeros(0, dtype=np.int64)
+    # the node classes of Section 4 are not built on faces (3D): their counts stay 0
+    has_classes = result.contact.size and result.mesh.dim == 2
+    classes = result.classes if has_classes else np.zeros(0, dtype=np.int64)
     report = result.report
     elasticity = est is _NO_ESTIMATE and not result.contact.size
     rec = (ElasticityRecord if elasticity else LevelRecord)(
