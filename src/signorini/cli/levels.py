@@ -39,7 +39,9 @@ def progress(level: Level) -> str:
     r = level.record
     if isinstance(r, ElasticityRecord):
         return elasticity_progress(r)
-    line = f"level {r.level:3d}  ndof {r.ndof:9d}  cells {r.n_cells:8d}  eta {r.eta:.4e}"
+    line = f"level {r.level:3d}  ndof {r.ndof:9d}  cells {r.n_cells:8d}"
+    if not np.isnan(r.eta):  # a 3D contact level has no estimator yet
+        line += f"  eta {r.eta:.4e}"
     if not np.isnan(r.error_energy):
         line += f"  error {r.error_energy:.4e}  eff {r.efficiency:.3f}"
     line += (

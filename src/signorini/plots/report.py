@@ -61,8 +61,8 @@ def make_figures(
     - Estimator contributions ``eta_1`` … ``eta_7`` in the history: their figure (Figs. 6.2,
       6.4), where a term that vanishes on every level is listed as ``≡ 0`` instead of drawn.
 
-    - Without an estimator (a 3D run: no finite ``eta``) and with a known error: the errors
-      alone (:func:`~.convergence.plot_errors`).
+    - Without an estimator (a 3D run: no finite ``eta``): with a known error the errors alone
+      (:func:`~.convergence.plot_errors`), else no convergence figure.
 
     Meshes and deformed bodies need more than the history; callers draw them with
     :func:`~signorini.plots.plot_mesh` and :func:`~signorini.plots.plot_deformed`.
@@ -94,8 +94,10 @@ def make_figures(
     out = Path(out_dir)
     written: list[Path] = []
     drawn = {"title": title, "reference_slope": optimal_slope(degree, dim)}
-    if not _estimated(history) and has_known_values(history, "error_energy"):
-        return plot_errors(history, out / f"{slug}_errors", **drawn)
+    if not _estimated(history):  # a 3D run: no estimator to draw
+        if has_known_values(history, "error_energy"):
+            return plot_errors(history, out / f"{slug}_errors", **drawn)
+        return []
     if has_known_values(history, "error_energy"):
         written += plot_error_and_estimator(history, out / f"{slug}_error_estimator", **drawn)
         written += plot_efficiency(history, out / f"{slug}_efficiency", title=title)
