@@ -40,6 +40,7 @@ part, 0.27 s of 0.55 at 3.5 × 10⁵). The issue's 0.5 × 10⁶ is reached on sm
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from functools import lru_cache
 
 import numpy as np
@@ -50,6 +51,7 @@ from .fixed_order import rows_times
 from .mapping import CellMap
 from .mapping3d import AffineTetrahedra, IsoparametricTetrahedra, TetrahedronMap
 from .material import CellMaterials, Material, lame_parameters, on_cells
+from .pattern3d import pattern_of
 from .quadrature import tetrahedron_rule
 
 __all__ = ["assemble_stiffness_3d", "element_stiffness_3d"]
@@ -84,6 +86,47 @@ def _reference_products(degree: int, per_point: bool) -> np.ndarray:
     return R
 
 
+def _chunks(
+    cells: _Tetrahedra,
+    material: Material | CellMaterials,
+    degree: int | None,
+    out: np.ndarray | None,
+) -> Iterator[tuple[slice, np.ndarray]]:
+    """The node blocks of the cells chunk by chunk, ``(rows, blocks (k, 10, 10, 3, 3))``: into
+    ``out[rows]`` if given, else into one scratch array reused from chunk to chunk (each
+    cell's blocks from its own data alone, module docstring)."""
+    lam, mu = lame_parameters(material, 3)
+    degree = 2 * cells.order if degree is None else degree
+    xi, w = tetrahedron_rule(degree)
+    m = len(cells)
+    J, det = cells.jacobians(xi)  # (m, p, 3, 3), p = 1 (affine) or q
+    jit = cells.inverse_transpose(xi)
+    R = _reference_products(degree, det.shape[1] > 1)  # (p · 9, 100)
+    scratch = np.empty((min(_CHUNK, m), 10, 10, 3, 3)) if out is None else None
+    for start in range(0, m, _CHUNK):  # chunks of cells bound the temporaries
+        rows = slice(start, min(start + _CHUNK, m))
+        d, t = det[rows], jit[rows]
+        block = out[rows] if out is not None else scratch[: len(d)]
+        # P[c, (i, j), p, k, l] = det J J⁻ᵀ[i, k] J⁻ᵀ[j, l] at point p, for i <= j
+        P = np.empty((len(d), len(_UPPER), d.shape[1], 3, 3))
+        for u, (i, j) in enumerate(_UPPER):
+            np.multiply(t[:, :, i, :, None], t[:, :, j, None, :], out=P[:, u])
+            P[:, u] *= d[:, :, None, None]
+        B = rows_times(P.reshape(-1, R.shape[0]), R).reshape(len(d), len(_UPPER), 10, 10)
+        B = {ij: B[:, u] for u, ij in enumerate(_UPPER)}
+        lam_k, mu_k = _per_cell(lam, rows), _per_cell(mu, rows)
+        trace = mu_k * (B[0, 0] + B[1, 1] + B[2, 2])  # μ ∫ ∇φ_a · ∇φ_b
+        for i, j in _UPPER:
+            K = block[:, :, :, i, j]
+            np.multiply(lam_k, B[i, j], out=K)
+            K += mu_k * np.swapaxes(B[i, j], -1, -2)
+            if i == j:
+                K += trace
+            else:  # K[(b, j), (a, i)] = K[(a, i), (b, j)]: the symmetric block
+                block[:, :, :, j, i] = np.swapaxes(K, -1, -2)
+        yield rows, block
+
+
 def node_blocks(
     cells: _Tetrahedra,
     material: Material | CellMaterials,
@@ -110,35 +153,47 @@ def node_blocks(
     -------
     (m, 10, 10, 3, 3) float64 array
     """
-    lam, mu = lame_parameters(material, 3)
-    degree = 2 * cells.order if degree is None else degree
-    xi, w = tetrahedron_rule(degree)
-    m = len(cells)
-    out = np.empty((m, 10, 10, 3, 3)) if out is None else out
-    J, det = cells.jacobians(xi)  # (m, p, 3, 3), p = 1 (affine) or q
-    jit = cells.inverse_transpose(xi)
-    R = _reference_products(degree, det.shape[1] > 1)  # (p · 9, 100)
-    for start in range(0, m, _CHUNK):  # chunks of cells bound the temporaries
-        rows = slice(start, min(start + _CHUNK, m))
-        # P[c, (i, j), p, k, l] = det J J⁻ᵀ[i, k] J⁻ᵀ[j, l] at point p, for i <= j
-        d, t = det[rows], jit[rows]
-        P = np.empty((len(d), len(_UPPER), d.shape[1], 3, 3))
-        for u, (i, j) in enumerate(_UPPER):
-            np.multiply(t[:, :, i, :, None], t[:, :, j, None, :], out=P[:, u])
-            P[:, u] *= d[:, :, None, None]
-        B = rows_times(P.reshape(-1, R.shape[0]), R).reshape(len(d), len(_UPPER), 10, 10)
-        B = {ij: B[:, u] for u, ij in enumerate(_UPPER)}
-        lam_k, mu_k = _per_cell(lam, rows), _per_cell(mu, rows)
-        trace = mu_k * (B[0, 0] + B[1, 1] + B[2, 2])  # μ ∫ ∇φ_a · ∇φ_b
-        for i, j in _UPPER:
-            K = out[rows, :, :, i, j]
-            np.multiply(lam_k, B[i, j], out=K)
-            K += mu_k * np.swapaxes(B[i, j], -1, -2)
-            if i == j:
-                K += trace
-            else:  # K[(b, j), (a, i)] = K[(a, i), (b, j)]: the symmetric block
-                out[rows, :, :, j, i] = np.swapaxes(K, -1, -2)
+    out = np.empty((len(cells), 10, 10, 3, 3)) if out is None else out
+    for _ in _chunks(cells, material, degree, out):
+        pass
     return out
+
+
+def upper_blocks(
+    cells: _Tetrahedra,
+    material: Material | CellMaterials,
+    select: np.ndarray,
+    out: np.ndarray,
+    rows: np.ndarray | slice = slice(None),
+) -> None:
+    """The node blocks of the upper node pairs of a group of tetrahedra,
+    ``out[rows[c], k] = node_blocks[c, a, b]`` with ``10 a + b = select[rows[c], k]``
+    (:mod:`signorini.fem.pattern3d`), chunk by chunk (the whole ``(m, 10, 10, 3, 3)`` array
+    is never formed).
+
+    Parameters
+    ----------
+    cells : AffineTetrahedra or IsoparametricTetrahedra
+    material : Material or CellMaterials
+        Of the group's cells in its order.
+    select : (n_cells, 55) int array
+        The mesh's local upper pairs (``NodePattern.select``).
+    out : (n_cells, 55, 9) float array
+        Receives the group's rows.
+    rows : (m,) int array or slice
+        The group's cells in the mesh (``cells.cells``).
+    """
+    whole = isinstance(rows, slice) and rows == slice(None)
+    index = None if whole else np.arange(len(select))[rows]
+    for chunk, block in _chunks(cells, material, None, None):
+        cell = chunk if whole else index[chunk]
+        flat = select[cell] + (100 * np.arange(len(block)))[:, None]
+        if whole:  # straight into the rows of out
+            np.take(block.reshape(-1, 9), flat.reshape(-1), axis=0, out=out[cell].reshape(-1, 9))
+        else:
+            out[cell] = np.take(block.reshape(-1, 9), flat.reshape(-1), axis=0).reshape(
+                len(block), -1, 9
+            )
 
 
 def element_stiffness_3d(
@@ -177,6 +232,12 @@ def assemble_stiffness_3d(
 ) -> sp.csr_matrix:
     """Global stiffness matrix ``(n_dofs, n_dofs)`` of 3D elasticity on P2 tetrahedra.
 
+    The mesh's pattern (:func:`~signorini.fem.pattern3d.pattern_of`) is built at the first
+    assembly with these ``cell_dofs`` and kept while the array lives; each assembly forms the
+    blocks of the cells' upper node pairs (:func:`upper_blocks`), sums them in cell order
+    (``pattern.sums @ blocks``) and lays the sums out as the CSR data, the lower triangle
+    mirrored from the upper one.
+
     Parameters
     ----------
     cells : TetrahedronMap or (m, 4, 3) float array
@@ -190,76 +251,19 @@ def assemble_stiffness_3d(
     Returns
     -------
     scipy.sparse.csr_matrix
-        Symmetric, sorted indices, the 3 × 3 node-block pattern.
+        Symmetric bit for bit, sorted indices, the 3 × 3 node-block pattern.
     """
     mapping = cells if isinstance(cells, CellMap) else TetrahedronMap(cells)
-    nodes = _cell_nodes(cell_dofs)
-    m = mapping.n_cells
-    blocks = np.empty((m, 10, 10, 3, 3))
-    order = []
-    start = 0
-    for g in mapping.groups:  # group after group into one array, the cells in that order
-        rows = slice(start, start + len(g))
-        node_blocks(g, on_cells(material, g.cells), out=blocks[rows])
-        order.append(np.arange(m)[g.cells])
-        start += len(g)
-    if len(mapping.groups) > 1:
-        nodes = nodes[np.concatenate(order)]
-    return _assemble_node_blocks(nodes, int(n_dofs) // 3, blocks)
-
-
-def _assemble_node_blocks(
-    cell_nodes: np.ndarray, n_nodes: int, blocks: np.ndarray
-) -> sp.csr_matrix:
-    """Sum per-cell 3 × 3 node blocks into a CSR matrix with the node-block pattern.
-
-    The ``(m, 10, 10)`` node pairs ``(z_a, z_b)`` of the cells are sorted once by their key
-    ``z_a n_nodes + z_b`` (a stable sort: the duplicates of a pair stay in cell order); the
-    pattern is the distinct keys, and the summation is one product ``S @ blocks`` with the
-    0/1 matrix ``S (n_pairs, m · 100)`` whose row p holds the sorted run of pair p (its CSR
-    arrays are the sort's run starts and order, built without a conversion): SciPy's loop
-    reads each block's nine entries where they lie and adds them in cell order. The summed
-    blocks, in the sort's order, are a BSR matrix as they stand (block row z, its columns
-    sorted), and SciPy's BSR → CSR loop lays them out (row ``3 z + i`` holds row ``i`` of node
-    ``z``'s blocks).
-
-    Parameters
-    ----------
-    cell_nodes : (m, 10) int array
-    n_nodes : int
-    blocks : (m, 10, 10, 3, 3) float array
-        :func:`node_blocks` of the cells, in the order of ``cell_nodes``.
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, shape (3 n_nodes, 3 n_nodes)
-        Sorted indices; a full 3 × 3 block for every coupled node pair.
-    """
-    z = np.asarray(cell_nodes, dtype=np.int64)
-    key = (z[:, :, None] * n_nodes + z[:, None, :]).reshape(-1)
-    order = np.argsort(key, kind="stable")
-    key = key[order]
-    new = np.empty(key.size + 1, dtype=bool)
-    new[0] = new[-1] = True
-    np.not_equal(key[1:], key[:-1], out=new[1:-1])
-    run = np.flatnonzero(new)  # run p of equal keys: order[run[p] : run[p + 1]]
-    start = run[:-1]
-    runs = np.int32 if key.size < 2**31 else np.int64
-    S = sp.csr_matrix(
-        (np.ones(key.size), order.astype(runs), run.astype(runs)),
-        shape=(start.size, key.size),
-        copy=False,
+    owner = cell_dofs if isinstance(cell_dofs, np.ndarray) else None
+    pattern = pattern_of(_cell_nodes(cell_dofs), int(n_dofs) // 3, owner)
+    blocks = np.empty((mapping.n_cells, len(pattern.select[0]) if mapping.n_cells else 55, 9))
+    for g in mapping.groups:  # each group into its cells' rows (mesh order)
+        upper_blocks(g, on_cells(material, g.cells), pattern.select, blocks, g.cells)
+    summed = pattern.sums @ blocks.reshape(-1, 9)  # (n_upper, 9), each pair in cell order
+    del blocks
+    data = np.take(summed.reshape(-1), pattern.source)
+    out = sp.csr_matrix(
+        (data, pattern.indices.copy(), pattern.indptr.copy()), shape=pattern.shape, copy=False
     )
-    summed = S @ np.ascontiguousarray(blocks).reshape(-1, 9)  # (n_pairs, 9)
-    row, col = np.divmod(key[start], n_nodes)
-    first = np.zeros(n_nodes + 1, dtype=np.int64)  # the block rows' starts
-    np.cumsum(np.bincount(row, minlength=n_nodes), out=first[1:])
-    index = np.int32 if summed.size < 2**31 else np.int64
-    bsr = sp.bsr_matrix(
-        (summed.reshape(-1, 3, 3), col.astype(index), first.astype(index)),
-        shape=(3 * n_nodes, 3 * n_nodes),
-        copy=False,
-    )
-    out = bsr.tocsr()  # SciPy's loop lays each block row out as three CSR rows
     out.has_sorted_indices = True
     return out
