@@ -87,14 +87,12 @@ def _reference_products(degree: int, per_point: bool) -> np.ndarray:
 
 
 def _chunks(
-    cells: _Tetrahedra,
-    material: Material | CellMaterials,
-    degree: int | None,
-    out: np.ndarray | None,
+    cells: _Tetrahedra, material: Material | CellMaterials, degree: int | None
 ) -> Iterator[tuple[slice, np.ndarray]]:
-    """The node blocks of the cells chunk by chunk, ``(rows, blocks (k, 10, 10, 3, 3))``: into
-    ``out[rows]`` if given, else into one scratch array reused from chunk to chunk (each
-    cell's blocks from its own data alone, module docstring)."""
+    """The node blocks of the cells chunk by chunk, ``(rows, K (9, k, 10, 10))`` with
+    ``K[3 i + j, c, a, b] = a(φ_b e_j, φ_a e_i)`` on cell ``rows[c]`` (module docstring), in
+    one scratch array reused from chunk to chunk; each cell's blocks from its own data alone.
+    """
     lam, mu = lame_parameters(material, 3)
     degree = 2 * cells.order if degree is None else degree
     xi, w = tetrahedron_rule(degree)
@@ -102,29 +100,29 @@ def _chunks(
     J, det = cells.jacobians(xi)  # (m, p, 3, 3), p = 1 (affine) or q
     jit = cells.inverse_transpose(xi)
     R = _reference_products(degree, det.shape[1] > 1)  # (p · 9, 100)
-    scratch = np.empty((min(_CHUNK, m), 10, 10, 3, 3)) if out is None else None
+    scratch = np.empty((9, min(_CHUNK, m), 10, 10))
     for start in range(0, m, _CHUNK):  # chunks of cells bound the temporaries
         rows = slice(start, min(start + _CHUNK, m))
         d, t = det[rows], jit[rows]
-        block = out[rows] if out is not None else scratch[: len(d)]
-        # P[c, (i, j), p, k, l] = det J J⁻ᵀ[i, k] J⁻ᵀ[j, l] at point p, for i <= j
-        P = np.empty((len(d), len(_UPPER), d.shape[1], 3, 3))
+        K = scratch[:, : len(d)]
+        # P[(i, j), c, p, k, l] = det J J⁻ᵀ[i, k] J⁻ᵀ[j, l] at point p, for i <= j
+        P = np.empty((len(_UPPER), len(d), d.shape[1], 3, 3))
         for u, (i, j) in enumerate(_UPPER):
-            np.multiply(t[:, :, i, :, None], t[:, :, j, None, :], out=P[:, u])
-            P[:, u] *= d[:, :, None, None]
-        B = rows_times(P.reshape(-1, R.shape[0]), R).reshape(len(d), len(_UPPER), 10, 10)
-        B = {ij: B[:, u] for u, ij in enumerate(_UPPER)}
+            np.multiply(t[:, :, i, :, None], t[:, :, j, None, :], out=P[u])
+            P[u] *= d[:, :, None, None]
+        B = rows_times(P.reshape(-1, R.shape[0]), R).reshape(len(_UPPER), len(d), 10, 10)
+        B = {ij: B[u] for u, ij in enumerate(_UPPER)}
         lam_k, mu_k = _per_cell(lam, rows), _per_cell(mu, rows)
         trace = mu_k * (B[0, 0] + B[1, 1] + B[2, 2])  # μ ∫ ∇φ_a · ∇φ_b
         for i, j in _UPPER:
-            K = block[:, :, :, i, j]
-            np.multiply(lam_k, B[i, j], out=K)
-            K += mu_k * np.swapaxes(B[i, j], -1, -2)
+            Kij = K[3 * i + j]
+            np.multiply(lam_k, B[i, j], out=Kij)
+            Kij += mu_k * np.swapaxes(B[i, j], -1, -2)
             if i == j:
-                K += trace
+                Kij += trace
             else:  # K[(b, j), (a, i)] = K[(a, i), (b, j)]: the symmetric block
-                block[:, :, :, j, i] = np.swapaxes(K, -1, -2)
-        yield rows, block
+                K[3 * j + i] = np.swapaxes(Kij, -1, -2)
+        yield rows, K
 
 
 def node_blocks(
@@ -154,8 +152,8 @@ def node_blocks(
     (m, 10, 10, 3, 3) float64 array
     """
     out = np.empty((len(cells), 10, 10, 3, 3)) if out is None else out
-    for _ in _chunks(cells, material, degree, out):
-        pass
+    for rows, K in _chunks(cells, material, degree):
+        out[rows] = K.reshape(3, 3, -1, 10, 10).transpose(2, 3, 4, 0, 1)
     return out
 
 
@@ -185,15 +183,15 @@ def upper_blocks(
     """
     whole = isinstance(rows, slice) and rows == slice(None)
     index = None if whole else np.arange(len(select))[rows]
-    for chunk, block in _chunks(cells, material, None, None):
+    for chunk, K in _chunks(cells, material, None):
         cell = chunk if whole else index[chunk]
-        flat = select[cell] + (100 * np.arange(len(block)))[:, None]
+        k = K.shape[1]
+        flat = select[cell] + (100 * np.arange(k))[:, None]
+        taken = np.take(K.reshape(9, -1), flat.reshape(-1), axis=1)  # (9, k · 55)
         if whole:  # straight into the rows of out
-            np.take(block.reshape(-1, 9), flat.reshape(-1), axis=0, out=out[cell].reshape(-1, 9))
+            np.copyto(out[cell].reshape(-1, 9), taken.T)
         else:
-            out[cell] = np.take(block.reshape(-1, 9), flat.reshape(-1), axis=0).reshape(
-                len(block), -1, 9
-            )
+            out[cell] = taken.T.reshape(k, -1, 9)
 
 
 def element_stiffness_3d(
