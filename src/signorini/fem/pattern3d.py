@@ -113,37 +113,30 @@ def node_pattern(cell_nodes: np.ndarray, n_nodes: int) -> NodePattern:
     z = np.array(cell_nodes, dtype=np.int64)  # a copy: the cache compares with it
     select, sums, key = _upper_sums(z, n_nodes)
     lo, hi = np.divmod(key, n_nodes)  # the upper pairs, sorted by (lo, hi)
-    strict = np.flatnonzero(lo != hi)
-    # both triangles: the mirrors first, so that a stable sort by row leaves each row's
-    # columns ascending (mirrors: columns < row, sorted; upper pairs: columns >= row, sorted)
-    row = np.concatenate([hi[strict], lo])
-    col = np.concatenate([lo[strict], hi])
-    pair = np.concatenate([strict, np.arange(lo.size)])
-    mirror = np.zeros(row.size, dtype=bool)
-    mirror[: strict.size] = True
-    order = np.argsort(row, kind="stable")
-    row, col, pair, mirror = row[order], col[order], pair[order], mirror[order]
-    first = np.zeros(n_nodes + 1, dtype=np.int64)  # node row z: entries first[z] : first[z+1]
-    np.cumsum(np.bincount(row, minlength=n_nodes), out=first[1:])
-    length = (first[1:] - first[:-1])[row]  # (n_full,) the length of each entry's node row
-    rank = np.arange(row.size) - first[row]
-    i = np.arange(3)[None, :, None]
-    j = np.arange(3)[None, None, :]
-    # entry (3 z + i, 3 w + j) lies at 9 first[z] + 3 i len_z + 3 rank + j
-    position = (9 * first[row] + 3 * rank)[:, None, None] + 3 * i * length[:, None, None] + j
-    upper_ij = np.where(mirror[:, None, None], 3 * j + i, 3 * i + j)
-    nnz = 9 * row.size
-    index = _index_type(max(nnz, 3 * n_nodes, 9 * lo.size))
-    source = np.empty(nnz, dtype=index)
-    source[position.reshape(-1)] = (9 * pair[:, None, None] + upper_ij).reshape(-1)
-    indices = np.empty(nnz, dtype=index)
-    indices[position.reshape(-1)] = np.broadcast_to(
-        3 * col[:, None, None] + j, position.shape
-    ).reshape(-1)
-    indptr = np.empty(3 * n_nodes + 1, dtype=index)
-    starts = 9 * first[:-1, None] + 3 * np.arange(3)[None, :] * (first[1:] - first[:-1])[:, None]
-    indptr[:-1] = starts.reshape(-1)
-    indptr[-1] = nnz
+    index = _index_type(max(9 * (2 * lo.size), 3 * n_nodes, 9 * lo.size))
+    # both triangles, merged row by row by SciPy (sorted, no overlap): the upper pairs with
+    # value p + 1, their mirrors (the strict ones transposed) with -(p + 1)
+    start = np.zeros(n_nodes + 1, dtype=np.int64)
+    np.cumsum(np.bincount(lo, minlength=n_nodes), out=start[1:])
+    p1 = np.arange(1, lo.size + 1, dtype=np.int64)
+    upper = sp.csr_matrix((p1, hi, start), shape=(n_nodes, n_nodes), copy=False)
+    strict = sp.csr_matrix((np.where(lo != hi, -p1, 0), hi, start), shape=upper.shape)
+    strict.eliminate_zeros()
+    both = upper + strict.T.tocsr()
+    first, col = both.indptr, both.indices
+    pair, mirror = np.abs(both.data) - 1, both.data < 0
+    # each entry's source, 9 p + 3 i + j (3 j + i for a mirror), laid out by SciPy's BSR -> CSR
+    # loop as the values will be: row 3 z + i holds row i of node row z's blocks
+    mirrored = np.array([3 * j + i for i in range(3) for j in range(3)])
+    local = np.where(mirror[:, None], mirrored, np.arange(9))
+    bsr = sp.bsr_matrix(
+        ((9 * pair[:, None] + local).astype(index).reshape(-1, 3, 3), col, first),
+        shape=(3 * n_nodes, 3 * n_nodes),
+        copy=False,
+    )
+    csr = bsr.tocsr()
+    source = csr.data
+    indices, indptr = csr.indices.astype(index, copy=False), csr.indptr.astype(index, copy=False)
     for a in (z, select, indptr, indices, source):
         a.setflags(write=False)
     return NodePattern(int(n_nodes), z, select, sums, indptr, indices, source)
