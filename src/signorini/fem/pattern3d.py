@@ -11,13 +11,12 @@ pattern holds
   the cell's sorted nodes (:func:`numpy.triu_indices`);
 * ``sums (n_upper, 55 m)``: the 0/1 matrix whose row ``p`` lists, in cell order, the cell
   pairs that add to upper pair ``p`` (one stable sort of the ``55 m`` keys ``z n + w``);
-* ``indptr, indices, source``: the node pattern of the whole matrix (both triangles, sorted)
-  and, for each of its blocks, the summed upper block it is: pair ``p`` on and above the
-  diagonal, the transpose of pair ``p`` below it (the mirror), so the matrix is symmetric
-  bit for bit.
+* ``indptr, indices, source``: the scalar CSR of the whole matrix (both triangles, 3 × 3
+  node blocks, sorted indices) and, for each of its entries, its place in the summed upper
+  blocks ``(n_upper, 9)``: ``9 p + 3 i + j`` above the diagonal and on it, ``9 p + 3 j + i``
+  below it (the mirror), so the matrix is symmetric bit for bit.
 
-Assembly is then ``sums @ blocks``, one gather of the blocks and SciPy's BSR -> CSR loop
-(:meth:`NodePattern.matrix`): no sort per assembly
+Assembly is then ``data = (sums @ blocks)[source]``: no sort and no conversion per assembly
 (:func:`signorini.fem.stiffness3d.assemble_stiffness_3d`). :func:`pattern_of` keeps the
 pattern of a cell-node array as long as that array lives (the space's ``cell_dofs`` is
 cached on the space, so its pattern lives with the space) and rebuilds it if the array's
@@ -37,9 +36,6 @@ __all__ = ["NodePattern", "node_pattern", "pattern_of"]
 #: the local pairs ``a ≤ b`` of a cell's sorted nodes: 55 for the ten nodes of a P2 tetrahedron
 _UPPER_A, _UPPER_B = np.triu_indices(10)
 
-#: a 3 × 3 block's entries, row-major, in the order of its transpose's
-_TRANSPOSED = np.arange(9).reshape(3, 3).T.reshape(-1)
-
 
 @dataclass(frozen=True, eq=False)
 class NodePattern:
@@ -55,10 +51,9 @@ class NodePattern:
     sums : scipy.sparse.csr_matrix, (n_upper, 55 m)
         Row ``p``: the cell pairs ``55 c + k`` of upper pair ``p`` in cell order.
     indptr, indices : int arrays
-        The node pattern of both triangles, ``(n_nodes, n_nodes)`` in CSR form (sorted).
-    source : (n_blocks,) int array
-        Each of its blocks' row in ``[summed upper blocks; their transposes]``, ``(2 n_upper,
-        9)``: ``p`` for upper pair ``p`` (and the diagonal), ``n_upper + p`` for its mirror.
+        The scalar CSR pattern ``(3 n_nodes, 3 n_nodes)``, sorted, node blocks full.
+    source : (nnz,) int array
+        Each CSR entry's index in the summed upper blocks, flattened ``(n_upper · 9,)``.
     """
 
     n_nodes: int
@@ -69,32 +64,10 @@ class NodePattern:
     indices: np.ndarray
     source: np.ndarray
 
-    def matrix(self, summed: np.ndarray) -> sp.csr_matrix:
-        """The scalar CSR matrix ``(3 n_nodes, 3 n_nodes)`` of the summed upper blocks.
-
-        Parameters
-        ----------
-        summed : (n_upper, 9) float array
-            ``sums @ blocks``: upper pair ``p``'s block, row-major.
-
-        Returns
-        -------
-        scipy.sparse.csr_matrix
-            Both triangles (the lower one the upper one's transpose, bit for bit), sorted
-            indices, full 3 × 3 node blocks: SciPy's BSR -> CSR loop lays block row ``z`` out
-            as the three rows ``3 z + i``.
-        """
-        n_upper = len(summed)
-        both = np.empty((2 * n_upper, 9))
-        both[:n_upper] = summed
-        np.take(summed, _TRANSPOSED, axis=1, out=both[n_upper:])
-        blocks = np.take(both, self.source, axis=0).reshape(-1, 3, 3)
-        del both
-        n = 3 * self.n_nodes
-        bsr = sp.bsr_matrix((blocks, self.indices, self.indptr), shape=(n, n), copy=False)
-        out = bsr.tocsr()
-        out.has_sorted_indices = True
-        return out
+    @property
+    def shape(self) -> tuple[int, int]:
+        """The scalar matrix's shape, ``(3 n_nodes, 3 n_nodes)``."""
+        return 3 * self.n_nodes, 3 * self.n_nodes
 
 
 def _index_type(size: int) -> type:
@@ -140,7 +113,7 @@ def node_pattern(cell_nodes: np.ndarray, n_nodes: int) -> NodePattern:
     z = np.array(cell_nodes, dtype=np.int64)  # a copy: the cache compares with it
     select, sums, key = _upper_sums(z, n_nodes)
     lo, hi = np.divmod(key, n_nodes)  # the upper pairs, sorted by (lo, hi)
-    index = _index_type(max(2 * lo.size, n_nodes))
+    index = _index_type(max(9 * (2 * lo.size), 3 * n_nodes, 9 * lo.size))
     # both triangles, merged row by row by SciPy (sorted, no overlap): the upper pairs with
     # value p + 1, their mirrors (the strict ones transposed) with -(p + 1)
     start = np.zeros(n_nodes + 1, dtype=np.int64)
@@ -152,9 +125,18 @@ def node_pattern(cell_nodes: np.ndarray, n_nodes: int) -> NodePattern:
     both = upper + strict.T.tocsr()
     first, col = both.indptr, both.indices
     pair, mirror = np.abs(both.data) - 1, both.data < 0
-    # each block's source in [summed upper blocks; their transposes]: p, or n_upper + p
-    source = np.where(mirror, lo.size + pair, pair).astype(index)
-    indices, indptr = col.astype(index, copy=False), first.astype(index, copy=False)
+    # each entry's source, 9 p + 3 i + j (3 j + i for a mirror), laid out by SciPy's BSR -> CSR
+    # loop as the values will be: row 3 z + i holds row i of node row z's blocks
+    mirrored = np.array([3 * j + i for i in range(3) for j in range(3)])
+    local = np.where(mirror[:, None], mirrored, np.arange(9))
+    bsr = sp.bsr_matrix(
+        ((9 * pair[:, None] + local).astype(index).reshape(-1, 3, 3), col, first),
+        shape=(3 * n_nodes, 3 * n_nodes),
+        copy=False,
+    )
+    csr = bsr.tocsr()
+    source = csr.data
+    indices, indptr = csr.indices.astype(index, copy=False), csr.indptr.astype(index, copy=False)
     for a in (z, select, indptr, indices, source):
         a.setflags(write=False)
     return NodePattern(int(n_nodes), z, select, sums, indptr, indices, source)
