@@ -23,19 +23,18 @@ rule is used (as in 2D).
 Assembly
 --------
 The element matrices are 3 × 3 node blocks (DOFs ``3 node + component``,
-:mod:`signorini.fem.dofs`), ``(m, 10, 10, 3, 3)`` (:func:`node_blocks`). The sum over cells
-sorts the ``m · 100`` node pairs once (:func:`_assemble_node_blocks`) and adds each pair's
-blocks in one sparse product with the 0/1 matrix of the sort's runs; the summed blocks are a
-BSR matrix (blocksize 3) as they stand, converted to CSR once: sorted indices, the
-node-block pattern (rows ``3z … 3z + 2`` share their columns), int32 indices while they fit.
-A scalar COO → CSR conversion would sort the 900 entries of each cell instead of its 100
-node pairs; the complex packing of the 2D assembly is a d = 2 trick and is not used.
+:mod:`signorini.fem.dofs`), ``(m, 10, 10, 3, 3)`` (:func:`node_blocks`), formed chunk by
+chunk component by component (``(9, k, 10, 10)``, contiguous writes). The matrix is symmetric,
+so the assembly keeps only each cell's 55 *upper* node pairs (the global row the smaller
+node, :func:`upper_blocks`) and sums them in cell order with one sparse product through the
+mesh's node-pair pattern (:mod:`signorini.fem.pattern3d`: built at the first assembly on a
+mesh, one stable sort of the ``55 m`` pair keys, and kept while the space's DOF array
+lives); the sums are laid out as the CSR data by one gather, the lower triangle mirrored from
+the upper one, so the matrix is symmetric bit for bit. The result has sorted indices, the
+node-block pattern (rows ``3z … 3z + 2`` share their columns) and int32 indices while they
+fit; the complex packing of the 2D assembly is a d = 2 trick and is not used.
 
-Measured on a shared two-core machine (``benchmarks/assembly3d.py``, Kuhn cube): 0.30–0.52 ×
-10⁶ unknowns per second of wall time from 1.5 × 10⁴ to 3.5 × 10⁵ unknowns, 24–38 times
-scikit-fem's ``asm`` on the same mesh in the same run; at 1.1 × 10⁵ unknowns 0.12 s of CPU
-for the element matrices and 0.15 s for the sum (the sort of the node pairs the largest
-part, 0.27 s of 0.55 at 3.5 × 10⁵). The issue's 0.5 × 10⁶ is reached on small meshes only.
+MEASURED
 """
 
 from __future__ import annotations
@@ -254,7 +253,7 @@ def assemble_stiffness_3d(
     mapping = cells if isinstance(cells, CellMap) else TetrahedronMap(cells)
     owner = cell_dofs if isinstance(cell_dofs, np.ndarray) else None
     pattern = pattern_of(_cell_nodes(cell_dofs), int(n_dofs) // 3, owner)
-    blocks = np.empty((mapping.n_cells, len(pattern.select[0]) if mapping.n_cells else 55, 9))
+    blocks = np.empty((mapping.n_cells, pattern.select.shape[1], 9))
     for g in mapping.groups:  # each group into its cells' rows (mesh order)
         upper_blocks(g, on_cells(material, g.cells), pattern.select, blocks, g.cells)
     summed = pattern.sums @ blocks.reshape(-1, 9)  # (n_upper, 9), each pair in cell order
