@@ -127,10 +127,11 @@ def node_pattern(cell_nodes: np.ndarray, n_nodes: int) -> NodePattern:
     pair, mirror = np.abs(both.data) - 1, both.data < 0
     # each entry's source, 9 p + 3 i + j (3 j + i for a mirror), laid out by SciPy's BSR -> CSR
     # loop as the values will be: row 3 z + i holds row i of node row z's blocks
-    mirrored = np.array([3 * j + i for i in range(3) for j in range(3)])
-    local = np.where(mirror[:, None], mirrored, np.arange(9))
+    mirrored = np.array([3 * j + i for i in range(3) for j in range(3)], dtype=index)
+    entry = np.where(mirror[:, None], mirrored, np.arange(9, dtype=index))  # (n_blocks, 9)
+    entry += (9 * pair).astype(index)[:, None]
     bsr = sp.bsr_matrix(
-        ((9 * pair[:, None] + local).astype(index).reshape(-1, 3, 3), col, first),
+        (entry.reshape(-1, 3, 3), col, first),
         shape=(3 * n_nodes, 3 * n_nodes),
         copy=False,
     )
