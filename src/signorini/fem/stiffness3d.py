@@ -34,7 +34,12 @@ the upper one, so the matrix is symmetric bit for bit. The result has sorted ind
 node-block pattern (rows ``3z … 3z + 2`` share their columns) and int32 indices while they
 fit; the complex packing of the 2D assembly is a d = 2 trick and is not used.
 
-MEASURED
+Measured on a shared two-core machine (``benchmarks/assembly3d.py``, Kuhn cube, best of
+three, NGSolve on one thread and scikit-fem on the same mesh in the same run): again on the
+same mesh 0.64–0.99 × 10⁶ unknowns per second from 1.5 × 10⁴ to 1.07 × 10⁶ unknowns (0.67 at
+1.07 × 10⁶), 3.1–4.0 times faster than NGSolve; the first assembly on a mesh (its pattern
+built) 0.23–0.60 × 10⁶ (0.36 at 1.07 × 10⁶), 1.3–2.6 times NGSolve's and 28–51 times
+scikit-fem's. Of a warm assembly the element matrices are about two thirds.
 """
 
 from __future__ import annotations
