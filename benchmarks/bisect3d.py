@@ -3,6 +3,9 @@
     python benchmarks/bisect3d.py            # rates, then 30 levels towards a vertex, an
                                              # edge and a face, and the curved sphere part
     python benchmarks/bisect3d.py --quick    # smaller sizes
+    python benchmarks/bisect3d.py --arbitrary  # only the Delaunay cube and ball, tagged by
+                                             # the global vertex order and by the 12-cell
+                                             # matching subdivision
 
 Speed: uniform refinement of a Kuhn box (three bisections of every cell) and local
 refinement (the cells within a ball about a corner) up to about 10⁶ P2 unknowns
@@ -132,63 +135,131 @@ def towards_sphere(levels: int, budget: int) -> None:
         )
 
 
-def arbitrary(levels: int, budget: int) -> None:
-    """A Delaunay mesh of a grid and random points (slivers included), tagged by the global
-    vertex order (no matching condition): rounds, smallest dihedral angle, classes."""
+def delaunay_cube(seed: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """A Delaunay mesh of a 4 × 4 × 4 grid and 60 random points in the unit cube (slivers
+    included): points and positively oriented cells."""
     from scipy.spatial import Delaunay
 
-    from signorini.mesh.bisect3d import bisect_tagged
-    from signorini.mesh.reference import TETRAHEDRON
-    from signorini.mesh.tags3d import mesh_cells, sorted_tags, with_face_parts
-    from signorini.mesh.topology import boundary_facets
-
-    rng = np.random.default_rng(1)
+    rng = np.random.default_rng(seed)
     g = np.linspace(0.0, 1.0, 4)
     grid = np.stack(np.meshgrid(g, g, g), axis=-1).reshape(-1, 3)
     points = np.vstack([grid, 0.1 + 0.8 * rng.random((60, 3))])
-    cells = Delaunay(points).simplices.astype(np.int64)
-    p = points[cells]
-    det = np.linalg.det(p[:, 1:] - p[:, :1])
-    cells = cells[np.abs(det) > 1e-10]
-    det = det[np.abs(det) > 1e-10]
-    cells[det < 0] = cells[det < 0][:, [0, 2, 1, 3]]
-    boundary = boundary_facets(cells, TETRAHEDRON.facets)
-    tags = with_face_parts(
-        points,
-        sorted_tags(cells),
-        np.zeros(len(cells), np.int8),
-        boundary,
-        np.zeros(len(boundary), np.int64),
-    )
-    print(
-        f"arbitrary (Delaunay, {len(cells)} cells, global vertex order): level  cells  rounds  "
-        f"min dihedral  classes; initially {min_dihedral_angle(points, cells):.2f}°"
-    )
-    for level in range(levels):
-        cells = mesh_cells(tags)
-        if cells.shape[0] > budget:
-            break
-        x = points[cells]
-        marked = (np.abs(x).sum(-1) < 1e-12).any(1)  # towards the corner 0
-        marked |= np.linalg.norm(x.mean(1) - 0.5, axis=1) < 0.5 ** (level / 3 + 2)
-        result = bisect_tagged(points, tags, marked)
-        points, tags = result.points, result.tags
-        cells = mesh_cells(tags)
-        print(
-            f"  {level:2d} {cells.shape[0]:8d} {result.rounds:3d} "
-            f"{min_dihedral_angle(points, cells):8.3f} {similarity_classes(points, cells):6d}"
+    return points, Delaunay(points).simplices.astype(np.int64)
+
+
+def delaunay_ball(seed: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """A Gmsh-like unstructured mesh of the unit ball: the centre and quasi-uniform
+    (Fibonacci) point sets on the spheres of radii 1/3, 2/3 and 1, slightly jittered, and
+    their Delaunay tetrahedra; the north pole ``(0, 0, 1)`` is point 0."""
+    from scipy.spatial import Delaunay
+
+    rng = np.random.default_rng(seed)
+    shells = [np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 0.0]])]
+    for radius, count in ((1.0, 120), (2 / 3, 54), (1 / 3, 14)):
+        k = np.arange(count) + 0.5
+        z = 1 - 2 * k / count
+        phi = np.pi * (1 + 5**0.5) * k + rng.random()
+        unit = np.column_stack(
+            [np.sqrt(1 - z * z) * np.cos(phi), np.sqrt(1 - z * z) * np.sin(phi), z]
         )
+        jitter = 0.02 * radius * rng.standard_normal(unit.shape)
+        x = radius * unit + (jitter if radius < 1 else 0.0)
+        shells.append(x / np.linalg.norm(x, axis=1, keepdims=True) if radius == 1 else x)
+    points = np.vstack(shells)
+    points = points[
+        np.r_[0, 1, 2 + np.flatnonzero(np.linalg.norm(points[2:] - points[0], axis=1) > 0.1)]
+    ]
+    return points, Delaunay(points).simplices.astype(np.int64)
+
+
+def arbitrary_mesh(points: np.ndarray, cells: np.ndarray):
+    """A Mesh of the cells (flat ones dropped, orientation fixed), one boundary part."""
+    import warnings
+
+    from signorini.mesh.mesh import Mesh
+
+    p = points[cells]
+    cells = cells[np.abs(np.linalg.det(p[:, 1:] - p[:, :1])) > 1e-10]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # slivers
+        return Mesh.from_arrays(points, cells, {"boundary": lambda x: np.ones(len(x), bool)})
+
+
+def arbitrary(levels: int, budget: int) -> None:
+    """Arbitrary (Delaunay) meshes tagged by the global vertex order (no matching condition)
+    and by the 12-cell subdivision (:func:`~signorini.mesh.matching3d.prepare_for_bisection`):
+    per level towards a vertex and towards a face, the cells, the closure rounds, the
+    smallest dihedral angle and the similarity classes."""
+    from signorini.mesh.bisect3d import bisect_tagged
+    from signorini.mesh.matching3d import prepare_for_bisection
+    from signorini.mesh.surfaces import Sphere
+    from signorini.mesh.tags3d import mesh_cells
+
+    sphere = Sphere((0.0, 0.0, 0.0), 1.0)  # the ball's boundary: new vertices on it
+    cube = arbitrary_mesh(*delaunay_cube())
+    ball = arbitrary_mesh(*delaunay_ball()).with_curve("boundary", sphere)
+
+    def vertex(points, cells, target):
+        return (np.abs(points[cells] - target).sum(-1) < 1e-12).any(1)
+
+    def cube_face(points, cells, level):  # the face z = 0 within x < 1/4
+        x = points[cells]
+        return ((np.abs(x[..., 2]) < 1e-12).sum(1) >= 3) & (x[..., 0].min(1) < 0.25)
+
+    def ball_face(points, cells, level):  # the cells with a boundary face within z > 0.8
+        x = points[cells]
+        on = np.abs(np.linalg.norm(x, axis=-1) - 1) < 1e-9  # vertices on the sphere
+        return (on.sum(1) >= 3) & (np.where(on, x[..., 2], 1.0).min(1) > 0.8)
+
+    cases = (
+        ("cube", cube, "vertex", lambda p, c, lev: vertex(p, c, np.zeros(3))),
+        ("cube", cube, "face", cube_face),
+        ("ball", ball, "vertex", lambda p, c, lev: vertex(p, c, np.array([0.0, 0.0, 1.0]))),
+        ("ball", ball, "face", ball_face),
+    )
+    for name, mesh, where, marking in cases:
+        for init, start in (("global order", mesh), ("12-cell matching", None)):
+            start = start if start is not None else prepare_for_bisection(mesh)
+            points, tags = start.points, refine3d.tags_of(start)
+            cells = start.cells
+            print(
+                f"{name} (Delaunay, {mesh.n_cells} cells) towards a {where}, {init}: "
+                f"{start.n_cells} cells, min dihedral {min_dihedral_angle(points, cells):.2f}°, "
+                f"{similarity_classes(points, cells)} classes, matches "
+                f"{refine3d.matches(points, tags)}"
+            )
+            print("  level  cells  rounds  min dihedral  classes")
+            for level in range(levels):
+                if cells.shape[0] > budget:
+                    break
+                result = bisect_tagged(
+                    points,
+                    tags,
+                    marking(points, cells, level),
+                    curved=np.array([name == "ball"]),
+                    halfway=lambda part, a, b: sphere.halfway(a, b),
+                )
+                points, tags = result.points, result.tags
+                cells = mesh_cells(tags)
+                print(
+                    f"  {level:2d} {cells.shape[0]:8d} {result.rounds:3d} "
+                    f"{min_dihedral_angle(points, cells):8.3f} "
+                    f"{similarity_classes(points, cells):6d}"
+                )
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--arbitrary", action="store_true", help="only the Delaunay meshes")
     args = parser.parse_args()
-    rates(4, 2 if args.quick else 3)
     budget = 20_000 if args.quick else 100_000
-    for where in ("vertex", "edge", "face"):
-        towards(where, 30, budget)
-    towards_sphere(30, budget)
+    if not args.arbitrary:
+        rates(4, 2 if args.quick else 3)
+        for where in ("vertex", "edge", "face"):
+            towards(where, 30, budget)
+    if not args.arbitrary:
+        towards_sphere(30, budget)
     arbitrary(30, budget)
 
 

@@ -250,7 +250,10 @@ def test_invalid_values_exit_nonzero(tmp_path, capsys, argv, message):
 @pytest.mark.parametrize(
     ("name", "message"),
     [
-        ("example-9.9", r"unknown problem 'example-9.9': give one of \['example-6.1', "),
+        (
+            "example-9.9",
+            r"unknown problem 'example-9.9': give one of \['elasticity-3d', 'example-6.1', ",
+        ),
         ("missing.py", "no problem file at missing.py"),
     ],
 )

@@ -217,6 +217,7 @@ def test_get_example():
         "two-cylinders",
         "stacked-blocks",
         "hertz-pair",
+        "elasticity-3d",
     }
     for name in EXAMPLES:
         assert get_example(name).name == name

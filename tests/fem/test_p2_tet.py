@@ -89,12 +89,28 @@ def test_face_sides_are_the_local_edges_of_the_face():
             assert set(TETRAHEDRON.edges[side]) == {x, y}
 
 
-@pytest.mark.parametrize("name", ["hat_share", "hat_pieces", "node_parts"])
-def test_contact_facts_of_a_face_refuse_naming_the_contact_issue(name):
+@pytest.mark.parametrize("name", ["hat_pieces", "node_parts"])
+def test_estimator_pieces_of_a_face_refuse_naming_the_contact_issue(name):
     with pytest.raises(NotImplementedError, match="issue 38"):
         getattr(P2_TRIANGLE, name)
-    with pytest.raises(NotImplementedError, match="issue 38"):
-        P2_TRIANGLE.pressure(np.ones(3), np.ones(3))
+
+
+@pytest.mark.parametrize("alpha", [0.0, 0.2, 0.35])
+def test_contact_weights_of_a_face(alpha):
+    s, w = triangle_rule(4)
+    phi = p2.basis(s)  # (q, 6); the reference triangle has area 1/2
+    T = np.eye(6)
+    for e, (a, b) in zip(range(3, 6), [(0, 1), (1, 2), (2, 0)], strict=True):
+        T[e, e], T[a, e], T[b, e] = 1 - 2 * alpha, alpha, alpha
+    share = 2 * (w @ (phi @ T.T))
+    np.testing.assert_allclose(P2_TRIANGLE.transformed_share(alpha), share, atol=1e-15)
+    assert P2_TRIANGLE.hat_share == (1 / 12, 1 / 12, 1 / 12, 1 / 4, 1 / 4, 1 / 4)
+    if alpha > 0:
+        p = P2_TRIANGLE.pressure(0.3 * np.array(share), np.array(share))
+        np.testing.assert_allclose(p, 0.3, rtol=1e-15)
+    else:
+        with pytest.raises(ValueError, match="integrate to zero"):
+            P2_TRIANGLE.pressure(np.ones(6), np.array(share))
 
 
 @pytest.mark.parametrize("degree", range(9))

@@ -71,9 +71,9 @@ def test_contact_gap_field():
     ("build", "message"),
     [
         (
-            lambda: Dirichlet((0.1, 0, 0)),
+            lambda: Dirichlet((0.1, 0, 0, 0)),
             "Dirichlet(value=...) must be two finite numbers (u_x, u_y) or a function u_D(x) "
-            "of points x (n, 2); got (0.1, 0, 0)",
+            "of points x (n, 2); got (0.1, 0, 0, 0)",
         ),
         (
             lambda: Dirichlet("0"),

@@ -168,6 +168,8 @@ def ordered_solver(
         check_symmetry=check_symmetry,
         ordering=Ordering(space) if ordering is None else ordering,
         rigid_modes=rigid_modes,
+        dimension=space.mesh.dim,
+        size=space.n_dofs,
     )
 
 
@@ -214,4 +216,6 @@ class SolverAhead:
             check_symmetry=request.check_symmetry,
             ordering=request.ordering,
             rigid_modes=request.rigid_modes,
+            dimension=request.dimension,
+            size=request.size,
         )

@@ -3,7 +3,9 @@ an algebraic multigrid builds its coarse spaces from (:mod:`signorini.algebra.ba
 
 Each body (a connected component of the mesh, :func:`~signorini.mesh.bodies.body_of_cells`)
 moves rigidly by ``u(x) = a + ω (−(y − y_b), x − x_b)``, ``(x_b, y_b)`` its centroid: two
-translations and a rotation, three vectors per body, each zero off its body. The assembled
+translations and a rotation, three vectors per body, each zero off its body; in 3D by
+``u(x) = a + ω × (x − x_b)``, three translations and three rotations, six vectors per body
+(docs/method.md, *Three dimensions: the linear solver (measured)*). The assembled
 stiffness matrix ``K`` annihilates them before the Dirichlet DOFs are fixed — in the
 system's unknowns ``y``, which are the Cartesian displacement written in node frames at the
 contact and roller nodes, ``u = Q y`` (:mod:`.node_frames`), and with contact pairs the
@@ -17,6 +19,7 @@ import numpy as np
 
 from ..fem.space import node_dofs
 from ..mesh.bodies import body_of_cells
+from ..problem.problem3d import rigid_modes_3d
 from .node_frames import to_frames
 from .system import Assembled
 
@@ -32,9 +35,11 @@ def system_rigid_modes(assembled: Assembled) -> np.ndarray:
 
     Returns
     -------
-    (n_dofs, 3 n_bodies) float array
-        Columns ``3b, 3b + 1, 3b + 2``: body b's translations along x and y and its rotation
-        about its centroid, written as the system's unknowns (module docstring).
+    (n_dofs, 3 n_bodies) float array in 2D, (n_dofs, 6 n_bodies) in 3D
+        2D: columns ``3b, 3b + 1, 3b + 2``, body b's translations along x and y and its
+        rotation about its centroid; 3D: columns ``6b + c`` the translations along ``e_c``
+        and ``6b + 3 + a`` the rotations ``e_a × (x − x_b)`` about the centroid ``x_b``;
+        written as the system's unknowns (module docstring).
     """
     space = assembled.space
     points = space.node_points
@@ -54,13 +59,23 @@ def system_rigid_modes(assembled: Assembled) -> np.ndarray:
         / np.maximum(count, 1)[:, None]
     )
     local = points - centre[body]
-    modes = np.zeros((space.n_dofs, 3 * n_bodies))
-    x, y = node_dofs(np.arange(space.n_nodes), space.n_components).T  # the 2D modes
-    modes[x, 3 * body] = 1.0
-    modes[y, 3 * body + 1] = 1.0
-    modes[x, 3 * body + 2] = -local[:, 1]
-    modes[y, 3 * body + 2] = local[:, 0]
+    d = space.mesh.dim
+    k = 3 if d == 2 else 6  # the rigid motions of one body: d translations, d(d-1)/2 rotations
+    modes = np.zeros((space.n_dofs, k * n_bodies))
+    dofs = node_dofs(np.arange(space.n_nodes), space.n_components).T  # (d, n_nodes)
+    if d == 2:
+        x, y = dofs
+        modes[x, 3 * body] = 1.0
+        modes[y, 3 * body + 1] = 1.0
+        modes[x, 3 * body + 2] = -local[:, 1]
+        modes[y, 3 * body + 2] = local[:, 0]
+    else:  # translations e_c and rotations e_a × (x − x_b)
+        motion = rigid_modes_3d(local)  # (n_nodes, 3, 6)
+        for c in range(3):  # a loop over the three components
+            modes[dofs[c][:, None], 6 * body[:, None] + np.arange(6)] = motion[:, c, :]
     transfer = assembled.contact.transfer
     if transfer is not None:  # the relative displacement of the contact pairs
         modes = modes - transfer.dofs @ modes
+    if space.mesh.dim == 3:  # no node frames in 3D yet (no contact, axis rollers only)
+        return modes
     return to_frames(modes, assembled.frame_nodes, assembled.frames)

@@ -41,13 +41,13 @@ from .nested import (
     round_off_scale,
     warm_active_set,
 )
-from .node_frames import to_cartesian
 from .ordering import SolverAhead, ordered_solver
 from .partition import Partition
 from .profile import ContactProfile, contact_profile
 from .rigid_modes import system_rigid_modes
+from .solution3d import cartesian_displacement, contact_force, errors_3d, nodal_pressure
 from .system import Assembled, assemble
-from .two_body import master_traction, physical
+from .two_body import master_traction
 
 __all__ = [
     "ContactProfile",
@@ -177,8 +177,8 @@ class ContactResult:
     @property
     def pressure(self) -> np.ndarray:
         """Consistent nodal contact pressure ``p_z = Λ_z / w_z``, ``w_z = ∫ψ_z`` (docs/method.md,
-        *Discrete problem*)."""
-        return self.space.element.facet.pressure(self.contact_force, self.contact.basis_integral)
+        *Discrete problem*; on faces :func:`~.solution3d.nodal_pressure`)."""
+        return nodal_pressure(self)
 
     @property
     def tangential_pressure(self) -> np.ndarray:
@@ -236,10 +236,13 @@ class ContactResult:
         return contact_profile(self, part)
 
     def errors(self, degree: int = ERROR_DEGREE) -> dict[str, float]:
-        """Energy-norm ``a(e,e)^{1/2}`` and H¹-seminorm errors against the exact solution."""
+        """Energy-norm ``a(e,e)^{1/2}`` and H¹-seminorm errors against the exact solution
+        (3D: also the L² error, :func:`~.solution3d.errors_3d`)."""
         exact = self.problem.exact
         if exact is None:
             raise ValueError(f"{self.problem.name} has no exact solution")
+        if self.mesh.dim == 3:
+            return errors_3d(self)
         u_cell = self.space.field_coefficients(self.u)
 
         def gradient(x: np.ndarray) -> np.ndarray:
@@ -319,7 +322,7 @@ def solve(
     ahead = None
     if assembled is None:
         serial = not solver_ranks(solver).distributed
-        ahead = SolverAhead(solver) if serial and takes_ordering(solver) else None
+        ahead = SolverAhead(solver) if serial and takes_ordering(solver) and mesh.dim == 2 else None
         assembled = assemble(
             problem, mesh, element=element, ranks=solver_ranks(solver),
             prefetch_ordering=ahead is not None, on_pattern=ahead and ahead.start,
@@ -337,11 +340,11 @@ def solve(
     active0 = None
     if u0 is not None:
         u0 = np.asarray(u0, dtype=np.float64)
-        if u0.shape != (space.n_nodes, 2):
-            raise ValueError(f"u0 must have shape ({space.n_nodes}, 2), got {u0.shape}")
+        if u0.shape != (space.n_nodes, mesh.dim):
+            raise ValueError(f"u0 must have shape ({space.n_nodes}, {mesh.dim}), got {u0.shape}")
         if not np.isfinite(u0).all():
             raise ValueError("u0 contains NaN or inf")
-        active0 = warm_active_set(cs, u0)
+        active0 = warm_active_set(cs, u0) if mesh.dim == 2 else None  # 3D: no contact
     # K and F divided by a power of 2 when E is extreme (exact; 1 otherwise), so that no
     # product in the factorization overflows or underflows
     diagonal = assembled.K if ranks.size == 1 else sp.diags(ranks.sum(assembled.K.diagonal()))
@@ -353,6 +356,7 @@ def solve(
         nested
         and active0 is None
         and mesh is not problem.mesh
+        and mesh.dim == 2
         and cs.size > 0
         and not cs.has_friction
         and problem.free_ndof(space) >= NESTED_MIN_NDOF
@@ -386,12 +390,9 @@ def solve(
     return ContactResult(
         problem=problem,
         space=space,
-        u=physical(
-            to_cartesian(solved.x, assembled.frame_nodes, assembled.frames).reshape(-1, 2),
-            cs.transfer,
-        ),
+        u=cartesian_displacement(solved.x, assembled),
         contact=cs,
-        contact_force=solved.normal_force if unit == 1.0 else solved.normal_force * unit,
+        contact_force=contact_force(cs, solved.normal_force * unit),
         active=solved.state != INACTIVE,
         report=report,
         dirichlet_nodes=assembled.dirichlet_nodes,

@@ -22,6 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..problem import ContactProblem
+from .elasticity3d import ELASTICITY_3D_METRICS, elasticity_3d
 from .hertz import HERTZ_METRICS, hertz
 from .metrics import Metrics, PressureComparison
 from .paper import example_6_1, example_6_2
@@ -41,6 +42,7 @@ __all__ = [
     "example_6_2",
     "example_6_2_coulomb",
     "example_6_2_tresca",
+    "elasticity_3d",
     "get_example",
     "hertz",
     "partial_slip",
@@ -100,6 +102,7 @@ EXAMPLES: dict[str, Example] = {
         Example("two-cylinders", two_cylinders, metrics=CYLINDERS_METRICS),
         Example("stacked-blocks", stacked_blocks, metrics=BLOCKS_METRICS),
         Example("hertz-pair", hertz_pair),
+        Example("elasticity-3d", elasticity_3d, metrics=ELASTICITY_3D_METRICS),
     )
 }
 

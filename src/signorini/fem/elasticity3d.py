@@ -18,7 +18,7 @@ import numpy as np
 
 from .dofs import node_dofs
 from .material import CellMaterials, Material, lame_parameters, on_cells, stress, von_mises
-from .p2_tet import basis, face_basis
+from .p2_tet import REFERENCE_NODES, basis, face_basis
 from .quadrature import tetrahedron_rule, triangle_rule
 
 if TYPE_CHECKING:
@@ -31,6 +31,7 @@ __all__ = [
     "energy_error2_3d",
     "h1_seminorm_error2_3d",
     "l2_error2_3d",
+    "nodal_stress_3d",
     "von_mises_3d",
 ]
 
@@ -120,6 +121,22 @@ def cell_stress_3d(
         grad = g.field_gradients(u_cell[g.cells], xi)
         out[g.cells] = stress(on_cells(material, g.cells), grad)
     return out
+
+
+def nodal_stress_3d(
+    space: P2TetSpace, material: Material | CellMaterials, u: np.ndarray
+) -> np.ndarray:
+    """``(n_nodes, 3, 3)`` σ(u_h) at the P2 nodes, each the mean of the values of the cells
+    that share the node (:func:`cell_stress_3d` at the reference nodes; exact where σ is
+    continuous and of degree ≤ 1), as 2D's :func:`~signorini.fem.postprocess.nodal_stress`."""
+    sigma = cell_stress_3d(space, material, u, REFERENCE_NODES).reshape(-1, 9)
+    nodes = space.cell_nodes.ravel()
+    count = np.bincount(nodes, minlength=space.n_nodes)
+    total = np.stack(
+        [np.bincount(nodes, weights=sigma[:, k], minlength=space.n_nodes) for k in range(9)],
+        axis=1,
+    )  # a loop over the nine components
+    return (total / np.maximum(count, 1)[:, None]).reshape(-1, 3, 3)
 
 
 def von_mises_3d(

@@ -140,24 +140,29 @@ P1_INTERVAL = FacetElement(
 
 
 def _contact_on_faces(what: str) -> property:
-    """A property that refuses: the contact facts of a face are the 3D contact issue's."""
+    """A property that refuses: the estimator's pieces of a face are not built yet."""
 
     def refuse(self: FaceElement) -> None:
         raise NotImplementedError(
-            f"{self.name}: {what} of a triangular face is not defined yet -- the discrete "
-            "contact condition on P2 faces is the subject of issue 38 (three dimensions, part "
-            "2: frictionless contact on faces); on a flat P2 triangle the vertex basis "
-            "functions integrate to zero, so the 2D shares do not carry over"
+            f"{self.name}: {what} of a triangular face is not defined yet -- the estimator on "
+            "contact faces is the third part of the 3D work (issue 38); on a flat P2 triangle "
+            "the vertex basis functions integrate to zero, so the 2D pieces do not carry over"
         )
 
     return property(refuse)
 
 
 class FaceElement(FacetElement):
-    """The trace of a 3D cell's element on a triangular face: its basis, nodes per face and
-    basis integrals; the contact facts (``hat_share``, ``hat_pieces``, ``node_parts``,
-    :meth:`pressure`) refuse with ``NotImplementedError`` until the 3D contact condition is
-    chosen (issue 38).
+    """The trace of a 3D cell's element on a triangular face: its basis, nodes per face, basis
+    integrals and contact weights (docs/method.md, *Three dimensions: contact on faces*).
+
+    The contact weights of a face: ``hat_share`` the shares ``∫_F φ_p / |F|`` of the P1 hats
+    of the once-refined face (the 4 triangles of its side midpoints; the 3D ``Q^h`` of the
+    force density ``s_z = Λ_z / m_z``, (4.1)), ``(1/12, 1/12, 1/12, 1/4, 1/4, 1/4)`` for P2;
+    ``basis_share`` those of the P2 functions, ``(0, 0, 0, 1/3, 1/3, 1/3)``, and
+    :meth:`transformed_share` those of the transformed basis φ̃ of contact condition (b),
+    positive for ``0 < α < 1/2``. The pieces ``γ̃_p`` of a face (``hat_pieces``,
+    ``node_parts``, the estimator's η6 and η8 on faces) refuse with ``NotImplementedError``.
 
     Parameters
     ----------
@@ -168,8 +173,8 @@ class FaceElement(FacetElement):
         Nodes per face (6 for P2: the vertices, then the midpoints of its sides).
     basis : callable
         Values ``(q, n_nodes)`` at triangle reference points ``s (q, 2)``.
-    basis_share : tuple of n_nodes floats
-        ``∫_F ψ_z ds / |F|`` on a flat face: ``(0, 0, 0, 1/3, 1/3, 1/3)`` for P2.
+    basis_share, hat_share : tuples of n_nodes floats
+        ``∫_F ψ_z / |F|`` and ``∫_F φ_z / |F|`` on a flat face.
     """
 
     def __init__(
@@ -179,6 +184,7 @@ class FaceElement(FacetElement):
         n_nodes: int,
         basis: Callable[[np.ndarray], np.ndarray],
         basis_share: tuple[float, ...],
+        hat_share: tuple[float, ...],
     ) -> None:
         for key, value in (
             ("name", name),
@@ -186,10 +192,10 @@ class FaceElement(FacetElement):
             ("n_nodes", n_nodes),
             ("basis", basis),
             ("basis_share", basis_share),
+            ("hat_share", hat_share),
         ):
             object.__setattr__(self, key, value)
 
-    hat_share = _contact_on_faces("the contact weights m_z / |F| (hat_share)")
     hat_pieces = _contact_on_faces("the pieces γ̃_p of a contact face (hat_pieces)")
     node_parts = _contact_on_faces("the pieces γ̃_p of a contact face (node_parts)")
 
@@ -197,17 +203,48 @@ class FaceElement(FacetElement):
         """Per-face nodal data ``(k, 6, ...)``, unchanged (P2)."""
         return np.asarray(values, dtype=np.float64)
 
+    def transformed_share(self, alpha: float) -> tuple[float, ...]:
+        """``∫_F φ̃_z / |F|`` on a flat face for the transformed basis ``φ̃_v = φ_v + α Σ φ_e``,
+        ``φ̃_e = (1 − 2α) φ_e`` (docs/method.md, *Three dimensions: the contact condition on P2
+        faces*): ``w_v + 2α w_e`` at a vertex (its two sides), ``(1 − 2α) w_e`` at a midpoint;
+        ``(2α/3, …, (1 − 2α)/3, …)`` for P2, the basis shares at ``α = 0``."""
+        w = self.basis_share
+        return tuple(w[v] + alpha * (w[3 + v] + w[3 + (v + 2) % 3]) for v in range(3)) + tuple(
+            (1.0 - 2.0 * alpha) * w[e] for e in range(3, 6)
+        )
+
     def pressure(self, force: np.ndarray, weight: np.ndarray) -> np.ndarray:
-        """Refused: ``w_z = 0`` at a P2 face's vertices (see :meth:`FacetElement.pressure`)."""
-        _contact_on_faces("the nodal pressure Λ_z / w_z").fget(self)
+        """The nodal pressure ``p_z = Λ_z / w_z`` of forces on a basis with positive integrals
+        ``w_z`` (the transformed basis of condition (b): ``Λ̃_z / ∫ φ̃_z``, exact for a constant
+        pressure).
+
+        Raises
+        ------
+        ValueError
+            Where a weight is not positive: the vertices of the P2 basis itself (condition
+            (a), ``∫_F ψ_v = 0``), whose pressure is the recovered one
+            (``FaceContactSet.recovered_pressure``).
+        """
+        weight = np.asarray(weight, dtype=np.float64)
+        bad = ~(weight > 0)
+        if bad.any():
+            k = int(np.flatnonzero(bad.reshape(weight.shape[0], -1).any(axis=1))[0])
+            raise ValueError(
+                f"{self.name}: the nodal pressure Λ_z / w_z needs positive weights; w[{k}] = "
+                f"{weight.ravel()[k]:.3g} (on a P2 face the vertex functions integrate to zero: "
+                "use the transformed basis, alpha > 0, or the recovered pressure)"
+            )
+        return np.asarray(force, dtype=np.float64) / weight
 
 
 #: P2 on a triangular face of a tetrahedron: the P2 triangle's basis; the vertex functions
-#: integrate to zero, the midpoint functions to |F|/3
+#: integrate to zero, the midpoint functions to |F|/3; the hats of the once-refined face to
+#: |F|/12 at a vertex (one of its 4 triangles) and |F|/4 at a midpoint (three)
 P2_TRIANGLE = FaceElement(
     name="P2 triangle",
     reference=TRIANGLE,
     n_nodes=6,
     basis=p2.basis,
     basis_share=(0.0, 0.0, 0.0, 1 / 3, 1 / 3, 1 / 3),
+    hat_share=(1 / 12, 1 / 12, 1 / 12, 1 / 4, 1 / 4, 1 / 4),
 )

@@ -188,8 +188,13 @@ def nodal_stress(space, u: np.ndarray, material: Material | CellMaterials) -> np
     -------
     (n_nodes, 3, 3) float array
         σ with σ_zz from the material (:func:`~signorini.fem.material.stress_zz`: λ tr ε in
-        plane strain, 0 in plane stress).
+        plane strain, 0 in plane stress). On a tetrahedral mesh (``u (n_nodes, 3)``) the
+        3D stress, :func:`~signorini.fem.elasticity3d.nodal_stress_3d`.
     """
+    if space.mesh.dim == 3:
+        from .elasticity3d import nodal_stress_3d  # the 3D module builds on this package
+
+        return nodal_stress_3d(space, material, u)
     nodes = space.cell_nodes  # (m, n_local): 6 for P2, 3 for P1
     m, k = nodes.shape
     u_cell = space.field_coefficients(u)  # (m, 12): a P1 field as the P2 field it is

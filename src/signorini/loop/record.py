@@ -7,6 +7,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field
 
+import numpy as np
+
 from ..contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
 from ..contact.solution import SLIP, STICK, ContactResult
 from ..estimator.names import TERM_TABLE, TERMS
@@ -196,8 +198,22 @@ class LevelRecord:
         return d
 
 
-def level_record(level: int, result: ContactResult, est: Estimate) -> LevelRecord:
-    classes = result.classes
+@dataclass(frozen=True)
+class _NoEstimate:
+    """What a record reads of an estimate where there is none (3D): NaN."""
+
+    eta: float = math.nan
+    eta_terms: tuple[float, ...] = (math.nan,) * len(TERMS)
+
+
+_NO_ESTIMATE = _NoEstimate()
+
+
+def level_record(level: int, result: ContactResult, est: Estimate | None) -> LevelRecord:
+    """The record of one level; without an estimate (3D) η and its terms are NaN."""
+    if est is None:
+        est = _NO_ESTIMATE
+    classes = result.classes if result.contact.size else np.zeros(0, dtype=np.int64)
     report = result.report
     rec = LevelRecord(
         level=level,

@@ -6,6 +6,7 @@ from .builders import half_disc, rectangle
 from .builders3d import box, eighth_ball, quarter_cylinder
 from .curves import Circle, Curve, Line, ProjectedCurve, QuadraticBoundary
 from .gmsh import read_mesh
+from .matching3d import prepare_for_bisection
 from .mesh import Mesh, MeshError
 from .refine import Refinement, refine_nvb, refine_uniform
 from .regions import with_regions
@@ -26,6 +27,7 @@ __all__ = [
     "box",
     "eighth_ball",
     "half_disc",
+    "prepare_for_bisection",
     "quarter_cylinder",
     "read_mesh",
     "rectangle",

@@ -11,6 +11,8 @@ a :class:`~signorini.mesh.surfaces.Surface` are placed by its ``halfway``.
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 from .bisect3d import bisect_tagged, boundary_of, edge_key
@@ -29,6 +31,8 @@ from .topology3d import refined_topology
 from .validation import MeshError
 
 __all__ = ["UNIFORM_BISECTIONS", "bisect_mesh", "matches", "tagged", "tags_of"]
+
+logger = logging.getLogger(__name__)
 
 #: Bisections of every cell per level of uniform refinement in 3D: ``h`` halves and the
 #: number of cells grows eightfold (the children of a Kuhn cell after three bisections are
@@ -167,7 +171,9 @@ def tags_of(mesh: Mesh) -> Tags:
     (:func:`~signorini.mesh.tags3d.kuhn_tags`); else the Kuhn paths of a mapped Kuhn grid in
     the builders' cell order (:func:`~signorini.mesh.builders3d.kuhn_paths`, plain or
     mirrored) if they pass :func:`matches`; else the global vertex order
-    (:func:`~signorini.mesh.tags3d.sorted_tags`, no matching condition: docs/method.md)."""
+    (:func:`~signorini.mesh.tags3d.sorted_tags`, no matching condition, logged at
+    ``INFO``: docs/method.md; :func:`~signorini.mesh.matching3d.prepare_for_bisection`
+    gives a mesh with it)."""
     tags = getattr(mesh, ATTRIBUTE, None)
     if tags is not None:
         return tags
@@ -188,5 +194,10 @@ def tags_of(mesh: Mesh) -> Tags:
                 break
     if tags is None:
         tags = tags_in(sorted_tags(mesh.cells))
+        logger.info(
+            "bisection: %d tetrahedra tagged by the global vertex order (no matching "
+            "condition; matching3d.prepare_for_bisection gives one)",
+            mesh.n_cells,
+        )
     setattr(mesh, ATTRIBUTE, tags)
     return tags

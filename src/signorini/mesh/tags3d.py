@@ -18,11 +18,13 @@ with the smallest coordinates along the common diagonal direction, ``x1 = x0 + h
 ``x2 = x1 + h_j e_j``, ``x3 = x2 + h_k e_k`` ([3]_, [4]_). For an arbitrary mesh
 :func:`sorted_tags` orders each cell by its global vertex numbers (a consistent order on
 every shared face), type 0: bisection then stays conforming and terminates on the meshes
-tested, but the matching condition, hence the bound on similarity classes and the closure
-estimate, is not guaranteed (Diening, Gehring, Storn [5]_ give an initialisation for any
-conforming mesh; it is not implemented). :func:`signorini.mesh.refine3d.tags_of` checks the
-condition's consequence that three bisections of every cell need no closure before it takes
-the Kuhn paths of a mapped Kuhn grid.
+tested, but the matching condition, hence the closure estimate and the bound of the closure
+rounds, is not guaranteed (Diening, Gehring, Storn [5]_ give an initialisation for any
+conforming mesh; it is not implemented). The guaranteed route for any conforming mesh is
+:func:`signorini.mesh.matching3d.prepare_for_bisection`: 12 tagged sub-cells per cell.
+:func:`signorini.mesh.refine3d.tags_of` checks the condition's consequence that three
+bisections of every cell need no closure before it takes the Kuhn paths of a mapped Kuhn
+grid.
 
 References
 ----------

@@ -18,6 +18,7 @@ import numpy as np
 from ..mesh.bodies import body_names, body_of_cells
 from ..mesh.mesh import Mesh
 from .files import atomic_write, replacing
+from .vtu3d import write_vtu_3d
 
 __all__ = [
     "CELL_FIELDS",
@@ -98,6 +99,8 @@ def write_vtu(path: str | os.PathLike, result, estimate=None) -> Path:
     result : ContactResult
     estimate : Estimate, optional
     """
+    if result.space.mesh.dim == 3:  # quadratic tetrahedra
+        return write_vtu_3d(path, result, von_mises)
     import meshio
 
     space, cs = result.space, result.contact

@@ -54,6 +54,13 @@ _GAP = "a finite number or a function gap(x) of points x (n, 2)"
 _NORMAL = "None or two finite numbers, not both zero"
 
 
+def _components(value: object) -> int:
+    """How many components constant data give: 3 for a tuple or list of three (a 3D
+    problem, docs/method.md, *Three dimensions: solving elasticity*), else 2 (the 2D
+    count every message states)."""
+    return 3 if isinstance(value, tuple | list) and len(value) == 3 else 2
+
+
 @dataclass(frozen=True)
 class Dirichlet:
     """Prescribed displacement ``u = u_D`` on a boundary part, or one component of it.
@@ -83,20 +90,24 @@ class Dirichlet:
             check_function(self.value, "Dirichlet(value=...)", _DIRICHLET)
             return
         value = self.value
-        if isinstance(value, tuple | list) and len(value) == 2 and any(v is None for v in value):
+        n = _components(value)
+        if isinstance(value, tuple | list) and len(value) == n and any(v is None for v in value):
             given = [v for v in value if v is not None]
             if not given:
                 raise ProblemError(
                     f"Dirichlet(value=...) must be {_COMPONENT}; got {value!r} (a part with "
                     "no component held needs Neumann((0, 0)))"
                 )
-            check_numbers(given, 1, "Dirichlet(value=...)", _COMPONENT, shown=value, bounded=True)
+            check_numbers(
+                given, len(given), "Dirichlet(value=...)", _COMPONENT, shown=value, bounded=True
+            )
         else:
-            check_numbers(value, 2, "Dirichlet(value=...)", _DIRICHLET, bounded=True)
+            check_numbers(value, n, "Dirichlet(value=...)", _DIRICHLET, bounded=True)
 
     @property
-    def components(self) -> tuple[bool, bool]:
-        """Which of ``(u_x, u_y)`` the condition holds."""
+    def components(self) -> tuple[bool, ...]:
+        """Which of ``(u_x, u_y)`` (3D: ``(u_x, u_y, u_z)``) the condition holds; a function
+        holds all (:func:`~.rollers.held_nodes` takes as many as the mesh has)."""
         if callable(self.value):
             return (True, True)
         held = tuple(v is not None for v in self.value)
@@ -106,7 +117,8 @@ class Dirichlet:
         """``u_D`` as a function of ``x (n, 2)`` (a free component reads 0)."""
         if callable(self.value):
             return self.value
-        return constant_field(tuple(0.0 if v is None else v for v in self.value))
+        value = tuple(0.0 if v is None else v for v in self.value)
+        return constant_field(value, shape=(len(value),))
 
 
 @dataclass(frozen=True)
@@ -173,13 +185,14 @@ class Neumann:
             call = check_function(self.traction, "Neumann(traction=...)", _TRACTION, normal=True)
             object.__setattr__(self, "_call", call)
         else:
-            check_numbers(self.traction, 2, "Neumann(traction=...)", _TRACTION)
+            n = _components(self.traction)
+            check_numbers(self.traction, n, "Neumann(traction=...)", _TRACTION)
 
     def field(self) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
         """``g`` as a function ``(x (n, 2), normal (n, 2))``, whatever form the user wrote."""
         g = self.traction
         if not callable(g):
-            const = constant_field(g)
+            const = constant_field(g, shape=(np.size(g),))
             return lambda x, normal: const(x)
         if self._call == CALL_NAMED:
             return lambda x, normal: g(x, normal=normal)
@@ -234,6 +247,10 @@ class Contact:
         bodies*). The constraint is the dual mortar one, the gap and the direction come from
         the two surfaces; the master part takes no condition of its own. Not with ``gap``,
         ``normal`` or ``obstacle``.
+    face_alpha : float or None
+        On a 3D mesh, the α of the transformed face basis, in [0, 1/2): None for the default
+        1/5 (condition (b)), 0 for the nodal constraints at all P2 nodes (condition (a));
+        docs/method.md, *Three dimensions: contact on faces*. Not on a 2D mesh.
 
     Raises
     ------
@@ -249,9 +266,13 @@ class Contact:
     obstacle: Obstacle | None = None
     friction: Friction | None = None
     master: str | None = None
+    face_alpha: float | None = None
 
     def __post_init__(self) -> None:
         friction = self.friction
+        alpha = self.face_alpha
+        if alpha is not None and not (isinstance(alpha, int | float) and 0 <= alpha < 0.5):
+            raise ProblemError(f"Contact(face_alpha=...) must be in [0, 1/2), got {alpha!r}")
         if self.master is not None:
             if not isinstance(self.master, str) or not self.master:
                 raise ProblemError(

@@ -233,10 +233,10 @@ def evaluate_field(
     """
     x = np.asarray(x, dtype=np.float64)
     lead = x.shape[:-1]
-    points = np.array(x.reshape(-1, 2))
+    points = np.array(x.reshape(-1, x.shape[-1]))  # (n, 2), or (n, 3) in 3D
     args = (points,)
     if normal is not None:
-        args += (np.array(np.broadcast_to(normal, x.shape).reshape(-1, 2)),)
+        args += (np.array(np.broadcast_to(normal, x.shape).reshape(points.shape)),)
     try:
         raw = func(*args)
     except ProblemError:

@@ -1,7 +1,8 @@
 """The obstacle protocol (docs/method.md, *Obstacles as shapes*): :class:`Obstacle`, the base
 every shape subclasses, and the argument checks the built-in shapes share.
 
-An obstacle answers :meth:`Obstacle.gap_and_direction` for points ``x (n, 2)``: with ``q``
+An obstacle answers :meth:`Obstacle.gap_and_direction` for points ``x (n, d)`` (``d`` its
+:attr:`Obstacle.dim`: 2 for the plane shapes, 3 for the solids of ``obstacles3d.py``): with ``q``
 the point of the obstacle closest to ``z``, ``n_z`` is the obstacle's unit normal at ``q``
 pointing *into* the obstacle and ``psi(z)`` the signed distance from ``z`` to the obstacle
 (positive outside, negative when ``z`` penetrates), so that ``q = z + psi(z) n_z``. The one
@@ -41,10 +42,11 @@ def finite_array(value, owner: str, name: str) -> np.ndarray:
     return array
 
 
-def checked_point(value, owner: str, name: str) -> np.ndarray:
+def checked_point(value, owner: str, name: str, dim: int = 2) -> np.ndarray:
+    """``value`` as a finite ``(dim,)`` float64 array (a copy), refused naming ``owner``."""
     array = finite_array(value, owner, name)
-    if array.shape != (2,):
-        raise ValueError(f"{owner}: {name} must have shape (2,), got {array.shape}")
+    if array.shape != (dim,):
+        raise ValueError(f"{owner}: {name} must have shape ({dim},), got {array.shape}")
     return array
 
 
@@ -80,58 +82,68 @@ class Obstacle(ABC):
             def _gap_and_direction(self, x):
                 return x[:, 1] + self.depth, np.tile([0.0, -1.0], (len(x), 1))
 
-    and is given as ``Contact(obstacle=Floor(0.1))``.
+    and is given as ``Contact(obstacle=Floor(0.1))``. A solid of space sets ``dim = 3`` and
+    answers for points ``(n, 3)`` (``obstacles3d.py``).
     """
+
+    #: the dimension of the points the shape answers for
+    dim: int = 2
 
     def gap_and_direction(self, x) -> tuple[np.ndarray, np.ndarray]:
         """Signed distance and constraint direction at the points ``x``.
 
         Parameters
         ----------
-        x : (n, 2) float array
-            Points, e.g. the body's boundary nodes.
+        x : (n, d) float array
+            Points, e.g. the body's boundary nodes (``d`` = :attr:`dim`).
 
         Returns
         -------
         psi : (n,) float array
             Signed distance from each point to the obstacle: positive outside, negative inside.
-        n : (n, 2) float array
+        n : (n, d) float array
             Unit normal of the obstacle at the closest point, pointing into the obstacle;
             ``x + psi[:, None] * n`` is that closest point.
 
         Raises
         ------
         ValueError
-            Naming the shape: for points that are not a finite ``(n, 2)`` array, or where the
-            shape's answer is not ``(n,)`` and ``(n, 2)`` finite numbers with unit directions
+            Naming the shape: for points that are not a finite ``(n, d)`` array, or where the
+            shape's answer is not ``(n,)`` and ``(n, d)`` finite numbers with unit directions
             (within :data:`UNIT_RTOL`).
         """
         try:
             points = np.asarray(x, dtype=np.float64)
         except (TypeError, ValueError) as err:
-            raise ValueError(f"{self!r}: x must be a numeric (n, 2) array") from err
-        if points.ndim != 2 or points.shape[1] != 2:
-            raise ValueError(f"{self!r}: x must have shape (n, 2), got {points.shape}")
+            raise ValueError(f"{self!r}: x must be a numeric (n, {self.dim}) array") from err
+        if points.ndim != 2 or points.shape[1] != self.dim:
+            raise ValueError(f"{self!r}: x must have shape (n, {self.dim}), got {points.shape}")
         if not np.isfinite(points).all():
             k = int(np.flatnonzero(~np.isfinite(points).all(axis=1))[0])
             raise ValueError(f"{self!r}: x[{k}] is not finite: {points[k]}")
         psi, n = self._gap_and_direction(points)
         return _checked_answer(self, points, psi, n)
 
+    def closest_point(self, x) -> np.ndarray:
+        """``(n, d)`` the point ``q = x + psi(x) n_x`` of the obstacle's surface closest to
+        each point ``x (n, d)`` (:meth:`gap_and_direction`)."""
+        psi, n = self.gap_and_direction(x)
+        return np.asarray(x, dtype=np.float64) + psi[:, None] * n
+
     @abstractmethod
     def _gap_and_direction(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``psi (n,)`` and ``n (n, 2)`` as :meth:`gap_and_direction` returns them, at the
-        checked points ``x (n, 2)`` (finite float64)."""
+        """``psi (n,)`` and ``n (n, d)`` as :meth:`gap_and_direction` returns them, at the
+        checked points ``x (n, d)`` (finite float64)."""
 
     @property
     def displacement(self) -> np.ndarray:
-        """``(2,)`` the prescribed rigid displacement of the obstacle from where it was given
+        """``(d,)`` the prescribed rigid displacement of the obstacle from where it was given
         (zero; :meth:`moved` sets it). The friction law measures slip relative to it
         (docs/method.md, *Obstacle motion*)."""
-        return np.zeros(2)
+        return np.zeros(self.dim)
 
     def moved(self, displacement) -> MovedObstacle:
-        """This obstacle translated rigidly by ``displacement (2,)`` (length units), e.g. one
+        """This obstacle translated rigidly by ``displacement (d,)`` (length units), e.g. one
         load step of a path: ``Disc(c, r).moved((0.1 * t, -0.02))``.
 
         The gap and direction are those of the moved shape; a friction law on the contact
@@ -147,7 +159,7 @@ UNIT_RTOL = 1e-6
 
 
 def _checked_answer(shape: Obstacle, x: np.ndarray, psi, n) -> tuple[np.ndarray, np.ndarray]:
-    """``psi (n,)`` and ``n (n, 2)`` as a shape returned them for ``x (n, 2)``, refused with
+    """``psi (n,)`` and ``n (n, d)`` as a shape returned them for ``x (n, d)``, refused with
     a ValueError naming the shape unless finite numbers of those shapes with unit ``n``."""
     try:
         psi, n = np.asarray(psi, dtype=np.float64), np.asarray(n, dtype=np.float64)
@@ -165,7 +177,7 @@ def _checked_answer(shape: Obstacle, x: np.ndarray, psi, n) -> tuple[np.ndarray,
             f"{shape!r}: gap_and_direction is not finite at x[{k}] = {x[k].tolist()} (psi "
             f"{psi[k]}, n {n[k].tolist()})"
         )
-    length = np.hypot(n[:, 0], n[:, 1])
+    length = np.hypot(n[:, 0], n[:, 1]) if x.shape[1] == 2 else np.linalg.norm(n, axis=1)
     off = np.abs(length - 1.0) > UNIT_RTOL
     if off.any():
         k = int(np.flatnonzero(off)[0])
@@ -183,14 +195,15 @@ class MovedObstacle(Obstacle):
     ----------
     shape : Obstacle
         The obstacle where it was given.
-    displacement : (2,) float array
-        Its rigid displacement from there.
+    displacement : (d,) float array
+        Its rigid displacement from there (``d`` the shape's :attr:`~Obstacle.dim`).
     """
 
     def __init__(self, shape: Obstacle, displacement):
         if not isinstance(shape, Obstacle):
             raise ValueError(f"MovedObstacle: shape must be an Obstacle, got {shape!r}")
-        d = checked_point(displacement, "Obstacle.moved", "displacement")
+        self.dim = shape.dim
+        d = checked_point(displacement, "Obstacle.moved", "displacement", shape.dim)
         if isinstance(shape, MovedObstacle):
             shape, d = shape.shape, shape.displacement + d
         self.shape = shape

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..fem.material import CellMaterials, Material
-from ..fem.space import LagrangeSpace, P2Space
+from ..fem.space import LagrangeSpace, P2Space, space_of
 from ..mesh.bodies import body_of_cells
 from ..mesh.curves import Line
 from ..mesh.geometry import facet_normals
@@ -33,6 +33,7 @@ from .fields import ProblemError, VectorField, check_function
 from .materials import check_materials
 from .normals import straight_normal
 from .pairs import contact_pairs, pair_rigid_motions
+from .problem3d import check_dimension, check_problem_3d
 from .rigid import free_rigid_motions
 from .rollers import check_roller_part, held_nodes, roller_normals
 
@@ -129,6 +130,7 @@ class ContactProblem:
                 f"conditions name boundary parts the mesh does not have: "
                 f"{unknown}; its parts are {list(mesh.part_names)}"
             )
+        check_dimension(mesh, self.conditions)
         object.__setattr__(self, "pairs", contact_pairs(mesh, self.conditions))
         masters = set(self.pairs.values())
         missing = [p for p in mesh.part_names if p not in self.conditions and p not in masters]
@@ -160,6 +162,12 @@ class ContactProblem:
         object.__setattr__(
             self, "rollers", {k: self.conditions[k] for k, v in held.items() if v is None}
         )
+        if mesh.dim == 3:  # 3D elasticity without contact (docs/method.md, *Three dimensions*)
+            check_problem_3d(mesh, self.held, self.rollers)
+            object.__setattr__(self, "rigid_motions", np.zeros((0, 6)))
+            object.__setattr__(self, "rigid_parts", ())
+            object.__setattr__(self, "contact_normals", {})
+            return
         if self.dirichlet_parts:
             _check_components(mesh, self.dirichlet_parts, self.contact_parts)
         if self.pairs:  # each body's own motions (docs/method.md, *Force control*)
@@ -227,13 +235,15 @@ class ContactProblem:
             return cond
         mean = straight_normal(self.mesh, name)
         if mean is None:
+            if self.mesh.dim == 3:
+                return None  # refused by check_problem_3d, naming the part
             check_roller_part(self.mesh, name)
             return None
         axis = int(np.argmax(np.abs(mean)))
-        if abs(mean[1 - axis]) > 1e-12:
+        if np.abs(np.delete(mean, axis)).max() > 1e-12:
             return None
         value = float(np.sign(mean[axis]) * cond.value)
-        return Dirichlet((value, None) if axis == 0 else (None, value))
+        return Dirichlet(tuple(value if c == axis else None for c in range(mean.size)))
 
     def _roller_vertices(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """The vertices of each oblique or curved roller part and its normals there."""
@@ -247,7 +257,7 @@ class ContactProblem:
     def free_ndof(self, mesh: Mesh | LagrangeSpace) -> int:
         """Free scalar unknowns on ``mesh`` (or its space), the paper's Ndof: all DOFs minus
         the held ones (:func:`free_ndof` without rollers; a roller holds one DOF a node)."""
-        space = mesh if isinstance(mesh, LagrangeSpace) else P2Space(mesh)
+        space = mesh if isinstance(mesh, LagrangeSpace) else space_of(mesh, "P2")
         return space.n_dofs - held_nodes(self, space, values=False).n_held
 
     def _segment_normal(self, name: str) -> np.ndarray | None:

@@ -141,13 +141,14 @@ def held_nodes(problem, space: P2Space, *, values: bool = True) -> HeldNodes:
     ProblemError
         If a node is held by rollers along more than two directions.
     """
-    comp = np.zeros((space.n_nodes, 2), dtype=bool)
-    order = np.full((space.n_nodes, 2), -1)  # the last part holding each component
-    val = np.zeros((space.n_nodes, 2)) if values else None
+    d = space.mesh.dim
+    comp = np.zeros((space.n_nodes, d), dtype=bool)
+    order = np.full((space.n_nodes, d), -1)  # the last part holding each component
+    val = np.zeros((space.n_nodes, d)) if values else None
     rank = {name: i for i, name in enumerate(problem.conditions)}
     for name, cond in problem.held.items():  # a loop over parts
         nodes = space.part_nodes([name])
-        held = np.asarray(cond.components)
+        held = np.resize(np.asarray(cond.components), d)  # a function: all d components
         comp[nodes] |= held
         order[nodes[:, None], np.flatnonzero(held)[None, :]] = rank[name]
         if values:
@@ -155,12 +156,13 @@ def held_nodes(problem, space: P2Space, *, values: bool = True) -> HeldNodes:
                 cond.field(),
                 space.node_points[nodes],
                 f"the Dirichlet value of part {name!r}",
+                shape=(d,),
                 bounded=True,
             )
             val[nodes[:, None], np.flatnonzero(held)[None, :]] = v[:, held]
     node, normal, value, part = _roller_rows(problem, space.mesh)
     if node.size == 0:
-        return HeldNodes(comp, val, np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros(0))
+        return HeldNodes(comp, val, np.zeros(0, np.int64), np.zeros((0, d)), np.zeros(0))
     k = np.array([rank[name] for name in problem.rollers])[part]
     # a node's rows along one line are one condition: the later part's value
     same = node[1:] == node[:-1]

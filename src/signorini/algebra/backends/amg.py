@@ -320,5 +320,9 @@ def amg_solver(request: SolverRequest) -> SPDSolver:
     :class:`AmgSolver` with the request's rigid modes for a symmetric request, SuperLU's LU
     (exact) for a non-symmetric one. The request's ordering is not computed."""
     if request.symmetric:
-        return AmgSolver(check_symmetry=request.check_symmetry, near_nullspace=request.rigid_modes)
+        return AmgSolver(
+            check_symmetry=request.check_symmetry,
+            near_nullspace=request.rigid_modes,
+            block_size=request.dimension,
+        )
     return superlu_solver(request)

@@ -44,12 +44,21 @@ class SolverRequest:
         its Dirichlet DOFs are fixed, computed only when called (an algebraic multigrid
         needs it, :mod:`.petsc_gamg`; the contact layer's
         :func:`signorini.contact.rigid_modes.system_rigid_modes`).
+    dimension : int
+        The space dimension of the elasticity problem, 2 or 3: the number of interleaved
+        DOFs of a node (an algebraic multigrid reads the matrix in ``dimension ×
+        dimension`` node blocks, :mod:`.amg`).
+    size : int
+        The number of unknowns, 0 when not known: :func:`~.selection.auto_solver` chooses
+        by it in 3D (docs/method.md, *Three dimensions: the linear solver (measured)*).
     """
 
     symmetric: bool = True
     check_symmetry: bool = True
     ordering: Callable[[], np.ndarray] | None = None
     rigid_modes: Callable[[], np.ndarray] | None = None
+    dimension: int = 2
+    size: int = 0
 
 
 class SolverFactory(Protocol):

@@ -56,6 +56,7 @@ from .solvers import SolverFactory, SolverRequest, SPDSolver
 from .superlu import superlu_solver
 
 __all__ = [
+    "AMG_FROM_3D",
     "SOLVERS",
     "auto_solver",
     "available_backends",
@@ -77,9 +78,17 @@ def _warn_fallback(reason: str) -> None:
     )
 
 
+#: from this many unknowns on, ``"auto"`` takes ``"amg"`` for a symmetric 3D system
+#: (docs/method.md, *Three dimensions: the linear solver (measured)*)
+AMG_FROM_3D = 60_000
+
+
 def auto_solver(request: SolverRequest) -> SPDSolver:
     """The default solver factory: PARDISO where it loads and works, else SuperLU with a
-    :class:`SolverFallbackWarning` (once per process and reason)."""
+    :class:`SolverFallbackWarning` (once per process and reason); for a symmetric 3D system
+    of :data:`AMG_FROM_3D` unknowns or more, ``"amg"`` (:func:`~.amg.amg_solver`)."""
+    if request.dimension == 3 and request.symmetric and request.size >= AMG_FROM_3D:
+        return amg_solver(request)
     problem = pardiso_problem()
     if problem is None:
         return pardiso_solver(request)
@@ -174,6 +183,8 @@ def make_solver(
     check_symmetry: bool = True,
     ordering: Callable[[], np.ndarray] | None = None,
     rigid_modes: Callable[[], np.ndarray] | None = None,
+    dimension: int = 2,
+    size: int = 0,
 ) -> SPDSolver:
     """A new solver from a factory, for symmetric positive definite or general matrices.
 
@@ -194,6 +205,8 @@ def make_solver(
         The rigid motions in the system's unknowns
         (:attr:`~.solvers.SolverRequest.rigid_modes`), computed only if the backend uses
         them (``"petsc-gamg"`` does).
+    dimension, size : int
+        The problem's dimension and number of unknowns (:class:`~.solvers.SolverRequest`).
 
     Returns
     -------
@@ -220,6 +233,8 @@ def make_solver(
         check_symmetry=bool(check_symmetry),
         ordering=ordering,
         rigid_modes=rigid_modes,
+        dimension=int(dimension),
+        size=int(size),
     )
     made = factory(request)
     if not isinstance(made, SPDSolver):

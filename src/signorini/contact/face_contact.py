@@ -1,0 +1,349 @@
+"""The contact set on faces: the constraints of Γ_C at the P2 nodes of its faces in three
+dimensions, their frames, the transformed face basis and the contact force and pressures
+(docs/method.md, *Three dimensions: contact on faces*).
+
+Every P2 node ``z`` (vertices and edge midpoints) of a contact part's faces carries a
+constraint row ``u_h(z)·n_z ≤ ψ(z)`` for that part, unless the held Cartesian components at
+``z`` fix ``u·n_z`` (a Dirichlet node, or a roller along ``n_z``). Directions: the obstacle's
+at its closest point for a shape; for a gap function the part's given normal, the surface's
+normal on a curved part, or else the body's normal, the normalised mean of the unit normals of
+the part's faces at ``z``. A node of several parts carries one row per part, rows of one
+direction (within :data:`SAME_DIRECTION`) merged into the first part's, as 2D corners do.
+A node with rows takes the frame of its rows and held directions
+(:func:`~.node_frames3d.row_frames`); condition (b) transforms the rows by the face basis of
+:mod:`.face_basis` (condition (a): α = 0).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..fem.facet_element import FaceElement
+from ..fem.quadrature import triangle_rule
+from ..mesh.geometry import facet_normals
+from ..problem.conditions import Contact
+from ..problem.fields import ProblemError, evaluate_field
+from .face_basis import DEFAULT_ALPHA, FaceEdges, change_of_variables, face_edges
+from .node_frames3d import frame_operator, row_frames
+
+if TYPE_CHECKING:
+    from ..fem.space3d import P2TetSpace
+
+__all__ = ["SAME_DIRECTION", "FaceContactSet", "face_contact_set"]
+
+#: two rows at a node whose directions differ by less than this (max-norm) are one row
+SAME_DIRECTION = 1e-8
+
+
+@dataclass(frozen=True)
+class FaceContactSet:
+    """The constraints of Γ_C on P2 faces, one row per constraint (sorted by node, then part).
+
+    Attributes
+    ----------
+    n_dofs : int
+    node, part : (k,) int arrays
+        Each row's node and contact part (index into ``parts``).
+    parts : tuple of str
+    direction : (k, 3) float array
+        ``n_z``, unit.
+    psi : (k,) float array
+        ``ψ(z)``, the gap along ``n_z`` (the bounds of the solver's variables are
+        :attr:`gap`).
+    dof : (k,) int array
+        The frame DOF the row bounds, ``3 z + j``.
+    frame_nodes : (m,) int array
+        The nodes with rows; ``frames (m, 3, 3)`` their ``Q_z`` (``u(z) = Q_z y_z``).
+    frames : (m, 3, 3) float array
+    held_dofs : (n_h,) int array
+        The held DOFs in the frame variables; ``held_values (n_h,)`` their values.
+    held_values : (n_h,) float array
+    faces : (n_f, 6) int array
+        The P2 nodes of the contact faces; ``face_part (n_f,)`` their parts.
+    face_part : (n_f,) int array
+    edges : FaceEdges
+        The transformed basis on the rows (α = 0: condition (a)).
+    basis_integral : (k,) float array
+        ``w_z = ∫_{Γ_C} ψ_z`` over the row's part (zero at the vertices of flat faces).
+    hat_integral : (k,) float array
+        ``m_z = ∫ φ_z`` of the hats of the once-refined faces (the force density's (4.1)).
+    facet : FaceElement
+        The space's face element (its weights and nodal pressure).
+    """
+
+    n_dofs: int
+    node: np.ndarray
+    part: np.ndarray
+    parts: tuple[str, ...]
+    direction: np.ndarray
+    psi: np.ndarray
+    dof: np.ndarray
+    frame_nodes: np.ndarray
+    frames: np.ndarray
+    held_dofs: np.ndarray
+    held_values: np.ndarray
+    faces: np.ndarray
+    face_part: np.ndarray
+    edges: FaceEdges
+    basis_integral: np.ndarray
+    hat_integral: np.ndarray
+    facet: FaceElement
+
+    @property
+    def operator(self) -> sp.csr_matrix:
+        """``Q P (n_dofs, n_dofs)``: ``u = Q P ỹ`` from the solver's variables (frames, then
+        the transformed basis on the rows) to Cartesian DOFs."""
+        Q = frame_operator(self.n_dofs, self.frame_nodes, self.frames)
+        return (Q @ change_of_variables(self.n_dofs, self.dof, self.edges)).tocsr()
+
+    @property
+    def gap(self) -> np.ndarray:
+        """``(k,)`` ψ̃ = T^{-T} ψ: the bounds ``ỹ_dof ≤ ψ̃`` of the solver's variables (ψ
+        itself for condition (a))."""
+        return self.edges.coefficients(self.psi)
+
+    @property
+    def transformed_integral(self) -> np.ndarray:
+        """``(k,)`` ``w̃_z = ∫ φ̃_z = (T w)_z``: positive for 0 < α < 1/2."""
+        return self.edges.transformed(self.basis_integral)
+
+    def system(self, K: sp.spmatrix, F: np.ndarray) -> tuple[sp.csr_matrix, np.ndarray]:
+        """``(Rᵀ K R, Rᵀ F)`` with ``R`` = :attr:`operator`: the bound-constrained system of
+        :func:`~signorini.algebra.pdas.solve_pdas` (constrained ``dof``, bounds
+        :attr:`gap`, Dirichlet ``held_dofs`` at ``held_values``)."""
+        R = self.operator
+        return (R.T @ K @ R).tocsr(), R.T @ np.asarray(F, dtype=np.float64)
+
+    def displacement(self, x: np.ndarray) -> np.ndarray:
+        """``(n_dofs,)`` Cartesian DOFs ``u = Q P x`` of the solver's solution ``x``."""
+        return self.operator @ x
+
+    def force(self, K: sp.spmatrix, F: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """``(k,)`` the discrete contact force (3.17) ``Λ_z = L(ψ_z n_z) − a(u_h, ψ_z n_z)``
+        of each row, ``(Qᵀ (F − K u))_dof`` (positive where the obstacle pushes)."""
+        Q = frame_operator(self.n_dofs, self.frame_nodes, self.frames)
+        return (Q.T @ (np.asarray(F, dtype=np.float64) - K @ u))[self.dof]
+
+    def pressure(self, force: np.ndarray) -> np.ndarray:
+        """``(k,)`` the transformed basis's nodal pressure ``p̃_z = Λ̃_z / w̃_z``
+        (``Λ̃ = T Λ``), exact for a constant pressure; refused for condition (a), where the
+        vertex weights vanish (:meth:`~signorini.fem.facet_element.FaceElement.pressure`)."""
+        return self.facet.pressure(self.edges.transformed(force), self.transformed_integral)
+
+    def recovered_pressure(self, force: np.ndarray) -> np.ndarray:
+        """``(k,)`` the P1-lumped recovered pressure of either condition: at a vertex the
+        force on the P1 hat over its lumped face mass, ``(T_½ Λ)_v / (T_½ w)_v``, at a midpoint
+        the mean of its edge's ends (a midpoint outside every transformed edge keeps
+        ``Λ_e / w_e``); exact for a constant pressure."""
+        half = FaceEdges(self.n_rows, 0.5, self.edges.mid, self.edges.start, self.edges.end)
+        weight = half.transformed(self.basis_integral)
+        p = np.divide(
+            half.transformed(force), weight, out=np.full(self.n_rows, np.nan), where=weight > 0
+        )
+        p[half.mid] = 0.5 * (p[half.start] + p[half.end])
+        return p
+
+    @property
+    def n_rows(self) -> int:
+        """The number of rows ``k``."""
+        return self.node.size
+
+    # what the solve reads of a contact set (as of the 2D ContactSet)
+    size = n_rows
+    has_friction = False
+    transfer = None
+
+    @property
+    def constrained_dofs(self) -> np.ndarray:
+        """``(k,)`` the bounded DOFs of the solver's variables (``dof``)."""
+        return self.dof
+
+
+def _body_normals(space, name: str, facets: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """``(j, 3)`` the body's normals at the nodes ``z`` of part ``name``: the surface's on a
+    curved part, else the normalised mean of the unit normals of the part's faces at z."""
+    mesh = space.mesh
+    nodes = space.facet_nodes(facets)
+    _, normal = facet_normals(mesh.points[nodes[:, :3]])
+    total = np.zeros((space.n_nodes, 3))
+    np.add.at(total, nodes.ravel(), np.repeat(normal, 6, axis=0))
+    n = total[z] / np.linalg.norm(total[z], axis=1)[:, None]
+    surface = mesh.curves[mesh.part_index(name)]
+    if surface is not None and getattr(surface, "has_normal", False):
+        m = surface.normal(space.node_points[z])
+        return m * np.where(np.einsum("jc,jc->j", m, n) < 0, -1.0, 1.0)[:, None]
+    return n
+
+
+def _part_rows(space, name: str, cond: Contact) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The nodes of part ``name``'s faces (sorted), their directions and gaps."""
+    facets = space.mesh.part_facets(name)
+    z = np.unique(space.facet_nodes(facets))
+    x = space.node_points[z]
+    if cond.obstacle is not None:
+        if cond.obstacle.dim != 3:
+            raise ProblemError(
+                f"the obstacle {cond.obstacle!r} of contact part {name!r} is a plane shape "
+                "(dim 2) on a 3D mesh: use a shape of signorini.problem.obstacles3d"
+            )
+        try:
+            psi, n = cond.obstacle.gap_and_direction(x)
+        except ValueError as err:
+            raise ProblemError(f"the obstacle of contact part {name!r}: {err}") from err
+        return z, n, psi
+    what = f"the gap function of contact part {name!r}"
+    psi = evaluate_field(cond.gap_field(), x, what, shape=(), bounded=True)
+    if cond.normal is not None:
+        given = np.asarray(cond.normal, dtype=np.float64)
+        if given.shape != (3,):
+            raise ProblemError(f"contact part {name!r}: normal must be 3 numbers on a 3D mesh")
+        return z, np.broadcast_to(given / np.linalg.norm(given), x.shape).copy(), psi
+    return z, _body_normals(space, name, facets, z), psi
+
+
+def face_contact_set(
+    space: P2TetSpace,
+    contact: Mapping[str, Contact],
+    held: np.ndarray,
+    held_values: np.ndarray,
+    alpha: float = DEFAULT_ALPHA,
+) -> FaceContactSet:
+    """Resolve the contact parts of a 3D problem on a P2 tetrahedral space.
+
+    Parameters
+    ----------
+    space : P2TetSpace
+    contact : mapping part name -> Contact
+        The contact parts, in order (gap function or shape of space; frictionless).
+    held : (n_nodes, 3) bool array
+        The Cartesian components held at each node (Dirichlet, axis rollers).
+    held_values : (n_nodes, 3) float array
+        Their values.
+    alpha : float
+        The transformed basis's α (0: condition (a); default 1/5: condition (b)).
+
+    Returns
+    -------
+    FaceContactSet
+
+    Raises
+    ------
+    ProblemError
+        Naming the part or the node: a plane obstacle, a gap function that is not finite, a
+        node with more than three rows and held directions.
+    """
+    parts = tuple(contact)
+    found = [_part_rows(space, name, contact[name]) for name in parts]  # a loop over parts
+    node = np.concatenate([f[0] for f in found])
+    part = np.repeat(np.arange(len(parts)), [f[0].size for f in found])
+    direction = np.concatenate([f[1] for f in found])
+    gap = np.concatenate([f[2] for f in found])
+    held = np.asarray(held, dtype=bool)
+    held_values = np.asarray(held_values, dtype=np.float64)
+    free_normal = np.abs(np.where(held[node], 0.0, direction)).max(axis=1) > SAME_DIRECTION
+    order = np.lexsort((part, node))
+    order = order[free_normal[order]]
+    node, part, direction, gap = node[order], part[order], direction[order], gap[order]
+    # merge a later part's row into an earlier one at the same node with the same direction
+    row_of_part = np.full((space.n_nodes, len(parts)), -1, dtype=np.int64)
+    first = np.r_[True, node[1:] != node[:-1]]
+    same = ~first & (
+        np.abs(direction - np.roll(direction, 1, axis=0)).max(axis=1) <= SAME_DIRECTION
+    )
+    keep = ~same
+    kept_index = np.cumsum(keep) - 1  # the row each candidate becomes (merged: its previous)
+    row_of_part[node, part] = kept_index
+    node, part, direction, gap = node[keep], part[keep], direction[keep], gap[keep]
+    return _assembled(
+        space, parts, node, part, direction, gap, row_of_part, held, held_values, alpha
+    )
+
+
+def _assembled(space, parts, node, part, direction, gap, row_of_part, held, values, alpha):
+    """The frames, held DOFs, face basis and weights of the rows (:func:`face_contact_set`)."""
+    k = node.size
+    frame_nodes, start, count = np.unique(node, return_index=True, return_counts=True)
+    j = np.arange(k) - np.repeat(start, count)  # each row's index at its node
+    n_held = held[frame_nodes].sum(axis=1)
+    total = count + n_held
+    if (total > 3).any():
+        z = int(frame_nodes[np.argmax(total)])
+        raise ProblemError(
+            f"node {z} at {space.node_points[z].tolist()} has {int(total.max())} constraint "
+            "and held directions (at most 3): contact parts and held components meet there"
+        )
+    rows = np.zeros((frame_nodes.size, 3, 3))
+    rows[np.repeat(np.arange(frame_nodes.size), count), j] = direction
+    position = np.cumsum(held[frame_nodes], axis=1) - 1 + count[:, None]  # the held rows' slots
+    f, c = np.nonzero(held[frame_nodes])
+    rows[f, position[f, c], c] = 1.0
+    mean = np.array([np.abs(direction[part == i].sum(axis=0)) for i in range(len(parts))])
+    pole = np.argmax(mean, axis=1)[part[start]] if k else np.zeros(0, np.int64)
+    try:
+        Q = row_frames(rows, total, pole)
+    except np.linalg.LinAlgError:
+        Q = np.full(rows.shape, np.nan)
+    if not np.isfinite(Q).all():
+        raise ProblemError(
+            "the constraint and held directions at a contact node are dependent (a contact "
+            "direction along a held axis beside another part's)"
+        )
+    rotated = np.zeros(space.n_nodes, dtype=bool)
+    rotated[frame_nodes] = True
+    cartesian = np.flatnonzero((held & ~rotated[:, None]).ravel())
+    held_dofs = np.concatenate([3 * frame_nodes[f] + position[f, c], cartesian])
+    held_vals = np.concatenate([values[frame_nodes[f], c], values.reshape(-1)[cartesian]])
+    facet_index = np.concatenate([space.mesh.part_facets(p) for p in parts])
+    faces = space.facet_nodes(facet_index)
+    face_part = np.repeat(np.arange(len(parts)), [space.mesh.part_facets(p).size for p in parts])
+
+    def row_of(nodes, which):
+        return row_of_part[nodes, which]
+
+    edges = face_edges(faces, face_part, row_of, k, alpha)
+    w, m = _weights(space, facet_index, faces, face_part, row_of, k)
+    return FaceContactSet(
+        n_dofs=space.n_dofs,
+        node=node,
+        part=part,
+        parts=parts,
+        direction=direction,
+        psi=gap,
+        dof=3 * node + j,
+        frame_nodes=frame_nodes,
+        frames=Q,
+        held_dofs=held_dofs,
+        held_values=held_vals,
+        faces=faces,
+        face_part=face_part,
+        edges=edges,
+        basis_integral=w,
+        hat_integral=m,
+        facet=space.element.facet,
+    )
+
+
+def _weights(space, facet_index, faces, face_part, row_of, k):
+    """``w (k,)`` the integrals of the P2 functions over the rows' faces (by quadrature, on
+    flat and quadratic faces alike) and ``m (k,)`` those of the hats of the once-refined faces
+    (the face element's hat shares times the face areas)."""
+    element = space.element.facet
+    s, wq = triangle_rule(4)
+    phi = element.basis(s)  # (q, 6)
+    integral = np.zeros(faces.shape)
+    area = np.zeros(faces.shape[0])
+    for rows, group in space.boundary_facets(facet_index):  # a loop over flat / quadratic
+        weight = group.speeds(s) * wq  # (j, q)
+        integral[rows] = weight @ phi
+        area[rows] = weight.sum(axis=1)
+    rows = row_of(faces, face_part[:, None])
+    ok = rows >= 0
+    w = np.bincount(rows[ok], weights=integral[ok], minlength=k)
+    hat = area[:, None] * np.asarray(element.hat_share)[None, :]
+    m = np.bincount(rows[ok], weights=hat[ok], minlength=k)
+    return w, m

@@ -1,0 +1,209 @@
+"""The algebraic problem of one tetrahedral mesh: 3D elasticity without contact
+(docs/method.md, *Three dimensions: solving elasticity*).
+
+:func:`~.system.assemble` hands a mesh with ``dim = 3`` here. The stiffness matrix is
+:func:`~signorini.fem.stiffness3d.assemble_stiffness_3d`'s, the load the body force and the
+Neumann tractions of :mod:`signorini.fem.elasticity3d`; the held DOFs are the Dirichlet
+parts' components and the axis rollers' (one Cartesian component each,
+:func:`~signorini.problem.rollers.held_nodes`), interleaved ``3 node + c``. Without contact
+parts there are no node frames, so the system is ``K u = F`` with Cartesian unknowns. With
+contact parts the contact set on faces (:func:`~.face_contact.face_contact_set`; condition
+(b) with ``DEFAULT_ALPHA`` unless the parts give ``face_alpha``) gives the system
+``Rᵀ K R ỹ = Rᵀ F``, ``u = R ỹ`` (node frames, then the transformed face basis), its bounds
+and its held DOFs (docs/method.md, *Three dimensions: contact on faces*).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..algebra.ranks import SERIAL
+from ..fem.elasticity3d import assemble_body_force_3d, assemble_face_load_3d
+from ..fem.space3d import P2TetSpace
+from ..fem.stiffness3d import assemble_stiffness_3d
+from ..mesh.mesh import Mesh
+from ..problem.conditions import Neumann, Roller
+from ..problem.fields import ProblemError, evaluate_field
+from ..problem.normals import straight_normal
+from ..problem.problem import ContactProblem
+from ..problem.rollers import held_nodes
+from .admissible import check_load_size
+from .contact_set import _empty
+from .discrete_conditions import DiscreteConditions
+from .face_basis import DEFAULT_ALPHA
+from .face_contact import face_contact_set
+from .ordering import Ordering
+from .system import Assembled, RollerDofs
+
+__all__ = ["assemble_3d", "LOAD_DEGREE_3D"]
+
+#: quadrature degree on the tetrahedron and its faces for loads with smooth data (the rule
+#: of degree 8 in 2D is for f·φ of high degree; degree 6 integrates a quartic load against
+#: the quadratic basis exactly)
+LOAD_DEGREE_3D = 6
+
+
+def discrete_conditions_3d(problem: ContactProblem, space: P2TetSpace) -> DiscreteConditions:
+    """The conditions of a 3D problem on the nodes of ``space``: the held components and
+    their values ``(n_nodes, 3)``, the axis rollers' outward normals, and nothing of contact
+    (:class:`~.discrete_conditions.DiscreteConditions` with ``d = 3`` columns)."""
+    n = space.n_nodes
+    held_parts = tuple(problem.dirichlet_parts)
+    held_part = np.full(n, -1, dtype=np.int64)
+    for i, name in enumerate(held_parts):  # a loop over parts: the later one wins
+        held_part[space.part_nodes([name])] = i
+    axis_normal = np.zeros((n, 3))
+    for name in reversed(problem.held):  # a loop over parts: the first one wins
+        if isinstance(problem.conditions[name], Roller):
+            normal = straight_normal(space.mesh, name)
+            c = int(np.argmax(np.abs(normal)))
+            axis_normal[space.part_nodes([name])] = np.eye(3)[c] * np.sign(normal[c])
+    none = np.zeros(0, dtype=np.int64)
+    return DiscreteConditions(
+        held=held_nodes(problem, space),
+        held_parts=held_parts,
+        held_part=held_part,
+        axis_normal=axis_normal,
+        contact_parts=(),
+        straight_normal=np.zeros((0, 3)),
+        obstacles=(),
+        obstacle_motion=np.zeros((0, 3)),
+        gap_nodes=none,
+        gap_part=none,
+        gap=np.zeros(0),
+        obstacle_direction=np.zeros((0, 3)),
+        friction=(),
+        pairs={},
+        rigid_motions=problem.rigid_motions,
+        rigid_field=np.zeros((0, n, 3)),
+    )
+
+
+def _roller_dofs_3d(conditions: DiscreteConditions) -> RollerDofs:
+    """The axis rollers' nodes that hold one component, ``3 z + c``, with their normals."""
+    axis = conditions.axis_normal
+    partial = conditions.held.components.sum(axis=1) == 1
+    z = np.flatnonzero(partial & axis.any(axis=1))
+    c = np.argmax(np.abs(axis[z]), axis=1)
+    return RollerDofs(z, 3 * z + c, axis[z, c], axis[z])
+
+
+def assemble_3d(problem: ContactProblem, mesh: Mesh) -> Assembled:
+    """Stiffness, load and held DOFs of a 3D ``problem`` on the tetrahedral ``mesh``.
+
+    ``K[3 z + i, 3 w + j] = a(φ_w e_j, φ_z e_i)``, ``F[3 z + i] = ∫_Ω f_i φ_z +
+    Σ_Neumann ∫_Γ g_i φ_z`` (docs/method.md, *Three dimensions: P2 tetrahedra and 3D
+    elasticity*), with the problem's data evaluated at points ``(n, 3)``.
+
+    Returns
+    -------
+    Assembled
+        With an empty contact set and no frames; ``dirichlet`` the held DOFs (sorted) and
+        ``dirichlet_values`` their prescribed displacements.
+
+    Raises
+    ------
+    ProblemError
+        If the stiffness matrix overflows, a load function does not give finite numbers
+        ``(n, 3)``, or a load's displacement would overflow (naming it).
+    """
+    t0 = time.perf_counter()
+    space = P2TetSpace(mesh)
+    n_dofs = space.n_dofs
+    material = problem.material_on(mesh)
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported just below
+        K = assemble_stiffness_3d(space.mapping, space.cell_dofs, n_dofs, material)
+    if not np.isfinite(K.data).all():
+        raise ProblemError(
+            f"material: the stiffness matrix overflows float64 (lam = {np.max(material.lam):.3g}"
+            f", mu = {np.max(material.mu):.3g}); state E in larger units"
+        )
+    F = np.zeros(n_dofs)
+    loads = {}
+    if problem.body_force is not None:
+
+        def force(x):
+            return evaluate_field(problem.body_force, x, "body_force", shape=(3,))
+
+        f = assemble_body_force_3d(space, force, degree=LOAD_DEGREE_3D)
+        F += f
+        loads["the body force"] = float(np.abs(f).max(initial=0.0))
+    for name in problem.neumann_parts:  # a loop over parts
+        cond: Neumann = problem.conditions[name]
+        if cond.is_zero:
+            continue
+        g = cond.field()
+        what = f"the traction of Neumann part {name!r}"
+
+        def traction(x, n, g=g, what=what):
+            return evaluate_field(g, x, what, shape=(3,), normal=n)
+
+        t = assemble_face_load_3d(space, mesh.part_facets(name), traction, LOAD_DEGREE_3D)
+        F += t
+        loads[what] = float(np.abs(t).max(initial=0.0))
+    check_load_size(K, F, loads, SERIAL)
+    conditions = discrete_conditions_3d(problem, space)
+    held = conditions.held
+    if problem.contact_parts:
+        return _with_contact(problem, space, K, F, conditions, time.perf_counter() - t0)
+    dirichlet = np.flatnonzero(held.components.ravel())
+    return Assembled(
+        space,
+        _empty(()),
+        K,
+        F,
+        dirichlet,
+        held.values.ravel()[dirichlet],
+        time.perf_counter() - t0,
+        conditions.dirichlet_nodes,
+        np.zeros((0, 3)),
+        np.zeros(0, dtype=np.int64),
+        np.zeros((0, 3, 3)),
+        _roller_dofs_3d(conditions),
+        conditions,
+        None,
+        Ordering(space),
+    )
+
+
+def _with_contact(
+    problem: ContactProblem,
+    space: P2TetSpace,
+    K: sp.csr_matrix,
+    F: np.ndarray,
+    conditions: DiscreteConditions,
+    seconds: float,
+) -> Assembled:
+    """The :class:`Assembled` of a 3D problem with contact parts: the system in the solver's
+    variables (:meth:`~.face_contact.FaceContactSet.system`), its held DOFs sorted, the
+    rollers off the contact nodes."""
+    t0 = time.perf_counter()
+    held = conditions.held
+    contact = {name: problem.conditions[name] for name in problem.contact_parts}
+    alpha = next(iter(contact.values())).face_alpha  # one for all parts (problem3d)
+    alpha = DEFAULT_ALPHA if alpha is None else alpha
+    cs = face_contact_set(space, contact, held.components, held.values, alpha)
+    K_rot, F_rot = cs.system(K, F)
+    order = np.argsort(cs.held_dofs)
+    rollers = _roller_dofs_3d(conditions)
+    off = ~np.isin(rollers.nodes, cs.frame_nodes)
+    return Assembled(
+        space,
+        cs,
+        K_rot,
+        F_rot,
+        cs.held_dofs[order],
+        cs.held_values[order],
+        seconds + time.perf_counter() - t0,
+        conditions.dirichlet_nodes,
+        np.zeros((cs.n_rows, 3)),
+        cs.frame_nodes,
+        cs.frames,
+        RollerDofs(rollers.nodes[off], rollers.dofs[off], rollers.sign[off], rollers.normal[off]),
+        conditions,
+        None,
+        Ordering(space),
+    )

@@ -1,0 +1,137 @@
+"""``elasticity-3d``: a manufactured smooth solution of 3D elasticity on the unit cube, no
+contact (docs/method.md, *Three dimensions: solving elasticity*) — the first thing a 3D user
+runs (``signorini run elasticity-3d --uniform``).
+
+``u = (sin πx sin πy sin πz, x y z eˣ, cos(πx/2) y² z)`` with ``λ = 1.7``, ``μ = 0.9``, the
+body force ``f = −div σ(u)`` and ``u`` itself on all six faces (Dirichlet). Under uniform
+refinement of P2 tetrahedra the energy error falls like ``h² ~ N^{−2/3}`` and the L² error
+like ``h³ ~ N^{−1}``. The measurements (:data:`ELASTICITY_3D_METRICS`) add the L² error and
+the observed rates of the three errors against the free unknowns N to the history.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..contact.solution import ContactResult
+from ..fem.material import Material
+from ..mesh.builders3d import box
+from ..problem.conditions import Dirichlet, ExactSolution
+from ..problem.problem import ContactProblem
+from .metrics import Metrics
+
+__all__ = ["ELASTICITY_3D_METRICS", "elasticity_3d"]
+
+MATERIAL = Material(lam=1.7, mu=0.9)
+
+
+def displacement(x: np.ndarray) -> np.ndarray:
+    """``u(x (n, 3)) -> (n, 3)``."""
+    X, Y, Z = x[:, 0], x[:, 1], x[:, 2]
+    return np.stack(
+        [
+            np.sin(np.pi * X) * np.sin(np.pi * Y) * np.sin(np.pi * Z),
+            X * Y * Z * np.exp(X),
+            np.cos(np.pi * X / 2) * Y**2 * Z,
+        ],
+        axis=-1,
+    )
+
+
+def _derivatives(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``∇u (n, 3, 3)`` and the Hessians ``H[n, i, j, k] = ∂_j ∂_k u_i (n, 3, 3, 3)``."""
+    X, Y, Z = x[:, 0], x[:, 1], x[:, 2]
+    pi, s, c, e = np.pi, np.sin, np.cos, np.exp(X)
+    sx, sy, sz, cx, cy, cz = s(pi * X), s(pi * Y), s(pi * Z), c(pi * X), c(pi * Y), c(pi * Z)
+    h, ch = s(pi * X / 2), c(pi * X / 2)
+    zero = np.zeros_like(X)
+    g = np.stack(
+        [
+            [pi * cx * sy * sz, pi * sx * cy * sz, pi * sx * sy * cz],
+            [Y * Z * e * (1 + X), X * Z * e, X * Y * e],
+            [-pi / 2 * h * Y**2 * Z, 2 * ch * Y * Z, ch * Y**2],
+        ]
+    )  # (3, 3, n)
+    p2 = pi**2
+    H = np.stack(
+        [
+            [
+                [-p2 * sx * sy * sz, p2 * cx * cy * sz, p2 * cx * sy * cz],
+                [p2 * cx * cy * sz, -p2 * sx * sy * sz, p2 * sx * cy * cz],
+                [p2 * cx * sy * cz, p2 * sx * cy * cz, -p2 * sx * sy * sz],
+            ],
+            [
+                [Y * Z * e * (2 + X), Z * e * (1 + X), Y * e * (1 + X)],
+                [Z * e * (1 + X), zero, X * e],
+                [Y * e * (1 + X), X * e, zero],
+            ],
+            [
+                [-p2 / 4 * ch * Y**2 * Z, -pi * h * Y * Z, -pi / 2 * h * Y**2],
+                [-pi * h * Y * Z, 2 * ch * Z, 2 * ch * Y],
+                [-pi / 2 * h * Y**2, 2 * ch * Y, zero],
+            ],
+        ]
+    )  # (3, 3, 3, n)
+    return np.moveaxis(g, -1, 0), np.moveaxis(H, -1, 0)
+
+
+def gradient(x: np.ndarray) -> np.ndarray:
+    """``∇u(x (n, 3)) -> (n, 3, 3)``, ``[:, i, j] = ∂u_i/∂x_j``."""
+    return _derivatives(x)[0]
+
+
+def body_force(x: np.ndarray) -> np.ndarray:
+    """``f = −div σ(u) = −(μ Δu + (λ + μ) ∇ div u)`` at ``x (n, 3)``."""
+    H = _derivatives(x)[1]
+    laplace = np.einsum("nijj->ni", H)
+    grad_div = np.einsum("njij->ni", H)
+    return -(MATERIAL.mu * laplace + (MATERIAL.lam + MATERIAL.mu) * grad_div)
+
+
+def elasticity_3d(n: int = 2) -> ContactProblem:
+    """The manufactured problem on the Kuhn mesh of ``n³`` cubes."""
+    mesh = box(n, n, n)
+    return ContactProblem(
+        mesh,
+        MATERIAL,
+        {name: Dirichlet(displacement) for name in mesh.part_names},
+        body_force=body_force,
+        exact=ExactSolution(displacement, gradient),
+        name="elasticity-3d",
+    )
+
+
+class _Rates:
+    """The errors of each level and their observed rates ``log(e_k / e_{k−1}) / log(N_k /
+    N_{k−1})`` against the previous level's (NaN on the first level of a run: a level no
+    finer than the one before starts a new run)."""
+
+    def __init__(self) -> None:
+        self.previous: tuple[float, dict[str, float]] | None = None
+
+    def __call__(self, result: ContactResult) -> dict[str, float]:
+        errors = result.errors()
+        n = float(result.ndof)
+        out = {"error_l2": errors["error_l2"]}
+        for name in ("error_energy", "error_h1", "error_l2"):
+            rate = math.nan
+            if self.previous is not None and self.previous[0] < n:  # else a new run
+                old_n, old = self.previous
+                rate = math.log(errors[name] / old[name]) / math.log(n / old_n)
+            out[f"rate_{name.removeprefix('error_')}"] = rate
+        self.previous = (n, errors)
+        return out
+
+
+#: the L² error and the observed rates of the three errors (columns of the history)
+ELASTICITY_3D_METRICS = Metrics(
+    _Rates(),
+    {
+        "error_l2": "‖u − u_h‖_{L²(Ω)} against the exact solution",
+        "rate_energy": "observed rate of error_energy against ndof (expected −2/3)",
+        "rate_h1": "observed rate of error_h1 against ndof (expected −2/3)",
+        "rate_l2": "observed rate of error_l2 against ndof (expected −1)",
+    },
+)
