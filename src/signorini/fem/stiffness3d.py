@@ -71,10 +71,10 @@ _UPPER = tuple((i, j) for i in range(3) for j in range(i, 3))
 
 
 def _per_cell(value: float | np.ndarray, rows: slice) -> float | np.ndarray:
-    """A scalar, or the rows ``rows`` of an ``(m,)`` array shaped ``(k, 1, 1)``."""
+    """A scalar, or the rows ``rows`` of an ``(m,)`` array shaped ``(k, 1, 1, 1)``."""
     if np.ndim(value) == 0:
         return value
-    return np.asarray(value)[rows, None, None]
+    return np.asarray(value)[rows, None, None, None]
 
 
 @lru_cache(maxsize=16)
@@ -105,6 +105,7 @@ def _chunks(
     jit = cells.inverse_transpose(xi)
     R = _reference_products(degree, det.shape[1] > 1)  # (p · 9, 100)
     scratch = np.empty((9, min(_CHUNK, m), 10, 10))
+    products = np.empty((len(_UPPER), min(_CHUNK, m), 100))
     for start in range(0, m, _CHUNK):  # chunks of cells bound the temporaries
         rows = slice(start, min(start + _CHUNK, m))
         d, t = det[rows], jit[rows]
@@ -114,18 +115,20 @@ def _chunks(
         for u, (i, j) in enumerate(_UPPER):
             np.multiply(t[:, :, i, :, None], t[:, :, j, None, :], out=P[u])
             P[u] *= d[:, :, None, None]
-        B = rows_times(P.reshape(-1, R.shape[0]), R).reshape(len(_UPPER), len(d), 10, 10)
-        B = {ij: B[u] for u, ij in enumerate(_UPPER)}
+        # K_ij = Q_ij R with Q_ij[kl] = λ P_ij[kl] + μ P_ij[lk] + δ_ij μ Σ_m P_mm[kl]
+        # (B_ijᵀ = P_ijᵀ R, the reference products being symmetric under (k, a) <-> (l, b))
         lam_k, mu_k = _per_cell(lam, rows), _per_cell(mu, rows)
-        trace = mu_k * (B[0, 0] + B[1, 1] + B[2, 2])  # μ ∫ ∇φ_a · ∇φ_b
-        for i, j in _UPPER:
-            Kij = K[3 * i + j]
-            np.multiply(lam_k, B[i, j], out=Kij)
-            Kij += mu_k * np.swapaxes(B[i, j], -1, -2)
+        Q = lam_k * P + mu_k * np.swapaxes(P, -1, -2)
+        trace = mu_k * (P[0] + P[_UPPER.index((1, 1))] + P[_UPPER.index((2, 2))])
+        for u, (i, j) in enumerate(_UPPER):
             if i == j:
-                Kij += trace
-            else:  # K[(b, j), (a, i)] = K[(a, i), (b, j)]: the symmetric block
-                K[3 * j + i] = np.swapaxes(Kij, -1, -2)
+                Q[u] += trace
+        B = rows_times(Q.reshape(-1, R.shape[0]), R, out=products[:, : len(d)].reshape(-1, 100))
+        B = B.reshape(len(_UPPER), len(d), 10, 10)
+        for u, (i, j) in enumerate(_UPPER):
+            K[3 * i + j] = B[u]
+            if i != j:  # K[(b, j), (a, i)] = K[(a, i), (b, j)]: the symmetric block
+                K[3 * j + i] = np.swapaxes(B[u], -1, -2)
         yield rows, K
 
 
