@@ -40,9 +40,11 @@ MATERIAL = Material.from_young(1.0, 0.3)
 
 
 def best_of(repeat: int, run) -> tuple[float, object]:
-    """The fastest of ``repeat`` runs (seconds) and the last result."""
+    """The fastest of ``repeat`` runs (seconds) and the last result (the previous one freed
+    before each run, as a program that assembles again would)."""
     best, out = np.inf, None
     for _ in range(repeat):
+        out = None
         t0 = time.perf_counter()
         out = run()
         best = min(best, time.perf_counter() - t0)

@@ -12,9 +12,12 @@ gradients ``∇φ_a = J⁻ᵀ ∇̂φ_a`` and the weights ``w_p det J(ξ_p)`` of
     K[(a, i), (b, j)] = λ B_ij[a, b] + μ B_ji[a, b] + μ δ_ij Σ_k B_kk[a, b],
 
 with ``B_ji = B_ijᵀ`` (in a, b), so only ``i ≤ j`` are formed and ``K[(b, j), (a, i)]`` is
-copied from ``K[(a, i), (b, j)]``. Where ``J`` is constant (affine cells) ``P`` has one point
-and ``R`` is summed over the rule first, ``(9, 100)``: one product of the ``(6 m, 9)``
-factors with it per chunk of cells, :func:`~signorini.fem.fixed_order.rows_times` (no BLAS),
+copied from ``K[(a, i), (b, j)]``. As ``R_p[lk, ba] = R_p[kl, ab]``, ``B_ijᵀ`` is the product
+of ``P_p[ij, lk]`` with ``R_p``, so the law is applied to the factors before the product:
+``K_ij = Σ_p Q_p[ij] R_p`` with ``Q_p[ij, kl] = λ P_p[ij, kl] + μ P_p[ij, lk] + μ δ_ij Σ_m
+P_p[mm, kl]``. Where ``J`` is constant (affine cells) ``P`` has one point and ``R`` is summed
+over the rule first, ``(9, 100)``: one product of the ``(6 m, 9)`` factors ``Q`` with it per
+chunk of cells, :func:`~signorini.fem.fixed_order.rows_times` (no BLAS),
 so each cell's matrix depends on that cell's data alone, bit for bit, whatever cells are
 computed beside it. On affine cells the integrand is of degree 2 and the four-point rule
 makes it exact; on the quadratic maps of isoparametric cells ``P`` varies and the degree-4
