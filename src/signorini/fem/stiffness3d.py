@@ -39,10 +39,10 @@ fit; the complex packing of the 2D assembly is a d = 2 trick and is not used.
 
 Measured on a shared two-core machine (``benchmarks/assembly3d.py``, Kuhn cube, best of
 three, NGSolve on one thread and scikit-fem on the same mesh in the same run): again on the
-same mesh 0.64–0.99 × 10⁶ unknowns per second from 1.5 × 10⁴ to 1.07 × 10⁶ unknowns (0.67 at
-1.07 × 10⁶), 3.1–4.0 times faster than NGSolve; the first assembly on a mesh (its pattern
-built) 0.23–0.60 × 10⁶ (0.36 at 1.07 × 10⁶), 1.3–2.6 times NGSolve's and 28–51 times
-scikit-fem's. Of a warm assembly the element matrices are about two thirds.
+same mesh 0.61–0.82 × 10⁶ unknowns per second from 1.5 × 10⁴ to 1.07 × 10⁶ unknowns, 2.2–4.1
+times faster than NGSolve; the first assembly on a mesh (its pattern built) 0.41–0.50 × 10⁶
+to 3.5 × 10⁵ unknowns, 1.1–3.9 times NGSolve's and 31–81 times scikit-fem's, 0.14 × 10⁶ at
+1.07 × 10⁶ (its memory faulted in). Of a warm assembly the element matrices are about half.
 """
 
 from __future__ import annotations
