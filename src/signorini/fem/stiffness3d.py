@@ -12,9 +12,12 @@ gradients ``∇φ_a = J⁻ᵀ ∇̂φ_a`` and the weights ``w_p det J(ξ_p)`` of
     K[(a, i), (b, j)] = λ B_ij[a, b] + μ B_ji[a, b] + μ δ_ij Σ_k B_kk[a, b],
 
 with ``B_ji = B_ijᵀ`` (in a, b), so only ``i ≤ j`` are formed and ``K[(b, j), (a, i)]`` is
-copied from ``K[(a, i), (b, j)]``. Where ``J`` is constant (affine cells) ``P`` has one point
-and ``R`` is summed over the rule first, ``(9, 100)``: one product of the ``(6 m, 9)``
-factors with it per chunk of cells, :func:`~signorini.fem.fixed_order.rows_times` (no BLAS),
+copied from ``K[(a, i), (b, j)]``. As ``R_p[lk, ba] = R_p[kl, ab]``, ``B_ijᵀ`` is the product
+of ``P_p[ij, lk]`` with ``R_p``, so the law is applied to the factors before the product:
+``K_ij = Σ_p Q_p[ij] R_p`` with ``Q_p[ij, kl] = λ P_p[ij, kl] + μ P_p[ij, lk] + μ δ_ij Σ_m
+P_p[mm, kl]``. Where ``J`` is constant (affine cells) ``P`` has one point and ``R`` is summed
+over the rule first, ``(9, 100)``: one product of the ``(6 m, 9)`` factors ``Q`` with it per
+chunk of cells, :func:`~signorini.fem.fixed_order.rows_times` (no BLAS),
 so each cell's matrix depends on that cell's data alone, bit for bit, whatever cells are
 computed beside it. On affine cells the integrand is of degree 2 and the four-point rule
 makes it exact; on the quadratic maps of isoparametric cells ``P`` varies and the degree-4
@@ -23,23 +26,28 @@ rule is used (as in 2D).
 Assembly
 --------
 The element matrices are 3 × 3 node blocks (DOFs ``3 node + component``,
-:mod:`signorini.fem.dofs`), ``(m, 10, 10, 3, 3)`` (:func:`node_blocks`). The sum over cells
-sorts the ``m · 100`` node pairs once (:func:`_assemble_node_blocks`) and adds each pair's
-blocks in one sparse product with the 0/1 matrix of the sort's runs; the summed blocks are a
-BSR matrix (blocksize 3) as they stand, converted to CSR once: sorted indices, the
-node-block pattern (rows ``3z … 3z + 2`` share their columns), int32 indices while they fit.
-A scalar COO → CSR conversion would sort the 900 entries of each cell instead of its 100
-node pairs; the complex packing of the 2D assembly is a d = 2 trick and is not used.
+:mod:`signorini.fem.dofs`), ``(m, 10, 10, 3, 3)`` (:func:`node_blocks`), formed chunk by
+chunk component by component (``(9, k, 10, 10)``, contiguous writes). The matrix is symmetric,
+so the assembly keeps only each cell's 55 *upper* node pairs (the global row the smaller
+node, :func:`upper_blocks`) and sums them in cell order with one sparse product through the
+mesh's node-pair pattern (:mod:`signorini.fem.pattern3d`: built at the first assembly on a
+mesh, one stable sort of the ``55 m`` pair keys, and kept while the space's DOF array
+lives); the sums are laid out as the CSR data by one gather, the lower triangle mirrored from
+the upper one, so the matrix is symmetric bit for bit. The result has sorted indices, the
+node-block pattern (rows ``3z … 3z + 2`` share their columns) and int32 indices while they
+fit; the complex packing of the 2D assembly is a d = 2 trick and is not used.
 
-Measured on a shared two-core machine (``benchmarks/assembly3d.py``, Kuhn cube): 0.30–0.52 ×
-10⁶ unknowns per second of wall time from 1.5 × 10⁴ to 3.5 × 10⁵ unknowns, 24–38 times
-scikit-fem's ``asm`` on the same mesh in the same run; at 1.1 × 10⁵ unknowns 0.12 s of CPU
-for the element matrices and 0.15 s for the sum (the sort of the node pairs the largest
-part, 0.27 s of 0.55 at 3.5 × 10⁵). The issue's 0.5 × 10⁶ is reached on small meshes only.
+Measured on a shared two-core machine (``benchmarks/assembly3d.py``, Kuhn cube, best of
+three, NGSolve on one thread and scikit-fem on the same mesh in the same run): again on the
+same mesh 0.61–0.82 × 10⁶ unknowns per second from 1.5 × 10⁴ to 1.07 × 10⁶ unknowns, 2.2–4.1
+times faster than NGSolve; the first assembly on a mesh (its pattern built) 0.41–0.50 × 10⁶
+to 3.5 × 10⁵ unknowns, 1.1–3.9 times NGSolve's and 31–81 times scikit-fem's, 0.14 × 10⁶ at
+1.07 × 10⁶ (its memory faulted in). Of a warm assembly the element matrices are about half.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from functools import lru_cache
 
 import numpy as np
@@ -50,6 +58,7 @@ from .fixed_order import rows_times
 from .mapping import CellMap
 from .mapping3d import AffineTetrahedra, IsoparametricTetrahedra, TetrahedronMap
 from .material import CellMaterials, Material, lame_parameters, on_cells
+from .pattern3d import pattern_of
 from .quadrature import tetrahedron_rule
 
 __all__ = ["assemble_stiffness_3d", "element_stiffness_3d"]
@@ -65,10 +74,10 @@ _UPPER = tuple((i, j) for i in range(3) for j in range(i, 3))
 
 
 def _per_cell(value: float | np.ndarray, rows: slice) -> float | np.ndarray:
-    """A scalar, or the rows ``rows`` of an ``(m,)`` array shaped ``(k, 1, 1)``."""
+    """A scalar, or the rows ``rows`` of an ``(m,)`` array shaped ``(k, 1, 1, 1)``."""
     if np.ndim(value) == 0:
         return value
-    return np.asarray(value)[rows, None, None]
+    return np.asarray(value)[rows, None, None, None]
 
 
 @lru_cache(maxsize=16)
@@ -82,6 +91,48 @@ def _reference_products(degree: int, per_point: bool) -> np.ndarray:
     R = R.reshape(len(w) * 9, 100) if per_point else R.sum(axis=0).reshape(9, 100)
     R.setflags(write=False)
     return R
+
+
+def _chunks(
+    cells: _Tetrahedra, material: Material | CellMaterials, degree: int | None
+) -> Iterator[tuple[slice, np.ndarray]]:
+    """The node blocks of the cells chunk by chunk, ``(rows, K (9, k, 10, 10))`` with
+    ``K[3 i + j, c, a, b] = a(φ_b e_j, φ_a e_i)`` on cell ``rows[c]`` (module docstring), in
+    one scratch array reused from chunk to chunk; each cell's blocks from its own data alone.
+    """
+    lam, mu = lame_parameters(material, 3)
+    degree = 2 * cells.order if degree is None else degree
+    xi, w = tetrahedron_rule(degree)
+    m = len(cells)
+    J, det = cells.jacobians(xi)  # (m, p, 3, 3), p = 1 (affine) or q
+    jit = cells.inverse_transpose(xi)
+    R = _reference_products(degree, det.shape[1] > 1)  # (p · 9, 100)
+    scratch = np.empty((9, min(_CHUNK, m), 10, 10))
+    products = np.empty((len(_UPPER), min(_CHUNK, m), 100))
+    for start in range(0, m, _CHUNK):  # chunks of cells bound the temporaries
+        rows = slice(start, min(start + _CHUNK, m))
+        d, t = det[rows], jit[rows]
+        K = scratch[:, : len(d)]
+        # P[(i, j), c, p, k, l] = det J J⁻ᵀ[i, k] J⁻ᵀ[j, l] at point p, for i <= j
+        P = np.empty((len(_UPPER), len(d), d.shape[1], 3, 3))
+        for u, (i, j) in enumerate(_UPPER):
+            np.multiply(t[:, :, i, :, None], t[:, :, j, None, :], out=P[u])
+            P[u] *= d[:, :, None, None]
+        # K_ij = Q_ij R with Q_ij[kl] = λ P_ij[kl] + μ P_ij[lk] + δ_ij μ Σ_m P_mm[kl]
+        # (B_ijᵀ = P_ijᵀ R, the reference products being symmetric under (k, a) <-> (l, b))
+        lam_k, mu_k = _per_cell(lam, rows), _per_cell(mu, rows)
+        Q = lam_k * P + mu_k * np.swapaxes(P, -1, -2)
+        trace = mu_k * (P[0] + P[_UPPER.index((1, 1))] + P[_UPPER.index((2, 2))])
+        for u, (i, j) in enumerate(_UPPER):
+            if i == j:
+                Q[u] += trace
+        B = rows_times(Q.reshape(-1, R.shape[0]), R, out=products[:, : len(d)].reshape(-1, 100))
+        B = B.reshape(len(_UPPER), len(d), 10, 10)
+        for u, (i, j) in enumerate(_UPPER):
+            K[3 * i + j] = B[u]
+            if i != j:  # K[(b, j), (a, i)] = K[(a, i), (b, j)]: the symmetric block
+                K[3 * j + i] = np.swapaxes(B[u], -1, -2)
+        yield rows, K
 
 
 def node_blocks(
@@ -110,35 +161,47 @@ def node_blocks(
     -------
     (m, 10, 10, 3, 3) float64 array
     """
-    lam, mu = lame_parameters(material, 3)
-    degree = 2 * cells.order if degree is None else degree
-    xi, w = tetrahedron_rule(degree)
-    m = len(cells)
-    out = np.empty((m, 10, 10, 3, 3)) if out is None else out
-    J, det = cells.jacobians(xi)  # (m, p, 3, 3), p = 1 (affine) or q
-    jit = cells.inverse_transpose(xi)
-    R = _reference_products(degree, det.shape[1] > 1)  # (p · 9, 100)
-    for start in range(0, m, _CHUNK):  # chunks of cells bound the temporaries
-        rows = slice(start, min(start + _CHUNK, m))
-        # P[c, (i, j), p, k, l] = det J J⁻ᵀ[i, k] J⁻ᵀ[j, l] at point p, for i <= j
-        d, t = det[rows], jit[rows]
-        P = np.empty((len(d), len(_UPPER), d.shape[1], 3, 3))
-        for u, (i, j) in enumerate(_UPPER):
-            np.multiply(t[:, :, i, :, None], t[:, :, j, None, :], out=P[:, u])
-            P[:, u] *= d[:, :, None, None]
-        B = rows_times(P.reshape(-1, R.shape[0]), R).reshape(len(d), len(_UPPER), 10, 10)
-        B = {ij: B[:, u] for u, ij in enumerate(_UPPER)}
-        lam_k, mu_k = _per_cell(lam, rows), _per_cell(mu, rows)
-        trace = mu_k * (B[0, 0] + B[1, 1] + B[2, 2])  # μ ∫ ∇φ_a · ∇φ_b
-        for i, j in _UPPER:
-            K = out[rows, :, :, i, j]
-            np.multiply(lam_k, B[i, j], out=K)
-            K += mu_k * np.swapaxes(B[i, j], -1, -2)
-            if i == j:
-                K += trace
-            else:  # K[(b, j), (a, i)] = K[(a, i), (b, j)]: the symmetric block
-                out[rows, :, :, j, i] = np.swapaxes(K, -1, -2)
+    out = np.empty((len(cells), 10, 10, 3, 3)) if out is None else out
+    for rows, K in _chunks(cells, material, degree):
+        out[rows] = K.reshape(3, 3, -1, 10, 10).transpose(2, 3, 4, 0, 1)
     return out
+
+
+def upper_blocks(
+    cells: _Tetrahedra,
+    material: Material | CellMaterials,
+    select: np.ndarray,
+    out: np.ndarray,
+    rows: np.ndarray | slice = slice(None),
+) -> None:
+    """The node blocks of the upper node pairs of a group of tetrahedra,
+    ``out[rows[c], k] = node_blocks[c, a, b]`` with ``10 a + b = select[rows[c], k]``
+    (:mod:`signorini.fem.pattern3d`), chunk by chunk (the whole ``(m, 10, 10, 3, 3)`` array
+    is never formed).
+
+    Parameters
+    ----------
+    cells : AffineTetrahedra or IsoparametricTetrahedra
+    material : Material or CellMaterials
+        Of the group's cells in its order.
+    select : (n_cells, 55) int array
+        The mesh's local upper pairs (``NodePattern.select``).
+    out : (n_cells, 55, 9) float array
+        Receives the group's rows.
+    rows : (m,) int array or slice
+        The group's cells in the mesh (``cells.cells``).
+    """
+    whole = isinstance(rows, slice) and rows == slice(None)
+    index = None if whole else np.arange(len(select))[rows]
+    for chunk, K in _chunks(cells, material, None):
+        cell = chunk if whole else index[chunk]
+        k = K.shape[1]
+        flat = select[cell] + (100 * np.arange(k))[:, None]
+        taken = np.take(K.reshape(9, -1), flat.reshape(-1), axis=1)  # (9, k · 55)
+        if whole:  # straight into the rows of out
+            np.copyto(out[cell].reshape(-1, 9), taken.T)
+        else:
+            out[cell] = taken.T.reshape(k, -1, 9)
 
 
 def element_stiffness_3d(
@@ -177,6 +240,12 @@ def assemble_stiffness_3d(
 ) -> sp.csr_matrix:
     """Global stiffness matrix ``(n_dofs, n_dofs)`` of 3D elasticity on P2 tetrahedra.
 
+    The mesh's pattern (:func:`~signorini.fem.pattern3d.pattern_of`) is built at the first
+    assembly with these ``cell_dofs`` and kept while the array lives; each assembly forms the
+    blocks of the cells' upper node pairs (:func:`upper_blocks`), sums them in cell order
+    (``pattern.sums @ blocks``) and lays the sums out as the CSR data, the lower triangle
+    mirrored from the upper one.
+
     Parameters
     ----------
     cells : TetrahedronMap or (m, 4, 3) float array
@@ -190,76 +259,19 @@ def assemble_stiffness_3d(
     Returns
     -------
     scipy.sparse.csr_matrix
-        Symmetric, sorted indices, the 3 × 3 node-block pattern.
+        Symmetric bit for bit, sorted indices, the 3 × 3 node-block pattern.
     """
     mapping = cells if isinstance(cells, CellMap) else TetrahedronMap(cells)
-    nodes = _cell_nodes(cell_dofs)
-    m = mapping.n_cells
-    blocks = np.empty((m, 10, 10, 3, 3))
-    order = []
-    start = 0
-    for g in mapping.groups:  # group after group into one array, the cells in that order
-        rows = slice(start, start + len(g))
-        node_blocks(g, on_cells(material, g.cells), out=blocks[rows])
-        order.append(np.arange(m)[g.cells])
-        start += len(g)
-    if len(mapping.groups) > 1:
-        nodes = nodes[np.concatenate(order)]
-    return _assemble_node_blocks(nodes, int(n_dofs) // 3, blocks)
-
-
-def _assemble_node_blocks(
-    cell_nodes: np.ndarray, n_nodes: int, blocks: np.ndarray
-) -> sp.csr_matrix:
-    """Sum per-cell 3 × 3 node blocks into a CSR matrix with the node-block pattern.
-
-    The ``(m, 10, 10)`` node pairs ``(z_a, z_b)`` of the cells are sorted once by their key
-    ``z_a n_nodes + z_b`` (a stable sort: the duplicates of a pair stay in cell order); the
-    pattern is the distinct keys, and the summation is one product ``S @ blocks`` with the
-    0/1 matrix ``S (n_pairs, m · 100)`` whose row p holds the sorted run of pair p (its CSR
-    arrays are the sort's run starts and order, built without a conversion): SciPy's loop
-    reads each block's nine entries where they lie and adds them in cell order. The summed
-    blocks, in the sort's order, are a BSR matrix as they stand (block row z, its columns
-    sorted), and SciPy's BSR → CSR loop lays them out (row ``3 z + i`` holds row ``i`` of node
-    ``z``'s blocks).
-
-    Parameters
-    ----------
-    cell_nodes : (m, 10) int array
-    n_nodes : int
-    blocks : (m, 10, 10, 3, 3) float array
-        :func:`node_blocks` of the cells, in the order of ``cell_nodes``.
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, shape (3 n_nodes, 3 n_nodes)
-        Sorted indices; a full 3 × 3 block for every coupled node pair.
-    """
-    z = np.asarray(cell_nodes, dtype=np.int64)
-    key = (z[:, :, None] * n_nodes + z[:, None, :]).reshape(-1)
-    order = np.argsort(key, kind="stable")
-    key = key[order]
-    new = np.empty(key.size + 1, dtype=bool)
-    new[0] = new[-1] = True
-    np.not_equal(key[1:], key[:-1], out=new[1:-1])
-    run = np.flatnonzero(new)  # run p of equal keys: order[run[p] : run[p + 1]]
-    start = run[:-1]
-    runs = np.int32 if key.size < 2**31 else np.int64
-    S = sp.csr_matrix(
-        (np.ones(key.size), order.astype(runs), run.astype(runs)),
-        shape=(start.size, key.size),
-        copy=False,
+    owner = cell_dofs if isinstance(cell_dofs, np.ndarray) else None
+    pattern = pattern_of(_cell_nodes(cell_dofs), int(n_dofs) // 3, owner)
+    blocks = np.empty((mapping.n_cells, pattern.select.shape[1], 9))
+    for g in mapping.groups:  # each group into its cells' rows (mesh order)
+        upper_blocks(g, on_cells(material, g.cells), pattern.select, blocks, g.cells)
+    summed = pattern.sums @ blocks.reshape(-1, 9)  # (n_upper, 9), each pair in cell order
+    del blocks
+    data = np.take(summed.reshape(-1), pattern.source)
+    out = sp.csr_matrix(
+        (data, pattern.indices.copy(), pattern.indptr.copy()), shape=pattern.shape, copy=False
     )
-    summed = S @ np.ascontiguousarray(blocks).reshape(-1, 9)  # (n_pairs, 9)
-    row, col = np.divmod(key[start], n_nodes)
-    first = np.zeros(n_nodes + 1, dtype=np.int64)  # the block rows' starts
-    np.cumsum(np.bincount(row, minlength=n_nodes), out=first[1:])
-    index = np.int32 if summed.size < 2**31 else np.int64
-    bsr = sp.bsr_matrix(
-        (summed.reshape(-1, 3, 3), col.astype(index), first.astype(index)),
-        shape=(3 * n_nodes, 3 * n_nodes),
-        copy=False,
-    )
-    out = bsr.tocsr()  # SciPy's loop lays each block row out as three CSR rows
     out.has_sorted_indices = True
     return out
