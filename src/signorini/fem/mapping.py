@@ -12,6 +12,8 @@ written once against these objects; the geometry decides what is constant:
 - :class:`IsoparametricCells`: ``x(ξ) = Σ_a x_a φ_a(ξ)`` through the six P2 node points
   (:mod:`signorini.fem.iso`): everything per point. The thin layer of cells with an edge on a
   curved boundary part.
+- :class:`AffineSimplices`, :class:`IsoparametricSimplices`: what these two share with the
+  tetrahedra (:mod:`signorini.fem.mapping3d`), by reference cell and P2 basis module.
 - :class:`CellMap`: a mesh's cells as such groups (affine first), each knowing its rows in
   the mesh (``cells``, a slice for all cells). :meth:`CellMap.per_cell` evaluates an integrand
   group by group and returns one array in mesh order: each row is computed once, by its own
