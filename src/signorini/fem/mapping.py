@@ -12,6 +12,8 @@ written once against these objects; the geometry decides what is constant:
 - :class:`IsoparametricCells`: ``x(ξ) = Σ_a x_a φ_a(ξ)`` through the six P2 node points
   (:mod:`signorini.fem.iso`): everything per point. The thin layer of cells with an edge on a
   curved boundary part.
+- :class:`AffineSimplices`, :class:`IsoparametricSimplices`: what these two share with the
+  tetrahedra (:mod:`signorini.fem.mapping3d`), by reference cell and P2 basis module.
 - :class:`CellMap`: a mesh's cells as such groups (affine first), each knowing its rows in
   the mesh (``cells``, a slice for all cells). :meth:`CellMap.per_cell` evaluates an integrand
   group by group and returns one array in mesh order: each row is computed once, by its own
@@ -30,18 +32,21 @@ determinants and normals here are those of plane (d = 2) cells and edges.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from types import ModuleType
 
 import numpy as np
 
 from ..mesh.geometry import facet_normals, spanned_normals
-from ..mesh.jacobians import determinant, inverse_transpose
-from ..mesh.reference import TRIANGLE
+from ..mesh.jacobians import affine_jacobian, determinant, inverse_transpose
+from ..mesh.reference import TRIANGLE, ReferenceCell
 from . import iso, p2
 
 __all__ = [
     "AffineCells",
+    "AffineSimplices",
     "CellMap",
     "IsoparametricCells",
+    "IsoparametricSimplices",
     "QuadraticFacets",
     "StraightFacets",
     "facet_groups",
@@ -168,13 +173,15 @@ def facet_groups(
 # --------------------------------------------------------------------------- cells
 
 
-class AffineCells:
-    """Straight cells ``x(ξ) = v0 + J ξ``, ``J = [v1 − v0, v2 − v0]`` (constant).
+class AffineSimplices:
+    """Straight cells of any dimension ``x(ξ) = v0 + J ξ``, ``J = [v1 − v0, …, v_d − v0]``
+    (constant): what the triangles (:class:`AffineCells`) and the tetrahedra
+    (:class:`~signorini.fem.mapping3d.AffineTetrahedra`) share.
 
     Parameters
     ----------
-    vertices : (m, 3, d) float array
-        Counter-clockwise.
+    vertices : (m, d + 1, d) float array
+        Positively oriented (``det J > 0``; counter-clockwise in 2D).
     cells : (m,) int array or slice
         Their rows in the mesh (``slice(None)``: all cells, in order).
     """
@@ -188,23 +195,110 @@ class AffineCells:
     def __len__(self) -> int:
         return len(self.vertices)
 
-    def points(self, xi: np.ndarray) -> np.ndarray:
-        """``(m, q, d)`` images of the reference points ``xi (q, 2)``."""
-        return p2.physical_points(self.vertices, xi)
-
     def jacobians(self, xi: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """``J (m, 1, d, 2)`` and ``det J (m, 1)``: one per cell, for every point."""
-        J, det = p2.jacobian(self.vertices)
+        """``J (m, 1, d, d)`` and ``det J (m, 1)``: one per cell, for every point."""
+        J, det = affine_jacobian(self.vertices)
         return J[:, None], det[:, None]
 
     def inverse_transpose(self, xi: np.ndarray | None = None) -> np.ndarray:
-        """``J^{-T}`` ``(m, 1, 2, 2)``: physical gradients are ``J^{-T} ∇̂``."""
-        J, det = p2.jacobian(self.vertices)
-        return p2.inverse_transpose(J, det)[:, None]
+        """``J^{-T}`` ``(m, 1, d, d)`` (cofactors times ``1 / det J``): physical gradients
+        are ``J^{-T} ∇̂``."""
+        J, det = affine_jacobian(self.vertices)
+        return inverse_transpose(J, det, reciprocal=True)[:, None]
 
     def measure(self, w: np.ndarray, xi: np.ndarray | None = None) -> np.ndarray:
-        """``(m, q)`` the weights ``w_q det J`` of a rule on the reference triangle."""
-        return p2.jacobian(self.vertices)[1][:, None] * w
+        """``(m, q)`` the weights ``w_q det J`` of a rule on the reference cell."""
+        return affine_jacobian(self.vertices)[1][:, None] * w
+
+    def rows(self, slot: np.ndarray) -> AffineSimplices:
+        """The cells at rows ``slot`` of this group, as a group of the same class."""
+        cells = slot if isinstance(self.cells, slice) else self.cells[slot]
+        return type(self)(self.vertices[slot], cells)
+
+
+class IsoparametricSimplices:
+    """Cells mapped by the quadratic ``x(ξ) = Σ_a x_a φ_a(ξ)`` through their P2 node points,
+    what the triangles (:class:`IsoparametricCells`) and the tetrahedra
+    (:class:`~signorini.fem.mapping3d.IsoparametricTetrahedra`) share: a subclass names its
+    reference cell and P2 basis module, and adds the field derivatives.
+
+    Parameters
+    ----------
+    nodes : (m, n_local, d) float array
+        Node points in local node order (:attr:`shape_functions`).
+    cells : (m,) int array or slice
+        Their rows in the mesh.
+    """
+
+    order = 2
+    #: the reference cell (its vertex count: the first nodes are the vertices)
+    reference: ReferenceCell = TRIANGLE
+    #: the module of the reference P2 basis (``basis``, ``grad_basis``)
+    shape_functions: ModuleType = p2
+
+    def __init__(self, nodes: np.ndarray, cells: np.ndarray | slice = _ALL) -> None:
+        self.nodes = np.asarray(nodes, dtype=np.float64)
+        self.cells = cells
+
+    def __len__(self) -> int:
+        return len(self.nodes)
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """``(m, d + 1, d)`` the vertices."""
+        return self.nodes[:, : self.reference.n_vertices]
+
+    def points(self, xi: np.ndarray) -> np.ndarray:
+        """``(m, q, d)`` images of the reference points ``xi (q, d)``."""
+        return np.einsum("qa,mai->mqi", self.shape_functions.basis(xi), self.nodes)
+
+    def jacobians(self, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``J (m, q, d, d)`` and ``det J (m, q)`` at each point.
+
+        ``J = Σ_a x_a ⊗ ∇φ_a(ξ)`` summed elementwise in the order a = 0 … n_local − 1: a
+        cell's Jacobians depend on its own nodes alone, bit for bit
+        (:mod:`signorini.fem.fixed_order`).
+        """
+        g = self.shape_functions.grad_basis(xi)[None, :, :, None, :]  # (1, q, n_local, 1, d)
+        x = self.nodes[:, None, :, :, None]  # (m, 1, n_local, d, 1)
+        J = x[:, :, 0] * g[:, :, 0]
+        for a in range(1, g.shape[2]):  # a loop over the local basis functions
+            J += x[:, :, a] * g[:, :, a]
+        return J, determinant(J)
+
+    def inverse_transpose(self, xi: np.ndarray) -> np.ndarray:
+        """``J^{-T}`` ``(m, q, d, d)`` at each point (cofactors divided by ``det J``)."""
+        J, det = self.jacobians(xi)
+        return inverse_transpose(J, det)
+
+    def measure(self, w: np.ndarray, xi: np.ndarray) -> np.ndarray:
+        """``(m, q)`` the weights ``w_q det J(ξ_q)`` of a rule on the reference cell."""
+        return self.jacobians(xi)[1] * w
+
+    def gradient_field(self, u_cell: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+        """The physical gradient of a P2 field, ``xi ↦ field_gradients(u_cell, xi)``."""
+        return lambda xi: self.field_gradients(u_cell, xi)
+
+    def rows(self, slot: np.ndarray) -> IsoparametricSimplices:
+        """The cells at rows ``slot`` of this group, as a group of the same class."""
+        cells = slot if isinstance(self.cells, slice) else self.cells[slot]
+        return type(self)(self.nodes[slot], cells)
+
+
+class AffineCells(AffineSimplices):
+    """Straight triangles ``x(ξ) = v0 + J ξ``, ``J = [v1 − v0, v2 − v0]`` (constant).
+
+    Parameters
+    ----------
+    vertices : (m, 3, d) float array
+        Counter-clockwise.
+    cells : (m,) int array or slice
+        Their rows in the mesh (``slice(None)``: all cells, in order).
+    """
+
+    def points(self, xi: np.ndarray) -> np.ndarray:
+        """``(m, q, d)`` images of the reference points ``xi (q, 2)``."""
+        return p2.physical_points(self.vertices, xi)
 
     def basis_gradients(self, xi: np.ndarray) -> np.ndarray:
         """``(m, q, 6, d)`` physical gradients of the six P2 basis functions."""
@@ -236,11 +330,6 @@ class AffineCells:
         """``(m, 1, 2, d, d)`` ``∂²u_i/∂x_j∂x_k`` of a P2 field (constant on each cell)."""
         return p2.field_hessian(self.vertices, u_cell)[:, None]
 
-    def rows(self, slot: np.ndarray) -> AffineCells:
-        """The cells at rows ``slot`` of this group, as a group."""
-        cells = slot if isinstance(self.cells, slice) else self.cells[slot]
-        return AffineCells(self.vertices[slot], cells)
-
     def local_facets(self, slot: np.ndarray, k: np.ndarray) -> StraightFacets:
         """Local facet ``k`` (an edge in 2D) of the cells at rows ``slot`` of this group."""
         flat = self.vertices.reshape(-1, self.vertices.shape[-1])
@@ -248,8 +337,8 @@ class AffineCells:
         return StraightFacets(np.stack([flat[start], flat[end]], 1))
 
 
-class IsoparametricCells:
-    """Cells mapped by the quadratic ``x(ξ) = Σ_a x_a φ_a(ξ)`` through their six P2 node
+class IsoparametricCells(IsoparametricSimplices):
+    """Triangles mapped by the quadratic ``x(ξ) = Σ_a x_a φ_a(ξ)`` through their six P2 node
     points (:mod:`signorini.fem.iso`): Jacobians vary from point to point.
 
     Parameters
@@ -260,53 +349,9 @@ class IsoparametricCells:
         Their rows in the mesh.
     """
 
-    order = 2
-
-    def __init__(self, nodes: np.ndarray, cells: np.ndarray | slice = _ALL) -> None:
-        self.nodes = np.asarray(nodes, dtype=np.float64)
-        self.cells = cells
-
-    def __len__(self) -> int:
-        return len(self.nodes)
-
-    @property
-    def vertices(self) -> np.ndarray:
-        """``(m, 3, d)`` the vertices."""
-        return self.nodes[:, :3]
-
-    def points(self, xi: np.ndarray) -> np.ndarray:
-        """``(m, q, d)`` images of the reference points ``xi (q, 2)``."""
-        return np.einsum("qa,mai->mqi", p2.basis(xi), self.nodes)
-
-    def jacobians(self, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``J (m, q, d, 2)`` and ``det J (m, q)`` at each point.
-
-        ``J = Σ_a x_a ⊗ ∇φ_a(ξ)`` summed elementwise in the order a = 0 … 5: a cell's
-        Jacobians depend on its own nodes alone, bit for bit (:mod:`signorini.fem.fixed_order`).
-        """
-        g = p2.grad_basis(xi)[None, :, :, None, :]  # (1, q, 6, 1, 2)
-        x = self.nodes[:, None, :, :, None]  # (m, 1, 6, d, 1)
-        J = x[:, :, 0] * g[:, :, 0]
-        for a in range(1, g.shape[2]):  # a loop over the local basis functions
-            J += x[:, :, a] * g[:, :, a]
-        return J, determinant(J)
-
-    def inverse_transpose(self, xi: np.ndarray) -> np.ndarray:
-        """``J^{-T}`` ``(m, q, 2, 2)`` at each point."""
-        J, det = self.jacobians(xi)
-        return inverse_transpose(J, det)
-
-    def measure(self, w: np.ndarray, xi: np.ndarray) -> np.ndarray:
-        """``(m, q)`` the weights ``w_q det J(ξ_q)`` of a rule on the reference triangle."""
-        return self.jacobians(xi)[1] * w
-
     def basis_gradients(self, xi: np.ndarray) -> np.ndarray:
         """``(m, q, 6, d)`` physical gradients of the six P2 basis functions."""
         return np.matmul(p2.grad_basis(xi)[None], np.swapaxes(self.inverse_transpose(xi), -1, -2))
-
-    def gradient_field(self, u_cell: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
-        """As :meth:`AffineCells.gradient_field`, through the quadratic map."""
-        return lambda xi: self.field_gradients(u_cell, xi)
 
     def field_gradients(self, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
         """``(m, q, 2, d)`` ``∂u_i/∂x_j`` of a P2 field at reference points ``xi``."""
@@ -315,11 +360,6 @@ class IsoparametricCells:
     def field_hessians(self, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
         """``(m, q, 2, d, d)`` ``∂²u_i/∂x_j∂x_k`` of a P2 field, exact through the map."""
         return iso.field_derivatives(self.nodes, u_cell, xi)[1]
-
-    def rows(self, slot: np.ndarray) -> IsoparametricCells:
-        """The cells at rows ``slot`` of this group, as a group."""
-        cells = slot if isinstance(self.cells, slice) else self.cells[slot]
-        return IsoparametricCells(self.nodes[slot], cells)
 
     def local_facets(self, slot: np.ndarray, k: np.ndarray) -> QuadraticFacets:
         """Local facet ``k`` (an edge in 2D) of the cells at rows ``slot``: the map

@@ -25,9 +25,9 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from ..mesh.geometry import facet_normals, spanned_normals
-from ..mesh.jacobians import affine_jacobian, determinant, inverse_transpose
+from ..mesh.reference import TETRAHEDRON
 from . import p2, p2_tet
-from .mapping import CellMap
+from .mapping import AffineSimplices, CellMap, IsoparametricSimplices
 
 __all__ = [
     "AffineTetrahedra",
@@ -46,8 +46,9 @@ def _coefficients(u_cell: np.ndarray) -> np.ndarray:
     return np.asarray(u_cell, dtype=np.float64).reshape(-1, 10, 3)
 
 
-class AffineTetrahedra:
-    """Straight tetrahedra ``x(ξ) = v0 + J ξ`` (constant ``J``).
+class AffineTetrahedra(AffineSimplices):
+    """Straight tetrahedra ``x(ξ) = v0 + J ξ`` (constant ``J``; its ``J``, ``det J``, ``J⁻ᵀ``
+    and measure those of :class:`~signorini.fem.mapping.AffineSimplices`).
 
     Parameters
     ----------
@@ -57,34 +58,11 @@ class AffineTetrahedra:
         Their rows in the mesh (``slice(None)``: all cells, in order).
     """
 
-    order = 1
-
-    def __init__(self, vertices: np.ndarray, cells: np.ndarray | slice = _ALL) -> None:
-        self.vertices = np.asarray(vertices, dtype=np.float64)
-        self.cells = cells
-
-    def __len__(self) -> int:
-        return len(self.vertices)
-
     def points(self, xi: np.ndarray) -> np.ndarray:
         """``(m, q, 3)`` images of the reference points ``xi (q, 3)``."""
         v = self.vertices
         xi = np.atleast_2d(np.asarray(xi, dtype=np.float64))
         return v[:, None, 0] + np.einsum("qk,mki->mqi", xi, v[:, 1:] - v[:, :1])
-
-    def jacobians(self, xi: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """``J (m, 1, 3, 3)`` and ``det J (m, 1)``: one per cell, for every point."""
-        J, det = affine_jacobian(self.vertices)
-        return J[:, None], det[:, None]
-
-    def inverse_transpose(self, xi: np.ndarray | None = None) -> np.ndarray:
-        """``J⁻ᵀ`` ``(m, 1, 3, 3)``: physical gradients are ``J⁻ᵀ ∇̂``."""
-        J, det = affine_jacobian(self.vertices)
-        return inverse_transpose(J, det, reciprocal=True)[:, None]
-
-    def measure(self, w: np.ndarray, xi: np.ndarray | None = None) -> np.ndarray:
-        """``(m, q)`` the weights ``w_q det J`` of a rule on the reference tetrahedron."""
-        return affine_jacobian(self.vertices)[1][:, None] * w
 
     def basis_gradients(self, xi: np.ndarray) -> np.ndarray:
         """``(m, q, 10, 3)`` physical gradients of the ten P2 basis functions."""
@@ -110,15 +88,11 @@ class AffineTetrahedra:
         href = np.einsum("mai,ars->mirs", _coefficients(u_cell), p2_tet.hessian_basis())
         return np.einsum("mjr,mirs,mks->mijk", jit, href, jit)[:, None]
 
-    def rows(self, slot: np.ndarray) -> AffineTetrahedra:
-        """The cells at rows ``slot`` of this group, as a group."""
-        cells = slot if isinstance(self.cells, slice) else self.cells[slot]
-        return AffineTetrahedra(self.vertices[slot], cells)
 
-
-class IsoparametricTetrahedra:
+class IsoparametricTetrahedra(IsoparametricSimplices):
     """Tetrahedra mapped by the quadratic ``x(ξ) = Σ_a x_a φ_a(ξ)`` through their ten P2 node
-    points: Jacobians vary from point to point.
+    points: Jacobians vary from point to point (points, ``J``, ``det J``, ``J⁻ᵀ`` and
+    measure those of :class:`~signorini.fem.mapping.IsoparametricSimplices`).
 
     Parameters
     ----------
@@ -128,42 +102,8 @@ class IsoparametricTetrahedra:
         Their rows in the mesh.
     """
 
-    order = 2
-
-    def __init__(self, nodes: np.ndarray, cells: np.ndarray | slice = _ALL) -> None:
-        self.nodes = np.asarray(nodes, dtype=np.float64)
-        self.cells = cells
-
-    def __len__(self) -> int:
-        return len(self.nodes)
-
-    @property
-    def vertices(self) -> np.ndarray:
-        """``(m, 4, 3)`` the vertices."""
-        return self.nodes[:, :4]
-
-    def points(self, xi: np.ndarray) -> np.ndarray:
-        """``(m, q, 3)`` images of the reference points ``xi (q, 3)``."""
-        return np.einsum("qa,mai->mqi", p2_tet.basis(xi), self.nodes)
-
-    def jacobians(self, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``J (m, q, 3, 3)`` and ``det J (m, q)`` at each point, ``J = Σ_a x_a ⊗ ∇φ_a(ξ)``
-        summed in the order a = 0 … 9 (a cell's Jacobians depend on its nodes alone)."""
-        g = p2_tet.grad_basis(xi)[None, :, :, None, :]  # (1, q, 10, 1, 3)
-        x = self.nodes[:, None, :, :, None]  # (m, 1, 10, 3, 1)
-        J = x[:, :, 0] * g[:, :, 0]
-        for a in range(1, g.shape[2]):  # a loop over the local basis functions
-            J += x[:, :, a] * g[:, :, a]
-        return J, determinant(J)
-
-    def inverse_transpose(self, xi: np.ndarray) -> np.ndarray:
-        """``J⁻ᵀ`` ``(m, q, 3, 3)`` at each point."""
-        J, det = self.jacobians(xi)
-        return inverse_transpose(J, det)
-
-    def measure(self, w: np.ndarray, xi: np.ndarray) -> np.ndarray:
-        """``(m, q)`` the weights ``w_q det J(ξ_q)``."""
-        return self.jacobians(xi)[1] * w
+    reference = TETRAHEDRON
+    shape_functions = p2_tet
 
     def basis_gradients(self, xi: np.ndarray) -> np.ndarray:
         """``(m, q, 10, 3)`` physical gradients of the ten P2 basis functions."""
@@ -177,15 +117,6 @@ class IsoparametricTetrahedra:
     def field_gradients(self, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
         """``(m, q, 3, 3)`` ``∂u_i/∂x_j`` of a P2 field at reference points ``xi``."""
         return np.einsum("mai,mqaj->mqij", _coefficients(u_cell), self.basis_gradients(xi))
-
-    def gradient_field(self, u_cell: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
-        """As :meth:`AffineTetrahedra.gradient_field`, through the quadratic map."""
-        return lambda xi: self.field_gradients(u_cell, xi)
-
-    def rows(self, slot: np.ndarray) -> IsoparametricTetrahedra:
-        """The cells at rows ``slot`` of this group, as a group."""
-        cells = slot if isinstance(self.cells, slice) else self.cells[slot]
-        return IsoparametricTetrahedra(self.nodes[slot], cells)
 
 
 class TetrahedronMap(CellMap):

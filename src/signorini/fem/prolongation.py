@@ -53,9 +53,7 @@ def prolongate_p2(
         If ``u`` does not have one row per node, or ``refinement`` is not a refinement of
         the coarse mesh.
     """
-    u = np.asarray(u, dtype=np.float64)
-    if u.shape[0] != coarse.n_nodes:
-        raise ValueError(f"u has {u.shape[0]} nodes, the space has {coarse.n_nodes}")
+    u = _nodal_values(coarse, u)
     parent = np.asarray(refinement.parent)
     if (
         parent.shape != (fine.mesh.n_cells,)
@@ -104,6 +102,15 @@ def prolongate_p2(
     return out
 
 
+def _nodal_values(space: P1Space | P2Space, u: np.ndarray) -> np.ndarray:
+    """``u`` as float64 ``(n_nodes, d)`` or ``(n_nodes,)``; raise ``ValueError`` unless it
+    has one row per node of ``space``."""
+    u = np.asarray(u, dtype=np.float64)
+    if u.shape[0] != space.n_nodes:
+        raise ValueError(f"u has {u.shape[0]} nodes, the space has {space.n_nodes}")
+    return u
+
+
 def _reference_nodes(coarse: Mesh, refinement: Refinement, fine: P2Space) -> np.ndarray:
     """``(n_nodes_new, d)`` where the new nodes lie in their parent cells: the fine node
     points, except that a vertex placed on a curve counts at the chord midpoint of the edge
@@ -137,12 +144,10 @@ def prolongate_p1(coarse: P1Space, u: np.ndarray, refinement: Refinement) -> np.
     Raises
     ------
     ValueError
-        If ``u`` does not have one row per node, or ``refinement`` is not a refinement of
-        the coarse mesh.
+        If ``u`` does not have one row per node, or ``refinement``'s bisected edges or
+        points do not match the coarse mesh.
     """
-    u = np.asarray(u, dtype=np.float64)
-    if u.shape[0] != coarse.n_nodes:
-        raise ValueError(f"u has {u.shape[0]} nodes, the space has {coarse.n_nodes}")
+    u = _nodal_values(coarse, u)
     n_old = coarse.mesh.n_points
     edge_point = np.asarray(refinement.edge_point)
     split = np.flatnonzero(edge_point >= 0) if edge_point.shape == (coarse.mesh.n_edges,) else None

@@ -185,51 +185,6 @@ def _check_points(points: np.ndarray, cells: np.ndarray) -> None:
         )
 
 
-def _edge_text(points: np.ndarray, edge: np.ndarray) -> str:
-    """``the edge from (x, y) to (x, y) (vertices i and j)`` for a vertex pair ``edge``."""
-    a, b = points[edge[0]], points[edge[1]]
-    return (
-        f"the edge from ({a[0]:.12g}, {a[1]:.12g}) to ({b[0]:.12g}, {b[1]:.12g}) (vertices "
-        f"{edge[0]} and {edge[1]})"
-    )
-
-
-def _check_part_labels(mesh: Mesh) -> None:
-    """Every boundary row has a valid part index, and every part owns an edge."""
-    if mesh.boundary_part.shape != (len(mesh.boundary),):
-        raise MeshError("boundary_part must have one entry per boundary edge")
-    bad_part = (mesh.boundary_part < 0) | (mesh.boundary_part >= len(mesh.part_names))
-    if bad_part.any():
-        first = mesh.boundary[np.flatnonzero(bad_part)[0]]
-        raise MeshError(
-            f"{int(bad_part.sum())} boundary edge(s) have no part, first "
-            f"{_edge_text(mesh.points, first)}; label every boundary edge"
-        )
-    for index, name in enumerate(mesh.part_names):
-        if not np.any(mesh.boundary_part == index):
-            raise MeshError(f"boundary part {name!r} has no edges")
-
-
-def _check_boundary_labelled(mesh: Mesh, is_bnd: np.ndarray) -> None:
-    """The listed boundary edges are exactly the edges with one cell, each listed once."""
-    be = mesh.boundary_facet  # raises for a listed pair that is not an edge
-    if np.any(~is_bnd[be]):
-        bad = mesh.boundary[np.flatnonzero(~is_bnd[be])[0]]
-        raise MeshError(
-            f"edge ({bad[0]}, {bad[1]}) is labelled as boundary but is shared by two cells"
-        )
-    if np.unique(be).size != be.size:
-        raise MeshError("a boundary edge is listed twice")
-    labelled = np.zeros(mesh.n_edges, dtype=bool)
-    labelled[be] = True
-    missing = np.flatnonzero(is_bnd & ~labelled)
-    if missing.size:
-        raise MeshError(
-            f"{missing.size} boundary edge(s) without a part, first "
-            f"{_edge_text(mesh.points, mesh.edges[missing[0]])}; label every boundary edge"
-        )
-
-
 def _check_opposite_traversal(mesh: Mesh, is_bnd: np.ndarray) -> None:
     """Neighbouring cells traverse a shared edge in opposite directions (else they overlap)."""
     local = mesh.cells[:, TRIANGLE.edges].reshape(-1, 2)
@@ -416,14 +371,16 @@ def validate_mesh(mesh: Mesh) -> None:
     points = as_points(mesh.points)
     cells = as_cells(mesh.cells, len(points))
     as_cells(mesh.boundary, len(points), what="boundary edges")
+    from .labels import check_boundary_labelled, check_part_labels  # they build on this module
+
     check_orientation(points, cells)
     _check_points(points, cells)
-    _check_part_labels(mesh)
+    check_part_labels(mesh)
     is_bnd = mesh.facet2cell[:, 1] < 0  # building the topology raises on non-manifold edges
     _check_opposite_traversal(mesh, is_bnd)
     _check_no_hanging_node(mesh, is_bnd)
     _check_no_overlap(mesh, is_bnd)
-    _check_boundary_labelled(mesh, is_bnd)
+    check_boundary_labelled(mesh, is_bnd)
 
 
 def check_on_curve(

@@ -24,6 +24,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .geometry import facet_normals, signed_area
+from .labels import check_boundary_labelled, check_part_labels
 from .reference import TETRAHEDRON
 from .topology import entity_keys
 from .validation import (
@@ -145,22 +146,6 @@ def _check_points(points: np.ndarray, cells: np.ndarray) -> None:
         raise MeshError(f"duplicate cells {a} and {b}: both have the vertices {cells[a].tolist()}")
 
 
-def _check_part_labels(mesh: Mesh) -> None:
-    """Every boundary face has a valid part index, and every part owns a face."""
-    if mesh.boundary_part.shape != (len(mesh.boundary),):
-        raise MeshError("boundary_part must have one entry per boundary face")
-    bad = (mesh.boundary_part < 0) | (mesh.boundary_part >= len(mesh.part_names))
-    if bad.any():
-        first = mesh.boundary[np.flatnonzero(bad)[0]]
-        raise MeshError(
-            f"{int(bad.sum())} boundary face(s) have no part, first "
-            f"{_face_text(mesh.points, first)}; label every boundary face"
-        )
-    for index, name in enumerate(mesh.part_names):
-        if not np.any(mesh.boundary_part == index):
-            raise MeshError(f"boundary part {name!r} has no faces")
-
-
 def _check_sides(mesh: Mesh, is_bnd: np.ndarray) -> None:
     """The two cells of each interior face lie on its two sides (else they overlap)."""
     inner = np.flatnonzero(~is_bnd)
@@ -212,26 +197,6 @@ def _check_no_hanging_node(mesh: Mesh, is_bnd: np.ndarray) -> None:
         )
 
 
-def _check_boundary_labelled(mesh: Mesh, is_bnd: np.ndarray) -> None:
-    """The listed boundary faces are exactly the faces with one cell, each listed once."""
-    listed = mesh.boundary_facet  # raises for a listed triple that is not a face
-    if np.any(~is_bnd[listed]):
-        bad = mesh.boundary[np.flatnonzero(~is_bnd[listed])[0]]
-        raise MeshError(
-            f"{_face_text(mesh.points, bad)} is labelled as boundary but is shared by two cells"
-        )
-    if np.unique(listed).size != listed.size:
-        raise MeshError("a boundary face is listed twice")
-    labelled = np.zeros(mesh.n_facets, dtype=bool)
-    labelled[listed] = True
-    missing = np.flatnonzero(is_bnd & ~labelled)
-    if missing.size:
-        raise MeshError(
-            f"{missing.size} boundary face(s) without a part, first "
-            f"{_face_text(mesh.points, mesh.facets[missing[0]])}; label every boundary face"
-        )
-
-
 def validate_tetrahedra(mesh: Mesh) -> None:
     """Check that ``mesh`` (``dim = 3``) is a valid conforming tetrahedral mesh with labelled
     boundary faces (module docstring); warn about slivers (:class:`SliverWarning`).
@@ -262,11 +227,11 @@ def validate_tetrahedra(mesh: Mesh) -> None:
             SliverWarning,
             stacklevel=3,
         )
-    _check_part_labels(mesh)
+    check_part_labels(mesh, "face", _face_text)
     is_bnd = mesh.facet2cell[:, 1] < 0  # building the topology raises on non-manifold faces
     _check_sides(mesh, is_bnd)
     _check_no_hanging_node(mesh, is_bnd)
-    _check_boundary_labelled(mesh, is_bnd)
+    check_boundary_labelled(mesh, is_bnd, "face", _face_text, _face_text)
 
 
 def check_on_surface(

@@ -161,18 +161,17 @@ class SignedDistance(Obstacle):
             raise ValueError(f"{self!r}: {name}(x) is not finite at x[{k}] = {x[k].tolist()}")
         return value
 
-    def _gap_and_direction(self, x):
-        n_points = x.shape[0]
-        psi = self._call(self.phi, "phi", x, (n_points,))
-        if self.grad is not None:
-            gradient = self._call(self.grad, "grad", x, (n_points, 2))
-        else:
-            h = self.step
-            shifts = np.array([[h, 0.0], [-h, 0.0], [0.0, h], [0.0, -h]])
-            stacked = (x[None, :, :] + shifts[:, None, :]).reshape(-1, 2)
-            values = self._call(self.phi, "phi", stacked, (4 * n_points,)).reshape(4, n_points)
-            gradient = np.stack([values[0] - values[1], values[2] - values[3]], axis=1) / (2 * h)
-        length = np.hypot(gradient[:, 0], gradient[:, 1])
+    def _shifted(self, x: np.ndarray, shifts: np.ndarray) -> np.ndarray:
+        """``(k, n)`` the values ``phi(x + s)`` at the points ``x (n, d)`` moved by each of
+        the ``shifts (k, d)`` (one call of ``phi``, shift by shift)."""
+        stacked = (x[None, :, :] + shifts[:, None, :]).reshape(-1, x.shape[1])
+        values = self._call(self.phi, "phi", stacked, (len(shifts) * len(x),))
+        return values.reshape(len(shifts), len(x))
+
+    def _direction(self, x: np.ndarray, gradient: np.ndarray, length: np.ndarray) -> np.ndarray:
+        """``n_z = −∇phi/|∇phi|`` ``(n, d)`` from the gradient ``(n, d)`` of ``phi`` at
+        ``x (n, d)`` and its length ``(n,)``, refused where the gradient vanishes or where
+        difference quotients are longer than ``√d`` (``phi`` not 1-Lipschitz)."""
         flat = length <= 1e-12
         if flat.any():
             k = int(np.flatnonzero(flat)[0])
@@ -180,10 +179,23 @@ class SignedDistance(Obstacle):
                 f"{self!r}: the gradient of phi vanishes at x[{k}] = {x[k].tolist()}, so no "
                 "direction to the obstacle exists there"
             )
-        if self.grad is None and (length > np.sqrt(2) * (1 + 1e-6)).any():
+        d = gradient.shape[1]
+        if self.grad is None and (length > np.sqrt(d) * (1 + 1e-6)).any():
             k = int(np.argmax(length))
             raise ValueError(
                 f"{self!r}: phi is not a signed distance: its difference quotients have "
-                f"length {length[k]:.6g} > sqrt(2) at x[{k}] = {x[k].tolist()}"
+                f"length {length[k]:.6g} > sqrt({d}) at x[{k}] = {x[k].tolist()}"
             )
-        return psi, -gradient / length[:, None]
+        return -gradient / length[:, None]
+
+    def _gap_and_direction(self, x):
+        n_points = x.shape[0]
+        psi = self._call(self.phi, "phi", x, (n_points,))
+        if self.grad is not None:
+            gradient = self._call(self.grad, "grad", x, (n_points, 2))
+        else:
+            h = self.step
+            values = self._shifted(x, np.array([[h, 0.0], [-h, 0.0], [0.0, h], [0.0, -h]]))
+            gradient = np.stack([values[0] - values[1], values[2] - values[3]], axis=1) / (2 * h)
+        length = np.hypot(gradient[:, 0], gradient[:, 1])
+        return psi, self._direction(x, gradient, length)

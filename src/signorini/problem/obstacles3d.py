@@ -170,22 +170,6 @@ class SignedDistance3D(SignedDistance):
         if self.grad is not None:
             gradient = self._call(self.grad, "grad", x, (n_points, 3))
         else:
-            shifts = self.step * np.vstack([np.eye(3), -np.eye(3)])  # (6, 3)
-            stacked = (x[None, :, :] + shifts[:, None, :]).reshape(-1, 3)
-            values = self._call(self.phi, "phi", stacked, (6 * n_points,)).reshape(6, n_points)
+            values = self._shifted(x, self.step * np.vstack([np.eye(3), -np.eye(3)]))  # (6, n)
             gradient = (values[:3] - values[3:]).T / (2 * self.step)
-        length = np.linalg.norm(gradient, axis=1)
-        flat = length <= 1e-12
-        if flat.any():
-            k = int(np.flatnonzero(flat)[0])
-            raise ValueError(
-                f"{self!r}: the gradient of phi vanishes at x[{k}] = {x[k].tolist()}, so no "
-                "direction to the obstacle exists there"
-            )
-        if self.grad is None and (length > np.sqrt(3) * (1 + 1e-6)).any():
-            k = int(np.argmax(length))
-            raise ValueError(
-                f"{self!r}: phi is not a signed distance: its difference quotients have "
-                f"length {length[k]:.6g} > sqrt(3) at x[{k}] = {x[k].tolist()}"
-            )
-        return psi, -gradient / length[:, None]
+        return psi, self._direction(x, gradient, np.linalg.norm(gradient, axis=1))
