@@ -74,7 +74,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ...fem.quadrature import gauss_legendre
-from .norms import l2_norm2_positive_part
+from .norms import l2_shares_of_pieces
 from .pieces import positive_part_pieces
 
 __all__ = [
@@ -113,7 +113,7 @@ def facet_norms2_positive_part(
     (:func:`.pieces.positive_part_pieces`); on each piece of ``{w > 0}``,
     ``v = c_0 + c_1 u + c_2 u²`` (``u ∈ [0, 1]``, piece length ``L``) and
     ``∫ |∂_τ v|² ds = L^{-1} ∫_0^1 (c_1 + 2 c_2 u)² du`` (2-point Gauss, exact); the L²
-    part is :func:`.norms.l2_norm2_positive_part`'s.
+    part is :func:`.norms.l2_shares_of_pieces`' of the same pieces.
 
     Parameters
     ----------
@@ -130,7 +130,7 @@ def facet_norms2_positive_part(
         Arrays of shape (k,).
     """
     pc = positive_part_pieces(x0, x1, w, validate=validate, scale=scale)
-    _, l2 = l2_norm2_positive_part(x0, x1, w, validate=False, scale=scale)
+    l2 = l2_shares_of_pieces(pc)
     t, wt = gauss_legendre(2)
     slope = pc.coef[:, 1:2] + 2.0 * pc.coef[:, 2:3] * t  # dv/du at the Gauss points, (m, 2)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -23,6 +23,7 @@ __all__ = [
     "hhalf_norm2_positive_part",
     "hhalf_seminorm2_positive_part",
     "l2_norm2_positive_part",
+    "l2_shares_of_pieces",
 ]
 
 
@@ -101,9 +102,15 @@ def l2_norm2_positive_part(
     eta2_edge : ndarray of float64, shape (k,)
         Share of each edge; sums to ``total``.
     """
-    pc = positive_part_pieces(x0, x1, w, validate=validate, scale=scale)
+    eta2 = l2_shares_of_pieces(positive_part_pieces(x0, x1, w, validate=validate, scale=scale))
+    return float(eta2.sum()), eta2
+
+
+def l2_shares_of_pieces(pc: PositivePartPieces) -> np.ndarray:
+    """``(k,)`` float64: each edge's ``||max(w, 0)||^2_{L^2}`` from the pieces of ``{w > 0}``
+    (:func:`.pieces.positive_part_pieces`), for callers that hold the pieces already."""
     eta2 = np.bincount(pc.edge, weights=_l2_shares(pc), minlength=pc.n_edges)
-    return float(eta2.sum()), eta2.astype(np.float64)
+    return eta2.astype(np.float64)
 
 
 def hhalf_seminorm2_positive_part(
