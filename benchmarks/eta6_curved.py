@@ -80,10 +80,10 @@ def measure(name: str, max_ndof: int) -> None:
         print(f"{rec.level:>10}  {rec.ndof:>10}  " + "  ".join(f"{v:10.3e}" for v in values))
     ndof, eta, eta6, diff = (np.array(c, dtype=float) for c in zip(*rows, strict=True))
     with np.errstate(divide="ignore", invalid="ignore"):
-        rate = lambda y: np.diff(np.log(y)) / np.diff(np.log(ndof))  # noqa: E731
+        slopes = [np.diff(np.log(y)) / np.diff(np.log(ndof)) for y in (eta, eta6, diff)]
     print(
-        f"{name}: slopes in Ndof between levels: eta {np.round(rate(eta), 2)}, "
-        f"eta_6 {np.round(rate(eta6), 2)}, diff_E {np.round(rate(diff), 2)}"
+        f"{name}: slopes in Ndof between levels: eta {np.round(slopes[0], 2)}, "
+        f"eta_6 {np.round(slopes[1], 2)}, diff_E {np.round(slopes[2], 2)}"
     )
 
 
