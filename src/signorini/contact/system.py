@@ -176,7 +176,12 @@ def assemble(
         raise ValueError(
             f"ranks must be a signorini.algebra.ranks.Ranks, got {type(ranks).__name__}"
         )
-    if mesh.dim == 3:  # 3D elasticity without contact: its own assembly, beside this one
+    if mesh.dim != problem.mesh.dim:
+        raise ValueError(
+            f"the problem {problem.name!r} is stated on a {problem.mesh.dim}D mesh and was "
+            f"handed a {mesh.dim}D mesh: solve it on its own mesh or a refinement of it"
+        )
+    if mesh.dim == 3:  # 3D elasticity and contact on faces: its own assembly, beside this one
         from .system3d import assemble_3d  # (which builds on this module's Assembled)
 
         space_of(mesh, element)  # refuses an element the tetrahedron does not have

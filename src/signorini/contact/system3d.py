@@ -29,12 +29,14 @@ from ..problem.conditions import Neumann, Roller
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.normals import straight_normal
 from ..problem.problem import ContactProblem
+from ..problem.rigid3d import motion_field_3d
 from ..problem.rollers import held_nodes
 from .admissible import check_load_size
 from .contact_set import _empty
 from .discrete_conditions import DiscreteConditions
 from .face_basis import DEFAULT_ALPHA
 from .face_contact import face_contact_set
+from .node_frames3d import held_frames, rotate_frames_3d
 from .ordering import Ordering
 from .system import Assembled, RollerDofs
 
@@ -78,17 +80,30 @@ def discrete_conditions_3d(problem: ContactProblem, space: P2TetSpace) -> Discre
         friction=(),
         pairs={},
         rigid_motions=problem.rigid_motions,
-        rigid_field=np.zeros((0, n, 3)),
+        rigid_field=motion_field_3d(space.mesh, problem.rigid_motions, space.node_points),
     )
 
 
-def _roller_dofs_3d(conditions: DiscreteConditions) -> RollerDofs:
-    """The axis rollers' nodes that hold one component, ``3 z + c``, with their normals."""
+def _roller_dofs_3d(conditions: DiscreteConditions, roller_dof: np.ndarray) -> RollerDofs:
+    """The held DOF of each node held along one roller's normal only, and that normal: an
+    axis roller's node holding one Cartesian component (``3 z + c``), an oblique or curved
+    roller's node with one roller row and nothing else held (its frame DOF in
+    ``roller_dof``), sorted by node."""
+    held = conditions.held
     axis = conditions.axis_normal
-    partial = conditions.held.components.sum(axis=1) == 1
-    z = np.flatnonzero(partial & axis.any(axis=1))
+    partial = held.components.sum(axis=1) == 1
+    rows = np.bincount(held.roller_nodes, minlength=axis.shape[0])
+    z = np.flatnonzero(partial & axis.any(axis=1) & (rows == 0))
     c = np.argmax(np.abs(axis[z]), axis=1)
-    return RollerDofs(z, 3 * z + c, axis[z, c], axis[z])
+    alone = (rows[held.roller_nodes] == 1) & ~held.components[held.roller_nodes].any(axis=1)
+    nodes = np.concatenate([z, held.roller_nodes[alone]])
+    order = np.argsort(nodes, kind="stable")
+    return RollerDofs(
+        nodes[order],
+        np.concatenate([3 * z + c, roller_dof[alone]])[order],
+        np.concatenate([axis[z, c], np.ones(alone.sum())])[order],
+        np.concatenate([axis[z], held.roller_normal[alone]])[order],
+    )
 
 
 def assemble_3d(problem: ContactProblem, mesh: Mesh) -> Assembled:
@@ -149,20 +164,24 @@ def assemble_3d(problem: ContactProblem, mesh: Mesh) -> Assembled:
     held = conditions.held
     if problem.contact_parts:
         return _with_contact(problem, space, K, F, conditions, time.perf_counter() - t0)
-    dirichlet = np.flatnonzero(held.components.ravel())
+    none = np.zeros(0, dtype=np.int64)
+    frames = held_frames(space.node_points, none, np.zeros((0, 3)), none, held)
+    if frames.frame_nodes.size:  # oblique and curved rollers: u = Q y at their nodes
+        K, F = rotate_frames_3d(K, F, frames.frame_nodes, frames.frames)
+    order = np.argsort(frames.held_dofs)
     return Assembled(
         space,
         _empty(()),
         K,
         F,
-        dirichlet,
-        held.values.ravel()[dirichlet],
+        frames.held_dofs[order],
+        frames.held_values[order],
         time.perf_counter() - t0,
         conditions.dirichlet_nodes,
         np.zeros((0, 3)),
-        np.zeros(0, dtype=np.int64),
-        np.zeros((0, 3, 3)),
-        _roller_dofs_3d(conditions),
+        frames.frame_nodes,
+        frames.frames,
+        _roller_dofs_3d(conditions, frames.roller_dof),
         conditions,
         None,
         Ordering(space),
@@ -185,11 +204,11 @@ def _with_contact(
     contact = {name: problem.conditions[name] for name in problem.contact_parts}
     alpha = next(iter(contact.values())).face_alpha  # one for all parts (problem3d)
     alpha = DEFAULT_ALPHA if alpha is None else alpha
-    cs = face_contact_set(space, contact, held.components, held.values, alpha)
+    cs = face_contact_set(space, contact, held, alpha=alpha)
     K_rot, F_rot = cs.system(K, F)
     order = np.argsort(cs.held_dofs)
-    rollers = _roller_dofs_3d(conditions)
-    off = ~np.isin(rollers.nodes, cs.frame_nodes)
+    rollers = _roller_dofs_3d(conditions, cs.roller_dof)
+    off = ~np.isin(rollers.nodes, cs.node)
     return Assembled(
         space,
         cs,
