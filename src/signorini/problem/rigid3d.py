@@ -63,7 +63,7 @@ def describe_motion_3d(mesh: Mesh, motion: np.ndarray) -> str:
     if np.linalg.norm(omega) * size <= MOTION_RTOL:
         d = a / np.linalg.norm(a)
         d = d if d[np.argmax(np.abs(d))] > 0 else -d
-        return f"translation along {tuple(np.round(d, 6).tolist())}"
+        return f"translation along {tuple((np.round(d, 6) + 0.0).tolist())}"
     w2 = float(omega @ omega)
     axis = omega / np.sqrt(w2)
     axis = axis if axis[np.argmax(np.abs(axis))] > 0 else -axis
@@ -72,8 +72,8 @@ def describe_motion_3d(mesh: Mesh, motion: np.ndarray) -> str:
         "rotation" if abs(a @ axis) <= MOTION_RTOL * np.linalg.norm(a) + 1e-15 else "screw motion"
     )
     return (
-        f"{kind} about the axis {tuple(np.round(axis, 6).tolist())} through "
-        f"{tuple(np.round(through + 0.0, 6).tolist())}"
+        f"{kind} about the axis {tuple((np.round(axis, 6) + 0.0).tolist())} through "
+        f"{tuple((np.round(through, 6) + 0.0).tolist())}"
     )
 
 
