@@ -22,6 +22,7 @@ from ..mesh.mesh import Mesh
 from ..problem.conditions import Neumann
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
+from ..problem.problem3d import check_mesh_dimension
 from ..problem.rollers import HeldNodes
 from .admissible import check_load_size
 from .contact_set import ContactSet, contact_set
@@ -176,11 +177,7 @@ def assemble(
         raise ValueError(
             f"ranks must be a signorini.algebra.ranks.Ranks, got {type(ranks).__name__}"
         )
-    if mesh.dim != problem.mesh.dim:
-        raise ValueError(
-            f"the problem {problem.name!r} is stated on a {problem.mesh.dim}D mesh and was "
-            f"handed a {mesh.dim}D mesh: solve it on its own mesh or a refinement of it"
-        )
+    check_mesh_dimension(problem.name, problem.mesh, mesh)
     if mesh.dim == 3:  # 3D elasticity and contact on faces: its own assembly, beside this one
         from .system3d import assemble_3d  # (which builds on this module's Assembled)
 

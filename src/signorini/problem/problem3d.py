@@ -24,7 +24,7 @@ from .fields import ProblemError
 from .rigid3d import free_rigid_motions_3d
 from .rollers3d import check_roller_part_3d
 
-__all__ = ["check_dimension", "check_problem_3d"]
+__all__ = ["check_dimension", "check_mesh_dimension", "check_problem_3d"]
 
 
 def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
@@ -99,6 +99,22 @@ def _check_contact_3d(conditions: Mapping[str, Condition]) -> None:
         raise ProblemError(
             f"the contact parts give different face_alpha {sorted(alphas, key=str)}: one "
             "discrete contact condition on all of Γ_C"
+        )
+
+
+def check_mesh_dimension(name: str, stated: Mesh, mesh: Mesh) -> None:
+    """Refuse a ``mesh`` of another dimension than the mesh the problem ``name`` is
+    ``stated`` on (a 2D problem handed a tetrahedral mesh, or the reverse).
+
+    Raises
+    ------
+    ValueError
+        Naming both dimensions.
+    """
+    if mesh.dim != stated.dim:
+        raise ValueError(
+            f"the problem {name!r} is stated on a {stated.dim}D mesh and was handed a "
+            f"{mesh.dim}D mesh: solve it on its own mesh or a refinement of it"
         )
 
 
