@@ -46,6 +46,15 @@ def span_residual(basis: np.ndarray, count: np.ndarray, n: np.ndarray) -> np.nda
     return n - np.einsum("jr,jrc->jc", coefficients, basis)
 
 
+def _axes(held: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The held Cartesian axes ``held (j, 3)`` as orthonormal rows ``(j, 3, 3)`` (the first
+    ``count (j,)`` of each) and their count."""
+    basis = np.zeros(held.shape + (3,))
+    r, c = np.nonzero(held)
+    basis[r, np.cumsum(held, axis=1)[r, c] - 1, c] = 1.0
+    return basis, held.sum(axis=1)
+
+
 def check_roller_part_3d(space, name: str) -> None:
     """Refuse a roller part of a tetrahedral mesh whose normal is not defined at a node: a
     crease (a face of the part more than :data:`~.rollers.MAX_ROLLER_TURN` away from the mean
@@ -109,11 +118,7 @@ def held_rows_3d(problem, space, comp: np.ndarray, val: np.ndarray | None) -> He
     node, normal, value = roller_rows_3d(problem, space)
     if node.size == 0:
         return HeldNodes(comp, val, node, normal, value)
-    # the held directions so far at each row's node: the Cartesian axes (orthonormal)
-    basis = np.zeros((node.size, 3, 3))
-    count = comp[node].sum(axis=1)
-    r, c = np.nonzero(comp[node])
-    basis[r, np.cumsum(comp[node], axis=1)[r, c] - 1, c] = 1.0
+    basis, count = _axes(comp[node])  # the held directions so far at each row's node
     start = np.searchsorted(node, node)  # the first row of each row's node
     rank = np.arange(node.size) - start
     keep = np.zeros(node.size, dtype=bool)
@@ -161,10 +166,7 @@ def held_basis(comp: np.ndarray, node: np.ndarray, normal: np.ndarray) -> tuple[
     beside the Cartesian axes ``comp (n_nodes, 3)``: the distinct nodes ``(u,)``, their bases
     ``(u, 3, 3)`` (rows) and the number of rows ``(u,)``."""
     nodes, first = np.unique(node, return_index=True)
-    basis = np.zeros((nodes.size, 3, 3))
-    count = comp[nodes].sum(axis=1)
-    r, c = np.nonzero(comp[nodes])
-    basis[r, np.cumsum(comp[nodes], axis=1)[r, c] - 1, c] = 1.0
+    basis, count = _axes(comp[nodes])
     rank = np.arange(node.size) - first[np.searchsorted(nodes, node)]
     for j in range(int(rank.max(initial=-1)) + 1):  # a loop over the roller rows of a node
         rows = np.flatnonzero(rank == j)
