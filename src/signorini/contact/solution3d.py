@@ -123,7 +123,8 @@ class FaceFields:
         for name, outside in self.SCALARS.items():  # a loop over the fields
             value = np.full(n_nodes, outside)
             value[self.node] = -np.inf
-            np.maximum.at(value, self.node, getattr(self, name).astype(np.float64))
+            with np.errstate(invalid="ignore"):  # NaN rows (pressure of (a)) stay NaN
+                np.maximum.at(value, self.node, getattr(self, name).astype(np.float64))
             out[name] = value
         normal = np.zeros((n_nodes, 3))
         nodes, first = np.unique(self.node, return_index=True)
