@@ -30,6 +30,7 @@ __all__ = [
     "VIEW",
     "face_colours",
     "plane_offset",
+    "plane_squares",
     "plot_body_3d",
     "render_body_3d",
     "shown_faces",
@@ -65,7 +66,7 @@ def plane_offset(plane: Plane, points: np.ndarray, displacement: np.ndarray, sca
     return float(((points + scale * displacement - point) @ m).min())
 
 
-def _plane_squares(
+def plane_squares(
     planes: Sequence[Plane],
     touching: tuple[ArrayLike, ArrayLike] | None,
     scale: float,
@@ -192,7 +193,7 @@ def plot_body_3d(
     fig = new_figure(5.6, 4.8)
     ax = fig.add_subplot(projection="3d")
     ax.computed_zorder = False  # a plane seen from the body's side lies behind it
-    squares = _plane_squares(planes, touching, scale, low, high)
+    squares = plane_squares(planes, touching, scale, low, high)
     for plane, square in zip(planes, squares, strict=True):  # a loop over the planes
         behind = float(np.asarray(plane[1]) @ _eye(VIEW)) > 0
         ax.add_collection3d(
@@ -256,7 +257,7 @@ def render_body_3d(
     surface.cell_data["von Mises"] = face_colours(tri, von_mises(np.asarray(stress, float)))
     drawn = x + scale * u
     low, high = drawn.min(axis=0), drawn.max(axis=0)
-    squares = _plane_squares(planes, touching, scale, low, high)
+    squares = plane_squares(planes, touching, scale, low, high)
     centre, size = 0.5 * (low + high), float((high - low).max())
     out = Path(f"{os.fspath(path)}.png")
     try:
