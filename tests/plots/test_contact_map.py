@@ -200,3 +200,35 @@ def test_the_body_with_its_plane(tmp_path, figures):
     assert (square[:, :2].min(axis=0) < low[:2]).all() and (
         square[:, :2].max(axis=0) > high[:2]
     ).all()
+
+
+def test_the_rendering_runs_apart_and_its_failure_costs_the_picture_only(tmp_path, monkeypatch):
+    """The PyVista rendering runs in a child process: one that ends by a signal or an error
+    (VTK without EGL or OSMesa) gives the note, one that writes the PNG gives the file. The
+    child here writes a stand-in (PyVista itself is an optional extra)."""
+    import importlib.util
+
+    from signorini.plots import body3d
+
+    find_spec = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util,
+        "find_spec",
+        lambda name, *a: object() if name == "pyvista" else find_spec(name, *a),
+    )
+    r = hertz(0.15)
+    n = r.mesh.points.shape[0]
+    faces = r.space.facet_nodes(r.mesh.boundary_facet)[:, :3]
+    body = (r.mesh.points, faces, r.u[:n], r.nodal_stress[:n])
+    monkeypatch.setattr(body3d, "RENDER", "import os, signal; os.kill(os.getpid(), signal.SIGSEGV)")
+    written, note = body3d.render_body_3d(*body, tmp_path / "crash")
+    assert written == [] and "exit status -11" in note and "EGL or OSMesa" in note
+    stand_in = (
+        "import sys, numpy as np; s = np.load(sys.argv[1]); "
+        "assert s['squares'].shape == (1, 4, 3) and s['cells'].size == 4 * s['value'].size; "
+        "open(sys.argv[2], 'wb').write(b'png')"
+    )
+    monkeypatch.setattr(body3d, "RENDER", stand_in)
+    s = surface_arrays(r)
+    written, note = body3d.render_body_3d(*body, tmp_path / "drawn", planes=s["planes"])
+    assert written == [tmp_path / "drawn.png"] and note == ""

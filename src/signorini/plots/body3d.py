@@ -237,6 +237,11 @@ def render_body_3d(
     ``[3d]`` extra) as ``<path>.png``: all boundary faces, the same magnification, view and
     planes (``planes``, ``touching`` as there).
 
+    VTK renders off screen through EGL or OSMesa (or a display); where it has none it may
+    end the process (measured: a segmentation fault when OSMesa is asked for and missing),
+    so the rendering runs in a child process (:data:`RENDER_SECONDS` at most) and a failed
+    one costs the picture only.
+
     Returns
     -------
     written : list of pathlib.Path
@@ -244,33 +249,69 @@ def render_body_3d(
     note : str
         Empty when written, else the one line for the run's log saying why not.
     """
-    try:
-        import pyvista
-    except ImportError:
+    import importlib.util
+    import subprocess
+    import sys
+    import tempfile
+
+    if importlib.util.find_spec("pyvista") is None:
         return [], "pyvista not installed (the [3d] extra): no PyVista rendering"
     x = np.asarray(points, dtype=np.float64)
     u = np.asarray(displacement, dtype=np.float64)
     tri = np.asarray(faces, dtype=np.int64)
     scale = displacement_scale(x, u)
-    cells = np.hstack([np.full((tri.shape[0], 1), 3), tri]).ravel()
-    surface = pyvista.PolyData(x + scale * u, cells)
-    surface.cell_data["von Mises"] = face_colours(tri, von_mises(np.asarray(stress, float)))
     drawn = x + scale * u
     low, high = drawn.min(axis=0), drawn.max(axis=0)
-    squares = plane_squares(planes, touching, scale, low, high)
     centre, size = 0.5 * (low + high), float((high - low).max())
     out = Path(f"{os.fspath(path)}.png")
-    try:
-        plotter = pyvista.Plotter(off_screen=True, window_size=(1200, 1000))
-        plotter.add_mesh(surface, scalars="von Mises", show_edges=True, cmap="viridis")
-        for square in squares:  # a loop over the planes
-            plane = pyvista.PolyData(square, np.array([4, 0, 1, 2, 3]))
-            plotter.add_mesh(plane, color="gray", opacity=0.35, show_edges=True)
-        plotter.camera_position = [tuple(centre + 3 * size * _eye(VIEW)), tuple(centre), (0, 0, 1)]
-        plotter.reset_camera()
-        plotter.add_text(f"displacement × {scale:g}", font_size=10)
-        plotter.screenshot(os.fspath(out))
-        plotter.close()
-    except Exception as exc:  # no off-screen context on this machine
-        return [], f"pyvista could not render off screen ({type(exc).__name__}: {exc})"
+    with tempfile.TemporaryDirectory() as folder:
+        scene = Path(folder) / "scene.npz"
+        np.savez(
+            scene,
+            points=drawn,
+            cells=np.hstack([np.full((tri.shape[0], 1), 3), tri]).ravel(),
+            value=face_colours(tri, von_mises(np.asarray(stress, dtype=np.float64))),
+            squares=np.reshape(plane_squares(planes, touching, scale, low, high), (-1, 4, 3)),
+            camera=np.array([centre + 3 * size * _eye(VIEW), centre, [0.0, 0.0, 1.0]]),
+        )
+        command = [sys.executable, "-c", RENDER, os.fspath(scene), os.fspath(out)]
+        try:
+            done = subprocess.run(
+                command + [f"displacement × {scale:g}"],
+                capture_output=True,
+                timeout=RENDER_SECONDS,
+                check=False,
+            )
+        except subprocess.TimeoutExpired:
+            return [], f"pyvista did not render off screen within {RENDER_SECONDS:g} s"
+    if done.returncode != 0 or not out.is_file():
+        return [], (
+            f"pyvista could not render off screen (exit status {done.returncode}): VTK needs "
+            "EGL or OSMesa (or a display)"
+        )
     return [out], ""
+
+
+#: The most seconds the off-screen rendering may take.
+RENDER_SECONDS = 120.0
+
+#: The child process of :func:`render_body_3d` (NumPy and PyVista only): the scene of the
+#: ``.npz`` file ``argv[1]`` rendered into ``argv[2]``, ``argv[3]`` written on it.
+RENDER = """
+import sys
+import numpy as np
+import pyvista
+scene = np.load(sys.argv[1])
+surface = pyvista.PolyData(scene["points"], scene["cells"])
+surface.cell_data["von Mises"] = scene["value"]
+plotter = pyvista.Plotter(off_screen=True, window_size=(1200, 1000))
+plotter.add_mesh(surface, scalars="von Mises", show_edges=True, cmap="viridis")
+for square in scene["squares"]:
+    plane = pyvista.PolyData(square, np.array([4, 0, 1, 2, 3]))
+    plotter.add_mesh(plane, color="gray", opacity=0.35, show_edges=True)
+plotter.camera_position = [tuple(row) for row in scene["camera"]]
+plotter.reset_camera()
+plotter.add_text(sys.argv[3], font_size=10)
+plotter.screenshot(sys.argv[2])
+plotter.close()
+"""
