@@ -105,7 +105,8 @@ def run_figures(
     dim : {2, 3}, optional
         The mesh's dimension; default ``last["dim"]``, else 2. A 3D level (the arrays of
         :func:`signorini.loop.arrays.body_arrays`) gets its convergence history and the
-        picture of its body; the figures of contact are 2D only.
+        picture of its body; with contact also its plane obstacles and the pressure map
+        over Γ_C (:func:`body_figures`).
     """
     known = {} if last is None else last
     name = str(known.get("name", example)) if name is None else name
