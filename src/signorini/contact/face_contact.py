@@ -29,6 +29,7 @@ from ..mesh.geometry import facet_normals
 from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
 from .face_basis import DEFAULT_ALPHA, FaceEdges, change_of_variables, face_edges
+from .face_fields import FaceFields
 from .node_frames3d import frame_operator, row_frames
 
 if TYPE_CHECKING:
@@ -147,6 +148,23 @@ class FaceContactSet:
         )
         p[half.mid] = 0.5 * (p[half.start] + p[half.end])
         return p
+
+    def fields(self, u: np.ndarray, force: np.ndarray, active: np.ndarray) -> FaceFields:
+        """The rows' gap ``u(z)·n_z − ψ(z)``, force, pressures (:meth:`pressure` for
+        condition (b), NaN for (a); :meth:`recovered_pressure`), flag and direction of a
+        solution ``u (n_nodes, 3)`` with forces ``Λ (k,)`` and active set ``(k,)``."""
+        force = np.asarray(force, dtype=np.float64)
+        p = self.pressure(force) if self.edges.alpha > 0 else np.full(self.n_rows, np.nan)
+        return FaceFields(
+            node=self.node,
+            part=self.part,
+            normal=self.direction,
+            gap=np.einsum("kc,kc->k", np.asarray(u)[self.node], self.direction) - self.psi,
+            contact_force=force,
+            pressure=p,
+            recovered_pressure=self.recovered_pressure(force),
+            active=np.asarray(active, dtype=bool),
+        )
 
     @property
     def n_rows(self) -> int:

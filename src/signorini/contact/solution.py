@@ -45,14 +45,7 @@ from .ordering import SolverAhead, ordered_solver
 from .partition import Partition
 from .profile import ContactProfile, contact_profile
 from .rigid_modes import system_rigid_modes
-from .solution3d import (
-    FaceFields,
-    cartesian_displacement,
-    contact_force,
-    errors_3d,
-    face_fields,
-    nodal_pressure,
-)
+from .solution3d import cartesian_displacement, contact_force, errors_3d, nodal_pressure
 from .system import Assembled, assemble
 from .two_body import master_traction
 
@@ -236,12 +229,6 @@ class ContactResult:
         dirichlet_touch = gap >= -TOUCH_RTOL * round_off_scale(self.u, cs.facet_gap)
         edge_in = np.where(loc >= 0, self.active[np.maximum(loc, 0)], dirichlet_touch)
         return node_classes(cs, self.active, edge_in)
-
-    @cached_property
-    def face_fields(self) -> FaceFields:
-        """3D contact: the gap, force, pressures, active flag and normal of every constraint
-        row (:func:`~.solution3d.face_fields`)."""
-        return face_fields(self)
 
     def contact_profile(self, part: str | None = None) -> ContactProfile:
         """The contact quantities of one contact part, ordered along the boundary

@@ -1,7 +1,7 @@
 """A 3D contact level's contact surface as plain arrays, for the figures that draw it
 (``plots.contact_map``, ``plots.body3d``): the P2 nodes of the contact parts' faces with the
-solution's fields there (:attr:`ContactResult.face_fields
-<signorini.contact.solution.ContactResult.face_fields>`), and the planes among the
+solution's fields there (:meth:`FaceContactSet.fields
+<signorini.contact.face_contact.FaceContactSet.fields>`), and the planes among the
 obstacles (docs/method.md, *Three dimensions: contact on faces*, "What a 3D contact run
 shows")."""
 
@@ -31,14 +31,15 @@ def surface_arrays(result: ContactResult) -> dict[str, Any]:
         face's nodes as rows of ``points`` (three vertices in outward order, then the
         midpoints of ab, bc, ca); ``face_part (f,)``, an index into ``parts``, the contact
         parts' names; ``displacement (m, 3)``; at each node the fields of
-        :meth:`FaceFields.at_nodes <signorini.contact.solution3d.FaceFields.at_nodes>`:
+        :meth:`FaceFields.at_nodes <signorini.contact.face_fields.FaceFields.at_nodes>`:
         ``recovered_pressure``, ``pressure``, ``gap``, ``contact_force`` ``(m,)``, ``active
         (m,)`` bool and ``normal (m, 3)``; ``planes``, the plane obstacles
         (:func:`obstacle_planes`).
     """
     cs = result.contact
     nodes, local = np.unique(cs.faces, return_inverse=True)
-    nodal = result.face_fields.at_nodes(result.space.n_nodes)
+    rows = cs.fields(result.u, result.contact_force, result.active)
+    nodal = rows.at_nodes(result.space.n_nodes)
     arrays = {
         "points": result.space.node_points[nodes],
         "faces": local.reshape(cs.faces.shape),

@@ -9,9 +9,10 @@ order, the space's own numbering); a face's three vertices in outward order, the
 ab, bc, ca (:meth:`~signorini.fem.space3d.P2TetSpace.facet_nodes`). :func:`write_vtu_3d` is
 what :func:`~.vtu.write_vtu` writes for a tetrahedral mesh.
 
-With contact the nodes of Γ_C carry its fields (:data:`CONTACT_FIELDS_3D`, the solution's
-``face_fields`` at the nodes, docs/method.md, *Three dimensions: contact on faces*); on the
-``triangle6`` faces of a contact part (threshold on ``part``) they show Γ_C.
+With contact the nodes of Γ_C carry its fields (:data:`CONTACT_FIELDS_3D`: the contact
+set's ``fields`` of the solution at the nodes, docs/method.md, *Three dimensions: contact
+on faces*); on the ``triangle6`` faces of a contact part (threshold on ``part``) they show
+Γ_C.
 """
 
 from __future__ import annotations
@@ -112,7 +113,7 @@ def write_vtu_3d(
     path : path of the ``.vtu`` file
     result : ContactResult
         ``result.u (n_nodes, 3)`` on ``result.space`` (a P2TetSpace); with contact rows
-        (``result.contact.size``) also ``result.face_fields``.
+        (``result.contact.size``) also ``result.contact.fields(u, force, active)``.
     mises : callable
         The von Mises stress ``(n,)`` of stress tensors ``(n, 3, 3)`` (:func:`~.vtu.von_mises`).
     """
@@ -125,7 +126,8 @@ def write_vtu_3d(
     n_cells, n_faces = mesh.n_cells, faces.shape[0]
     point_data = {"displacement": result.u, "stress": voigt, "von_mises": mises(sigma)}
     if result.contact.size:
-        nodal = result.face_fields.at_nodes(space.n_nodes)
+        rows = result.contact.fields(result.u, result.contact_force, result.active)
+        nodal = rows.at_nodes(space.n_nodes)
         point_data |= {name: nodal[key] for name, (key, _) in CONTACT_FIELDS_3D.items()}
         point_data["active"] = point_data["active"].astype(np.int32)
     data = meshio.Mesh(
