@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ..algebra.backends.selection import solver_library, solver_name
 from ..loop import COLUMNS, Level, adaptive
-from ..loop.record import COLUMNS_3D
+from ..loop.record import COLUMNS_3D, COLUMNS_3D_CONTACT
 from ..output import HistoryWriter, write_columns
 from ..output.check import CHECK, write_check
 from ..output.environment import environment
@@ -193,11 +193,12 @@ def _solve_levels(work: _Run, status: Status) -> Level | None:
     out, state, options, say = work.folder.path, work.state, work.settings.options, work.say
     job = work.job
     work.folder.add_files("history.csv", "history.md")
-    three = job.problem.mesh.dim == 3  # no estimator, no contact: their columns left out
+    three = job.problem.mesh.dim == 3  # no estimator (nor contact): their columns left out
+    columns = COLUMNS_3D_CONTACT if job.problem.contact_parts else COLUMNS_3D
     write_columns(
         out / "history.md",
         {
-            **(COLUMNS_3D if three else COLUMNS),
+            **(columns if three else COLUMNS),
             **(job.metrics.columns if job.metrics else {}),
             "t_output": "seconds spent writing the level's VTU file and recording it",
         },

@@ -32,6 +32,7 @@ from ..problem.rollers import HeldNodes
 from ..problem.rollers3d import held_basis, span_residual
 from .face_basis import DEFAULT_ALPHA, FaceEdges, change_of_variables, face_edges
 from .face_checks import check_deep_overlap, given_directions
+from .face_fields import FaceFields
 from .node_frames3d import frame_operator, held_frames, to_frames_3d
 
 if TYPE_CHECKING:
@@ -178,6 +179,23 @@ class FaceContactSet:
         values ``u (n_nodes, 3)``."""
         return np.einsum("fjc,fjc->fj", np.asarray(u)[self.faces], self.facet_direction) - (
             self.facet_gap
+        )
+
+    def fields(self, u: np.ndarray, force: np.ndarray, active: np.ndarray) -> FaceFields:
+        """The rows' gap ``u(z)·n_z − ψ(z)``, force, pressures (:meth:`pressure` for
+        condition (b), NaN for (a); :meth:`recovered_pressure`), flag and direction of a
+        solution ``u (n_nodes, 3)`` with forces ``Λ (k,)`` and active set ``(k,)``."""
+        force = np.asarray(force, dtype=np.float64)
+        p = self.pressure(force) if self.edges.alpha > 0 else np.full(self.n_rows, np.nan)
+        return FaceFields(
+            node=self.node,
+            part=self.part,
+            normal=self.direction,
+            gap=np.einsum("kc,kc->k", np.asarray(u)[self.node], self.direction) - self.psi,
+            contact_force=force,
+            pressure=p,
+            recovered_pressure=self.recovered_pressure(force),
+            active=np.asarray(active, dtype=bool),
         )
 
     @property

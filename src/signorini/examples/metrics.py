@@ -47,6 +47,11 @@ class PressureComparison:
         ``"inactive"``, ``"stick"`` or ``"slip"`` per node.
     window : (2,) float or None
         The x range to show (a zoom on the contact zone).
+    xlabel : str
+        What ``x`` is (the figure's x-axis label).
+    joined : bool
+        The computed values are joined by a line (a pressure linear between the nodes along
+        a line, e.g. through a 3D contact zone), not markers only.
     """
 
     x: np.ndarray
@@ -60,6 +65,8 @@ class PressureComparison:
     tangential_label: str = ""
     state: np.ndarray | None = None
     window: tuple[float, float] | None = None
+    xlabel: str = r"$x$"
+    joined: bool = False
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,15 @@ from ..contact.solution import SLIP, STICK, ContactResult
 from ..estimator.names import TERM_TABLE, TERMS
 from ..estimator.residual import Estimate
 
-__all__ = ["COLUMNS", "COLUMNS_3D", "ElasticityRecord", "LevelRecord", "level_record"]
+__all__ = [
+    "COLUMNS",
+    "COLUMNS_3D",
+    "COLUMNS_3D_CONTACT",
+    "ElasticityRecord",
+    "FaceContactRecord",
+    "LevelRecord",
+    "level_record",
+]
 
 #: What each :class:`LevelRecord` field (= each column of a run's ``history.csv``) means,
 #: with its unit. Units are those of the problem's data ("consistent units": if E is in MPa
@@ -243,6 +251,61 @@ COLUMNS_3D: dict[str, str] = {
 }
 
 
+#: The columns a 3D contact level's row leaves out: the node classes of Section 4 (not built
+#: on faces) and the friction's (3D contact is frictionless).
+FACE_CONTACT_LEFT_OUT = (
+    "n_full_contact", "n_semi_contact", "n_no_contact", "n_stick", "n_slip",
+    "kkt_tangential_bound", "kkt_tangential_complementarity",
+)  # fmt: skip
+
+
+@dataclass
+class FaceContactRecord(LevelRecord):
+    """The record of a 3D contact level (docs/method.md, *Three dimensions: contact on
+    faces*): its row leaves out :data:`FACE_CONTACT_LEFT_OUT` and, on a level without an
+    estimate (η NaN), the estimator's columns; an iterative solve adds
+    ``linear_iterations`` to :attr:`extra`."""
+
+    LEFT_OUT: ClassVar[tuple[str, ...]] = FACE_CONTACT_LEFT_OUT
+
+    def row(self) -> dict:
+        """Flat dict for a CSV row (without :attr:`LEFT_OUT`, and without the estimator's
+        columns where there is no estimate)."""
+        d = super().row()
+        if math.isnan(self.eta):
+            for name in NO_ESTIMATE_COLUMNS:
+                del d[name]
+        return d
+
+
+#: The columns of a 3D contact run's history (:class:`FaceContactRecord`), with their
+#: meaning in 3D.
+_IN_3D_CONTACT = {
+    "pdas_iterations": "primal-dual active set iterations",
+    "n_active": "constraint rows in the final active set: the P2 nodes of Γ_C in contact (one "
+    "row per node and contact part; for condition (b) the transformed coefficient at its "
+    "bound)",
+    "n_constrained": "constraint rows: the P2 nodes (vertices and edge midpoints) of the "
+    "contact parts' faces whose normal component is not held, one per node and part",
+    "contact_force": "Σ Λ_z (3.17) over the rows, force units: the resultant normal force on "
+    "Γ_C where all n_z agree",
+    "kkt_primal": "largest penetration of the solver's bounds (for condition (b) those of the "
+    "transformed coefficients, ỹ ≤ ψ̃), relative to the contact's displacement scale "
+    "(docs/method.md, *Solver*), no unit",
+    "kkt_dual": "largest negative multiplier (for condition (b) the transformed force "
+    "Λ̃ = T Λ), relative to the total contact force",
+    "kkt_complementarity": "largest min(|multiplier| / force scale, |bound − variable| / "
+    "displacement scale) over the rows, in the solver's variables",
+    "linear_iterations": "CG iterations of an iterative solver (amg), summed over the level's "
+    "PDAS solves; absent with a direct solver",
+}
+COLUMNS_3D_CONTACT: dict[str, str] = {
+    name: _IN_3D_CONTACT.get(name) or COLUMNS_3D.get(name) or COLUMNS[name]
+    for name in [*COLUMNS, "linear_iterations"]
+    if name not in NO_ESTIMATE_COLUMNS + FACE_CONTACT_LEFT_OUT
+}
+
+
 @dataclass(frozen=True)
 class _NoEstimate:
     """What a record reads of an estimate where there is none (3D): NaN."""
@@ -256,7 +319,8 @@ _NO_ESTIMATE = _NoEstimate()
 
 def level_record(level: int, result: ContactResult, est: Estimate | None) -> LevelRecord:
     """The record of one level; without an estimate (3D) η and its terms are NaN, and
-    without contact as well an :class:`ElasticityRecord`, whose row leaves them out."""
+    without contact as well an :class:`ElasticityRecord`, whose row leaves them out; a 3D
+    level with contact a :class:`FaceContactRecord`."""
     if est is None:
         est = _NO_ESTIMATE
     # the node classes of Section 4 are not built on faces (3D): their counts stay 0
@@ -264,7 +328,9 @@ def level_record(level: int, result: ContactResult, est: Estimate | None) -> Lev
     classes = result.classes if has_classes else np.zeros(0, dtype=np.int64)
     report = result.report
     elasticity = est is _NO_ESTIMATE and not result.contact.size
-    rec = (ElasticityRecord if elasticity else LevelRecord)(
+    three = result.mesh.dim == 3
+    kind = ElasticityRecord if elasticity else FaceContactRecord if three else LevelRecord
+    rec = kind(
         level=level,
         ndof=result.ndof,
         ndof_total=result.space.n_dofs,
@@ -289,7 +355,7 @@ def level_record(level: int, result: ContactResult, est: Estimate | None) -> Lev
         t_assemble=result.timings["assemble"],
         t_solve=result.timings["solve"],
     )
-    if elasticity and report.linear_iterations:
+    if three and report.linear_iterations:
         rec.extra["linear_iterations"] = int(sum(report.linear_iterations))
     if result.problem.exact is not None:
         err = result.errors()
