@@ -85,6 +85,7 @@ def punch_3d(
     poisson: float = 0.3,
     *,
     n: int = 4,
+    face_alpha: float | None = None,
 ) -> ContactProblem:
     """The 3D punch problem: a block pressed by a rounded rigid punch, held by a wall.
 
@@ -108,6 +109,10 @@ def punch_3d(
         E (stress units) and ν of the block.
     n : int
         The initial mesh: ``box(2n, n, n)`` Kuhn cubes of the block.
+    face_alpha : float, optional
+        The discrete contact condition of both parts (:class:`~signorini.problem.Contact`):
+        None for (b), the transformed face basis with α = 1/5; 0 for (a), nodal constraints
+        at all P2 nodes.
 
     Raises
     ------
@@ -140,8 +145,10 @@ def punch_3d(
             "y0": Roller(),
             "x0": Neumann((0.0, 0.0, 0.0)),
             "y1": Neumann((0.0, 0.0, 0.0)),
-            "z1": Contact(obstacle=tool),
-            "x1": Contact(obstacle=HalfSpace((width, 0.0, 0.0), (-1.0, 0.0, 0.0))),
+            "z1": Contact(obstacle=tool, face_alpha=face_alpha),
+            "x1": Contact(
+                obstacle=HalfSpace((width, 0.0, 0.0), (-1.0, 0.0, 0.0)), face_alpha=face_alpha
+            ),
         },
         name="punch-3d",
     )
