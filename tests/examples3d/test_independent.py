@@ -8,8 +8,8 @@ from functools import cache
 
 import numpy as np
 import pytest
-
 from examples3d.independent_qp import kkt_residuals, solve_independent
+
 from signorini.contact.solution import solve
 from signorini.examples import EXAMPLES
 from signorini.examples.hertz3d import hertz_3d
