@@ -116,7 +116,6 @@ def test_pyramid_is_interpolated_exactly_on_the_mirrored_mesh_only():
     bary = np.array([[1 / 3, 1 / 3, 1 / 3], [0.6, 0.3, 0.1], [0.1, 0.2, 0.7], [0.45, 0.1, 0.45]])
     for n in (2, 4):
         psi, psi_h, space, nodes = _face_values(mirrored_box(n, n, n), "x1", bary)
-        # the midpoint order of facet_nodes: check the interpolant at the nodes themselves
         np.testing.assert_allclose(psi_h, psi, rtol=0, atol=1e-15)
         psi, psi_h, *_ = _face_values(box(n, n, n), "x1", bary)
         assert np.abs(psi_h - psi).max() > 1e-3
