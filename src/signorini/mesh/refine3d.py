@@ -22,9 +22,10 @@ from .surfaces import Surface
 from .tags3d import (
     ATTRIBUTE,
     Tags,
+    coloured_tags,
+    greedy_colouring,
     kuhn_tags,
     mesh_cells,
-    sorted_tags,
     with_face_parts,
 )
 from .topology3d import refined_topology
@@ -170,10 +171,11 @@ def tags_of(mesh: Mesh) -> Tags:
     refinement (or :func:`tagged`) attached; else the Kuhn paths of an axis-aligned Kuhn mesh
     (:func:`~signorini.mesh.tags3d.kuhn_tags`); else the Kuhn paths of a mapped Kuhn grid in
     the builders' cell order (:func:`~signorini.mesh.builders3d.kuhn_paths`, plain or
-    mirrored) if they pass :func:`matches`; else the global vertex order
-    (:func:`~signorini.mesh.tags3d.sorted_tags`, no matching condition, logged at
-    ``INFO``: docs/method.md; :func:`~signorini.mesh.matching3d.prepare_for_bisection`
-    gives a mesh with it)."""
+    mirrored) if they pass :func:`matches`; else (any conforming mesh, e.g. from Gmsh)
+    Diening, Gehring and Storn's initialisation from a greedy vertex colouring
+    (:func:`~signorini.mesh.tags3d.coloured_tags`, logged at ``INFO``), with which the
+    bisection keeps its closure estimate and shape regularity (docs/method.md, *The initial
+    condition*)."""
     tags = getattr(mesh, ATTRIBUTE, None)
     if tags is not None:
         return tags
@@ -193,11 +195,13 @@ def tags_of(mesh: Mesh) -> Tags:
                 tags = candidate
                 break
     if tags is None:
-        tags = tags_in(sorted_tags(mesh.cells))
+        colour = greedy_colouring(mesh.edges, mesh.n_points)
+        tags = tags_in(coloured_tags(mesh.cells, colour))
         logger.info(
-            "bisection: %d tetrahedra tagged by the global vertex order (no matching "
-            "condition; matching3d.prepare_for_bisection gives one)",
+            "bisection: %d tetrahedra tagged from a greedy colouring of their vertices in %d "
+            "colours (Diening-Gehring-Storn)",
             mesh.n_cells,
+            int(colour.max(initial=0)) + 1,
         )
     setattr(mesh, ATTRIBUTE, tags)
     return tags
