@@ -15,7 +15,7 @@ import logging
 
 import numpy as np
 
-from .bisect3d import bisect_tagged, boundary_of, edge_key
+from .bisect3d import KEY_BASE, bisect_tagged, boundary_of, edge_key
 from .builders3d import kuhn_paths
 from .mesh import Mesh
 from .surfaces import Surface
@@ -47,7 +47,7 @@ EDGE_CACHE, FACET_CACHE = "_edge_topology", "_topology"
 
 def bisect_mesh(
     mesh: Mesh, marked: np.ndarray, bisections: int = 1
-) -> tuple[Mesh, np.ndarray, np.ndarray]:
+) -> tuple[Mesh, np.ndarray, np.ndarray, np.ndarray]:
     """Bisect the marked cells of a tetrahedral mesh ``bisections`` times each (the children
     of a marked cell are marked for the next bisection), with closure.
 
@@ -67,6 +67,9 @@ def bisect_mesh(
         The old cell that contains each new cell.
     edge_point : (n_edges_old,) int64 array
         The new vertex at the midpoint of each bisected old edge, ``-1`` elsewhere.
+    parent_edge : (n_points_new - n_points_old, 2) int64 array
+        The ends of the edge each new vertex bisected (old edges and edges made in this
+        step; :attr:`~signorini.mesh.refine.Refinement.parent_edge`).
 
     Raises
     ------
@@ -77,6 +80,8 @@ def bisect_mesh(
     edge_point = np.full(old.size, -1, dtype=np.int64)
     parent = np.arange(mesh.n_cells, dtype=np.int64)
     marked = np.asarray(marked, dtype=bool)
+    n_old = mesh.n_points
+    ends = []
     for _ in range(bisections):  # a loop over bisections, not cells
         mesh, step, split_key, split_point = _bisect_once(mesh, marked[parent])
         parent = parent[step]
@@ -84,7 +89,11 @@ def bisect_mesh(
             pos = np.minimum(np.searchsorted(split_key, old), split_key.size - 1)
             hit = (split_key[pos] == old) & (edge_point < 0)
             edge_point[hit] = split_point[pos[hit]]
-    return mesh, parent, edge_point
+            by_point = np.argsort(split_point)  # new points are numbered in order
+            ends.append(np.column_stack(np.divmod(split_key[by_point], KEY_BASE)))
+    parent_edge = np.concatenate(ends) if ends else np.zeros((0, 2), dtype=np.int64)
+    assert parent_edge.shape[0] == mesh.n_points - n_old
+    return mesh, parent, edge_point, parent_edge
 
 
 def _bisect_once(mesh: Mesh, marked: np.ndarray) -> tuple[Mesh, np.ndarray, np.ndarray, np.ndarray]:
