@@ -15,16 +15,16 @@ as the vertices.
 Initial condition. Stevenson's matching condition holds for a Kuhn (Freudenthal) mesh of a
 box ordered along the path of each simplex, type 0 (:func:`kuhn_tags`): ``x0`` the corner
 with the smallest coordinates along the common diagonal direction, ``x1 = x0 + h_i e_i``,
-``x2 = x1 + h_j e_j``, ``x3 = x2 + h_k e_k`` ([3]_, [4]_). For an arbitrary mesh
-:func:`sorted_tags` orders each cell by its global vertex numbers (a consistent order on
-every shared face), type 0: bisection then stays conforming and terminates on the meshes
-tested, but the matching condition, hence the closure estimate and the bound of the closure
-rounds, is not guaranteed (Diening, Gehring, Storn [5]_ give an initialisation for any
-conforming mesh; it is not implemented). The guaranteed route for any conforming mesh is
-:func:`signorini.mesh.matching3d.prepare_for_bisection`: 12 tagged sub-cells per cell.
-:func:`signorini.mesh.refine3d.tags_of` checks the condition's consequence that three
-bisections of every cell need no closure before it takes the Kuhn paths of a mapped Kuhn
-grid.
+``x2 = x1 + h_j e_j``, ``x3 = x2 + h_k e_k`` ([3]_, [4]_). For an arbitrary conforming mesh,
+Diening, Gehring and Storn's initialisation [5]_: a greedy vertex colouring
+(:func:`greedy_colouring`) and each cell ordered by it (:func:`coloured_tags`), with which
+the bisection keeps the closure estimate and shape regularity (at most 36 similarity
+classes per initial cell) without the matching condition. :func:`sorted_tags` orders each
+cell by its global vertex numbers (a consistent order on every shared face, no guarantee);
+:func:`signorini.mesh.matching3d.prepare_for_bisection` gives the matching condition itself
+with 12 tagged sub-cells per cell. :func:`signorini.mesh.refine3d.tags_of` checks the
+condition's consequence that three bisections of every cell need no closure before it takes
+the Kuhn paths of a mapped Kuhn grid, and colours any other mesh.
 
 References
 ----------
@@ -37,7 +37,7 @@ References
 .. [4] D. N. Arnold, A. Mukherjee, L. Pouly, Locally adapted tetrahedral meshes using
    bisection, SIAM J. Sci. Comput. 22 (2000) 431–448.
 .. [5] L. Diening, L. Gehring, J. Storn, Adaptive mesh refinement for arbitrary initial
-   triangulations, arXiv:2306.02674 (2023).
+   triangulations, Found. Comput. Math. (2025), arXiv:2306.02674.
 """
 
 from __future__ import annotations
