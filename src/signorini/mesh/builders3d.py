@@ -13,8 +13,14 @@ negative orientation along the path and are listed with their vertices 1 and 2 s
 ``cells[c, [0, 2, 1, 3]]`` for odd ``σ`` (:func:`kuhn_paths`).
 
 The curved meshes map a Kuhn grid of the unit cube (square) onto the eighth ball (quarter
-disc) by :func:`round_corner`, which keeps the cells shape-regular (smallest dihedral angle
-above 30° for every ``n`` tried) and the symmetry planes in place.
+disc) by :func:`round_corner`, which keeps the symmetry planes in place and the cells shape
+regular: the smallest dihedral angle falls with ``n`` towards the smallest over the domain of
+the Kuhn cells mapped by the map's Jacobian, above :data:`MIN_DIHEDRAL_BALL` (28°) for
+:func:`eighth_ball` (45.0° at ``n = 1``, 39.5° at 2, 33.7° at 4, 30.9° at 8, 29.1° at 24;
+the limit 28.6° at the rim ``x = 0``, ``y = z = 1``) and above
+:data:`MIN_DIHEDRAL_CYLINDER` (20°) for :func:`quarter_cylinder` with its default ``nz``
+(35.3°, 28.2°, 24.4°, 22.6°, 21.4° at the same ``n``; the limit 20.9° where the cylinder
+meets the plane ``x = 0``); docs/method.md, *Three dimensions: bisection*.
 
 References
 ----------
@@ -36,6 +42,8 @@ from .topology import boundary_facets
 
 __all__ = [
     "BOX_PARTS",
+    "MIN_DIHEDRAL_BALL",
+    "MIN_DIHEDRAL_CYLINDER",
     "box",
     "eighth_ball",
     "kuhn_grid",
@@ -47,6 +55,12 @@ __all__ = [
 
 #: The six faces of a box, as parts: ``x0``/``x1`` at the lower/upper x, and so on.
 BOX_PARTS = ("x0", "x1", "y0", "y1", "z0", "z1")
+
+#: A lower bound (degrees) of the smallest dihedral angle of :func:`eighth_ball` at every
+#: ``n`` (module docstring: the limit of large ``n`` is 28.6°).
+MIN_DIHEDRAL_BALL = 28.0
+#: The same for :func:`quarter_cylinder` with its default ``nz`` (the limit is 20.9°).
+MIN_DIHEDRAL_CYLINDER = 20.0
 
 #: The six permutations of the axes, the even ones first (``σ`` of the Kuhn path).
 _SIGMA = np.array(list(permutations(range(3))))[[0, 3, 4, 1, 2, 5]]
