@@ -11,6 +11,10 @@ system's unknowns ``y``, which are the Cartesian displacement written in node fr
 contact and roller nodes, ``u = Q y`` (:mod:`.node_frames`), and with contact pairs the
 relative displacement ``ũ = (I − T_d) u`` (:mod:`.two_body`). So a motion ``u`` of the
 bodies is ``y = Q⁻¹ (I − T_d) u`` there, and ``K y = 0`` holds to round-off (tested).
+On 3D contact faces the unknowns are ``ỹ`` with ``u = Q P ỹ`` (node frames, then the
+transformed face basis, :attr:`~.face_contact.FaceContactSet.operator`), so a motion is
+``ỹ = P⁻¹ Q⁻¹ u``: ``Q_z⁻¹ u(z)`` at the frame nodes, and on the constraint DOFs the
+coefficients ``T^{-T}`` of those frame values (:meth:`~.face_basis.FaceEdges.coefficients`).
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ import numpy as np
 from ..fem.space import node_dofs
 from ..mesh.bodies import body_of_cells
 from ..problem.problem3d import rigid_modes_3d
+from .face_contact import FaceContactSet
 from .node_frames import to_frames
 from .system import Assembled
 
@@ -41,6 +46,14 @@ def system_rigid_modes(assembled: Assembled) -> np.ndarray:
         and ``6b + 3 + a`` the rotations ``e_a × (x − x_b)`` about the centroid ``x_b``;
         written as the system's unknowns (module docstring).
     """
+    if isinstance(assembled.contact, FaceContactSet):
+        return _on_faces(_cartesian_modes(assembled), assembled.contact)
+    return _in_system(_cartesian_modes(assembled), assembled)
+
+
+def _cartesian_modes(assembled: Assembled) -> np.ndarray:
+    """The rigid motions of every body as Cartesian DOFs (the columns of
+    :func:`system_rigid_modes`, before the change of unknowns)."""
     space = assembled.space
     points = space.node_points
     cell_body = body_of_cells(space.mesh)
@@ -73,9 +86,26 @@ def system_rigid_modes(assembled: Assembled) -> np.ndarray:
         motion = rigid_modes_3d(local)  # (n_nodes, 3, 6)
         for c in range(3):  # a loop over the three components
             modes[dofs[c][:, None], 6 * body[:, None] + np.arange(6)] = motion[:, c, :]
+    return modes
+
+
+def _in_system(modes: np.ndarray, assembled: Assembled) -> np.ndarray:
+    """Cartesian ``modes`` as the unknowns of a 2D system (relative displacement, frames)
+    or of a 3D system without contact (Cartesian itself)."""
+    space = assembled.space
     transfer = assembled.contact.transfer
     if transfer is not None:  # the relative displacement of the contact pairs
         modes = modes - transfer.dofs @ modes
-    if space.mesh.dim == 3:  # no node frames in 3D yet (no contact, axis rollers only)
+    if space.mesh.dim == 3:  # 3D without contact faces: Cartesian unknowns
         return modes
     return to_frames(modes, assembled.frame_nodes, assembled.frames)
+
+
+def _on_faces(modes: np.ndarray, contact: FaceContactSet) -> np.ndarray:
+    """Cartesian ``modes (n_dofs, k)`` as the unknowns ``ỹ = P⁻¹ Q⁻¹ u`` of a 3D system with
+    contact on faces (module docstring)."""
+    y = np.array(modes, dtype=np.float64)
+    dofs = node_dofs(contact.frame_nodes, 3)  # (m, 3)
+    y[dofs] = np.linalg.solve(contact.frames, y[dofs])  # Q_z⁻¹ u(z), every column
+    y[contact.dof] = contact.edges.coefficients(y[contact.dof])
+    return y
