@@ -118,6 +118,11 @@ class GamgSolver(PetscRows):
         Processes of ``PETSC_COMM_WORLD``.
     split : bool
         Whether the last analysed matrix was split by rows over the processes.
+    matrix_block_size : int
+        The block size PETSc read the last analysed matrix in (:attr:`block_size` where
+        every process's rows are whole nodes, else 1; 0 before an analysis).
+    near_nullspace_size : int
+        The vectors of the last near-nullspace GAMG was set up with (0: GAMG's default).
 
     Raises
     ------
@@ -151,6 +156,7 @@ class GamgSolver(PetscRows):
         self.rtol = float(rtol)
         self.max_it = int(max_it)
         self.iterations: list[int] = []
+        self.matrix_block_size = self.near_nullspace_size = 0
         self._mat = self._ksp = self._x = self._b = self._scatter = self._all = None
         self._modes: np.ndarray | None = None
         self._keep: np.ndarray | None = None
@@ -183,9 +189,10 @@ class GamgSolver(PetscRows):
         # whole nodes (d × d blocks) on every process
         d = self.block_size
         nodes = m % d == 0 and (self._order is None or _whole_nodes(own, d))
+        self.matrix_block_size = d if n % d == 0 and self._everywhere(nodes) else 1
         mat = PETSc.Mat().createAIJ(
             size=((m, n), (m, n)),
-            bsize=d if n % d == 0 and self._everywhere(nodes) else 1,
+            bsize=self.matrix_block_size,
             csr=(*self._csr, np.zeros(self._csr[1].size)),
             comm=PETSc.COMM_WORLD,
         )
@@ -246,6 +253,7 @@ class GamgSolver(PetscRows):
             v = self._mat.createVecLeft()
             v.setArray(np.ascontiguousarray(local[:, k]))
             vectors.append(v)
+        self.near_nullspace_size = len(vectors)
         space = PETSc.NullSpace().create(vectors=vectors, comm=PETSc.COMM_WORLD)
         self._mat.setNearNullSpace(space)
         space.destroy()
