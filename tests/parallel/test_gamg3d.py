@@ -99,3 +99,25 @@ def test_the_rigid_motions_in_the_solver_variables_cut_the_iterations():
         assert result.kkt.max <= KKT_RTOL and np.array_equal(result.active, reference.active)
     assert len(counts["rigid"]) == len(counts["default"]) == 2
     assert (np.array(counts["rigid"]) < 0.8 * np.array(counts["default"])).all(), counts
+
+
+def test_the_petsc_backend_takes_gamg_for_large_symmetric_3d_systems():
+    """``"petsc"`` chooses by size as ``"auto"`` does: CG + GAMG (block size 3) for a
+    symmetric 3D request of AMG_FROM_3D unknowns or more, MUMPS below it, in 2D and for LU."""
+    from signorini.algebra import SolverRequest
+    from signorini.algebra.backends.petsc import PetscLUSolver, PetscSolver, petsc_solver
+    from signorini.algebra.backends.petsc_gamg import GamgSolver
+    from signorini.algebra.backends.requests import AMG_FROM_3D
+
+    cases = [
+        (SolverRequest(dimension=3, size=AMG_FROM_3D), GamgSolver),
+        (SolverRequest(dimension=3, size=AMG_FROM_3D - 1), PetscSolver),
+        (SolverRequest(dimension=2, size=10 * AMG_FROM_3D), PetscSolver),
+        (SolverRequest(dimension=3, size=AMG_FROM_3D, symmetric=False), PetscLUSolver),
+    ]
+    for request, kind in cases:
+        solver = petsc_solver(request)
+        assert type(solver) is kind, (request, type(solver))
+        if kind is GamgSolver:
+            assert solver.block_size == 3 and solver.rtol == 1e-8
+        solver.close()

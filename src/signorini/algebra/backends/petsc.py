@@ -273,17 +273,25 @@ class PetscLUSolver(PetscSolver):
         super().__init__(A, check_symmetry=False, ordering=ordering)
 
 
-def petsc_solver(request: SolverRequest) -> PetscSolver:
+def petsc_solver(request: SolverRequest) -> PetscRows:
     """The PETSc backend's solver factory (:class:`~.solvers.SolverFactory`):
     :class:`PetscSolver` (MUMPS Cholesky, ordered by METIS on the matrix) for a symmetric
     request, :class:`PetscLUSolver` otherwise, given the request's ordering on one process
-    (docs/parallel.md, *Measurements*: MUMPS's LU with it against its own METIS).
+    (docs/parallel.md, *Measurements*: MUMPS's LU with it against its own METIS). A symmetric
+    3D request of :data:`~.requests.AMG_FROM_3D` unknowns or more
+    (:attr:`~.requests.SolverRequest.multigrid_by_size`) gets CG + GAMG instead
+    (:func:`~.petsc_gamg.petsc_gamg_solver`): a direct factor of 3D elasticity grows like
+    N^1.4 and does not fit at 10⁶ unknowns (docs/parallel.md, *Three dimensions*).
 
     Raises
     ------
     BackendUnavailableError
         If petsc4py or MUMPS is missing, naming the extra that brings them.
     """
+    if request.multigrid_by_size:
+        from .petsc_gamg import petsc_gamg_solver  # (which builds on this module's LU)
+
+        return petsc_gamg_solver(request)
     if request.symmetric:
         return PetscSolver(check_symmetry=request.check_symmetry)
     return PetscLUSolver(ordering=_lu_ordering(request))

@@ -13,7 +13,12 @@ import numpy as np
 if TYPE_CHECKING:
     from .solvers import SPDSolver
 
-__all__ = ["SolverFactory", "SolverRequest"]
+__all__ = ["AMG_FROM_3D", "SolverFactory", "SolverRequest"]
+
+#: from this many unknowns on, a symmetric 3D system goes to an algebraic multigrid: ``"auto"``
+#: takes ``"amg"`` (pyamg) instead of PARDISO, ``"petsc"`` takes CG + GAMG instead of MUMPS
+#: (measured: docs/method.md, *Three dimensions: the linear solver (measured)*)
+AMG_FROM_3D = 150_000
 
 
 @dataclass(frozen=True)
@@ -59,6 +64,12 @@ class SolverRequest:
     rigid_modes: Callable[[], np.ndarray] | None = None
     dimension: int = 2
     size: int = 0
+
+    @property
+    def multigrid_by_size(self) -> bool:
+        """Whether the automatic choice by size takes an algebraic multigrid for these
+        systems: symmetric, 3D, :data:`AMG_FROM_3D` unknowns or more."""
+        return self.dimension == 3 and self.symmetric and self.size >= AMG_FROM_3D
 
 
 class SolverFactory(Protocol):
