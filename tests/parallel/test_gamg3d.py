@@ -103,17 +103,21 @@ def test_the_rigid_motions_in_the_solver_variables_cut_the_iterations():
 
 def test_the_petsc_backend_takes_gamg_for_large_symmetric_3d_systems():
     """``"petsc"`` chooses by size as ``"auto"`` does: CG + GAMG (block size 3) for a
-    symmetric 3D request of AMG_FROM_3D unknowns or more, MUMPS below it, in 2D and for LU."""
+    symmetric 3D request of GAMG_FROM_3D unknowns or more, MUMPS below it, in 2D and for LU."""
     from signorini.algebra import SolverRequest
-    from signorini.algebra.backends.petsc import PetscLUSolver, PetscSolver, petsc_solver
+    from signorini.algebra.backends.petsc import (
+        GAMG_FROM_3D,
+        PetscLUSolver,
+        PetscSolver,
+        petsc_solver,
+    )
     from signorini.algebra.backends.petsc_gamg import GamgSolver
-    from signorini.algebra.backends.requests import AMG_FROM_3D
 
     cases = [
-        (SolverRequest(dimension=3, size=AMG_FROM_3D), GamgSolver),
-        (SolverRequest(dimension=3, size=AMG_FROM_3D - 1), PetscSolver),
-        (SolverRequest(dimension=2, size=10 * AMG_FROM_3D), PetscSolver),
-        (SolverRequest(dimension=3, size=AMG_FROM_3D, symmetric=False), PetscLUSolver),
+        (SolverRequest(dimension=3, size=GAMG_FROM_3D), GamgSolver),
+        (SolverRequest(dimension=3, size=GAMG_FROM_3D - 1), PetscSolver),
+        (SolverRequest(dimension=2, size=10 * GAMG_FROM_3D), PetscSolver),
+        (SolverRequest(dimension=3, size=GAMG_FROM_3D, symmetric=False), PetscLUSolver),
     ]
     for request, kind in cases:
         solver = petsc_solver(request)

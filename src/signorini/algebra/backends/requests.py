@@ -13,12 +13,7 @@ import numpy as np
 if TYPE_CHECKING:
     from .solvers import SPDSolver
 
-__all__ = ["AMG_FROM_3D", "SolverFactory", "SolverRequest"]
-
-#: from this many unknowns on, a symmetric 3D system goes to an algebraic multigrid: ``"auto"``
-#: takes ``"amg"`` (pyamg) instead of PARDISO, ``"petsc"`` takes CG + GAMG instead of MUMPS
-#: (measured: docs/method.md, *Three dimensions: the linear solver (measured)*)
-AMG_FROM_3D = 150_000
+__all__ = ["SolverFactory", "SolverRequest"]
 
 
 @dataclass(frozen=True)
@@ -65,11 +60,11 @@ class SolverRequest:
     dimension: int = 2
     size: int = 0
 
-    @property
-    def multigrid_by_size(self) -> bool:
-        """Whether the automatic choice by size takes an algebraic multigrid for these
-        systems: symmetric, 3D, :data:`AMG_FROM_3D` unknowns or more."""
-        return self.dimension == 3 and self.symmetric and self.size >= AMG_FROM_3D
+    def multigrid_from(self, size: int) -> bool:
+        """Whether a backend that takes an algebraic multigrid for symmetric 3D systems of
+        ``size`` unknowns or more (its crossover with a direct factorization, measured:
+        :data:`~.selection.AMG_FROM_3D`, :data:`~.petsc.GAMG_FROM_3D`) takes it for these."""
+        return self.dimension == 3 and self.symmetric and self.size >= size
 
 
 class SolverFactory(Protocol):

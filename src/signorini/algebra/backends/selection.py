@@ -15,7 +15,8 @@ backend by name (:func:`solver_name`).
 ``"petsc"``
     :func:`~.petsc.petsc_solver`: MUMPS through PETSc (the optional extra ``signorini[mpi]``),
     serial or under ``mpiexec`` (docs/parallel.md); for a symmetric 3D system of
-    :data:`AMG_FROM_3D` unknowns or more CG + GAMG (``"petsc-gamg"``'s solver); raises
+    :data:`~.petsc.GAMG_FROM_3D` unknowns or more CG + GAMG (``"petsc-gamg"``'s solver);
+    raises
     :class:`~.errors.BackendUnavailableError` naming the extra where petsc4py is missing.
 ``"petsc-gamg"``
     :func:`~.petsc_gamg.petsc_gamg_solver`: CG preconditioned by PETSc's GAMG with the
@@ -53,7 +54,6 @@ from .mkl import mkl_version
 from .pardiso import pardiso_problem, pardiso_solver
 from .petsc import petsc_library, petsc_solver
 from .petsc_gamg import petsc_gamg_solver
-from .requests import AMG_FROM_3D
 from .solvers import SolverFactory, SolverRequest, SPDSolver
 from .superlu import superlu_solver
 
@@ -80,11 +80,16 @@ def _warn_fallback(reason: str) -> None:
     )
 
 
+#: from this many unknowns on, ``"auto"`` takes ``"amg"`` for a symmetric 3D system
+#: (measured: docs/method.md, *Three dimensions: solving elasticity*)
+AMG_FROM_3D = 150_000
+
+
 def auto_solver(request: SolverRequest) -> SPDSolver:
     """The default solver factory: PARDISO where it loads and works, else SuperLU with a
     :class:`SolverFallbackWarning` (once per process and reason); for a symmetric 3D system
     of :data:`AMG_FROM_3D` unknowns or more, ``"amg"`` (:func:`~.amg.amg_solver`)."""
-    if request.multigrid_by_size:
+    if request.multigrid_from(AMG_FROM_3D):
         return amg_solver(request)
     problem = pardiso_problem()
     if problem is None:
