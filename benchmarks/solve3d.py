@@ -1,5 +1,6 @@
-"""Benchmark: the linear solver of 3D elasticity, PARDISO against ``"amg"``, on the package's
-own path (docs/method.md, *Three dimensions: solving elasticity*).
+"""Benchmark: the linear solver of 3D elasticity, PARDISO against ``"amg"`` (and
+``"petsc-gamg"`` where petsc4py loads), on the package's own path (docs/method.md, *Three
+dimensions: the linear solver (measured)*).
 
 A cantilever on the Kuhn mesh of the unit cube (``signorini.mesh.builders3d.box``, ``n``
 cubes a side, ``3 (2 n + 1)³`` P2 unknowns): clamped on ``x0``, a body force, traction-free
@@ -7,20 +8,28 @@ elsewhere. Each system is assembled once (``signorini.contact.system.assemble``)
 by ``signorini.contact.solution.solve(..., assembled=...)`` with each solver **alternately**
 (PARDISO, amg, PARDISO, amg, … ``--repeat`` times each), so that the machine's noise shows
 as the spread of one solver's times on the same matrix. Printed per system: the free
-unknowns ``ndof`` and all of them, ``n_dofs`` (what ``auto_solver`` chooses by),
-each solver's best time (set-up and solve: analysis, factorization or hierarchy, and the
-solves of the active set loop: without contact one for PARDISO, for amg a second to the
-tightened tolerance) and its spread (max/min), the peak memory of the solve above the
-memory before it (``VmHWM`` after returning freed memory to the system and resetting the
-mark through ``/proc/self/clear_refs``, Linux), and amg's CG iterations (summed over its
-solves).
+unknowns ``ndof`` and all of them, ``n_dofs`` (what ``auto_solver`` chooses by), and per
+solver its best time (set-up and solve: analysis, factorization or hierarchy, and the
+solves of the active set loop: without contact one for PARDISO, for an iterative solver a
+second to the tightened tolerance), its spread (max/min), the set-up and solve seconds of
+that best run (``setup``: analysis and factorization or the AMG hierarchy; ``solve``: the
+solves), the peak memory of the solve above the memory before it (``VmHWM`` after returning
+freed memory to the system and resetting the mark through ``/proc/self/clear_refs``,
+Linux), and an iterative solver's CG iterations (summed over its solves).
 
 Graded meshes: the same cube refined by the package's 3D bisection (``refine_nvb``) towards
 the vertex ``(0, 0, 0)`` or the edge ``x = y = 0``: each local level bisects the cells that
-touch it, ``--levels`` times; amg's iterations on them show whether they stay bounded.
+touch it, ``--levels`` times; the AMG iterations on them show whether they stay bounded.
+
+``--solvers`` names the solvers (default: PARDISO up to ``--pardiso-up-to`` and amg);
+``petsc-gamg`` needs the extra ``signorini[mpi]`` (a Python >= 3.12 venv, docs/parallel.md),
+and its GAMG options come from PETSc's options database with the prefix ``signorini_gamg_``
+(``PETSC_OPTIONS="-signorini_gamg_pc_gamg_threshold 0.02"``).
 
     python benchmarks/solve3d.py                          # the table of docs/method.md
     python benchmarks/solve3d.py --sizes 4 8 --graded 2 --levels 4 --repeat 1   # a quick look
+    python benchmarks/solve3d.py --sizes 35 --graded 30 --towards edge --repeat 1 --solvers amg
+    .venv-mpi/bin/python benchmarks/solve3d.py --solvers amg petsc-gamg --repeat 1
 """
 
 from __future__ import annotations
@@ -78,9 +87,10 @@ def _peak_kb() -> tuple[int, int]:
     return int(status["VmRSS"].split()[0]), int(status["VmHWM"].split()[0])
 
 
-def timed_solve(problem: ContactProblem, assembled, solver: str) -> tuple[float, float, int]:
-    """Seconds of one solve (set-up included), its peak memory above the memory before it
-    (MB), and the CG iterations (0 for a direct solver)."""
+def timed_solve(problem: ContactProblem, assembled, solver: str) -> dict[str, float]:
+    """One solve (set-up included): its seconds (``total``, and ``setup``: analysis and
+    factorization or hierarchy, ``solve``: the solves), its peak memory above the memory
+    before it (``peak``, MB) and the CG iterations (``its``, 0 for a direct solver)."""
     _trim()  # freed memory back to the system, so that the peak is this solve's own
     try:
         with open("/proc/self/clear_refs", "w") as fh:
@@ -93,51 +103,63 @@ def timed_solve(problem: ContactProblem, assembled, solver: str) -> tuple[float,
     result = solve(problem, assembled.space.mesh, solver=SOLVERS[solver], assembled=assembled)
     seconds = time.perf_counter() - t0
     peak = (_peak_kb()[1] - before) / 1024.0
-    return seconds, peak, sum(result.report.linear_iterations)
+    times = result.report.times
+    return {
+        "total": seconds,
+        "setup": times.get("analysis", 0.0) + times.get("factorization", 0.0),
+        "solve": times.get("solve", 0.0),
+        "peak": peak,
+        "its": sum(result.report.linear_iterations),
+    }
 
 
 def compare(mesh: Mesh, solvers: list[str], repeat: int, label: str) -> None:
     """One row: the system of ``mesh`` solved by ``solvers`` alternately, ``repeat`` each."""
     problem = cantilever(mesh)
     assembled = assemble(problem, mesh)
-    times: dict[str, list[float]] = {s: [] for s in solvers}
-    peaks: dict[str, float] = {s: 0.0 for s in solvers}
-    its: dict[str, int] = {}
+    runs: dict[str, list[dict[str, float]]] = {s: [] for s in solvers}
     for _ in range(repeat):
         for s in solvers:
-            t, peak, k = timed_solve(problem, assembled, s)
-            times[s].append(t)
-            peaks[s] = max(peaks[s], peak)
-            its[s] = k
+            runs[s].append(timed_solve(problem, assembled, s))
     cells = []
     for s in solvers:
-        best, spread = min(times[s]), max(times[s]) / min(times[s])
-        cell = f"{s} {best:7.2f} s (×{spread:4.2f}) {peaks[s]:7.0f} MB"
-        cells.append(cell + (f" {its[s]:3d} its" if its[s] else ""))
+        best = min(runs[s], key=lambda r: r["total"])
+        spread = max(r["total"] for r in runs[s]) / best["total"]
+        peak = max(r["peak"] for r in runs[s])
+        cell = (
+            f"{s} {best['total']:7.2f} s (×{spread:4.2f}) setup {best['setup']:6.2f} solve "
+            f"{best['solve']:6.2f} {peak:7.0f} MB"
+        )
+        cells.append(cell + (f" {best['its']:3d} its" if best["its"] else ""))
     ndof, size = problem.free_ndof(assembled.space), assembled.space.n_dofs
     print(f"{label:>16s} {ndof:9d} {size:9d} {mesh.n_cells:9d}   " + "   ".join(cells), flush=True)
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--sizes", type=int, nargs="+", default=[8, 12, 16, 20, 28])
+    parser.add_argument("--sizes", type=int, nargs="*", default=[8, 12, 16, 20, 28])
     parser.add_argument(
         "--pardiso-up-to", type=int, default=20, help="largest n PARDISO solves (default 20)"
     )
-    parser.add_argument("--graded", type=int, nargs="+", default=[2, 4, 8])
+    parser.add_argument("--graded", type=int, nargs="*", default=[2, 4, 8])
     parser.add_argument("--levels", type=int, default=15)
+    parser.add_argument("--towards", nargs="+", default=["vertex", "edge"])
     parser.add_argument("--repeat", type=int, default=2)
+    parser.add_argument(
+        "--solvers", nargs="+", help="the solvers (default: PARDISO up to --pardiso-up-to, amg)"
+    )
     args = parser.parse_args(argv)
     direct = ["pardiso"] if "pardiso" in available_backends() else ["scipy"]
     head = f"{'mesh':>16s} {'ndof':>9s} {'n_dofs':>9s} {'cells':>9s}"
-    print(head + "   solver best (max/min) peak [its]")
+    print(head + "   solver best (max/min) setup solve peak [its]", flush=True)
     for n in args.sizes:
-        solvers = (direct if n <= args.pardiso_up_to else []) + ["amg"]
-        compare(box(n, n, n), solvers, args.repeat if n <= args.pardiso_up_to else 1, f"box {n}")
-    for towards in ("vertex", "edge"):
+        solvers = args.solvers or (direct if n <= args.pardiso_up_to else []) + ["amg"]
+        repeat = args.repeat if n <= args.pardiso_up_to else 1
+        compare(box(n, n, n), solvers, repeat, f"box {n}")
+    for towards in args.towards:
         for n in args.graded:
             mesh = graded(n, towards, args.levels)
-            compare(mesh, ["amg"], 1, f"{towards} {n}+{args.levels}")
+            compare(mesh, args.solvers or ["amg"], 1, f"{towards} {n}+{args.levels}")
 
 
 if __name__ == "__main__":

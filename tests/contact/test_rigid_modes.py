@@ -72,3 +72,26 @@ def test_the_contact_layer_offers_the_rigid_motions_to_the_factory(make):
     assert len(requests) == 1 and requests[0].symmetric
     a = assemble(problem, problem.mesh)
     np.testing.assert_array_equal(requests[0].rigid_modes(), system_rigid_modes(a))
+
+
+@pytest.mark.parametrize("alpha", [None, 0.0])
+def test_on_3d_contact_faces_the_modes_are_the_solver_variables_of_the_rigid_motions(alpha):
+    """hertz-3d (contact on the sphere, frames and the transformed face basis): ``R ỹ`` is the
+    Cartesian motion (``R`` the system's change of unknowns) and ``Rᵀ K R`` annihilates ``ỹ``,
+    for condition (b) (α = 1/5) and (a) (α = 0, frames only)."""
+    from signorini.examples import hertz_3d
+    from signorini.problem.problem3d import rigid_modes_3d
+
+    problem = hertz_3d(face_alpha=alpha, h_contact=0.2)
+    a = assemble(problem, problem.mesh)
+    modes = system_rigid_modes(a)
+    assert modes.shape == (a.K.shape[0], 6) and a.frame_nodes.size >= 10
+    points = a.space.node_points
+    expected = rigid_modes_3d(points - points.mean(axis=0))  # (n_nodes, 3, 6)
+    back = a.contact.operator @ modes
+    np.testing.assert_allclose(back, expected.reshape(-1, 6), atol=1e-12)
+    for k in range(6):
+        defect = np.abs(a.K @ modes[:, k]).max() / abs_matvec(a.K, modes[:, k]).max()
+        assert defect < 1e-12, f"mode {k}: max|K m| / max|K||m| = {defect:.1e}"
+    # the frames turn with the sphere's normals: the rows differ from the Cartesian motion
+    assert np.abs(modes - expected.reshape(-1, 6)).max() > 0.05

@@ -47,7 +47,7 @@ class Partition:
     rank, size : int
         This rank and the number of ranks.
     node_owner : (n_nodes,) int array
-        The rank that owns each node of the space (and the rows of its two DOFs).
+        The rank that owns each node of the space (and the rows of its ``d`` DOFs).
     cell_owner : (n_cells,) int array
         The rank that owns each cell (its estimator terms).
     space : LagrangeSpace
@@ -70,8 +70,8 @@ class Partition:
 
     @property
     def owned_dofs(self) -> np.ndarray:
-        """``(n_dofs,)`` bool: the DOFs of this rank's nodes (interleaved, ``2 node + k``)."""
-        return np.repeat(self.owned_nodes, 2)
+        """``(n_dofs,)`` bool: the DOFs of this rank's nodes (interleaved, ``d node + k``)."""
+        return np.repeat(self.owned_nodes, self.space.n_components)
 
     @property
     def owned_cells(self) -> np.ndarray:

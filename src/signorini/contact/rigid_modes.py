@@ -45,6 +45,12 @@ def system_rigid_modes(assembled: Assembled) -> np.ndarray:
         and ``6b + 3 + a`` the rotations ``e_a × (x − x_b)`` about the centroid ``x_b``;
         written as the system's unknowns (module docstring).
     """
+    return _in_system(_cartesian_modes(assembled), assembled)
+
+
+def _cartesian_modes(assembled: Assembled) -> np.ndarray:
+    """The rigid motions of every body as Cartesian DOFs (the columns of
+    :func:`system_rigid_modes`, before the change of unknowns)."""
     space = assembled.space
     points = space.node_points
     cell_body = body_of_cells(space.mesh)
@@ -77,6 +83,13 @@ def system_rigid_modes(assembled: Assembled) -> np.ndarray:
         motion = rigid_modes_3d(local)  # (n_nodes, 3, 6)
         for c in range(3):  # a loop over the three components
             modes[dofs[c][:, None], 6 * body[:, None] + np.arange(6)] = motion[:, c, :]
+    return modes
+
+
+def _in_system(modes: np.ndarray, assembled: Assembled) -> np.ndarray:
+    """Cartesian ``modes`` as the unknowns of a 2D system (relative displacement, frames)
+    or of a 3D system without contact (Cartesian itself)."""
+    space = assembled.space
     transfer = assembled.contact.transfer
     if transfer is not None:  # the relative displacement of the contact pairs
         modes = modes - transfer.dofs @ modes

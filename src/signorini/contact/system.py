@@ -182,9 +182,7 @@ def assemble(
         from .system3d import assemble_3d  # (which builds on this module's Assembled)
 
         space_of(mesh, element)  # refuses an element the tetrahedron does not have
-        if ranks.size > 1:
-            raise ValueError("a 3D problem is assembled on one process (no MPI partition yet)")
-        return assemble_3d(problem, mesh)
+        return assemble_3d(problem, mesh, ranks)
     space = space_of(mesh, element)
     if problem.pairs and space.element.name != "P2":
         raise ValueError(

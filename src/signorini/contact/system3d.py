@@ -13,6 +13,13 @@ contact parts the contact set on faces (:func:`~.face_contact.face_contact_set`;
 (b) with ``DEFAULT_ALPHA`` unless the parts give ``face_alpha``) gives the system
 ``Rᵀ K R ỹ = Rᵀ F``, ``u = R ỹ`` (node frames, then the transformed face basis), its bounds
 and its held DOFs (docs/method.md, *Three dimensions: contact on faces*).
+
+On ``ranks`` of several MPI processes the nodes are partitioned as in 2D
+(:func:`~.partition.partition`) and this rank assembles the stiffness rows of its own nodes
+(and, with contact, the rows its rows of ``Rᵀ K R`` read: the edge midpoints of Γ_C that the
+transformed basis couples to its vertices), from the cells that touch them; its system's
+``K`` is the serial one with the other ranks' rows emptied, bit for bit. ``F`` and everything
+else are the same on every rank (docs/parallel.md, *A stiffness matrix split by rows*).
 """
 
 from __future__ import annotations
@@ -22,7 +29,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from ..algebra.ranks import SERIAL
+from ..algebra.ranks import SERIAL, Ranks
 from ..fem.elasticity3d import assemble_body_force_3d, assemble_face_load_3d
 from ..fem.space3d import P2TetSpace
 from ..fem.stiffness3d import assemble_stiffness_3d
@@ -40,6 +47,7 @@ from .face_basis import DEFAULT_ALPHA
 from .face_contact import FaceContactSet, face_contact_set
 from .node_frames3d import held_frames, rotate_frames_3d
 from .ordering import Ordering
+from .partition import Partition, partition
 from .system import Assembled, RollerDofs
 
 __all__ = ["assemble_3d", "LOAD_DEGREE_3D"]
@@ -108,8 +116,9 @@ def _roller_dofs_3d(conditions: DiscreteConditions, roller_dof: np.ndarray) -> R
     )
 
 
-def assemble_3d(problem: ContactProblem, mesh: Mesh) -> Assembled:
-    """Stiffness, load and held DOFs of a 3D ``problem`` on the tetrahedral ``mesh``.
+def assemble_3d(problem: ContactProblem, mesh: Mesh, ranks: Ranks = SERIAL) -> Assembled:
+    """Stiffness, load and held DOFs of a 3D ``problem`` on the tetrahedral ``mesh``; on
+    ``ranks`` of several processes this rank's rows of the system (module docstring).
 
     ``K[3 z + i, 3 w + j] = a(φ_w e_j, φ_z e_i)``, ``F[3 z + i] = ∫_Ω f_i φ_z +
     Σ_Neumann ∫_Γ g_i φ_z`` (docs/method.md, *Three dimensions: P2 tetrahedra and 3D
@@ -139,14 +148,22 @@ def assemble_3d(problem: ContactProblem, mesh: Mesh) -> Assembled:
     # checked before any work on the system
     conditions = discrete_conditions_3d(problem, space)
     cs = _face_contact(problem, space, conditions) if problem.contact_parts else None
-    K, F = _stiffness_and_load(problem, space)
+    part, rows = None, None
+    if ranks.size > 1:  # this rank's rows, and with contact the rows they read
+        part = partition(space, ranks)
+        rows = part.owned_dofs
+        if cs is not None:
+            rows = np.repeat((abs(cs.operator) @ rows).reshape(-1, 3).any(axis=1), 3)
+    K, F = _stiffness_and_load(problem, space, rows, ranks)
     if cs is not None:
-        return _with_contact(space, cs, K, F, conditions, time.perf_counter() - t0)
+        return _with_contact(space, cs, (K, F), conditions, part, time.perf_counter() - t0)
     held = conditions.held
     none = np.zeros(0, dtype=np.int64)
     frames = held_frames(space.node_points, none, np.zeros((0, 3)), none, held)
     if frames.frame_nodes.size:  # oblique and curved rollers: u = Q y at their nodes
         K, F = rotate_frames_3d(K, F, frames.frame_nodes, frames.frames)
+    if part is not None:
+        K = part.own_rows(K)
     order = np.argsort(frames.held_dofs)
     return Assembled(
         space,
@@ -162,19 +179,25 @@ def assemble_3d(problem: ContactProblem, mesh: Mesh) -> Assembled:
         frames.frames,
         _roller_dofs_3d(conditions, frames.roller_dof),
         conditions,
-        None,
+        part,
         Ordering(space),
     )
 
 
-def _stiffness_and_load(problem: ContactProblem, space: P2TetSpace) -> tuple:
-    """``(K, F)`` Cartesian: the stiffness matrix and the load (body force, tractions),
-    checked for overflow (:func:`~.admissible.check_load_size`)."""
+def _stiffness_and_load(
+    problem: ContactProblem, space: P2TetSpace, rows: np.ndarray | None, ranks: Ranks
+) -> tuple:
+    """``(K, F)`` Cartesian: the stiffness matrix (only the DOF ``rows`` when given: the
+    rows this rank reads) and the load (body force, tractions), checked for overflow on every
+    rank (:func:`~.admissible.check_load_size`)."""
     mesh, n_dofs = space.mesh, space.n_dofs
     material = problem.material_on(mesh)
     with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported just below
-        K = assemble_stiffness_3d(space.mapping, space.cell_dofs, n_dofs, material)
-    if not np.isfinite(K.data).all():
+        K = assemble_stiffness_3d(space.mapping, space.cell_dofs, n_dofs, material, rows)
+    overflow = not np.isfinite(K.data).all()
+    if ranks.size > 1:  # every rank raises, or none
+        overflow = ranks.max(float(overflow)) > 0.0
+    if overflow:
         raise ProblemError(
             f"material: the stiffness matrix overflows float64 (lam = {np.max(material.lam):.3g}"
             f", mu = {np.max(material.mu):.3g}); state E in larger units"
@@ -202,7 +225,7 @@ def _stiffness_and_load(problem: ContactProblem, space: P2TetSpace) -> tuple:
         t = assemble_face_load_3d(space, mesh.part_facets(name), traction, LOAD_DEGREE_3D)
         F += t
         loads[what] = float(np.abs(t).max(initial=0.0))
-    check_load_size(K, F, loads, SERIAL)
+    check_load_size(K, F, loads, ranks)
     return K, F
 
 
@@ -219,16 +242,19 @@ def _face_contact(
 def _with_contact(
     space: P2TetSpace,
     cs: FaceContactSet,
-    K: sp.csr_matrix,
-    F: np.ndarray,
+    system: tuple[sp.csr_matrix, np.ndarray],
     conditions: DiscreteConditions,
+    part: Partition | None,
     seconds: float,
 ) -> Assembled:
-    """The :class:`Assembled` of a 3D problem with contact parts: the system in the solver's
-    variables (:meth:`~.face_contact.FaceContactSet.system`), its held DOFs sorted, the
-    rollers off the contact nodes."""
+    """The :class:`Assembled` of a 3D problem with contact parts: the system ``system = (K,
+    F)`` in the solver's variables (:meth:`~.face_contact.FaceContactSet.system`; this rank's
+    rows of it on several), its held DOFs sorted, the rollers off the contact nodes."""
     t0 = time.perf_counter()
+    K, F = system
     K_rot, F_rot = cs.system(K, F)
+    if part is not None:
+        K_rot = part.own_rows(K_rot)
     order = np.argsort(cs.held_dofs)
     rollers = _roller_dofs_3d(conditions, cs.roller_dof)
     off = ~np.isin(rollers.nodes, cs.node)
@@ -246,6 +272,6 @@ def _with_contact(
         cs.frames,
         RollerDofs(rollers.nodes[off], rollers.dofs[off], rollers.sign[off], rollers.normal[off]),
         conditions,
-        None,
+        part,
         Ordering(space),
     )

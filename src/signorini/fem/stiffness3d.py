@@ -237,8 +237,10 @@ def assemble_stiffness_3d(
     cell_dofs: np.ndarray,
     n_dofs: int,
     material: Material | CellMaterials,
+    rows: np.ndarray | None = None,
 ) -> sp.csr_matrix:
-    """Global stiffness matrix ``(n_dofs, n_dofs)`` of 3D elasticity on P2 tetrahedra.
+    """Global stiffness matrix ``(n_dofs, n_dofs)`` of 3D elasticity on P2 tetrahedra, or
+    some of its rows.
 
     The mesh's pattern (:func:`~signorini.fem.pattern3d.pattern_of`) is built at the first
     assembly with these ``cell_dofs`` and kept while the array lives; each assembly forms the
@@ -255,23 +257,79 @@ def assemble_stiffness_3d(
         Interleaved global DOFs, ``cell_dofs[:, 3 a + c] = 3 node_a + c``.
     n_dofs : int
     material : Material or CellMaterials
+    rows : (n_dofs,) bool array, optional
+        The rows to assemble (the three DOFs of a node together): the rows a rank of a run on
+        several MPI ranks owns (docs/parallel.md, *A stiffness matrix split by rows*). Only
+        the cells with a node of these rows are integrated, and their pattern is that of
+        those cells (kept as the whole mesh's is); the other rows are left empty. Each kept
+        row is the whole matrix's bit for bit: its node's pairs are summed over the same
+        cells in the same order.
 
     Returns
     -------
     scipy.sparse.csr_matrix
-        Symmetric bit for bit, sorted indices, the 3 × 3 node-block pattern.
+        Symmetric bit for bit (without ``rows``), sorted indices, the 3 × 3 node-block
+        pattern; with ``rows``, the rows not asked for have no stored entry.
+
+    Raises
+    ------
+    ValueError
+        If ``rows`` is not an ``(n_dofs,)`` bool array that takes the three DOFs of a node
+        together.
     """
     mapping = cells if isinstance(cells, CellMap) else TetrahedronMap(cells)
     owner = cell_dofs if isinstance(cell_dofs, np.ndarray) else None
-    pattern = pattern_of(_cell_nodes(cell_dofs), int(n_dofs) // 3, owner)
-    blocks = np.empty((mapping.n_cells, pattern.select.shape[1], 9))
-    for g in mapping.groups:  # each group into its cells' rows (mesh order)
-        upper_blocks(g, on_cells(material, g.cells), pattern.select, blocks, g.cells)
+    nodes = _cell_nodes(cell_dofs)
+    groups = [(g, g.cells) for g in mapping.groups]
+    kept = None
+    if rows is not None:
+        kept = _node_rows(rows, int(n_dofs))
+        touch = kept[nodes].any(axis=1)  # the cells whose matrices the rows need
+        position = np.cumsum(touch) - 1  # a mesh cell's row among them
+        every = np.arange(mapping.n_cells)
+        groups = []
+        for g in mapping.groups:  # each group's cells among them, in mesh order
+            mine = every[g.cells]
+            slot = np.flatnonzero(touch[mine])
+            groups.append((g.rows(slot), position[mine[slot]]))
+        nodes = nodes[touch]
+    pattern = pattern_of(nodes, int(n_dofs) // 3, owner)
+    blocks = np.empty((nodes.shape[0], pattern.select.shape[1], 9))
+    for g, at in groups:  # each group into its cells' rows (mesh order)
+        upper_blocks(g, on_cells(material, g.cells), pattern.select, blocks, at)
     summed = pattern.sums @ blocks.reshape(-1, 9)  # (n_upper, 9), each pair in cell order
     del blocks
     data = np.take(summed.reshape(-1), pattern.source)
-    out = sp.csr_matrix(
-        (data, pattern.indices.copy(), pattern.indptr.copy()), shape=pattern.shape, copy=False
-    )
+    indptr, indices = pattern.indptr, pattern.indices
+    if kept is not None:  # the kept rows' entries only
+        data, indices, indptr = _rows_of(np.repeat(kept, 3), indptr, indices, data)
+    out = sp.csr_matrix((data, indices.copy(), indptr.copy()), shape=pattern.shape, copy=False)
     out.has_sorted_indices = True
     return out
+
+
+def _node_rows(rows: object, n_dofs: int) -> np.ndarray:
+    """``(n_nodes,)`` bool of the DOF rows ``rows (n_dofs,) bool``; a ValueError unless it
+    takes the three DOFs of every node together."""
+    r = np.asarray(rows)
+    if r.dtype != np.bool_ or r.shape != (n_dofs,) or n_dofs % 3:
+        raise ValueError(f"rows must be a bool array of shape ({n_dofs},), got {r.dtype} {r.shape}")
+    by_node = r.reshape(-1, 3)
+    split = np.flatnonzero(by_node.any(axis=1) != by_node.all(axis=1))
+    if split.size:
+        raise ValueError(
+            f"rows must take the three DOFs of a node or none; node {split[0]} has some "
+            f"({split.size} such nodes)"
+        )
+    return by_node[:, 0].copy()
+
+
+def _rows_of(
+    keep: np.ndarray, indptr: np.ndarray, indices: np.ndarray, data: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The CSR arrays with only the rows ``keep (n,) bool`` stored, the others empty."""
+    length = np.where(keep, np.diff(indptr), 0)
+    entries = np.repeat(keep, np.diff(indptr))
+    out = np.zeros_like(indptr)
+    np.cumsum(length, out=out[1:])
+    return data[entries], indices[entries], out

@@ -2,10 +2,11 @@
 
 The iterative path that needs nothing beyond pip's wheels: conjugate gradients with one
 V-cycle of pyamg's smoothed-aggregation AMG (Vaněk, Mandel, Brezina [1]_) per iteration,
-for the symmetric positive definite systems of the active set methods. It is chosen only
-when asked for (``--backend amg``, ``solver="amg"``); the automatic choice stays direct
-(docs/method.md, *Three dimensions: the linear solver (measured)*, gives the rule by size
-for 3D and the measurements behind this module's defaults).
+for the symmetric positive definite systems of the active set methods: asked for
+(``--backend amg``, ``solver="amg"``) or taken by ``"auto"`` for symmetric 3D systems from
+:data:`~.selection.AMG_FROM_3D` unknowns (docs/method.md, *Three dimensions: the linear
+solver (measured)* and *Three dimensions: solving elasticity*, give the rule by size and
+the measurements behind this module's defaults).
 
 **The near-nullspace.** Smoothed aggregation builds its coarse spaces from the modes the
 matrix nearly annihilates; for elasticity the rigid motions (2D: three per body, 3D: six),

@@ -16,15 +16,18 @@ the caller's numbering, renumbered to PETSc's and back.
 
 **The near-nullspace.** Smoothed aggregation builds its coarse spaces from the modes the
 matrix nearly annihilates; for elasticity these are the rigid motions of each body, two
-translations and a rotation in 2D. The systems are written in node frames at the contact and
-roller nodes and, with two bodies, in the basis of the relative displacement
-(docs/method.md, *Two bodies*), so the motions must be written in those unknowns too: the
-contact layer computes them (:func:`signorini.contact.rigid_modes.system_rigid_modes`) and
-hands them over as :attr:`~.solvers.SolverRequest.rigid_modes`. Without them GAMG falls back
-to the constant vectors of each of the two components. The matrix has block size 2 (a node's
-two DOFs aggregate together) where every process's rows are whole nodes: an even ``n``, and
-with a split matrix each process's rows pairs ``2i, 2i + 1`` (both DOFs of a node on one rank,
-as :func:`signorini.contact.partition.partition` makes them); else block size 1.
+translations and a rotation in 2D, three translations and three rotations in 3D. The
+systems are written in node frames at the contact and roller nodes, with two bodies in the
+basis of the relative displacement (docs/method.md, *Two bodies*) and on 3D contact faces in
+the transformed face basis (docs/method.md, *Three dimensions: contact on faces*), so the
+motions must be written in those unknowns too: the contact layer computes them
+(:func:`signorini.contact.rigid_modes.system_rigid_modes`) and hands them over as
+:attr:`~.solvers.SolverRequest.rigid_modes`. Without them GAMG falls back to the constant
+vectors of each component. The matrix has block size ``d`` (the request's
+:attr:`~.solvers.SolverRequest.dimension`: a node's ``d`` DOFs aggregate together) where every
+process's rows are whole nodes: ``n`` a multiple of ``d``, and with a split matrix each
+process's rows runs ``d i, …, d i + d − 1`` (all DOFs of a node on one rank, as
+:func:`signorini.contact.partition.partition` makes them); else block size 1.
 
 **The eliminated DOFs.** The active set methods impose the Dirichlet and active DOFs by
 zeroing their rows and columns in place, the diagonal kept (:mod:`.elimination`): such a
@@ -104,6 +107,8 @@ class GamgSolver(PetscRows):
         The relative residual of a solve; :data:`RTOL`.
     max_it : int
         Largest number of CG iterations per solve; :data:`MAX_IT`.
+    block_size : int
+        DOFs per node (interleaved): 2 in 2D, 3 in 3D.
 
     Attributes
     ----------
@@ -113,13 +118,18 @@ class GamgSolver(PetscRows):
         Processes of ``PETSC_COMM_WORLD``.
     split : bool
         Whether the last analysed matrix was split by rows over the processes.
+    matrix_block_size : int
+        The block size PETSc read the last analysed matrix in (:attr:`block_size` where
+        every process's rows are whole nodes, else 1; 0 before an analysis).
+    near_nullspace_size : int
+        The vectors of the last near-nullspace GAMG was set up with (0: GAMG's default).
 
     Raises
     ------
     BackendUnavailableError
         If petsc4py is missing (:func:`~.petsc.petsc_module`).
     ValueError
-        If ``rtol`` is not in (0, 1) or ``max_it`` not a positive integer.
+        If ``rtol`` is not in (0, 1), or ``max_it`` or ``block_size`` not a positive integer.
     """
 
     backend = "petsc-gamg"
@@ -134,15 +144,19 @@ class GamgSolver(PetscRows):
         near_nullspace: Callable[[], np.ndarray] | None = None,
         rtol: float = RTOL,
         max_it: int = MAX_IT,
+        block_size: int = 2,
     ) -> None:
         if not (isinstance(rtol, (int, float)) and 0 < rtol < 1):
             raise ValueError(f"rtol must be a number in (0, 1), got {rtol!r}")
-        if isinstance(max_it, bool) or not isinstance(max_it, (int, np.integer)) or max_it < 1:
-            raise ValueError(f"max_it must be a positive integer, got {max_it!r}")
+        for name, value in (("max_it", max_it), ("block_size", block_size)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+                raise ValueError(f"{name} must be a positive integer, got {value!r}")
+        self.block_size = int(block_size)
         self.near_nullspace = near_nullspace
         self.rtol = float(rtol)
         self.max_it = int(max_it)
         self.iterations: list[int] = []
+        self.matrix_block_size = self.near_nullspace_size = 0
         self._mat = self._ksp = self._x = self._b = self._scatter = self._all = None
         self._modes: np.ndarray | None = None
         self._keep: np.ndarray | None = None
@@ -153,12 +167,13 @@ class GamgSolver(PetscRows):
 
     def _whole_rows(self, n: int) -> tuple[int, int]:
         """A whole matrix's rows of this process: :func:`~.petsc_rows.row_block` of the
-        ``n // 2`` nodes, in DOFs, for an even ``n`` (whole 2 × 2 node blocks, PETSc's block
-        size 2)."""
-        if n % 2:
+        ``n // d`` nodes, in DOFs, for ``n`` a multiple of ``d`` = :attr:`block_size` (whole
+        ``d × d`` node blocks, PETSc's block size ``d``)."""
+        d = self.block_size
+        if n % d:
             return row_block(n, self._rank, self.comm_size)
-        lo, hi = row_block(n // 2, self._rank, self.comm_size)
-        return 2 * lo, 2 * hi
+        lo, hi = row_block(n // d, self._rank, self.comm_size)
+        return d * lo, d * hi
 
     def _row_ordering(self) -> None:
         """None: the rows stay in increasing order within each process (whole nodes; the
@@ -171,11 +186,13 @@ class GamgSolver(PetscRows):
         n = A.shape[0]
         own = self._rows(A)
         m = own.size
-        # whole nodes (2 × 2 blocks) on every process
-        nodes = m % 2 == 0 and (self._order is None or _node_pairs(own))
+        # whole nodes (d × d blocks) on every process
+        d = self.block_size
+        nodes = m % d == 0 and (self._order is None or _whole_nodes(own, d))
+        self.matrix_block_size = d if n % d == 0 and self._everywhere(nodes) else 1
         mat = PETSc.Mat().createAIJ(
             size=((m, n), (m, n)),
-            bsize=2 if n % 2 == 0 and self._everywhere(nodes) else 1,
+            bsize=self.matrix_block_size,
             csr=(*self._csr, np.zeros(self._csr[1].size)),
             comm=PETSc.COMM_WORLD,
         )
@@ -236,6 +253,7 @@ class GamgSolver(PetscRows):
             v = self._mat.createVecLeft()
             v.setArray(np.ascontiguousarray(local[:, k]))
             vectors.append(v)
+        self.near_nullspace_size = len(vectors)
         space = PETSc.NullSpace().create(vectors=vectors, comm=PETSc.COMM_WORLD)
         self._mat.setNearNullSpace(space)
         space.destroy()
@@ -306,9 +324,11 @@ class GamgSolver(PetscRows):
         super().close()
 
 
-def _node_pairs(own: np.ndarray) -> bool:
-    """Whether the rows ``own`` (in order) are whole nodes: pairs ``2i, 2i + 1``."""
-    return bool((own[0::2] % 2 == 0).all() and (own[1::2] == own[0::2] + 1).all())
+def _whole_nodes(own: np.ndarray, d: int) -> bool:
+    """Whether the rows ``own`` (in order, ``own.size`` a multiple of ``d``) are whole nodes:
+    runs ``d i, d i + 1, …, d i + d − 1``."""
+    runs = own.reshape(-1, d)
+    return bool((runs[:, 0] % d == 0).all() and (runs == runs[:, :1] + np.arange(d)).all())
 
 
 def petsc_gamg_solver(request: SolverRequest) -> SPDSolver:
@@ -326,6 +346,7 @@ def petsc_gamg_solver(request: SolverRequest) -> SPDSolver:
         return GamgSolver(
             check_symmetry=request.check_symmetry,
             near_nullspace=getattr(request, "rigid_modes", None),
+            block_size=request.dimension,
         )
     return PetscLUSolver()
 

@@ -60,6 +60,12 @@ class SolverRequest:
     dimension: int = 2
     size: int = 0
 
+    def multigrid_from(self, size: int) -> bool:
+        """Whether a backend that takes an algebraic multigrid for symmetric 3D systems of
+        ``size`` unknowns or more (its crossover with a direct factorization, measured:
+        :data:`~.selection.AMG_FROM_3D`, :data:`~.petsc.GAMG_FROM_3D`) takes it for these."""
+        return self.dimension == 3 and self.symmetric and self.size >= size
+
 
 class SolverFactory(Protocol):
     """A callable that makes a new solver for one sequence of linear systems.

@@ -14,8 +14,10 @@ backend by name (:func:`solver_name`).
     :func:`~.superlu.superlu_solver`: SuperLU, always there, with no reuse of the analysis.
 ``"petsc"``
     :func:`~.petsc.petsc_solver`: MUMPS through PETSc (the optional extra ``signorini[mpi]``),
-    serial or under ``mpiexec`` (docs/parallel.md); raises
-    :class:`~.errors.BackendUnavailableError` naming the extra where petsc4py is missing.
+    serial or under ``mpiexec`` (docs/parallel.md); for a symmetric 3D system of
+    :data:`~.petsc.GAMG_FROM_3D` unknowns or more CG + GAMG (``"petsc-gamg"``'s solver);
+    raises :class:`~.errors.BackendUnavailableError` naming the extra where petsc4py is
+    missing.
 ``"petsc-gamg"``
     :func:`~.petsc_gamg.petsc_gamg_solver`: CG preconditioned by PETSc's GAMG with the
     rigid-body near-nullspace (the extra ``signorini[mpi]``), an iterative solver with the
@@ -23,12 +25,13 @@ backend by name (:func:`solver_name`).
 ``"amg"``
     :func:`~.amg.amg_solver`: CG preconditioned by pyamg's smoothed aggregation with the
     rigid-body near-nullspace, in the default install; iterative, with the inexact active
-    set stopping rule of :mod:`.inexact`; SuperLU's LU for non-symmetric systems. Only when
-    asked for: ``"auto"`` stays direct (docs/method.md, *Three dimensions: the linear solver
-    (measured)*, gives the rule by size for 3D).
+    set stopping rule of :mod:`.inexact`; SuperLU's LU for non-symmetric systems. ``"auto"``
+    takes it for symmetric 3D systems from :data:`AMG_FROM_3D` unknowns (docs/method.md,
+    *Three dimensions: solving elasticity*).
 ``"auto"``
     :func:`auto_solver`, the default everywhere: PARDISO when it loads and solves a small test
-    system; otherwise SuperLU, and a :class:`SolverFallbackWarning` says why (once per reason
+    system (``"amg"`` for a symmetric 3D system of :data:`AMG_FROM_3D` unknowns or more);
+    otherwise SuperLU, and a :class:`SolverFallbackWarning` says why (once per reason
     and process). The solver's :attr:`~.solvers.SPDSolver.backend` (the ``backend`` column of
     the history) tells which one was taken.
 
@@ -87,7 +90,7 @@ def auto_solver(request: SolverRequest) -> SPDSolver:
     """The default solver factory: PARDISO where it loads and works, else SuperLU with a
     :class:`SolverFallbackWarning` (once per process and reason); for a symmetric 3D system
     of :data:`AMG_FROM_3D` unknowns or more, ``"amg"`` (:func:`~.amg.amg_solver`)."""
-    if request.dimension == 3 and request.symmetric and request.size >= AMG_FROM_3D:
+    if request.multigrid_from(AMG_FROM_3D):
         return amg_solver(request)
     problem = pardiso_problem()
     if problem is None:
