@@ -80,7 +80,7 @@ def test_on_3d_contact_faces_the_modes_are_the_solver_variables_of_the_rigid_mot
     Cartesian motion (``R`` the system's change of unknowns) and ``Rᵀ K R`` annihilates ``ỹ``,
     for condition (b) (α = 1/5) and (a) (α = 0, frames only)."""
     from signorini.examples import hertz_3d
-    from signorini.problem.problem3d import rigid_modes_3d
+    from signorini.problem.rigid3d import rigid_modes_3d
 
     problem = hertz_3d(face_alpha=alpha, h_contact=0.2)
     a = assemble(problem, problem.mesh)
