@@ -34,7 +34,7 @@ from .node_frames3d import frame_operator, row_frames
 if TYPE_CHECKING:
     from ..fem.space3d import P2TetSpace
 
-__all__ = ["SAME_DIRECTION", "FaceContactSet", "face_contact_set"]
+__all__ = ["SAME_DIRECTION", "FaceContactSet", "face_contact_set", "part_rows"]
 
 #: two rows at a node whose directions differ by less than this (max-norm) are one row
 SAME_DIRECTION = 1e-8
@@ -74,6 +74,14 @@ class FaceContactSet:
         ``m_z = ∫ φ_z`` of the hats of the once-refined faces (the force density's (4.1)).
     facet : FaceElement
         The space's face element (its weights and nodal pressure).
+    facet_local : (n_f, 6) int array
+        The row of each face node for the face's part (the row it was merged into where the
+        part's row joined another part's of the same direction), ``-1`` where the node is held
+        along the part's direction (the 2D ``ContactSet.facet_local`` on faces).
+    facet_direction : (n_f, 6, 3) float array
+        The part's direction at each face node; ``facet_gap (n_f, 6)`` its ψ there (held
+        nodes included: the node classes and the estimator read them).
+    facet_gap : (n_f, 6) float array
     """
 
     n_dofs: int
@@ -93,6 +101,9 @@ class FaceContactSet:
     basis_integral: np.ndarray
     hat_integral: np.ndarray
     facet: FaceElement
+    facet_local: np.ndarray
+    facet_direction: np.ndarray
+    facet_gap: np.ndarray
 
     @property
     def operator(self) -> sp.csr_matrix:
@@ -148,6 +159,13 @@ class FaceContactSet:
         p[half.mid] = 0.5 * (p[half.start] + p[half.end])
         return p
 
+    def facet_normal_gap(self, u: np.ndarray) -> np.ndarray:
+        """``(n_f, 6)`` ``u(z)·n_z − ψ(z)`` at the nodes of each contact face, with the face
+        part's direction and ψ at every node (held ones too): its P2 interpolant on a face is
+        ``u_h·n − ψ_h`` (the faces' counterpart of the 2D ``ContactSet.facet_normal_gap``)."""
+        u = np.asarray(u, dtype=np.float64).reshape(-1, 3)
+        return np.einsum("fac,fac->fa", self.facet_direction, u[self.faces]) - self.facet_gap
+
     @property
     def n_rows(self) -> int:
         """The number of rows ``k``."""
@@ -180,8 +198,9 @@ def _body_normals(space, name: str, facets: np.ndarray, z: np.ndarray) -> np.nda
     return n
 
 
-def _part_rows(space, name: str, cond: Contact) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The nodes of part ``name``'s faces (sorted), their directions and gaps."""
+def part_rows(space, name: str, cond: Contact) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The nodes of part ``name``'s faces (sorted), their directions and gaps ψ (before the
+    held directions are left out)."""
     facets = space.mesh.part_facets(name)
     z = np.unique(space.facet_nodes(facets))
     x = space.node_points[z]
@@ -238,7 +257,7 @@ def face_contact_set(
         node with more than three rows and held directions.
     """
     parts = tuple(contact)
-    found = [_part_rows(space, name, contact[name]) for name in parts]  # a loop over parts
+    found = [part_rows(space, name, contact[name]) for name in parts]  # a loop over parts
     node = np.concatenate([f[0] for f in found])
     part = np.repeat(np.arange(len(parts)), [f[0].size for f in found])
     direction = np.concatenate([f[1] for f in found])
@@ -260,11 +279,11 @@ def face_contact_set(
     row_of_part[node, part] = kept_index
     node, part, direction, gap = node[keep], part[keep], direction[keep], gap[keep]
     return _assembled(
-        space, parts, node, part, direction, gap, row_of_part, held, held_values, alpha
+        space, parts, node, part, direction, gap, row_of_part, held, held_values, alpha, found
     )
 
 
-def _assembled(space, parts, node, part, direction, gap, row_of_part, held, values, alpha):
+def _assembled(space, parts, node, part, direction, gap, row_of_part, held, values, alpha, found):
     """The frames, held DOFs, face basis and weights of the rows (:func:`face_contact_set`)."""
     k = node.size
     frame_nodes, start, count = np.unique(node, return_index=True, return_counts=True)
@@ -325,7 +344,21 @@ def _assembled(space, parts, node, part, direction, gap, row_of_part, held, valu
         basis_integral=w,
         hat_integral=m,
         facet=space.element.facet,
+        facet_local=row_of(faces, face_part[:, None]),
+        **_face_data(found, faces, face_part),
     )
+
+
+def _face_data(found, faces: np.ndarray, face_part: np.ndarray) -> dict[str, np.ndarray]:
+    """The part's direction and ψ at every node of its faces (``found``: each part's sorted
+    nodes, directions and ψ, :func:`part_rows`)."""
+    direction = np.zeros(faces.shape + (3,))
+    psi = np.zeros(faces.shape)
+    for i, (z, n, g) in enumerate(found):  # a loop over parts
+        mine = face_part == i
+        at = np.searchsorted(z, faces[mine])
+        direction[mine], psi[mine] = n[at], g[at]
+    return {"facet_direction": direction, "facet_gap": psi}
 
 
 def _weights(space, facet_index, faces, face_part, row_of, k):
