@@ -228,6 +228,10 @@ def estimate(
     """
     if eta5_variant not in ETA5_VARIANTS:
         raise ValueError(f"eta5_variant must be one of {ETA5_VARIANTS}, got {eta5_variant!r}")
+    if result.mesh.dim == 3:  # tetrahedra: the 3D table, one process (it imports this module)
+        from .residual3d import estimate_3d
+
+        return estimate_3d(result, eta5_variant)
     own = own_part(result, ranks, partition)  # None: one process, every cell and facet
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells

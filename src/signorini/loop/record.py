@@ -216,19 +216,28 @@ NO_CONTACT_COLUMNS = (
 
 @dataclass
 class ElasticityRecord(LevelRecord):
-    """The record of a level of elasticity without an estimator and without contact (3D,
-    docs/method.md, *Three dimensions: solving elasticity*): its row leaves out the
-    estimator's and the contact's columns, which hold nothing there (NaN, zero); the
-    attributes stay (NaN, zero), so code reading a record reads either kind. An iterative
-    solve adds ``linear_iterations`` to :attr:`extra`."""
+    """The record of a level of 3D elasticity without contact (docs/method.md, *Three
+    dimensions: solving elasticity*): its row leaves out the contact's columns, which hold
+    nothing there (zero, NaN), and without an estimate the estimator's as well (NaN); the
+    attributes stay, so code reading a record reads either kind. An
+    iterative solve adds ``linear_iterations`` to :attr:`extra`."""
 
-    LEFT_OUT: ClassVar[tuple[str, ...]] = NO_ESTIMATE_COLUMNS + NO_CONTACT_COLUMNS
+    LEFT_OUT: ClassVar[tuple[str, ...]] = NO_CONTACT_COLUMNS
+
+    def row(self) -> dict:
+        """Flat dict for a CSV row, without the contact's columns (and the estimator's where
+        there is no estimate)."""
+        d = super().row()
+        if math.isnan(self.eta):
+            for name in NO_ESTIMATE_COLUMNS:
+                del d[name]
+        return d
 
 
-#: The columns of a 3D elasticity run's history (:class:`ElasticityRecord`), with their
-#: meaning in 3D.
+#: The columns of a 3D run's history, with their meaning in 3D (an
+#: :class:`ElasticityRecord`'s row has those but the contact's).
 COLUMNS_3D: dict[str, str] = {
-    **{k: v for k, v in COLUMNS.items() if k not in ElasticityRecord.LEFT_OUT},
+    **COLUMNS,
     "ndof": "free scalar unknowns, 3 × (vertices + edges) of the P2 tetrahedra minus 3 per "
     "node on a Dirichlet part (one per fixed component on a roller)",
     "ndof_total": "all scalar P2 unknowns, 3 × (vertices + edges), Dirichlet ones included",
@@ -239,7 +248,10 @@ COLUMNS_3D: dict[str, str] = {
     "linear_iterations": "CG iterations of an iterative solver (amg), summed over the level's "
     "solves; absent with a direct solver",
     "backend": "sparse solver backend used (pardiso, scipy or amg)",
-    "t_estimate": "seconds spent computing the estimator (0: none in 3D yet)",
+    "n_constrained": "constraint rows on the contact parts (a P2 node of the contact faces "
+    "per part whose direction is not held)",
+    "n_active": "constraint rows in the final active set (condition (b): their transformed "
+    "constraint ũ·n = ψ̃ imposed)",
 }
 
 
@@ -255,15 +267,15 @@ _NO_ESTIMATE = _NoEstimate()
 
 
 def level_record(level: int, result: ContactResult, est: Estimate | None) -> LevelRecord:
-    """The record of one level; without an estimate (3D) η and its terms are NaN, and
-    without contact as well an :class:`ElasticityRecord`, whose row leaves them out."""
+    """The record of one level; without an estimate η and its terms are NaN; a 3D level
+    without contact is an :class:`ElasticityRecord`, whose row leaves the contact's columns
+    out (and the estimator's without an estimate)."""
     if est is None:
         est = _NO_ESTIMATE
-    # the node classes of Section 4 are not built on faces (3D): their counts stay 0
-    has_classes = result.contact.size and result.mesh.dim == 2
+    has_classes = result.contact.size > 0
     classes = result.classes if has_classes else np.zeros(0, dtype=np.int64)
     report = result.report
-    elasticity = est is _NO_ESTIMATE and not result.contact.size
+    elasticity = result.mesh.dim == 3 and not result.contact.size
     rec = (ElasticityRecord if elasticity else LevelRecord)(
         level=level,
         ndof=result.ndof,

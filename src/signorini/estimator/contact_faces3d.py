@@ -1,0 +1,200 @@
+"""The contact terms of the 3D estimator on the faces of Γ_C: η4, η5, η6 and η7
+(docs/method.md, *Three dimensions: the estimator on tetrahedra and faces*).
+
+- **η4, η5** split the traction σ(u_h)n along the constraint direction field d (the
+  normalised P2 interpolant of the nodal directions n_z, :func:`.faces3d.direction_field_3d`):
+  ``σ_nn = d·σn`` and the tangent vector ``σ_t = σn − σ_nn d``; the consistent η5 is
+  ``‖σ_nn + p_h‖²``, p_h the P2 interpolant on the face of the nodal pressure of
+  :data:`PRESSURE_3D` (``transformed``: ``p̃_z = Λ̃_z / w̃_z`` of condition (b); ``recovered``:
+  the P1-lumped pressure of either condition; held nodes 0, as Dirichlet end points in 2D).
+- **η6** ``= s_p d_p`` at the semi-contact rows, ``d_p = ∫_{γ̃_p} (ψ_h − u_h·n)⁺ φ_p``: φ_p
+  the P1 hat of the once-refined face (its support γ̃_p: a vertex's corner triangle, a
+  midpoint's three triangles), ``ψ_h − u_h·n`` the P2 interpolant on the face of the nodal
+  gaps ``ψ(z) − u_h(z)·n_z`` (the obstacle the constraints see), integrated over its positive
+  set by :func:`~.surface.positive_part.positive_region_rule`; ``s_p = Λ̃_p / m_p``, the
+  solver's multiplier (``Λ̃ = T Λ``, the force on the transformed functions; Λ itself for
+  condition (a)) over ``m_p = ∫ φ_p``.
+- **η7** is the localised bound ``B`` of ``‖(u_h·n − ψ_h)⁺‖_{H^{1/2}(Γ_C)}``
+  (:func:`~.h_half_norm.localised.localised_bound2`, docs/method.md, *η7 on surfaces*),
+  ``h_F = |F|^{1/2}``, its face norms on the positive set of ``u_h·n − ψ_h``: the 3D
+  replacement of the exact norm, an upper bound up to the constant discussed there.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..contact.contact_set import SEMI_CONTACT
+from ..contact.solution import ContactResult
+from ..fem.p2 import basis as face_basis_at
+from ..fem.p2 import grad_basis
+from ..fem.p2_tet import face_basis
+from .faces3d import TetStress, direction_field_3d, face_geometry
+from .h_half_norm.localised import FacetNorms, localised_bound2
+from .surface.positive_part import positive_region_rule, refined_face_hats
+from .terms import FacetSet, normal_stress, tangential_stress
+
+__all__ = ["PRESSURES_3D", "PRESSURE_3D", "ContactTerms", "contact_terms", "eta5_pressure"]
+
+#: the nodal pressures the consistent η5 may balance σ_nn with
+PRESSURES_3D = ("transformed", "recovered")
+#: the default: (b)'s own p̃ (docs/method.md, *Three dimensions: the estimator on
+#: tetrahedra and faces*, the measured comparison); condition (a) has none and takes the
+#: recovered one
+PRESSURE_3D = "transformed"
+#: polynomial degree of the rules on the positive sets: ``v φ_p`` (η6) is cubic, ``v²`` (η7)
+#: quartic
+ETA6_DEGREE, ETA7_DEGREE = 3, 4
+
+
+class ContactTerms(NamedTuple):
+    """The contact faces and the contact terms' integrals on them.
+
+    Attributes
+    ----------
+    faces : FacetSet
+        The contact faces (nodes ``(n_f, 6)``, :attr:`FaceContactSet.faces`).
+    J4, J5 : (n_f,) float arrays
+        ``‖σ_t‖²_F`` and ``‖σ_nn [+ p_h]‖²_F``.
+    parts6 : (n_f, 6) float array
+        η6's ``s_p d_p`` share of each face node.
+    eta7 : (n_f,) float array
+        Each face's share of η7² (the localised bound).
+    """
+
+    faces: FacetSet
+    J4: np.ndarray
+    J5: np.ndarray
+    parts6: np.ndarray
+    eta7: np.ndarray
+
+
+def contact_terms(
+    result: ContactResult,
+    stresses: TetStress,
+    eta5_variant: str,
+    s: np.ndarray,
+    w: np.ndarray,
+    pressure: str = PRESSURE_3D,
+) -> ContactTerms | None:
+    """η4 … η7 on the contact faces of a 3D solution (None without contact).
+
+    Parameters
+    ----------
+    result : ContactResult
+    stresses : TetStress
+        σ(u_h) in the stress unit.
+    eta5_variant : {"consistent", "paper"}
+    s, w : triangle rule
+        Points ``(q, 2)`` and weights (summing to 1/2) for η4, η5.
+    pressure : {"transformed", "recovered"}
+        The nodal pressure of the consistent η5 (:func:`eta5_pressure`).
+    """
+    cs, space, mesh = result.contact, result.space, result.mesh
+    if not cs.size:
+        return None
+    e = np.concatenate([mesh.part_facets(p) for p in cs.parts])
+    faces = FacetSet(e, cs.faces, mesh.facet2cell[e], mesh.facet_measure[e])
+    rows = cs.facet_local
+    on_faces = np.where(rows >= 0, 1.0, 0.0)
+    p_face = None
+    if eta5_variant == "consistent":
+        p = eta5_pressure(result, pressure) / stresses.unit
+        p_face = on_faces * p[np.maximum(rows, 0)]
+    d = direction_field_3d(cs.facet_direction, s)
+    J4, J5 = np.zeros(e.size), np.zeros(e.size)
+    for sel, geometry in face_geometry(space, cs.faces):
+        sigma = stresses.at_faces(faces.cells[sel, 0], cs.faces[sel, :3], s)
+        n = np.broadcast_to(geometry.normals(s), sigma.shape[:2] + (3,))
+        sn = (sigma @ n[..., None])[..., 0]
+        if p_face is not None:  # σn + p_h d: its d-part is σ_nn + p_h, its tangent part σ_t
+            sn = sn + (p_face[sel] @ face_basis(s).T)[..., None] * d[sel]
+        speeds = geometry.speeds(s)
+        J4[sel] = tangential_stress(sn, d[sel], w, speeds)
+        J5[sel] = normal_stress(sn, d[sel], None, w, speeds)
+    gap = cs.facet_normal_gap(result.u)  # u_h·n − ψ_h at the face nodes
+    points = space.node_points[cs.faces]
+    density = _semi_contact_density(result) / stresses.unit
+    parts6 = on_faces * density[np.maximum(rows, 0)] * _hat_integrals(-gap, points)
+    return ContactTerms(faces, J4, J5, parts6, _penetration_shares(gap, points))
+
+
+def eta5_pressure(result: ContactResult, which: str = PRESSURE_3D) -> np.ndarray:
+    """``(k,)`` the nodal pressure of the consistent η5: ``transformed`` (p̃ = Λ̃ / w̃ of
+    condition (b); the recovered one for condition (a), whose vertex weights vanish) or
+    ``recovered`` (:meth:`~signorini.contact.face_contact.FaceContactSet.recovered_pressure`).
+
+    Raises
+    ------
+    ValueError
+        For another ``which``.
+    """
+    if which not in PRESSURES_3D:
+        raise ValueError(f"the 3D eta5 pressure must be one of {PRESSURES_3D}, got {which!r}")
+    cs = result.contact
+    if which == "transformed" and cs.edges.alpha > 0:
+        return cs.pressure(result.contact_force)
+    return cs.recovered_pressure(result.contact_force)
+
+
+def _semi_contact_density(result: ContactResult) -> np.ndarray:
+    """``(k,)`` ``s_p = Λ̃_p / m_p`` at the semi-contact rows, else 0; a negative Λ̃_p is
+    round-off (the KKT check bounds it) and counts as 0, so that η6² stays ≥ 0."""
+    cs = result.contact
+    force = cs.edges.transformed(result.contact_force)  # Λ̃ = T Λ, the solver's multiplier
+    semi = result.classes == SEMI_CONTACT
+    return np.where(semi, np.maximum(force / cs.hat_integral, 0.0), 0.0)
+
+
+def _tangents(points: np.ndarray, face: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """``(m, 2, 3)`` ``∂x/∂s₁, ∂x/∂s₂`` of the P2 face maps of faces ``face (m,)`` (node
+    points ``points (n_f, 6, 3)``) at one point ``s (m, 2)`` each (flat faces: constant)."""
+    return np.einsum("mar,mai->mri", grad_basis(s), points[face])
+
+
+def _hat_integrals(v: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """``(n_f, 6)`` ``∫_F v⁺ φ_a`` over each face for the refined-face hats φ_a, v the P2
+    function of the nodal values ``v (n_f, 6)``, through each face's area element."""
+    rule = positive_region_rule(v, ETA6_DEGREE)
+    out = np.zeros(v.shape)
+    if rule.face.size == 0:
+        return out
+    t = _tangents(points, rule.face, rule.s)
+    area = np.linalg.norm(np.cross(t[:, 0], t[:, 1]), axis=1)
+    value = np.einsum("ma,ma->m", face_basis_at(rule.s), v[rule.face])
+    weight = rule.w * area * np.maximum(value, 0.0)
+    hats = refined_face_hats(rule.s, rule.piece)
+    for a in range(v.shape[1]):  # a loop over the six face nodes
+        out[:, a] = np.bincount(rule.face, weights=weight * hats[:, a], minlength=len(v))
+    return out
+
+
+def _penetration_shares(gap: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """``(n_f,)`` each face's share of the localised bound ``B²`` of ``(u_h·n − ψ_h)⁺``
+    (``gap (n_f, 6)`` the nodal ``u_h·n − ψ_h``): ``‖v‖²_F (1 + h_F⁻¹) + h_F ‖∇_Γ v‖²_F``
+    with ``h_F = |F|^{1/2}``, the surface gradient ``∇_Γ v = T G⁻¹ ∇_s v`` (T the tangents,
+    G = TᵀT)."""
+    rule = positive_region_rule(gap, ETA7_DEGREE)
+    n_f = len(gap)
+    if rule.face.size == 0:
+        return np.zeros(n_f)
+    t = _tangents(points, rule.face, rule.s)
+    area = np.linalg.norm(np.cross(t[:, 0], t[:, 1]), axis=1)
+    g = gap[rule.face]
+    value = np.einsum("ma,ma->m", face_basis_at(rule.s), g)
+    grad_s = np.einsum("mar,ma->mr", grad_basis(rule.s), g)  # (m, 2)
+    metric = np.einsum("mri,msi->mrs", t, t)
+    grad2 = np.einsum("mr,mrs,ms->m", grad_s, np.linalg.inv(metric), grad_s)
+    weight = rule.w * area
+    l2 = np.bincount(rule.face, weights=weight * np.maximum(value, 0.0) ** 2, minlength=n_f)
+    gradient = np.bincount(rule.face, weights=weight * grad2, minlength=n_f)
+    corners = points[:, :3]
+    h = np.sqrt(
+        0.5
+        * np.linalg.norm(
+            np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1
+        )
+    )
+    return localised_bound2(FacetNorms(h, l2, gradient))[1]
