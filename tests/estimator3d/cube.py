@@ -15,6 +15,8 @@ so that on z = 0: ψ − u·n = g, σ_nn = −p and σ_13 = μ(∂_z u_1 + ∂_x
 
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 import sympy as s
 
@@ -41,7 +43,8 @@ def _vector(exprs, shape):
 
 
 def _fields(g, p, a, q, c, psi):
-    """u, ∇u, σ(u), f, ψ as NumPy functions of points ``(..., 3)``."""
+    """u, ∇u, σ(u), f, ψ as NumPy functions of points ``(..., 3)`` (built once per process:
+    sympy differentiates and compiles them in about a second)."""
     lam = E * NU / ((1 + NU) * (1 - 2 * NU))
     mu = E / (2 * (1 + NU))
     div_a = s.diff(a[0], x) + s.diff(a[1], y)
@@ -69,12 +72,14 @@ _Q = (3 * s.cos(x + y) / 100, 3 * s.sin(x - y) / 100)
 _PSI = (1 + s.sin(2 * x + y)) / 50
 
 
+@cache
 def full_contact_fields():
     """g = 0, p = 0.1 (1 + ½ sin πx cos πy): every point of Γ_C in contact."""
     p = s.Rational(1, 10) * (1 + s.sin(s.pi * x) * s.cos(s.pi * y) / 2)
     return _fields(s.Integer(0), p, _A, _Q, s.sin(x + y) / 20, _PSI)
 
 
+@cache
 def transition_fields(radius: float = 0.3):
     """Contact inside the circle of ``radius`` about (½, ½): p = 300 (φ⁻)³, g = (φ⁺)³."""
     phi = (x - s.Rational(1, 2)) ** 2 + (y - s.Rational(1, 2)) ** 2 - s.nsimplify(radius) ** 2
@@ -83,6 +88,7 @@ def transition_fields(radius: float = 0.3):
     return _fields(g, p, _A, _Q, s.sin(x + y) / 20, _PSI)
 
 
+@cache
 def patch_fields():
     """u affine, σ constant, p = 0.1, ψ affine: reproduced by P2 exactly."""
     a = (x / 100 + y / 50, -x / 100 + y / 200)

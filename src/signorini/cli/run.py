@@ -211,7 +211,7 @@ def _solve_levels(work: _Run, status: Status) -> Level | None:
         write_fields(out / "fields.md", job.problem.mesh)  # its regions' and bodies' names
     history = HistoryWriter(out / "history.csv", rows=state.history_rows if state else ())
     mode = "uniform" if options.uniform else f"adaptive, theta={options.theta}"
-    eta5 = f", eta5={options.eta5_variant}"
+    eta5 = "" if three and not job.problem.contact_parts else f", eta5={options.eta5_variant}"
     say(f"{job.problem.name}: {mode}{eta5}, max_ndof={options.max_ndof} -> {out}")
     loop = {"metrics": job.metrics, "path": job.path}
     status.phase = "at level 0" if state is None else f"at level {state.level + 1}"
