@@ -50,29 +50,38 @@ class TetStress:
         corners = cell_stress_3d(space, material, u, _TET_VERTICES)
         #: the stress unit σ₀ (1 for ordinary stresses; docs/method.md, *Estimator*, "Units")
         self.unit = stress_unit(float(np.abs(corners).max(initial=0.0)))
+        #: σ(u_h) / σ₀ at the vertices of each cell ``(n_cells, 4, 3, 3)``: linear on the
+        #: affine cells, so interpolated from these there
+        self.vertex_stress = corners / self.unit if self.unit != 1.0 else corners
 
     def at_faces(self, cell: np.ndarray, vertices: np.ndarray, s: np.ndarray) -> np.ndarray:
         """``(k, q, 3, 3)`` σ(u_h) / σ₀ of cells ``cell (k,)`` at the points ``s (q, 2)`` of
         their faces with vertices ``vertices (k, 3)`` (global vertex numbers, in the face's
         order), through each cell's map.
 
-        The cells are taken by the position of the face's vertices among their own (at most
-        24 patterns, a loop over them), each pattern at its reference points ``ξ(s)``.
+        On an affine cell σ(u_h) is linear: the barycentric combination of its values at the
+        face's vertices. On an isoparametric cell it is taken through the map at the reference
+        points ``ξ(s)`` of the face, by the position of the face's vertices among the cell's
+        (at most 24 placements, a loop over them).
         """
         mesh = self.space.mesh
         local = (mesh.cells[cell][:, None, :] == vertices[:, :, None]).argmax(axis=2)
-        code = local @ np.array([16, 4, 1])
         bary = np.column_stack([1.0 - s[:, 0] - s[:, 1], s[:, 0], s[:, 1]])  # (q, 3)
         out = np.empty((len(cell), len(s), 3, 3))
-        for pattern in np.unique(code):  # a loop over the ≤ 24 placements of a face
-            rows = np.flatnonzero(code == pattern)
-            xi = bary @ _TET_VERTICES[local[rows[0]]]  # (q, 3)
-            c = cell[rows]
-            for sub, g, slot in self.space.mapping.split(c):  # affine, isoparametric
-                grad = g.rows(slot).field_gradients(self.u_cell[c[sub]], xi)
-                out[rows[sub]] = stress(on_cells(self.material, c[sub]), grad)
-        if self.unit != 1.0:
-            out /= self.unit
+        for sub, g, slot in self.space.mapping.split(cell):  # affine, isoparametric
+            rows = np.arange(len(cell))[sub]
+            if g.order == 1:
+                at = self.vertex_stress[cell[rows][:, None], local[rows]]  # (r, 3, 3, 3)
+                out[rows] = np.einsum("qj,rjab->rqab", bary, at)
+                continue
+            code = local[rows] @ np.array([16, 4, 1])
+            for pattern in np.unique(code):  # a loop over the ≤ 24 placements of a face
+                mine = np.flatnonzero(code == pattern)
+                xi = bary @ _TET_VERTICES[local[rows[mine[0]]]]  # (q, 3)
+                c = cell[rows[mine]]
+                grad = g.rows(slot[mine]).field_gradients(self.u_cell[c], xi)
+                sigma = stress(on_cells(self.material, c), grad)
+                out[rows[mine]] = sigma / self.unit if self.unit != 1.0 else sigma
         return out
 
 
