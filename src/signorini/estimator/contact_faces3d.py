@@ -28,15 +28,24 @@ import numpy as np
 
 from ..contact.contact_set import SEMI_CONTACT
 from ..contact.solution import ContactResult
+from ..fem.p2 import REFERENCE_NODES, grad_basis
 from ..fem.p2 import basis as face_basis_at
-from ..fem.p2 import grad_basis
 from ..fem.p2_tet import face_basis
+from ..fem.quadrature import triangle_rule
+from ..problem.fields import evaluate_field
 from .faces3d import TetStress, direction_field_3d, face_geometry
 from .h_half_norm.localised import FacetNorms, localised_bound2
-from .surface.positive_part import positive_region_rule, refined_face_hats
+from .surface.positive_part import PIECE_NODES, positive_region_rule, refined_face_hats
 from .terms import FacetSet, normal_stress, tangential_stress
 
-__all__ = ["PRESSURES_3D", "PRESSURE_3D", "ContactTerms", "contact_terms", "eta5_pressure"]
+__all__ = [
+    "PRESSURES_3D",
+    "PRESSURE_3D",
+    "ContactTerms",
+    "contact_terms",
+    "eta5_pressure",
+    "obstacle_oscillation",
+]
 
 #: the nodal pressures the consistent η5 may balance σ_nn with
 PRESSURES_3D = ("transformed", "recovered")
@@ -63,6 +72,9 @@ class ContactTerms(NamedTuple):
         η6's ``s_p d_p`` share of each face node.
     eta7 : (n_f,) float array
         Each face's share of η7² (the localised bound).
+    oscillation : (n_f,) float array
+        Each face's ``|∫_F λ̃_h (ψ − ψ_h)|`` (:func:`obstacle_oscillation`), in the unit of
+        η6²; reported beside η_h, not a part of it.
     """
 
     faces: FacetSet
@@ -70,6 +82,7 @@ class ContactTerms(NamedTuple):
     J5: np.ndarray
     parts6: np.ndarray
     eta7: np.ndarray
+    oscillation: np.ndarray
 
 
 def contact_terms(
@@ -119,7 +132,47 @@ def contact_terms(
     points = space.node_points[cs.faces]
     density = _semi_contact_density(result) / stresses.unit
     parts6 = on_faces * density[np.maximum(rows, 0)] * _hat_integrals(-gap, points)
-    return ContactTerms(faces, J4, J5, parts6, _penetration_shares(gap, points))
+    force = np.maximum(cs.edges.transformed(result.contact_force) / cs.hat_integral, 0.0)
+    s_face = on_faces * (force / stresses.unit)[np.maximum(rows, 0)]
+    oscillation = obstacle_oscillation(result, s_face)
+    return ContactTerms(faces, J4, J5, parts6, _penetration_shares(gap, points), oscillation)
+
+
+def obstacle_oscillation(result: ContactResult, density: np.ndarray) -> np.ndarray:
+    """``(n_f,)`` ``|∫_F λ̃_h (ψ − ψ_h)|`` on each contact face: the obstacle's interpolation
+    term of the reliability bound (docs/method.md, *Three dimensions: the estimator on
+    tetrahedra and faces*, "η6 and the obstacle").
+
+    ``λ̃_h = Σ_p s_p φ_p`` with the refined-face hats and the nodal densities ``density (n_f,
+    6)`` (``s_p = Λ̃_p / m_p`` at every row, in the stress unit), ψ the part's obstacle or gap
+    function at the points of a degree-6 rule in each of the four triangles of the once-refined
+    face, ψ_h its P2 interpolant through the nodal ψ. Zero where ψ is piecewise quadratic on
+    the faces (ψ = ψ_h) or nothing pushes."""
+    cs, space = result.contact, result.space
+    xi, w = triangle_rule(6)
+    corners = REFERENCE_NODES[PIECE_NODES]  # (4, 3, 2)
+    s = np.concatenate([c[0] + xi @ np.stack([c[1] - c[0], c[2] - c[0]]) for c in corners])
+    piece = np.repeat(np.arange(4), len(xi))
+    weight = np.tile(w / 4.0, 4)  # each piece is a quarter of the reference triangle
+    lam = density @ refined_face_hats(s, piece).T  # (n_f, 4q)
+    psi_h = cs.facet_gap @ face_basis(s).T
+    out = np.zeros(len(cs.faces))
+    for sel, geometry in face_geometry(space, cs.faces):
+        x = np.broadcast_to(geometry.points(s), (len(geometry), len(s), 3))
+        psi = np.empty(x.shape[:2])
+        part = cs.face_part[sel]
+        for i, name in enumerate(cs.parts):  # a loop over parts
+            mine = part == i
+            cond = result.problem.conditions[name]
+            y = x[mine].reshape(-1, 3)
+            if cond.obstacle is not None:
+                value = cond.obstacle.gap_and_direction(y)[0]
+            else:
+                value = evaluate_field(cond.gap_field(), y, f"the gap of {name!r}", shape=())
+            psi[mine] = value.reshape(-1, len(s))
+        area = np.broadcast_to(geometry.speeds(s), psi.shape) * weight
+        out[sel] = np.abs((area * lam[sel] * (psi - psi_h[sel])).sum(axis=1))
+    return out
 
 
 def eta5_pressure(result: ContactResult, which: str = PRESSURE_3D) -> np.ndarray:

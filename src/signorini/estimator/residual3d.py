@@ -29,6 +29,8 @@ element indicators sum to η_h² exactly.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..contact.solution import ContactResult
@@ -54,7 +56,7 @@ from .terms import (
     spread_node_parts,
 )
 
-__all__ = ["CELL_DEGREE_3D", "FACE_DEGREE", "NEUMANN_DEGREE_3D", "estimate_3d"]
+__all__ = ["CELL_DEGREE_3D", "FACE_DEGREE", "NEUMANN_DEGREE_3D", "Estimate3D", "estimate_3d"]
 
 #: tetrahedron rule for η1 with a body force (27 points; f is smooth data)
 CELL_DEGREE_3D = 5
@@ -120,12 +122,24 @@ def estimate_3d(
         shares["eta_5"] = on_faces(faces, contact.J5)
         shares["eta_6"] = spread_node_parts(faces, contact.parts6, n_nodes, n_cells)
         shares["eta_7"] = TermShares(None, boundary_cell_shares(faces, contact.eta7, n_cells))
-    return Estimate(
+    oscillation = 0.0 if contact is None else float(np.sqrt(contact.oscillation.sum() * unit))
+    return Estimate3D(
         eta2_cell=np.stack([shares[name].cell for name in TERMS]),
         eta2_node=np.stack([shares[name].node for name in NODE_TERMS]),
         eta5_variant=eta5_variant,
         unit=unit,
+        obstacle_oscillation=oscillation,
     )
+
+
+@dataclass(frozen=True)
+class Estimate3D(Estimate):
+    """The :class:`~signorini.estimator.residual.Estimate` of a 3D solution, and beside it
+    (not in η_h) the obstacle's interpolation term ``osc_ψ = (Σ_F |∫_F λ̃_h (ψ − ψ_h)|)^{1/2}``
+    of the reliability bound (:func:`~.contact_faces3d.obstacle_oscillation`; the unit of η6;
+    0 without contact and where ψ is piecewise quadratic on the faces)."""
+
+    obstacle_oscillation: float = 0.0
 
 
 def _face_set(space: P2TetSpace, e: np.ndarray) -> FacetSet:

@@ -248,6 +248,9 @@ COLUMNS_3D: dict[str, str] = {
     "linear_iterations": "CG iterations of an iterative solver (amg), summed over the level's "
     "solves; absent with a direct solver",
     "backend": "sparse solver backend used (pardiso, scipy or amg)",
+    "osc_obstacle": "the obstacle's interpolation term beside eta, (Σ_F |∫_F λ̃_h (ψ − ψ_h)|)^(1/2) "
+    "(docs/method.md, *Three dimensions: the estimator on tetrahedra and faces*); not a part "
+    "of eta, unit of eta_6; 3D contact runs only",
     "n_constrained": "constraint rows on the contact parts (a P2 node of the contact faces "
     "per part whose direction is not held)",
     "n_active": "constraint rows in the final active set (condition (b): their transformed "
@@ -301,6 +304,9 @@ def level_record(level: int, result: ContactResult, est: Estimate | None) -> Lev
         t_assemble=result.timings["assemble"],
         t_solve=result.timings["solve"],
     )
+    oscillation = getattr(est, "obstacle_oscillation", None)  # a 3D estimate with contact
+    if oscillation is not None and result.contact.size:
+        rec.extra["osc_obstacle"] = oscillation
     if elasticity and report.linear_iterations:
         rec.extra["linear_iterations"] = int(sum(report.linear_iterations))
     if result.problem.exact is not None:
