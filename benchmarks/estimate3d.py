@@ -43,7 +43,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[16], help="elasticity-3d n")
     parser.add_argument(
-        "--h-contact", type=float, nargs="+", default=[0.03], help="hertz-3d h_contact"
+        "--h-contact", type=float, nargs="+", default=[0.018], help="hertz-3d h_contact"
     )
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
