@@ -69,3 +69,23 @@ def test_hertz_3d_adaptive_refines_at_the_contact_zone_and_continues_exactly():
         adaptive(problem, max_levels=4, mesh=full[1].next_mesh, u0=full[1].next_u0, first_level=2)
     )
     _same_levels(full[2:], rest)
+
+
+@pytest.mark.slow
+def test_signorini_run_hertz_3d_adaptive_writes_every_eta_column(tmp_path, capsys):
+    """``signorini run hertz-3d`` without ``--uniform``: the level lines show η, the history
+    has every η column, the node classes, the obstacle's term beside η (0 for the plane: ψ is
+    affine) and the marked cells of each level."""
+    import csv
+
+    from signorini.cli import main
+    from signorini.estimator.names import TERMS
+
+    out = tmp_path / "run"
+    assert main(["run", "hertz-3d", "--max-ndof", "7000", "--out", str(out), "--no-figures"]) == 0
+    lines = [line for line in capsys.readouterr().out.splitlines() if line.startswith("level ")]
+    assert len(lines) >= 2 and all(" eta " in line for line in lines)
+    rows = list(csv.DictReader(open(out / "history.csv")))
+    assert {"eta", *TERMS, "n_semi_contact", "osc_obstacle"} <= set(rows[0])
+    assert all(float(r["eta"]) > 0 and float(r["osc_obstacle"]) < 1e-6 for r in rows)
+    assert int(rows[0]["n_marked"]) > 0 and int(rows[0]["n_semi_contact"]) > 0

@@ -198,7 +198,8 @@ def estimate(
     ranks: Ranks = SERIAL,
     partition: Partition | None = None,
 ) -> Estimate:
-    """Compute η_h and all its contributions for a discrete solution (paper, Section 5).
+    """Compute η_h and all its contributions for a discrete solution (paper, Section 5); on
+    tetrahedra :func:`~.residual3d.estimate_3d` (one process).
 
     Parameters
     ----------
