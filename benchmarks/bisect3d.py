@@ -4,7 +4,8 @@
                                              # edge and a face, and the curved sphere part
     python benchmarks/bisect3d.py --quick    # smaller sizes
     python benchmarks/bisect3d.py --arbitrary  # only the Delaunay cube and ball, tagged by
-                                             # the global vertex order and by the 12-cell
+                                             # the vertex colouring (the default), the
+                                             # global vertex order and the 12-cell
                                              # matching subdivision
 
 Speed: uniform refinement of a Kuhn box (three bisections of every cell) and local
@@ -186,14 +187,16 @@ def arbitrary_mesh(points: np.ndarray, cells: np.ndarray):
 
 
 def arbitrary(levels: int, budget: int) -> None:
-    """Arbitrary (Delaunay) meshes tagged by the global vertex order (no matching condition)
-    and by the 12-cell subdivision (:func:`~signorini.mesh.matching3d.prepare_for_bisection`):
-    per level towards a vertex and towards a face, the cells, the closure rounds, the
-    smallest dihedral angle and the similarity classes."""
+    """Arbitrary (Delaunay) meshes tagged by Diening-Gehring-Storn's colouring (the default,
+    :func:`~signorini.mesh.tags3d.coloured_tags`), by the global vertex order and by the
+    12-cell subdivision (:func:`~signorini.mesh.matching3d.prepare_for_bisection`): per
+    level towards a vertex and towards a face, the cells, the closure rounds, the cells
+    added per cell marked (the closure estimate), the smallest dihedral angle and the
+    similarity classes."""
     from signorini.mesh.bisect3d import bisect_tagged
     from signorini.mesh.matching3d import prepare_for_bisection
     from signorini.mesh.surfaces import Sphere
-    from signorini.mesh.tags3d import mesh_cells
+    from signorini.mesh.tags3d import mesh_cells, sorted_tags, with_face_parts
 
     sphere = Sphere((0.0, 0.0, 0.0), 1.0)  # the ball's boundary: new vertices on it
     cube = arbitrary_mesh(*delaunay_cube())
@@ -218,24 +221,29 @@ def arbitrary(levels: int, budget: int) -> None:
         ("ball", ball, "face", ball_face),
     )
     for name, mesh, where, marking in cases:
-        for init, start in (("global order", mesh), ("12-cell matching", None)):
-            start = start if start is not None else prepare_for_bisection(mesh)
+        for init in ("colouring", "global order", "12-cell matching"):
+            start = prepare_for_bisection(mesh) if init == "12-cell matching" else mesh
             points, tags = start.points, refine3d.tags_of(start)
-            cells = start.cells
+            if init == "global order":
+                order, gamma = sorted_tags(mesh.cells), np.zeros(mesh.n_cells, np.int8)
+                tags = with_face_parts(points, order, gamma, mesh.boundary, mesh.boundary_part)
+            cells, n_marked = start.cells, 0
             print(
                 f"{name} (Delaunay, {mesh.n_cells} cells) towards a {where}, {init}: "
                 f"{start.n_cells} cells, min dihedral {min_dihedral_angle(points, cells):.2f}°, "
                 f"{similarity_classes(points, cells)} classes, matches "
                 f"{refine3d.matches(points, tags)}"
             )
-            print("  level  cells  rounds  min dihedral  classes")
+            print("  level  cells  rounds  added/marked  min dihedral  classes")
             for level in range(levels):
                 if cells.shape[0] > budget:
                     break
+                marked = marking(points, cells, level)
+                n_marked += int(marked.sum())
                 result = bisect_tagged(
                     points,
                     tags,
-                    marking(points, cells, level),
+                    marked,
                     curved=np.array([name == "ball"]),
                     halfway=lambda part, a, b: sphere.halfway(a, b),
                 )
@@ -243,6 +251,7 @@ def arbitrary(levels: int, budget: int) -> None:
                 cells = mesh_cells(tags)
                 print(
                     f"  {level:2d} {cells.shape[0]:8d} {result.rounds:3d} "
+                    f"{(cells.shape[0] - start.n_cells) / max(n_marked, 1):8.2f} "
                     f"{min_dihedral_angle(points, cells):8.3f} "
                     f"{similarity_classes(points, cells):6d}"
                 )

@@ -219,6 +219,9 @@ def test_get_example():
         "hertz-pair",
         "elasticity-3d",
         "hertz-3d",
+        "example-6.1-3d",
+        "example-6.2-3d",
+        "punch-3d",
     }
     for name in EXAMPLES:
         assert get_example(name).name == name

@@ -405,3 +405,17 @@ def test_adaptive_with_coulomb_friction_records_and_warm_starts():
     np.testing.assert_allclose(
         warm.result.u, cold.result.u, atol=1e-12 * np.abs(cold.result.u).max()
     )
+
+
+def test_a_3d_uniform_run_warm_starts_across_the_curved_part():
+    """hertz-3d refined uniformly: the bisection puts new vertices on the sphere off the old
+    cells' straight edges, and the next level still starts from the prolongated solution
+    (fem/prolongation.py in the parents' reference coordinates), not cold."""
+    from signorini.examples.hertz3d import hertz_3d
+
+    problem = hertz_3d(h_contact=0.3)
+    level = next(adaptive(problem, uniform=True, max_levels=3))
+    assert level.next_mesh is not None and level.next_u0 is not None
+    n_old = problem.mesh.n_points
+    assert level.next_u0.shape == (level.next_mesh.n_points + level.next_mesh.n_edges, 3)
+    np.testing.assert_array_equal(level.next_u0[:n_old], level.result.u[:n_old])

@@ -12,13 +12,10 @@ import pytest
 
 from signorini.contact.contact_set import FULL_CONTACT, NO_CONTACT, SEMI_CONTACT
 from signorini.contact.solution import solve
-from signorini.estimator.contact_faces3d import (
-    _hat_integrals,
-    _penetration_shares,
-    eta5_pressure,
-)
+from signorini.estimator.contact_faces3d import _hat_integrals, eta5_pressure
 from signorini.estimator.residual import estimate
 from signorini.estimator.residual3d import estimate_3d
+from signorini.estimator.surface.penetration import surface_penetration
 from signorini.fem.facet_element import P2_TRIANGLE
 from signorini.fem.p2 import basis, grad_basis
 
@@ -87,28 +84,7 @@ def test_the_hat_integrals_of_constants_are_the_hat_shares_and_of_negatives_zero
     # P2 function with negative nodal values may still be positive inside, −φ_v is)
     negative = -0.55 + 0.05 * RNG.uniform(-1, 1, size=(4, 6))
     assert (_hat_integrals(negative, np.repeat(points, 4, 0)) == 0).all()
-    assert (_penetration_shares(negative, np.repeat(points, 4, 0)) == 0).all()
-
-
-def test_the_penetration_bound_of_constant_and_linear_gaps():
-    """On a flat face ``B_F² = (1 + h_F⁻¹) ‖v‖² + h_F ‖∇_Γ v‖²``, h_F = |F|^{1/2}: for v = c,
-    ``c² |F| (1 + |F|^{-1/2})``; for v = g·x + c > 0 on the face, the surface gradient is the
-    tangential part of g."""
-    points = _face(False)
-    x0, x1, x2 = points[0, :3]
-    normal = np.cross(x1 - x0, x2 - x0)
-    area = 0.5 * np.linalg.norm(normal)
-    h = np.sqrt(area)
-    share = _penetration_shares(np.full((1, 6), 0.2), points)[0]
-    np.testing.assert_allclose(share, 0.04 * area * (1 + 1 / h), rtol=1e-12)
-    g = np.array([0.3, -0.2, 0.5])
-    v = points[0] @ g + 1.0  # positive on the face
-    n = normal / np.linalg.norm(normal)
-    tangential = g - (g @ n) * n
-    xi = np.array([[1 / 6, 1 / 6], [2 / 3, 1 / 6], [1 / 6, 2 / 3]])  # degree-2 exact
-    l2 = area / 3 * np.sum((basis(xi) @ v) ** 2)
-    expected = l2 * (1 + 1 / h) + h * area * tangential @ tangential
-    np.testing.assert_allclose(_penetration_shares(v[None], points)[0], expected, rtol=1e-12)
+    assert (surface_penetration(np.repeat(points, 4, 0), negative) == 0).all()
 
 
 @cache
@@ -150,7 +126,7 @@ def test_eta6_lives_on_semi_contact_nodes_and_eta7_where_the_solution_penetrates
     assert eta6_nodes.size > 0 and np.isin(eta6_nodes, semi_nodes).all()
     # η7's shares by face, recomputed: zero where the quadratic gap is nowhere positive
     gap = cs.facet_normal_gap(result.u)
-    shares = _penetration_shares(gap, result.space.node_points[cs.faces])
+    shares = surface_penetration(result.space.node_points[cs.faces], gap)
     s = np.random.default_rng(0).dirichlet(np.ones(3), size=2000)[:, 1:]
     sampled = (gap @ basis(s).T).max(axis=1)
     assert (shares[sampled <= 0] == 0).all()

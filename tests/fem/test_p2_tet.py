@@ -247,7 +247,7 @@ def test_prolongation_onto_a_bisected_mesh_is_exact_for_quadratics(bisections):
     mesh = distorted_box(2, seed=7)
     marked = np.zeros(mesh.n_cells, dtype=bool)
     marked[::5] = True
-    fine, parent, edge_point = bisect_mesh(mesh, marked, bisections)
+    fine, parent, edge_point, parent_edge = bisect_mesh(mesh, marked, bisections)
     coarse_space, fine_space = space_of(mesh), space_of(fine)
     A = RNG.normal(size=(3, 3, 3))
 
@@ -255,6 +255,6 @@ def test_prolongation_onto_a_bisected_mesh_is_exact_for_quadratics(bisections):
         return np.einsum("ijk,...j,...k->...i", A, x, x) + x
 
     u = coarse_space.interpolate(field)
-    v = coarse_space.prolongate(u, Refinement(fine, parent, edge_point))
+    v = coarse_space.prolongate(u, Refinement(fine, parent, edge_point, parent_edge))
     assert v.shape == (fine_space.n_nodes, 3)
     assert np.abs(v - fine_space.interpolate(field)).max() < 1e-13

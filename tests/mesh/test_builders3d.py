@@ -9,6 +9,8 @@ import pytest
 
 from signorini.mesh import MeshError
 from signorini.mesh.builders3d import (
+    MIN_DIHEDRAL_BALL,
+    MIN_DIHEDRAL_CYLINDER,
     box,
     eighth_ball,
     kuhn_grid,
@@ -16,6 +18,7 @@ from signorini.mesh.builders3d import (
     quarter_cylinder,
     round_corner,
 )
+from signorini.mesh.quality3d import dihedral_angles, min_dihedral_angle
 from signorini.mesh.surfaces import Cylinder, Sphere
 
 
@@ -126,3 +129,47 @@ def test_with_curve_in_3d_checks_the_surface():
         mesh.with_curve("x1", Sphere((0, 0, 0), 1.0))
     with pytest.raises(MeshError, match="must be a Surface"):
         mesh.with_curve("x1", object())
+
+
+def _mapped_kuhn_limit(k: int, m: int) -> float:
+    """The smallest dihedral angle (degrees) of the six Kuhn cells of the unit cube mapped by
+    the Jacobian of ``round_corner`` on ``[0, 1]^k`` (central differences) at ``m^k`` points:
+    the limit of large ``n`` of the builders' smallest angle (the identity along z for the
+    cylinder)."""
+    g = np.linspace(0.0, 1.0, m)
+    x = np.stack(np.meshgrid(*[g] * k, indexing="ij"), axis=-1).reshape(-1, k)
+    J = np.broadcast_to(np.eye(3), (len(x), 3, 3)).copy()
+    for i in range(k):  # a loop over the axes
+        step = np.zeros(k)
+        step[i] = 1e-6
+        J[:, :k, i] = (round_corner(x + step) - round_corner(x - step)) / 2e-6
+    grid, cells = kuhn_grid(1, 1, 1)
+    corners = np.einsum("xij,vj->xvi", J, grid.astype(float)).reshape(-1, 3)
+    mapped = (8 * np.arange(len(x))[:, None, None] + cells[None]).reshape(-1, 4)
+    return float(np.degrees(dihedral_angles(corners, mapped).min()))
+
+
+def test_curved_builders_keep_their_documented_smallest_dihedral_angle():
+    ball = [min_dihedral_angle(m.points, m.cells) for m in map(eighth_ball, (1, 2, 4, 8))]
+    cylinder = [min_dihedral_angle(m.points, m.cells) for m in map(quarter_cylinder, (1, 2, 4, 8))]
+    print(f"eighth ball n = 1, 2, 4, 8: {np.round(ball, 2)}; quarter cylinder: "
+          f"{np.round(cylinder, 2)}")  # fmt: skip
+    np.testing.assert_allclose(ball, [45.0, 39.48, 33.74, 30.90], atol=0.01)
+    np.testing.assert_allclose(cylinder, [35.26, 28.18, 24.37, 22.55], atol=0.01)
+    assert np.all(np.diff(ball) < 0) and np.all(np.diff(cylinder) < 0)  # falling with n
+    assert min(ball) > MIN_DIHEDRAL_BALL and min(cylinder) > MIN_DIHEDRAL_CYLINDER
+
+
+@pytest.mark.slow
+def test_the_smallest_dihedral_angles_tend_to_the_mapped_kuhn_cells_limit():
+    """For large n the cells are the Kuhn cells mapped by the Jacobian of round_corner: its
+    smallest angle over the domain is the limit, above the documented bounds, and the
+    meshes at n = 24 lie between it and n = 8's."""
+    ball_limit, cylinder_limit = _mapped_kuhn_limit(3, 81), _mapped_kuhn_limit(2, 401)
+    ball = min_dihedral_angle(*(lambda m: (m.points, m.cells))(eighth_ball(24)))
+    cylinder = min_dihedral_angle(*(lambda m: (m.points, m.cells))(quarter_cylinder(24)))
+    print(f"limits {ball_limit:.2f}, {cylinder_limit:.2f}; n = 24: {ball:.2f}, {cylinder:.2f}")
+    assert ball_limit == pytest.approx(28.57, abs=0.05)
+    assert cylinder_limit == pytest.approx(20.89, abs=0.05)
+    assert MIN_DIHEDRAL_BALL < ball_limit < ball < 30.9
+    assert MIN_DIHEDRAL_CYLINDER < cylinder_limit < cylinder < 22.55

@@ -76,10 +76,12 @@ def draw_figures(
     """Announce, draw and record the figures of a run whose last level is ``last`` (None:
     the convergence figures of its history only)."""
     out = folder.path
-    three = last is not None and last.result.mesh.dim == 3  # no contact figures in 3D
+    three = last is not None and last.result.mesh.dim == 3  # no mesh figure in 3D
     kinds = "convergence history, mesh, deformed body" if last else "convergence history"
     if three:
         kinds = "convergence history, deformed body"
+        if last.result.contact.size:
+            kinds += ", contact pressure over Γ_C"
     say(f"drawing the figures of {label} ({kinds}) ...")
     written = figures(label, out, last)
     if last is not None and metrics is not None and metrics.pressure is not None:

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ..algebra.backends.selection import solver_library, solver_name
 from ..loop import COLUMNS, Level, adaptive
-from ..loop.record import COLUMNS_3D, ElasticityRecord
+from ..loop.record import COLUMNS_3D, COLUMNS_3D_CONTACT, ElasticityRecord
 from ..output import HistoryWriter, write_columns
 from ..output.check import CHECK, write_check
 from ..output.environment import environment
@@ -194,13 +194,13 @@ def _solve_levels(work: _Run, status: Status) -> Level | None:
     job = work.job
     work.folder.add_files("history.csv", "history.md")
     three = job.problem.mesh.dim == 3
-    columns = COLUMNS_3D if three else COLUMNS
+    columns = COLUMNS_3D_CONTACT if job.problem.contact_parts else COLUMNS_3D
     if three and not job.problem.contact_parts:  # 3D elasticity: no contact columns
         columns = {k: v for k, v in columns.items() if k not in ElasticityRecord.LEFT_OUT}
     write_columns(
         out / "history.md",
         {
-            **columns,
+            **(columns if three else COLUMNS),
             **(job.metrics.columns if job.metrics else {}),
             "t_output": "seconds spent writing the level's VTU file and recording it",
         },

@@ -25,16 +25,20 @@ import scipy.sparse as sp
 
 from ..fem.facet_element import FaceElement
 from ..fem.quadrature import triangle_rule
-from ..mesh.geometry import facet_normals
 from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
+from ..problem.normals import face_node_normals
+from ..problem.rollers import HeldNodes
+from ..problem.rollers3d import held_basis, span_residual
 from .face_basis import DEFAULT_ALPHA, FaceEdges, change_of_variables, face_edges
-from .node_frames3d import frame_operator, row_frames
+from .face_checks import check_deep_overlap, given_directions
+from .face_fields import FaceFields
+from .node_frames3d import frame_operator, held_frames, to_frames_3d
 
 if TYPE_CHECKING:
     from ..fem.space3d import P2TetSpace
 
-__all__ = ["SAME_DIRECTION", "FaceContactSet", "face_contact_set", "part_rows"]
+__all__ = ["SAME_DIRECTION", "FaceContactSet", "face_contact_set"]
 
 #: two rows at a node whose directions differ by less than this (max-norm) are one row
 SAME_DIRECTION = 1e-8
@@ -75,13 +79,15 @@ class FaceContactSet:
     facet : FaceElement
         The space's face element (its weights and nodal pressure).
     facet_local : (n_f, 6) int array
-        The row of each face node for the face's part (the row it was merged into where the
-        part's row joined another part's of the same direction), ``-1`` where the node is held
-        along the part's direction (the 2D ``ContactSet.facet_local`` on faces).
-    facet_direction : (n_f, 6, 3) float array
-        The part's direction at each face node; ``facet_gap (n_f, 6)`` its ψ there (held
-        nodes included: the node classes and the estimator read them).
+        The row of each contact face's nodes for the face's part, ``-1`` at a node without
+        one (held); the node classes of Section 4 read it (:func:`~.contact_set.node_classes`).
     facet_gap : (n_f, 6) float array
+        ψ at the contact faces' nodes (held nodes too); ``facet_direction (n_f, 6, 3)`` the
+        directions there.
+    facet_direction : (n_f, 6, 3) float array
+    roller_dof : (r,) int array
+        The frame DOF held by each oblique or curved roller row
+        (:attr:`~signorini.problem.rollers.HeldNodes.roller_nodes`).
     """
 
     n_dofs: int
@@ -102,8 +108,9 @@ class FaceContactSet:
     hat_integral: np.ndarray
     facet: FaceElement
     facet_local: np.ndarray
-    facet_direction: np.ndarray
     facet_gap: np.ndarray
+    facet_direction: np.ndarray
+    roller_dof: np.ndarray
 
     @property
     def operator(self) -> sp.csr_matrix:
@@ -159,12 +166,37 @@ class FaceContactSet:
         p[half.mid] = 0.5 * (p[half.start] + p[half.end])
         return p
 
+    def unknowns(self, u: np.ndarray) -> np.ndarray:
+        """``(n_dofs,)`` the solver's variables ``ỹ = P⁻¹ Q⁻¹ u`` of Cartesian DOFs ``u``
+        (the inverse of :meth:`displacement`: out of the frames, then ``T^{-T}`` on the
+        rows' DOFs)."""
+        y = to_frames_3d(u, self.frame_nodes, self.frames)
+        y[self.dof] = self.edges.coefficients(y[self.dof])
+        return y
+
     def facet_normal_gap(self, u: np.ndarray) -> np.ndarray:
-        """``(n_f, 6)`` ``u(z)·n_z − ψ(z)`` at the nodes of each contact face, with the face
-        part's direction and ψ at every node (held ones too): its P2 interpolant on a face is
-        ``u_h·n − ψ_h`` (the faces' counterpart of the 2D ``ContactSet.facet_normal_gap``)."""
-        u = np.asarray(u, dtype=np.float64).reshape(-1, 3)
-        return np.einsum("fac,fac->fa", self.facet_direction, u[self.faces]) - self.facet_gap
+        """``u(z)·n_z − ψ(z)`` at the nodes of each contact face ``(n_f, 6)``, for nodal
+        values ``u (n_nodes, 3)``."""
+        return np.einsum("fjc,fjc->fj", np.asarray(u)[self.faces], self.facet_direction) - (
+            self.facet_gap
+        )
+
+    def fields(self, u: np.ndarray, force: np.ndarray, active: np.ndarray) -> FaceFields:
+        """The rows' gap ``u(z)·n_z − ψ(z)``, force, pressures (:meth:`pressure` for
+        condition (b), NaN for (a); :meth:`recovered_pressure`), flag and direction of a
+        solution ``u (n_nodes, 3)`` with forces ``Λ (k,)`` and active set ``(k,)``."""
+        force = np.asarray(force, dtype=np.float64)
+        p = self.pressure(force) if self.edges.alpha > 0 else np.full(self.n_rows, np.nan)
+        return FaceFields(
+            node=self.node,
+            part=self.part,
+            normal=self.direction,
+            gap=np.einsum("kc,kc->k", np.asarray(u)[self.node], self.direction) - self.psi,
+            contact_force=force,
+            pressure=p,
+            recovered_pressure=self.recovered_pressure(force),
+            active=np.asarray(active, dtype=bool),
+        )
 
     @property
     def n_rows(self) -> int:
@@ -182,25 +214,8 @@ class FaceContactSet:
         return self.dof
 
 
-def _body_normals(space, name: str, facets: np.ndarray, z: np.ndarray) -> np.ndarray:
-    """``(j, 3)`` the body's normals at the nodes ``z`` of part ``name``: the surface's on a
-    curved part, else the normalised mean of the unit normals of the part's faces at z."""
-    mesh = space.mesh
-    nodes = space.facet_nodes(facets)
-    _, normal = facet_normals(mesh.points[nodes[:, :3]])
-    total = np.zeros((space.n_nodes, 3))
-    np.add.at(total, nodes.ravel(), np.repeat(normal, 6, axis=0))
-    n = total[z] / np.linalg.norm(total[z], axis=1)[:, None]
-    surface = mesh.curves[mesh.part_index(name)]
-    if surface is not None and getattr(surface, "has_normal", False):
-        m = surface.normal(space.node_points[z])
-        return m * np.where(np.einsum("jc,jc->j", m, n) < 0, -1.0, 1.0)[:, None]
-    return n
-
-
-def part_rows(space, name: str, cond: Contact) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The nodes of part ``name``'s faces (sorted), their directions and gaps ψ (before the
-    held directions are left out)."""
+def _part_rows(space, name: str, cond: Contact) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The nodes of part ``name``'s faces (sorted), their directions and gaps."""
     facets = space.mesh.part_facets(name)
     z = np.unique(space.facet_nodes(facets))
     x = space.node_points[z]
@@ -217,19 +232,17 @@ def part_rows(space, name: str, cond: Contact) -> tuple[np.ndarray, np.ndarray, 
         return z, n, psi
     what = f"the gap function of contact part {name!r}"
     psi = evaluate_field(cond.gap_field(), x, what, shape=(), bounded=True)
-    if cond.normal is not None:
-        given = np.asarray(cond.normal, dtype=np.float64)
-        if given.shape != (3,):
-            raise ProblemError(f"contact part {name!r}: normal must be 3 numbers on a 3D mesh")
-        return z, np.broadcast_to(given / np.linalg.norm(given), x.shape).copy(), psi
-    return z, _body_normals(space, name, facets, z), psi
+    body = face_node_normals(space, name, z)
+    if cond.normal is None:
+        return z, body, psi
+    return z, given_directions(cond.normal, name, x, body), psi
 
 
 def face_contact_set(
     space: P2TetSpace,
     contact: Mapping[str, Contact],
-    held: np.ndarray,
-    held_values: np.ndarray,
+    held: np.ndarray | HeldNodes,
+    held_values: np.ndarray | None = None,
     alpha: float = DEFAULT_ALPHA,
 ) -> FaceContactSet:
     """Resolve the contact parts of a 3D problem on a P2 tetrahedral space.
@@ -239,10 +252,12 @@ def face_contact_set(
     space : P2TetSpace
     contact : mapping part name -> Contact
         The contact parts, in order (gap function or shape of space; frictionless).
-    held : (n_nodes, 3) bool array
-        The Cartesian components held at each node (Dirichlet, axis rollers).
+    held : (n_nodes, 3) bool array or HeldNodes
+        The Cartesian components held at each node (Dirichlet, axis rollers); or all that
+        the Dirichlet and Roller parts hold, oblique and curved rollers' rows among it
+        (:func:`~signorini.problem.rollers3d.held_rows_3d`).
     held_values : (n_nodes, 3) float array
-        Their values.
+        The held components' values (with a bool ``held``).
     alpha : float
         The transformed basis's α (0: condition (a); default 1/5: condition (b)).
 
@@ -254,72 +269,76 @@ def face_contact_set(
     ------
     ProblemError
         Naming the part or the node: a plane obstacle, a gap function that is not finite, a
-        node with more than three rows and held directions.
+        node with more than three rows and held directions, a given normal of the wrong
+        shape or length, an obstacle that starts deep inside the body.
     """
+    if not isinstance(held, HeldNodes):
+        none = np.zeros(0, dtype=np.int64)
+        values = np.asarray(held_values, dtype=np.float64)
+        held = HeldNodes(np.asarray(held, dtype=bool), values, none, np.zeros((0, 3)), none * 0.0)
     parts = tuple(contact)
-    found = [part_rows(space, name, contact[name]) for name in parts]  # a loop over parts
+    found = [_part_rows(space, name, contact[name]) for name in parts]  # a loop over parts
     node = np.concatenate([f[0] for f in found])
     part = np.repeat(np.arange(len(parts)), [f[0].size for f in found])
     direction = np.concatenate([f[1] for f in found])
     gap = np.concatenate([f[2] for f in found])
-    held = np.asarray(held, dtype=bool)
-    held_values = np.asarray(held_values, dtype=np.float64)
-    free_normal = np.abs(np.where(held[node], 0.0, direction)).max(axis=1) > SAME_DIRECTION
+    check_deep_overlap(
+        space, held, (node, part, direction, gap), [contact[p] for p in parts], parts
+    )
+    free_normal = _free_normal(held, node, direction)
     order = np.lexsort((part, node))
     order = order[free_normal[order]]
-    node, part, direction, gap = node[order], part[order], direction[order], gap[order]
     # merge a later part's row into an earlier one at the same node with the same direction
     row_of_part = np.full((space.n_nodes, len(parts)), -1, dtype=np.int64)
-    first = np.r_[True, node[1:] != node[:-1]]
-    same = ~first & (
-        np.abs(direction - np.roll(direction, 1, axis=0)).max(axis=1) <= SAME_DIRECTION
-    )
+    first = np.r_[True, node[order][1:] != node[order][:-1]]
+    d = direction[order]
+    same = ~first & (np.abs(d - np.roll(d, 1, axis=0)).max(axis=1) <= SAME_DIRECTION)
     keep = ~same
-    kept_index = np.cumsum(keep) - 1  # the row each candidate becomes (merged: its previous)
-    row_of_part[node, part] = kept_index
-    node, part, direction, gap = node[keep], part[keep], direction[keep], gap[keep]
-    return _assembled(
-        space, parts, node, part, direction, gap, row_of_part, held, held_values, alpha, found
-    )
+    row_of_part[node[order], part[order]] = np.cumsum(keep) - 1  # merged: the previous row
+    rows = order[keep]
+    face_data = _face_data(space, found, parts, row_of_part)
+    return _assembled(space, parts, (node[rows], part[rows], direction[rows], gap[rows]),
+                      row_of_part, held, alpha, face_data)  # fmt: skip
 
 
-def _assembled(space, parts, node, part, direction, gap, row_of_part, held, values, alpha, found):
-    """The frames, held DOFs, face basis and weights of the rows (:func:`face_contact_set`)."""
-    k = node.size
-    frame_nodes, start, count = np.unique(node, return_index=True, return_counts=True)
-    j = np.arange(k) - np.repeat(start, count)  # each row's index at its node
-    n_held = held[frame_nodes].sum(axis=1)
-    total = count + n_held
-    if (total > 3).any():
-        z = int(frame_nodes[np.argmax(total)])
-        raise ProblemError(
-            f"node {z} at {space.node_points[z].tolist()} has {int(total.max())} constraint "
-            "and held directions (at most 3): contact parts and held components meet there"
-        )
-    rows = np.zeros((frame_nodes.size, 3, 3))
-    rows[np.repeat(np.arange(frame_nodes.size), count), j] = direction
-    position = np.cumsum(held[frame_nodes], axis=1) - 1 + count[:, None]  # the held rows' slots
-    f, c = np.nonzero(held[frame_nodes])
-    rows[f, position[f, c], c] = 1.0
-    mean = np.array([np.abs(direction[part == i].sum(axis=0)) for i in range(len(parts))])
-    pole = np.argmax(mean, axis=1)[part[start]] if k else np.zeros(0, np.int64)
-    try:
-        Q = row_frames(rows, total, pole)
-    except np.linalg.LinAlgError:
-        Q = np.full(rows.shape, np.nan)
-    if not np.isfinite(Q).all():
-        raise ProblemError(
-            "the constraint and held directions at a contact node are dependent (a contact "
-            "direction along a held axis beside another part's)"
-        )
-    rotated = np.zeros(space.n_nodes, dtype=bool)
-    rotated[frame_nodes] = True
-    cartesian = np.flatnonzero((held & ~rotated[:, None]).ravel())
-    held_dofs = np.concatenate([3 * frame_nodes[f] + position[f, c], cartesian])
-    held_vals = np.concatenate([values[frame_nodes[f], c], values.reshape(-1)[cartesian]])
+def _free_normal(held: HeldNodes, node: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """``(c,)`` whether a candidate row's direction is free of the directions held at its
+    node (else the held components fix ``u·n_z`` and the row is left out)."""
+    free = np.abs(np.where(held.components[node], 0.0, direction)).max(axis=1) > SAME_DIRECTION
+    if held.roller_nodes.size == 0:
+        return free
+    nodes, basis, count = held_basis(held.components, held.roller_nodes, held.roller_normal)
+    at = np.flatnonzero(np.isin(node, nodes))
+    i = np.searchsorted(nodes, node[at])
+    residual = span_residual(basis[i], count[i], direction[at])
+    free[at] = np.abs(residual).max(axis=1) > SAME_DIRECTION
+    return free
+
+
+def _face_data(space, found, parts, row_of_part) -> tuple[np.ndarray, ...]:
+    """The contact faces' nodes ``(n_f, 6)``, parts, and at their nodes the row (``-1`` at a
+    held node), ψ and the direction of the face's part."""
     facet_index = np.concatenate([space.mesh.part_facets(p) for p in parts])
     faces = space.facet_nodes(facet_index)
     face_part = np.repeat(np.arange(len(parts)), [space.mesh.part_facets(p).size for p in parts])
+    gap = np.zeros(faces.shape)
+    direction = np.zeros(faces.shape + (3,))
+    for i, (z, n, psi) in enumerate(found):  # a loop over parts
+        on = face_part == i
+        at = np.searchsorted(z, faces[on])
+        gap[on], direction[on] = psi[at], n[at]
+    local = row_of_part[faces, face_part[:, None]]
+    return facet_index, faces, face_part, local, gap, direction
+
+
+def _assembled(space, parts, rows, row_of_part, held, alpha, face_data):
+    """The frames, held DOFs, face basis and weights of the rows (:func:`face_contact_set`)."""
+    node, part, direction, gap = rows
+    k = node.size
+    mean = np.array([np.abs(direction[part == i].sum(axis=0)) for i in range(len(parts))])
+    pole = np.argmax(mean, axis=1)[part] if k else np.zeros(0, np.int64)
+    frames = held_frames(space.node_points, node, direction, pole, held)
+    facet_index, faces, face_part, local, face_gap, face_direction = face_data
 
     def row_of(nodes, which):
         return row_of_part[nodes, which]
@@ -333,32 +352,22 @@ def _assembled(space, parts, node, part, direction, gap, row_of_part, held, valu
         parts=parts,
         direction=direction,
         psi=gap,
-        dof=3 * node + j,
-        frame_nodes=frame_nodes,
-        frames=Q,
-        held_dofs=held_dofs,
-        held_values=held_vals,
+        dof=frames.row_dof,
+        frame_nodes=frames.frame_nodes,
+        frames=frames.frames,
+        held_dofs=frames.held_dofs,
+        held_values=frames.held_values,
         faces=faces,
         face_part=face_part,
         edges=edges,
         basis_integral=w,
         hat_integral=m,
         facet=space.element.facet,
-        facet_local=row_of(faces, face_part[:, None]),
-        **_face_data(found, faces, face_part),
+        facet_local=local,
+        facet_gap=face_gap,
+        facet_direction=face_direction,
+        roller_dof=frames.roller_dof,
     )
-
-
-def _face_data(found, faces: np.ndarray, face_part: np.ndarray) -> dict[str, np.ndarray]:
-    """The part's direction and ψ at every node of its faces (``found``: each part's sorted
-    nodes, directions and ψ, :func:`part_rows`)."""
-    direction = np.zeros(faces.shape + (3,))
-    psi = np.zeros(faces.shape)
-    for i, (z, n, g) in enumerate(found):  # a loop over parts
-        mine = face_part == i
-        at = np.searchsorted(z, faces[mine])
-        direction[mine], psi[mine] = n[at], g[at]
-    return {"facet_direction": direction, "facet_gap": psi}
 
 
 def _weights(space, facet_index, faces, face_part, row_of, k):

@@ -18,6 +18,7 @@ from scipy.optimize import nnls
 
 from ..problem.fields import DATA_MAX, ProblemError
 from ..problem.rigid import describe_motion
+from .face_contact import FaceContactSet
 from .node_frames import to_frames
 from .system import Assembled
 
@@ -64,9 +65,12 @@ def check_load_carried(assembled: Assembled) -> None:
     """
     space, cs = assembled.space, assembled.contact
     motions = assembled.conditions.rigid_motions
-    r = motion_fields(assembled)  # (k, n_nodes, 2)
+    r = motion_fields(assembled)  # (k, n_nodes, d)
     nodes, frames = assembled.frame_nodes, assembled.frames
-    y = np.stack([to_frames(ri.ravel(), nodes, frames) for ri in r])  # k ≤ 3
+    if isinstance(cs, FaceContactSet):  # the solver's variables (k ≤ 6)
+        y = np.stack([cs.unknowns(ri.ravel()) for ri in r])
+    else:
+        y = np.stack([to_frames(ri.ravel(), nodes, frames) for ri in r])  # k ≤ 3
     # a load beyond DATA_MAX (E extreme, the loads with it) is divided by a power of 2 near
     # its size (exact), so that the norms below do not overflow
     big = np.abs(assembled.F).max(initial=0.0)
@@ -74,7 +78,7 @@ def check_load_carried(assembled: Assembled) -> None:
     F = np.ldexp(assembled.F, -e)
     work = y @ F  # (k,)
     scale = np.abs(y) @ np.abs(F)  # (k,)
-    along = np.einsum("knc,nc->kn", r[:, cs.nodes], cs.normal)  # (k, n_constraints)
+    along = _along(cs, r, y)  # (k, n_constraints)
     parts = list(cs.parts)
     size = float(np.linalg.norm(scale))
 
@@ -126,9 +130,24 @@ def initial_active_set(assembled: Assembled) -> np.ndarray:
     gap = cs.gap
     first = gap <= gap.min() + 1e-12 * max(np.abs(gap).max(), np.finfo(float).tiny)
     motions = assembled.conditions.rigid_motions
-    r = motion_fields(assembled)[:, cs.nodes[first]]
-    along = np.einsum("knc,nc->kn", r, cs.normal[first])
+    if isinstance(cs, FaceContactSet):
+        along = _along(
+            cs, None, np.stack([cs.unknowns(ri.ravel()) for ri in motion_fields(assembled)])
+        )[:, first]
+    else:
+        r = motion_fields(assembled)[:, cs.nodes[first]]
+        along = np.einsum("knc,nc->kn", r, cs.normal[first])
     s = np.linalg.svd(along, compute_uv=False)
     if s.size == motions.shape[0] and s.min() > 1e-9 * max(s.max(), 1.0):
         return first
     return np.ones(cs.size, dtype=bool)
+
+
+def _along(cs, r: np.ndarray | None, y: np.ndarray) -> np.ndarray:
+    """``(k, n_constraints)`` each free motion's component along each constraint: ``r(z)·n_z``
+    of the motions at the nodes ``r (k, n_nodes, 2)``; on faces the bounded unknowns of the
+    motions in the solver's variables ``y (k, n_dofs)`` (``ỹ_dof``: the transformed basis's
+    coefficients of ``r·n_z``, against which the multipliers ``Λ̃ ≥ 0`` work)."""
+    if isinstance(cs, FaceContactSet):
+        return y[:, cs.dof]
+    return np.einsum("knc,nc->kn", r[:, cs.nodes], cs.normal)

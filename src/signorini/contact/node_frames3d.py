@@ -24,13 +24,19 @@ frames are continuous unless its normals turn by more than about 90°; on a flat
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.sparse as sp
 
 from ..fem.dofs import node_dofs
+from ..problem.fields import ProblemError
+from ..problem.rollers import HeldNodes
 
 __all__ = [
+    "HeldFrames",
     "frame_operator",
+    "held_frames",
     "row_frames",
     "rotate_frames_3d",
     "tangent_completion",
@@ -153,3 +159,106 @@ def to_cartesian_3d(y: np.ndarray, nodes: np.ndarray, frames: np.ndarray) -> np.
     dofs = node_dofs(np.asarray(nodes, dtype=np.int64), 3)
     x[dofs] = np.einsum("mij,mj->mi", frames, x[dofs])
     return x
+
+
+@dataclass(frozen=True)
+class HeldFrames:
+    """The frames of the nodes with constraint rows or roller rows, and the held DOFs.
+
+    Attributes
+    ----------
+    frame_nodes : (m,) int array
+        The nodes in a frame (sorted); ``frames (m, 3, 3)`` their ``Q_z``.
+    frames : (m, 3, 3) float array
+    row_dof : (k,) int array
+        The frame DOF ``3 z + j`` each constraint row bounds.
+    held_dofs : (n_h,) int array
+        The held DOFs: frame DOFs of held axes and roller rows at the frame nodes, Cartesian
+        DOFs elsewhere; ``held_values (n_h,)`` their values.
+    held_values : (n_h,) float array
+    roller_dof : (r,) int array
+        The frame DOF each roller row holds (``held.roller_nodes`` order).
+    """
+
+    frame_nodes: np.ndarray
+    frames: np.ndarray
+    row_dof: np.ndarray
+    held_dofs: np.ndarray
+    held_values: np.ndarray
+    roller_dof: np.ndarray
+
+
+def held_frames(
+    points: np.ndarray,
+    row_node: np.ndarray,
+    row_direction: np.ndarray,
+    row_pole: np.ndarray,
+    held: HeldNodes,
+) -> HeldFrames:
+    """The frames ``Q_z = A_z^{-1}`` (one row: the rotation of :func:`tangent_completion`)
+    of the nodes with constraint rows or roller rows, the rows of ``A_z`` in the order
+    constraint rows, held Cartesian axes ``e_c``, roller normals (docs/method.md, *Three
+    dimensions: contact on faces*, "The frames"; *Three dimensions: rollers, force
+    control, regions*).
+
+    Parameters
+    ----------
+    points : (n_nodes, 3) float array
+        The nodes' coordinates (for messages).
+    row_node : (k,) int array
+        The constraint rows' nodes, sorted.
+    row_direction : (k, 3) float array
+        Their unit directions.
+    row_pole : (k,) int array
+        The completion's pole of each row's node (its part's).
+    held : HeldNodes
+        The held Cartesian components and values ``(n_nodes, 3)`` and the roller rows
+        (:func:`~signorini.problem.rollers3d.held_rows_3d`).
+
+    Raises
+    ------
+    ProblemError
+        For a node with more than three rows and held directions, or dependent ones.
+    """
+    comp, values = held.components, held.values
+    rn = held.roller_nodes
+    frame_nodes = np.union1d(row_node, rn).astype(np.int64)
+    m, k = frame_nodes.size, row_node.size
+    at_row = np.searchsorted(frame_nodes, row_node)
+    at_roller = np.searchsorted(frame_nodes, rn)
+    n_rows = np.bincount(at_row, minlength=m)
+    n_held = comp[frame_nodes].sum(axis=1)
+    total = n_rows + n_held + np.bincount(at_roller, minlength=m)
+    if (total > 3).any():
+        z = int(frame_nodes[np.argmax(total)])
+        raise ProblemError(
+            f"node {z} at {points[z].tolist()} has {int(total.max())} constraint "
+            "and held directions (at most 3): contact parts and held components meet there"
+        )
+    rows = np.zeros((m, 3, 3))
+    j = np.arange(k) - np.searchsorted(row_node, row_node)  # each row's index at its node
+    rows[at_row, j] = row_direction
+    position = np.cumsum(comp[frame_nodes], axis=1) - 1 + n_rows[:, None]  # held axes' slots
+    f, c = np.nonzero(comp[frame_nodes])
+    rows[f, position[f, c], c] = 1.0
+    slot = n_rows[at_roller] + n_held[at_roller] + np.arange(rn.size) - np.searchsorted(rn, rn)
+    rows[at_roller, slot] = held.roller_normal
+    pole = np.argmax(np.abs(rows[:, 0]), axis=1)
+    pole[at_row] = row_pole
+    try:
+        Q = row_frames(rows, total, pole)
+    except np.linalg.LinAlgError:
+        Q = np.full(rows.shape, np.nan)
+    if not np.isfinite(Q).all():
+        raise ProblemError(
+            "the constraint and held directions at a contact or roller node are dependent (a "
+            "contact direction along a held axis beside another part's)"
+        )
+    rotated = np.zeros(comp.shape[0], dtype=bool)
+    rotated[frame_nodes] = True
+    cartesian = np.flatnonzero((comp & ~rotated[:, None]).ravel())
+    held_dofs = np.concatenate([3 * frame_nodes[f] + position[f, c], 3 * rn + slot, cartesian])
+    held_values = np.concatenate(
+        [values[frame_nodes[f], c], held.roller_value, values.reshape(-1)[cartesian]]
+    )
+    return HeldFrames(frame_nodes, Q, 3 * row_node + j, held_dofs, held_values, 3 * rn + slot)

@@ -10,7 +10,9 @@ stiffness matrix ``K`` annihilates them before the Dirichlet DOFs are fixed — 
 system's unknowns ``y``, which are the Cartesian displacement written in node frames at the
 contact and roller nodes, ``u = Q y`` (:mod:`.node_frames`), and with contact pairs the
 relative displacement ``ũ = (I − T_d) u`` (:mod:`.two_body`). So a motion ``u`` of the
-bodies is ``y = Q⁻¹ (I − T_d) u`` there, and ``K y = 0`` holds to round-off (tested).
+bodies is ``y = Q⁻¹ (I − T_d) u`` there, and ``K y = 0`` holds to round-off (tested). In 3D
+with contact the unknowns are those of the frames and the transformed face basis,
+``ỹ = P⁻¹ Q⁻¹ u`` (:meth:`~.face_contact.FaceContactSet.unknowns`).
 """
 
 from __future__ import annotations
@@ -19,8 +21,10 @@ import numpy as np
 
 from ..fem.space import node_dofs
 from ..mesh.bodies import body_of_cells
-from ..problem.problem3d import rigid_modes_3d
+from ..problem.rigid3d import rigid_modes_3d
+from .face_contact import FaceContactSet
 from .node_frames import to_frames
+from .node_frames3d import to_frames_3d
 from .system import Assembled
 
 __all__ = ["system_rigid_modes"]
@@ -76,6 +80,10 @@ def system_rigid_modes(assembled: Assembled) -> np.ndarray:
     transfer = assembled.contact.transfer
     if transfer is not None:  # the relative displacement of the contact pairs
         modes = modes - transfer.dofs @ modes
-    if space.mesh.dim == 3:  # no node frames in 3D yet (no contact, axis rollers only)
-        return modes
+    if isinstance(assembled.contact, FaceContactSet):  # ỹ = P⁻¹ Q⁻¹ u, six per body
+        return np.column_stack([assembled.contact.unknowns(m) for m in modes.T])
+    if space.mesh.dim == 3:  # the frames of the oblique and curved rollers
+        return np.column_stack(
+            [to_frames_3d(m, assembled.frame_nodes, assembled.frames) for m in modes.T]
+        )
     return to_frames(modes, assembled.frame_nodes, assembled.frames)

@@ -14,6 +14,7 @@ from ..fem.elasticity3d import energy_error2_3d, h1_seminorm_error2_3d, l2_error
 from ..problem.fields import evaluate_field
 from .face_contact import FaceContactSet
 from .node_frames import to_cartesian
+from .node_frames3d import to_cartesian_3d
 from .system import Assembled
 from .two_body import physical
 
@@ -38,12 +39,12 @@ def cartesian_displacement(x: np.ndarray, assembled: Assembled) -> np.ndarray:
     """``(n_nodes, d)`` the Cartesian nodal displacements of the system's unknowns ``x
     (n_dofs,)``: out of the node frames (:func:`~.node_frames.to_cartesian`) and, with
     contact pairs, back from the relative displacement (:func:`~.two_body.physical`); in
-    3D ``x`` itself, node by node, or with contact ``R x`` out of the frames and the
+    3D ``x`` out of the rollers' frames, or with contact ``R x`` out of the frames and the
     transformed face basis (:meth:`~.face_contact.FaceContactSet.displacement`)."""
     if isinstance(assembled.contact, FaceContactSet):
         return assembled.contact.displacement(x).reshape(-1, 3)
-    if assembled.space.mesh.dim == 3:
-        return x.reshape(-1, 3)
+    if assembled.space.mesh.dim == 3:  # out of the oblique and curved rollers' frames
+        return to_cartesian_3d(x, assembled.frame_nodes, assembled.frames).reshape(-1, 3)
     y = to_cartesian(x, assembled.frame_nodes, assembled.frames).reshape(-1, 2)
     return physical(y, assembled.contact.transfer)
 

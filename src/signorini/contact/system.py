@@ -22,6 +22,7 @@ from ..mesh.mesh import Mesh
 from ..problem.conditions import Neumann
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.problem import ContactProblem
+from ..problem.problem3d import check_mesh_dimension
 from ..problem.rollers import HeldNodes
 from .admissible import check_load_size
 from .contact_set import ContactSet, contact_set
@@ -176,7 +177,8 @@ def assemble(
         raise ValueError(
             f"ranks must be a signorini.algebra.ranks.Ranks, got {type(ranks).__name__}"
         )
-    if mesh.dim == 3:  # 3D elasticity without contact: its own assembly, beside this one
+    check_mesh_dimension(problem.name, problem.mesh, mesh)
+    if mesh.dim == 3:  # 3D elasticity and contact on faces: its own assembly, beside this one
         from .system3d import assemble_3d  # (which builds on this module's Assembled)
 
         space_of(mesh, element)  # refuses an element the tetrahedron does not have

@@ -1,12 +1,14 @@
-"""The algebraic problem of one tetrahedral mesh: 3D elasticity without contact
-(docs/method.md, *Three dimensions: solving elasticity*).
+"""The algebraic problem of one tetrahedral mesh: 3D elasticity and contact on faces
+(docs/method.md, *Three dimensions: solving elasticity*, *Three dimensions: rollers, force
+control, regions*).
 
 :func:`~.system.assemble` hands a mesh with ``dim = 3`` here. The stiffness matrix is
 :func:`~signorini.fem.stiffness3d.assemble_stiffness_3d`'s, the load the body force and the
 Neumann tractions of :mod:`signorini.fem.elasticity3d`; the held DOFs are the Dirichlet
 parts' components and the axis rollers' (one Cartesian component each,
-:func:`~signorini.problem.rollers.held_nodes`), interleaved ``3 node + c``. Without contact
-parts there are no node frames, so the system is ``K u = F`` with Cartesian unknowns. With
+:func:`~signorini.problem.rollers.held_nodes`), interleaved ``3 node + c``, and the
+oblique and curved rollers' normal components in node frames. Without contact parts the
+system is ``K u = F`` with Cartesian unknowns but at the rollers' frame nodes. With
 contact parts the contact set on faces (:func:`~.face_contact.face_contact_set`; condition
 (b) with ``DEFAULT_ALPHA`` unless the parts give ``face_alpha``) gives the system
 ``Rᵀ K R ỹ = Rᵀ F``, ``u = R ỹ`` (node frames, then the transformed face basis), its bounds
@@ -29,12 +31,14 @@ from ..problem.conditions import Neumann, Roller
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.normals import straight_normal
 from ..problem.problem import ContactProblem
+from ..problem.rigid3d import motion_field_3d
 from ..problem.rollers import held_nodes
 from .admissible import check_load_size
 from .contact_set import _empty
 from .discrete_conditions import DiscreteConditions
 from .face_basis import DEFAULT_ALPHA
-from .face_contact import face_contact_set
+from .face_contact import FaceContactSet, face_contact_set
+from .node_frames3d import held_frames, rotate_frames_3d
 from .ordering import Ordering
 from .system import Assembled, RollerDofs
 
@@ -78,17 +82,30 @@ def discrete_conditions_3d(problem: ContactProblem, space: P2TetSpace) -> Discre
         friction=(),
         pairs={},
         rigid_motions=problem.rigid_motions,
-        rigid_field=np.zeros((0, n, 3)),
+        rigid_field=motion_field_3d(space.mesh, problem.rigid_motions, space.node_points),
     )
 
 
-def _roller_dofs_3d(conditions: DiscreteConditions) -> RollerDofs:
-    """The axis rollers' nodes that hold one component, ``3 z + c``, with their normals."""
+def _roller_dofs_3d(conditions: DiscreteConditions, roller_dof: np.ndarray) -> RollerDofs:
+    """The held DOF of each node held along one roller's normal only, and that normal: an
+    axis roller's node holding one Cartesian component (``3 z + c``), an oblique or curved
+    roller's node with one roller row and nothing else held (its frame DOF in
+    ``roller_dof``), sorted by node."""
+    held = conditions.held
     axis = conditions.axis_normal
-    partial = conditions.held.components.sum(axis=1) == 1
-    z = np.flatnonzero(partial & axis.any(axis=1))
+    partial = held.components.sum(axis=1) == 1
+    rows = np.bincount(held.roller_nodes, minlength=axis.shape[0])
+    z = np.flatnonzero(partial & axis.any(axis=1) & (rows == 0))
     c = np.argmax(np.abs(axis[z]), axis=1)
-    return RollerDofs(z, 3 * z + c, axis[z, c], axis[z])
+    alone = (rows[held.roller_nodes] == 1) & ~held.components[held.roller_nodes].any(axis=1)
+    nodes = np.concatenate([z, held.roller_nodes[alone]])
+    order = np.argsort(nodes, kind="stable")
+    return RollerDofs(
+        nodes[order],
+        np.concatenate([3 * z + c, roller_dof[alone]])[order],
+        np.concatenate([axis[z, c], np.ones(alone.sum())])[order],
+        np.concatenate([axis[z], held.roller_normal[alone]])[order],
+    )
 
 
 def assemble_3d(problem: ContactProblem, mesh: Mesh) -> Assembled:
@@ -98,21 +115,62 @@ def assemble_3d(problem: ContactProblem, mesh: Mesh) -> Assembled:
     Σ_Neumann ∫_Γ g_i φ_z`` (docs/method.md, *Three dimensions: P2 tetrahedra and 3D
     elasticity*), with the problem's data evaluated at points ``(n, 3)``.
 
+    The held components, rollers and contact parts are resolved first (their user
+    functions evaluated and checked: a refusal comes before any work on the system); an
+    oblique or curved roller's nodes get the frames of :func:`~.node_frames3d.held_frames`
+    (``Qᵀ K Q``, ``Qᵀ F``), contact parts the system in the solver's variables.
+
     Returns
     -------
     Assembled
-        With an empty contact set and no frames; ``dirichlet`` the held DOFs (sorted) and
-        ``dirichlet_values`` their prescribed displacements.
+        Without contact an empty contact set and the rollers' frames; ``dirichlet`` the held
+        DOFs (sorted) and ``dirichlet_values`` their prescribed values.
 
     Raises
     ------
     ProblemError
-        If the stiffness matrix overflows, a load function does not give finite numbers
-        ``(n, 3)``, or a load's displacement would overflow (naming it).
+        If the stiffness matrix overflows, a load, gap, normal or Dirichlet function does not
+        give finite numbers of the right shape, an obstacle starts deep inside the body, or
+        a load's displacement would overflow (naming it).
     """
     t0 = time.perf_counter()
     space = P2TetSpace(mesh)
-    n_dofs = space.n_dofs
+    # the conditions and the contact set first: their user functions are evaluated and
+    # checked before any work on the system
+    conditions = discrete_conditions_3d(problem, space)
+    cs = _face_contact(problem, space, conditions) if problem.contact_parts else None
+    K, F = _stiffness_and_load(problem, space)
+    if cs is not None:
+        return _with_contact(space, cs, K, F, conditions, time.perf_counter() - t0)
+    held = conditions.held
+    none = np.zeros(0, dtype=np.int64)
+    frames = held_frames(space.node_points, none, np.zeros((0, 3)), none, held)
+    if frames.frame_nodes.size:  # oblique and curved rollers: u = Q y at their nodes
+        K, F = rotate_frames_3d(K, F, frames.frame_nodes, frames.frames)
+    order = np.argsort(frames.held_dofs)
+    return Assembled(
+        space,
+        _empty(()),
+        K,
+        F,
+        frames.held_dofs[order],
+        frames.held_values[order],
+        time.perf_counter() - t0,
+        conditions.dirichlet_nodes,
+        np.zeros((0, 3)),
+        frames.frame_nodes,
+        frames.frames,
+        _roller_dofs_3d(conditions, frames.roller_dof),
+        conditions,
+        None,
+        Ordering(space),
+    )
+
+
+def _stiffness_and_load(problem: ContactProblem, space: P2TetSpace) -> tuple:
+    """``(K, F)`` Cartesian: the stiffness matrix and the load (body force, tractions),
+    checked for overflow (:func:`~.admissible.check_load_size`)."""
+    mesh, n_dofs = space.mesh, space.n_dofs
     material = problem.material_on(mesh)
     with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported just below
         K = assemble_stiffness_3d(space.mapping, space.cell_dofs, n_dofs, material)
@@ -145,33 +203,22 @@ def assemble_3d(problem: ContactProblem, mesh: Mesh) -> Assembled:
         F += t
         loads[what] = float(np.abs(t).max(initial=0.0))
     check_load_size(K, F, loads, SERIAL)
-    conditions = discrete_conditions_3d(problem, space)
-    held = conditions.held
-    if problem.contact_parts:
-        return _with_contact(problem, space, K, F, conditions, time.perf_counter() - t0)
-    dirichlet = np.flatnonzero(held.components.ravel())
-    return Assembled(
-        space,
-        _empty(()),
-        K,
-        F,
-        dirichlet,
-        held.values.ravel()[dirichlet],
-        time.perf_counter() - t0,
-        conditions.dirichlet_nodes,
-        np.zeros((0, 3)),
-        np.zeros(0, dtype=np.int64),
-        np.zeros((0, 3, 3)),
-        _roller_dofs_3d(conditions),
-        conditions,
-        None,
-        Ordering(space),
-    )
+    return K, F
+
+
+def _face_contact(
+    problem: ContactProblem, space: P2TetSpace, conditions: DiscreteConditions
+) -> FaceContactSet:
+    """The contact set on faces of the problem's contact parts (one α for all)."""
+    contact = {name: problem.conditions[name] for name in problem.contact_parts}
+    alpha = next(iter(contact.values())).face_alpha  # one for all parts (problem3d)
+    alpha = DEFAULT_ALPHA if alpha is None else alpha
+    return face_contact_set(space, contact, conditions.held, alpha=alpha)
 
 
 def _with_contact(
-    problem: ContactProblem,
     space: P2TetSpace,
+    cs: FaceContactSet,
     K: sp.csr_matrix,
     F: np.ndarray,
     conditions: DiscreteConditions,
@@ -181,15 +228,10 @@ def _with_contact(
     variables (:meth:`~.face_contact.FaceContactSet.system`), its held DOFs sorted, the
     rollers off the contact nodes."""
     t0 = time.perf_counter()
-    held = conditions.held
-    contact = {name: problem.conditions[name] for name in problem.contact_parts}
-    alpha = next(iter(contact.values())).face_alpha  # one for all parts (problem3d)
-    alpha = DEFAULT_ALPHA if alpha is None else alpha
-    cs = face_contact_set(space, contact, held.components, held.values, alpha)
     K_rot, F_rot = cs.system(K, F)
     order = np.argsort(cs.held_dofs)
-    rollers = _roller_dofs_3d(conditions)
-    off = ~np.isin(rollers.nodes, cs.frame_nodes)
+    rollers = _roller_dofs_3d(conditions, cs.roller_dof)
+    off = ~np.isin(rollers.nodes, cs.node)
     return Assembled(
         space,
         cs,

@@ -14,10 +14,9 @@
   set by :func:`~.surface.positive_part.positive_region_rule`; ``s_p = Λ̃_p / m_p``, the
   solver's multiplier (``Λ̃ = T Λ``, the force on the transformed functions; Λ itself for
   condition (a)) over ``m_p = ∫ φ_p``.
-- **η7** is the localised bound ``B`` of ``‖(u_h·n − ψ_h)⁺‖_{H^{1/2}(Γ_C)}``
-  (:func:`~.h_half_norm.localised.localised_bound2`, docs/method.md, *η7 on surfaces*),
-  ``h_F = |F|^{1/2}``, its face norms on the positive set of ``u_h·n − ψ_h``: the 3D
-  replacement of the exact norm, an upper bound up to the constant discussed there.
+- **η7** is the guaranteed localised bound ``G`` of ``‖(u_h·n − ψ_h)⁺‖_{H^{1/2}(Γ_C)}``
+  (:func:`~.surface.penetration.surface_penetration`; docs/method.md, *Three dimensions:
+  positive parts on faces and η7 on surfaces*): the 3D replacement of the exact norm.
 """
 
 from __future__ import annotations
@@ -34,7 +33,7 @@ from ..fem.p2_tet import face_basis
 from ..fem.quadrature import triangle_rule
 from ..problem.fields import evaluate_field
 from .faces3d import TetStress, direction_field_3d, face_geometry
-from .h_half_norm.localised import FacetNorms, localised_bound2
+from .surface.penetration import surface_penetration
 from .surface.positive_part import PIECE_NODES, positive_region_rule, refined_face_hats
 from .terms import FacetSet, normal_stress, tangential_stress
 
@@ -53,10 +52,10 @@ PRESSURES_3D = ("transformed", "recovered")
 #: tetrahedra and faces*, the measured comparison); condition (a) has none and takes the
 #: recovered one
 PRESSURE_3D = "transformed"
-#: polynomial degree of the rules on the positive sets: ``v φ_p`` (η6) is cubic, ``v²`` (η7)
-#: quartic on a flat face; two more for the area element of a quadratic face (measured on a
-#: strongly curved face: 7·10⁻⁵ relative at degree 3, below the reference's 3·10⁻⁵ at 5)
-ETA6_DEGREE, ETA7_DEGREE = 5, 6
+#: polynomial degree of η6's rule on the positive sets: ``v φ_p`` is cubic on a flat face;
+#: two more for the area element of a quadratic face (measured on a strongly curved face:
+#: 7·10⁻⁵ relative at degree 3, below the reference's 3·10⁻⁵ at 5)
+ETA6_DEGREE = 5
 
 
 class ContactTerms(NamedTuple):
@@ -71,7 +70,7 @@ class ContactTerms(NamedTuple):
     parts6 : (n_f, 6) float array
         η6's ``s_p d_p`` share of each face node.
     eta7 : (n_f,) float array
-        Each face's share of η7² (the localised bound).
+        Each face's share of η7² (the guaranteed bound G).
     oscillation : (n_f,) float array
         Each face's ``|∫_F λ̃_h (ψ − ψ_h)|`` (:func:`obstacle_oscillation`), in the unit of
         η6²; reported beside η_h, not a part of it.
@@ -135,7 +134,7 @@ def contact_terms(
     force = np.maximum(cs.edges.transformed(result.contact_force) / cs.hat_integral, 0.0)
     s_face = on_faces * (force / stresses.unit)[np.maximum(rows, 0)]
     oscillation = obstacle_oscillation(result, s_face)
-    return ContactTerms(faces, J4, J5, parts6, _penetration_shares(gap, points), oscillation)
+    return ContactTerms(faces, J4, J5, parts6, surface_penetration(points, gap), oscillation)
 
 
 def obstacle_oscillation(result: ContactResult, density: np.ndarray) -> np.ndarray:
@@ -223,32 +222,3 @@ def _hat_integrals(v: np.ndarray, points: np.ndarray) -> np.ndarray:
     for a in range(v.shape[1]):  # a loop over the six face nodes
         out[:, a] = np.bincount(rule.face, weights=weight * hats[:, a], minlength=len(v))
     return out
-
-
-def _penetration_shares(gap: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """``(n_f,)`` each face's share of the localised bound ``B²`` of ``(u_h·n − ψ_h)⁺``
-    (``gap (n_f, 6)`` the nodal ``u_h·n − ψ_h``): ``‖v‖²_F (1 + h_F⁻¹) + h_F ‖∇_Γ v‖²_F``
-    with ``h_F = |F|^{1/2}``, the surface gradient ``∇_Γ v = T G⁻¹ ∇_s v`` (T the tangents,
-    G = TᵀT)."""
-    rule = positive_region_rule(gap, ETA7_DEGREE)
-    n_f = len(gap)
-    if rule.face.size == 0:
-        return np.zeros(n_f)
-    t = _tangents(points, rule.face, rule.s)
-    area = np.linalg.norm(np.cross(t[:, 0], t[:, 1]), axis=1)
-    g = gap[rule.face]
-    value = np.einsum("ma,ma->m", face_basis_at(rule.s), g)
-    grad_s = np.einsum("mar,ma->mr", grad_basis(rule.s), g)  # (m, 2)
-    metric = np.einsum("mri,msi->mrs", t, t)
-    grad2 = np.einsum("mr,mrs,ms->m", grad_s, np.linalg.inv(metric), grad_s)
-    weight = rule.w * area
-    l2 = np.bincount(rule.face, weights=weight * np.maximum(value, 0.0) ** 2, minlength=n_f)
-    gradient = np.bincount(rule.face, weights=weight * grad2, minlength=n_f)
-    corners = points[:, :3]
-    h = np.sqrt(
-        0.5
-        * np.linalg.norm(
-            np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1
-        )
-    )
-    return localised_bound2(FacetNorms(h, l2, gradient))[1]

@@ -13,7 +13,7 @@ longest edge of the tetrahedron):
 η4   ``h_p ‖σ(u_h)n − (d·σ(u_h)n) d‖²_F`` (a tangent vector)          contact faces
 η5   ``h_p ‖d·σ(u_h)n + p_h‖²_F`` (``consistent``) or without p_h    contact faces
 η6   ``s_p d_p``, ``d_p = ∫_{γ̃_p} (ψ_h − u_h·n)⁺ φ_p``             semi-contact nodes
-η7   the localised bound of ``‖(u_h·n − ψ_h)⁺‖_{H^{1/2}(Γ_C)}``      global
+η7   the guaranteed bound G of ``‖(u_h·n − ψ_h)⁺‖_{H^{1/2}(Γ_C)}``   global
 η8   0 (frictionless in 3D)
 ==== ============================================================ ==========================
 

@@ -9,6 +9,10 @@ curved geometry.
   pulled sideways (Cattaneo–Mindlin), a load path of two steps;
 - :mod:`.hertz3d`: the eighth of an elastic ball pressed onto a rigid plane (3D), with the
   Hertz solution;
+- :mod:`.paper3d`: the paper's Examples 6.1 (a manufactured solution, :mod:`.manufactured3d`,
+  in contact on a disc) and 6.2 (the pyramid obstacle) on the unit cube (3D);
+- :mod:`.punch3d`: a rigid punch with rounded edges pressed into a block held against a wall
+  (3D, the half of a symmetric model);
 - :mod:`.two_bodies`: contact between two elastic bodies: two cylinders (Hertz), two
   mirror-image half-discs, two blocks with non-matching meshes (the contact patch test).
 
@@ -29,9 +33,11 @@ from .hertz import HERTZ_METRICS, hertz
 from .hertz3d import HERTZ_3D_METRICS, hertz_3d
 from .metrics import Metrics, PressureComparison
 from .paper import example_6_1, example_6_2
+from .paper3d import EXAMPLE_6_1_3D_METRICS, example_6_1_3d, example_6_2_3d
 from .paper_friction import example_6_2_coulomb, example_6_2_tresca
 from .partial_slip import PARTIAL_SLIP_METRICS, partial_slip, partial_slip_path
 from .punch import punch
+from .punch3d import punch_3d
 from .two_bodies import BLOCKS_METRICS, CYLINDERS_METRICS, hertz_pair, stacked_blocks, two_cylinders
 
 __all__ = [
@@ -43,6 +49,8 @@ __all__ = [
     "PressureComparison",
     "example_6_1",
     "example_6_2",
+    "example_6_1_3d",
+    "example_6_2_3d",
     "example_6_2_coulomb",
     "example_6_2_tresca",
     "elasticity_3d",
@@ -52,6 +60,7 @@ __all__ = [
     "partial_slip",
     "partial_slip_path",
     "punch",
+    "punch_3d",
     "hertz_pair",
     "stacked_blocks",
     "two_cylinders",
@@ -108,6 +117,9 @@ EXAMPLES: dict[str, Example] = {
         Example("hertz-pair", hertz_pair),
         Example("elasticity-3d", elasticity_3d, metrics=ELASTICITY_3D_METRICS),
         Example("hertz-3d", hertz_3d, metrics=HERTZ_3D_METRICS),
+        Example("example-6.1-3d", example_6_1_3d, metrics=EXAMPLE_6_1_3D_METRICS),
+        Example("example-6.2-3d", example_6_2_3d),
+        Example("punch-3d", punch_3d),
     )
 }
 

@@ -11,16 +11,13 @@ the observed rates of the three errors against the free unknowns N to the histor
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from ..contact.solution import ContactResult
 from ..fem.material import Material
 from ..mesh.builders3d import box
 from ..problem.conditions import Dirichlet, ExactSolution
 from ..problem.problem import ContactProblem
-from .metrics import Metrics
+from .metrics import error_rate_metrics
 
 __all__ = ["ELASTICITY_3D_METRICS", "elasticity_3d"]
 
@@ -103,35 +100,5 @@ def elasticity_3d(n: int = 2) -> ContactProblem:
     )
 
 
-class _Rates:
-    """The errors of each level and their observed rates ``log(e_k / e_{k−1}) / log(N_k /
-    N_{k−1})`` against the previous level's (NaN on the first level of a run: a level no
-    finer than the one before starts a new run)."""
-
-    def __init__(self) -> None:
-        self.previous: tuple[float, dict[str, float]] | None = None
-
-    def __call__(self, result: ContactResult) -> dict[str, float]:
-        errors = result.errors()
-        n = float(result.ndof)
-        out = {"error_l2": errors["error_l2"]}
-        for name in ("error_energy", "error_h1", "error_l2"):
-            rate = math.nan
-            if self.previous is not None and self.previous[0] < n:  # else a new run
-                old_n, old = self.previous
-                rate = math.log(errors[name] / old[name]) / math.log(n / old_n)
-            out[f"rate_{name.removeprefix('error_')}"] = rate
-        self.previous = (n, errors)
-        return out
-
-
 #: the L² error and the observed rates of the three errors (columns of the history)
-ELASTICITY_3D_METRICS = Metrics(
-    _Rates(),
-    {
-        "error_l2": "‖u − u_h‖_{L²(Ω)} against the exact solution",
-        "rate_energy": "observed rate of error_energy against ndof (expected −2/3)",
-        "rate_h1": "observed rate of error_h1 against ndof (expected −2/3)",
-        "rate_l2": "observed rate of error_l2 against ndof (expected −1)",
-    },
-)
+ELASTICITY_3D_METRICS = error_rate_metrics()

@@ -61,6 +61,9 @@ DEPTH_3D = 0.01
 #: the contact disc of the whole ball over the eighth's quarter disc: ``P = 4 Σ Λ_z``
 QUARTERS = 4
 
+#: a node within this distance (times R) of the plane y = 0 lies on the pressure's line
+LINE_TOL = 1e-9
+
 #: the bisections :func:`graded_eighth_ball` may take before it gives up
 MAX_GRADING_STEPS = 60
 
@@ -242,21 +245,26 @@ def hertz_3d_metrics(result: ContactResult) -> dict[str, float]:
 
 
 def hertz_3d_pressure(result: ContactResult) -> PressureComparison:
-    """The recovered pressure of the rows within 2a of the axis against their distance r from
-    it, beside Hertz's ``p0 √(1 − r² / a²)`` of the same total force."""
+    """The recovered pressure along the line y = 0 through the contact disc (the rows on
+    the symmetry plane ``"y0"``, whose nodes lie on the line: the pressure there is linear
+    between them), against r = x up to 2a, beside Hertz's ``p0 √(1 − r² / a²)`` of the
+    same total force."""
     zone = hertz_3d_contact(result)
     a, p0 = hertz_3d_solution(zone["force"], zone["radius"], result.problem.material)
-    r, pressure = zone["r"], zone["pressure"]
-    near = r <= 2.0 * a
-    order = np.argsort(r[near], kind="stable")
+    x = result.space.node_points[result.contact.node]
+    on_line = np.abs(x[:, 1]) <= LINE_TOL * zone["radius"]
+    near = on_line & (zone["r"] <= 2.0 * a)
+    order = np.argsort(x[near, 0], kind="stable")
     r_ref = np.linspace(0.0, a, 201)
     return PressureComparison(
-        x=r[near][order],
-        pressure=pressure[near][order],
+        x=x[near, 0][order],
+        pressure=zone["pressure"][near][order],
         x_reference=r_ref,
         reference=p0 * np.sqrt(np.maximum(1.0 - (r_ref / a) ** 2, 0.0)),
         label=rf"Hertz, $a$ = {a:.4g}, $p_0$ = {p0:.4g}",
-        title=f"hertz-3d: recovered contact pressure against r, {result.ndof} unknowns",
+        title=f"hertz-3d: recovered contact pressure along y = 0, {result.ndof} unknowns",
+        xlabel=r"$r = x$ (along $y = 0$)",
+        joined=True,
     )
 
 

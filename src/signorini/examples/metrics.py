@@ -9,6 +9,7 @@ also give a reference pressure to draw beside the computed one.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
@@ -16,7 +17,7 @@ import numpy as np
 
 from ..contact.solution import ContactResult
 
-__all__ = ["Metrics", "PressureComparison"]
+__all__ = ["ErrorRates", "Metrics", "PressureComparison", "error_rate_metrics"]
 
 
 @dataclass(frozen=True)
@@ -47,6 +48,11 @@ class PressureComparison:
         ``"inactive"``, ``"stick"`` or ``"slip"`` per node.
     window : (2,) float or None
         The x range to show (a zoom on the contact zone).
+    xlabel : str
+        What ``x`` is (the figure's x-axis label).
+    joined : bool
+        The computed values are joined by a line (a pressure linear between the nodes along
+        a line, e.g. through a 3D contact zone), not markers only.
     """
 
     x: np.ndarray
@@ -60,6 +66,8 @@ class PressureComparison:
     tangential_label: str = ""
     state: np.ndarray | None = None
     window: tuple[float, float] | None = None
+    xlabel: str = r"$x$"
+    joined: bool = False
 
 
 @dataclass(frozen=True)
@@ -84,3 +92,41 @@ class Metrics:
     def __call__(self, result: ContactResult) -> dict[str, float]:
         """``measure(result)``."""
         return self.measure(result)
+
+
+class ErrorRates:
+    """The L² error of each level and the observed rates ``log(e_k / e_{k−1}) / log(N_k /
+    N_{k−1})`` of the energy, H¹ and L² errors against the previous level's (NaN on the first
+    level of a run: a level no finer than the one before starts a new run), for a problem
+    with an exact solution (:meth:`ContactResult.errors`)."""
+
+    def __init__(self) -> None:
+        self.previous: tuple[float, dict[str, float]] | None = None
+
+    def __call__(self, result: ContactResult) -> dict[str, float]:
+        errors = result.errors()
+        n = float(result.ndof)
+        out = {"error_l2": errors["error_l2"]}
+        for name in ("error_energy", "error_h1", "error_l2"):
+            rate = math.nan
+            if self.previous is not None and self.previous[0] < n:  # else a new run
+                old_n, old = self.previous
+                rate = math.log(errors[name] / old[name]) / math.log(n / old_n)
+            out[f"rate_{name.removeprefix('error_')}"] = rate
+        self.previous = (n, errors)
+        return out
+
+
+def error_rate_metrics() -> Metrics:
+    """The measurements of a 3D example with an exact solution: the L² error and the observed
+    rates of the three errors against the free unknowns (:class:`ErrorRates`; P2 tetrahedra:
+    −2/3 for the energy and H¹ errors, −1 for the L² error)."""
+    return Metrics(
+        ErrorRates(),
+        {
+            "error_l2": "‖u − u_h‖_{L²(Ω)} against the exact solution",
+            "rate_energy": "observed rate of error_energy against ndof (expected −2/3)",
+            "rate_h1": "observed rate of error_h1 against ndof (expected −2/3)",
+            "rate_l2": "observed rate of error_l2 against ndof (expected −1)",
+        },
+    )

@@ -15,6 +15,8 @@ import numpy as np
 
 from ..mesh.jacobians import affine_jacobian
 from ..mesh.mesh import Mesh
+from ..mesh.nesting import parent_barycentrics
+from ..mesh.reference import TETRAHEDRON
 from ..mesh.refine import Refinement
 from . import p2_tet
 from .p2 import basis_barycentric
@@ -85,21 +87,62 @@ def prolongate_p2(
     cell, local = np.nonzero(~known[fine_nodes])
     if cell.size:
         nodes = fine_nodes[cell, local]
-        P = coarse.vertices[parent[cell]]  # (k, 3, d)
-        X = _reference_nodes(coarse.mesh, refinement, fine)[nodes]  # (k, d)
-        J, _ = affine_jacobian(P)  # columns v_k − v_0
-        xi = np.linalg.solve(J, (X - P[:, 0])[..., None])[..., 0]  # (k, d)
-        bary = np.concatenate([1 - xi.sum(-1, keepdims=True), xi], axis=-1)
-        if bary.min(initial=0.0) < -1e-8:
-            raise ValueError(
-                "the refinement is not a refinement of this space's mesh (a new "
-                "cell is not inside its parent cell)"
-            )
+        if coarse.mesh.dim == 3:
+            bary = _tetrahedron_barycentrics(coarse.mesh, fine.mesh, refinement, cell, local)
+        else:
+            bary = _triangle_barycentrics(coarse, fine, refinement, parent[cell], nodes)
         tet = bary.shape[-1] == 4  # the P2 tetrahedron's ten nodes, else the triangle's six
         phi = (p2_tet.basis_barycentric if tet else basis_barycentric)(bary)  # (k, n_local)
         parent_values = u[coarse_nodes[parent[cell]]]  # (k, 6) or (k, 6, d)
         out[nodes] = np.einsum("kj,kj...->k...", phi, parent_values)
     return out
+
+
+def _tetrahedron_barycentrics(
+    coarse: Mesh, fine: Mesh, refinement: Refinement, cell: np.ndarray, local: np.ndarray
+) -> np.ndarray:
+    """``(k, 4)`` the barycentric coordinates, in the parent cell, of the local nodes
+    ``local`` of the refined cells ``cell``: those of the cell's vertices
+    (:func:`~signorini.mesh.nesting.parent_barycentrics`, from the refinement's parent
+    edges) and the midpoints of its edges' (docs/method.md, *Prolongation on curved parts*):
+    the reference point where the parent's (isoparametric or affine) map puts the node, so
+    the parent's P2 field is reproduced on curved parts too."""
+    if refinement.parent_edge is None:
+        raise ValueError(
+            "the refinement does not give the parent edges of its new points "
+            "(Refinement.parent_edge), which the prolongation on tetrahedra needs"
+        )
+    parent_edge = np.asarray(refinement.parent_edge, dtype=np.int64)
+    if parent_edge.shape != (fine.n_points - coarse.n_points, 2):
+        raise ValueError(
+            f"the refinement's parent_edge needs shape ({fine.n_points - coarse.n_points}, 2) "
+            f"(one row per new point), got {parent_edge.shape}"
+        )
+    rows, at = np.unique(cell, return_inverse=True)
+    vertex = parent_barycentrics(
+        coarse.cells, fine.cells[rows], refinement.parent[rows], parent_edge, coarse.n_points
+    )
+    e = TETRAHEDRON.edges
+    nodes = np.concatenate([vertex, 0.5 * (vertex[:, e[:, 0]] + vertex[:, e[:, 1]])], axis=1)
+    return nodes[at, local]
+
+
+def _triangle_barycentrics(
+    coarse: P2Space, fine: P2Space, refinement: Refinement, parent: np.ndarray, nodes: np.ndarray
+) -> np.ndarray:
+    """``(k, 3)`` the barycentric coordinates of the refined mesh's ``nodes`` in their
+    ``parent`` triangles, from the node positions (:func:`_reference_nodes`)."""
+    P = coarse.vertices[parent]  # (k, 3, 2)
+    X = _reference_nodes(coarse.mesh, refinement, fine)[nodes]  # (k, 2)
+    J, _ = affine_jacobian(P)  # columns v_k − v_0
+    xi = np.linalg.solve(J, (X - P[:, 0])[..., None])[..., 0]  # (k, 2)
+    bary = np.concatenate([1 - xi.sum(-1, keepdims=True), xi], axis=-1)
+    if bary.min(initial=0.0) < -1e-8:
+        raise ValueError(
+            "the refinement is not a refinement of this space's mesh (a new "
+            "cell is not inside its parent cell)"
+        )
+    return bary
 
 
 def _nodal_values(space: P1Space | P2Space, u: np.ndarray) -> np.ndarray:

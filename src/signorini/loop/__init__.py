@@ -28,7 +28,7 @@ from ..estimator.residual import Estimate, estimate
 from ..estimator.roundoff import roundoff_level
 from ..fem.space import space_of
 from ..mesh.mesh import Mesh
-from ..mesh.refine import Refinement, refine_nvb, refine_uniform
+from ..mesh.refine import refine_nvb, refine_uniform
 from ..problem.problem import ContactProblem
 from .options import AdaptiveOptions, OptionError, check_count
 from .record import COLUMNS, LevelRecord, level_record
@@ -199,18 +199,6 @@ def _changed(options: AdaptiveOptions | None, changes: Mapping[str, object]) -> 
     return replace(options, **changes) if changes else options
 
 
-def _warm_start(warm: ContactResult, refinement: Refinement, three: bool) -> np.ndarray | None:
-    """``warm.u`` prolongated to the refined mesh; in 3D None (a cold start) where the
-    prolongation refuses the refinement: a bisection's closure may put new vertices on a
-    curved part off the old edges, outside their straight parent cells."""
-    try:
-        return warm.space.prolongate(warm.u, refinement)
-    except ValueError:
-        if not three:
-            raise
-        return None
-
-
 def _levels(
     problem: ContactProblem,
     mesh: Mesh,
@@ -234,7 +222,6 @@ def _levels(
         u0 = None
         on_ranks = _estimator_ranks(result, solver)
         t0 = time.perf_counter()
-        three = mesh.dim == 3
         est = estimate(result, eta5_variant=options.eta5_variant, **on_ranks)
         t_est = time.perf_counter() - t0
         record = level_record(level, result, est)
@@ -260,7 +247,7 @@ def _levels(
             next_mesh = refinement.mesh
             last = problem.free_ndof(space_of(next_mesh, element)) > options.max_ndof
             if not last and options.warm_start:
-                u0 = _warm_start(warm, refinement, three)
+                u0 = warm.space.prolongate(warm.u, refinement)
             record.t_refine = time.perf_counter() - t0
             if last:
                 marked = next_mesh = None  # the budget ends the run: this marking is discarded

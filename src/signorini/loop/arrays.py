@@ -14,6 +14,7 @@ from scipy.sparse.csgraph import dijkstra
 from ..contact.contact_set import ContactSet
 from ..contact.solution import SLIP, STICK
 from ..fem.element import P1
+from .arrays3d import surface_arrays
 
 if TYPE_CHECKING:
     from . import Level
@@ -38,10 +39,12 @@ def body_arrays(level: Level) -> dict[str, Any]:
         faces' vertices in outward order (the space's
         :meth:`~signorini.fem.space3d.P2TetSpace.facet_nodes`); ``displacement (n, 3)`` and
         the nodal Cauchy stress ``stress (n, 3, 3)`` at the vertices; ``name``, the
-        problem's; ``degree``, the element's; ``dim`` 3.
+        problem's; ``degree``, the element's; ``dim`` 3; with contact ``contact``, the
+        contact surface (:func:`~.arrays3d.surface_arrays`).
     """
     res = level.result
     mesh, n = res.mesh, res.mesh.points.shape[0]
+    contact = {"contact": surface_arrays(res)} if res.contact.size else {}
     return {
         "level": level.record.level,
         "points": mesh.points,
@@ -51,6 +54,7 @@ def body_arrays(level: Level) -> dict[str, Any]:
         "name": res.problem.name,
         "degree": res.space.element.degree,
         "dim": mesh.dim,
+        **contact,
     }
 
 

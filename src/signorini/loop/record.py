@@ -15,7 +15,15 @@ from ..contact.solution import SLIP, STICK, ContactResult
 from ..estimator.names import TERM_TABLE, TERMS
 from ..estimator.residual import Estimate
 
-__all__ = ["COLUMNS", "COLUMNS_3D", "ElasticityRecord", "LevelRecord", "level_record"]
+__all__ = [
+    "COLUMNS",
+    "COLUMNS_3D",
+    "COLUMNS_3D_CONTACT",
+    "ElasticityRecord",
+    "FaceContactRecord",
+    "LevelRecord",
+    "level_record",
+]
 
 #: What each :class:`LevelRecord` field (= each column of a run's ``history.csv``) means,
 #: with its unit. Units are those of the problem's data ("consistent units": if E is in MPa
@@ -251,10 +259,64 @@ COLUMNS_3D: dict[str, str] = {
     "osc_obstacle": "the obstacle's interpolation term beside eta, (Σ_F |∫_F λ̃_h (ψ − ψ_h)|)^(1/2) "
     "(docs/method.md, *Three dimensions: the estimator on tetrahedra and faces*); not a part "
     "of eta, unit of eta_6; 3D contact runs only",
-    "n_constrained": "constraint rows on the contact parts (a P2 node of the contact faces "
-    "per part whose direction is not held)",
-    "n_active": "constraint rows in the final active set (condition (b): their transformed "
-    "constraint ũ·n = ψ̃ imposed)",
+}
+
+
+#: The columns a 3D contact level's row leaves out: the friction's (3D contact is
+#: frictionless).
+FACE_CONTACT_LEFT_OUT = (
+    "n_stick", "n_slip", "kkt_tangential_bound", "kkt_tangential_complementarity",
+)  # fmt: skip
+
+
+@dataclass
+class FaceContactRecord(LevelRecord):
+    """The record of a 3D contact level (docs/method.md, *Three dimensions: contact on
+    faces*): its row leaves out :data:`FACE_CONTACT_LEFT_OUT` and, on a level without an
+    estimate (η NaN), the estimator's columns; an iterative solve adds
+    ``linear_iterations`` to :attr:`extra`."""
+
+    LEFT_OUT: ClassVar[tuple[str, ...]] = FACE_CONTACT_LEFT_OUT
+
+    def row(self) -> dict:
+        """Flat dict for a CSV row (without :attr:`LEFT_OUT`, and without the estimator's
+        columns where there is no estimate)."""
+        d = super().row()
+        if math.isnan(self.eta):
+            for name in NO_ESTIMATE_COLUMNS:
+                del d[name]
+        return d
+
+
+#: The columns of a 3D contact run's history (:class:`FaceContactRecord`), with their
+#: meaning in 3D.
+_IN_3D_CONTACT = {
+    "pdas_iterations": "primal-dual active set iterations",
+    "n_active": "constraint rows in the final active set: the P2 nodes of Γ_C in contact (one "
+    "row per node and contact part; for condition (b) the transformed coefficient at its "
+    "bound)",
+    "n_full_contact": "rows in full contact (Section 4 on faces: every node of every contact "
+    "face at the row in contact)",
+    "n_semi_contact": "rows in contact but not in full contact (where η6 lives)",
+    "n_no_contact": "rows not in contact",
+    "n_constrained": "constraint rows: the P2 nodes (vertices and edge midpoints) of the "
+    "contact parts' faces whose normal component is not held, one per node and part",
+    "contact_force": "Σ Λ_z (3.17) over the rows, force units: the resultant normal force on "
+    "Γ_C where all n_z agree",
+    "kkt_primal": "largest penetration of the solver's bounds (for condition (b) those of the "
+    "transformed coefficients, ỹ ≤ ψ̃), relative to the contact's displacement scale "
+    "(docs/method.md, *Solver*), no unit",
+    "kkt_dual": "largest negative multiplier (for condition (b) the transformed force "
+    "Λ̃ = T Λ), relative to the total contact force",
+    "kkt_complementarity": "largest min(|multiplier| / force scale, |bound − variable| / "
+    "displacement scale) over the rows, in the solver's variables",
+    "linear_iterations": "CG iterations of an iterative solver (amg), summed over the level's "
+    "PDAS solves; absent with a direct solver",
+}
+COLUMNS_3D_CONTACT: dict[str, str] = {
+    name: _IN_3D_CONTACT.get(name) or COLUMNS_3D.get(name) or COLUMNS[name]
+    for name in [*COLUMNS, "osc_obstacle", "linear_iterations"]
+    if name not in FACE_CONTACT_LEFT_OUT
 }
 
 
@@ -272,14 +334,17 @@ _NO_ESTIMATE = _NoEstimate()
 def level_record(level: int, result: ContactResult, est: Estimate | None) -> LevelRecord:
     """The record of one level; without an estimate η and its terms are NaN; a 3D level
     without contact is an :class:`ElasticityRecord`, whose row leaves the contact's columns
-    out (and the estimator's without an estimate)."""
+    out (and the estimator's without an estimate), a 3D level with contact a
+    :class:`FaceContactRecord`."""
     if est is None:
         est = _NO_ESTIMATE
     has_classes = result.contact.size > 0
     classes = result.classes if has_classes else np.zeros(0, dtype=np.int64)
     report = result.report
     elasticity = result.mesh.dim == 3 and not result.contact.size
-    rec = (ElasticityRecord if elasticity else LevelRecord)(
+    three = result.mesh.dim == 3
+    kind = ElasticityRecord if elasticity else FaceContactRecord if three else LevelRecord
+    rec = kind(
         level=level,
         ndof=result.ndof,
         ndof_total=result.space.n_dofs,
@@ -307,7 +372,7 @@ def level_record(level: int, result: ContactResult, est: Estimate | None) -> Lev
     oscillation = getattr(est, "obstacle_oscillation", None)  # a 3D estimate with contact
     if oscillation is not None and result.contact.size:
         rec.extra["osc_obstacle"] = oscillation
-    if elasticity and report.linear_iterations:
+    if three and report.linear_iterations:
         rec.extra["linear_iterations"] = int(sum(report.linear_iterations))
     if result.problem.exact is not None:
         err = result.errors()

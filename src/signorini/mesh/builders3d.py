@@ -13,8 +13,14 @@ negative orientation along the path and are listed with their vertices 1 and 2 s
 ``cells[c, [0, 2, 1, 3]]`` for odd ``σ`` (:func:`kuhn_paths`).
 
 The curved meshes map a Kuhn grid of the unit cube (square) onto the eighth ball (quarter
-disc) by :func:`round_corner`, which keeps the cells shape-regular (smallest dihedral angle
-above 30° for every ``n`` tried) and the symmetry planes in place.
+disc) by :func:`round_corner`, which keeps the symmetry planes in place and the cells shape
+regular: the smallest dihedral angle falls with ``n`` towards the smallest over the domain of
+the Kuhn cells mapped by the map's Jacobian, above :data:`MIN_DIHEDRAL_BALL` (28°) for
+:func:`eighth_ball` (45.0° at ``n = 1``, 39.5° at 2, 33.7° at 4, 30.9° at 8, 29.1° at 24;
+the limit 28.6° at the rim ``x = 0``, ``y = z = 1``) and above
+:data:`MIN_DIHEDRAL_CYLINDER` (20°) for :func:`quarter_cylinder` with its default ``nz``
+(35.3°, 28.2°, 24.4°, 22.6°, 21.4° at the same ``n``; the limit 20.9° where the cylinder
+meets the plane ``x = 0``); docs/method.md, *Three dimensions: bisection*.
 
 References
 ----------
@@ -34,10 +40,27 @@ from .regions import RegionSpec
 from .surfaces import Cylinder, Sphere
 from .topology import boundary_facets
 
-__all__ = ["BOX_PARTS", "box", "eighth_ball", "kuhn_grid", "kuhn_paths", "quarter_cylinder"]
+__all__ = [
+    "BOX_PARTS",
+    "MIN_DIHEDRAL_BALL",
+    "MIN_DIHEDRAL_CYLINDER",
+    "box",
+    "eighth_ball",
+    "kuhn_grid",
+    "kuhn_paths",
+    "mirrored_box",
+    "mirrored_kuhn_grid",
+    "quarter_cylinder",
+]
 
 #: The six faces of a box, as parts: ``x0``/``x1`` at the lower/upper x, and so on.
 BOX_PARTS = ("x0", "x1", "y0", "y1", "z0", "z1")
+
+#: A lower bound (degrees) of the smallest dihedral angle of :func:`eighth_ball` at every
+#: ``n`` (module docstring: the limit of large ``n`` is 28.6°).
+MIN_DIHEDRAL_BALL = 28.0
+#: The same for :func:`quarter_cylinder` with its default ``nz`` (the limit is 20.9°).
+MIN_DIHEDRAL_CYLINDER = 20.0
 
 #: The six permutations of the axes, the even ones first (``σ`` of the Kuhn path).
 _SIGMA = np.array(list(permutations(range(3))))[[0, 3, 4, 1, 2, 5]]
@@ -140,6 +163,113 @@ def box(
     points = lo + (hi - lo) * (grid / n)
     parts = _face_parts(grid, boundary_facets(cells, TETRAHEDRON.facets), n)
     return Mesh.from_arrays(points, cells, parts, regions=regions)
+
+
+def mirrored_kuhn_grid(
+    nx: int, ny: int, nz: int, axes: tuple[int, ...] = (1, 2)
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The Kuhn grid of :func:`kuhn_grid` with every cube in the upper half along each of
+    ``axes`` mirrored in that axis: the split is symmetric about the mid-planes of ``axes``
+    (a 3D "union jack").
+
+    A cube's Kuhn path ``x0 + o_0 … x0 + o_3`` (offsets ``o ∈ {0, 1}³``) becomes ``x0 + o′``
+    with ``o′_a = 1 − o_a`` for each axis ``a`` it is mirrored in: the Kuhn path of the
+    mirrored diagonal. Faces across a mid-plane are each other's mirror images, so the mesh
+    is conforming; each cell keeps its path as its bisection tag order, and a cell mirrored
+    an odd number of times has its vertices 1 and 2 swapped (positive orientation).
+
+    Parameters
+    ----------
+    nx, ny, nz : int
+        Cubes per direction; even along each axis of ``axes``.
+    axes : tuple of int
+        The axes (0, 1, 2 for x, y, z) whose mid-planes are planes of symmetry.
+
+    Returns
+    -------
+    grid : (n_points, 3) int array
+        As :func:`kuhn_grid`.
+    cells : (6 nx ny nz, 4) int array
+        Positively oriented.
+    paths : (6 nx ny nz, 4) int array
+        The cells' Kuhn paths (the tag order of bisection, :func:`~.refine3d.tagged`).
+    """
+    n = np.array(_counts((nx, ny, nz)))
+    axes = tuple(int(a) for a in axes)
+    if any(a not in (0, 1, 2) for a in axes) or len(set(axes)) != len(axes):
+        raise MeshError(f"mirrored_kuhn_grid: axes must be distinct among 0, 1, 2, got {axes}")
+    if any(n[a] % 2 for a in axes):
+        raise MeshError(
+            f"mirrored_kuhn_grid: the counts along the mirrored axes {axes} must be even, "
+            f"got {tuple(n.tolist())}"
+        )
+    grid, _ = kuhn_grid(*n)
+    shape = n + 1
+    stride = np.array([1, shape[0], shape[0] * shape[1]])
+    ck, cj, ci = np.meshgrid(np.arange(n[2]), np.arange(n[1]), np.arange(n[0]), indexing="ij")
+    corner = np.column_stack([ci.ravel(), cj.ravel(), ck.ravel()])  # (n_cubes, 3)
+    offsets = np.concatenate(
+        [np.zeros((6, 1, 3), np.int64), np.cumsum(np.eye(3, dtype=np.int64)[_SIGMA], axis=1)],
+        axis=1,
+    )  # (6, 4, 3): the Kuhn paths' vertex offsets
+    flip = np.zeros(corner.shape, dtype=bool)
+    for a in axes:  # a loop over the mirrored axes
+        flip[:, a] = corner[:, a] >= n[a] // 2
+    o = np.where(flip[:, None, None, :], 1 - offsets[None], offsets[None])  # (c, 6, 4, 3)
+    paths = ((corner[:, None, None, :] + o) @ stride).reshape(-1, 4)
+    odd = (_ODD[None, :] != (flip.sum(axis=1) % 2 == 1)[:, None]).ravel()
+    cells = paths.copy()
+    cells[odd] = cells[odd][:, [0, 2, 1, 3]]
+    return grid, cells, paths
+
+
+def mirrored_box(
+    nx: int,
+    ny: int,
+    nz: int,
+    *,
+    axes: tuple[int, ...] = (1, 2),
+    lower: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    upper: tuple[float, float, float] = (1.0, 1.0, 1.0),
+) -> Mesh:
+    """The box of :func:`box` on the mirrored Kuhn grid (:func:`mirrored_kuhn_grid`): its
+    cells are symmetric about the mid-planes of ``axes``, and with ``axes = (1, 2)`` and
+    ``ny == nz`` also under the swap of y and z; on a face normal to the third axis the
+    diagonals of the squares run towards the face's centre, along both of its diagonals.
+
+    The cells carry their Kuhn paths as bisection tags (:func:`~.refine3d.tagged`), so
+    refinement bisects the mirrored cells as mirror images and keeps the symmetry.
+
+    Parameters
+    ----------
+    nx, ny, nz : int
+        Cubes per direction, even along each axis of ``axes``.
+    axes : tuple of int
+        The axes whose mid-planes are planes of symmetry of the mesh.
+    lower, upper : (3,) float
+        Opposite corners.
+
+    Returns
+    -------
+    Mesh
+        Parts :data:`BOX_PARTS`, as :func:`box`.
+    """
+    from .refine3d import tagged  # refine3d reads this module's Kuhn paths
+
+    lo, hi = np.asarray(lower, dtype=np.float64), np.asarray(upper, dtype=np.float64)
+    if (
+        lo.shape != (3,)
+        or hi.shape != (3,)
+        or not (np.isfinite([lo, hi]).all() and (hi > lo).all())
+    ):
+        raise MeshError(
+            f"mirrored_box needs lower < upper, two points (x, y, z); got {lower}, {upper}"
+        )
+    grid, cells, paths = mirrored_kuhn_grid(nx, ny, nz, axes)
+    n = np.array([nx, ny, nz])
+    points = lo + (hi - lo) * (grid / n)
+    parts = _face_parts(grid, boundary_facets(cells, TETRAHEDRON.facets), n)
+    return tagged(Mesh.from_arrays(points, cells, parts), paths)
 
 
 def round_corner(p: np.ndarray) -> np.ndarray:

@@ -96,8 +96,10 @@ def matching_subdivision(
 
 def prepare_for_bisection(mesh: Mesh) -> Mesh:
     """The mesh subdivided into 12 sub-tetrahedra per cell, tagged with the matching
-    condition for bisection (module docstring): the initialisation for an arbitrary
-    (e.g. Gmsh) tetrahedral mesh, where the global vertex order carries no guarantee.
+    condition for bisection (module docstring): an initialisation of an arbitrary (e.g.
+    Gmsh) tetrahedral mesh, opt-in beside the default colouring
+    (:func:`~signorini.mesh.tags3d.coloured_tags`; docs/method.md, *The default for a Gmsh
+    mesh*).
 
     Parameters
     ----------

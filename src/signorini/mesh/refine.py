@@ -43,11 +43,17 @@ class Refinement:
     edge_point : (n_edges_old,) int array
         New point index at the midpoint of each bisected old edge, ``-1`` where the edge was
         not bisected.
+    parent_edge : (n_points_new - n_points_old, 2) int array or None
+        The ends of the edge each new point bisected (new point ``n_points_old + i`` of
+        ``parent_edge[i]``; in 3D also the edges the bisection created and cut in the same
+        step), where :func:`signorini.mesh.nesting.parent_barycentrics` reads the new
+        points' places in their parent cells; None if not known.
     """
 
     mesh: Mesh
     parent: np.ndarray
     edge_point: np.ndarray
+    parent_edge: np.ndarray | None = None
 
 
 def closure(mesh: Mesh, marked_edges: np.ndarray) -> np.ndarray:
@@ -207,7 +213,7 @@ def _bisect(mesh: Mesh, marked_edges: np.ndarray) -> Refinement:
         cell_region=mesh.cell_region[parent],  # a child takes its parent's region
         region_names=mesh.region_names,
     )
-    return Refinement(refined, parent, edge_point)
+    return Refinement(refined, parent, edge_point, mesh.edges[bisected])
 
 
 def _curved_bisected(mesh: Mesh, edge_point: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:

@@ -15,16 +15,17 @@ import logging
 
 import numpy as np
 
-from .bisect3d import bisect_tagged, boundary_of, edge_key
+from .bisect3d import KEY_BASE, bisect_tagged, boundary_of, edge_key
 from .builders3d import kuhn_paths
 from .mesh import Mesh
 from .surfaces import Surface
 from .tags3d import (
     ATTRIBUTE,
     Tags,
+    coloured_tags,
+    greedy_colouring,
     kuhn_tags,
     mesh_cells,
-    sorted_tags,
     with_face_parts,
 )
 from .topology3d import refined_topology
@@ -46,7 +47,7 @@ EDGE_CACHE, FACET_CACHE = "_edge_topology", "_topology"
 
 def bisect_mesh(
     mesh: Mesh, marked: np.ndarray, bisections: int = 1
-) -> tuple[Mesh, np.ndarray, np.ndarray]:
+) -> tuple[Mesh, np.ndarray, np.ndarray, np.ndarray]:
     """Bisect the marked cells of a tetrahedral mesh ``bisections`` times each (the children
     of a marked cell are marked for the next bisection), with closure.
 
@@ -66,6 +67,9 @@ def bisect_mesh(
         The old cell that contains each new cell.
     edge_point : (n_edges_old,) int64 array
         The new vertex at the midpoint of each bisected old edge, ``-1`` elsewhere.
+    parent_edge : (n_points_new - n_points_old, 2) int64 array
+        The ends of the edge each new vertex bisected (old edges and edges made in this
+        step; :attr:`~signorini.mesh.refine.Refinement.parent_edge`).
 
     Raises
     ------
@@ -76,6 +80,8 @@ def bisect_mesh(
     edge_point = np.full(old.size, -1, dtype=np.int64)
     parent = np.arange(mesh.n_cells, dtype=np.int64)
     marked = np.asarray(marked, dtype=bool)
+    n_old = mesh.n_points
+    ends = []
     for _ in range(bisections):  # a loop over bisections, not cells
         mesh, step, split_key, split_point = _bisect_once(mesh, marked[parent])
         parent = parent[step]
@@ -83,7 +89,11 @@ def bisect_mesh(
             pos = np.minimum(np.searchsorted(split_key, old), split_key.size - 1)
             hit = (split_key[pos] == old) & (edge_point < 0)
             edge_point[hit] = split_point[pos[hit]]
-    return mesh, parent, edge_point
+            by_point = np.argsort(split_point)  # new points are numbered in order
+            ends.append(np.column_stack(np.divmod(split_key[by_point], KEY_BASE)))
+    parent_edge = np.concatenate(ends) if ends else np.zeros((0, 2), dtype=np.int64)
+    assert parent_edge.shape[0] == mesh.n_points - n_old
+    return mesh, parent, edge_point, parent_edge
 
 
 def _bisect_once(mesh: Mesh, marked: np.ndarray) -> tuple[Mesh, np.ndarray, np.ndarray, np.ndarray]:
@@ -170,10 +180,11 @@ def tags_of(mesh: Mesh) -> Tags:
     refinement (or :func:`tagged`) attached; else the Kuhn paths of an axis-aligned Kuhn mesh
     (:func:`~signorini.mesh.tags3d.kuhn_tags`); else the Kuhn paths of a mapped Kuhn grid in
     the builders' cell order (:func:`~signorini.mesh.builders3d.kuhn_paths`, plain or
-    mirrored) if they pass :func:`matches`; else the global vertex order
-    (:func:`~signorini.mesh.tags3d.sorted_tags`, no matching condition, logged at
-    ``INFO``: docs/method.md; :func:`~signorini.mesh.matching3d.prepare_for_bisection`
-    gives a mesh with it)."""
+    mirrored) if they pass :func:`matches`; else (any conforming mesh, e.g. from Gmsh)
+    Diening, Gehring and Storn's initialisation from a greedy vertex colouring
+    (:func:`~signorini.mesh.tags3d.coloured_tags`, logged at ``INFO``), with which the
+    bisection keeps its closure estimate and shape regularity (docs/method.md, *The initial
+    condition*)."""
     tags = getattr(mesh, ATTRIBUTE, None)
     if tags is not None:
         return tags
@@ -193,11 +204,13 @@ def tags_of(mesh: Mesh) -> Tags:
                 tags = candidate
                 break
     if tags is None:
-        tags = tags_in(sorted_tags(mesh.cells))
+        colour = greedy_colouring(mesh.edges, mesh.n_points)
+        tags = tags_in(coloured_tags(mesh.cells, colour))
         logger.info(
-            "bisection: %d tetrahedra tagged by the global vertex order (no matching "
-            "condition; matching3d.prepare_for_bisection gives one)",
+            "bisection: %d tetrahedra tagged from a greedy colouring of their vertices in %d "
+            "colours (Diening-Gehring-Storn)",
             mesh.n_cells,
+            int(colour.max(initial=0)) + 1,
         )
     setattr(mesh, ATTRIBUTE, tags)
     return tags

@@ -15,16 +15,16 @@ as the vertices.
 Initial condition. Stevenson's matching condition holds for a Kuhn (Freudenthal) mesh of a
 box ordered along the path of each simplex, type 0 (:func:`kuhn_tags`): ``x0`` the corner
 with the smallest coordinates along the common diagonal direction, ``x1 = x0 + h_i e_i``,
-``x2 = x1 + h_j e_j``, ``x3 = x2 + h_k e_k`` ([3]_, [4]_). For an arbitrary mesh
-:func:`sorted_tags` orders each cell by its global vertex numbers (a consistent order on
-every shared face), type 0: bisection then stays conforming and terminates on the meshes
-tested, but the matching condition, hence the closure estimate and the bound of the closure
-rounds, is not guaranteed (Diening, Gehring, Storn [5]_ give an initialisation for any
-conforming mesh; it is not implemented). The guaranteed route for any conforming mesh is
-:func:`signorini.mesh.matching3d.prepare_for_bisection`: 12 tagged sub-cells per cell.
-:func:`signorini.mesh.refine3d.tags_of` checks the condition's consequence that three
-bisections of every cell need no closure before it takes the Kuhn paths of a mapped Kuhn
-grid.
+``x2 = x1 + h_j e_j``, ``x3 = x2 + h_k e_k`` ([3]_, [4]_). For an arbitrary conforming mesh,
+Diening, Gehring and Storn's initialisation [5]_: a greedy vertex colouring
+(:func:`greedy_colouring`) and each cell ordered by it (:func:`coloured_tags`), with which
+the bisection keeps the closure estimate and shape regularity (at most 36 similarity
+classes per initial cell) without the matching condition. :func:`sorted_tags` orders each
+cell by its global vertex numbers (a consistent order on every shared face, no guarantee);
+:func:`signorini.mesh.matching3d.prepare_for_bisection` gives the matching condition itself
+with 12 tagged sub-cells per cell. :func:`signorini.mesh.refine3d.tags_of` checks the
+condition's consequence that three bisections of every cell need no closure before it takes
+the Kuhn paths of a mapped Kuhn grid, and colours any other mesh.
 
 References
 ----------
@@ -37,7 +37,7 @@ References
 .. [4] D. N. Arnold, A. Mukherjee, L. Pouly, Locally adapted tetrahedral meshes using
    bisection, SIAM J. Sci. Comput. 22 (2000) 431–448.
 .. [5] L. Diening, L. Gehring, J. Storn, Adaptive mesh refinement for arbitrary initial
-   triangulations, arXiv:2306.02674 (2023).
+   triangulations, Found. Comput. Math. (2025), arXiv:2306.02674.
 """
 
 from __future__ import annotations
@@ -50,7 +50,18 @@ from .reference import TETRAHEDRON
 from .topology import entity_keys
 from .validation import MeshError
 
-__all__ = ["Tags", "kuhn_tags", "mesh_cells", "sorted_tags", "with_face_parts"]
+__all__ = [
+    "Tags",
+    "coloured_tags",
+    "greedy_colouring",
+    "kuhn_tags",
+    "mesh_cells",
+    "sorted_tags",
+    "with_face_parts",
+]
+
+#: The seed of the fixed pseudo-random vertex priorities of :func:`greedy_colouring`.
+COLOURING_SEED = 20230605
 
 #: The attribute of a 3D Mesh that carries its :class:`Tags` (set by refinement and by
 #: :func:`signorini.mesh.refine3d.tags_of`).
@@ -168,3 +179,55 @@ def sorted_tags(cells: np.ndarray) -> np.ndarray:
     """The tag order ``(n, 4)`` of any conforming mesh: each cell's vertices in increasing
     global number, type 0 (no guarantee of the matching condition, see the module notes)."""
     return np.sort(np.asarray(cells, dtype=np.int64), axis=1)
+
+
+def greedy_colouring(edges: np.ndarray, n_points: int) -> np.ndarray:
+    """A proper vertex colouring ``(n_points,)`` int64 of the graph ``edges (m, 2)``: the
+    greedy colouring (each vertex the smallest colour none of its earlier neighbours has) in
+    the order of fixed pseudo-random priorities (seed :data:`COLOURING_SEED`), so at most
+    ``1 +`` the largest vertex degree colours (Diening, Gehring, Storn [5]_, Algorithm 2).
+
+    Computed in rounds over arrays (Jones–Plassmann): a round colours at once every
+    uncoloured vertex whose priority exceeds that of all its uncoloured neighbours (no two
+    of them are neighbours, and all their earlier neighbours are coloured), which gives the
+    sequential greedy colouring in that order; the rounds are the longest chain of
+    decreasing priorities, a few tens on tetrahedral meshes.
+    """
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    priority = np.random.default_rng(COLOURING_SEED).permutation(n_points)
+    colour = np.full(n_points, -1, dtype=np.int64)
+    # each edge from its later end (lower priority) to its earlier one
+    later = np.where(priority[edges[:, 0]] < priority[edges[:, 1]], edges[:, 0], edges[:, 1])
+    earlier = edges.sum(axis=1) - later
+    while True:  # a loop over rounds, not vertices
+        open_ = colour[earlier] < 0
+        blocked = np.zeros(n_points, dtype=bool)
+        blocked[later[open_]] = True
+        ready = np.flatnonzero((colour < 0) & ~blocked)
+        if ready.size == 0:
+            return colour
+        slot = np.full(n_points, -1, dtype=np.int64)
+        slot[ready] = np.arange(ready.size)
+        mine = slot[later] >= 0  # edges to the ready vertices' earlier, coloured neighbours
+        taken = np.zeros((ready.size, int(colour.max(initial=-1)) + 2), dtype=bool)
+        taken[slot[later[mine]], colour[earlier[mine]]] = True
+        colour[ready] = np.argmin(taken, axis=1)
+
+
+def coloured_tags(cells: np.ndarray, colour: np.ndarray) -> np.ndarray:
+    """The tag order ``(n, 4)`` of any conforming mesh from a proper vertex colouring
+    ``colour`` (:func:`greedy_colouring`), type 0: Diening, Gehring, Storn's initialisation
+    of Maubach's bisection [5]_ (Definition 2): each cell's vertices by increasing colour,
+    except that a vertex of the largest colour of the mesh goes first.
+
+    Maubach's tagged simplex ``[y0, y1, y2, y3]`` of tag 3 bisects as the type-0 tagged
+    simplex ``(y0, y1, y2, y3)_0`` of :mod:`signorini.mesh.bisect3d` (the same children at
+    every generation: docs/method.md, *The initial condition*), so the order is used as it
+    is. The colours of a cell are distinct, so the order agrees on every shared face.
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    by_colour = np.argsort(colour[cells], axis=1, kind="stable")
+    order = np.take_along_axis(cells, by_colour, axis=1)
+    top = colour[order[:, 3]] == colour.max(initial=0)
+    order[top] = np.roll(order[top], 1, axis=1)
+    return order

@@ -18,7 +18,7 @@ import numpy as np
 from ..mesh.bodies import body_names, body_of_cells
 from ..mesh.mesh import Mesh
 from .files import atomic_write, replacing
-from .vtu3d import write_vtu_3d
+from .vtu3d import fields_lines_3d, write_vtu_3d
 
 __all__ = [
     "CELL_FIELDS",
@@ -226,33 +226,39 @@ def write_pvd(folder: str | os.PathLike, levels: Sequence[tuple[int, int]]) -> l
 def write_fields(path: str | os.PathLike, mesh: Mesh | None = None) -> Path:
     """Write the description of the VTU files' fields as Markdown (``fields.md``); with the
     run's ``mesh``, which region index and which body number is which name (the same on
-    every level: refinement keeps the regions, and the bodies' order is the union's)."""
-    lines = [
-        "# Fields of the level_NNN.vtu files",
-        "",
-        "Quadratic triangles (VTK_QUADRATIC_TRIANGLE: 3 vertices, then the midpoints of "
-        "v0-v1, v1-v2, v2-v0); linear triangles (VTK_TRIANGLE) in a run with --element P1. "
-        "`levels.pvd` collects the levels with the level index as "
-        "time, `levels_ndof.pvd` with N_dof as time. Units are those of the problem's data.",
-        "",
-        "## Point data",
-        "",
-        "| field | meaning |",
-        "|---|---|",
-        *(f"| `{name}` | {text} |" for name, text in POINT_FIELDS.items()),
-        "",
-        "## Cell data",
-        "",
-        "| field | meaning |",
-        "|---|---|",
-        *(f"| `{name}` | {text} |" for name, text in CELL_FIELDS.items()),
-        "",
-        "## Field data",
-        "",
-        "| field | meaning |",
-        "|---|---|",
-        *(f"| `{name}` | {text} |" for name, text in NAME_FIELDS.items()),
-    ]
+    every level: refinement keeps the regions, and the bodies' order is the union's); a
+    tetrahedral ``mesh``'s files are described by :func:`~.vtu3d.fields_lines_3d`."""
+    three = mesh is not None and mesh.dim == 3
+    lines = (
+        fields_lines_3d()
+        if three
+        else [
+            "# Fields of the level_NNN.vtu files",
+            "",
+            "Quadratic triangles (VTK_QUADRATIC_TRIANGLE: 3 vertices, then the midpoints of "
+            "v0-v1, v1-v2, v2-v0); linear triangles (VTK_TRIANGLE) in a run with --element P1. "
+            "`levels.pvd` collects the levels with the level index as "
+            "time, `levels_ndof.pvd` with N_dof as time. Units are those of the problem's data.",
+            "",
+            "## Point data",
+            "",
+            "| field | meaning |",
+            "|---|---|",
+            *(f"| `{name}` | {text} |" for name, text in POINT_FIELDS.items()),
+            "",
+            "## Cell data",
+            "",
+            "| field | meaning |",
+            "|---|---|",
+            *(f"| `{name}` | {text} |" for name, text in CELL_FIELDS.items()),
+            "",
+            "## Field data",
+            "",
+            "| field | meaning |",
+            "|---|---|",
+            *(f"| `{name}` | {text} |" for name, text in NAME_FIELDS.items()),
+        ]
+    )
     if mesh is not None:
         lines += ["", "## Regions and bodies", "", "| `region` | region name |", "|---|---|"]
         lines += [f"| {k} | `{name}` |" for k, name in enumerate(mesh.region_names)]

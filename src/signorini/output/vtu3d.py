@@ -8,6 +8,11 @@ of the edges 01, 12, 20, 03, 13, 23 (:data:`~signorini.mesh.reference.TETRAHEDRO
 order, the space's own numbering); a face's three vertices in outward order, then its edges
 ab, bc, ca (:meth:`~signorini.fem.space3d.P2TetSpace.facet_nodes`). :func:`write_vtu_3d` is
 what :func:`~.vtu.write_vtu` writes for a tetrahedral mesh.
+
+With contact the nodes of Γ_C carry its fields (:data:`CONTACT_FIELDS_3D`: the contact
+set's ``fields`` of the solution at the nodes, docs/method.md, *Three dimensions: contact
+on faces*); on the ``triangle6`` faces of a contact part (threshold on ``part``) they show
+Γ_C.
 """
 
 from __future__ import annotations
@@ -20,7 +25,13 @@ import numpy as np
 
 from .files import replacing
 
-__all__ = ["CELL_FIELDS_3D", "POINT_FIELDS_3D", "write_vtu_3d"]
+__all__ = [
+    "CELL_FIELDS_3D",
+    "CONTACT_FIELDS_3D",
+    "POINT_FIELDS_3D",
+    "fields_lines_3d",
+    "write_vtu_3d",
+]
 
 #: Point data of a 3D level's VTU file: name -> meaning (units are the problem's).
 POINT_FIELDS_3D: dict[str, str] = {
@@ -29,11 +40,65 @@ POINT_FIELDS_3D: dict[str, str] = {
     "order (xx, yy, zz, xy, yz, xz), averaged over the cells that share the node",
     "von_mises": "von Mises stress of the nodal stress",
 }
+#: Point data of a 3D level's VTU file with contact: name -> (the solution's per-row field,
+#: meaning). A node of several rows (contact parts meeting) takes the largest value of its rows.
+CONTACT_FIELDS_3D: dict[str, tuple[str, str]] = {
+    "gap": ("gap", "on Γ_C u_h·n_z − ψ(z): 0 in contact, negative off the obstacle (nan "
+            "elsewhere)"),
+    "contact_force": ("contact_force", "on Γ_C the nodal contact force Λ_z (3.17), force "
+                      "units (0 elsewhere)"),
+    "pressure": ("pressure", "on Γ_C the transformed basis's nodal pressure p̃_z = Λ̃_z / w̃_z "
+                 "of condition (b) (nan for condition (a), whose P2 vertex weights vanish; "
+                 "0 elsewhere)"),
+    "recovered_pressure": ("recovered_pressure", "on Γ_C the P1-lumped recovered pressure "
+                           "(T_½ Λ)_v / (T_½ w)_v at a vertex, the mean of its edge's ends at "
+                           "a midpoint; exact for a constant pressure (0 elsewhere)"),
+    "active": ("active", "1 where the node's constraint is in the final active set (the "
+               "node is in contact), else 0"),
+    "contact_normal": ("normal", "on Γ_C the constraint's unit direction n_z (3 "
+                       "components; the first part's at a node of several; 0 elsewhere)"),
+}  # fmt: skip
 #: Cell data of a 3D level's VTU file: name -> meaning (-1 where it does not apply).
 CELL_FIELDS_3D: dict[str, str] = {
     "region": "a tetrahedron's material region (index into mesh.region_names); -1 on faces",
     "part": "a boundary face's part (index into mesh.part_names); -1 on tetrahedra",
 }
+
+
+def fields_lines_3d() -> list[str]:
+    """The Markdown lines of ``fields.md`` that describe a 3D level's VTU file (the run's
+    regions follow, :func:`~.vtu.write_fields`)."""
+
+    def table(rows: dict[str, str]) -> list[str]:
+        return ["| field | meaning |", "|---|---|", *(f"| `{k}` | {v} |" for k, v in rows.items())]
+
+    contact = {name: text for name, (_, text) in CONTACT_FIELDS_3D.items()}
+    return [
+        "# Fields of the level_NNN.vtu files",
+        "",
+        "Quadratic tetrahedra (VTK_QUADRATIC_TETRA: 4 vertices, then the midpoints of the "
+        "edges 01, 12, 20, 03, 13, 23) and their boundary faces as quadratic triangles "
+        "(VTK_QUADRATIC_TRIANGLE: 3 vertices in outward order, then the midpoints of ab, bc, "
+        "ca), which carry their part (threshold on `part` in ParaView to see one, e.g. Γ_C). "
+        "`levels.pvd` collects the levels with the level index as time, `levels_ndof.pvd` "
+        "with N_dof as time. Units are those of the problem's data.",
+        "",
+        "## Point data",
+        "",
+        *table(POINT_FIELDS_3D),
+        "",
+        "## Point data of Γ_C (runs with contact parts)",
+        "",
+        "One value per node of the contact parts' faces, from the constraint rows of the "
+        "discrete contact condition (docs/method.md, *Three dimensions: contact on faces*); a "
+        "node of several rows (contact parts meeting) takes the largest value of its rows.",
+        "",
+        *table(contact),
+        "",
+        "## Cell data",
+        "",
+        *table(CELL_FIELDS_3D),
+    ]
 
 
 def write_vtu_3d(
@@ -47,7 +112,8 @@ def write_vtu_3d(
     ----------
     path : path of the ``.vtu`` file
     result : ContactResult
-        ``result.u (n_nodes, 3)`` on ``result.space`` (a P2TetSpace).
+        ``result.u (n_nodes, 3)`` on ``result.space`` (a P2TetSpace); with contact rows
+        (``result.contact.size``) also ``result.contact.fields(u, force, active)``.
     mises : callable
         The von Mises stress ``(n,)`` of stress tensors ``(n, 3, 3)`` (:func:`~.vtu.von_mises`).
     """
@@ -58,10 +124,16 @@ def write_vtu_3d(
     voigt = sigma.reshape(-1, 9)[:, [0, 4, 8, 1, 5, 2]]  # xx, yy, zz, xy, yz, xz
     faces = space.facet_nodes(mesh.boundary_facet)
     n_cells, n_faces = mesh.n_cells, faces.shape[0]
+    point_data = {"displacement": result.u, "stress": voigt, "von_mises": mises(sigma)}
+    if result.contact.size:
+        rows = result.contact.fields(result.u, result.contact_force, result.active)
+        nodal = rows.at_nodes(space.n_nodes)
+        point_data |= {name: nodal[key] for name, (key, _) in CONTACT_FIELDS_3D.items()}
+        point_data["active"] = point_data["active"].astype(np.int32)
     data = meshio.Mesh(
         space.node_points,
         [("tetra10", space.cell_nodes), ("triangle6", faces)],
-        point_data={"displacement": result.u, "stress": voigt, "von_mises": mises(sigma)},
+        point_data=point_data,
         cell_data={
             "region": [mesh.cell_region.astype(np.int32), np.full(n_faces, -1, np.int32)],
             "part": [np.full(n_cells, -1, np.int32), mesh.boundary_part.astype(np.int32)],

@@ -63,6 +63,7 @@ def plot_pressure_comparison(
     xlabel: str = r"$x$",
     friction: FrictionCurves | None = None,
     window: tuple[float, float] | None = None,
+    joined: bool = False,
 ) -> list[Path]:
     """The nodal pressure p_z against x, with the known pressure drawn as a line above it.
 
@@ -86,6 +87,8 @@ def plot_pressure_comparison(
         stick/slip states.
     window : (2,) float, optional
         The x range shown (a zoom on the contact zone).
+    joined : bool
+        Join the computed values by a thin line (a pressure linear between the nodes).
 
     Returns
     -------
@@ -121,8 +124,9 @@ def plot_pressure_comparison(
         )  # fmt: skip
         ax.plot(
             x[order], pressure[order], color=style["color"], marker=style["marker"],
-            markersize=size, markerfacecolor="none", markeredgewidth=0.6, linestyle="none",
-            label=style["label"], zorder=MARKER_ZORDER,
+            markersize=size, markerfacecolor="none", markeredgewidth=0.6,
+            linestyle="-" if joined else "none", linewidth=0.7, label=style["label"],
+            zorder=MARKER_ZORDER,
         )  # fmt: skip
         if qt is not None:
             ax.plot(

@@ -23,6 +23,7 @@ from ..mesh.mesh import Mesh
 from ..output import read_history
 from .body3d import plot_body_3d, render_body_3d
 from .contact_line import free_boundary_ends
+from .contact_map import plot_contact_map
 from .mesh import boundary_groups
 
 __all__ = [
@@ -104,7 +105,8 @@ def run_figures(
     dim : {2, 3}, optional
         The mesh's dimension; default ``last["dim"]``, else 2. A 3D level (the arrays of
         :func:`signorini.loop.arrays.body_arrays`) gets its convergence history and the
-        picture of its body; the figures of contact are 2D only.
+        picture of its body; with contact also its plane obstacles and the pressure map
+        over Γ_C (:func:`body_figures`).
     """
     known = {} if last is None else last
     name = str(known.get("name", example)) if name is None else name
@@ -180,10 +182,31 @@ def body_figures(example: str, out: Path, last: Mapping[str, Any], name: str) ->
     :func:`~.body3d.plot_body_3d`) and, with PyVista installed (the ``[3d]`` extra), its
     off-screen rendering (``<example>_body_pyvista.png``); without it one line in the log.
     ``last`` holds ``points (n, 3)``, ``faces (k, 3)``, ``displacement (n, 3)`` and ``stress
-    (n, 3, 3)`` at the vertices (:func:`signorini.loop.arrays.body_arrays`)."""
+    (n, 3, 3)`` at the vertices (:func:`signorini.loop.arrays.body_arrays`); with contact
+    ``contact`` (:func:`signorini.loop.arrays3d.surface_arrays`): then the body is drawn with
+    its plane obstacles, and the pressure over Γ_C as a map (``<example>_contact_pressure``,
+    :func:`~.contact_map.plot_contact_map`)."""
     body = (last["points"], last["faces"], last["displacement"], last["stress"])
-    written = plot_body_3d(*body, out / f"{example}_body", title=name)
-    rendered, note = render_body_3d(*body, out / f"{example}_body_pyvista")
+    surface = last.get("contact")
+    drawn = {}
+    if surface is not None:
+        on = surface["active"]
+        drawn = {
+            "planes": surface["planes"],
+            "touching": (surface["points"][on], surface["displacement"][on]),
+        }
+    written = plot_body_3d(*body, out / f"{example}_body", title=name, **drawn)
+    if surface is not None:
+        written += plot_contact_map(
+            surface["points"],
+            surface["faces"],
+            surface["recovered_pressure"],
+            surface["active"],
+            surface["normal"],
+            out / f"{example}_contact_pressure",
+            title=name,
+        )
+    rendered, note = render_body_3d(*body, out / f"{example}_body_pyvista", **drawn)
     if note:
         log.info(note)
     return written + rendered
@@ -245,4 +268,6 @@ def pressure_figure(example: str, out: Path, known: KnownPressure) -> list[Path]
             known.tangential, known.tangential_reference, known.tangential_label, known.state
         ),
         window=getattr(known, "window", None),
+        xlabel=getattr(known, "xlabel", r"$x$"),
+        joined=getattr(known, "joined", False),
     )

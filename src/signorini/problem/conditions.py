@@ -52,6 +52,10 @@ _TRACTION = (
 )
 _GAP = "a finite number or a function gap(x) of points x (n, 2)"
 _NORMAL = "None or two finite numbers, not both zero"
+_NORMAL_3D = (
+    "None, three finite numbers, not all zero, or a function n(x) of points x (n, 3) "
+    "returning unit vectors (n, 3) (on a 3D mesh)"
+)
 
 
 def _components(value: object) -> int:
@@ -228,10 +232,14 @@ class Contact:
         units): a constant, or a function ``ψ(x)`` of the points ``x``, a float array of shape
         ``(n, 2)``, returning ``(n,)`` (or one value for all points); docs/method.md, *User
         functions*. Not with ``obstacle``.
-    normal : two floats or None
+    normal : two floats, three floats, a function or None
         The outward normal of a straight part (normalised here); ``None`` takes it from the
         geometry. A given normal must agree with the geometry (checked by
-        :class:`~signorini.problem.problem.ContactProblem`). Not with ``obstacle``.
+        :class:`~signorini.problem.problem.ContactProblem`). Not with ``obstacle``. On a 3D
+        mesh: three numbers, or a direction field ``n(x)`` of points ``(n, 3)`` returning unit
+        vectors ``(n, 3)``, the constraint directions instead of the body's normal, each
+        pointing out of the body (docs/method.md, *Three dimensions: rollers, force control,
+        regions*).
     obstacle : Obstacle or None
         A rigid obstacle given as a shape: :class:`~signorini.problem.obstacles.HalfPlane`,
         :class:`~signorini.problem.obstacles.Disc`,
@@ -262,7 +270,7 @@ class Contact:
     """
 
     gap: Callable[[np.ndarray], np.ndarray] | float = 0.0
-    normal: tuple[float, float] | None = None
+    normal: tuple[float, ...] | Callable[[np.ndarray], np.ndarray] | None = None
     obstacle: Obstacle | None = None
     friction: Friction | None = None
     master: str | None = None
@@ -303,8 +311,11 @@ class Contact:
             check_function(self.gap, "Contact(gap=...)", _GAP)
         else:
             check_numbers(self.gap, 1, "Contact(gap=...)", _GAP, bounded=True)
-        if self.normal is not None:
-            check_numbers(self.normal, 2, "Contact(normal=...)", _NORMAL)
+        if callable(self.normal):  # a direction field n(x): 3D only (problem3d)
+            check_function(self.normal, "Contact(normal=...)", _NORMAL_3D)
+        elif self.normal is not None:
+            size = 3 if np.size(self.normal) == 3 else 2  # three numbers: 3D only (problem3d)
+            check_numbers(self.normal, size, "Contact(normal=...)", (_NORMAL, _NORMAL_3D)[size - 2])
             if not np.any(np.asarray(self.normal, dtype=np.float64)):
                 raise ProblemError(f"Contact(normal=...) must be {_NORMAL}; got {self.normal!r}")
         if self.obstacle is not None:

@@ -260,7 +260,12 @@ def evaluate_field(
             f"got {values.shape}"
         )
     if not np.isfinite(values).all():
-        raise ProblemError(f"{what} returned NaN or inf")
+        bad = ~np.isfinite(values.reshape(points.shape[0], -1)).all(axis=1)
+        k = int(np.argmax(bad))
+        raise ProblemError(
+            f"{what} returned NaN or inf at x = {tuple(points[k].tolist())} "
+            f"({int(bad.sum())} of {points.shape[0]} points)"
+        )
     if bounded and _too_large(values):
         k = int(np.argmax(np.abs(values).reshape(points.shape[0], -1).max(axis=1)))
         raise ProblemError(

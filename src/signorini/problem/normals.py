@@ -21,7 +21,13 @@ from ..mesh.mesh import Mesh
 from ..mesh.validation import MeshError
 from .fields import ProblemError
 
-__all__ = ["CURVE_NORMAL_ANGLE", "STRAIGHT_RTOL", "node_normals", "straight_normal"]
+__all__ = [
+    "CURVE_NORMAL_ANGLE",
+    "STRAIGHT_RTOL",
+    "face_node_normals",
+    "node_normals",
+    "straight_normal",
+]
 
 #: a curve's normal at a node of a part's facet may differ from the facet chord's normal by at
 #: most this angle (radians, 60°): the curve turns by about h / R over a facet, far less on
@@ -119,3 +125,31 @@ def _check_across(part: str, cos: np.ndarray, x: np.ndarray) -> None:
             "runs along the boundary, not across it. ProjectedCurve(normal=...) must return "
             "the curve's normal, not its tangent"
         )
+
+
+def face_node_normals(space, name: str, z: np.ndarray) -> np.ndarray:
+    """``(j, 3)`` the body's outward unit normals at the P2 nodes ``z (j,)`` of part
+    ``name``'s faces on a tetrahedral mesh (docs/method.md, *Three dimensions: contact on
+    faces*): the surface's exact normal on a part carrying a :class:`~signorini.mesh.surfaces.
+    Surface` with a normal (oriented as the faces), else the normalised mean of the unit
+    normals of the part's faces at each node (on a flat part: its normal).
+
+    Parameters
+    ----------
+    space : P2TetSpace
+    name : str
+        The boundary part.
+    z : (j,) int array
+        Nodes of the part's faces.
+    """
+    mesh = space.mesh
+    nodes = space.facet_nodes(mesh.part_facets(name))
+    _, normal = facet_normals(mesh.points[nodes[:, :3]])
+    total = np.zeros((space.n_nodes, 3))
+    np.add.at(total, nodes.ravel(), np.repeat(normal, nodes.shape[1], axis=0))
+    n = total[z] / np.linalg.norm(total[z], axis=1)[:, None]
+    surface = mesh.curves[mesh.part_index(name)]
+    if surface is not None and getattr(surface, "has_normal", False):
+        m = surface.normal(space.node_points[z])
+        return m * np.where(np.einsum("jc,jc->j", m, n) < 0, -1.0, 1.0)[:, None]
+    return n

@@ -162,9 +162,9 @@ class ContactProblem:
         object.__setattr__(
             self, "rollers", {k: self.conditions[k] for k, v in held.items() if v is None}
         )
-        if mesh.dim == 3:  # 3D elasticity without contact (docs/method.md, *Three dimensions*)
-            check_problem_3d(mesh, self.held, self.rollers)
-            object.__setattr__(self, "rigid_motions", np.zeros((0, 6)))
+        if mesh.dim == 3:  # docs/method.md, *Three dimensions: rollers, force control, ...*
+            motions = check_problem_3d(mesh, self.held, self.rollers, self.contact_parts)
+            object.__setattr__(self, "rigid_motions", motions)
             object.__setattr__(self, "rigid_parts", ())
             object.__setattr__(self, "contact_normals", {})
             return
@@ -236,7 +236,7 @@ class ContactProblem:
         mean = straight_normal(self.mesh, name)
         if mean is None:
             if self.mesh.dim == 3:
-                return None  # refused by check_problem_3d, naming the part
+                return None  # held in node frames (problem/rollers3d.py)
             check_roller_part(self.mesh, name)
             return None
         axis = int(np.argmax(np.abs(mean)))

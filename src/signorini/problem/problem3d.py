@@ -1,11 +1,14 @@
 """The checks of a :class:`~signorini.problem.problem.ContactProblem` on a tetrahedral mesh
-(docs/method.md, *Three dimensions: solving elasticity*): 3D elasticity without contact.
+(docs/method.md, *Three dimensions: solving elasticity*, *Three dimensions: rollers, force
+control, regions*).
 
-A 3D problem holds Dirichlet parts (all or some of ``(u_x, u_y, u_z)``), rollers on planar
-parts normal to an axis (one Cartesian component held), Neumann parts and frictionless
-contact parts against a gap function or a shape of space (docs/method.md, *Three
-dimensions: contact on faces*); friction, contact pairs, plane shapes and oblique rollers are
-refused here, before any work.
+A 3D problem holds Dirichlet parts (all or some of ``(u_x, u_y, u_z)``), rollers (on planes
+normal to an axis one Cartesian component held, on oblique planes and curved parts the normal
+component in node frames), Neumann parts and frictionless contact parts against a gap
+function or a shape of space, along given directions or the body's normal (docs/method.md,
+*Three dimensions: contact on faces*); a body may be held along some rigid motions by its
+contact parts alone (force control). Friction, contact pairs and plane shapes are refused
+here, before any work, and so are a 2D mesh's data on a 3D mesh and the reverse.
 """
 
 from __future__ import annotations
@@ -14,15 +17,14 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from ..fem.space import space_of
 from ..mesh.mesh import Mesh
 from .conditions import Condition, Contact, Dirichlet, Neumann
 from .fields import ProblemError
+from .rigid3d import free_rigid_motions_3d
+from .rollers3d import check_roller_part_3d
 
-__all__ = ["check_dimension", "check_problem_3d", "rigid_modes_3d"]
-
-#: the relative size of a singular value of the held rigid motions' matrix below which a
-#: rigid motion counts as free
-RIGID_RTOL = 1e-8
+__all__ = ["check_dimension", "check_mesh_dimension", "check_problem_3d"]
 
 
 def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
@@ -38,6 +40,22 @@ def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
     """
     if mesh.dim == 3:
         _check_contact_3d(conditions)
+    for name, cond in conditions.items():  # a loop over parts
+        if not isinstance(cond, Contact) or cond.normal is None:
+            continue
+        size = None if callable(cond.normal) else np.size(cond.normal)
+        if mesh.dim == 2 and size != 2:
+            raise ProblemError(
+                f"contact part {name!r} gives normal={cond.normal!r} on a 2D mesh: give two "
+                "numbers (n_x, n_y) (a direction field n(x) and three numbers are for 3D "
+                "meshes)"
+            )
+        if mesh.dim == 3 and size == 2:
+            raise ProblemError(
+                f"contact part {name!r} gives normal={cond.normal!r} (2 numbers) on a 3D "
+                "mesh: give three numbers or a function n(x) of points (n, 3) returning unit "
+                "vectors (n, 3)"
+            )
     alpha = [
         n for n, c in conditions.items() if isinstance(c, Contact) and c.face_alpha is not None
     ]
@@ -84,23 +102,30 @@ def _check_contact_3d(conditions: Mapping[str, Condition]) -> None:
         )
 
 
-def rigid_modes_3d(x: np.ndarray) -> np.ndarray:
-    """``(n, 3, 6)`` the rigid motions at points ``x (n, 3)``: the translations ``e_k`` and
-    the rotations ``e_k × x`` (k = 0, 1, 2)."""
-    n = x.shape[0]
-    modes = np.zeros((n, 3, 6))
-    modes[:, [0, 1, 2], [0, 1, 2]] = 1.0
-    eye = np.eye(3)
-    modes[:, :, 3:] = np.cross(eye[None, :, :], x[:, None, :]).transpose(0, 2, 1)
-    return modes
+def check_mesh_dimension(name: str, stated: Mesh, mesh: Mesh) -> None:
+    """Refuse a ``mesh`` of another dimension than the mesh the problem ``name`` is
+    ``stated`` on (a 2D problem handed a tetrahedral mesh, or the reverse).
+
+    Raises
+    ------
+    ValueError
+        Naming both dimensions.
+    """
+    if mesh.dim != stated.dim:
+        raise ValueError(
+            f"the problem {name!r} is stated on a {stated.dim}D mesh and was handed a "
+            f"{mesh.dim}D mesh: solve it on its own mesh or a refinement of it"
+        )
 
 
 def check_problem_3d(
     mesh: Mesh,
     held: Mapping[str, Dirichlet],
     rollers: Mapping[str, object],
-) -> None:
-    """The checks of a 3D problem beyond the 2D ones that hold as they are.
+    contact_parts: list[str],
+) -> np.ndarray:
+    """The checks of a 3D problem beyond the 2D ones that hold as they are, and its free
+    rigid motions.
 
     Parameters
     ----------
@@ -109,33 +134,24 @@ def check_problem_3d(
     held : mapping part -> Dirichlet
         The Dirichlet parts and the axis rollers as Dirichlet conditions.
     rollers : mapping part -> Roller
-        The rollers not along an axis (refused).
+        The rollers on oblique planes and curved parts (their normal components held in node
+        frames, :mod:`.rollers3d`).
+    contact_parts : list of str
+
+    Returns
+    -------
+    (k, 6) float array
+        The rigid motions the held components leave free, each held by a contact part
+        (:func:`~.rigid3d.free_rigid_motions_3d`): the body is under force control along
+        them.
 
     Raises
     ------
     ProblemError
-        For an oblique or non-planar roller, or rigid motions the held components leave
-        free (the matrix would be singular).
+        For a roller part with a crease (:func:`~.rollers3d.check_roller_part_3d`), or a
+        rigid motion held by nothing (named).
     """
-    if rollers:
-        raise ProblemError(
-            f"roller part(s) {list(rollers)} on a 3D mesh are not planar faces normal to the "
-            "x, y or z axis: in 3D a Roller holds one Cartesian component of a plane "
-            "x, y or z = const (oblique and curved rollers need the node frames of issue 38)"
-        )
-    # the held components at the held parts' vertices against the six rigid motions
-    rows = []
-    for name, cond in held.items():  # a loop over parts
-        vertices = np.unique(mesh.facets[mesh.part_facets(name)])
-        comp = np.resize(np.asarray(cond.components), 3)
-        rows.append(rigid_modes_3d(mesh.points[vertices])[:, comp, :].reshape(-1, 6))
-    if not rows:
-        return
-    scale = 1.0 + np.abs(mesh.points).max()
-    s = np.linalg.svd(np.concatenate(rows) / scale, compute_uv=False)
-    free = 6 - int((s > RIGID_RTOL * s.max(initial=0.0)).sum()) if s.size else 6
-    if free > 0:
-        raise ProblemError(
-            f"the Dirichlet and Roller parts {list(held)} leave {free} rigid motion(s) of the "
-            "body free: hold more components (e.g. one part with Dirichlet((0, 0, 0)))"
-        )
+    space = space_of(mesh, "P2")
+    for name in rollers:  # a loop over parts
+        check_roller_part_3d(space, name)
+    return free_rigid_motions_3d(space, held, rollers, contact_parts)

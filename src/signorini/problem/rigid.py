@@ -48,7 +48,12 @@ def motion_field(mesh: Mesh, motions: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def describe_motion(mesh: Mesh, motion: np.ndarray) -> str:
-    """A rigid motion in words: ``translation along (0, 1)`` or ``rotation about (x, y)``."""
+    """A rigid motion in words: ``translation along (0, 1)`` or ``rotation about (x, y)``
+    (on a tetrahedral mesh :func:`~.rigid3d.describe_motion_3d`'s words)."""
+    if mesh.dim == 3:
+        from .rigid3d import describe_motion_3d  # (which builds on this module's frame)
+
+        return describe_motion_3d(mesh, motion)
     centre, size = _frame(mesh)
     a, b, c = np.asarray(motion, dtype=np.float64) / np.abs(motion).max()
     if abs(c) <= 1e-8:

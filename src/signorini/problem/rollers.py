@@ -160,6 +160,10 @@ def held_nodes(problem, space: P2Space, *, values: bool = True) -> HeldNodes:
                 bounded=True,
             )
             val[nodes[:, None], np.flatnonzero(held)[None, :]] = v[:, held]
+    if d == 3:  # the oblique and curved rollers of a tetrahedral mesh (docs/method.md)
+        from .rollers3d import held_rows_3d
+
+        return held_rows_3d(problem, space, comp, val)
     node, normal, value, part = _roller_rows(problem, space.mesh)
     if node.size == 0:
         return HeldNodes(comp, val, np.zeros(0, np.int64), np.zeros((0, d)), np.zeros(0))

@@ -1,0 +1,44 @@
+"""Shared 3D contact problems of tests/contact3d: a rotation about no axis and the block
+pressed onto a half-space on two symmetry rollers (force control)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from signorini.algebra.backends.selection import SOLVERS
+from signorini.fem.material import Material
+from signorini.mesh.builders3d import box
+from signorini.mesh.mesh import Mesh
+from signorini.problem.conditions import Contact, Neumann, Roller
+from signorini.problem.obstacles3d import HalfSpace
+from signorini.problem.problem import ContactProblem
+
+MATERIAL = Material.from_young(1.0, 0.3)
+DIRECT = SOLVERS["scipy"]
+
+
+def rotation() -> np.ndarray:
+    """A rotation about no coordinate axis (0.7 rad about z after 0.7 rad about x)."""
+    c, s = np.cos(0.7), np.sin(0.7)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ np.array(
+        [[1.0, 0.0, 0.0], [0.0, c, s], [0.0, -s, c]]
+    )
+
+
+def pressed_block(R: np.ndarray, load: float = -0.1) -> ContactProblem:
+    """The unit cube of box(2) rotated by ``R``: symmetry rollers on x0 and y0, pressed by
+    the traction ``(0.01, 0, load)`` on z1 and a body force onto the half-space below z0 (a
+    gap of 10⁻³): held along its normal by its contact alone (force control)."""
+    base = box(2, 2, 2)
+    parts = {p: base.facets[base.part_facets(p)] for p in base.part_names}
+    mesh = Mesh.from_arrays(base.points @ R.T, base.cells, parts)
+    traction = R @ np.array([0.01, 0.0, load])
+    conditions = {name: Neumann((0.0, 0.0, 0.0)) for name in mesh.part_names}
+    conditions.update(
+        x0=Roller(),
+        y0=Roller(),
+        z1=Neumann(tuple(traction.tolist())),
+        z0=Contact(obstacle=HalfSpace(R @ [0.0, 0.0, -1e-3], R @ [0.0, 0.0, 1.0])),
+    )
+    force = R @ np.array([0.0, 0.02, -0.05])
+    return ContactProblem(mesh, MATERIAL, conditions, body_force=lambda x: force)
