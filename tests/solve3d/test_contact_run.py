@@ -1,6 +1,7 @@
 """A 3D contact run of the command line, ``signorini run hertz-3d --uniform``: its history
-holds the contact columns that mean something on faces (n_active, contact_force, the KKT
-residuals) and agrees with its own VTU file read back; history.md describes exactly the
+holds the estimator's columns (η and its terms, the obstacle's term beside it) and the contact
+columns that mean something on faces (n_active, contact_force, the KKT residuals, the node
+classes of Section 4) and agrees with its own VTU file read back; history.md describes exactly the
 columns written; fields.md the 3D contact fields; the figures of a 3D contact run are drawn
 and listed."""
 
@@ -32,7 +33,11 @@ def test_the_history_of_a_3d_contact_run(tmp_path, capsys):
     columns = set(row)
     assert {"n_active", "n_constrained", "contact_force", "kkt_primal", "kkt_dual"} <= columns
     assert {"kkt_complementarity", "a", "p0", "total_force"} <= columns
-    assert not columns & set(FACE_CONTACT_LEFT_OUT + NO_ESTIMATE_COLUMNS)
+    assert not columns & set(FACE_CONTACT_LEFT_OUT)
+    classes = {"n_full_contact", "n_semi_contact", "n_no_contact"}
+    assert set(NO_ESTIMATE_COLUMNS) | classes | {"osc_obstacle"} <= columns
+    assert float(row["eta"]) > 0
+    assert sum(int(row[c]) for c in classes) == int(row["n_constrained"])
     for name in ("kkt_primal", "kkt_dual", "kkt_complementarity", "kkt_stationarity"):
         assert float(row[name]) <= 1e-10, name
     # the history against the level's VTU file

@@ -1,5 +1,6 @@
 """The first 3D run a user makes: ``signorini run elasticity-3d --uniform`` prints what a
-level without an estimator has, writes an honest history and draws its figures."""
+level without contact has (the estimator, the errors), writes an honest history and draws
+its figures."""
 
 from __future__ import annotations
 
@@ -28,19 +29,27 @@ def test_the_level_lines_show_what_exists(tmp_path, capsys):
     levels = [line for line in lines if line.startswith("level ")]
     assert len(levels) == len(rows) == 2
     for line in lines:
-        assert not re.search(r"\beta\b|eff |nan|active|eta5", line), line
-    assert re.search(r"ndof +81 +cells +48 +error 7\.8100e-01 +h1 .* l2 .* pardiso", levels[0])
+        assert not re.search(r"nan|active|eta5", line), line
+    assert re.search(
+        r"ndof +81 +cells +48 +eta \d\.\d{4}e\+01 +eff \d\d\.\d{3} +error 7\.8100e-01 +h1 .* l2 .* "
+        r"pardiso",
+        levels[0],
+    )
     assert re.search(r"error 2\.0330e-01 \(-0\.53\) +h1 [0-9.e-]+ \(-0\.5\d\)", levels[1])
 
 
-def test_the_history_leaves_the_estimator_and_contact_out(tmp_path, capsys):
+def test_the_history_has_the_estimator_and_leaves_contact_out(tmp_path, capsys):
     _, rows = _run(tmp_path, capsys, "--no-figures")
     columns = set(rows[0])
-    assert not columns & set(NO_ESTIMATE_COLUMNS + NO_CONTACT_COLUMNS)
+    assert not columns & set(NO_CONTACT_COLUMNS)
+    assert set(NO_ESTIMATE_COLUMNS) <= columns
     assert {"ndof", "error_energy", "error_h1", "error_l2", "rate_energy"} <= columns
-    assert all("nan" not in (r["error_energy"], r["error_l2"]) for r in rows)
+    assert all("nan" not in (r["error_energy"], r["error_l2"], r["eta"]) for r in rows)
+    for r in rows:  # the efficiency index is η_h over the energy error
+        assert float(r["efficiency"]) == float(r["eta"]) / float(r["error_energy"])
     described = (tmp_path / "run" / "history.md").read_text()
-    assert "tetrahedra of the mesh" in described and "`eta`" not in described
+    assert "tetrahedra of the mesh" in described and "`eta`" in described
+    assert "`n_active`" not in described
     assert set(columns) - {"t_output", "error_l2", "rate_energy", "rate_h1", "rate_l2"} <= set(
         COLUMNS_3D
     )
@@ -55,19 +64,21 @@ def test_an_iterative_solve_prints_its_iterations(tmp_path, capsys):
 
 
 def test_the_figures_of_a_3d_run(tmp_path, capsys):
+    """With the estimator a 3D run gets the convergence figures of Section 6 (error and η_h,
+    the efficiency index, η's terms) and the body; no contact figures without contact."""
     lines, _ = _run(tmp_path, capsys)
     out = tmp_path / "run"
-    assert "figures: elasticity-3d_errors.png" in lines[-2]
-    for stem, size in (("elasticity-3d_errors", None), ("elasticity-3d_body", (840, 720))):
-        png = out / f"{stem}.png"
-        assert png.stat().st_size > 5000 and (out / f"{stem}.pdf").stat().st_size > 5000
-        if size is not None:
-            assert png_size(png) == size
+    assert "figures: elasticity-3d_error_estimator.png" in lines[-2]
+    stems = ("error_estimator", "efficiency", "contributions", "body")
+    for stem in stems:
+        png = out / f"elasticity-3d_{stem}.png"
+        assert png.stat().st_size > 5000 and png.with_suffix(".pdf").stat().st_size > 5000
+    assert png_size(out / "elasticity-3d_body.png") == (840, 720)
     assert not list(out.glob("*pressure*")) and not list(out.glob("*mesh*"))
     # ``signorini figures`` redraws the history of the 3D run (no level: no body)
-    (out / "elasticity-3d_errors.png").unlink()
+    (out / "elasticity-3d_error_estimator.png").unlink()
     assert main(["figures", "elasticity-3d", str(out)]) == 0
-    assert (out / "elasticity-3d_errors.png").stat().st_size > 5000
+    assert (out / "elasticity-3d_error_estimator.png").stat().st_size > 5000
 
 
 def test_without_pyvista_one_line_in_the_log(tmp_path, capsys, caplog):

@@ -98,9 +98,13 @@ def test_refused_at_the_boundary(conditions, message):
         ContactProblem(mesh, MATERIAL, full)
 
 
-def test_adaptive_3d_refused_naming_the_estimator():
-    with pytest.raises(ValueError, match="estimator"):
-        adaptive(elasticity_3d(1), max_ndof=1000)
+def test_adaptive_3d_runs_with_the_estimator():
+    """Without ``uniform`` a 3D problem is refined where the estimator marks (Dörfler,
+    tests/estimator3d has the estimator's own tests)."""
+    levels = list(adaptive(elasticity_3d(2), max_levels=2))
+    assert levels[0].estimate is not None and levels[0].record.eta > 0
+    assert 0 < levels[0].marked.sum() < levels[0].marked.size
+    assert levels[1].result.mesh.n_cells > levels[0].result.mesh.n_cells
 
 
 def test_vtu_tetra10_read_back(tmp_path):

@@ -34,13 +34,13 @@ ERRORS_SHOWN = (
 
 
 def progress(level: Level) -> str:
-    """The progress line of a finished level (:func:`elasticity_progress` for a level without
-    an estimator and without contact)."""
+    """The progress line of a finished level (:func:`elasticity_progress` for a 3D level
+    without contact)."""
     r = level.record
     if isinstance(r, ElasticityRecord):
         return elasticity_progress(r)
     line = f"level {r.level:3d}  ndof {r.ndof:9d}  cells {r.n_cells:8d}"
-    if not np.isnan(r.eta):  # a 3D contact level has no estimator yet
+    if not np.isnan(r.eta):
         line += f"  eta {r.eta:.4e}"
     if not np.isnan(r.error_energy):
         line += f"  error {r.error_energy:.4e}  eff {r.efficiency:.3f}"
@@ -52,12 +52,16 @@ def progress(level: Level) -> str:
 
 
 def elasticity_progress(r: ElasticityRecord) -> str:
-    """The progress line of a level without an estimator and without contact (3D): its
-    unknowns and cells, the errors it knows with their observed rates (the history's
+    """The progress line of a level without contact (3D): its unknowns and cells, η_h and
+    the efficiency index where known, the errors it knows with their observed rates (the history's
     ``rate_*`` columns, when the problem measures them), the solver and, if iterative, its
     iterations, the seconds of its steps."""
     row = {"error_energy": r.error_energy, "error_h1": r.error_h1, **r.extra}
     line = f"level {r.level:3d}  ndof {r.ndof:9d}  cells {r.n_cells:8d}"
+    if math.isfinite(r.eta):
+        line += f"  eta {r.eta:.4e}"
+        if math.isfinite(r.efficiency):
+            line += f"  eff {r.efficiency:.3f}"
     for shown, column, rate in ERRORS_SHOWN:
         value = float(row.get(column, math.nan))
         if math.isfinite(value):

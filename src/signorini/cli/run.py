@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ..algebra.backends.selection import solver_library, solver_name
 from ..loop import COLUMNS, Level, adaptive
-from ..loop.record import COLUMNS_3D, COLUMNS_3D_CONTACT
+from ..loop.record import COLUMNS_3D, COLUMNS_3D_CONTACT, ElasticityRecord
 from ..output import HistoryWriter, write_columns
 from ..output.check import CHECK, write_check
 from ..output.environment import environment
@@ -193,8 +193,10 @@ def _solve_levels(work: _Run, status: Status) -> Level | None:
     out, state, options, say = work.folder.path, work.state, work.settings.options, work.say
     job = work.job
     work.folder.add_files("history.csv", "history.md")
-    three = job.problem.mesh.dim == 3  # no estimator (nor contact): their columns left out
+    three = job.problem.mesh.dim == 3
     columns = COLUMNS_3D_CONTACT if job.problem.contact_parts else COLUMNS_3D
+    if three and not job.problem.contact_parts:  # 3D elasticity: no contact columns
+        columns = {k: v for k, v in columns.items() if k not in ElasticityRecord.LEFT_OUT}
     write_columns(
         out / "history.md",
         {
@@ -209,7 +211,7 @@ def _solve_levels(work: _Run, status: Status) -> Level | None:
         write_fields(out / "fields.md", job.problem.mesh)  # its regions' and bodies' names
     history = HistoryWriter(out / "history.csv", rows=state.history_rows if state else ())
     mode = "uniform" if options.uniform else f"adaptive, theta={options.theta}"
-    eta5 = "" if three else f", eta5={options.eta5_variant}"
+    eta5 = "" if three and not job.problem.contact_parts else f", eta5={options.eta5_variant}"
     say(f"{job.problem.name}: {mode}{eta5}, max_ndof={options.max_ndof} -> {out}")
     loop = {"metrics": job.metrics, "path": job.path}
     status.phase = "at level 0" if state is None else f"at level {state.level + 1}"

@@ -198,7 +198,8 @@ def estimate(
     ranks: Ranks = SERIAL,
     partition: Partition | None = None,
 ) -> Estimate:
-    """Compute η_h and all its contributions for a discrete solution (paper, Section 5).
+    """Compute η_h and all its contributions for a discrete solution (paper, Section 5); on
+    tetrahedra :func:`~.residual3d.estimate_3d` (one process).
 
     Parameters
     ----------
@@ -228,6 +229,10 @@ def estimate(
     """
     if eta5_variant not in ETA5_VARIANTS:
         raise ValueError(f"eta5_variant must be one of {ETA5_VARIANTS}, got {eta5_variant!r}")
+    if result.mesh.dim == 3:  # tetrahedra: the 3D table, one process (it imports this module)
+        from .residual3d import estimate_3d
+
+        return estimate_3d(result, eta5_variant)
     own = own_part(result, ranks, partition)  # None: one process, every cell and facet
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells

@@ -32,6 +32,7 @@ __all__ = [
     "h1_seminorm_error2_3d",
     "l2_error2_3d",
     "nodal_stress_3d",
+    "stress_divergence_3d",
     "von_mises_3d",
 ]
 
@@ -137,6 +138,20 @@ def nodal_stress_3d(
         axis=1,
     )  # a loop over the nine components
     return (total / np.maximum(count, 1)[:, None]).reshape(-1, 3, 3)
+
+
+def stress_divergence_3d(hess: np.ndarray, material: Material | CellMaterials) -> np.ndarray:
+    """``div σ(u) (m, ..., 3)`` from the Hessians ``hess (m, ..., 3, 3, 3)``,
+    ``[..., i, j, k] = ∂_j ∂_k u_i`` (e.g. :meth:`~signorini.fem.mapping3d.AffineTetrahedra.
+    field_hessians`): ``μ Δu_i + (λ + μ) ∂_i div u`` (the 3D law; a
+    :class:`~signorini.fem.material.CellMaterials` of the leading axis' cells)."""
+    lam, mu = lame_parameters(material, 3)
+    laplace = np.einsum("...ijj->...i", hess)
+    grad_div = np.einsum("...jji->...i", hess)
+    shape = (-1,) + (1,) * (laplace.ndim - 1)
+    lam = np.reshape(lam, shape) if np.ndim(lam) else lam
+    mu = np.reshape(mu, shape) if np.ndim(mu) else mu
+    return mu * laplace + (lam + mu) * grad_div
 
 
 def von_mises_3d(

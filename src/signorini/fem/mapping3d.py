@@ -118,6 +118,18 @@ class IsoparametricTetrahedra(IsoparametricSimplices):
         """``(m, q, 3, 3)`` ``∂u_i/∂x_j`` of a P2 field at reference points ``xi``."""
         return np.einsum("mai,mqaj->mqij", _coefficients(u_cell), self.basis_gradients(xi))
 
+    def field_hessians(self, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
+        """``(m, q, 3, 3, 3)`` ``∂²u_i/∂x_j∂x_k`` of a P2 field at ``xi (q, 3)``, exact through
+        the quadratic map (the 3D form of :func:`signorini.fem.iso.field_derivatives`):
+        ``∇²u_h = J⁻ᵀ (D²û − Σ_i (∂_i u_h) D²x_i) J⁻¹`` with the constant ``D²x_i``."""
+        href = p2_tet.hessian_basis()  # (10, 3, 3)
+        d2u = np.einsum("mai,ars->mirs", _coefficients(u_cell), href)
+        d2x = np.einsum("mai,ars->mirs", self.nodes, href)
+        grad = self.field_gradients(u_cell, xi)  # (m, q, 3, 3): [c, i]
+        inner = d2u[:, None] - np.einsum("mqci,mirs->mqcrs", grad, d2x)
+        jit = self.inverse_transpose(xi)  # [j, r] = ∂ξ_r / ∂x_j
+        return np.einsum("mqjr,mqcrs,mqks->mqcjk", jit, inner, jit)
+
 
 class TetrahedronMap(CellMap):
     """The tetrahedra of a mesh as groups of one geometry: affine, then isoparametric.

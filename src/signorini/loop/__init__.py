@@ -12,7 +12,6 @@ the same levels as an uninterrupted run.
 from __future__ import annotations
 
 import logging
-import math
 import numbers
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -57,8 +56,9 @@ class Level:
         The level's row of the convergence history.
     result : ContactResult
         The discrete solution on the level's mesh (``result.mesh``).
-    estimate : Estimate or None
-        The a posteriori estimator of that solution; None in 3D (uniform refinement).
+    estimate : Estimate
+        The a posteriori estimator of that solution (in 3D :mod:`signorini.estimator.
+        residual3d`).
     marked : (n_cells,) bool array or None
         Cells marked for refinement; None on the last level.
     next_mesh : Mesh or None
@@ -174,12 +174,6 @@ def adaptive(
             )
         path = check_path([*path, problem])[:-1]
     mesh = problem.mesh if mesh is None else mesh
-    if mesh.dim == 3 and not options.uniform:
-        raise ValueError(
-            "a 3D problem runs with uniform refinement only (uniform=True, --uniform): the "
-            "a posteriori estimator on tetrahedra, the loop's ESTIMATE step in 3D, is not "
-            "built yet (issue 39, three dimensions part 3)"
-        )
     if problem.free_ndof(space_of(mesh, options.element)) > options.max_ndof:
         raise ValueError(
             f"the initial mesh already has {problem.free_ndof(space_of(mesh, options.element))} "
@@ -228,8 +222,7 @@ def _levels(
         u0 = None
         on_ranks = _estimator_ranks(result, solver)
         t0 = time.perf_counter()
-        three = mesh.dim == 3  # uniform refinement, no estimator (checked by adaptive)
-        est = None if three else estimate(result, eta5_variant=options.eta5_variant, **on_ranks)
+        est = estimate(result, eta5_variant=options.eta5_variant, **on_ranks)
         t_est = time.perf_counter() - t0
         record = level_record(level, result, est)
         record.t_estimate = t_est
@@ -237,7 +230,7 @@ def _levels(
             _add_path_counts(record, steps)
         if metrics is not None:
             record.extra.update(_measured(metrics, result))
-        record.eta_roundoff = math.nan if three else roundoff_level(result)
+        record.eta_roundoff = roundoff_level(result)
         record.stop = _stop_reason(record, options)
         last = bool(record.stop)
         marked = next_mesh = None

@@ -224,19 +224,28 @@ NO_CONTACT_COLUMNS = (
 
 @dataclass
 class ElasticityRecord(LevelRecord):
-    """The record of a level of elasticity without an estimator and without contact (3D,
-    docs/method.md, *Three dimensions: solving elasticity*): its row leaves out the
-    estimator's and the contact's columns, which hold nothing there (NaN, zero); the
-    attributes stay (NaN, zero), so code reading a record reads either kind. An iterative
-    solve adds ``linear_iterations`` to :attr:`extra`."""
+    """The record of a level of 3D elasticity without contact (docs/method.md, *Three
+    dimensions: solving elasticity*): its row leaves out the contact's columns, which hold
+    nothing there (zero, NaN), and without an estimate the estimator's as well (NaN); the
+    attributes stay, so code reading a record reads either kind. An
+    iterative solve adds ``linear_iterations`` to :attr:`extra`."""
 
-    LEFT_OUT: ClassVar[tuple[str, ...]] = NO_ESTIMATE_COLUMNS + NO_CONTACT_COLUMNS
+    LEFT_OUT: ClassVar[tuple[str, ...]] = NO_CONTACT_COLUMNS
+
+    def row(self) -> dict:
+        """Flat dict for a CSV row, without the contact's columns (and the estimator's where
+        there is no estimate)."""
+        d = super().row()
+        if math.isnan(self.eta):
+            for name in NO_ESTIMATE_COLUMNS:
+                del d[name]
+        return d
 
 
-#: The columns of a 3D elasticity run's history (:class:`ElasticityRecord`), with their
-#: meaning in 3D.
+#: The columns of a 3D run's history, with their meaning in 3D (an
+#: :class:`ElasticityRecord`'s row has those but the contact's).
 COLUMNS_3D: dict[str, str] = {
-    **{k: v for k, v in COLUMNS.items() if k not in ElasticityRecord.LEFT_OUT},
+    **COLUMNS,
     "ndof": "free scalar unknowns, 3 × (vertices + edges) of the P2 tetrahedra minus 3 per "
     "node on a Dirichlet part (one per fixed component on a roller)",
     "ndof_total": "all scalar P2 unknowns, 3 × (vertices + edges), Dirichlet ones included",
@@ -247,15 +256,16 @@ COLUMNS_3D: dict[str, str] = {
     "linear_iterations": "CG iterations of an iterative solver (amg), summed over the level's "
     "solves; absent with a direct solver",
     "backend": "sparse solver backend used (pardiso, scipy or amg)",
-    "t_estimate": "seconds spent computing the estimator (0: none in 3D yet)",
+    "osc_obstacle": "the obstacle's interpolation term beside eta, (Σ_F |∫_F λ̃_h (ψ − ψ_h)|)^(1/2) "
+    "(docs/method.md, *Three dimensions: the estimator on tetrahedra and faces*); not a part "
+    "of eta, unit of eta_6; 3D contact runs only",
 }
 
 
-#: The columns a 3D contact level's row leaves out: the node classes of Section 4 (not built
-#: on faces) and the friction's (3D contact is frictionless).
+#: The columns a 3D contact level's row leaves out: the friction's (3D contact is
+#: frictionless).
 FACE_CONTACT_LEFT_OUT = (
-    "n_full_contact", "n_semi_contact", "n_no_contact", "n_stick", "n_slip",
-    "kkt_tangential_bound", "kkt_tangential_complementarity",
+    "n_stick", "n_slip", "kkt_tangential_bound", "kkt_tangential_complementarity",
 )  # fmt: skip
 
 
@@ -285,6 +295,10 @@ _IN_3D_CONTACT = {
     "n_active": "constraint rows in the final active set: the P2 nodes of Γ_C in contact (one "
     "row per node and contact part; for condition (b) the transformed coefficient at its "
     "bound)",
+    "n_full_contact": "rows in full contact (Section 4 on faces: every node of every contact "
+    "face at the row in contact)",
+    "n_semi_contact": "rows in contact but not in full contact (where η6 lives)",
+    "n_no_contact": "rows not in contact",
     "n_constrained": "constraint rows: the P2 nodes (vertices and edge midpoints) of the "
     "contact parts' faces whose normal component is not held, one per node and part",
     "contact_force": "Σ Λ_z (3.17) over the rows, force units: the resultant normal force on "
@@ -301,8 +315,8 @@ _IN_3D_CONTACT = {
 }
 COLUMNS_3D_CONTACT: dict[str, str] = {
     name: _IN_3D_CONTACT.get(name) or COLUMNS_3D.get(name) or COLUMNS[name]
-    for name in [*COLUMNS, "linear_iterations"]
-    if name not in NO_ESTIMATE_COLUMNS + FACE_CONTACT_LEFT_OUT
+    for name in [*COLUMNS, "osc_obstacle", "linear_iterations"]
+    if name not in FACE_CONTACT_LEFT_OUT
 }
 
 
@@ -318,16 +332,16 @@ _NO_ESTIMATE = _NoEstimate()
 
 
 def level_record(level: int, result: ContactResult, est: Estimate | None) -> LevelRecord:
-    """The record of one level; without an estimate (3D) η and its terms are NaN, and
-    without contact as well an :class:`ElasticityRecord`, whose row leaves them out; a 3D
-    level with contact a :class:`FaceContactRecord`."""
+    """The record of one level; without an estimate η and its terms are NaN; a 3D level
+    without contact is an :class:`ElasticityRecord`, whose row leaves the contact's columns
+    out (and the estimator's without an estimate), a 3D level with contact a
+    :class:`FaceContactRecord`."""
     if est is None:
         est = _NO_ESTIMATE
-    # the node classes of Section 4 are not built on faces (3D): their counts stay 0
-    has_classes = result.contact.size and result.mesh.dim == 2
+    has_classes = result.contact.size > 0
     classes = result.classes if has_classes else np.zeros(0, dtype=np.int64)
     report = result.report
-    elasticity = est is _NO_ESTIMATE and not result.contact.size
+    elasticity = result.mesh.dim == 3 and not result.contact.size
     three = result.mesh.dim == 3
     kind = ElasticityRecord if elasticity else FaceContactRecord if three else LevelRecord
     rec = kind(
@@ -355,6 +369,9 @@ def level_record(level: int, result: ContactResult, est: Estimate | None) -> Lev
         t_assemble=result.timings["assemble"],
         t_solve=result.timings["solve"],
     )
+    oscillation = getattr(est, "obstacle_oscillation", None)  # a 3D estimate with contact
+    if oscillation is not None and result.contact.size:
+        rec.extra["osc_obstacle"] = oscillation
     if three and report.linear_iterations:
         rec.extra["linear_iterations"] = int(sum(report.linear_iterations))
     if result.problem.exact is not None:

@@ -1,0 +1,225 @@
+"""ESTIMATE on P2 tetrahedra: the residual estimator η_h of the paper's (5.1) in three
+dimensions, the same :class:`~signorini.estimator.residual.Estimate` as in 2D
+(docs/method.md, *Three dimensions: the estimator on tetrahedra and faces*).
+
+For every P2 node p that is not a Dirichlet node, ``h_p = max_{T ∋ p} h_T`` (h_T the
+longest edge of the tetrahedron):
+
+==== ============================================================ ==========================
+η1   ``h_p² ‖f + div σ(u_h)‖²_{ω_p}``                                every cell of ω_p
+η2   ``h_p ‖⟦σ(u_h) n⟧‖²_F``                                        interior faces F ∋ p
+η3   ``h_p ‖σ(u_h)n − g‖²_F``; on rollers the tangential part of     Neumann, roller faces
+     σ(u_h)n, on parts holding some components the free ones
+η4   ``h_p ‖σ(u_h)n − (d·σ(u_h)n) d‖²_F`` (a tangent vector)          contact faces
+η5   ``h_p ‖d·σ(u_h)n + p_h‖²_F`` (``consistent``) or without p_h    contact faces
+η6   ``s_p d_p``, ``d_p = ∫_{γ̃_p} (ψ_h − u_h·n)⁺ φ_p``             semi-contact nodes
+η7   the guaranteed bound G of ``‖(u_h·n − ψ_h)⁺‖_{H^{1/2}(Γ_C)}``   global
+η8   0 (frictionless in 3D)
+==== ============================================================ ==========================
+
+A face F "contains" p when p is one of its six P2 nodes (where the P2 function of p does not
+vanish on F). d is the constraint direction field on Γ_C (:func:`.faces3d.direction_field_3d`),
+p_h the P2 interpolant of the nodal pressure on each face, γ̃_p the support of the hat φ_p of
+the once-refined face and s_p = Λ̃_p / m_p (:mod:`.contact_faces3d`, which integrates η4 … η7).
+Each integral is taken once per cell or face through its own geometry (affine or
+isoparametric tetrahedra, flat or quadratic faces, :mod:`signorini.fem.mapping3d`), the
+kernels of :mod:`.terms` turn them into node contributions and cell shares as in 2D, so the
+element indicators sum to η_h² exactly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..contact.solution import ContactResult
+from ..fem.elasticity3d import stress_divergence_3d
+from ..fem.material import CellMaterials, Material, on_cells
+from ..fem.quadrature import tetrahedron_rule, triangle_rule
+from ..fem.space3d import P2TetSpace
+from ..problem.conditions import Dirichlet, Roller
+from ..problem.fields import evaluate_field
+from .contact_faces3d import PRESSURE_3D, contact_terms
+from .faces3d import TetStress, face_geometry
+from .names import TERMS
+from .residual import NODE_TERMS, Estimate
+from .terms import (
+    FacetSet,
+    TermShares,
+    boundary_cell_shares,
+    interior_residual,
+    neumann_residual,
+    node_mesh_size,
+    spread_cell_integrals,
+    spread_facet_integrals,
+    spread_node_parts,
+)
+
+__all__ = ["CELL_DEGREE_3D", "FACE_DEGREE", "NEUMANN_DEGREE_3D", "Estimate3D", "estimate_3d"]
+
+#: tetrahedron rule for η1 with a body force (27 points; f is smooth data)
+CELL_DEGREE_3D = 5
+#: triangle rule on the faces for η2, η4, η5: σ(u_h) is linear on a straight cell, p_h
+#: quadratic, so the squares are of degree 4 on flat faces; one more for quadratic faces
+FACE_DEGREE = 5
+#: triangle rule for η3 with data g that is not a polynomial: finer, so that quadrature stays
+#: far below the residual itself
+NEUMANN_DEGREE_3D = 10
+
+
+def estimate_3d(
+    result: ContactResult, eta5_variant: str = "consistent", pressure: str = PRESSURE_3D
+) -> Estimate:
+    """η_h and its contributions for a 3D discrete solution (P2 tetrahedra); called by
+    :func:`~signorini.estimator.residual.estimate` on a tetrahedral mesh (which checks
+    ``eta5_variant``).
+
+    Parameters
+    ----------
+    result : ContactResult
+    eta5_variant : {"consistent", "paper"}
+    pressure : {"transformed", "recovered"}
+        The nodal pressure the consistent η5 balances σ_nn with
+        (:func:`~.contact_faces3d.eta5_pressure`; default :data:`~.contact_faces3d.PRESSURE_3D`).
+
+    Returns
+    -------
+    Estimate
+        ``eta2_cell (8, n_cells)``, ``eta2_node (7, n_nodes)`` as in 2D (η8 = 0).
+    """
+    problem, space, mesh = result.problem, result.space, result.mesh
+    n_nodes, n_cells = space.n_nodes, mesh.n_cells
+    h_p = node_mesh_size(mesh.h, space.cell_nodes, result.dirichlet_nodes, n_nodes)
+    material = problem.material_on(mesh)
+    stresses = TetStress(space, result.u, material)
+    unit = stresses.unit
+    s, w = triangle_rule(FACE_DEGREE)
+
+    R = _cell_residuals(result, material, stresses)
+    inner = _face_set(space, np.flatnonzero(mesh.facet2cell[:, 1] >= 0))
+    J2 = _jumps(space, stresses, inner, s, w)
+    boundary, J3 = _traction_residuals(result, stresses)
+    contact = contact_terms(result, stresses, eta5_variant, s, w, pressure)
+
+    def on_faces(faces: FacetSet, J: np.ndarray) -> TermShares:
+        return spread_facet_integrals(faces, J, h_p, n_cells)
+
+    zero = TermShares(np.zeros(n_nodes), np.zeros(n_cells))
+    shares = {
+        "eta_1": spread_cell_integrals(R, space.cell_nodes, h_p),
+        "eta_2": on_faces(inner, J2),
+        "eta_3": on_faces(boundary, J3),
+        "eta_4": zero,
+        "eta_5": zero,
+        "eta_6": zero,
+        "eta_7": TermShares(None, np.zeros(n_cells)),
+        "eta_8": zero,
+    }
+    if contact is not None:
+        faces = contact.faces
+        shares["eta_4"] = on_faces(faces, contact.J4)
+        shares["eta_5"] = on_faces(faces, contact.J5)
+        shares["eta_6"] = spread_node_parts(faces, contact.parts6, n_nodes, n_cells)
+        shares["eta_7"] = TermShares(None, boundary_cell_shares(faces, contact.eta7, n_cells))
+    oscillation = 0.0 if contact is None else float(np.sqrt(contact.oscillation.sum() * unit))
+    return Estimate3D(
+        eta2_cell=np.stack([shares[name].cell for name in TERMS]),
+        eta2_node=np.stack([shares[name].node for name in NODE_TERMS]),
+        eta5_variant=eta5_variant,
+        unit=unit,
+        obstacle_oscillation=oscillation,
+    )
+
+
+@dataclass(frozen=True)
+class Estimate3D(Estimate):
+    """The :class:`~signorini.estimator.residual.Estimate` of a 3D solution, and beside it
+    (not in η_h) the obstacle's interpolation term ``osc_ψ = (Σ_F |∫_F λ̃_h (ψ − ψ_h)|)^{1/2}``
+    of the reliability bound (:func:`~.contact_faces3d.obstacle_oscillation`; the unit of η6;
+    0 without contact and where ψ is piecewise quadratic on the faces)."""
+
+    obstacle_oscillation: float = 0.0
+
+
+def _face_set(space: P2TetSpace, e: np.ndarray) -> FacetSet:
+    """Mesh faces ``e`` with their six nodes (the first cell's face order), cells, areas."""
+    mesh = space.mesh
+    return FacetSet(e, space.mesh_facet_nodes(e), mesh.facet2cell[e], mesh.facet_measure[e])
+
+
+def _cell_residuals(
+    result: ContactResult, material: Material | CellMaterials, stresses: TetStress
+) -> np.ndarray:
+    """η1's ``‖f + div σ(u_h)‖²_T`` ``(n_cells,)`` in the stress unit: div σ(u_h) from the
+    Hessians through each cell's map (constant on affine cells), f at the points of the
+    degree-``CELL_DEGREE_3D`` rule. :func:`~.terms.interior_residual` reads a rule whose
+    weights sum to 1/2 and the cells' ``det J / 2``: the tetrahedron's weights (summing to
+    1/6) enter times 3 and ``det J / 6`` (the volume) as its measure, the same sums."""
+    problem, cells, unit = result.problem, result.space.mapping, stresses.unit
+    xi, w = tetrahedron_rule(CELL_DEGREE_3D)
+    f = None
+    if problem.body_force is not None:
+        f = evaluate_field(problem.body_force, cells.points(xi), "body_force", shape=(3,)) / unit
+
+    def residual(g) -> np.ndarray:
+        hess = g.field_hessians(stresses.u_cell[g.cells], xi)
+        div = stress_divergence_3d(hess, on_cells(material, g.cells)) / unit
+        volume = g.jacobians(xi)[1] / 6.0
+        return interior_residual(volume, div, None if f is None else f[g.cells], 3.0 * w)
+
+    return cells.per_cell(residual)
+
+
+def _traction(stresses: TetStress, cells: np.ndarray, nodes: np.ndarray, s, geometry):
+    """``σ(u_h) n (k, q, 3)`` of ``cells`` on their faces (nodes ``(k, 6)``, outward normals
+    of ``geometry``) at the points ``s``."""
+    sigma = stresses.at_faces(cells, nodes[:, :3], s)
+    n = np.broadcast_to(geometry.normals(s), sigma.shape[:2] + (3,))
+    return (sigma @ n[..., None])[..., 0]
+
+
+def _jumps(space, stresses: TetStress, faces: FacetSet, s, w) -> np.ndarray:
+    """η2's ``‖⟦σ(u_h) n⟧‖²_F`` on interior faces: both cells at the same points, the jump
+    ``(σ₀ − σ₁) n₀`` with the first cell's outward normal."""
+    J = np.zeros(faces.index.size)
+    for rows, geometry in face_geometry(space, faces.nodes):
+        nodes, cells = faces.nodes[rows], faces.cells[rows]
+        jump = _traction(stresses, cells[:, 0], nodes, s, geometry)
+        jump -= _traction(stresses, cells[:, 1], nodes, s, geometry)
+        J[rows] = neumann_residual(jump, w, geometry.speeds(s))
+    return J
+
+
+def _traction_residuals(result: ContactResult, stresses: TetStress) -> tuple[FacetSet, np.ndarray]:
+    """η3's faces and ``‖r‖²_F`` on each, part after part: ``r = σ(u_h)n − g`` on Neumann parts
+    (g at the points and with the normals of each face's geometry), the tangential part of
+    σ(u_h)n on rollers, the free components of σ(u_h)n on Dirichlet parts that hold some
+    (docs/method.md, *Rollers and components*)."""
+    problem, space, mesh = result.problem, result.space, result.mesh
+    s, w = triangle_rule(NEUMANN_DEGREE_3D)
+    index, values = [], []
+    for name, cond in problem.conditions.items():  # a loop over parts
+        if isinstance(cond, Dirichlet) and all(cond.components):
+            continue
+        if not isinstance(cond, Dirichlet | Roller) and name not in problem.neumann_parts:
+            continue
+        e = mesh.part_facets(name)
+        faces = _face_set(space, e)
+        J = np.zeros(e.size)
+        for rows, geometry in face_geometry(space, faces.nodes):
+            sn = _traction(stresses, faces.cells[rows, 0], faces.nodes[rows], s, geometry)
+            n = np.broadcast_to(geometry.normals(s), sn.shape)
+            if isinstance(cond, Roller):
+                sn = sn - np.einsum("kqc,kqc->kq", sn, n)[..., None] * n
+            elif isinstance(cond, Dirichlet):
+                sn = sn * ~np.asarray(cond.components)
+            elif not cond.is_zero:
+                what = f"the traction of Neumann part {name!r}"
+                g = evaluate_field(cond.field(), geometry.points(s), what, shape=(3,), normal=n)
+                sn = sn - g / stresses.unit
+            J[rows] = neumann_residual(sn, w, geometry.speeds(s))
+        index.append(e)
+        values.append(J)
+    e = np.concatenate(index) if index else np.zeros(0, np.int64)
+    return _face_set(space, e), (np.concatenate(values) if values else np.zeros(0))
