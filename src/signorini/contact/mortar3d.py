@@ -45,6 +45,7 @@ __all__ = [
     "MORTAR_DEGREE",
     "MortarCoupling3D",
     "dual_coefficients",
+    "face_duals",
     "face_transform",
     "mortar_coupling_3d",
     "plane_barycentric",
@@ -89,7 +90,7 @@ def dual_coefficients(mass: np.ndarray, weight: np.ndarray) -> np.ndarray:
     return np.swapaxes(np.linalg.solve(mass, weight[:, :, None] * np.eye(6)), 1, 2)
 
 
-def _face_duals(triangles: np.ndarray, alpha: float) -> tuple[np.ndarray, np.ndarray]:
+def face_duals(triangles: np.ndarray, alpha: float) -> tuple[np.ndarray, np.ndarray]:
     """Per slave face (straight triangles ``(f, 3, 3)``) the weights ``D_F (f, 6)`` and the
     dual coefficients ``A_F (f, 6, 6)`` of the transformed basis."""
     s, w = triangle_rule(MORTAR_DEGREE)
@@ -215,7 +216,7 @@ def mortar_coupling_3d(
             f"{pair}: no part of the slave lies over the master along its normals (the parts "
             "do not face each other)"
         )
-    weight, coef = _face_duals(s_tri, alpha)
+    weight, coef = face_duals(s_tri, alpha)
     slave_nodes, index = np.unique(sf, return_inverse=True)
     index = index.reshape(sf.shape)
     D = np.bincount(index.ravel(), weights=weight.ravel(), minlength=slave_nodes.size)

@@ -36,7 +36,7 @@ from .face_contact import SAME_DIRECTION
 from .face_fields import FaceFields
 from .mortar3d import MortarCoupling3D
 from .mortar_checks import COVERAGE_TOL
-from .node_frames3d import frame_operator, held_frames
+from .node_frames3d import frame_operator, held_frames, to_frames_3d
 
 __all__ = ["MortarFaceSet", "mortar_face_set"]
 
@@ -71,7 +71,7 @@ class MortarFaceSet:
         The frame DOF of each oblique or curved roller row (none on a slave node).
     operator : (n_dofs, n_dofs) scipy.sparse.csr_matrix
         ``R``: Cartesian DOFs of the solver's variables.
-    transfer : (k, n_nodes) scipy.sparse.csr_matrix
+    node_transfer : (k, n_nodes) scipy.sparse.csr_matrix
         ``T_jk = M_jk / D_jj`` of the rows.
     faces, face_part : (n_f, 6) and (n_f,) int arrays
         The slave faces' nodes and pairs.
@@ -95,14 +95,15 @@ class MortarFaceSet:
     held_values: np.ndarray
     roller_dof: np.ndarray
     operator: sp.csr_matrix
-    transfer: sp.csr_matrix
+    node_transfer: sp.csr_matrix
     faces: np.ndarray
     face_part: np.ndarray
     edges: np.ndarray
     alpha: float
 
-    # what the solve reads of a contact set
+    # what the solve reads of a contact set (``transfer``: the 2D pairs' change of basis)
     has_friction = False
+    transfer = None
 
     @property
     def n_rows(self) -> int:
@@ -146,11 +147,21 @@ class MortarFaceSet:
         out[e] = (out[e] - self.alpha * (out[a] + out[b])) / (1.0 - 2.0 * self.alpha)
         return out
 
+    def unknowns(self, u: np.ndarray) -> np.ndarray:
+        """``(n_dofs,)`` the solver's variables ``y = R⁻¹ u`` of Cartesian DOFs ``u``: the
+        transformed coefficients, minus ``T_d u`` at the rows (``T_d² = 0``), into the
+        frames."""
+        u = np.asarray(u, dtype=np.float64)
+        r = self.coefficients(u.reshape(-1, 3))
+        rel = np.einsum("kc,kc->k", self.node_transfer @ u.reshape(-1, 3), self.direction)
+        r[self.node] -= rel[:, None] * self.direction
+        return to_frames_3d(r.ravel(), self.frame_nodes, self.frames)
+
     def relative_gap(self, u: np.ndarray) -> np.ndarray:
         """``(k,)`` ``n_j·(ũ_j − Σ_k T_jk u_k) − g̃_j / D_jj`` of nodal values ``u (n_nodes,
         3)``: 0 in contact, negative where the bodies are apart."""
         u = np.asarray(u, dtype=np.float64)
-        rel = self.coefficients(u)[self.node] - self.transfer @ u
+        rel = self.coefficients(u)[self.node] - self.node_transfer @ u
         return np.einsum("kc,kc->k", rel, self.direction) - self.psi
 
     def master_forces(self, force: np.ndarray, n_nodes: int) -> np.ndarray:
@@ -159,7 +170,7 @@ class MortarFaceSet:
         towards the master): equal and opposite resultants where ``Σ_k M_jk = D_jj``."""
         f = np.asarray(force, dtype=np.float64)[:, None] * self.direction
         out = np.zeros((n_nodes, 3))
-        out[: self.transfer.shape[1]] = self.transfer.T @ f
+        out[: self.node_transfer.shape[1]] = self.node_transfer.T @ f
         return out
 
     def fields(self, u: np.ndarray, force: np.ndarray, active: np.ndarray) -> FaceFields:
@@ -282,7 +293,7 @@ def mortar_face_set(space, couplings: Sequence[MortarCoupling3D], held: HeldNode
         masters=tuple(c.master for c in couplings), direction=direction, psi=gap / D,
         basis_integral=D, dof=frames.row_dof, frame_nodes=frames.frame_nodes,
         frames=frames.frames, held_dofs=frames.held_dofs, held_values=frames.held_values,
-        roller_dof=frames.roller_dof, operator=R, transfer=T, faces=faces,
+        roller_dof=frames.roller_dof, operator=R, node_transfer=T, faces=faces,
         face_part=face_part, edges=edges, alpha=alpha,
     )  # fmt: skip
 
