@@ -88,9 +88,7 @@ def transformed(c, values: np.ndarray) -> np.ndarray:
     ((3, 3, 1), (4, 4, 1), "lower.z1", "upper.z0"),
     ((2, 5, 1), (5, 3, 1), "upper.z0", "lower.z1"),
 ])  # fmt: skip
-def test_mortar_matrices_reproduce_p2_fields_across_nonmatching_meshes(
-    upper, lower, slave, master
-):
+def test_mortar_matrices_reproduce_p2_fields_across_nonmatching_meshes(upper, lower, slave, master):
     """Σ_k M_jk = D_jj (constants: coverage 1), and Σ_k M_jk f(x_k) = D_jj f̃_j for affine
     and quadratic f (f̃ the transformed coefficients of f on the slave), to 1e-14 of max D;
     the weighted gap over D is the gap 0.01 along the slave's normal."""

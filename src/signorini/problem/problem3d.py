@@ -178,12 +178,19 @@ def check_problem_3d(
 
 
 def _held_bodies(space, held: Mapping, rollers: Mapping, pairs: Mapping[str, str]) -> np.ndarray:
-    """With contact pairs (3D): every body held in all its rigid motions by its own
-    Dirichlet and Roller parts (force control across a pair is built in 2D only); no free
-    motion."""
+    """With contact pairs (3D): no pair on one body (self contact), every body held in all
+    its rigid motions by its own Dirichlet and Roller parts (force control across a pair is
+    built in 2D only); no free motion."""
     mesh = space.mesh
     body = body_of_cells(mesh)
     part_body = {p: int(body[mesh.facet2cell[mesh.part_facets(p)[0], 0]]) for p in mesh.part_names}
+    for slave, master in pairs.items():  # a loop over pairs
+        if part_body[slave] == part_body[master]:
+            raise ProblemError(
+                f"the contact pair {slave!r} / {master!r}: both parts lie on one body: self "
+                "contact is not modelled (in small deformation a body does not reach its own "
+                "boundary); a pair joins parts of two bodies"
+            )
     for b in range(int(body.max()) + 1):  # a loop over bodies
         own = [p for p in mesh.part_names if part_body[p] == b]
         try:
