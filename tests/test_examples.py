@@ -222,6 +222,7 @@ def test_get_example():
         "example-6.1-3d",
         "example-6.2-3d",
         "punch-3d",
+        "stacked-cubes",
     }
     for name in EXAMPLES:
         assert get_example(name).name == name

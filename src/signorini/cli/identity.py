@@ -16,6 +16,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..contact.face_contact import FaceContactSet
+from ..contact.mortar3d_set import MortarFaceSet
 from ..contact.system import assemble
 from ..loop import AdaptiveOptions, adaptive
 from ..output.check import CHECK, MESH_ARRAYS, differences, read_check
@@ -94,7 +95,7 @@ def _step_data(problem: ContactProblem, mesh, k: int) -> dict[str, np.ndarray]:
     system = assemble(problem, mesh)
     cs = system.contact
     probe = np.sin(1.0 + np.arange(system.K.shape[0]))  # no zero entry, no symmetry
-    if isinstance(cs, FaceContactSet):  # on faces (3D): the rows' directions, no friction
+    if isinstance(cs, FaceContactSet | MortarFaceSet):  # on faces (3D): no friction
         normal, nodes, friction = cs.direction, cs.node, np.zeros(0)
     else:
         normal, nodes = cs.normal, cs.nodes

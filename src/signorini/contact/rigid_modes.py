@@ -23,6 +23,7 @@ from ..fem.space import node_dofs
 from ..mesh.bodies import body_of_cells
 from ..problem.rigid3d import rigid_modes_3d
 from .face_contact import FaceContactSet
+from .mortar3d_set import MortarFaceSet
 from .node_frames import to_frames
 from .node_frames3d import to_frames_3d
 from .system import Assembled
@@ -93,7 +94,7 @@ def _in_system(modes: np.ndarray, assembled: Assembled) -> np.ndarray:
     transfer = assembled.contact.transfer
     if transfer is not None:  # the relative displacement of the contact pairs
         modes = modes - transfer.dofs @ modes
-    if isinstance(assembled.contact, FaceContactSet):  # ỹ = P⁻¹ Q⁻¹ u, six per body
+    if isinstance(assembled.contact, FaceContactSet | MortarFaceSet):  # ỹ = R⁻¹ u
         return np.column_stack([assembled.contact.unknowns(m) for m in modes.T])
     if space.mesh.dim == 3:  # the frames of the oblique and curved rollers
         return np.column_stack(

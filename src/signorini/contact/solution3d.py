@@ -13,6 +13,7 @@ import numpy as np
 from ..fem.elasticity3d import energy_error2_3d, h1_seminorm_error2_3d, l2_error2_3d
 from ..problem.fields import evaluate_field
 from .face_contact import FaceContactSet
+from .mortar3d_set import MortarFaceSet
 from .node_frames import to_cartesian
 from .node_frames3d import to_cartesian_3d
 from .system import Assembled
@@ -41,7 +42,7 @@ def cartesian_displacement(x: np.ndarray, assembled: Assembled) -> np.ndarray:
     contact pairs, back from the relative displacement (:func:`~.two_body.physical`); in
     3D ``x`` out of the rollers' frames, or with contact ``R x`` out of the frames and the
     transformed face basis (:meth:`~.face_contact.FaceContactSet.displacement`)."""
-    if isinstance(assembled.contact, FaceContactSet):
+    if isinstance(assembled.contact, FaceContactSet | MortarFaceSet):
         return assembled.contact.displacement(x).reshape(-1, 3)
     if assembled.space.mesh.dim == 3:  # out of the oblique and curved rollers' frames
         return to_cartesian_3d(x, assembled.frame_nodes, assembled.frames).reshape(-1, 3)
@@ -60,9 +61,10 @@ def contact_force(contact: ContactSet | FaceContactSet, multiplier: np.ndarray) 
 
 def nodal_pressure(result: ContactResult) -> np.ndarray:
     """``(k,)`` the consistent nodal pressure: ``Λ_z / w_z`` by the facet element, or on faces
-    the transformed basis's ``Λ̃_z / w̃_z`` (:meth:`~.face_contact.FaceContactSet.pressure`)."""
+    the transformed basis's ``Λ̃_z / w̃_z`` (:meth:`~.face_contact.FaceContactSet.pressure`),
+    of contact pairs the dual basis's ``Λ̃_j / D_jj``."""
     cs = result.contact
-    if isinstance(cs, FaceContactSet):
+    if isinstance(cs, FaceContactSet | MortarFaceSet):
         return cs.pressure(result.contact_force)
     return result.space.element.facet.pressure(result.contact_force, cs.basis_integral)
 

@@ -45,6 +45,8 @@ from .contact_set import _empty
 from .discrete_conditions import DiscreteConditions
 from .face_basis import DEFAULT_ALPHA
 from .face_contact import FaceContactSet, face_contact_set
+from .mortar3d import mortar_coupling_3d
+from .mortar3d_set import MortarFaceSet, mortar_face_set
 from .node_frames3d import held_frames, rotate_frames_3d
 from .ordering import Ordering
 from .partition import Partition, partition
@@ -231,17 +233,24 @@ def _stiffness_and_load(
 
 def _face_contact(
     problem: ContactProblem, space: P2TetSpace, conditions: DiscreteConditions
-) -> FaceContactSet:
-    """The contact set on faces of the problem's contact parts (one α for all)."""
+) -> FaceContactSet | MortarFaceSet:
+    """The contact set on faces of the problem's contact parts (one α for all): against
+    obstacles, or the dual mortar constraints of its contact pairs (problem3d: not both)."""
     contact = {name: problem.conditions[name] for name in problem.contact_parts}
     alpha = next(iter(contact.values())).face_alpha  # one for all parts (problem3d)
     alpha = DEFAULT_ALPHA if alpha is None else alpha
+    if problem.pairs:  # docs/method.md, *Two bodies in three dimensions*
+        couplings = [
+            mortar_coupling_3d(space, slave, master, alpha=alpha)
+            for slave, master in problem.pairs.items()
+        ]  # a loop over pairs
+        return mortar_face_set(space, couplings, conditions.held)
     return face_contact_set(space, contact, conditions.held, alpha=alpha)
 
 
 def _with_contact(
     space: P2TetSpace,
-    cs: FaceContactSet,
+    cs: FaceContactSet | MortarFaceSet,
     system: tuple[sp.csr_matrix, np.ndarray],
     conditions: DiscreteConditions,
     part: Partition | None,

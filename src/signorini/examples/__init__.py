@@ -14,7 +14,9 @@ curved geometry.
 - :mod:`.punch3d`: a rigid punch with rounded edges pressed into a block held against a wall
   (3D, the half of a symmetric model);
 - :mod:`.two_bodies`: contact between two elastic bodies: two cylinders (Hertz), two
-  mirror-image half-discs, two blocks with non-matching meshes (the contact patch test).
+  mirror-image half-discs, two blocks with non-matching meshes (the contact patch test);
+- :mod:`.two_bodies3d`: two boxes with non-matching meshes in contact (3D, the dual mortar
+  coupling on faces; the contact patch test).
 
 :data:`EXAMPLES` holds one :class:`Example` record per built-in example, by the name the
 command line takes (``signorini run hertz``): its problem, and where it has them its
@@ -39,6 +41,7 @@ from .partial_slip import PARTIAL_SLIP_METRICS, partial_slip, partial_slip_path
 from .punch import punch
 from .punch3d import punch_3d
 from .two_bodies import BLOCKS_METRICS, CYLINDERS_METRICS, hertz_pair, stacked_blocks, two_cylinders
+from .two_bodies3d import CUBES_METRICS, stacked_cubes
 
 __all__ = [
     "EXAMPLES",
@@ -63,6 +66,7 @@ __all__ = [
     "punch_3d",
     "hertz_pair",
     "stacked_blocks",
+    "stacked_cubes",
     "two_cylinders",
 ]
 
@@ -120,6 +124,7 @@ EXAMPLES: dict[str, Example] = {
         Example("example-6.1-3d", example_6_1_3d, metrics=EXAMPLE_6_1_3D_METRICS),
         Example("example-6.2-3d", example_6_2_3d),
         Example("punch-3d", punch_3d),
+        Example("stacked-cubes", stacked_cubes, metrics=CUBES_METRICS),
     )
 }
 

@@ -20,6 +20,7 @@ from scipy.sparse.csgraph import connected_components
 from .mesh import Mesh
 from .regions import DEFAULT_REGION
 from .validation import MeshError, winding_numbers
+from .validation3d import solid_winding_numbers
 
 __all__ = ["BODY_SEPARATOR", "body_names", "body_of_cells", "union"]
 
@@ -98,16 +99,22 @@ def _check_apart(names: list[str], meshes: list[Mesh]) -> None:
     """No cell centroid of one body lies inside another (winding number of its boundary)."""
     for a, mesh in enumerate(meshes):  # a loop over bodies
         segments = mesh.oriented_boundary(np.flatnonzero(mesh.facet2cell[:, 1] < 0))
+        winding = solid_winding_numbers if mesh.dim == 3 else winding_numbers
         for b, other in enumerate(meshes):
             if a == b:
                 continue
+            if other.dim != mesh.dim:
+                raise MeshError(
+                    f"union: body {names[b]!r} is {other.dim}D and body {names[a]!r} "
+                    f"{mesh.dim}D: the bodies of one mesh have one dimension"
+                )
             centroid = other.points[other.cells].mean(axis=1)
-            inside = np.flatnonzero(winding_numbers(mesh.points, segments, centroid) != 0)
+            inside = np.flatnonzero(winding(mesh.points, segments, centroid) != 0)
             if inside.size:
-                x = centroid[inside[0]]
+                x = ", ".join(f"{v:.6g}" for v in centroid[inside[0]])
                 raise MeshError(
                     f"union: body {names[b]!r} overlaps body {names[a]!r}: the centroid "
-                    f"({x[0]:.6g}, {x[1]:.6g}) of its cell {inside[0]} ({inside.size} cell(s) "
+                    f"({x}) of its cell {inside[0]} ({inside.size} cell(s) "
                     "in all) lies inside the other body. Bodies in contact touch along their "
                     "boundaries; move them apart"
                 )

@@ -163,7 +163,9 @@ class ContactProblem:
             self, "rollers", {k: self.conditions[k] for k, v in held.items() if v is None}
         )
         if mesh.dim == 3:  # docs/method.md, *Three dimensions: rollers, force control, ...*
-            motions = check_problem_3d(mesh, self.held, self.rollers, self.contact_parts)
+            motions = check_problem_3d(
+                mesh, self.held, self.rollers, self.contact_parts, self.pairs
+            )
             object.__setattr__(self, "rigid_motions", motions)
             object.__setattr__(self, "rigid_parts", ())
             object.__setattr__(self, "contact_normals", {})

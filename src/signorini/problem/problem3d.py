@@ -7,8 +7,10 @@ normal to an axis one Cartesian component held, on oblique planes and curved par
 component in node frames), Neumann parts and frictionless contact parts against a gap
 function or a shape of space, along given directions or the body's normal (docs/method.md,
 *Three dimensions: contact on faces*); a body may be held along some rigid motions by its
-contact parts alone (force control). Friction, contact pairs and plane shapes are refused
-here, before any work, and so are a 2D mesh's data on a 3D mesh and the reverse.
+contact parts alone (force control). Frictionless contact pairs between bodies
+(docs/method.md, *Two bodies in three dimensions*) stand alone (no obstacle parts beside
+them), with every body held by its own parts. Friction and plane shapes are refused here,
+before any work, and so are a 2D mesh's data on a 3D mesh and the reverse.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..fem.space import space_of
+from ..mesh.bodies import body_of_cells
 from ..mesh.mesh import Mesh
 from .conditions import Condition, Contact, Dirichlet, Neumann
 from .fields import ProblemError
@@ -28,9 +31,9 @@ __all__ = ["check_dimension", "check_mesh_dimension", "check_problem_3d"]
 
 
 def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
-    """Refuse on a tetrahedral ``mesh`` what 3D contact does not build (friction, pairs,
-    plane shapes), and constant data with another number of components than the mesh has
-    dimensions.
+    """Refuse on a tetrahedral ``mesh`` what 3D contact does not build (friction, pairs
+    beside obstacles, plane shapes), and constant data with another number of components
+    than the mesh has dimensions.
 
     Raises
     ------
@@ -77,16 +80,22 @@ def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
 
 
 def _check_contact_3d(conditions: Mapping[str, Condition]) -> None:
-    """Refuse what 3D contact on faces does not build yet: friction, contact pairs, a plane
-    shape (dim 2) as the obstacle; and contact parts with different ``face_alpha``."""
+    """Refuse what 3D contact on faces does not build yet: friction, a plane shape (dim 2) as
+    the obstacle, pairs beside obstacle parts, a pair with condition (a) or an obstacle; and
+    contact parts with different ``face_alpha``."""
     for name, cond in conditions.items():  # a loop over parts
         if not isinstance(cond, Contact):
             continue
         what = None
         if cond.friction is not None:
             what = "friction on faces is not built yet (frictionless contact only)"
-        elif cond.master is not None:
-            what = "contact pairs between bodies are not built in 3D yet"
+        elif cond.master is not None and cond.face_alpha == 0:
+            what = (
+                "face_alpha=0 in a contact pair: the dual mortar basis on P2 faces needs the "
+                "transformed basis (0 < face_alpha < 1/2; None for 1/5)"
+            )
+        elif cond.master is not None and (cond.obstacle is not None or cond.normal is not None):
+            what = "a contact pair takes no obstacle and no normal (the bodies give them)"
         elif cond.obstacle is not None and cond.obstacle.dim != 3:
             what = (
                 f"the obstacle {cond.obstacle!r} is a plane shape: use a shape of space "
@@ -94,6 +103,12 @@ def _check_contact_3d(conditions: Mapping[str, Condition]) -> None:
             )
         if what is not None:
             raise ProblemError(f"contact part {name!r} on a 3D (tetrahedral) mesh: {what}")
+    kinds = {c.master is not None for c in conditions.values() if isinstance(c, Contact)}
+    if len(kinds) > 1:
+        raise ProblemError(
+            "a 3D problem with contact pairs between bodies takes no contact parts against "
+            "obstacles yet: state the pairs alone"
+        )
     alphas = {c.face_alpha for c in conditions.values() if isinstance(c, Contact)}
     if len(alphas) > 1:
         raise ProblemError(
@@ -123,6 +138,7 @@ def check_problem_3d(
     held: Mapping[str, Dirichlet],
     rollers: Mapping[str, object],
     contact_parts: list[str],
+    pairs: Mapping[str, str] | None = None,
 ) -> np.ndarray:
     """The checks of a 3D problem beyond the 2D ones that hold as they are, and its free
     rigid motions.
@@ -137,6 +153,8 @@ def check_problem_3d(
         The rollers on oblique planes and curved parts (their normal components held in node
         frames, :mod:`.rollers3d`).
     contact_parts : list of str
+    pairs : mapping slave part -> master part, optional
+        The contact pairs: then every body must be held by its own parts.
 
     Returns
     -------
@@ -154,4 +172,39 @@ def check_problem_3d(
     space = space_of(mesh, "P2")
     for name in rollers:  # a loop over parts
         check_roller_part_3d(space, name)
+    if pairs:
+        return _held_bodies(space, held, rollers, pairs)
     return free_rigid_motions_3d(space, held, rollers, contact_parts)
+
+
+def _held_bodies(space, held: Mapping, rollers: Mapping, pairs: Mapping[str, str]) -> np.ndarray:
+    """With contact pairs (3D): no pair on one body (self contact), every body held in all
+    its rigid motions by its own Dirichlet and Roller parts (force control across a pair is
+    built in 2D only); no free motion."""
+    mesh = space.mesh
+    body = body_of_cells(mesh)
+    part_body = {p: int(body[mesh.facet2cell[mesh.part_facets(p)[0], 0]]) for p in mesh.part_names}
+    for slave, master in pairs.items():  # a loop over pairs
+        if part_body[slave] == part_body[master]:
+            raise ProblemError(
+                f"the contact pair {slave!r} / {master!r}: both parts lie on one body: self "
+                "contact is not modelled (in small deformation a body does not reach its own "
+                "boundary); a pair joins parts of two bodies"
+            )
+    for b in range(int(body.max()) + 1):  # a loop over bodies
+        own = [p for p in mesh.part_names if part_body[p] == b]
+        try:
+            free_rigid_motions_3d(
+                space,
+                {p: c for p, c in held.items() if p in own},
+                {p: c for p, c in rollers.items() if p in own},
+                [],
+            )
+        except ProblemError as err:
+            raise ProblemError(
+                f"the body with the parts {own} in a 3D problem with contact pairs "
+                f"{dict(pairs)}: each body must be held in all its rigid motions by its own "
+                f"Dirichlet and Roller parts (force control across a pair is built in 2D "
+                f"only). {err}"
+            ) from None
+    return np.zeros((0, 6))
