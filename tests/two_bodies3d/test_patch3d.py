@@ -182,3 +182,20 @@ def test_bad_pairs_refused():
         solve(ContactProblem(mesh=wide, material=base.material, conditions=base.conditions))
     with pytest.raises(ProblemError, match="held in all its rigid motions"):
         pair_problem(**{"upper.z1": Neumann((0.0, 0.0, -0.01))})
+
+
+def test_pairs_in_3d_refused_where_not_built():
+    """An adaptive 3D run with pairs (the estimator has no mortar terms on faces yet) and a
+    3D pair system on several MPI ranks are refused before any work, naming the pairs."""
+    from signorini.algebra.ranks import Ranks
+    from signorini.loop import adaptive
+
+    problem = stacked_cubes(((2, 2, 1), (2, 2, 1)))
+    with pytest.raises(ValueError, match="uniform refinement only"):
+        adaptive(problem)
+    assert next(iter(adaptive(problem, uniform=True, max_levels=1))).record.ndof > 0
+
+    two = Ranks()  # a rank count only: the refusal comes before any communication
+    two.size = 2
+    with pytest.raises(ValueError, match="not split over MPI ranks"):
+        assemble(problem, problem.mesh, ranks=two)

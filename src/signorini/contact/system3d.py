@@ -151,6 +151,11 @@ def assemble_3d(problem: ContactProblem, mesh: Mesh, ranks: Ranks = SERIAL) -> A
     conditions = discrete_conditions_3d(problem, space)
     cs = _face_contact(problem, space, conditions) if problem.contact_parts else None
     part, rows = None, None
+    if ranks.size > 1 and isinstance(cs, MortarFaceSet):
+        raise ValueError(
+            f"contact pairs {sorted(problem.pairs)} on a tetrahedral mesh run on one process: "
+            "the rows of the 3D mortar coupling are not split over MPI ranks yet"
+        )
     if ranks.size > 1:  # this rank's rows, and with contact the rows they read
         part = partition(space, ranks)
         rows = part.owned_dofs

@@ -338,7 +338,8 @@ def level_record(level: int, result: ContactResult, est: Estimate | None) -> Lev
     :class:`FaceContactRecord`."""
     if est is None:
         est = _NO_ESTIMATE
-    has_classes = result.contact.size > 0
+    # the node classes of Section 4 on faces; not built for 3D pairs (the mortar side)
+    has_classes = result.contact.size > 0 and not (result.mesh.dim == 3 and result.problem.pairs)
     classes = result.classes if has_classes else np.zeros(0, dtype=np.int64)
     report = result.report
     elasticity = result.mesh.dim == 3 and not result.contact.size
