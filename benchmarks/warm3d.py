@@ -8,7 +8,8 @@ solution prolongated to the refined mesh, read in the solver's variables) and wi
 level: the free unknowns, the rows in contact, and per run the PDAS steps (``pdas``), the
 linear solves (``solves``: factorizations and bordered updates, or the iterative path's
 loose and confirming solves) and the solve time; then the mean solves per level after the
-first level.
+first level. ``hertz-3d-coarse`` is ``hertz_3d(h_contact=0.2)``: a level more within the
+budget.
 
     python benchmarks/warm3d.py                                 # the table of docs/method.md
     python benchmarks/warm3d.py --problems hertz-3d --max-ndof 60000  # a quick look
@@ -21,7 +22,15 @@ import argparse
 import numpy as np
 
 from signorini.examples import get_example
+from signorini.examples.hertz3d import hertz_3d
 from signorini.loop import adaptive
+
+#: the problems by name: the built-in ones, and hertz-3d from a coarser mesh (more levels)
+PROBLEMS = {
+    "hertz-3d": lambda: get_example("hertz-3d"),
+    "hertz-3d-coarse": lambda: hertz_3d(h_contact=0.2),
+    "example-6.2-3d": lambda: get_example("example-6.2-3d"),
+}
 
 
 def _levels(problem, max_ndof: float, warm: bool) -> list:
@@ -34,11 +43,11 @@ def _levels(problem, max_ndof: float, warm: bool) -> list:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--problems", nargs="+", default=["hertz-3d", "example-6.2-3d"])
-    parser.add_argument("--max-ndof", type=float, default=450_000)
+    parser.add_argument("--problems", nargs="+", choices=sorted(PROBLEMS), default=list(PROBLEMS))
+    parser.add_argument("--max-ndof", type=float, default=200_000)
     args = parser.parse_args(argv)
     for name in args.problems:  # a loop over problems
-        problem = get_example(name)
+        problem = PROBLEMS[name]()
         runs = {warm: _levels(problem, args.max_ndof, warm) for warm in (True, False)}
         print(f"{name}:")
         print(

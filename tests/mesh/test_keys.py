@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from contact3d_problems import mirrored
 
 from signorini.mesh import MeshError
 from signorini.mesh.builders3d import box, eighth_ball, quarter_cylinder
@@ -112,3 +113,20 @@ def test_curved_builders_beyond_the_cells_limit():
     assert cylinder.n_points == 33 * 33 * 65 and ball.n_points == 41**3
     assert abs(cylinder.volume.sum() / (np.pi / 2) - 1) < 2e-3
     assert abs(ball.volume.sum() / (np.pi / 6) - 1) < 2e-3
+
+
+@pytest.mark.slow
+def test_the_half_ball_mirrored_from_eighth_ball_32():
+    """``eighth_ball(32)`` (35 937 points) and the lower half ball made of it and its mirror
+    images in x = 0 and y = 0 (139 425 points, 786 432 cells, beyond the cells' limit):
+    valid, the volume four times the eighth's, the boundary parts' areas those of the
+    sphere's lower half and the equatorial disc within the mesh's O(h²)."""
+    eighth = eighth_ball(32)
+    quarter, _ = mirrored(eighth, 0)
+    half, _ = mirrored(quarter, 1)
+    assert half.n_points == 65 * 65 * 33 and half.n_cells == 4 * eighth.n_cells
+    assert set(half.part_names) == {"z1", "sphere"}
+    assert np.isclose(half.volume.sum(), 4 * eighth.volume.sum(), rtol=1e-12)
+    assert abs(half.volume.sum() / (2 * np.pi / 3) - 1) < 2e-3
+    assert abs(half.part_measure("sphere") / (2 * np.pi) - 1) < 2e-3
+    assert abs(half.part_measure("z1") / np.pi - 1) < 2e-3
