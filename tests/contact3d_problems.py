@@ -1,5 +1,6 @@
-"""Shared 3D contact problems of tests/contact3d: a rotation about no axis and the block
-pressed onto a half-space on two symmetry rollers (force control)."""
+"""Shared 3D contact problems of tests/contact3d: a rotation about no axis, the block
+pressed onto a half-space on two symmetry rollers (force control), and a mesh joined to its
+mirror image."""
 
 from __future__ import annotations
 
@@ -42,3 +43,28 @@ def pressed_block(R: np.ndarray, load: float = -0.1) -> ContactProblem:
     )
     force = R @ np.array([0.0, 0.02, -0.05])
     return ContactProblem(mesh, MATERIAL, conditions, body_force=lambda x: force)
+
+
+def mirrored(mesh: Mesh, axis: int) -> tuple[Mesh, np.ndarray]:
+    """``mesh`` and its mirror image in the plane ``x_axis = 0`` (its vertices there kept
+    once): the image's cells with vertices 1 and 2 swapped (positive again), each part the
+    union of its faces and their images except a part on the plane (now inside), curved
+    parts carrying their (symmetric) surfaces; and each vertex's image."""
+    p = mesh.points
+    off = p[:, axis] != 0.0
+    image = np.arange(mesh.n_points)
+    image[off] = mesh.n_points + np.arange(off.sum())
+    flipped = p[off].copy()
+    flipped[:, axis] *= -1.0
+    parts = {}
+    for name in mesh.part_names:  # a loop over parts
+        faces = mesh.facets[mesh.part_facets(name)]
+        if off[faces].any():
+            parts[name] = np.vstack([faces, image[faces]])
+    whole = Mesh.from_arrays(
+        np.vstack([p, flipped]), np.vstack([mesh.cells, image[mesh.cells][:, [0, 2, 1, 3]]]), parts
+    )
+    for name, curve in zip(mesh.part_names, mesh.curves, strict=True):
+        if curve is not None and name in parts:
+            whole = whole.with_curve(name, curve)
+    return whole, image

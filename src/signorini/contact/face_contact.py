@@ -174,6 +174,13 @@ class FaceContactSet:
         y[self.dof] = self.edges.coefficients(y[self.dof])
         return y
 
+    def normal_displacement(self, u: np.ndarray) -> np.ndarray:
+        """``(k,)`` the rows' bounded variables ``ỹ_dof`` (:meth:`unknowns`) of nodal values
+        ``u (n_nodes, 3)``: what :attr:`gap` bounds, so that a warm start's rows at their
+        bound are read where the solver reads them (for condition (a) at a node of one row
+        ``u(z)·n_z``; :func:`~.nested.warm_active_set`)."""
+        return self.unknowns(np.asarray(u, dtype=np.float64).ravel())[self.dof]
+
     def facet_normal_gap(self, u: np.ndarray) -> np.ndarray:
         """``u(z)·n_z − ψ(z)`` at the nodes of each contact face ``(n_f, 6)``, for nodal
         values ``u (n_nodes, 3)``."""

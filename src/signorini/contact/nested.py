@@ -26,6 +26,7 @@ from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
 from ..mesh.refine import refine_nvb
 from .contact_set import ContactSet
+from .face_contact import FaceContactSet
 
 __all__ = [
     "GLOBAL_SHARE",
@@ -60,10 +61,12 @@ def round_off_scale(u: np.ndarray, gap: np.ndarray) -> np.ndarray:
     return np.maximum(np.abs(u).max(initial=0.0), np.abs(gap))
 
 
-def warm_active_set(contact: ContactSet, u0: np.ndarray) -> np.ndarray:
+def warm_active_set(contact: ContactSet | FaceContactSet, u0: np.ndarray) -> np.ndarray:
     """``(m,) bool``: the constraints whose node meets its bound under the warm start
-    ``u0 (n_nodes, 2)`` to :data:`WARM_START_RTOL` (:data:`PAIR_WARM_START_RTOL` with
-    contact pairs) relative to :func:`round_off_scale`: PDAS's first active set."""
+    ``u0 (n_nodes, d)`` to :data:`WARM_START_RTOL` (:data:`PAIR_WARM_START_RTOL` with
+    contact pairs) relative to :func:`round_off_scale`: PDAS's first active set. On faces
+    (a :class:`~.face_contact.FaceContactSet`) in the solver's variables, the transformed
+    basis's ``ỹ_dof ≤ ψ̃`` (docs/method.md, *Three dimensions: warm starts*)."""
     rtol = WARM_START_RTOL if contact.transfer is None else PAIR_WARM_START_RTOL
     gap = contact.gap
     return contact.normal_displacement(u0) - gap >= -rtol * round_off_scale(u0, gap)

@@ -344,7 +344,7 @@ def solve(
             raise ValueError(f"u0 must have shape ({space.n_nodes}, {mesh.dim}), got {u0.shape}")
         if not np.isfinite(u0).all():
             raise ValueError("u0 contains NaN or inf")
-        active0 = warm_active_set(cs, u0) if mesh.dim == 2 else None  # 3D: no contact
+        active0 = warm_active_set(cs, u0) if mesh.dim == 2 or cs.size else None
     # K and F divided by a power of 2 when E is extreme (exact; 1 otherwise), so that no
     # product in the factorization overflows or underflows
     diagonal = assembled.K if ranks.size == 1 else sp.diags(ranks.sum(assembled.K.diagonal()))

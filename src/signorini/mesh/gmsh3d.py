@@ -28,7 +28,7 @@ from .mesh import Mesh, MeshError
 from .reference import TETRAHEDRON, TRIANGLE
 from .regions import DEFAULT_REGION
 from .surfaces import Surface
-from .topology import entity_keys
+from .topology import entity_keys, find_rows
 
 __all__ = ["SURFACE_RTOL", "read_tetrahedra"]
 
@@ -110,7 +110,6 @@ def _surface_groups(
     a triangle that is no face of a tetrahedron is refused."""
     names = _names(m, 2)
     faces = cells[:, TETRAHEDRON.facets].reshape(-1, 3)
-    keys = np.unique(entity_keys(faces, max(len(renumber), 1)))
     groups: dict[str, list[np.ndarray]] = {}
     for i, block in enumerate(m.cells):  # type: ignore[attr-defined]
         if block.type not in _TRIANGLES or tags is None:
@@ -120,9 +119,8 @@ def _surface_groups(
                 continue
             name = names.get(int(tag), f"part{int(tag)}")
             tri = renumber[block.data[tags[i] == tag][:, :3]]
-            k = entity_keys(np.where(tri < 0, 0, tri), max(len(renumber), 1))
-            pos = np.minimum(np.searchsorted(keys, k), keys.size - 1)
-            stray = (tri < 0).any(1) | (keys[pos] != k)
+            _, found = find_rows(faces, np.where(tri < 0, 0, tri), max(len(renumber), 1))
+            stray = (tri < 0).any(1) | ~found
             if stray.any():
                 raise MeshError(
                     f"{path} mixes 2D and 3D cells: {int(stray.sum())} triangle(s) of group "

@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from .topology import entity_keys
+from .topology import find_rows
 from .validation import MeshError, as_cells
 
 __all__ = ["check_parts", "part_indices"]
@@ -108,8 +108,6 @@ def part_indices(
     part_of = np.full(len(bnd), -1, dtype=np.int64)
     width = bnd.shape[1]
     what = "edge" if width == 2 else "face"
-    keys = entity_keys(bnd, len(points))
-    order = np.argsort(keys)
     listed = None  # edges named by an explicit list; predicates only claim the others
     for index in sorted(range(len(names)), key=lambda i: callable(parts[names[i]])):
         name = names[index]
@@ -131,17 +129,13 @@ def part_indices(
                 if pairs.ndim == 1 and pairs.size % width == 0:
                     pairs = pairs.reshape(-1, width)
                 pairs = as_cells(pairs, len(points), what=f"boundary {what}s", width=width)
-                k = entity_keys(pairs, len(points))
-                pos = np.searchsorted(keys, k, sorter=order)
-                pos = np.minimum(pos, len(keys) - 1)
-                found = keys[order[pos]] == k
+                where, found = find_rows(bnd, pairs, len(points))
                 if not found.all():
                     bad = pairs[~found][0]
                     raise MeshError(
                         f"boundary part {name!r}: {tuple(int(v) for v in bad)} is not a "
                         f"boundary {what} of the mesh"
                     )
-                where = order[pos]
         taken = where[part_of[where] >= 0]
         if taken.size:
             other = names[part_of[taken[0]]]

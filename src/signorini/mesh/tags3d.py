@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .reference import TETRAHEDRON
-from .topology import entity_keys
+from .topology import find_rows
 from .validation import MeshError
 
 __all__ = [
@@ -125,15 +125,16 @@ def with_face_parts(
     """
     order = np.ascontiguousarray(order, dtype=np.int64)
     n = order.shape[0]
-    key = entity_keys(order[:, TETRAHEDRON.facets].reshape(-1, 3), points.shape[0])
-    bkey = entity_keys(np.asarray(boundary, dtype=np.int64).reshape(-1, 3), points.shape[0])
-    sort = np.argsort(key, kind="stable")
-    pos = np.minimum(np.searchsorted(key[sort], bkey), key.size - 1)
-    if bkey.size and not np.array_equal(key[sort][pos], bkey):
-        bad = np.flatnonzero(key[sort][pos] != bkey)
+    row, found = find_rows(
+        order[:, TETRAHEDRON.facets].reshape(-1, 3),
+        np.asarray(boundary, dtype=np.int64).reshape(-1, 3),
+        points.shape[0],
+    )
+    if not found.all():
+        bad = np.flatnonzero(~found)
         raise MeshError(f"tagging: boundary face(s) {bad[:5].tolist()} are not cell faces")
     face_part = np.full(4 * n, -1, dtype=np.int64)
-    face_part[sort[pos]] = np.asarray(boundary_part, dtype=np.int64)
+    face_part[row] = np.asarray(boundary_part, dtype=np.int64)
     return Tags(
         order, np.asarray(gamma, dtype=np.int8), _signs(points, order), face_part.reshape(n, 4)
     )

@@ -12,17 +12,22 @@ scikit-fem builds its ``t2f``/``f2t`` from ``refdom`` tables: the entities of th
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from .reference import TRIANGLE
 from .validation import MeshError, format_indices
 
 __all__ = [
+    "KEY_LIMIT",
     "boundary_facets",
+    "common_keys",
     "edge_keys",
     "entity_keys",
     "entity_topology",
     "facet_local",
+    "find_rows",
     "longest_edge_first",
     "rows_of",
 ]
@@ -34,27 +39,78 @@ def _frozen(a: np.ndarray) -> np.ndarray:
     return a
 
 
+#: Keys are int64: every key is below this bound.
+KEY_LIMIT = 2**63
+
+
 def entity_keys(tuples: np.ndarray, n_points: int) -> np.ndarray:
-    """Unique int64 key of each unordered vertex set ``tuples (n, k)``: its sorted vertices
-    as the digits of a number in base ``n_points`` (for ``k = 2``, ``min * n_points + max``).
+    """Int64 key of each unordered vertex set ``tuples (n, k)`` (:func:`common_keys` of the
+    one array): equal keys for equal sets, ordered as the sorted vertex rows are
+    lexicographically; for ``k = 2``, ``min * n_points + max``."""
+    return common_keys([tuples], n_points)[0]
+
+
+def common_keys(arrays: Sequence[np.ndarray], n_points: int) -> list[np.ndarray]:
+    """Int64 keys of the unordered vertex sets of each of ``arrays`` ``(n_i, k)`` (vertices
+    below ``n_points``), comparable across the arrays: two sets have equal keys if and only
+    if they are equal, and the keys are ordered as the sets' sorted vertex rows are
+    lexicographically (so a sort by key is a lexicographic sort of the rows).
+
+    While ``n_points ** k`` fits into an int64 (faces up to 2 097 152 points, cells up to
+    55 108), the key is the sorted vertices read as the digits of a number in base
+    ``n_points``, the same in every call. Beyond, the leading digits are first replaced by
+    their rank among the rows of all ``arrays`` (one sort of the keys so far; the rank
+    keeps the lexicographic order), so that ``rank * n_points + next`` fits again: keys of
+    any mesh that fits in memory, comparable only among the arrays of one call —
+    compare keys of different arrays by passing them together (:func:`find_rows`).
 
     Raises
     ------
     MeshError
-        If ``n_points ** k`` does not fit into an int64.
+        If even the ranks do not fit (more than ``2**63 / n_points`` rows).
     """
-    k = tuples.shape[1]
-    if k > 2 and float(n_points) ** k >= 2.0**63:
-        raise MeshError(f"{n_points} points are too many for int64 keys of {k}-vertex entities")
-    if k == 2:
-        lo = np.minimum(tuples[:, 0], tuples[:, 1]).astype(np.int64)
-        hi = np.maximum(tuples[:, 0], tuples[:, 1]).astype(np.int64)
-        return lo * np.int64(n_points) + hi
-    s = np.sort(tuples, axis=1).astype(np.int64)
-    key = s[:, 0]
+    k = arrays[0].shape[1]
+    n = int(n_points)
+    if k == 2 and n * n <= KEY_LIMIT:
+        out = []
+        for pairs in arrays:  # a loop over the arrays
+            lo = np.minimum(pairs[:, 0], pairs[:, 1]).astype(np.int64)
+            hi = np.maximum(pairs[:, 0], pairs[:, 1]).astype(np.int64)
+            out.append(lo * np.int64(n) + hi)
+        return out
+    rows = [np.sort(np.asarray(a), axis=1).astype(np.int64) for a in arrays]
+    s = rows[0] if len(rows) == 1 else np.concatenate(rows)
+    key, bound = s[:, 0], n  # every key is below bound
     for j in range(1, k):  # a loop over an entity's vertices
-        key = key * np.int64(n_points) + s[:, j]
-    return key
+        if bound * n > KEY_LIMIT:
+            _, key = np.unique(key, return_inverse=True)
+            bound = int(key.max(initial=0)) + 1
+            if bound * n > KEY_LIMIT:
+                raise MeshError(f"{s.shape[0]} vertex sets of {n} points are too many for keys")
+        key = key * np.int64(n) + s[:, j]
+        bound *= n
+    return np.split(key, np.cumsum([r.shape[0] for r in rows])[:-1])
+
+
+def find_rows(
+    reference: np.ndarray, queries: np.ndarray, n_points: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The row of ``reference (n, k)`` that holds the vertex set of each row of ``queries
+    (m, k)`` (in any vertex order; the first such row), and whether there is one
+    (:func:`common_keys`).
+
+    Returns
+    -------
+    row : (m,) int64 array
+        The row of ``reference``; any row where ``found`` is false.
+    found : (m,) bool array
+    """
+    keys, want = common_keys([reference, queries], n_points)
+    if keys.size == 0:
+        return np.zeros(want.size, dtype=np.int64), np.zeros(want.size, dtype=bool)
+    order = np.argsort(keys, kind="stable")
+    pos = np.minimum(np.searchsorted(keys[order], want), keys.size - 1)
+    return order[pos], keys[order[pos]] == want
 
 
 def edge_keys(pairs: np.ndarray, n_points: int) -> np.ndarray:
@@ -142,8 +198,7 @@ def rows_of(entities: np.ndarray, tuples: np.ndarray, n_points: int) -> np.ndarr
     MeshError
         Naming the rows of ``tuples`` that are not entities.
     """
-    keys = entity_keys(entities, n_points)  # sorted by construction
-    k = entity_keys(tuples, n_points)
+    keys, k = common_keys([entities, tuples], n_points)  # keys sorted by construction
     pos = np.minimum(np.searchsorted(keys, k), keys.size - 1)
     if keys.size == 0 or not np.array_equal(keys[pos], k):
         bad = np.flatnonzero(keys[pos] != k)
