@@ -74,7 +74,7 @@ def run(name: str, max_ndof: int, uniform: bool) -> dict:
             ratio = np.median(mesh.h[near]) / np.median(mesh.h[~near])
             print(f"last level: median h_T at the {label} set / elsewhere = {ratio:.3f}")
     for key in ("eta", "error_energy"):
-        if np.isfinite(history[key]).all():
+        if np.isfinite(history[key]).all() and len(history[key]) >= 2:
             slope = fitted_slope(history["ndof"], history[key], 4)
             print(f"slope of {key} over the last 4 levels: {slope:.3f}")
     print(f"{len(history['ndof'])} levels in {time.perf_counter() - t0:.0f} s")
