@@ -123,3 +123,25 @@ def test_hertz_3d_marks_at_the_contact_zone_boundary():
     pooled = (near_marked / near_all) / (far_marked / far_all)
     print("concentration per level", np.round(per_level, 2), f"pooled {pooled:.1f}")
     assert min(per_level) >= 5 and pooled > 10
+
+
+@pytest.mark.slow
+def test_compare_uniform_draws_the_3d_optimal_slope(tmp_path, monkeypatch):
+    """``signorini run example-6.1-3d --compare-uniform``: both comparison figures (η and the
+    error) carry the reference triangle of P2 in 3D, slope −2/3 (not 2D's −1)."""
+    from signorini import plots
+    from signorini.cli import main
+
+    drawn = []
+    plot = plots.plot_adaptive_vs_uniform
+
+    def record(histories, path, **kwargs):
+        drawn.append((kwargs["key"], kwargs["reference_slope"]))
+        return plot(histories, path, **kwargs)
+
+    monkeypatch.setattr(plots, "plot_adaptive_vs_uniform", record)
+    out = tmp_path / "run"
+    args = ["run", "example-6.1-3d", "--max-ndof", "700", "--compare-uniform", "--no-vtu"]
+    assert main([*args, "--quiet", "--out", str(out)]) == 0
+    assert drawn == [("eta", pytest.approx(-2 / 3)), ("error_energy", pytest.approx(-2 / 3))]
+    assert (out / "adaptive_vs_uniform.png").stat().st_size > 0
