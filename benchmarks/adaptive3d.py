@@ -31,6 +31,7 @@ from examples3d.adaptive_measures import (  # noqa: E402
     marking_concentration,
     ndof_ratio,
     near_cells,
+    ridge_vertices,
     zone_boundary_vertices,
 )
 
@@ -39,12 +40,24 @@ from signorini.loop import adaptive  # noqa: E402
 from signorini.output import fitted_slope  # noqa: E402
 
 
+def set_names(name: str) -> list[str]:
+    """The vertex sets where the marking is measured: the contact zone's boundary, the
+    Dirichlet–Neumann edges, and for example-6.2-3d the pyramid's ridges."""
+    return ["zone", "DN", "ridge"] if name == "example-6.2-3d" else ["zone", "DN"]
+
+
+def marked_sets(name: str, result) -> dict[str, np.ndarray]:
+    """The vertices of each of :func:`set_names` on ``result``'s mesh."""
+    of = {"zone": zone_boundary_vertices, "DN": dirichlet_neumann_vertices, "ridge": ridge_vertices}
+    return {label: of[label](result) for label in set_names(name)}
+
+
 def run(name: str, max_ndof: int, uniform: bool) -> dict:
     problem = EXAMPLES[name].problem()
     history: dict[str, list] = {"ndof": [], "eta": [], "error_energy": []}
     print(f"{name} {'uniform' if uniform else 'adaptive'}, max_ndof {max_ndof}")
     head = "level      N        eta " + " ".join(f"  eta_{k}   " for k in range(1, 8))
-    print(head + "   error     eff  active pdas c_zone  c_DN")
+    print(head + "   error     eff  active pdas  c_" + "  c_".join(set_names(name)))
     t0 = time.perf_counter()
     last = None
     for lev in adaptive(problem, max_ndof=max_ndof, uniform=uniform):
@@ -52,23 +65,19 @@ def run(name: str, max_ndof: int, uniform: bool) -> dict:
         for key in history:
             history[key].append(getattr(r, key))
         terms = " ".join(f"{getattr(r, f'eta_{k}'):.3e}" for k in range(1, 8))
-        zone, dn = zone_boundary_vertices(lev.result), dirichlet_neumann_vertices(lev.result)
-        mesh = lev.result.mesh
-        cz = cd = math.nan
+        shares = [math.nan] * len(set_names(name))
         if lev.marked is not None and not uniform:
-            cz = marking_concentration(mesh, lev.marked, zone)
-            cd = marking_concentration(mesh, lev.marked, dn)
+            sets = marked_sets(name, lev.result).values()
+            shares = [marking_concentration(lev.result.mesh, lev.marked, v) for v in sets]
         print(
             f"{r.level:5d} {r.ndof:7d} {r.eta:.4e} {terms} {r.error_energy:.3e} "
-            f"{r.efficiency:7.2f} {r.n_active:6d} {r.pdas_iterations:4d} {cz:6.2f} {cd:5.2f}",
+            f"{r.efficiency:7.2f} {r.n_active:6d} {r.pdas_iterations:4d} "
+            + " ".join(f"{c:6.2f}" for c in shares),
             flush=True,
         )
         last = lev
     mesh = last.result.mesh
-    for label, vertices in (
-        ("zone", zone_boundary_vertices(last.result)),
-        ("DN", dirichlet_neumann_vertices(last.result)),
-    ):
+    for label, vertices in marked_sets(name, last.result).items():
         near = near_cells(mesh, vertices)
         if near.any() and not near.all():
             ratio = np.median(mesh.h[near]) / np.median(mesh.h[~near])

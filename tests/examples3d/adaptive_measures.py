@@ -6,6 +6,8 @@ the tables of docs/method.md, *Three dimensions: the adaptive loop on the built-
   in contact (the discrete contact zone's boundary on Γ_C);
 - :func:`dirichlet_neumann_vertices`: the vertices on both a Dirichlet face and a face of a
   Neumann part (the Dirichlet–Neumann edges);
+- :func:`ridge_vertices`: example-6.2-3d's vertices on the pyramid's ridges (the diagonals of
+  the face x = 1, where the obstacle has its kinks);
 - :func:`marking_concentration`: P(marked | cell touches the set) / P(marked | cell far from
   it): above 1 where Dörfler's marking gathers at the set, whatever the local mesh size;
 - :func:`ndof_ratio`: N_adaptive / N_uniform at the same η, both histories interpolated
@@ -46,6 +48,15 @@ def dirichlet_neumann_vertices(result) -> np.ndarray:
     held = [n for n, c in conditions.items() if isinstance(c, Dirichlet)]
     free = [n for n, c in conditions.items() if isinstance(c, Neumann)]
     return np.intersect1d(_part_vertices(mesh, held), _part_vertices(mesh, free))
+
+
+def ridge_vertices(result) -> np.ndarray:
+    """example-6.2-3d: the vertices of the face x = 1 on its diagonals y = z, y + z = 1 (mesh
+    edges of the mirrored Kuhn mesh and of its bisections: the pyramid's kinks)."""
+    x = result.mesh.points
+    on_face = np.abs(x[:, 0] - 1.0) < 1e-12
+    diagonal = (np.abs(x[:, 1] - x[:, 2]) < 1e-12) | (np.abs(x[:, 1] + x[:, 2] - 1.0) < 1e-12)
+    return np.flatnonzero(on_face & diagonal)
 
 
 def near_cells(mesh, vertices: np.ndarray) -> np.ndarray:
