@@ -244,7 +244,7 @@ def test_a_manifest_that_is_not_json_is_reported_as_such(part, capsys):
     "change, fault",
     [
         ({"level": np.array(-1)}, "says level -1 finished: not a state signorini saved"),
-        ({"u0": np.zeros((7, 2))}, "holds a warm start of shape (7, 2) on a mesh of"),
+        ({"u0": np.zeros((7, 2))}, "holds a warm start of shape (7, 2) on a 2D mesh of"),
         ({"u0": np.full((1, 1), np.nan)}, "holds a warm start of shape (1, 1)"),
     ],
 )

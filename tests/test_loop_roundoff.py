@@ -71,3 +71,53 @@ def test_the_command_line_says_it_stopped_at_round_off(tmp_path, capsys):
     assert float(rows[0]["eta_roundoff"]) == pytest.approx(level, rel=1e-3)
     assert float(rows[0]["eta_roundoff"]) == pytest.approx(1.1255e-12, rel=1e-4)
     assert "round-off" in (out / "history.md").read_text()
+
+
+def test_hooke_norm_in_3d_is_the_largest_eigenvalue_of_the_3d_law():
+    """The 3D ``‖C‖`` against the eigenvalues of Hooke's law on the six symmetric strains
+    (Mandel basis: the off-diagonal ones scaled by √2, so that C is a symmetric 6 × 6
+    matrix): 3λ + 2μ = E / (1 − 2ν) = 2.5 for E = 1, ν = 0.3."""
+    from estimator3d.cube import cube_problem, patch_fields
+
+    problem = cube_problem(patch_fields(), 2)
+    m = problem.material
+    basis = []
+    for i, j in [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)]:
+        e = np.zeros((3, 3))
+        e[i, j] = e[j, i] = 1.0 if i == j else 1.0 / math.sqrt(2.0)
+        basis.append(e)
+    hooke = np.array(
+        [
+            [np.sum((m.lam * np.trace(b) * np.eye(3) + 2 * m.mu * b) * a) for b in basis]
+            for a in basis
+        ]
+    )
+    largest = np.linalg.eigvalsh(hooke).max()
+    assert hooke_norm(problem) == pytest.approx(largest, rel=1e-14)
+    assert hooke_norm(problem) == pytest.approx(2.5, rel=1e-14)
+
+
+def test_the_3d_patch_test_stops_at_round_off_on_its_first_mesh():
+    """The constant-pressure contact patch test on the cube (u affine, exact in P2): η_h is
+    5–8 times ``ε ‖C‖ max|u_h| √n_cells``, far below the level (factor 10⁴); the 3D loop stops
+    there, as the 2D one does on ``stacked-blocks``."""
+    from estimator3d.cube import cube_problem, patch_fields
+
+    levels = list(adaptive(cube_problem(patch_fields(), 2), max_ndof=100_000))
+    assert len(levels) == 1
+    record, result = levels[0].record, levels[0].result
+    level = ROUNDOFF_FACTOR * EPS * 2.5 * np.abs(result.u).max() * math.sqrt(48)
+    print(f"eta {record.eta:.3e}, round-off level {record.eta_roundoff:.4e}")
+    assert record.n_cells == 48 and record.eta_roundoff == pytest.approx(level, rel=1e-12)
+    assert 0 < record.eta < record.eta_roundoff / 100 and record.stop == "round-off"
+
+
+def test_a_3d_discretization_error_is_far_above_the_round_off_level():
+    """example-6.1-3d keeps refining: its η_h is 10⁹ times its round-off level or more."""
+    from signorini.examples.paper3d import example_6_1_3d
+
+    levels = list(adaptive(example_6_1_3d(), max_ndof=700))
+    ratios = [lv.record.eta / lv.record.eta_roundoff for lv in levels]
+    print(f"{len(levels)} levels, eta / round-off level from {min(ratios):.2e}")
+    assert len(levels) >= 3 and min(ratios) > 1e9
+    assert [lv.record.stop for lv in levels] == [""] * (len(levels) - 1) + ["max_ndof"]

@@ -118,7 +118,7 @@ def compare_uniform(
     say("drawing adaptive against uniform refinement ...")
     histories = {"adaptive": out / "history.csv", "uniform": uni / "history.csv"}
     degree = element_of(options.element).degree
-    drawn = {"title": problem.name, "reference_slope": optimal_slope(degree)}
+    drawn = {"title": problem.name, "reference_slope": optimal_slope(degree, problem.mesh.dim)}
     written = plots.plot_adaptive_vs_uniform(
         histories, out / "adaptive_vs_uniform", key="eta", **drawn
     )

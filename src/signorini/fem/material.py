@@ -189,6 +189,13 @@ class Material:
         ``max(2 (λ* + μ), 2 μ)`` (λ* = :attr:`lam_eff`)."""
         return max(2.0 * (self.lam_eff + self.mu), 2.0 * self.mu)
 
+    @property
+    def hooke_norm_3d(self) -> float:
+        """``‖C‖`` of the 3D Hooke's law on symmetric 3 × 3 strains: σ = λ tr(ε) I + 2 μ ε
+        has ``3 λ + 2 μ`` on ε ∝ I and ``2 μ`` on trace-free ε, so ``max(3 λ + 2 μ, 2 μ)``
+        (the material's own λ: plane strain is the 3D law, plane stress is refused in 3D)."""
+        return max(3.0 * self.lam + 2.0 * self.mu, 2.0 * self.mu)
+
     def stress_zz(self, grad_u: np.ndarray) -> np.ndarray:
         """The out-of-plane stress σ_zz of displacement gradients ``grad_u (..., 2, 2)``:
         ``lam (ε_xx + ε_yy)`` in plane strain, zero in plane stress; shape ``(...)``."""

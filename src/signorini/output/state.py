@@ -4,8 +4,9 @@ The file holds plain arrays (``numpy.load`` without pickles, read through
 :func:`~signorini.output.guard.open_npz`): the index of the last finished level, whether it
 was the run's last, the next level's mesh exactly as stored (points, cells in their vertex
 order, which fixes the refinement edges of newest vertex bisection, boundary edges and
-parts, cell regions) and its warm start; after the run's last level, that level's own mesh
-and solution.
+parts, cell regions; a tetrahedral mesh also its bisection tags, the vertex order and type of
+each cell that fix the next bisections, :func:`~signorini.mesh.refine3d.tags_of`) and its warm
+start; after the run's last level, that level's own mesh and solution.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import numpy as np
 
 from ..mesh.bodies import body_of_cells, validated_bodies
 from ..mesh.mesh import Mesh
+from ..mesh.refine3d import tagged, tags_of
 from .files import replacing
 from .guard import RunFolderError, open_npz
 
@@ -74,6 +76,9 @@ def write_state(
             region_names=np.array(mesh.region_names, dtype=str),
             bodies=np.array(int(body_of_cells(mesh).max(initial=0)) + 1),
         )
+        if mesh.dim == 3:  # without its tags a tetrahedral mesh would bisect differently
+            tags = tags_of(mesh)
+            arrays.update(tag_order=tags.order, tag_gamma=tags.gamma)
         if u0 is not None:
             arrays["u0"] = np.asarray(u0, dtype=np.float64)
     with replacing(Path(folder) / STATE) as tmp, open(tmp, "wb") as fh:
@@ -99,6 +104,8 @@ def read_state(folder: str | os.PathLike) -> ResumeState | None:
             arrays = (data[k] for k in ("points", "cells", "boundary", "boundary_part"))
             mesh = Mesh(*arrays, [str(n) for n in data["part_names"]], **options)
             mesh = mesh if options["validate"] else validated_bodies(mesh)
+            if "tag_order" in data:
+                mesh = tagged(mesh, np.array(data["tag_order"]), np.array(data["tag_gamma"]))
             u0 = np.array(data["u0"]) if "u0" in data else None
         _check_state(file, level, mesh, u0)
     except RunFolderError as exc:
@@ -112,16 +119,17 @@ def read_state(folder: str | os.PathLike) -> ResumeState | None:
 
 def _check_state(file: Path, level: int, mesh: Mesh, u0: np.ndarray | None) -> None:
     """Refuse a saved state whose level is negative or whose warm start is not finite values
-    at the nodes of its mesh (P2: vertices then edge midpoints; P1: vertices)."""
+    at the nodes of its mesh (P2: vertices then edge midpoints; P1: vertices), one component
+    per axis of the mesh."""
     if level < 0:
         raise RunFolderError(f"{file} says level {level} finished: not a state signorini saved")
     if u0 is None:
         return
     nodes = (mesh.n_points, mesh.n_points + mesh.n_edges)
-    if u0.ndim != 2 or u0.shape[1] != 2 or u0.shape[0] not in nodes:
+    if u0.ndim != 2 or u0.shape[1] != mesh.dim or u0.shape[0] not in nodes:
         raise RunFolderError(
-            f"{file} holds a warm start of shape {u0.shape} on a mesh of {nodes[0]} points and "
-            f"{mesh.n_edges} edges: not a state signorini saved"
+            f"{file} holds a warm start of shape {u0.shape} on a {mesh.dim}D mesh of "
+            f"{nodes[0]} points and {mesh.n_edges} edges: not a state signorini saved"
         )
     if u0.dtype.kind != "f" or not np.isfinite(u0).all():
         raise RunFolderError(f"{file} holds a warm start that is not finite numbers")
