@@ -32,6 +32,7 @@ from ..mesh.mesh import Mesh
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
+from .face_contact import FaceContactSet
 from .force_control import check_load_carried, initial_active_set
 from .frictional import Solved, check_previous, solve_frictional
 from .nested import (
@@ -40,6 +41,7 @@ from .nested import (
     nested_active_set,
     round_off_scale,
     warm_active_set,
+    warm_rule_active_set,
 )
 from .ordering import SolverAhead, ordered_solver
 from .partition import Partition
@@ -350,6 +352,9 @@ def solve(
     diagonal = assembled.K if ranks.size == 1 else sp.diags(ranks.sum(assembled.K.diagonal()))
     unit = stiffness_unit(diagonal)
     K, F = (assembled.K, assembled.F) if unit == 1.0 else (assembled.K / unit, assembled.F / unit)
+    if active0 is not None and isinstance(cs, FaceContactSet):  # 3D: the rule at u0
+        held = (assembled.dirichlet, assembled.dirichlet_values)
+        active0 = warm_rule_active_set(cs, u0, (K, F), held, ranks)
     t0 = time.perf_counter()
     timings = {"assemble": assembled.seconds}
     if (
