@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -29,6 +30,9 @@ from ..mesh.mesh import Mesh
 from ..mesh.refine import refine_nvb
 from .contact_set import ContactSet
 from .face_contact import FaceContactSet
+
+if TYPE_CHECKING:
+    from .system import Assembled
 
 __all__ = [
     "GLOBAL_SHARE",
@@ -64,12 +68,22 @@ def round_off_scale(u: np.ndarray, gap: np.ndarray) -> np.ndarray:
     return np.maximum(np.abs(u).max(initial=0.0), np.abs(gap))
 
 
-def warm_active_set(contact: ContactSet | FaceContactSet, u0: np.ndarray) -> np.ndarray:
+def warm_active_set(
+    contact: ContactSet | FaceContactSet,
+    u0: np.ndarray,
+    assembled: Assembled | None = None,
+    system: tuple | None = None,
+) -> np.ndarray:
     """``(m,) bool``: the constraints whose node meets its bound under the warm start
     ``u0 (n_nodes, d)`` to :data:`WARM_START_RTOL` (:data:`PAIR_WARM_START_RTOL` with
     contact pairs) relative to :func:`round_off_scale`: PDAS's first active set. On faces
     (a :class:`~.face_contact.FaceContactSet`) in the solver's variables, the transformed
-    basis's ``ỹ_dof ≤ ψ̃`` (docs/method.md, *Three dimensions: warm starts*)."""
+    basis's ``ỹ_dof ≤ ψ̃`` (docs/method.md, *Three dimensions: warm starts*); given the
+    ``assembled`` system and its ``system = (K̃, F̃)`` (as scaled for the solver), there the
+    active set rule at ``u0`` instead (:func:`warm_rule_active_set`)."""
+    if system is not None and isinstance(contact, FaceContactSet):
+        held = (assembled.dirichlet, assembled.dirichlet_values)
+        return warm_rule_active_set(contact, u0, system, held, assembled.ranks)
     rtol = WARM_START_RTOL if contact.transfer is None else PAIR_WARM_START_RTOL
     gap = contact.gap
     return contact.normal_displacement(u0) - gap >= -rtol * round_off_scale(u0, gap)
