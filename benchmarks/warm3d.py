@@ -2,8 +2,9 @@
 without the warm start (docs/method.md, *Three dimensions: warm starts*).
 
 Each problem is run twice by ``signorini.adaptive(problem, uniform=True, ...)``: with
-``warm_start=True`` (each level starts PDAS from the contact rows of the previous level's
-solution prolongated to the refined mesh, read in the solver's variables) and with
+``warm_start=True`` (each level starts PDAS from the active set rule at the previous level's
+solution prolongated to the refined mesh, in the solver's variables: docs/method.md, *Three
+dimensions: warm starts by the active set rule*) and with
 ``warm_start=False`` (the empty active set; 3D has no nested iteration yet). Printed per
 level: the free unknowns, the rows in contact, and per run the PDAS steps (``pdas``), the
 linear solves (``solves``: factorizations and bordered updates, or the iterative path's

@@ -49,7 +49,7 @@ from .ranks import SERIAL, Ranks
 from .result import PDASResult, PDASStep
 from .sparse import abs_matvec
 
-__all__ = ["KKT_WARN", "PDASOptions", "solve_pdas"]
+__all__ = ["KKT_WARN", "PDASOptions", "rule_active_set", "solve_pdas"]
 
 logger = logging.getLogger(__name__)
 
@@ -252,6 +252,26 @@ def solve_pdas(
         n_updates=system.n_updates,
         linear_iterations=linear_iterations,
     )
+
+
+def rule_active_set(
+    K: sp.spmatrix,
+    F: np.ndarray,
+    constrained: np.ndarray,
+    gap: np.ndarray | float,
+    x0: np.ndarray,
+    dirichlet: np.ndarray | None = None,
+    *,
+    ranks: Ranks = SERIAL,
+) -> np.ndarray:
+    """``(m,) bool``: the active set rule of :func:`solve_pdas` at ``x0``,
+    ``{ Λ0 + c (x0_c − g) > 0 }`` with ``Λ0 = F_c − (K x0)_c`` and ``c`` the default
+    constant (the mean diagonal of ``K`` over ``constrained``): the active set the first
+    PDAS step from ``x0`` would take, its ``x0`` argument's (docs/method.md, *Three
+    dimensions: warm starts by the active set rule*). The arguments are those of
+    :func:`solve_pdas`; a ValueError names a malformed one."""
+    qp = check_qp(K, F, constrained, gap, dirichlet, ranks=ranks)
+    return _initial_active_set(qp, _rule_constant(qp, None), x0, None)
 
 
 # ----------------------------------------------------------------------------------------------

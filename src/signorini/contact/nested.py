@@ -17,16 +17,22 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from ..algebra.errors import PDASConvergenceError
+from ..algebra.pdas import rule_active_set
+from ..algebra.ranks import SERIAL, Ranks
 from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
 from ..mesh.refine import refine_nvb
 from .contact_set import ContactSet
 from .face_contact import FaceContactSet
+
+if TYPE_CHECKING:
+    from .system import Assembled
 
 __all__ = [
     "GLOBAL_SHARE",
@@ -39,6 +45,7 @@ __all__ = [
     "round_off_scale",
     "transfer_active",
     "warm_active_set",
+    "warm_rule_active_set",
 ]
 
 #: a warm start's node starts in the active set where
@@ -61,15 +68,47 @@ def round_off_scale(u: np.ndarray, gap: np.ndarray) -> np.ndarray:
     return np.maximum(np.abs(u).max(initial=0.0), np.abs(gap))
 
 
-def warm_active_set(contact: ContactSet | FaceContactSet, u0: np.ndarray) -> np.ndarray:
+def warm_active_set(
+    contact: ContactSet | FaceContactSet,
+    u0: np.ndarray,
+    assembled: Assembled | None = None,
+    system: tuple | None = None,
+) -> np.ndarray:
     """``(m,) bool``: the constraints whose node meets its bound under the warm start
     ``u0 (n_nodes, d)`` to :data:`WARM_START_RTOL` (:data:`PAIR_WARM_START_RTOL` with
     contact pairs) relative to :func:`round_off_scale`: PDAS's first active set. On faces
     (a :class:`~.face_contact.FaceContactSet`) in the solver's variables, the transformed
-    basis's ``ỹ_dof ≤ ψ̃`` (docs/method.md, *Three dimensions: warm starts*)."""
+    basis's ``ỹ_dof ≤ ψ̃`` (docs/method.md, *Three dimensions: warm starts*); given the
+    ``assembled`` system and its ``system = (K̃, F̃)`` (as scaled for the solver), there the
+    active set rule at ``u0`` instead (:func:`warm_rule_active_set`)."""
+    if system is not None and isinstance(contact, FaceContactSet):
+        held = (assembled.dirichlet, assembled.dirichlet_values)
+        return warm_rule_active_set(contact, u0, system, held, assembled.ranks)
     rtol = WARM_START_RTOL if contact.transfer is None else PAIR_WARM_START_RTOL
     gap = contact.gap
     return contact.normal_displacement(u0) - gap >= -rtol * round_off_scale(u0, gap)
+
+
+def warm_rule_active_set(
+    contact: FaceContactSet,
+    u0: np.ndarray,
+    system: tuple,
+    held: tuple[np.ndarray, np.ndarray],
+    ranks: Ranks = SERIAL,
+) -> np.ndarray:
+    """``(k,) bool``: PDAS's first active set of a 3D warm start ``u0 (n_nodes, 3)`` on faces,
+    the active set rule at it (:func:`~signorini.algebra.pdas.rule_active_set`): a row is
+    active where ``Λ0 + c (ỹ0 − ψ̃) > 0``, ``Λ0 = F̃ − K̃ ỹ0`` the residual of the warm start
+    in the solver's variables ``ỹ0`` (:meth:`~.face_contact.FaceContactSet.unknowns`) with
+    the held DOFs at their values ``held = (dofs, values)``, ``system = (K̃, F̃)``. Unlike
+    :func:`warm_active_set` it reads the contact force the refined mesh puts on the rows
+    where the prolongated solution is off its bound (a zone that grows between levels, new
+    nodes of a curved surface off the coarse cells), and drops the rows at their bound
+    that pull (docs/method.md, *Three dimensions: warm starts by the active set rule*)."""
+    K, F = system
+    x0 = contact.unknowns(np.asarray(u0, dtype=np.float64).ravel())
+    x0[held[0]] = held[1]
+    return rule_active_set(K, F, contact.constrained_dofs, contact.gap, x0, held[0], ranks=ranks)
 
 
 log = logging.getLogger(__name__)

@@ -337,6 +337,11 @@ def solve(
         check_previous(previous, space, cs)
         if u0 is None and not cs.has_friction:
             u0 = previous.u
+    # K and F divided by a power of 2 when E is extreme (exact; 1 otherwise), so that no
+    # product in the factorization overflows or underflows
+    diagonal = assembled.K if ranks.size == 1 else sp.diags(ranks.sum(assembled.K.diagonal()))
+    unit = stiffness_unit(diagonal)
+    K, F = (assembled.K, assembled.F) if unit == 1.0 else (assembled.K / unit, assembled.F / unit)
     active0 = None
     if u0 is not None:
         u0 = np.asarray(u0, dtype=np.float64)
@@ -344,12 +349,7 @@ def solve(
             raise ValueError(f"u0 must have shape ({space.n_nodes}, {mesh.dim}), got {u0.shape}")
         if not np.isfinite(u0).all():
             raise ValueError("u0 contains NaN or inf")
-        active0 = warm_active_set(cs, u0) if mesh.dim == 2 or cs.size else None
-    # K and F divided by a power of 2 when E is extreme (exact; 1 otherwise), so that no
-    # product in the factorization overflows or underflows
-    diagonal = assembled.K if ranks.size == 1 else sp.diags(ranks.sum(assembled.K.diagonal()))
-    unit = stiffness_unit(diagonal)
-    K, F = (assembled.K, assembled.F) if unit == 1.0 else (assembled.K / unit, assembled.F / unit)
+        active0 = warm_active_set(cs, u0, assembled, (K, F)) if mesh.dim == 2 or cs.size else None
     t0 = time.perf_counter()
     timings = {"assemble": assembled.seconds}
     if (
