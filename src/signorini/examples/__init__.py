@@ -7,8 +7,8 @@ curved geometry.
 - :mod:`.paper_friction`: Example 6.2 with Tresca or Coulomb friction on its contact part;
 - :mod:`.partial_slip`: the Hertz half-disc pressed on a plane with Coulomb friction, then
   pulled sideways (Cattaneo–Mindlin), a load path of two steps;
-- :mod:`.hertz3d`: the eighth of an elastic ball pressed onto a rigid plane (3D), with the
-  Hertz solution;
+- :mod:`.hertz3d`: the eighth of an elastic ball pressed onto a rigid plane by a total force
+  (3D, force control), with the Hertz solution;
 - :mod:`.paper3d`: the paper's Examples 6.1 (a manufactured solution, :mod:`.manufactured3d`,
   in contact on a disc) and 6.2 (the pyramid obstacle) on the unit cube (3D);
 - :mod:`.punch3d`: a rigid punch with rounded edges pressed into a block held against a wall
@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from ..problem import ContactProblem
 from .elasticity3d import ELASTICITY_3D_METRICS, elasticity_3d
 from .hertz import HERTZ_METRICS, hertz
-from .hertz3d import HERTZ_3D_METRICS, hertz_3d
+from .hertz3d import HERTZ_3D_METRICS, hertz_3d, hertz_3d_force_control
 from .metrics import Metrics, PressureComparison
 from .paper import example_6_1, example_6_2
 from .paper3d import EXAMPLE_6_1_3D_METRICS, example_6_1_3d, example_6_2_3d
@@ -120,7 +120,7 @@ EXAMPLES: dict[str, Example] = {
         Example("stacked-blocks", stacked_blocks, metrics=BLOCKS_METRICS),
         Example("hertz-pair", hertz_pair),
         Example("elasticity-3d", elasticity_3d, metrics=ELASTICITY_3D_METRICS),
-        Example("hertz-3d", hertz_3d, metrics=HERTZ_3D_METRICS),
+        Example("hertz-3d", hertz_3d_force_control, metrics=HERTZ_3D_METRICS),
         Example("example-6.1-3d", example_6_1_3d, metrics=EXAMPLE_6_1_3D_METRICS),
         Example("example-6.2-3d", example_6_2_3d),
         Example("punch-3d", punch_3d),

@@ -14,8 +14,9 @@ whole ball and ``E* = E / (1 − ν²)``, gives
 
     a = (3 P R / (4 E*))^{1/3},   p0 = 3 P / (2 π a²),   p(r) = p0 √(1 − r² / a²),
 
-r the distance from the axis. The eighth carries a quarter of the contact disc, so
-``P = 4 Σ_z Λ_z``. Each level is compared with the Hertz solution of its own P
+r the distance from the axis. The eighth carries a quarter of the contact disc, so the
+measured total force is ``4 Σ_z Λ_z``. Each level is compared with the Hertz solution of the
+prescribed P under force control, of its own measured P under displacement control
 (:func:`hertz_3d_metrics`): the radius from the nodal forces,
 ``a_h = √(5/2 · Σ Λ_z r_z² / Σ Λ_z)`` (exact for the Hertz profile: ``∫ r² p dA / ∫ p dA =
 2 a² / 5``, and ``r² = x² + y²`` is quadratic), and the peak pressure, the recovered
@@ -34,29 +35,40 @@ from __future__ import annotations
 import numpy as np
 
 from ..contact.solution import ContactResult
+from ..fem.elasticity3d import assemble_face_load_3d
 from ..fem.material import Material
+from ..fem.space3d import P2TetSpace
 from ..mesh.builders3d import eighth_ball
 from ..mesh.mesh import Mesh
 from ..mesh.refine import refine_nvb
-from ..problem import Contact, ContactProblem, Dirichlet
+from ..problem import Contact, ContactProblem, Dirichlet, Neumann
 from ..problem.conditions import Roller
 from ..problem.obstacles3d import HalfSpace
 from .metrics import Metrics, PressureComparison
 
 __all__ = [
+    "CONTACT_RADIUS_3D",
     "DEPTH_3D",
+    "FORCE_3D",
     "HERTZ_3D_METRICS",
     "QUARTERS",
     "graded_eighth_ball",
     "hertz_3d",
     "hertz_3d_contact",
+    "hertz_3d_force",
+    "hertz_3d_force_control",
     "hertz_3d_metrics",
     "hertz_3d_pressure",
     "hertz_3d_solution",
+    "prescribed_force",
+    "top_area",
 ]
 
 #: the prescribed displacement of the top, δ / R: gives a / R ≈ 0.102 with ν = 0.3
 DEPTH_3D = 0.01
+
+#: Hertz's contact radius a / R of the built-in ``hertz-3d``'s force (:data:`FORCE_3D`)
+CONTACT_RADIUS_3D = 0.1
 
 #: the contact disc of the whole ball over the eighth's quarter disc: ``P = 4 Σ Λ_z``
 QUARTERS = 4
@@ -119,6 +131,7 @@ def hertz_3d(
     young: float = 1.0,
     poisson: float = 0.3,
     *,
+    force: float | None = None,
     n: int = 2,
     h_contact: float | None = None,
     grading: float = 0.5,
@@ -126,7 +139,8 @@ def hertz_3d(
     face_alpha: float | None = None,
 ) -> ContactProblem:
     """The 3D Hertz problem: the eighth of an elastic ball pressed by its flat top onto a rigid
-    plane.
+    plane, under a prescribed displacement of the top (the default) or a prescribed total
+    force (``force``; the built-in ``hertz-3d``, :func:`hertz_3d_force_control`).
 
     Defaults: R = 1, δ = 0.01 R (:data:`DEPTH_3D`), E = 1, ν = 0.3 (consistent units; the
     problem is linear in E, and a / R depends on δ / R and ν only): a / R ≈ 0.102.
@@ -137,9 +151,15 @@ def hertz_3d(
         R, the radius of the ball (length units).
     depth : float, optional
         δ, the downward displacement ``u_z = −δ`` prescribed on the flat top (length units);
-        default ``DEPTH_3D * radius``.
+        default ``DEPTH_3D * radius`` when ``force`` is not given.
     young, poisson : float
         E (stress units) and ν of the body.
+    force : float, optional
+        P, the total force pressing the whole ball onto the plane (force units; the eighth
+        carries P / 4): the top carries the uniform traction ``(0, 0, −P / (4 |z1|_h))``
+        (:func:`top_area`) instead of ``u_z = −δ``, and the body is held along z by its
+        contact alone (force control). A P < 0 pulls the ball off and is refused by the
+        solve, naming the free translation along z. Not with ``depth``.
     n, h_contact, grading, patch : optional
         The initial mesh, :func:`graded_eighth_ball` ``(n, radius, h_contact, grading,
         patch)``; ``h_contact`` defaults to ``0.1 R``, ``patch`` to ``0.15 R`` (the
@@ -152,13 +172,30 @@ def hertz_3d(
     Returns
     -------
     ContactProblem
-        Named ``"hertz-3d"``; parts ``"x0"``, ``"y0"`` (rollers), ``"z1"`` (``u_z = −δ``) and
-        ``"sphere"`` (contact with ``HalfSpace((0, 0, 0), (0, 0, 1))``).
+        Named ``"hertz-3d"``; parts ``"x0"``, ``"y0"`` (rollers), ``"z1"`` (``u_z = −δ``, or
+        the traction of ``force``) and ``"sphere"`` (contact with ``HalfSpace((0, 0, 0),
+        (0, 0, 1))``).
+
+    Raises
+    ------
+    ValueError
+        If ``force`` is not a finite non-zero number, or both ``depth`` and ``force`` are
+        given.
     """
-    depth = DEPTH_3D * radius if depth is None else depth
+    if force is not None:
+        if depth is not None:
+            raise ValueError("hertz_3d: give depth (displacement control) or force, not both")
+        if isinstance(force, bool) or not isinstance(force, int | float | np.floating):
+            raise ValueError(f"hertz_3d: force must be a number (P), got {force!r}")
+        if not np.isfinite(force) or force == 0:
+            raise ValueError(f"hertz_3d: force must be finite and non-zero (P), got {force!r}")
     h_contact = 0.1 * radius if h_contact is None else h_contact
     patch = 0.15 * radius if patch is None else patch
     mesh = graded_eighth_ball(n, radius, h_contact, grading, patch)
+    if force is None:
+        top = Dirichlet((None, None, -(DEPTH_3D * radius if depth is None else depth)))
+    else:
+        top = Neumann((0.0, 0.0, -float(force) / (QUARTERS * top_area(mesh))))
     plane = HalfSpace([0.0, 0.0, 0.0], [0.0, 0.0, 1.0])
     return ContactProblem(
         mesh=mesh,
@@ -166,11 +203,53 @@ def hertz_3d(
         conditions={
             "x0": Roller(),
             "y0": Roller(),
-            "z1": Dirichlet((None, None, -depth)),
+            "z1": top,
             "sphere": Contact(obstacle=plane, face_alpha=face_alpha),
         },
         name="hertz-3d",
     )
+
+
+def top_area(mesh: Mesh) -> float:
+    """``|z1|_h``, the area of the flat top ``"z1"`` of :func:`graded_eighth_ball`'s mesh as
+    the Neumann load integrates it: ``Σ_z G[3 z + 2]`` of the load of the unit traction
+    ``e_z`` (:func:`~signorini.fem.elasticity3d.assemble_face_load_3d`; the P2 basis sums to
+    one). Its faces at the rim are curved in their plane (their midpoints on the sphere), so
+    it is below the quarter disc's πR²/4 (−6.6·10⁻⁵ relative on the default mesh) and grows
+    as the rim is refined."""
+    unit = np.array([0.0, 0.0, 1.0])
+    load = assemble_face_load_3d(
+        P2TetSpace(mesh), mesh.part_facets("z1"), lambda x: np.broadcast_to(unit, x.shape)
+    )
+    return float(load[2::3].sum())
+
+
+def prescribed_force(problem: ContactProblem) -> float | None:
+    """P, the whole ball's total force a force-controlled :func:`hertz_3d` prescribes (its
+    top's traction times ``4 |z1|_h`` on the problem's mesh, :func:`top_area`), or None under
+    displacement control."""
+    top = problem.conditions["z1"]
+    if not isinstance(top, Neumann):
+        return None
+    return -QUARTERS * float(top.traction[2]) * top_area(problem.mesh)
+
+
+def hertz_3d_force(contact_radius: float, radius: float, material: Material) -> float:
+    """The total force P whose Hertz contact radius is ``contact_radius``: the inverse of
+    :func:`hertz_3d_solution`, ``P = 4 E* a³ / (3 R)``."""
+    e_star = material.young / (1.0 - material.poisson**2)
+    return 4.0 * e_star * contact_radius**3 / (3.0 * radius)
+
+
+#: the built-in ``hertz-3d``'s total force (R = 1, E = 1, ν = 0.3): Hertz's a = 0.1 R
+#: (:data:`CONTACT_RADIUS_3D`), P = 4 E* (0.1 R)³ / (3 R) ≈ 1.4652·10⁻³ E R²
+FORCE_3D = hertz_3d_force(CONTACT_RADIUS_3D, 1.0, Material.from_young(1.0, 0.3))
+
+
+def hertz_3d_force_control() -> ContactProblem:
+    """The built-in ``hertz-3d``: :func:`hertz_3d` under the total force :data:`FORCE_3D`
+    (force control, Hertz's a = 0.1 R), on the default graded mesh and condition (b)."""
+    return hertz_3d(force=FORCE_3D)
 
 
 def hertz_3d_solution(force: float, radius: float, material: Material) -> tuple[float, float]:
@@ -225,17 +304,23 @@ def hertz_3d_contact(result: ContactResult) -> dict[str, object]:
 
 
 def hertz_3d_metrics(result: ContactResult) -> dict[str, float]:
-    """The level's total force, contact radius and peak pressure, their errors against Hertz
-    with the level's own P (:func:`hertz_3d_contact`, :func:`hertz_3d_solution`), and the
-    discrete contact condition's α (NaN without contact)."""
+    """The level's total force, contact radius and peak pressure (:func:`hertz_3d_contact`),
+    their errors against Hertz (:func:`hertz_3d_solution`) for the prescribed P under force
+    control (:func:`prescribed_force`; ``force`` and ``force_rel_error``, the measured total
+    force against it) or for the level's own measured P under displacement control (``force``
+    NaN), and the discrete contact condition's α (NaN without contact)."""
     alpha = float(result.contact.edges.alpha)
+    prescribed = prescribed_force(result.problem)
+    force = float("nan") if prescribed is None else prescribed
     if not result.total_contact_force > 0:
-        keys = ("total_force", "a", "p0", "a_rel_error", "p0_rel_error")
-        return dict.fromkeys(keys, float("nan")) | {"face_alpha": alpha}
+        keys = ("total_force", "force_rel_error", "a", "p0", "a_rel_error", "p0_rel_error")
+        return dict.fromkeys(keys, float("nan")) | {"force": force, "face_alpha": alpha}
     zone = hertz_3d_contact(result)
-    a, p0 = hertz_3d_solution(zone["force"], zone["radius"], result.problem.material)
+    a, p0 = _hertz(result, zone)
     return {
         "total_force": zone["force"],
+        "force": force,
+        "force_rel_error": zone["force"] / force - 1.0,
         "a": zone["a"],
         "p0": zone["p0"],
         "a_rel_error": zone["a"] / a - 1.0,
@@ -244,13 +329,21 @@ def hertz_3d_metrics(result: ContactResult) -> dict[str, float]:
     }
 
 
+def _hertz(result: ContactResult, zone: dict[str, object]) -> tuple[float, float]:
+    """Hertz's a and p0 for the prescribed force of ``result``'s problem, else for the
+    measured one ``zone["force"]``."""
+    prescribed = prescribed_force(result.problem)
+    force = zone["force"] if prescribed is None else prescribed
+    return hertz_3d_solution(force, zone["radius"], result.problem.material)
+
+
 def hertz_3d_pressure(result: ContactResult) -> PressureComparison:
     """The recovered pressure along the line y = 0 through the contact disc (the rows on
     the symmetry plane ``"y0"``, whose nodes lie on the line: the pressure there is linear
     between them), against r = x up to 2a, beside Hertz's ``p0 √(1 − r² / a²)`` of the
-    same total force."""
+    prescribed total force (force control) or of the measured one (:func:`_hertz`)."""
     zone = hertz_3d_contact(result)
-    a, p0 = hertz_3d_solution(zone["force"], zone["radius"], result.problem.material)
+    a, p0 = _hertz(result, zone)
     x = result.space.node_points[result.contact.node]
     on_line = np.abs(x[:, 1]) <= LINE_TOL * zone["radius"]
     near = on_line & (zone["r"] <= 2.0 * a)
@@ -272,12 +365,19 @@ def hertz_3d_pressure(result: ContactResult) -> PressureComparison:
 HERTZ_3D_METRICS = Metrics(
     measure=hertz_3d_metrics,
     columns={
-        "total_force": "P = 4 Σ Λ_z, the whole ball's contact force (the eighth carries a "
+        "total_force": "4 Σ Λ_z, the whole ball's measured contact force (the eighth carries a "
         "quarter of the contact disc; contact_force is Σ Λ_z), force units",
+        "force": "P, the prescribed total force under force control (the built-in hertz-3d: "
+        "the top's uniform traction times 4 |z1|_h on the initial mesh); NaN under "
+        "displacement control, force units",
+        "force_rel_error": "total_force / force − 1: round-off on the initial mesh; on a "
+        "refined one the rim's new points on the sphere enlarge the loaded top by up to "
+        "1e-4 relative; NaN under displacement control, no unit",
         "a": "contact radius from the nodal forces, √(5/2 · Σ Λ_z r_z² / Σ Λ_z), length units",
         "p0": "recovered (P1-lumped) contact pressure at the pole node, stress units",
-        "a_rel_error": "a / a_Hertz − 1, a_Hertz = (3 P R / (4 E*))^(1/3) with P the level's "
-        "total_force, no unit",
+        "a_rel_error": "a / a_Hertz − 1, a_Hertz = (3 P R / (4 E*))^(1/3) with P the "
+        "prescribed force (force control) or the level's total_force (displacement control), "
+        "no unit",
         "p0_rel_error": "p0 / p0_Hertz − 1, p0_Hertz = 3 P / (2 π a_Hertz²), no unit",
         "face_alpha": "the discrete contact condition: 0 for (a), nodal constraints at all P2 "
         "nodes; 0.2 for (b), the transformed face basis",
