@@ -29,6 +29,7 @@ __all__ = [
     "check_initial_overlap",
     "check_load_size",
     "check_obstacle_side",
+    "deepest_overlap",
 ]
 
 
@@ -309,17 +310,15 @@ def check_initial_overlap(
     value, _ = _dirichlet_values(conditions, conditions.dirichlet_nodes)
     # (deep,) max_y u_D(y)·(−n_z); with no Dirichlet node (a body under force control) the
     # Dirichlet data move the body out by nothing
-    moved = (value @ -direction[deep].T).max(axis=0) if len(value) else np.zeros(deep.size)
-    need = -gap[deep] - moved
-    worst = int(np.argmax(need))
-    if need[worst] <= DEEP_OVERLAP * size:
+    found = deepest_overlap(gap, direction, deep, value, size)
+    if found is None:
         return
-    i = deep[worst]
+    i, moved = found
     x, name = space.node_points[nodes[i]], parts[0][parts[1][i]]
     raise ProblemError(
         f"the obstacle of contact part {name!r} starts {-gap[i]:.6g} deep inside the body at "
         f"({x[0]:.12g}, {x[1]:.12g}) (ψ = {gap[i]:.6g}; the Dirichlet data move the body out "
-        f"by at most {moved[worst]:.6g} along the constraint direction), more than "
+        f"by at most {moved:.6g} along the constraint direction), more than "
         f"{DEEP_OVERLAP} times the body's size {size:.6g} (its bounding box's diagonal): the "
         "linearised, small-deformation contact model cannot represent an initial overlap that "
         "deep (it would pull the body through the obstacle with strains of order one). Place "
@@ -368,3 +367,20 @@ def check_load_size(K, F: np.ndarray, loads: Mapping[str, float], ranks: Ranks) 
         "State the loads in the units of E (a load 1e300 times the modulus moves nothing "
         "like a small-deformation body), or check their size"
     )
+
+
+def deepest_overlap(
+    gap: np.ndarray, direction: np.ndarray, deep: np.ndarray, value: np.ndarray, size: float
+) -> tuple[int, float] | None:
+    """The entry of ``deep`` (rows with ``−ψ > DEEP_OVERLAP · size`` against a shape) that the
+    Dirichlet values ``value (m, d)`` move out least, ``need = −ψ − max_y u_D(y)·(−n_z)``, as
+    ``(row, moved)`` when its need still exceeds ``DEEP_OVERLAP · size``; None when the data
+    move every such row out (:func:`check_initial_overlap`, docs/method.md, *Obstacles as
+    shapes*, "Initial overlap"). With no Dirichlet value (a body under force control) the
+    data move the body out by nothing."""
+    moved = (value @ -direction[deep].T).max(axis=0) if len(value) else np.zeros(deep.size)
+    need = -gap[deep] - moved
+    worst = int(np.argmax(need))
+    if need[worst] <= DEEP_OVERLAP * size:
+        return None
+    return int(deep[worst]), float(moved[worst])

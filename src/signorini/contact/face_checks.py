@@ -14,7 +14,7 @@ import numpy as np
 from ..problem.conditions import Contact
 from ..problem.fields import ProblemError, evaluate_field
 from ..problem.rollers import HeldNodes
-from .admissible import DEEP_OVERLAP
+from .admissible import DEEP_OVERLAP, deepest_overlap
 
 __all__ = ["UNIT_RTOL", "check_deep_overlap", "given_directions"]
 
@@ -99,17 +99,15 @@ def check_deep_overlap(
         return
     full = held.components.all(axis=1)
     value = held.values[full] if held.values is not None else np.zeros((0, 3))
-    moved = (value @ -direction[deep].T).max(axis=0) if len(value) else np.zeros(deep.size)
-    need = -gap[deep] - moved
-    worst = int(np.argmax(need))
-    if need[worst] <= DEEP_OVERLAP * size:
+    found = deepest_overlap(gap, direction, deep, value, size)
+    if found is None:
         return
-    i = deep[worst]
+    i, moved = found
     x = space.node_points[node[i]]
     raise ProblemError(
         f"the obstacle of contact part {parts[part[i]]!r} starts {-gap[i]:.6g} deep inside "
         f"the body at {tuple(x.tolist())} (ψ = {gap[i]:.6g}; the Dirichlet data move the "
-        f"body out by at most {moved[worst]:.6g} along the constraint direction), more than "
+        f"body out by at most {moved:.6g} along the constraint direction), more than "
         f"{DEEP_OVERLAP} times the body's size {size:.6g} (its bounding box's diagonal): the "
         "linearised, small-deformation contact model cannot represent an initial overlap that "
         "deep. Place the obstacle at the body's surface (ψ ≈ 0) and move it in by steps of a "
