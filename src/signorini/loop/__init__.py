@@ -57,9 +57,10 @@ class Level:
         The level's row of the convergence history.
     result : ContactResult
         The discrete solution on the level's mesh (``result.mesh``).
-    estimate : Estimate
+    estimate : Estimate or None
         The a posteriori estimator of that solution (in 3D :mod:`signorini.estimator.
-        residual3d`).
+        residual3d`); None for contact pairs in 3D, which refine uniformly (no mortar terms on
+        faces yet).
     marked : (n_cells,) bool array or None
         Cells marked for refinement; None on the last level.
     next_mesh : Mesh or None
