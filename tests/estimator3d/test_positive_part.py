@@ -239,6 +239,24 @@ def test_invariant_under_relabelling_the_vertices():
         assert np.allclose(h2, hat[:, order], rtol=MOMENT_BOUND, atol=MOMENT_BOUND)
 
 
+@pytest.mark.parametrize("tiny", [1e-12, 1e-17, 1e-30, 1e-100, 1e-200])
+def test_a_root_beside_a_corner_gives_finite_weights_and_areas_that_add_up(tiny):
+    """A vertex value of ``±tiny`` puts the side roots at ``ρ ~ tiny`` from it: the rays'
+    exit ``1/ρ`` once overflowed (infinite weights from 10⁻¹⁷ on). ``{v > 0}`` and
+    ``{−v > 0}`` tile the triangle (area 1/2), and the corner's own region is small: about
+    ``tiny²/2`` on the first face, ``0.46 tiny^{3/2}`` on the second (its side 2–0 leaves the
+    corner with zero slope, so the root there is at ``(tiny/2)^{1/2}``)."""
+    v = np.array([[tiny, -1.0, -1.0, -0.5, -1.0, -0.5], [-tiny, 1.0, 2.0, 0.5, 1.5, 0.5]])
+    with np.errstate(over="raise", invalid="raise"):
+        plus, minus = positive_region_rule(v, 3), positive_region_rule(-v, 3)
+    assert np.isfinite(plus.w).all() and np.isfinite(minus.w).all()
+    area_plus = np.bincount(plus.face, weights=plus.w, minlength=2)
+    area_minus = np.bincount(minus.face, weights=minus.w, minlength=2)
+    assert np.allclose(area_plus + area_minus, 0.5, rtol=AREA_BOUND, atol=0.0)
+    corner = np.array([area_plus[0], area_minus[1]])  # the tiny corner's side of the cut
+    assert (corner >= 0.0).all() and (corner <= tiny**1.5).all()
+
+
 @pytest.mark.parametrize(
     ("v", "degree", "depth", "word"),
     [

@@ -96,6 +96,12 @@ ARC_RATIO = 0.1
 #: extra points give 2·10⁻⁷, 4·10⁻⁹, 3·10⁻¹⁰ for ``∫ v``)
 RAY_POINTS = 6
 
+#: the largest exit parameter ``1/μ`` of a ray (:func:`_curved`), in units of its distance to
+#: the chord: its square scales the ray's quadratic and the discriminant squares that again,
+#: so 10⁵⁰ keeps every product finite (a root at ``ρ = 10⁻¹⁷`` from the apex overflowed
+#: ``1/(1 − (1 − ρ))`` to 10³⁰⁰ and gave infinite weights)
+EXIT_BOUND = 1e50
+
 #: the four triangles of the once-refined face by local nodes (P2 order: vertices, then the
 #: midpoints of local edges 0 (v0–v1), 1 (v1–v2), 2 (v2–v0)): corner p is ``[p, midpoint of
 #: edge p, midpoint of edge p − 1]``, the middle one the three midpoints; all counter-clockwise
@@ -328,31 +334,35 @@ def _leaf_points(c, face, piece, corners, cut, rows, degree, rule) -> list[tuple
     r1, r2 = x + rho1[:, None] * (b - x), x + rho2[:, None] * (cc - x)
     n_t = (degree + 3) // 2  # Gauss points in t: exact for degree + 1 (the Jacobian t)
     one = simple & (n_pos == 1)
-    out = [_curved(cf, face, piece, (x, r1, r2), (1 - rho1, 1 - rho2), one, n_t)]
-    zero = np.zeros_like(rho1)
-    for choice, tri, ray, lam in (
-        (simple & (n_pos == 2) & apex_c, (r1, b, cc), (cc, r2, r1), (rho2, zero)),
-        (simple & (n_pos == 2) & ~apex_c, (b, cc, r2), (b, r1, r2), (rho1, zero)),
+    out = [_curved(cf, face, piece, (x, r1, r2), (rho1, rho2), one, n_t)]
+    whole = np.ones_like(rho1)
+    for choice, tri, ray, mu in (
+        (simple & (n_pos == 2) & apex_c, (r1, b, cc), (cc, r2, r1), (1 - rho2, whole)),
+        (simple & (n_pos == 2) & ~apex_c, (b, cc, r2), (b, r1, r2), (1 - rho1, whole)),
     ):
         tri = np.stack([p[choice] for p in tri], axis=1)
         out.append(_triangle_points(face[choice], piece[choice], tri, xi, wq))
-        out.append(_curved(cf, face, piece, ray, lam, choice, n_t))
+        out.append(_curved(cf, face, piece, ray, mu, choice, n_t))
     out.append(_rays(cf[~simple], face[~simple], piece[~simple], corners[~simple], n_t))
     return out
 
 
-def _curved(cf, face, piece, ray, lam, rows, n_t) -> tuple:
+def _curved(cf, face, piece, ray, mu, rows, n_t) -> tuple:
     """The curved triangle with positive apex ``X`` and base ``R₁R₂`` along the rays from
-    ``X`` to the base, each cut at its first root (module notes, step 3); ``lam`` the apex's
-    barycentric coordinate in the leaf at ``R₁`` and ``R₂`` (where a ray leaves the leaf)."""
+    ``X`` to the base, each cut at its first root (module notes, step 3); ``mu`` one minus
+    the apex's barycentric coordinate in the leaf at ``R₁`` and ``R₂``, so a ray leaves the
+    leaf at ``t = 1/μ``. ``μ`` is passed as such (a root's ``ρ`` itself, not ``1 − (1 − ρ)``)
+    and ``1/μ`` held below ``EXIT_BOUND``: for a root at ``ρ → 0`` beside the apex the
+    exit lies far out, and its square in the ray's polynomial must stay finite (the ray's
+    root ``t ≈ 1`` is found either way; the arc then spans an area of order ``ρ²``)."""
     cf, face, piece = cf[rows], face[rows], piece[rows]
     x, r1, r2 = (p[rows] for p in ray)
-    l1, l2 = (lv[rows] for lv in lam)
+    m1, m2 = (m[rows] for m in mu)
     sig, ws = gauss_legendre(n_t + RAY_POINTS)
     tau, wt = gauss_legendre(n_t)
     base = r1[:, None] + sig[:, None] * (r2 - r1)[:, None]  # (n, nσ, 2)
     d = base - x[:, None]
-    exit_t = 1.0 / np.maximum(1.0 - ((1.0 - sig) * l1[:, None] + sig * l2[:, None]), 1e-300)
+    exit_t = 1.0 / np.maximum((1.0 - sig) * m1[:, None] + sig * m2[:, None], 1.0 / EXIT_BOUND)
     coef = along(cf, x[:, None], d) * np.stack([np.ones_like(exit_t), exit_t, exit_t**2], -1)
     roots = roots_in_unit_interval(coef.reshape(-1, 3)).reshape(coef.shape[:2] + (2,))
     u = np.fmin(np.fmin(roots[..., 0], roots[..., 1]), 1.0)  # NaN-ignoring: 1 where none
