@@ -299,11 +299,12 @@ def assemble_stiffness_3d(
         upper_blocks(g, on_cells(material, g.cells), pattern.select, blocks, at)
     summed = pattern.sums @ blocks.reshape(-1, 9)  # (n_upper, 9), each pair in cell order
     del blocks
-    data = np.take(summed.reshape(-1), pattern.source)
-    indptr, indices = pattern.indptr, pattern.indices
+    indices, data = pattern.laid_out(summed)
+    del summed
+    indptr = pattern.indptr
     if kept is not None:  # the kept rows' entries only
         data, indices, indptr = _rows_of(np.repeat(kept, 3), indptr, indices, data)
-    out = sp.csr_matrix((data, indices.copy(), indptr.copy()), shape=pattern.shape, copy=False)
+    out = sp.csr_matrix((data, indices, indptr.copy()), shape=pattern.shape, copy=False)
     out.has_sorted_indices = True
     return out
 
