@@ -17,19 +17,21 @@ pattern holds
   scalar rows' starts (3 × 3 blocks: row ``3 z + i`` holds row ``i`` of node row ``z``'s
   blocks).
 
-Assembly is then ``summed = sums @ blocks`` and :meth:`NodePattern.laid_out`, which writes
-the scalar CSR's indices and data from the summed blocks chunk of node rows by chunk (SciPy's
-BSR -> CSR loop): no sort and no ``(nnz,)`` array kept in the pattern, so the first assembly
-on a mesh faults in less memory (:func:`signorini.fem.stiffness3d.assemble_stiffness_3d`).
-:func:`pattern_of` keeps the
-pattern of a cell-node array as long as that array lives (the space's ``cell_dofs`` is
-cached on the space, so its pattern lives with the space) and rebuilds it if the array's
-values changed.
+Assembly is then :meth:`NodePattern.scalar_indices` (the CSR's indices, first: before the
+element blocks are formed, so that the data can later reuse their freed memory), ``summed =
+sums @ blocks`` and :meth:`NodePattern.laid_out` (the CSR's data from the summed blocks), both
+written chunk of node rows by chunk through SciPy's BSR -> CSR loop: no sort and no ``(nnz,)``
+array kept in the pattern, so the first assembly on a mesh faults in less memory
+(:func:`signorini.fem.stiffness3d.assemble_stiffness_3d`). :func:`pattern_of` keeps the
+pattern of a cell-node array as long as that array lives (the space's ``cell_dofs`` is cached
+on the space, so its pattern lives with the space) and rebuilds it if the array's values
+changed.
 """
 
 from __future__ import annotations
 
 import weakref
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -79,11 +81,37 @@ class NodePattern:
         """The scalar matrix's shape, ``(3 n_nodes, 3 n_nodes)``."""
         return 3 * self.n_nodes, 3 * self.n_nodes
 
-    def laid_out(self, summed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The scalar CSR's ``indices`` and ``data`` of the summed upper blocks ``summed
-        (n_upper, 9)``: each node block its pair's, transposed below the diagonal, laid out
-        by SciPy's BSR -> CSR conversion chunk of node rows by chunk (the temporaries stay
-        small; the two outputs are new arrays).
+    def _row_chunks(self) -> Iterator[tuple[int, int, int, int]]:
+        """Chunks ``(r0, r1, f0, f1)`` of node rows and their blocks, about ``_BLOCKS`` each."""
+        first = self.first
+        cuts = np.searchsorted(first, np.arange(0, first[-1], _BLOCKS), side="right") - 1
+        cuts = np.append(np.unique(cuts), self.n_nodes)
+        for r0, r1 in zip(cuts[:-1].tolist(), cuts[1:].tolist(), strict=True):
+            yield r0, r1, int(first[r0]), int(first[r1])
+
+    def _scalar(self, values: np.ndarray, r0: int, r1: int, f0: int, f1: int) -> sp.csr_matrix:
+        """The scalar CSR rows ``3 r0 … 3 r1 - 1`` of the node blocks ``values (k, 3, 3)`` of
+        blocks ``f0 … f1 - 1``, by SciPy's BSR -> CSR loop."""
+        starts = self.first[r0 : r1 + 1] - f0
+        bsr = sp.bsr_matrix(
+            (values, self.column[f0:f1], starts), shape=(3 * (r1 - r0), 3 * self.n_nodes)
+        )
+        return bsr.tocsr()
+
+    def scalar_indices(self) -> np.ndarray:
+        """The scalar CSR's column indices ``(nnz,)`` (a new array), sorted in each row: the
+        node blocks' columns ``3 w + j``, written chunk of node rows by chunk."""
+        indices = np.empty(9 * int(self.first[-1]), dtype=self.indptr.dtype)
+        for r0, r1, f0, f1 in self._row_chunks():
+            values = np.zeros((f1 - f0, 3, 3), dtype=np.int8)
+            indices[9 * f0 : 9 * f1] = self._scalar(values, r0, r1, f0, f1).indices
+        return indices
+
+    def laid_out(self, summed: np.ndarray) -> np.ndarray:
+        """The scalar CSR's data ``(nnz,)`` (a new array, in the order of
+        :meth:`scalar_indices`) of the summed upper blocks ``summed (n_upper, 9)``: each node
+        block its pair's, transposed below the diagonal, chunk of node rows by chunk (the
+        temporaries stay in the cache).
 
         Parameters
         ----------
@@ -91,26 +119,16 @@ class NodePattern:
 
         Returns
         -------
-        indices : (nnz,) int array
-        data : (nnz,) float64 array
+        (nnz,) float64 array
         """
-        first, n = self.first, self.n_nodes
         blocks = summed.reshape(-1, 3, 3)
-        nnz = 9 * int(first[-1])
-        indices, data = np.empty(nnz, dtype=self.indptr.dtype), np.empty(nnz)
-        cuts = np.searchsorted(first, np.arange(0, first[-1], _BLOCKS), side="right") - 1
-        cuts = np.append(np.unique(cuts), n)
-        for r0, r1 in zip(cuts[:-1], cuts[1:], strict=True):  # chunks of node rows
-            f0, f1 = int(first[r0]), int(first[r1])
+        data = np.empty(9 * int(self.first[-1]))
+        for r0, r1, f0, f1 in self._row_chunks():
             values = np.take(blocks, self.pair[f0:f1], axis=0)  # (k, 3, 3): the pair's block
             mirror = self.mirror[f0:f1, None, None]
             values = np.where(mirror, values.transpose(0, 2, 1), values)  # or its transpose
-            starts = first[r0 : r1 + 1] - f0
-            shape = (3 * (r1 - r0), 3 * n)
-            csr = sp.bsr_matrix((values, self.column[f0:f1], starts), shape=shape).tocsr()
-            indices[9 * f0 : 9 * f1] = csr.indices
-            data[9 * f0 : 9 * f1] = csr.data
-        return indices, data
+            data[9 * f0 : 9 * f1] = self._scalar(values, r0, r1, f0, f1).data
+        return data
 
 
 def _index_type(size: int) -> type:
