@@ -1,6 +1,6 @@
 """The node-pair pattern of P2 tetrahedra (:mod:`signorini.fem.pattern3d`) against the pairs
-of np.unique, and the assembly
-through it against a scalar COO assembly of the element matrices."""
+of ``np.unique``, and the assembly through it against a scalar COO assembly of the element
+matrices."""
 
 import gc
 
