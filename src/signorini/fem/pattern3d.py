@@ -17,10 +17,10 @@ pattern holds
   scalar rows' starts (3 × 3 blocks: row ``3 z + i`` holds row ``i`` of node row ``z``'s
   blocks).
 
-Assembly is then :meth:`NodePattern.scalar_indices` (the CSR's indices, first: before the
-element blocks are formed, so that the data can later reuse their freed memory), ``summed =
-sums @ blocks`` and :meth:`NodePattern.laid_out` (the CSR's data from the summed blocks), both
-written chunk of node rows by chunk through SciPy's BSR -> CSR loop: no sort and no ``(nnz,)``
+Assembly is then ``summed = sums @ blocks`` and :meth:`NodePattern.laid_out`, the CSR's data
+and indices from the summed blocks (the indices' array allocated before the element blocks,
+so that the data can reuse their freed memory), written chunk of node rows by chunk through
+SciPy's BSR -> CSR loop: no sort and no ``(nnz,)``
 array kept in the pattern, so the first assembly on a mesh faults in less memory
 (:func:`signorini.fem.stiffness3d.assemble_stiffness_3d`). :func:`pattern_of` keeps the
 pattern of a cell-node array as long as that array lives (the space's ``cell_dofs`` is cached
@@ -107,7 +107,7 @@ class NodePattern:
             indices[9 * f0 : 9 * f1] = self._scalar(values, r0, r1, f0, f1).indices
         return indices
 
-    def laid_out(self, summed: np.ndarray) -> np.ndarray:
+    def laid_out(self, summed: np.ndarray, indices: np.ndarray | None = None) -> np.ndarray:
         """The scalar CSR's data ``(nnz,)`` (a new array, in the order of
         :meth:`scalar_indices`) of the summed upper blocks ``summed (n_upper, 9)``: each node
         block its pair's, transposed below the diagonal, chunk of node rows by chunk (the
@@ -116,6 +116,9 @@ class NodePattern:
         Parameters
         ----------
         summed : (n_upper, 9) float array
+        indices : (nnz,) int array, optional
+            Receives :meth:`scalar_indices` in the same pass (allocated by the caller before
+            the element blocks, so that the data can reuse their freed memory).
 
         Returns
         -------
@@ -127,7 +130,10 @@ class NodePattern:
             values = np.take(blocks, self.pair[f0:f1], axis=0)  # (k, 3, 3): the pair's block
             mirror = self.mirror[f0:f1, None, None]
             values = np.where(mirror, values.transpose(0, 2, 1), values)  # or its transpose
-            data[9 * f0 : 9 * f1] = self._scalar(values, r0, r1, f0, f1).data
+            csr = self._scalar(values, r0, r1, f0, f1)
+            data[9 * f0 : 9 * f1] = csr.data
+            if indices is not None:
+                indices[9 * f0 : 9 * f1] = csr.indices
         return data
 
 

@@ -294,13 +294,14 @@ def assemble_stiffness_3d(
             groups.append((g.rows(slot), position[mine[slot]]))
         nodes = nodes[touch]
     pattern = pattern_of(nodes, int(n_dofs) // 3, owner)
-    indices = pattern.scalar_indices()  # before the blocks: the data reuses their memory
+    # the indices' array before the blocks, so that the data can reuse the blocks' memory
+    indices = np.empty(pattern.indptr[-1], dtype=pattern.indptr.dtype)
     blocks = np.empty((nodes.shape[0], pattern.select.shape[1], 9))
     for g, at in groups:  # each group into its cells' rows (mesh order)
         upper_blocks(g, on_cells(material, g.cells), pattern.select, blocks, at)
     summed = pattern.sums @ blocks.reshape(-1, 9)  # (n_upper, 9), each pair in cell order
     del blocks
-    data = pattern.laid_out(summed)
+    data = pattern.laid_out(summed, indices)
     del summed
     indptr = pattern.indptr
     if kept is not None:  # the kept rows' entries only
