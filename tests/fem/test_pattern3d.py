@@ -1,5 +1,6 @@
-"""The node-pair pattern of P2 tetrahedra (:mod:`signorini.fem.pattern3d`) and the assembly
-through it against a scalar COO assembly of the element matrices."""
+"""The node-pair pattern of P2 tetrahedra (:mod:`signorini.fem.pattern3d`) against the pairs
+of ``np.unique``, and the assembly through it against a scalar COO assembly of the element
+matrices."""
 
 import gc
 
@@ -13,6 +14,7 @@ from signorini.fem.mapping3d import TetrahedronMap
 from signorini.fem.material import CellMaterials, Material, on_cells
 from signorini.fem.space import space_of
 from signorini.fem.stiffness3d import assemble_stiffness_3d, element_stiffness_3d
+from signorini.mesh.refine3d import bisect_mesh
 
 RNG = np.random.default_rng(3)
 
@@ -81,3 +83,99 @@ def test_pattern_kept_while_the_dof_array_lives_and_rebuilt_when_it_changes():
     del owner
     gc.collect()
     assert key not in pattern3d._PATTERNS
+
+
+def unique_pairs_reference(cell_nodes):
+    """Every coupled node pair ``(z, w)`` of both triangles, by ``np.unique`` of all cells'
+    100 ordered local pairs (written without the pattern's construction)."""
+    z = np.asarray(cell_nodes)
+    rows = np.repeat(z, 10, axis=1).ravel()
+    cols = np.tile(z, (1, 10)).ravel()
+    return np.unique(np.column_stack([rows, cols]), axis=0)
+
+
+def refined_space():
+    """A box bisected twice where random cells were marked: varied node degrees."""
+    mesh = distorted_box(2)
+    for _ in range(2):
+        marked = RNG.random(mesh.n_cells) < 0.3
+        mesh = bisect_mesh(mesh, marked, 1)[0]
+    return space_of(mesh)
+
+
+def check_pattern(cell_nodes, n_nodes):
+    p = pattern3d.node_pattern(cell_nodes, n_nodes)
+    ref = unique_pairs_reference(cell_nodes)
+    z_row = np.repeat(np.arange(n_nodes), np.diff(p.first))
+    # the node-block CSR: exactly the coupled pairs, rows in order, columns sorted
+    assert np.array_equal(np.column_stack([z_row, p.column]), ref)
+    # each block is its unordered pair's, mirrored below the diagonal only
+    assert np.array_equal(p.mirror, z_row > p.column)
+    lo, hi = np.minimum(z_row, p.column), np.maximum(z_row, p.column)
+    n_upper = p.sums.shape[0]
+    assert np.array_equal(np.sort(p.pair[~p.mirror]), np.arange(n_upper))
+    owner = np.full((n_upper, 2), -1)
+    owner[p.pair[~p.mirror]] = np.column_stack([lo, hi])[~p.mirror]
+    assert np.array_equal(owner[p.pair], np.column_stack([lo, hi]))
+    # sums: row q lists, in cell order, every cell pair 55 c + k with the nodes of pair q
+    a, b = np.divmod(p.select.astype(np.int64), 10)
+    cells = np.asarray(cell_nodes)
+    za = np.take_along_axis(cells, a, axis=1).ravel()
+    zb = np.take_along_axis(cells, b, axis=1).ravel()
+    assert np.all(za <= zb)
+    coo = p.sums.tocoo()
+    assert np.all(coo.data == 1.0) and coo.nnz == cells.shape[0] * 55
+    assert np.array_equal(np.sort(coo.col), np.arange(coo.nnz))  # every cell pair once
+    assert np.array_equal(owner[coo.row], np.column_stack([za, zb])[coo.col])
+    step = np.diff(p.sums.indices)  # increasing within each row: cell order
+    inside = np.ones(step.size, dtype=bool)
+    inside[p.sums.indptr[1:-1] - 1] = False
+    assert np.all(step[inside] > 0)
+    # the scalar CSR: full 3 x 3 blocks, rows 3 z + i, sorted columns
+    scalar = sp.csr_matrix((np.ones(len(ref)), (ref[:, 0], ref[:, 1])), shape=(n_nodes, n_nodes))
+    expanded = sp.kron(scalar, np.ones((3, 3)), format="csr")
+    expanded.sort_indices()
+    assert np.array_equal(p.indptr, expanded.indptr)
+    assert np.array_equal(p.scalar_indices(), expanded.indices)
+
+
+def test_pattern_equals_unique_pairs_on_random_refined_and_curved_meshes():
+    V = space_of(distorted_box(2))
+    renumber = RNG.permutation(V.n_nodes)
+    shuffled = renumber[V.cell_nodes][RNG.permutation(len(V.cell_nodes))]
+    check_pattern(shuffled, V.n_nodes)  # random numbering and cell order
+    W = refined_space()
+    check_pattern(W.cell_nodes, W.n_nodes)
+    mapping, cell_dofs, n_dofs, _ = mixed_problem()  # curved cells: the pattern of its nodes
+    check_pattern(cell_dofs[:, 0::3] // 3, n_dofs // 3)
+    sub = shuffled[: len(shuffled) // 3]  # some cells only: nodes no cell has are empty rows
+    check_pattern(sub, V.n_nodes)
+
+
+def test_laid_out_places_each_pair_block_and_its_transpose():
+    W = refined_space()
+    p = pattern3d.node_pattern(W.cell_nodes, W.n_nodes)
+    summed = RNG.normal(size=(p.sums.shape[0], 9))
+    data = p.laid_out(summed)
+    K = sp.csr_matrix((data, p.scalar_indices(), p.indptr), shape=p.shape)
+    # an independent layout: each upper pair's block at (lo, hi), transposed at (hi, lo)
+    up = ~p.mirror
+    z_row = np.repeat(np.arange(W.n_nodes), np.diff(p.first))
+    lo, hi, q = z_row[up], p.column[up], p.pair[up]
+    blocks = summed[q].reshape(-1, 3, 3)
+    i, j = np.meshgrid(np.arange(3), np.arange(3), indexing="ij")
+    rows = np.concatenate(
+        [(3 * lo[:, None, None] + i).ravel(), (3 * hi[:, None, None] + j).ravel()]
+    )
+    cols = np.concatenate(
+        [(3 * hi[:, None, None] + j).ravel(), (3 * lo[:, None, None] + i).ravel()]
+    )
+    strict = np.repeat(lo != hi, 9)
+    vals = np.concatenate([blocks.ravel(), np.where(strict, blocks.ravel(), 0.0)])
+    ref = sp.csr_matrix((vals, (rows, cols)), shape=p.shape)
+    assert np.array_equal(K.toarray(), ref.toarray())
+    diagonal = q[lo == hi]  # symmetric diagonal blocks (as a stiffness's): K is symmetric
+    sym = summed.reshape(-1, 3, 3)[diagonal]
+    summed.reshape(-1, 3, 3)[diagonal] = sym + sym.transpose(0, 2, 1)
+    dense = sp.csr_matrix((p.laid_out(summed), p.scalar_indices(), p.indptr)).toarray()
+    assert np.array_equal(dense, dense.T)

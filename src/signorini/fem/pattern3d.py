@@ -11,21 +11,27 @@ pattern holds
   the cell's sorted nodes (:func:`numpy.triu_indices`);
 * ``sums (n_upper, 55 m)``: the 0/1 matrix whose row ``p`` lists, in cell order, the cell
   pairs that add to upper pair ``p`` (one stable sort of the ``55 m`` keys ``z n + w``);
-* ``indptr, indices, source``: the scalar CSR of the whole matrix (both triangles, 3 × 3
-  node blocks, sorted indices) and, for each of its entries, its place in the summed upper
-  blocks ``(n_upper, 9)``: ``9 p + 3 i + j`` above the diagonal and on it, ``9 p + 3 j + i``
-  below it (the mirror), so the matrix is symmetric bit for bit.
+* ``first, column, pair, mirror``: the node-block CSR of the whole matrix (both triangles,
+  sorted columns), each block the summed upper pair ``pair`` or, below the diagonal
+  (``mirror``), its transpose, so the matrix is symmetric bit for bit; and ``indptr``, the
+  scalar rows' starts (3 × 3 blocks: row ``3 z + i`` holds row ``i`` of node row ``z``'s
+  blocks).
 
-Assembly is then ``data = (sums @ blocks)[source]``: no sort and no conversion per assembly
+Assembly is then ``summed = sums @ blocks`` and :meth:`NodePattern.laid_out`, the CSR's data
+and indices from the summed blocks (the indices' array allocated before the element blocks,
+so that the data can reuse their freed memory), written chunk of node rows by chunk through
+SciPy's BSR -> CSR loop: no sort and no ``(nnz,)``
+array kept in the pattern, so the first assembly on a mesh faults in less memory
 (:func:`signorini.fem.stiffness3d.assemble_stiffness_3d`). :func:`pattern_of` keeps the
-pattern of a cell-node array as long as that array lives (the space's ``cell_dofs`` is
-cached on the space, so its pattern lives with the space) and rebuilds it if the array's
-values changed.
+pattern of a cell-node array as long as that array lives (the space's ``cell_dofs`` is cached
+on the space, so its pattern lives with the space) and rebuilds it if the array's values
+changed.
 """
 
 from __future__ import annotations
 
 import weakref
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,24 +56,85 @@ class NodePattern:
         Local pair ``10 a + b`` (node blocks ``[c, a, b]``) of each cell's upper pairs.
     sums : scipy.sparse.csr_matrix, (n_upper, 55 m)
         Row ``p``: the cell pairs ``55 c + k`` of upper pair ``p`` in cell order.
-    indptr, indices : int arrays
-        The scalar CSR pattern ``(3 n_nodes, 3 n_nodes)``, sorted, node blocks full.
-    source : (nnz,) int array
-        Each CSR entry's index in the summed upper blocks, flattened ``(n_upper · 9,)``.
+    first, column : int arrays
+        The node-block CSR pattern ``(n_nodes, n_nodes)``: both triangles, sorted columns.
+    pair : (n_blocks,) int array
+        Each block's upper pair.
+    mirror : (n_blocks,) bool array
+        The blocks below the diagonal: the transpose of their pair's block.
+    indptr : (3 n_nodes + 1,) int array
+        The scalar CSR's row starts, ``9 first[z] + 3 i deg z`` for row ``3 z + i``.
     """
 
     n_nodes: int
     cell_nodes: np.ndarray
     select: np.ndarray
     sums: sp.csr_matrix
+    first: np.ndarray
+    column: np.ndarray
+    pair: np.ndarray
+    mirror: np.ndarray
     indptr: np.ndarray
-    indices: np.ndarray
-    source: np.ndarray
 
     @property
     def shape(self) -> tuple[int, int]:
         """The scalar matrix's shape, ``(3 n_nodes, 3 n_nodes)``."""
         return 3 * self.n_nodes, 3 * self.n_nodes
+
+    def _row_chunks(self) -> Iterator[tuple[int, int, int, int]]:
+        """Chunks ``(r0, r1, f0, f1)`` of node rows and their blocks, about ``_BLOCKS`` each."""
+        first = self.first
+        cuts = np.searchsorted(first, np.arange(0, first[-1], _BLOCKS), side="right") - 1
+        cuts = np.append(np.unique(cuts), self.n_nodes)
+        for r0, r1 in zip(cuts[:-1].tolist(), cuts[1:].tolist(), strict=True):
+            yield r0, r1, int(first[r0]), int(first[r1])
+
+    def _scalar(self, values: np.ndarray, r0: int, r1: int, f0: int, f1: int) -> sp.csr_matrix:
+        """The scalar CSR rows ``3 r0 … 3 r1 - 1`` of the node blocks ``values (k, 3, 3)`` of
+        blocks ``f0 … f1 - 1``, by SciPy's BSR -> CSR loop."""
+        starts = self.first[r0 : r1 + 1] - f0
+        bsr = sp.bsr_matrix(
+            (values, self.column[f0:f1], starts), shape=(3 * (r1 - r0), 3 * self.n_nodes)
+        )
+        return bsr.tocsr()
+
+    def scalar_indices(self) -> np.ndarray:
+        """The scalar CSR's column indices ``(nnz,)`` (a new array), sorted in each row: the
+        node blocks' columns ``3 w + j``, written chunk of node rows by chunk."""
+        indices = np.empty(9 * int(self.first[-1]), dtype=self.indptr.dtype)
+        for r0, r1, f0, f1 in self._row_chunks():
+            values = np.zeros((f1 - f0, 3, 3), dtype=np.int8)
+            indices[9 * f0 : 9 * f1] = self._scalar(values, r0, r1, f0, f1).indices
+        return indices
+
+    def laid_out(self, summed: np.ndarray, indices: np.ndarray | None = None) -> np.ndarray:
+        """The scalar CSR's data ``(nnz,)`` (a new array, in the order of
+        :meth:`scalar_indices`) of the summed upper blocks ``summed (n_upper, 9)``: each node
+        block its pair's, transposed below the diagonal, chunk of node rows by chunk (the
+        temporaries stay in the cache).
+
+        Parameters
+        ----------
+        summed : (n_upper, 9) float array
+        indices : (nnz,) int array, optional
+            Receives :meth:`scalar_indices` in the same pass (allocated by the caller before
+            the element blocks, so that the data can reuse their freed memory).
+
+        Returns
+        -------
+        (nnz,) float64 array
+        """
+        blocks = summed.reshape(-1, 3, 3)
+        data = np.empty(9 * int(self.first[-1]))
+        for r0, r1, f0, f1 in self._row_chunks():
+            values = np.take(blocks, self.pair[f0:f1], axis=0)  # (k, 3, 3): the pair's block
+            mirror = self.mirror[f0:f1, None, None]
+            values = np.where(mirror, values.transpose(0, 2, 1), values)  # or its transpose
+            csr = self._scalar(values, r0, r1, f0, f1)
+            data[9 * f0 : 9 * f1] = csr.data
+            if indices is not None:
+                indices[9 * f0 : 9 * f1] = csr.indices
+        return data
 
 
 def _index_type(size: int) -> type:
@@ -97,6 +164,10 @@ def _upper_sums(z: np.ndarray, n_nodes: int) -> tuple[np.ndarray, sp.csr_matrix,
     return select, sums, key[run[:-1]]
 
 
+#: node blocks per chunk of :meth:`NodePattern.laid_out`: its temporaries stay in the cache
+_BLOCKS = 1 << 15
+
+
 def node_pattern(cell_nodes: np.ndarray, n_nodes: int) -> NodePattern:
     """The pattern of the stiffness matrix of P2 tetrahedra with nodes ``cell_nodes``.
 
@@ -123,24 +194,16 @@ def node_pattern(cell_nodes: np.ndarray, n_nodes: int) -> NodePattern:
     strict = sp.csr_matrix((np.where(lo != hi, -p1, 0), hi, start), shape=upper.shape)
     strict.eliminate_zeros()
     both = upper + strict.T.tocsr()
-    first, col = both.indptr, both.indices
-    pair, mirror = np.abs(both.data) - 1, both.data < 0
-    # each entry's source, 9 p + 3 i + j (3 j + i for a mirror), laid out by SciPy's BSR -> CSR
-    # loop as the values will be: row 3 z + i holds row i of node row z's blocks
-    mirrored = np.array([3 * j + i for i in range(3) for j in range(3)], dtype=index)
-    entry = np.where(mirror[:, None], mirrored, np.arange(9, dtype=index))  # (n_blocks, 9)
-    entry += (9 * pair).astype(index)[:, None]
-    bsr = sp.bsr_matrix(
-        (entry.reshape(-1, 3, 3), col, first),
-        shape=(3 * n_nodes, 3 * n_nodes),
-        copy=False,
-    )
-    csr = bsr.tocsr()
-    source = csr.data
-    indices, indptr = csr.indices.astype(index, copy=False), csr.indptr.astype(index, copy=False)
-    for a in (z, select, indptr, indices, source):
+    first = both.indptr.astype(np.int64)
+    column, mirror = both.indices.astype(index), both.data < 0
+    pair = (np.abs(both.data) - 1).astype(index)
+    deg = np.diff(first)
+    indptr = np.empty(3 * n_nodes + 1, dtype=index)
+    indptr[:-1] = (9 * first[:-1, None] + 3 * deg[:, None] * np.arange(3)).reshape(-1)
+    indptr[-1] = 9 * first[-1]
+    for a in (z, select, first, column, pair, mirror, indptr):
         a.setflags(write=False)
-    return NodePattern(int(n_nodes), z, select, sums, indptr, indices, source)
+    return NodePattern(int(n_nodes), z, select, sums, first, column, pair, mirror, indptr)
 
 
 #: patterns by the identity of the cell-node array they were built for (while it lives)

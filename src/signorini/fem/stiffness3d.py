@@ -32,8 +32,9 @@ so the assembly keeps only each cell's 55 *upper* node pairs (the global row the
 node, :func:`upper_blocks`) and sums them in cell order with one sparse product through the
 mesh's node-pair pattern (:mod:`signorini.fem.pattern3d`: built at the first assembly on a
 mesh, one stable sort of the ``55 m`` pair keys, and kept while the space's DOF array
-lives); the sums are laid out as the CSR data by one gather, the lower triangle mirrored from
-the upper one, so the matrix is symmetric bit for bit. The result has sorted indices, the
+lives); the sums are laid out as the CSR data and indices chunk of node rows by chunk
+(:meth:`~signorini.fem.pattern3d.NodePattern.laid_out`), the lower triangle mirrored from the
+upper one, so the matrix is symmetric bit for bit. The result has sorted indices, the
 node-block pattern (rows ``3z … 3z + 2`` share their columns) and int32 indices while they
 fit; the complex packing of the 2D assembly is a d = 2 trick and is not used.
 
@@ -43,6 +44,10 @@ same mesh 0.61–0.82 × 10⁶ unknowns per second from 1.5 × 10⁴ to 1.07 × 
 times faster than NGSolve; the first assembly on a mesh (its pattern built) 0.41–0.50 × 10⁶
 to 3.5 × 10⁵ unknowns, 1.1–3.9 times NGSolve's and 31–81 times scikit-fem's, 0.14 × 10⁶ at
 1.07 × 10⁶ (its memory faulted in). Of a warm assembly the element matrices are about half.
+Since the pattern keeps no nnz-sized array (the CSR laid out per assembly), the cold assembly
+at 1.07 × 10⁶ faults in 0.66 GB less and took 5.5–6.1 s instead of 8.4–9.7 s (one call in a
+fresh process, alternated with the previous code), the warm one about 25 % more CPU
+(docs/method.md, *The kept pattern without nnz-sized arrays*).
 """
 
 from __future__ import annotations
@@ -294,16 +299,19 @@ def assemble_stiffness_3d(
             groups.append((g.rows(slot), position[mine[slot]]))
         nodes = nodes[touch]
     pattern = pattern_of(nodes, int(n_dofs) // 3, owner)
+    # the indices' array before the blocks, so that the data can reuse the blocks' memory
+    indices = np.empty(pattern.indptr[-1], dtype=pattern.indptr.dtype)
     blocks = np.empty((nodes.shape[0], pattern.select.shape[1], 9))
     for g, at in groups:  # each group into its cells' rows (mesh order)
         upper_blocks(g, on_cells(material, g.cells), pattern.select, blocks, at)
     summed = pattern.sums @ blocks.reshape(-1, 9)  # (n_upper, 9), each pair in cell order
     del blocks
-    data = np.take(summed.reshape(-1), pattern.source)
-    indptr, indices = pattern.indptr, pattern.indices
+    data = pattern.laid_out(summed, indices)
+    del summed
+    indptr = pattern.indptr
     if kept is not None:  # the kept rows' entries only
         data, indices, indptr = _rows_of(np.repeat(kept, 3), indptr, indices, data)
-    out = sp.csr_matrix((data, indices.copy(), indptr.copy()), shape=pattern.shape, copy=False)
+    out = sp.csr_matrix((data, indices, indptr.copy()), shape=pattern.shape, copy=False)
     out.has_sorted_indices = True
     return out
 
