@@ -61,9 +61,9 @@ WARM_START_RTOL = 1e-10
 PAIR_WARM_START_RTOL = 1e-5
 #: projected ℓ1-Jacobi sweeps on the prolongated solution before the active set rule of a 3D
 #: warm start (:func:`warm_rule_active_set`; docs/method.md, *Three dimensions: warm starts
-#: by the active set rule*). Measured on hertz-3d adaptive, levels 1–9 to 35k unknowns: rows
-#: the rule misses per level 4 8 0 5 6 2 12 9 2 with 0 sweeps, 0 2 0 2 0 2 0 2 0 with 20,
-#: 0 2 0 2 0 2 0 0 0 with 40 (benchmarks/warm3d.py)
+#: smoothed before the rule*). Measured on hertz-3d adaptive, levels 1–9 to 35k unknowns, rows of
+#: the converged set the prediction misses: 4 8 0 5 6 2 12 7 2 with 0 sweeps, 0 4 0 2 2 2 2 2 0
+#: with 20, 0 2 0 2 0 2 0 0 0 with 40 (``benchmarks/warm3d.py --adaptive``)
 WARM_SMOOTHING_SWEEPS = 40
 
 
@@ -139,7 +139,7 @@ def projected_l1_jacobi(
     positive semi-definite (diagonally dominant), each step minimises a quadratic majorant
     of the energy ``½ xᵀKx − Fᵀx`` over the bounds, so the energy never increases (the ℓ1
     smoother of algebraic multigrid with the box projection; docs/method.md, *Three
-    dimensions: warm starts by the active set rule*). ``K``'s rows may be split over
+    dimensions: warm starts smoothed before the rule*). ``K``'s rows may be split over
     ``ranks``; the result is the same on every rank."""
     x = x.copy()
     step = ranks.sum(abs(K) @ np.ones(x.size))
