@@ -83,3 +83,49 @@ def test_coarse_two_spheres_kkt_and_hertz(slave):
 def test_bad_input_refused(kwargs, match):
     with pytest.raises(ValueError, match=match):
         two_spheres(**kwargs)
+
+
+def _coupling(h=0.07):
+    from signorini.contact.mortar3d import mortar_coupling_3d
+    from signorini.fem.space3d import P2TetSpace
+
+    problem = two_spheres(h_contact=h)
+    space = P2TetSpace(problem.mesh)
+    return space, mortar_coupling_3d(space, "upper.cap", "lower.sphere")
+
+
+def test_rim_rows_scaled_to_coverage_one(monkeypatch):
+    """At the symmetry planes the projected master misses slivers of the slave (coverage
+    1 − 2·10⁻³ on this mesh without the scaling); the rim rows are scaled so that every row
+    transfers constants exactly, and no interior row is touched."""
+    import signorini.contact.mortar3d as m3
+
+    space, scaled = _coupling()
+    assert np.abs(scaled.coverage - 1).max() <= 1e-12
+    monkeypatch.setattr(m3, "_rim_scaled", lambda space, slave, M, *rest: M)
+    _, raw = _coupling()
+    off = np.abs(raw.coverage - 1)
+    assert 1e-4 < off.max() <= m3.RIM_COVERAGE
+    x = space.node_points[raw.slave_nodes]
+    touched = off > 1e-12
+    # touched rows lie on, or one face from, the symmetry planes
+    assert np.minimum(x[touched, 0], x[touched, 1]).max() < 0.1
+    np.testing.assert_array_equal(raw.M[~touched].toarray(), scaled.M[~touched].toarray())
+
+
+def test_multiplier_moment_is_the_integral_of_the_interpolant():
+    """``Σ_j D_jj r̃²_j = ∫_Γs r²_h`` (the identity behind ``a_h``: a uniform multiplier,
+    Λ̃_j = D_jj), the right side from the straight faces directly: the P2 vertex functions
+    integrate to 0 on a flat triangle and the midpoint functions to |F| / 3."""
+    space, c = _coupling(h=0.1)
+    x = space.node_points
+    r2 = np.sum(x[:, :2] ** 2, axis=1)
+    f = c.slave_faces
+    tri = x[f[:, :3]]
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    direct = float(np.sum(area / 3 * r2[f[:, 3:]].sum(axis=1)))
+    alpha = c.alpha
+    rt = r2.copy()
+    for e, a, b in ((3, 0, 1), (4, 1, 2), (5, 2, 0)):
+        rt[f[:, e]] = (r2[f[:, e]] - alpha * (r2[f[:, a]] + r2[f[:, b]])) / (1 - 2 * alpha)
+    assert float(c.D @ rt[c.slave_nodes]) == pytest.approx(direct, rel=1e-12)
