@@ -103,7 +103,7 @@ def test_rim_rows_scaled_to_coverage_one(monkeypatch):
     space, scaled = _coupling()
     assert np.abs(scaled.coverage - 1).max() <= 1e-12
     monkeypatch.setattr(m3, "_rim_scaled", lambda space, slave, M, *rest: M)
-    _, raw = _coupling()
+    raw = m3.mortar_coupling_3d(space, "upper.cap", "lower.sphere")
     off = np.abs(raw.coverage - 1)
     assert 1e-4 < off.max() <= m3.RIM_COVERAGE
     x = space.node_points[raw.slave_nodes]
