@@ -12,6 +12,7 @@ import scipy.linalg as la
 import scipy.sparse as sp
 from scipy.optimize import nnls
 
+from signorini import adaptive
 from signorini.contact import solve
 from signorini.contact.mortar3d import mortar_coupling_3d
 from signorini.contact.system import assemble
@@ -199,3 +200,19 @@ def test_pairs_in_3d_refused_where_not_built():
     two.size = 2
     with pytest.raises(ValueError, match="not split over MPI ranks"):
         assemble(problem, problem.mesh, ranks=two)
+
+
+@pytest.mark.parametrize("slave", ["upper", "lower"])
+def test_patch_test_on_a_uniformly_refined_level_with_a_warm_start(slave):
+    """Issue 41's patch test through the loop, either side as slave: the second, uniformly
+    refined level starts warm from the first (its active set read in the mortar set's
+    variables) and still transmits the uniform pressure to round-off,
+    ``slave_pressure_deviation`` ≤ 1e-9 with tol 1e-10."""
+    levels = list(
+        adaptive(stacked_cubes(slave=slave), uniform=True, tol=1e-10, max_levels=2,
+                 metrics=cubes_metrics)
+    )  # fmt: skip
+    assert len(levels) == 2
+    for level in levels:
+        assert level.record.extra["slave_pressure_deviation"] <= 1e-9
+        assert level.record.extra["master_force_deviation"] <= 1e-9

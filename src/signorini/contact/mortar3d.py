@@ -40,9 +40,11 @@ from ..problem.fields import ProblemError
 from ..problem.normals import face_node_normals
 from .face_basis import DEFAULT_ALPHA
 from .mortar3d_segments import Segments, plane_frames, segments
+from .mortar_checks import COVERAGE_TOL
 
 __all__ = [
     "MORTAR_DEGREE",
+    "RIM_COVERAGE",
     "MortarCoupling3D",
     "dual_coefficients",
     "face_duals",
@@ -54,6 +56,13 @@ __all__ = [
 #: the triangle rule's degree on the integration cells and the slave faces: ψ_j (φ_k ∘ π)
 #: and φ̃_a φ̃_b are polynomials of degree 4 there (π affine on each cell)
 MORTAR_DEGREE = 4
+
+#: a slave node whose ψ_j reaches the slave part's rim (a face with a vertex on another
+#: boundary part, e.g. a symmetry plane) may miss this share of its coverage: the master's
+#: edge on a plane the slave's edge also lies on, projected along a face normal that is
+#: not in that plane, leaves a sliver of width gap · |n_S · e_plane| (docs/method.md, *Two
+#: bodies in three dimensions*, "Rims"); such rows are scaled to coverage 1
+RIM_COVERAGE = 0.05
 
 #: the midpoint and the two ends of the sides (a, b), (b, c), (c, a) of a 6-node face
 _SIDES = np.array([[3, 0, 1], [4, 1, 2], [5, 2, 0]])
@@ -226,8 +235,9 @@ def mortar_coupling_3d(
     M = sp.coo_matrix(
         (entries.ravel(), (rows.ravel(), cols.ravel())), shape=(slave_nodes.size, space.n_nodes)
     ).tocsr()
+    M = _rim_scaled(space, slave, M, D, slave_nodes, index)
     normal = face_node_normals(space, slave, slave_nodes)
-    gap = np.einsum("sc,sc->s", M @ x - D[:, None] * x[slave_nodes], normal)
+    gap = np.einsum("sc,sc->s", _gap_vectors(space, sf, M, D, slave_nodes, alpha), normal)
     coverage = np.asarray(M.sum(axis=1)).ravel() / D
     return MortarCoupling3D(
         slave, master, float(alpha), slave_nodes, sf, normal, D, M, gap, coverage, cells
@@ -247,3 +257,36 @@ def _cell_entries(cells: Segments, s_tri, m_tri, coef, T) -> np.ndarray:
     lm = plane_barycentric(m_tri[cells.master], x, in_plane)
     psi = np.einsum("cqb,cab->cqa", basis_barycentric(ls) @ T.T, coef[cells.slave])
     return np.einsum("cq,cqa,cqb->cab", ws, psi, basis_barycentric(lm))
+
+
+def _rim_scaled(space, slave: str, M: sp.csr_matrix, D, slave_nodes, index) -> sp.csr_matrix:
+    """``M`` with the rows of the rim nodes (:data:`RIM_COVERAGE`) whose coverage
+    ``Σ_k M_jk / D_jj`` is within ``RIM_COVERAGE`` of 1 scaled to coverage 1: the constant
+    is transferred exactly again (the patch test, equal and opposite resultants), at a
+    change of ``M`` of the order of the sliver. Rows within ``COVERAGE_TOL`` of 1 (a flat
+    interface) or beyond ``RIM_COVERAGE`` (refused by the contact set as large sliding) stay
+    as they are."""
+    mesh = space.mesh
+    others = [p for p in mesh.part_names if p != slave]
+    rim = np.isin(slave_nodes, space.part_nodes(others))
+    vertex_on_rim = rim[index[:, :3]].any(axis=1)  # faces touching the rim
+    near = np.zeros(slave_nodes.size, dtype=bool)
+    near[index[vertex_on_rim].ravel()] = True
+    coverage = np.asarray(M.sum(axis=1)).ravel() / D
+    off = np.abs(coverage - 1.0)
+    scale = np.where(near & (off > COVERAGE_TOL) & (off <= RIM_COVERAGE), 1.0 / coverage, 1.0)
+    return sp.csr_matrix(sp.diags(scale) @ M)
+
+
+def _gap_vectors(space, faces, M: sp.csr_matrix, D, slave_nodes, alpha: float) -> np.ndarray:
+    """``(s, 3)`` ``Σ_k M_jk x_k − D_jj x̃_j``: the ψ_j-weighted distance vector from the slave
+    to the master of the isoparametric (curved) P2 surfaces, x the node points (midpoints on
+    a carried surface), ``x̃`` the slave's coordinates in the transformed basis
+    (``∫ ψ_j x_s = D_jj x̃_j``); on straight faces the chords' midpoints, ``x̃ = x``."""
+    x = np.asarray(space.node_points, dtype=np.float64)
+    xt = x.copy()
+    for e, a, b in _SIDES:  # the three sides of a face
+        xt[faces[:, e]] = (x[faces[:, e]] - alpha * (x[faces[:, a]] + x[faces[:, b]])) / (
+            1.0 - 2.0 * alpha
+        )
+    return M @ x - D[:, None] * xt[slave_nodes]

@@ -157,6 +157,12 @@ class MortarFaceSet:
         r[self.node] -= rel[:, None] * self.direction
         return to_frames_3d(r.ravel(), self.frame_nodes, self.frames)
 
+    def normal_displacement(self, u: np.ndarray) -> np.ndarray:
+        """``(k,)`` the rows' bounded variables ``y_dof`` (:meth:`unknowns`) of nodal values
+        ``u (n_nodes, 3)``: what :attr:`gap` bounds, read where the solver reads it (a
+        warm start's first active set, :func:`~.nested.warm_active_set`)."""
+        return self.unknowns(np.asarray(u, dtype=np.float64).ravel())[self.dof]
+
     def relative_gap(self, u: np.ndarray) -> np.ndarray:
         """``(k,)`` ``n_j·(ũ_j − Σ_k T_jk u_k) − g̃_j / D_jj`` of nodal values ``u (n_nodes,
         3)``: 0 in contact, negative where the bodies are apart."""

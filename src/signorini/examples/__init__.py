@@ -42,6 +42,7 @@ from .punch import punch
 from .punch3d import punch_3d
 from .two_bodies import BLOCKS_METRICS, CYLINDERS_METRICS, hertz_pair, stacked_blocks, two_cylinders
 from .two_bodies3d import CUBES_METRICS, stacked_cubes
+from .two_spheres3d import SPHERES_METRICS, two_spheres
 
 __all__ = [
     "EXAMPLES",
@@ -67,6 +68,7 @@ __all__ = [
     "hertz_pair",
     "stacked_blocks",
     "stacked_cubes",
+    "two_spheres",
     "two_cylinders",
 ]
 
@@ -125,6 +127,7 @@ EXAMPLES: dict[str, Example] = {
         Example("example-6.2-3d", example_6_2_3d),
         Example("punch-3d", punch_3d),
         Example("stacked-cubes", stacked_cubes, metrics=CUBES_METRICS),
+        Example("two-spheres", two_spheres, metrics=SPHERES_METRICS),
     )
 }
 
