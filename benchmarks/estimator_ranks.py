@@ -1,4 +1,5 @@
-"""Benchmark: the estimator on several MPI ranks, on one solution of Example 6.2.
+"""Benchmark: the estimator on several MPI ranks, on one solution of Example 6.2 (or
+``--problem hertz-3d``, P2 tetrahedra).
 
 Run under ``mpiexec -n N python benchmarks/estimator_ranks.py [--max-ndof 200000]``: every
 rank runs the adaptive loop (θ = 0.4) on the ``"petsc"`` backend to the budget, then times,
@@ -10,6 +11,7 @@ reduction of the integrals alone. Each rank prints one line; the estimates must 
 largest difference is printed.
 
     mpiexec -n 2 python benchmarks/estimator_ranks.py --max-ndof 200000
+    mpiexec -n 2 python benchmarks/estimator_ranks.py --problem hertz-3d --max-ndof 40000
 """
 
 from __future__ import annotations
@@ -24,6 +26,9 @@ from signorini.algebra import solver_factory
 from signorini.algebra.ranks import solver_ranks
 from signorini.contact.partition import partition
 from signorini.estimator.residual import estimate
+from signorini.examples import hertz_3d
+
+PROBLEMS = {"example-6.2": example_6_2, "hertz-3d": lambda: hertz_3d(h_contact=0.2)}
 
 
 def best(func, repeat: int, clock=time.perf_counter) -> tuple[float, object]:
@@ -40,10 +45,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max-ndof", type=int, default=200_000)
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--problem", default="example-6.2", choices=tuple(PROBLEMS))
     args = parser.parse_args()
     factory = solver_factory("petsc")
     ranks = solver_ranks(factory)
-    for level in adaptive(example_6_2(), max_ndof=args.max_ndof, solver=factory):
+    for level in adaptive(PROBLEMS[args.problem](), max_ndof=args.max_ndof, solver=factory):
         result = level.result
     t_part, part = best(lambda: partition(result.space, ranks), args.repeat)
     t_serial, serial = best(lambda: estimate(result), args.repeat)
@@ -52,7 +58,8 @@ def main() -> None:
     cpu_ranks, _ = best(
         lambda: estimate(result, ranks=ranks, partition=part), args.repeat, time.process_time
     )
-    n_integrals = result.mesh.n_cells + result.mesh.n_edges  # about the size of the reduction
+    mesh = result.mesh  # about the size of the reduction: cells and edges (faces in 3D)
+    n_integrals = mesh.n_cells + (mesh.n_edges if mesh.dim == 2 else len(mesh.facet2cell))
     t_sum, _ = best(lambda: ranks.sum(np.zeros(n_integrals)), args.repeat)
     diff = np.abs(split.eta2_cell - serial.eta2_cell).max() / serial.eta2_cell.max()
     print(

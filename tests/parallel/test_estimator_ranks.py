@@ -7,7 +7,8 @@ serial ones; the integrals the ranks hand to ``sum`` are nonzero on disjoint set
 to the one-rank integrals bit for bit (each integral computed on exactly one rank). Example
 6.2 (frictionless, both η5 variants, P1), its Coulomb variant (η8), Example 6.1 (a body
 force), the curved Hertz half-disc, its quarter with a roller (η3 on a held part) and two
-cylinders (a contact pair: η3 on the master, two materials) on N = 2 and 3.
+cylinders (a contact pair: η3 on the master, two materials) on N = 2 and 3; in 3D Hertz
+(contact faces, rollers, a Neumann top) and the manufactured body-force block.
 """
 
 from __future__ import annotations
@@ -20,7 +21,15 @@ import pytest
 from signorini.algebra.ranks import SERIAL, Ranks
 from signorini.contact.partition import partition
 from signorini.estimator.residual import estimate
-from signorini.examples import example_6_1, example_6_2, example_6_2_coulomb, hertz, two_cylinders
+from signorini.examples import (
+    elasticity_3d,
+    example_6_1,
+    example_6_2,
+    example_6_2_coulomb,
+    hertz,
+    hertz_3d,
+    two_cylinders,
+)
 from signorini.examples.hertz_half import hertz_quarter
 from signorini.fem.material import Material
 from signorini.loop import adaptive
@@ -64,7 +73,10 @@ PROBLEMS = {  # the problem, its element, its levels: 130 to 760 cells
     "hertz-quarter": (hertz_quarter, "P2", 10),
     "two-cylinders": (two_cylinders, "P2", 6),
     "held-block": (held_block, "P2", 8),
+    "hertz-3d": (lambda: hertz_3d(h_contact=0.2), "P2", 3),  # tetrahedra: 486 to ~2000 cells
+    "elasticity-3d": (lambda: elasticity_3d(2), "P2", 2),
 }
+PROBLEMS_3D = ("hertz-3d", "elasticity-3d")
 
 
 @cache
@@ -85,7 +97,8 @@ def on_ranks(result, size: int, variant: str):
     return out
 
 
-CASES = [(name, "consistent") for name in PROBLEMS] + [("example-6.2", "paper")]
+CASES = [(name, "consistent") for name in PROBLEMS if name not in PROBLEMS_3D]
+CASES += [("example-6.2", "paper")]
 
 
 @pytest.mark.parametrize("size", [2, 3])
@@ -107,6 +120,30 @@ def test_the_ranks_indicators_sum_to_the_serial_ones(name, variant, size):
     assert all(np.count_nonzero(flat) > 0 for flat in flats)
     (_, whole), = on_ranks(result, 1, variant)  # fmt: skip
     np.testing.assert_array_equal(sum(flats), whole)
+
+
+@pytest.mark.parametrize("size", [2, 3])
+@pytest.mark.parametrize("name", PROBLEMS_3D)
+def test_the_ranks_3d_indicators_sum_to_the_serial_ones(name, size):
+    """As in 2D, on tetrahedra: each rank integrates η1 on its cells, η2 and η3 on the faces
+    whose first cell is its own, η4 … η7 on its own contact faces (estimator/residual3d.py)."""
+    result = solved(name)
+    serial = estimate(result)
+    parts = on_ranks(result, size, "consistent")
+    assert all(est.unit == serial.unit for est, _ in parts)
+    for field in ("eta2_cell", "eta2_node"):
+        total = sum(getattr(est, field) for est, _ in parts)
+        want = getattr(serial, field)
+        scale = np.abs(want).max(axis=1, keepdims=True)
+        assert (np.abs(total - want) <= 1e-13 * np.maximum(np.abs(want), 1e-3 * scale)).all()
+    flats = [flat for _, flat in parts]
+    assert (sum((flat != 0).astype(int) for flat in flats) <= 1).all()
+    assert all(np.count_nonzero(flat) > 0 for flat in flats)
+    (_, whole), = on_ranks(result, 1, "consistent")  # fmt: skip
+    np.testing.assert_array_equal(sum(flats), whole)
+    (one, _), = on_ranks(result, 1, "consistent")  # fmt: skip
+    np.testing.assert_array_equal(one.eta2_cell, serial.eta2_cell)
+    np.testing.assert_array_equal(one.eta2_node, serial.eta2_node)
 
 
 @pytest.mark.parametrize("name", ["example-6.2", "example-6.2-coulomb", "hertz", "two-cylinders"])

@@ -199,7 +199,7 @@ def estimate(
     partition: Partition | None = None,
 ) -> Estimate:
     """Compute η_h and all its contributions for a discrete solution (paper, Section 5); on
-    tetrahedra :func:`~.residual3d.estimate_3d` (one process).
+    tetrahedra :func:`~.residual3d.estimate_3d`.
 
     Parameters
     ----------
@@ -229,11 +229,11 @@ def estimate(
     """
     if eta5_variant not in ETA5_VARIANTS:
         raise ValueError(f"eta5_variant must be one of {ETA5_VARIANTS}, got {eta5_variant!r}")
-    if result.mesh.dim == 3:  # tetrahedra: the 3D table, one process (it imports this module)
+    own = own_part(result, ranks, partition)  # None: one process, every cell and facet
+    if result.mesh.dim == 3:  # tetrahedra: the 3D table (it imports this module)
         from .residual3d import estimate_3d
 
-        return estimate_3d(result, eta5_variant)
-    own = own_part(result, ranks, partition)  # None: one process, every cell and facet
+        return estimate_3d(result, eta5_variant, own=own)
     problem, space, mesh, cs = result.problem, result.space, result.mesh, result.contact
     n_nodes, n_cells = space.n_nodes, mesh.n_cells
     element = space.element  # P2, or P1 read as the P2 field it is (docs/method.md, *P1 ...*)

@@ -29,6 +29,7 @@ element indicators sum to η_h² exactly.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,6 +44,7 @@ from ..problem.fields import evaluate_field
 from .contact_faces3d import PRESSURE_3D, contact_terms
 from .faces3d import TetStress, face_geometry
 from .names import TERMS
+from .owned import OwnPart, per_cell_of
 from .residual import NODE_TERMS, Estimate
 from .terms import (
     FacetSet,
@@ -69,7 +71,10 @@ NEUMANN_DEGREE_3D = 10
 
 
 def estimate_3d(
-    result: ContactResult, eta5_variant: str = "consistent", pressure: str = PRESSURE_3D
+    result: ContactResult,
+    eta5_variant: str = "consistent",
+    pressure: str = PRESSURE_3D,
+    own: OwnPart | None = None,
 ) -> Estimate:
     """η_h and its contributions for a 3D discrete solution (P2 tetrahedra); called by
     :func:`~signorini.estimator.residual.estimate` on a tetrahedral mesh (which checks
@@ -82,6 +87,12 @@ def estimate_3d(
     pressure : {"transformed", "recovered"}
         The nodal pressure the consistent η5 balances σ_nn with
         (:func:`~.contact_faces3d.eta5_pressure`; default :data:`~.contact_faces3d.PRESSURE_3D`).
+    own : OwnPart, optional
+        This rank's part on a run of several ranks (:func:`~.owned.own_part`; default every
+        cell and face): η1 on its cells, η2 and η3 on the faces whose first cell is its own,
+        η4 … η7 on every contact face (Γ_C's data is replicated) kept on its own faces; the
+        integrals are summed over the ranks before they are spread, as in 2D
+        (docs/parallel.md, *The estimator on several ranks*).
 
     Returns
     -------
@@ -96,11 +107,21 @@ def estimate_3d(
     unit = stresses.unit
     s, w = triangle_rule(FACE_DEGREE)
 
-    R = _cell_residuals(result, material, stresses)
+    mine = None if own is None else own.cells  # None: every cell and face (one process)
+    R = _cell_residuals(result, material, stresses, mine)
     inner = _face_set(space, np.flatnonzero(mesh.facet2cell[:, 1] >= 0))
-    J2 = _jumps(space, stresses, inner, s, w)
-    boundary, J3 = _traction_residuals(result, stresses)
+    J2 = _on_own_faces(inner, mine, lambda faces: _jumps(space, stresses, faces, s, w))
+    boundary, J3 = _traction_residuals(result, stresses, mine)
     contact = contact_terms(result, stresses, eta5_variant, s, w, pressure)
+    if own is not None:  # each integral from the one rank that owns it, summed over the ranks
+        if contact is None:
+            R, J2, J3 = own.sum([R, J2, J3])
+        else:
+            keep = own.facets(contact.faces.cells)
+            J4, J5, eta7 = (np.where(keep, a, 0.0) for a in (contact.J4, contact.J5, contact.eta7))
+            parts6 = np.where(keep[:, None], contact.parts6, 0.0)
+            R, J2, J3, J4, J5, parts6, eta7 = own.sum([R, J2, J3, J4, J5, parts6, eta7])
+            contact = contact._replace(J4=J4, J5=J5, parts6=parts6, eta7=eta7)
 
     def on_faces(faces: FacetSet, J: np.ndarray) -> TermShares:
         return spread_facet_integrals(faces, J, h_p, n_cells)
@@ -148,14 +169,32 @@ def _face_set(space: P2TetSpace, e: np.ndarray) -> FacetSet:
     return FacetSet(e, space.mesh_facet_nodes(e), mesh.facet2cell[e], mesh.facet_measure[e])
 
 
+def _on_own_faces(
+    faces: FacetSet, mine: np.ndarray | None, integrals: Callable[[FacetSet], np.ndarray]
+) -> np.ndarray:
+    """``integrals(faces)`` ``(k,)``; with this rank's cells ``mine`` on the faces whose first
+    cell is one of them only, zero on the others."""
+    if mine is None:
+        return integrals(faces)
+    keep = np.flatnonzero(mine[faces.cells[:, 0]])
+    J = np.zeros(faces.index.size)
+    own = FacetSet(faces.index[keep], faces.nodes[keep], faces.cells[keep], faces.measure[keep])
+    J[keep] = integrals(own)
+    return J
+
+
 def _cell_residuals(
-    result: ContactResult, material: Material | CellMaterials, stresses: TetStress
+    result: ContactResult,
+    material: Material | CellMaterials,
+    stresses: TetStress,
+    mine: np.ndarray | None = None,
 ) -> np.ndarray:
     """η1's ``‖f + div σ(u_h)‖²_T`` ``(n_cells,)`` in the stress unit: div σ(u_h) from the
     Hessians through each cell's map (constant on affine cells), f at the points of the
     degree-``CELL_DEGREE_3D`` rule. :func:`~.terms.interior_residual` reads a rule whose
     weights sum to 1/2 and the cells' ``det J / 2``: the tetrahedron's weights (summing to
-    1/6) enter times 3 and ``det J / 6`` (the volume) as its measure, the same sums."""
+    1/6) enter times 3 and ``det J / 6`` (the volume) as its measure, the same sums. With
+    this rank's cells ``mine`` on those only (zero on the others)."""
     problem, cells, unit = result.problem, result.space.mapping, stresses.unit
     xi, w = tetrahedron_rule(CELL_DEGREE_3D)
     f = None
@@ -168,7 +207,12 @@ def _cell_residuals(
         volume = g.jacobians(xi)[1] / 6.0
         return interior_residual(volume, div, None if f is None else f[g.cells], 3.0 * w)
 
-    return cells.per_cell(residual)
+    if mine is None:
+        return cells.per_cell(residual)
+    subset = np.flatnonzero(mine)
+    R = np.zeros(result.mesh.n_cells)
+    R[subset] = per_cell_of(cells, subset, lambda g, rows: residual(g))
+    return R
 
 
 def _traction(stresses: TetStress, cells: np.ndarray, nodes: np.ndarray, s, geometry):
@@ -191,11 +235,14 @@ def _jumps(space, stresses: TetStress, faces: FacetSet, s, w) -> np.ndarray:
     return J
 
 
-def _traction_residuals(result: ContactResult, stresses: TetStress) -> tuple[FacetSet, np.ndarray]:
+def _traction_residuals(
+    result: ContactResult, stresses: TetStress, mine: np.ndarray | None = None
+) -> tuple[FacetSet, np.ndarray]:
     """η3's faces and ``‖r‖²_F`` on each, part after part: ``r = σ(u_h)n − g`` on Neumann parts
     (g at the points and with the normals of each face's geometry), the tangential part of
     σ(u_h)n on rollers, the free components of σ(u_h)n on Dirichlet parts that hold some
-    (docs/method.md, *Rollers and components*)."""
+    (docs/method.md, *Rollers and components*). With this rank's cells ``mine``, on the faces
+    whose cell is one of them only (zero on the others)."""
     problem, space, mesh = result.problem, result.space, result.mesh
     s, w = triangle_rule(NEUMANN_DEGREE_3D)
     index, values = [], []
@@ -205,21 +252,33 @@ def _traction_residuals(result: ContactResult, stresses: TetStress) -> tuple[Fac
         if not isinstance(cond, Dirichlet | Roller) and name not in problem.neumann_parts:
             continue
         e = mesh.part_facets(name)
-        faces = _face_set(space, e)
-        J = np.zeros(e.size)
-        for rows, geometry in face_geometry(space, faces.nodes):
-            sn = _traction(stresses, faces.cells[rows, 0], faces.nodes[rows], s, geometry)
-            n = np.broadcast_to(geometry.normals(s), sn.shape)
-            if isinstance(cond, Roller):
-                sn = sn - np.einsum("kqc,kqc->kq", sn, n)[..., None] * n
-            elif isinstance(cond, Dirichlet):
-                sn = sn * ~np.asarray(cond.components)
-            elif not cond.is_zero:
-                what = f"the traction of Neumann part {name!r}"
-                g = evaluate_field(cond.field(), geometry.points(s), what, shape=(3,), normal=n)
-                sn = sn - g / stresses.unit
-            J[rows] = neumann_residual(sn, w, geometry.speeds(s))
+        J = _on_own_faces(
+            _face_set(space, e),
+            mine,
+            lambda faces, c=cond, n=name: _part_tractions(stresses, faces, c, n, s, w),
+        )
         index.append(e)
         values.append(J)
     e = np.concatenate(index) if index else np.zeros(0, np.int64)
     return _face_set(space, e), (np.concatenate(values) if values else np.zeros(0))
+
+
+def _part_tractions(
+    stresses: TetStress, faces: FacetSet, cond: object, name: str, s: np.ndarray, w: np.ndarray
+) -> np.ndarray:
+    """η3's ``‖r‖²_F`` on the faces ``faces`` of the part ``name`` with condition ``cond``
+    (:func:`_traction_residuals`)."""
+    J = np.zeros(faces.index.size)
+    for rows, geometry in face_geometry(stresses.space, faces.nodes):
+        sn = _traction(stresses, faces.cells[rows, 0], faces.nodes[rows], s, geometry)
+        n = np.broadcast_to(geometry.normals(s), sn.shape)
+        if isinstance(cond, Roller):
+            sn = sn - np.einsum("kqc,kqc->kq", sn, n)[..., None] * n
+        elif isinstance(cond, Dirichlet):
+            sn = sn * ~np.asarray(cond.components)
+        elif not cond.is_zero:
+            what = f"the traction of Neumann part {name!r}"
+            g = evaluate_field(cond.field(), geometry.points(s), what, shape=(3,), normal=n)
+            sn = sn - g / stresses.unit
+        J[rows] = neumann_residual(sn, w, geometry.speeds(s))
+    return J
