@@ -48,6 +48,12 @@ bodies); its floor factorizes the two-body matrix (the relative displacement's b
 docs/method.md, *Two bodies*).
 
     python benchmarks/adaptive.py --problem two-cylinders
+
+With ``--problem example-6.2-3d`` or ``hertz-3d`` the run is the 3D loop and its floor is one
+complete iterative solve per level (AMG set-up + CG to the loop's tolerance, from zero):
+``benchmarks/floor3d.py`` prints that table.
+
+    python benchmarks/adaptive.py --problem example-6.2-3d --max-ndof 200000
 """
 
 from __future__ import annotations
@@ -55,6 +61,7 @@ from __future__ import annotations
 import argparse
 import functools
 import resource
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -168,7 +175,7 @@ def main() -> None:
     )
     parser.add_argument(
         "--problem",
-        choices=("example-6.2", "two-cylinders"),
+        choices=("example-6.2", "two-cylinders", "example-6.2-3d", "hertz-3d"),
         default="example-6.2",
         help="Example 6.2 (with --friction) or the two-cylinder problem of two elastic bodies",
     )
@@ -180,6 +187,14 @@ def main() -> None:
     )
     args = parser.parse_args()
     retain_freed_memory()
+    if args.problem.endswith("-3d"):  # the 3D floor: benchmarks/floor3d.py
+        if args.friction != "none":
+            parser.error("--friction applies to example-6.2 only")
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from floor3d import run
+
+        run(args.problem, args.theta, args.max_ndof, level_peak_bytes, reset_peak)
+        return
     out = args.out or Path(tempfile.mkdtemp(prefix="signorini-bench-"))
     history = HistoryWriter(out / "history.csv")
     problem = {

@@ -16,6 +16,14 @@ dense peak).
 
     python benchmarks/throughput.py                     # levels at 1e5 and 1e6 unknowns
     python benchmarks/throughput.py --sizes 200000 --blas-n 2000
+
+With ``--dim 3`` it runs ``--problem`` (``example-6.2-3d`` or ``hertz-3d``) adaptively with
+the loop's own solver and prints, at the first level with at least each of ``--sizes``
+unknowns, the refinement, assembly and estimator rates in unknowns per second per core: the
+wall-clock rate divided by the cores the level kept busy (its process CPU time over its wall
+time), no factorization columns.
+
+    python benchmarks/throughput.py --dim 3 --sizes 50000 200000
 """
 
 from __future__ import annotations
@@ -91,6 +99,57 @@ def measure(sizes: list[int], theta: float, repeat: int) -> list[dict[str, float
     return rows
 
 
+def measure_3d(name: str, sizes: list[int], theta: float) -> list[dict[str, float]]:
+    """One row per size for the 3D problem ``name``: the phases' rates per core at the first
+    adaptive level with ≥ size unknowns (refinement: the next level's unknowns per second of
+    the refinement that made them)."""
+    from signorini.examples import EXAMPLES
+
+    targets = sorted(sizes)
+    rows: list[dict[str, float]] = []
+    pending: dict[str, float] | None = None
+    generator = adaptive(EXAMPLES[name].problem(), theta=theta, max_ndof=np.inf)
+    while True:
+        wall, cpu = time.perf_counter(), time.process_time()
+        level = next(generator, None)
+        if level is None:
+            break
+        r = level.record
+        cores = max((time.process_time() - cpu) / (time.perf_counter() - wall), 1.0)
+        if pending is not None:
+            pending["refine"] = r.ndof / (pending.pop("t_refine") * cores)
+            rows.append(pending)
+            pending = None
+            if len(rows) == len(sizes):
+                break
+        if r.ndof < targets[len(rows)]:
+            continue
+        pending = {
+            "ndof": r.ndof,
+            "cores": cores,
+            "t_refine": r.t_refine,
+            "assemble": r.ndof / (r.t_assemble * cores),
+            "estimate": r.ndof / (r.t_estimate * cores),
+        }
+    generator.close()
+    return rows
+
+
+def table_3d(rows: list[dict[str, float]]) -> str:
+    """The Markdown table of :func:`measure_3d`'s rows."""
+    lines = [
+        "| unknowns | cores busy | refinement (unknowns/s/core) | assembly (unknowns/s/core) "
+        "| estimator (unknowns/s/core) |",
+        "|---:|---:|---:|---:|---:|",
+    ]
+    for row in rows:
+        lines.append(
+            f"| {row['ndof']:,} | {row['cores']:.2f} | {row['refine']:.3g} "
+            f"| {row['assemble']:.3g} | {row['estimate']:.3g} |".replace(",", " ")
+        )
+    return "\n".join(lines)
+
+
 def table(rows: list[dict[str, float]], peak: float) -> str:
     """The Markdown table of :func:`measure`'s rows against the dense peak (GFlop/s)."""
     lines = [
@@ -113,10 +172,18 @@ def main() -> None:
     parser.add_argument("--theta", type=float, default=0.4)
     parser.add_argument("--repeat", type=int, default=3, help="best of this many runs")
     parser.add_argument("--blas-n", type=int, default=4000, help="order of the dense product")
+    parser.add_argument("--dim", type=int, choices=(2, 3), default=2)
+    parser.add_argument(
+        "--problem", choices=("example-6.2-3d", "hertz-3d"), default="example-6.2-3d",
+        help="the 3D problem (with --dim 3)",
+    )  # fmt: skip
     args = parser.parse_args()
     if min(args.sizes) < 1 or args.repeat < 1 or args.blas_n < 1:
         parser.error("--sizes, --repeat and --blas-n must be positive")
     retain_freed_memory()
+    if args.dim == 3:
+        print(table_3d(measure_3d(args.problem, args.sizes, args.theta)))
+        return
     peak = dense_peak_gflops(args.blas_n, args.repeat)
     rows = measure(args.sizes, args.theta, args.repeat)
     print(table(rows, peak))

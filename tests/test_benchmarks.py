@@ -311,3 +311,33 @@ def test_ordering_benchmark_compares_both_orderings_on_both_meshes():
     assert float(lines[-2].split("=")[1]) == ratios[3]
     assert re.fullmatch(r"ordering_ratio=\d+\.\d{3}", lines[-1])
     assert float(lines[-1].split("=")[1]) == ratios[2]
+
+
+@pytest.mark.slow
+def test_adaptive_benchmark_3d_floor_shares_sum_to_the_ratio():
+    """benchmarks/adaptive.py --problem example-6.2-3d on a small budget: each level's ratio
+    is its total over its floor, the floor's CG converged in a positive number of
+    iterations, the phase shares sum to ratio_to_floor (the sum of totals over the sum of
+    floors), and largest_ndof is the table's largest level."""
+    command = [sys.executable, str(ROOT / "benchmarks" / "adaptive.py")]
+    command += ["--problem", "example-6.2-3d", "--max-ndof", "3000"]
+    out = subprocess.run(command, capture_output=True, text=True, timeout=300, check=True).stdout
+    lines = out.strip().splitlines()
+    header = lines[0].split()
+    end = lines.index("")
+    table = [dict(zip(header, line.split(), strict=True)) for line in lines[1:end]]
+    assert len(table) >= 2
+    for row in table:
+        total, floor, ratio = (float(row[k]) for k in ("total", "floor", "ratio"))
+        assert floor > 0 and int(row["fl_its"]) > 0
+        # the printed values are rounded to 3 decimals: the ratio lies in the interval
+        low, high = (total - 5e-4) / (floor + 5e-4), (total + 5e-4) / (floor - 5e-4)
+        assert low - 5e-4 <= ratio <= high + 5e-4
+    totals = sum(float(row["total"]) for row in table)
+    floors = sum(float(row["floor"]) for row in table)
+    ratio = float(re.search(r"^ratio_to_floor=([0-9.]+)$", out, re.M).group(1))
+    assert abs(ratio - totals / floors) <= 0.01 * ratio
+    shares = re.search(r"^ratio_to_floor by phase .*: (.*)$", out, re.M).group(1)
+    assert abs(sum(float(s.split()[1]) for s in shares.split(" + ")) - ratio) <= 0.01
+    largest = int(re.search(r"^largest_ndof=(\d+)$", out, re.M).group(1))
+    assert largest == max(int(row["ndof"]) for row in table)

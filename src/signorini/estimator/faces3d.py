@@ -18,10 +18,9 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from ..fem.elasticity3d import cell_stress_3d
 from ..fem.mapping3d import FlatFaces, QuadraticFaces, face_groups
 from ..fem.material import CellMaterials, Material, on_cells, stress
-from ..fem.p2_tet import REFERENCE_NODES, face_basis
+from ..fem.p2_tet import REFERENCE_NODES, face_basis, grad_basis
 from ..fem.space3d import P2TetSpace
 from .residual import stress_unit
 
@@ -29,6 +28,8 @@ __all__ = ["TetStress", "direction_field_3d", "face_geometry"]
 
 #: the reference tetrahedron's vertices ``(4, 3)``
 _TET_VERTICES = REFERENCE_NODES[:4]
+#: the reference gradients of the ten P2 basis functions at the four vertices ``(4, 10, 3)``
+_VERTEX_GRADIENTS = grad_basis(_TET_VERTICES)
 
 
 class TetStress:
@@ -47,12 +48,31 @@ class TetStress:
     ) -> None:
         self.space, self.material = space, material
         self.u_cell = space.field_coefficients(u)  # (n_cells, 30)
-        corners = cell_stress_3d(space, material, u, _TET_VERTICES)
+        corners = space.mapping.per_cell(lambda g: self._corners(g, material))
         #: the stress unit σ₀ (1 for ordinary stresses; docs/method.md, *Estimator*, "Units")
         self.unit = stress_unit(float(np.abs(corners).max(initial=0.0)))
         #: σ(u_h) / σ₀ at the vertices of each cell ``(n_cells, 4, 3, 3)``: linear on the
         #: affine cells, so interpolated from these there
         self.vertex_stress = corners / self.unit if self.unit != 1.0 else corners
+
+    def _corners(self, g, material: Material | CellMaterials) -> np.ndarray:
+        """σ(u_h) at the four vertices of the cells of group ``g`` ``(m, 4, 3, 3)``. On
+        affine cells the reference gradients are contracted with the coefficients first and
+        ``J⁻ᵀ`` applied once per cell (``∇u = (Σ_a u_a ⊗ ∇̂φ_a) J⁻¹``), without the
+        ``(m, 4, 10, 3)`` physical basis gradients; through the map elsewhere."""
+        u_cell = self.u_cell[g.cells]
+        if g.order != 1:
+            return stress(on_cells(material, g.cells), g.field_gradients(u_cell, _TET_VERTICES))
+        ref = np.tensordot(u_cell.reshape(-1, 10, 3), _VERTEX_GRADIENTS, axes=([1], [1]))
+        jit = g.inverse_transpose()[:, 0]  # (m, 3, 3): [j, r]
+        grad = ref.transpose(0, 2, 1, 3) @ jit.transpose(0, 2, 1)[:, None]  # (m, 4, i, j)
+        return stress(on_cells(material, g.cells), grad)
+
+    def at_vertices(self, cell: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+        """``(k, 3, 3, 3)`` σ(u_h) / σ₀ of affine cells ``cell (k,)`` at their face's
+        vertices ``vertices (k, 3)`` (global numbers, in the face's order)."""
+        local = (self.space.mesh.cells[cell][:, None, :] == vertices[:, :, None]).argmax(axis=2)
+        return self.vertex_stress[cell[:, None], local]
 
     def at_faces(self, cell: np.ndarray, vertices: np.ndarray, s: np.ndarray) -> np.ndarray:
         """``(k, q, 3, 3)`` σ(u_h) / σ₀ of cells ``cell (k,)`` at the points ``s (q, 2)`` of
