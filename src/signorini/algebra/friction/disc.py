@@ -129,7 +129,9 @@ def check_disc(
     return DiscProblem(qp, normal, tangent, g, ref, friction)
 
 
-def disc_kkt(problem: DiscProblem, x: np.ndarray, in_contact: np.ndarray | None = None) -> FrictionKKT:
+def disc_kkt(
+    problem: DiscProblem, x: np.ndarray, in_contact: np.ndarray | None = None
+) -> FrictionKKT:
     """Relative KKT residuals of ``x`` for both laws, scaled as :func:`.kkt.friction_kkt`
     (the tangential ones with ``‖·‖`` of the vectors in ``[t_1 t_2]``; the slip residual's
     wrong way is ``(‖Λ_t‖ ‖x_t − x_ref‖ − Λ_t·(x_t − x_ref))``, zero when they are parallel).
