@@ -56,6 +56,8 @@ class DiscProblem:
         ``K``, ``F``, the Dirichlet data; its constrained DOFs the normal ones, bounds ``gap``.
     normal : (m,) int64 array
     tangent : (m, 2) int64 array
+        ``-1`` where the tangent is held (a roller through the node): the law then acts on
+        the other component alone, this one's force and slip are 0.
     gap : (m,) float array
     reference : (m, 2) float array
         ``x_ref`` per node and tangent.
@@ -107,12 +109,17 @@ def check_disc(
             f"tangent must be (m, 2) = ({m}, 2), the DOFs of t_1 and t_2 per contact node, "
             f"got shape {np.shape(tangent)}"
         )
-    tangent = _index_array(np.asarray(tangent).ravel(), n, "tangent").reshape(m, 2)
-    _disjoint(normal, tangent.ravel(), "normal", "tangent")
+    tangent = np.asarray(tangent)
+    if tangent.size and (not np.issubdtype(tangent.dtype, np.integer) or tangent.min() < -1):
+        raise ValueError("tangent must hold DOF indices, or -1 for a held tangent")
+    tangent = tangent.astype(np.int64)
+    present = tangent[tangent >= 0]
+    _index_array(present, n, "tangent")
+    _disjoint(normal, present, "normal", "tangent")
     if dirichlet is not None:
         d = _index_array(dirichlet, n, "dirichlet")
         _disjoint(normal, d, "normal", "dirichlet")
-        _disjoint(tangent.ravel(), d, "tangent", "dirichlet")
+        _disjoint(present, d, "tangent", "dirichlet")
     g = check_vector(gap, m, "gap", allow_scalar=True)
     if reference is None:
         ref = np.zeros((m, 2))
@@ -129,6 +136,11 @@ def check_disc(
     return DiscProblem(qp, normal, tangent, g, ref, friction)
 
 
+def _tangential(v: np.ndarray, tangent: np.ndarray) -> np.ndarray:
+    """``(m, 2)`` the entries of ``v (n,)`` at the tangential DOFs, 0 where held (-1)."""
+    return np.where(tangent >= 0, v[np.maximum(tangent, 0)], 0.0)
+
+
 def disc_kkt(
     problem: DiscProblem, x: np.ndarray, in_contact: np.ndarray | None = None
 ) -> FrictionKKT:
@@ -140,9 +152,9 @@ def disc_kkt(
     Kx = qp.matvec(x)
     r = qp.F - Kx
     force = force_scale(qp.K, qp.F, x, Kx, ranks=qp.ranks)
-    lam_n, lam_t = r[problem.normal], r[problem.tangent]
+    lam_n, lam_t = r[problem.normal], _tangential(r, problem.tangent)
     slack = x[problem.normal] - problem.gap
-    slide = x[problem.tangent] - problem.reference
+    slide = _tangential(x, problem.tangent) - problem.reference * (problem.tangent >= 0)
     disp = max(
         np.abs(x).max(initial=0.0),
         np.abs(qp.dirichlet_values).max(initial=0.0),
@@ -159,7 +171,7 @@ def disc_kkt(
     slip = np.maximum(np.abs(norm_lam - s) / fc, np.maximum(wrong_way, 0.0))
     other = np.ones(x.size, dtype=bool)
     other[problem.normal] = False
-    other[problem.tangent.ravel()] = False
+    other[problem.tangent[problem.tangent >= 0]] = False
     other[qp.dirichlet] = False
     return FrictionKKT(
         primal=float(np.maximum(slack, 0.0).max(initial=0.0) / disp),
@@ -241,12 +253,15 @@ def solve_disc(
     nf = int(free.sum())
     K_ff = qp.K[free][:, free].tocsr()
     b = qp.F[free] - qp.K[free][:, qp.dirichlet] @ qp.dirichlet_values
-    jn, jt = where[problem.normal], where[problem.tangent]  # (m,), (m, 2) free indices
-    # the contact forces as unknowns: E places Λ_n, Λ_t on their rows
+    jn = where[problem.normal]  # (m,) free indices
+    jt = np.where(problem.tangent >= 0, where[np.maximum(problem.tangent, 0)], -1)  # (m, 2)
+    # the contact forces as unknowns: E places Λ_n, Λ_t on their rows (held tangents: none)
     cols = np.concatenate([jn, jt.ravel()])
-    E = sp.csr_matrix((np.ones(3 * m), (cols, np.arange(3 * m))), shape=(nf, 3 * m))
+    on = cols >= 0
+    E = sp.csr_matrix((np.ones(on.sum()), (cols[on], np.arange(3 * m)[on])), shape=(nf, 3 * m))
+    reference = problem.reference * (problem.tangent >= 0)
     r = qp.F - qp.matvec(x)
-    lam_n, lam_t = r[problem.normal].copy(), r[problem.tangent].copy()
+    lam_n, lam_t = r[problem.normal].copy(), _tangential(r, problem.tangent)
     states_seen, state = None, np.full(m, INACTIVE, dtype=np.int8)
     for it in range(1, max_iter + 1):
         xf = x[free]
@@ -254,13 +269,15 @@ def solve_disc(
         contact = mu > 0
         s = law.slip_bound(np.maximum(mu, 0.0), contact)
         ds = np.where(contact, law.bound_derivative(contact), 0.0)
-        xi = lam_t + c * (x[problem.tangent] - problem.reference)
+        xi = lam_t + c * (_tangential(x, problem.tangent) - reference)
         norm_xi = np.linalg.norm(xi, axis=1)
         rubs = (s > 0) & (contact | law.everywhere)
         stick = rubs & (norm_xi < s)
         slip = rubs & ~stick
         state = np.where(stick, STICK, np.where(slip, SLIP, INACTIVE)).astype(np.int8)
-        A, R = _linearised(problem, x, lam_n, lam_t, c, contact, stick, slip, s, ds, xi, jn, jt, nf)
+        A, R = _linearised(
+            problem, x, (lam_n, lam_t), c, (contact, stick, slip), (s, ds, xi), (jn, jt), nf
+        )
         J = sp.bmat([[K_ff, E], [A[:, :nf], A[:, nf:]]], format="csc")
         res = np.concatenate([K_ff @ xf + E @ np.concatenate([lam_n, lam_t.ravel()]) - b, R])
         step = spla.spsolve(J, -res)
@@ -278,11 +295,13 @@ def solve_disc(
     )
 
 
-def _linearised(problem, x, lam_n, lam_t, c, contact, stick, slip, s, ds, xi, jn, jt, nf):
+def _linearised(problem, x, lam, c, states, bound, columns, nf):
     """The rows ``A (3m, nf + 3m)`` and residuals ``R (3m,)`` of the linearised contact
     equations of the current states (rows: the normal ones, then ``t_1, t_2`` per node;
     columns: ``x_free``, then ``Λ_n``, then ``Λ_t`` node by node)."""
+    (lam_n, lam_t), (contact, stick, slip), (s, ds, xi), (jn, jt) = lam, states, bound, columns
     m = problem.m
+    absent = (jt < 0).ravel()  # held tangents: Λ_t = 0 on their rows, nothing else
     rows, cols, vals = [], [], []
     R = np.zeros(3 * m)
     nodes = np.arange(m)
@@ -297,9 +316,9 @@ def _linearised(problem, x, lam_n, lam_t, c, contact, stick, slip, s, ds, xi, jn
     free_t = ~(stick | slip)
     for k in range(2):  # the two tangents
         rows.append(t_rows[:, k])
-        cols.append(np.where(stick, jt[:, k], lt_cols[:, k]))
+        cols.append(np.where(stick & (jt[:, k] >= 0), jt[:, k], lt_cols[:, k]))
         vals.append(np.where(stick | free_t, 1.0, 0.0))
-    slide = x[problem.tangent] - problem.reference
+    slide = _tangential(x, problem.tangent) - problem.reference * (jt >= 0)
     R[m:] = np.where(stick[:, None], slide, np.where(free_t[:, None], lam_t, 0.0)).ravel()
     # slip: C = ‖ξ‖ Λ_t − s ξ, dC = (‖ξ‖ − s) dΛ_t + Λ̃ vᵀ dξ − s c dx_t − ξ ds
     i = np.flatnonzero(slip)
@@ -327,6 +346,12 @@ def _linearised(problem, x, lam_n, lam_t, c, contact, stick, slip, s, ds, xi, jn
         vals += [coef, c * coef]
         R[t_rows[i].ravel()] = (norm[:, None] * lt - s_i[:, None] * xi_i).ravel()
     rows, cols, vals = (np.concatenate(a) for a in (rows, cols, vals))
-    keep = vals != 0
+    keep = (vals != 0) & ~(absent[np.maximum(rows - m, 0)] & (rows >= m))
+    held_rows = m + np.flatnonzero(absent)
+    rows = np.concatenate([rows[keep], held_rows])
+    cols = np.concatenate([cols[keep], nf + held_rows])
+    vals = np.concatenate([vals[keep], np.ones(held_rows.size)])
+    keep = np.ones(rows.size, dtype=bool)
+    R[held_rows] = lam_t.ravel()[held_rows - m]
     A = sp.csr_matrix((vals[keep], (rows[keep], cols[keep])), shape=(3 * m, nf + 3 * m))
     return A, R
