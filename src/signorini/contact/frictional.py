@@ -140,7 +140,8 @@ def check_previous(previous: object, space: LagrangeSpace, cs: ContactSet) -> No
         )
     pc = previous.contact
     nodes = cs.nodes if hasattr(cs, "nodes") else cs.node  # 2D constraints, or faces' rows
-    if pc.parts != cs.parts or not np.array_equal(getattr(pc, "nodes", pc.node), nodes):
+    old = pc.nodes if hasattr(pc, "nodes") else pc.node
+    if pc.parts != cs.parts or not np.array_equal(old, nodes):
         raise ValueError(
             f"previous has the contact parts {list(pc.parts)} with {pc.size} constraints, this "
             f"problem {list(cs.parts)} with {cs.size}: the steps of a load path share their "
