@@ -223,6 +223,7 @@ def test_get_example():
         "example-6.2-3d",
         "punch-3d",
         "stacked-cubes",
+        "partial-slip-3d",
     }
     for name in EXAMPLES:
         assert get_example(name).name == name

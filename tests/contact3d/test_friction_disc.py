@@ -141,3 +141,36 @@ def test_bad_tangent_and_reference_are_named():
         _disc(assembled, Tresca(1.0), 1.0, reference=np.zeros(cs.dof.size))
     with pytest.raises(ValueError, match="max_iter"):
         solve_disc(_disc(assembled, Tresca(1.0), 1.0), max_iter=0)
+
+
+def _block_path(law, shifts=(0.0, 0.004)):
+    """box(2) pressed (step 1), then its top moved along x (step 2), through ``solve``."""
+    from signorini.contact.solution import solve
+
+    mesh = box(2, 2, 2)
+    results = []
+    for shift in shifts:  # a loop over load steps
+        cond = {p: Neumann((0.0, 0.0, 0.0)) for p in mesh.part_names}
+        cond.update(
+            z1=Dirichlet((shift, 0.0, -0.01)),
+            z0=Contact(obstacle=HalfSpace([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]), friction=law),
+        )
+        problem = ContactProblem(mesh, MATERIAL, cond)
+        results.append(solve(problem, mesh, previous=results[-1] if results else None))
+    return results
+
+
+@pytest.mark.parametrize("law", [Tresca(1e-3), Coulomb(0.3)])
+def test_a_load_path_through_solve_meets_both_laws_on_the_slip_increment(law):
+    press, pull = _block_path(law)
+    for r in (press, pull):
+        assert r.report.kkt.max <= 1e-12
+        assert r.tangential_force.shape == (r.contact.n_rows, 2)
+    # the pull's reference is the press's tangential displacement in the solver's variables
+    cs = pull.contact
+    y = cs.unknowns(press.u.ravel())
+    np.testing.assert_array_equal(pull.tangential_reference, y[cs.friction.tangent])
+    # pulled along +x: Λ_t points along the slip, +x (the obstacle acts on the body with −Λ)
+    frames = _frames(cs)
+    force = np.einsum("kci,ki->kc", frames[:, :, 1:], pull.tangential_force)
+    assert force[:, 0].sum() > 0

@@ -80,7 +80,7 @@ def partial_slip_3d_path(
     press: float = PRESS_3D,
     pull: float = PULL_3D,
     n: int = 2,
-    h_contact: float = 0.05,
+    h_contact: float = 0.1,
 ) -> list[ContactProblem]:
     """The two load steps (press, pull) on one half-ball mesh (:func:`half_ball` with
     ``h_contact`` relative to R), named ``"partial-slip-3d"``."""

@@ -45,6 +45,12 @@ from .result import INACTIVE, SLIP, STICK
 
 __all__ = ["DiscProblem", "DiscResult", "check_disc", "disc_kkt", "solve_disc"]
 
+#: a Newton step below this times ``max |x|`` is round-off: the iteration has converged
+ROUND_OFF = 1e-13
+#: the largest relative KKT residual accepted at a round-off step (that of the 2D solver,
+#: :class:`~.newton.FrictionOptions`)
+ACCEPT = 1e-8
+
 
 @dataclass(frozen=True)
 class DiscProblem:
@@ -224,7 +230,8 @@ def solve_disc(
     """Semismooth Newton for the disc law (module docstring; docs/method.md, *Friction in
     three dimensions*): each step solves the linearised equations of the current node
     states with the equilibrium ``K x + E Λ = F`` in ``(x_free, Λ_n, Λ_t)`` by sparse LU;
-    it stops when the states repeat and the KKT residuals are at most ``kkt_tol``.
+    it stops when the states repeat and the KKT residuals are at most ``kkt_tol``, or the
+    step is round-off (:data:`ROUND_OFF`) with residuals at most :data:`ACCEPT`.
 
     ``c`` defaults to the mean diagonal of ``K`` over the normal DOFs.
 
@@ -286,7 +293,10 @@ def solve_disc(
         lam_t = lam_t + step[nf + m :].reshape(m, 2)
         key = (contact.tobytes(), state.tobytes())
         kkt = disc_kkt(problem, x, contact)
-        if key == states_seen and kkt.max <= kkt_tol:
+        # converged: the states repeat, and the residuals are at kkt_tol or the step at
+        # round-off (a system whose round-off floor is above kkt_tol)
+        still = np.abs(step[:nf]).max(initial=0.0) <= ROUND_OFF * np.abs(x).max(initial=1.0)
+        if key == states_seen and (kkt.max <= kkt_tol or (still and kkt.max <= ACCEPT)):
             return DiscResult(x, lam_n, lam_t, state, it, kkt)
         states_seen = key
     raise RuntimeError(
