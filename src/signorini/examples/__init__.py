@@ -126,9 +126,7 @@ EXAMPLES: dict[str, Example] = {
         Example("example-6.2-3d", example_6_2_3d),
         Example("punch-3d", punch_3d),
         Example("stacked-cubes", stacked_cubes, metrics=CUBES_METRICS),
-        Example(
-            "partial-slip-3d", partial_slip_3d, PARTIAL_SLIP_3D_METRICS, partial_slip_3d_path
-        ),
+        Example("partial-slip-3d", partial_slip_3d, PARTIAL_SLIP_3D_METRICS, partial_slip_3d_path),
     )
 }
 

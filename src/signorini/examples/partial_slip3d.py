@@ -22,6 +22,8 @@ rows' shares of Γ_C).
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from ..contact.solution import STICK, ContactResult
@@ -49,10 +51,12 @@ COEFFICIENT_3D = 0.5
 PRESS_3D, PULL_3D = 0.01, 0.002
 
 
+@lru_cache(maxsize=8)
 def half_ball(n: int = 2, radius: float = 1.0, h_contact: float = 0.05, patch: float = 0.12):
     """The half ball y ≥ 0 about (0, 0, R) below its equator: :func:`~.hertz3d.graded_eighth_ball`
     mirrored in x = 0 (the image's cells reoriented, the part ``x0`` now inside). Parts
-    ``y0 z1 sphere``."""
+    ``y0 z1 sphere``. Cached: the steps of a load path built twice (the problem and its path,
+    as the command line asks them) share one mesh object."""
     eighth = graded_eighth_ball(n, radius, h_contact, 0.5, patch)
     p = eighth.points
     off = p[:, 0] != 0.0
@@ -136,12 +140,10 @@ def partial_slip_3d_metrics(result: ContactResult) -> dict[str, float]:
 PARTIAL_SLIP_3D_METRICS = Metrics(
     measure=partial_slip_3d_metrics,
     columns={
-        "a": "radius of the contact disc from the nodal forces, √(5/2 Σ Λ r² / Σ Λ), length "
-        "units",
+        "a": "radius of the contact disc from the nodal forces, √(5/2 Σ Λ r² / Σ Λ), length units",
         "c_over_a": "c/a, c the radius of the discrete stick set's area (π c²/2 = Σ_stick w̃_z)"
         ", no unit",
-        "c_over_a_theory": "Mindlin's c/a = (1 − Q/(F P))^(1/3) with the level's P and Q, no "
-        "unit",
+        "c_over_a_theory": "Mindlin's c/a = (1 − Q/(F P))^(1/3) with the level's P and Q, no unit",
         "q_over_fp": "Q/(F P), no unit",
         "stick_nodes": "rows that stick",
         "slip_nodes": "rows that slip",
