@@ -224,6 +224,7 @@ def test_get_example():
         "punch-3d",
         "stacked-cubes",
         "two-spheres",
+        "partial-slip-3d",
     }
     for name in EXAMPLES:
         assert get_example(name).name == name

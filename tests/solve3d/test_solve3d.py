@@ -19,9 +19,8 @@ from signorini.loop import adaptive
 from signorini.mesh.builders3d import box
 from signorini.mesh.mesh import Mesh
 from signorini.output.vtu import write_vtu
-from signorini.problem.conditions import Contact, Dirichlet, Neumann, Roller
+from signorini.problem.conditions import Dirichlet, Neumann, Roller
 from signorini.problem.fields import ProblemError
-from signorini.problem.friction_laws import Tresca
 from signorini.problem.problem import ContactProblem
 
 
@@ -85,7 +84,6 @@ def test_roller_holds_one_component():
 @pytest.mark.parametrize(
     ("conditions", "message"),
     [
-        ({"z0": Contact(gap=0.0, friction=Tresca(0.1))}, "friction on faces"),
         ({"x0": Dirichlet((0.0, 0.0))}, "give 3"),
         ({"x0": Dirichlet((0.0, None, 0.0))}, "rigid motion"),
     ],

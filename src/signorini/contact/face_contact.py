@@ -33,6 +33,7 @@ from ..problem.rollers3d import held_basis, span_residual
 from .face_basis import DEFAULT_ALPHA, FaceEdges, change_of_variables, face_edges
 from .face_checks import check_deep_overlap, given_directions
 from .face_fields import FaceFields
+from .face_friction import FaceFriction
 from .node_frames3d import frame_operator, held_frames, to_frames_3d
 
 if TYPE_CHECKING:
@@ -111,13 +112,24 @@ class FaceContactSet:
     facet_gap: np.ndarray
     facet_direction: np.ndarray
     roller_dof: np.ndarray
+    #: with friction (:mod:`.face_friction`): the laws and the tangential DOFs of the rows
+    friction: FaceFriction | None = None
+
+    @property
+    def has_friction(self) -> bool:
+        """Whether some row has a friction law."""
+        return self.friction is not None and self.friction.laws.any
 
     @property
     def operator(self) -> sp.csr_matrix:
         """``Q P (n_dofs, n_dofs)``: ``u = Q P ỹ`` from the solver's variables (frames, then
-        the transformed basis on the rows) to Cartesian DOFs."""
+        the transformed basis on the rows; with friction on their tangential DOFs too) to
+        Cartesian DOFs."""
         Q = frame_operator(self.n_dofs, self.frame_nodes, self.frames)
-        return (Q @ change_of_variables(self.n_dofs, self.dof, self.edges)).tocsr()
+        P = change_of_variables(self.n_dofs, self.dof, self.edges)
+        if self.friction is not None:
+            P = P @ self.friction.change_of_variables(self.n_dofs)
+        return (Q @ P).tocsr()
 
     @property
     def gap(self) -> np.ndarray:
@@ -172,7 +184,7 @@ class FaceContactSet:
         rows' DOFs)."""
         y = to_frames_3d(u, self.frame_nodes, self.frames)
         y[self.dof] = self.edges.coefficients(y[self.dof])
-        return y
+        return y if self.friction is None else self.friction.coefficients(y)
 
     def normal_displacement(self, u: np.ndarray) -> np.ndarray:
         """``(k,)`` the rows' bounded variables ``ỹ_dof`` (:meth:`unknowns`) of nodal values
@@ -212,7 +224,6 @@ class FaceContactSet:
 
     # what the solve reads of a contact set (as of the 2D ContactSet)
     size = n_rows
-    has_friction = False
     transfer = None
 
     @property

@@ -139,7 +139,9 @@ def check_previous(previous: object, space: LagrangeSpace, cs: ContactSet) -> No
             f"{space.cell_nodes.shape[0]}): the steps of a load path share one mesh"
         )
     pc = previous.contact
-    if pc.parts != cs.parts or not np.array_equal(pc.nodes, cs.nodes):
+    nodes = cs.nodes if hasattr(cs, "nodes") else cs.node  # 2D constraints, or faces' rows
+    old = pc.nodes if hasattr(pc, "nodes") else pc.node
+    if pc.parts != cs.parts or not np.array_equal(old, nodes):
         raise ValueError(
             f"previous has the contact parts {list(pc.parts)} with {pc.size} constraints, this "
             f"problem {list(cs.parts)} with {cs.size}: the steps of a load path share their "

@@ -33,7 +33,7 @@ from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
 from .contact_set import ContactSet, node_classes
 from .force_control import check_load_carried, initial_active_set
-from .frictional import Solved, check_previous, solve_frictional
+from .frictional3d import Solved, check_previous, solve_frictional
 from .nested import (
     NESTED_MIN_NDOF,
     WARM_START_RTOL,

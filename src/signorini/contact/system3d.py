@@ -25,6 +25,7 @@ else are the same on every rank (docs/parallel.md, *A stiffness matrix split by 
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -45,6 +46,7 @@ from .contact_set import _empty
 from .discrete_conditions import DiscreteConditions
 from .face_basis import DEFAULT_ALPHA
 from .face_contact import FaceContactSet, face_contact_set
+from .face_friction import face_friction
 from .mortar3d import mortar_coupling_3d
 from .mortar3d_set import MortarFaceSet, mortar_face_set
 from .node_frames3d import held_frames, rotate_frames_3d
@@ -250,7 +252,11 @@ def _face_contact(
             for slave, master in problem.pairs.items()
         ]  # a loop over pairs
         return mortar_face_set(space, couplings, conditions.held)
-    return face_contact_set(space, contact, conditions.held, alpha=alpha)
+    cs = face_contact_set(space, contact, conditions.held, alpha=alpha)
+    laws = [contact[name].friction for name in contact]
+    if any(law is not None for law in laws):  # docs/method.md, *Friction in three dimensions*
+        cs = replace(cs, friction=face_friction(space, cs, laws))
+    return cs
 
 
 def _with_contact(

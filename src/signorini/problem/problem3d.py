@@ -4,13 +4,14 @@ control, regions*).
 
 A 3D problem holds Dirichlet parts (all or some of ``(u_x, u_y, u_z)``), rollers (on planes
 normal to an axis one Cartesian component held, on oblique planes and curved parts the normal
-component in node frames), Neumann parts and frictionless contact parts against a gap
+component in node frames), Neumann parts and contact parts against a gap
 function or a shape of space, along given directions or the body's normal (docs/method.md,
 *Three dimensions: contact on faces*); a body may be held along some rigid motions by its
 contact parts alone (force control). Frictionless contact pairs between bodies
 (docs/method.md, *Two bodies in three dimensions*) stand alone (no obstacle parts beside
-them), with every body held by its own parts. Friction and plane shapes are refused here,
-before any work, and so are a 2D mesh's data on a 3D mesh and the reverse.
+them), with every body held by its own parts. Friction on obstacle parts is the disc law
+(docs/method.md, *Friction in three dimensions*); friction in pairs and plane shapes are
+refused here, before any work, and so are a 2D mesh's data on a 3D mesh and the reverse.
 """
 
 from __future__ import annotations
@@ -80,15 +81,15 @@ def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
 
 
 def _check_contact_3d(conditions: Mapping[str, Condition]) -> None:
-    """Refuse what 3D contact on faces does not build yet: friction, a plane shape (dim 2) as
-    the obstacle, pairs beside obstacle parts, a pair with condition (a) or an obstacle; and
-    contact parts with different ``face_alpha``."""
+    """Refuse what 3D contact on faces does not build yet: friction in a pair, a plane shape
+    (dim 2) as the obstacle, pairs beside obstacle parts, a pair with condition (a) or an
+    obstacle; and contact parts with different ``face_alpha``."""
     for name, cond in conditions.items():  # a loop over parts
         if not isinstance(cond, Contact):
             continue
         what = None
-        if cond.friction is not None:
-            what = "friction on faces is not built yet (frictionless contact only)"
+        if cond.friction is not None and cond.master is not None:
+            what = "friction between two bodies (a contact pair) is not built yet in 3D"
         elif cond.master is not None and cond.face_alpha == 0:
             what = (
                 "face_alpha=0 in a contact pair: the dual mortar basis on P2 faces needs the "

@@ -12,5 +12,6 @@ re-exported by :mod:`signorini.algebra`.
 ``rule``              the update rule of the node states
 ``fixed_point``       Coulomb's fallback: the fixed point on the slip bound
 ``newton``            ``solve_friction``: semismooth Newton for Tresca and Coulomb friction
+``disc``              3D: the disc law and ``solve_disc``, its semismooth Newton method
 ====================  ==========================================================================
 """

@@ -1,0 +1,136 @@
+"""Friction on the rows of a face contact set (docs/method.md, *Friction in three dimensions:
+the disc law*): the tangential DOFs of each row in its node frame ``[n t_1 t_2]``, the
+transformed face basis on them, and each row's law and nodal weight.
+
+The tangential DOFs of a row are the two frame DOFs of its node other than the row's own
+(``3 z + j``); one held by a roller through the node (a symmetry plane) is marked held and
+the law acts on the other alone. The transformed basis of the rows (:mod:`.face_basis`)
+acts on each tangential slot too, on the edges whose three nodes have that slot free, so
+that ``Λ̃_t`` and ``Λ̃_n`` are forces on the same functions ``φ̃_z``. The nodal weights are
+the laws' :meth:`~signorini.algebra.friction.laws.FrictionLaw.nodal_weight` with
+``integrate(f) = ∫ f φ̃_z`` (Tresca: ``s_z = ∫ s φ̃_z``; Coulomb: ``F``), by the degree-4
+rule on the (flat or quadratic) faces of the row's part.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..algebra.friction.laws import FrictionLaw, LawGroups
+from ..fem.quadrature import triangle_rule
+from ..problem.fields import ProblemError
+from .face_basis import FaceEdges, change_of_variables
+
+if TYPE_CHECKING:
+    from ..fem.space3d import P2TetSpace
+    from .face_contact import FaceContactSet
+
+__all__ = ["FaceFriction", "face_friction"]
+
+
+class FaceFriction:
+    """The friction data of a face contact set's rows.
+
+    Attributes
+    ----------
+    laws : LawGroups
+        Each row's law and weight (``-1``: a frictionless part).
+    tangent : (k, 2) int64 array
+        The two tangential frame DOFs of each row.
+    held : (k, 2) bool array
+        Whether each is held (a roller through the node).
+    edges : tuple of FaceEdges
+        The transformed basis on each tangential slot (the edges with that slot free).
+    """
+
+    def __init__(self, laws: LawGroups, tangent: np.ndarray, held: np.ndarray, edges: tuple):
+        self.laws, self.tangent, self.held, self.edges = laws, tangent, held, edges
+
+    def change_of_variables(self, n_dofs: int) -> sp.csr_matrix:
+        """``P_t (n_dofs, n_dofs)``: ``Tᵀ`` on each tangential slot (the identity elsewhere)."""
+        P = change_of_variables(n_dofs, self.tangent[:, 0], self.edges[0])
+        return (P @ change_of_variables(n_dofs, self.tangent[:, 1], self.edges[1])).tocsr()
+
+    def coefficients(self, y: np.ndarray) -> np.ndarray:
+        """``y`` with ``T^{-T}`` applied on each tangential slot (the inverse of
+        :meth:`change_of_variables`)."""
+        y = np.array(y, dtype=np.float64)
+        for j in range(2):  # the two tangential slots
+            y[self.tangent[:, j]] = self.edges[j].coefficients(y[self.tangent[:, j]])
+        return y
+
+    def solver_tangent(self) -> np.ndarray:
+        """``(k, 2)`` the tangential DOFs for :func:`~signorini.algebra.friction.disc.check_disc`,
+        ``-1`` where held."""
+        return np.where(self.held, -1, self.tangent)
+
+
+def face_friction(
+    space: P2TetSpace, cs: FaceContactSet, laws: Sequence[FrictionLaw | None]
+) -> FaceFriction:
+    """The friction data of ``cs`` with ``laws[i]`` the law of its part ``i`` (module
+    docstring).
+
+    Raises
+    ------
+    ProblemError
+        At a node with rows of two parts (a corner: friction there is not built), or if a
+        law's nodal weights are not finite and ``≥ 0``.
+    """
+    k = cs.n_rows
+    node, dof = cs.node, cs.dof
+    shared = np.flatnonzero(np.r_[False, node[1:] == node[:-1]])
+    if shared.size:
+        raise ProblemError(
+            f"node {node[shared[0]]} carries rows of two contact parts (a corner): friction "
+            "at such a node is not built in 3D; join the parts or make one frictionless"
+        )
+    slot = dof % 3
+    tangent = 3 * node[:, None] + (slot[:, None] + np.array([1, 2])) % 3
+    held = np.isin(tangent, cs.held_dofs)
+    e = cs.edges
+    edges = tuple(
+        FaceEdges(k, e.alpha, e.mid[ok], e.start[ok], e.end[ok])
+        for ok in (~held[e.mid, j] & ~held[e.start, j] & ~held[e.end, j] for j in range(2))
+    )
+    index = np.full(k, -1, dtype=np.int64)
+    weight = np.zeros(k)
+    used = []
+    for i, law in enumerate(laws):  # a loop over parts
+        if law is None:
+            continue
+        what = f"the {type(law).__name__} bound of contact part {cs.parts[i]!r}"
+        values = np.asarray(law.nodal_weight(_integrator(space, cs, i), k), dtype=np.float64)
+        if values.shape != (k,) or not np.isfinite(values).all() or (values < 0).any():
+            raise ProblemError(f"{what}: its nodal weights must be {k} finite numbers >= 0")
+        mine = cs.part == i
+        index[mine] = len(used)
+        weight[mine] = values[mine]
+        used.append(law)
+    return FaceFriction(LawGroups(tuple(used), index, weight), tangent, held, edges)
+
+
+def _integrator(space: P2TetSpace, cs: FaceContactSet, i: int):
+    """``integrate(f) = (T ∫ f ψ_z)`` over the faces of part ``i`` per row ``(k,)``."""
+    parts = cs.parts
+    facet_index = np.concatenate([space.mesh.part_facets(p) for p in parts])
+    on = np.flatnonzero(cs.face_part == i)
+    s, wq = triangle_rule(4)
+    phi = space.element.facet.basis(s)  # (q, 6)
+
+    def integrate(field) -> np.ndarray:
+        integral = np.zeros((on.size, 6))
+        for rows, group in space.boundary_facets(facet_index[on]):  # flat / quadratic
+            x = group.points(s)  # (j, q, 3)
+            f = np.asarray(field(x.reshape(-1, 3)), dtype=np.float64).reshape(x.shape[:2])
+            integral[rows] = (group.speeds(s) * wq * f) @ phi
+        local = cs.facet_local[on]
+        ok = local >= 0
+        w = np.bincount(local[ok], weights=integral[ok], minlength=cs.n_rows)
+        return cs.edges.transformed(w)
+
+    return integrate
