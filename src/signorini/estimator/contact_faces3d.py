@@ -33,6 +33,7 @@ from ..fem.p2_tet import face_basis
 from ..fem.quadrature import triangle_rule
 from ..problem.fields import evaluate_field
 from .faces3d import TetStress, direction_field_3d, face_geometry
+from .friction_faces3d import eta8_parts, friction_faces
 from .surface.penetration import surface_penetration
 from .surface.positive_part import PIECE_NODES, positive_region_rule, refined_face_hats
 from .terms import FacetSet, normal_stress, tangential_stress
@@ -74,6 +75,9 @@ class ContactTerms(NamedTuple):
     oscillation : (n_f,) float array
         Each face's ``|∫_F λ̃_h (ψ − ψ_h)|`` (:func:`obstacle_oscillation`), in the unit of
         η6²; reported beside η_h, not a part of it.
+    parts8 : (n_f, 6) float array or None
+        η8's share of each face node with friction (:func:`.friction_faces3d.eta8_parts`);
+        None without.
     """
 
     faces: FacetSet
@@ -82,6 +86,7 @@ class ContactTerms(NamedTuple):
     parts6: np.ndarray
     eta7: np.ndarray
     oscillation: np.ndarray
+    parts8: np.ndarray | None = None
 
 
 def contact_terms(
@@ -117,6 +122,8 @@ def contact_terms(
         p = eta5_pressure(result, pressure) / stresses.unit
         p_face = on_faces * p[np.maximum(rows, 0)]
     d = direction_field_3d(cs.facet_direction, s)
+    friction = friction_faces(result, stresses.unit)
+    p_t = None if friction is None else np.einsum("qa,fac->fqc", face_basis(s), friction.friction)
     J4, J5 = np.zeros(e.size), np.zeros(e.size)
     for sel, geometry in face_geometry(space, cs.faces):
         sigma = stresses.at_faces(faces.cells[sel, 0], cs.faces[sel, :3], s)
@@ -125,7 +132,9 @@ def contact_terms(
         if p_face is not None:  # σn + p_h d: its d-part is σ_nn + p_h, its tangent part σ_t
             sn = sn + (p_face[sel] @ face_basis(s).T)[..., None] * d[sel]
         speeds = geometry.speeds(s)
-        J4[sel] = tangential_stress(sn, d[sel], w, speeds)
+        # with friction η4 balances σ_t by the friction stress: the tangent part of σn + p_t,h
+        sn4 = sn if p_t is None else sn + p_t[sel]
+        J4[sel] = tangential_stress(sn4, d[sel], w, speeds)
         J5[sel] = normal_stress(sn, d[sel], None, w, speeds)
     gap = cs.facet_normal_gap(result.u)  # u_h·n − ψ_h at the face nodes
     points = space.node_points[cs.faces]
@@ -134,7 +143,9 @@ def contact_terms(
     force = np.maximum(cs.edges.transformed(result.contact_force) / cs.hat_integral, 0.0)
     s_face = on_faces * (force / stresses.unit)[np.maximum(rows, 0)]
     oscillation = obstacle_oscillation(result, s_face)
-    return ContactTerms(faces, J4, J5, parts6, surface_penetration(points, gap), oscillation)
+    parts8 = None if friction is None else eta8_parts(result, friction)
+    eta7 = surface_penetration(points, gap)
+    return ContactTerms(faces, J4, J5, parts6, eta7, oscillation, parts8)
 
 
 def obstacle_oscillation(result: ContactResult, density: np.ndarray) -> np.ndarray:

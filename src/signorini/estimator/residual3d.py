@@ -10,11 +10,12 @@ longest edge of the tetrahedron):
 η2   ``h_p ‖⟦σ(u_h) n⟧‖²_F``                                        interior faces F ∋ p
 η3   ``h_p ‖σ(u_h)n − g‖²_F``; on rollers the tangential part of     Neumann, roller faces
      σ(u_h)n, on parts holding some components the free ones
-η4   ``h_p ‖σ(u_h)n − (d·σ(u_h)n) d‖²_F`` (a tangent vector)          contact faces
+η4   ``h_p ‖σ_t(u_h)‖²_F``, σ_t the tangent part of σ(u_h)n          contact faces
+     (of ``σ(u_h)n + p_t,h`` with friction)
 η5   ``h_p ‖d·σ(u_h)n + p_h‖²_F`` (``consistent``) or without p_h    contact faces
 η6   ``s_p d_p``, ``d_p = ∫_{γ̃_p} (ψ_h − u_h·n)⁺ φ_p``             semi-contact nodes
 η7   the guaranteed bound G of ``‖(u_h·n − ψ_h)⁺‖_{H^{1/2}(Γ_C)}``   global
-η8   0 (frictionless in 3D)
+η8   ``∫_{γ̃_p} (max(b_h, ‖p_t,h‖) ‖u_t‖ − p_t,h·u_t)`` with friction  contact faces
 ==== ============================================================ ==========================
 
 A face F "contains" p when p is one of its six P2 nodes (where the P2 function of p does not
@@ -98,7 +99,8 @@ def estimate_3d(
     Returns
     -------
     Estimate
-        ``eta2_cell (8, n_cells)``, ``eta2_node (7, n_nodes)`` as in 2D (η8 = 0).
+        ``eta2_cell (8, n_cells)``, ``eta2_node (7, n_nodes)`` as in 2D (η8 = 0 without
+        friction).
     """
     problem, space, mesh = result.problem, result.space, result.mesh
     n_nodes, n_cells = space.n_nodes, mesh.n_cells
@@ -123,6 +125,9 @@ def estimate_3d(
             parts6 = np.where(keep[:, None], contact.parts6, 0.0)
             R, J2, J3, J4, J5, parts6, eta7 = own.sum([R, J2, J3, J4, J5, parts6, eta7])
             contact = contact._replace(J4=J4, J5=J5, parts6=parts6, eta7=eta7)
+            if contact.parts8 is not None:
+                parts8 = own.sum([np.where(keep[:, None], contact.parts8, 0.0)])[0]
+                contact = contact._replace(parts8=parts8)
 
     def on_faces(faces: FacetSet, J: np.ndarray) -> TermShares:
         return spread_facet_integrals(faces, J, h_p, n_cells)
@@ -144,6 +149,8 @@ def estimate_3d(
         shares["eta_5"] = on_faces(faces, contact.J5)
         shares["eta_6"] = spread_node_parts(faces, contact.parts6, n_nodes, n_cells)
         shares["eta_7"] = TermShares(None, boundary_cell_shares(faces, contact.eta7, n_cells))
+        if contact.parts8 is not None:  # friction (docs/method.md, η4 and η8 on faces)
+            shares["eta_8"] = spread_node_parts(faces, contact.parts8, n_nodes, n_cells)
     oscillation = 0.0 if contact is None else float(np.sqrt(contact.oscillation.sum() * unit))
     return Estimate3D(
         eta2_cell=np.stack([shares[name].cell for name in TERMS]),
