@@ -155,3 +155,16 @@ def test_eta8_lives_on_the_stick_slip_transition_of_partial_slip_3d():
     assert parts[transition].sum() >= 0.99 * parts.sum()
     assert parts[transition].max() > 100.0 * parts[~transition].max()
     np.testing.assert_allclose(e.eta2_cell[ETA8].sum(), parts.sum(), rtol=1e-12)
+
+
+def test_the_3d_loop_records_eta8_of_the_frictional_estimate():
+    from signorini.loop import adaptive
+
+    law = Coulomb(0.3)
+    press, pull = _block(law, shift=(0.0, 0.0)), _block(law)
+    level = next(iter(adaptive(pull, path=[press], max_levels=1)))
+    row = level.record.row()
+    _, r = _solved(law, path=True)
+    eta8 = float(np.sqrt(estimate(r).eta2_cell[ETA8].sum()))
+    assert eta8 > 0
+    np.testing.assert_allclose(row["eta_8"], eta8, rtol=1e-6)
