@@ -40,6 +40,8 @@ __all__ = ["ETA8_DEGREE", "ETA8_SPLIT", "FrictionFaces", "eta8_parts", "friction
 ETA8_SPLIT = 4
 #: degree of the rule on each sub-triangle
 ETA8_DEGREE = 4
+#: faces per block of η8's integrand (its temporaries are ``BLOCK × 96 × 3`` floats)
+BLOCK = 4096
 
 
 class FrictionFaces(NamedTuple):
@@ -123,11 +125,13 @@ def eta8_parts(result: ContactResult, data: FrictionFaces) -> np.ndarray:
     cs = result.contact
     s, w, piece = composite_rule()
     phi = face_basis(s)  # (q, 6)
-    p = np.einsum("qa,fac->fqc", phi, data.friction)
-    u = np.einsum("qa,fac->fqc", phi, data.slip)
-    b = data.bound @ phi.T
-    size = np.linalg.norm(u, axis=-1)
-    f = np.maximum(b, np.linalg.norm(p, axis=-1)) * size - np.einsum("fqc,fqc->fq", p, u)
+    f = np.empty((len(cs.faces), len(w)))
+    for start in range(0, len(f), BLOCK):  # blocks of faces: bounded temporaries
+        at = slice(start, start + BLOCK)
+        p = np.einsum("qa,fac->fqc", phi, data.friction[at])
+        u = np.einsum("qa,fac->fqc", phi, data.slip[at])
+        bound = np.maximum(data.bound[at] @ phi.T, np.linalg.norm(p, axis=-1))
+        f[at] = bound * np.linalg.norm(u, axis=-1) - np.einsum("fqc,fqc->fq", p, u)
     f = np.maximum(f, 0.0)  # ≥ 0 pointwise (Cauchy–Schwarz); round-off below
     hats = refined_face_hats(s, piece)  # (q, 6)
     parts = np.zeros(data.bound.shape)
