@@ -15,7 +15,8 @@ longest edge of the tetrahedron):
 η5   ``h_p ‖d·σ(u_h)n + p_h‖²_F`` (``consistent``) or without p_h    contact faces
 η6   ``s_p d_p``, ``d_p = ∫_{γ̃_p} (ψ_h − u_h·n)⁺ φ_p``             semi-contact nodes
 η7   the guaranteed bound G of ``‖(u_h·n − ψ_h)⁺‖_{H^{1/2}(Γ_C)}``   global
-η8   ``∫_{γ̃_p} (max(b_h, ‖p_t,h‖) ‖u_t‖ − p_t,h·u_t)`` with friction  contact faces
+η8   ``∫ (max(b_h, ‖p_t,h‖) ‖u_t‖ − p_t,h·u_t) φ_p`` with friction   contact faces
+     (:mod:`.friction_faces3d`; 0 without)
 ==== ============================================================ ==========================
 
 A face F "contains" p when p is one of its six P2 nodes (where the P2 function of p does not
