@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ..algebra.backends.selection import solver_library, solver_name
 from ..loop import COLUMNS, Level, adaptive
-from ..loop.record import COLUMNS_3D, COLUMNS_3D_CONTACT, ElasticityRecord
+from ..loop.record import COLUMNS_3D, COLUMNS_3D_CONTACT, COLUMNS_3D_FRICTION, ElasticityRecord
 from ..output import HistoryWriter, write_columns
 from ..output.check import CHECK, write_check
 from ..output.environment import environment
@@ -195,6 +195,9 @@ def _solve_levels(work: _Run, status: Status) -> Level | None:
     work.folder.add_files("history.csv", "history.md")
     three = job.problem.mesh.dim == 3
     columns = COLUMNS_3D_CONTACT if job.problem.contact_parts else COLUMNS_3D
+    conditions = job.problem.conditions
+    if any(getattr(conditions[p], "friction", None) is not None for p in job.problem.contact_parts):
+        columns = COLUMNS_3D_FRICTION
     if three and not job.problem.contact_parts:  # 3D elasticity: no contact columns
         columns = {k: v for k, v in columns.items() if k not in ElasticityRecord.LEFT_OUT}
     write_columns(

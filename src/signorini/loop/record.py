@@ -19,8 +19,10 @@ __all__ = [
     "COLUMNS",
     "COLUMNS_3D",
     "COLUMNS_3D_CONTACT",
+    "COLUMNS_3D_FRICTION",
     "ElasticityRecord",
     "FaceContactRecord",
+    "FrictionalFaceContactRecord",
     "LevelRecord",
     "level_record",
 ]
@@ -262,8 +264,8 @@ COLUMNS_3D: dict[str, str] = {
 }
 
 
-#: The columns a 3D contact level's row leaves out: the friction's (3D contact is
-#: frictionless).
+#: The columns a frictionless 3D contact level's row leaves out: the friction's
+#: (:class:`FrictionalFaceContactRecord` keeps them).
 FACE_CONTACT_LEFT_OUT = (
     "n_stick", "n_slip", "kkt_tangential_bound", "kkt_tangential_complementarity",
 )  # fmt: skip
@@ -318,6 +320,35 @@ COLUMNS_3D_CONTACT: dict[str, str] = {
     for name in [*COLUMNS, "osc_obstacle", "linear_iterations"]
     if name not in FACE_CONTACT_LEFT_OUT
 }
+#: The friction's columns of a 3D frictional run's history, with their meaning on faces
+#: (docs/method.md, *Friction in three dimensions: the disc law*).
+_FRICTION_3D = {
+    "n_stick": "contact rows in contact that stick (‖ξ‖ < s: the slip increment is 0)",
+    "n_slip": "contact rows in contact that slip (‖Λ_t‖ = s, the slip along Λ_t); a "
+    "frictionless row in contact counts here",
+    "kkt_tangential_bound": "largest friction force beyond its bound, max(‖Λ_t‖ − s, 0), "
+    "relative to the contact force scale (‖·‖ of the node frame's [t_1 t_2] components)",
+    "kkt_tangential_complementarity": "largest min(stick residual ‖x_t − x_ref‖, slip "
+    "residual) over the rows: the slip residual is the larger of | ‖Λ_t‖ − s | and the "
+    "wrong way ‖Λ_t‖ ‖x_t − x_ref‖ − Λ_t·(x_t − x_ref), each scaled (docs/method.md)",
+}
+#: The columns of a 3D frictional contact run's history
+#: (:class:`FrictionalFaceContactRecord`).
+COLUMNS_3D_FRICTION: dict[str, str] = {
+    name: _FRICTION_3D.get(name) or COLUMNS_3D_CONTACT[name]
+    for name in [*COLUMNS, "osc_obstacle", "linear_iterations"]
+    if name in COLUMNS_3D_CONTACT or name in _FRICTION_3D
+}
+
+
+@dataclass
+class FrictionalFaceContactRecord(FaceContactRecord):
+    """The record of a 3D contact level with friction: a :class:`FaceContactRecord` whose
+    row keeps the friction's columns (the counts of the node states and the tangential KKT
+    residuals of :func:`~signorini.algebra.friction.disc.disc_kkt`, as the 2D columns are
+    named)."""
+
+    LEFT_OUT: ClassVar[tuple[str, ...]] = ()
 
 
 @dataclass(frozen=True)
@@ -345,6 +376,8 @@ def level_record(level: int, result: ContactResult, est: Estimate | None) -> Lev
     elasticity = result.mesh.dim == 3 and not result.contact.size
     three = result.mesh.dim == 3
     kind = ElasticityRecord if elasticity else FaceContactRecord if three else LevelRecord
+    if three and not elasticity and result.contact.has_friction:
+        kind = FrictionalFaceContactRecord
     rec = kind(
         level=level,
         ndof=result.ndof,

@@ -28,6 +28,7 @@ from .files import replacing
 __all__ = [
     "CELL_FIELDS_3D",
     "CONTACT_FIELDS_3D",
+    "FRICTION_FIELDS_3D",
     "POINT_FIELDS_3D",
     "fields_lines_3d",
     "write_vtu_3d",
@@ -58,6 +59,14 @@ CONTACT_FIELDS_3D: dict[str, tuple[str, str]] = {
     "contact_normal": ("normal", "on Γ_C the constraint's unit direction n_z (3 "
                        "components; the first part's at a node of several; 0 elsewhere)"),
 }  # fmt: skip
+#: Point data of a 3D level's VTU file with friction (docs/method.md, *Friction in three
+#: dimensions: the disc law*): name -> meaning. Written only when a contact part has a law.
+FRICTION_FIELDS_3D: dict[str, str] = {
+    "contact_state": "0 inactive (free), 1 stick, 2 slip (a frictionless node in contact "
+    "slips), −1 off Γ_C",
+    "slip_direction": "on Γ_C the unit direction Λ_t / ‖Λ_t‖ of a slipping node's friction "
+    "force in Cartesian components (3; the slip increment is along it), 0 elsewhere",
+}
 #: Cell data of a 3D level's VTU file: name -> meaning (-1 where it does not apply).
 CELL_FIELDS_3D: dict[str, str] = {
     "region": "a tetrahedron's material region (index into mesh.region_names); -1 on faces",
@@ -95,10 +104,28 @@ def fields_lines_3d() -> list[str]:
         "",
         *table(contact),
         "",
+        "## Point data of Γ_C with friction (runs with a friction law)",
+        "",
+        *table(FRICTION_FIELDS_3D),
+        "",
         "## Cell data",
         "",
         *table(CELL_FIELDS_3D),
     ]
+
+
+def friction_fields_3d(result, n_nodes: int) -> dict[str, np.ndarray]:
+    """:data:`FRICTION_FIELDS_3D` at the ``n_nodes`` nodes of a frictional 3D result: its
+    rows' ``state`` and ``direction (k, 2)`` (in the node frame's ``[t_1 t_2]``) carried to
+    Cartesian components by the frame ``[n t_1 t_2]`` of each row's node (a frictional node
+    has one row, :func:`~signorini.contact.face_friction.face_friction`)."""
+    cs = result.contact
+    frames = cs.frames[np.searchsorted(cs.frame_nodes, cs.node)]  # (k, 3, 3), columns n t1 t2
+    state = np.full(n_nodes, -1, dtype=np.int32)
+    state[cs.node] = result.state.astype(np.int32)
+    direction = np.zeros((n_nodes, 3))
+    direction[cs.node] = np.einsum("kci,ki->kc", frames[:, :, 1:], result.direction)
+    return {"contact_state": state, "slip_direction": direction}
 
 
 def write_vtu_3d(
@@ -130,6 +157,8 @@ def write_vtu_3d(
         nodal = rows.at_nodes(space.n_nodes)
         point_data |= {name: nodal[key] for name, (key, _) in CONTACT_FIELDS_3D.items()}
         point_data["active"] = point_data["active"].astype(np.int32)
+        if result.contact.has_friction:
+            point_data |= friction_fields_3d(result, space.n_nodes)
     data = meshio.Mesh(
         space.node_points,
         [("tetra10", space.cell_nodes), ("triangle6", faces)],
