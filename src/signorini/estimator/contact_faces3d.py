@@ -33,7 +33,7 @@ from ..fem.p2_tet import face_basis
 from ..fem.quadrature import triangle_rule
 from ..problem.fields import evaluate_field
 from .faces3d import TetStress, direction_field_3d, face_geometry
-from .friction_faces3d import eta8_parts, friction_faces
+from .friction_faces3d import consistent_pressure, eta8_parts, friction_faces
 from .surface.penetration import surface_penetration
 from .surface.positive_part import PIECE_NODES, positive_region_rule, refined_face_hats
 from .terms import FacetSet, normal_stress, tangential_stress
@@ -197,10 +197,9 @@ def eta5_pressure(result: ContactResult, which: str = PRESSURE_3D) -> np.ndarray
     """
     if which not in PRESSURES_3D:
         raise ValueError(f"the 3D eta5 pressure must be one of {PRESSURES_3D}, got {which!r}")
-    cs = result.contact
-    if which == "transformed" and cs.edges.alpha > 0:
-        return cs.pressure(result.contact_force)
-    return cs.recovered_pressure(result.contact_force)
+    if which == "transformed":
+        return consistent_pressure(result, result.contact_force)
+    return result.contact.recovered_pressure(result.contact_force)
 
 
 def _semi_contact_density(result: ContactResult) -> np.ndarray:

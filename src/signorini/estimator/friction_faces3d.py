@@ -33,7 +33,14 @@ from ..fem.quadrature import triangle_rule
 from .faces3d import face_geometry
 from .surface.positive_part import refined_face_hats
 
-__all__ = ["ETA8_DEGREE", "ETA8_SPLIT", "FrictionFaces", "eta8_parts", "friction_faces"]
+__all__ = [
+    "ETA8_DEGREE",
+    "ETA8_SPLIT",
+    "FrictionFaces",
+    "consistent_pressure",
+    "eta8_parts",
+    "friction_faces",
+]
 
 #: sub-triangles per side of the composite rule of η8 (even: each lies in one piece of the
 #: once-refined face)
@@ -69,7 +76,7 @@ def friction_faces(result: ContactResult, unit: float = 1.0) -> FrictionFaces | 
     free = ~fr.held
 
     def stress(force: np.ndarray) -> np.ndarray:  # Λ̃ (k,) to a nodal stress
-        return np.nan_to_num(_pressure(result, cs.edges.untransformed(force)))
+        return np.nan_to_num(consistent_pressure(result, cs.edges.untransformed(force)))
 
     force_t = np.where(free, result.tangential_force, 0.0)
     p = sum(stress(force_t[:, j])[:, None] * t[:, j] for j in range(2))  # (k, 3)
@@ -90,8 +97,10 @@ def friction_faces(result: ContactResult, unit: float = 1.0) -> FrictionFaces | 
     )
 
 
-def _pressure(result: ContactResult, force: np.ndarray) -> np.ndarray:
-    """The consistent η5's nodal stress of a force ``Λ (k,)`` on the rows."""
+def consistent_pressure(result: ContactResult, force: np.ndarray) -> np.ndarray:
+    """The consistent η5's nodal stress of a force ``Λ (k,)`` on the rows: ``Λ̃ / w̃`` for
+    condition (b) (α > 0), the recovered one for condition (a), whose vertex weights
+    vanish (:func:`~.contact_faces3d.eta5_pressure` of the contact force)."""
     cs = result.contact
     if cs.edges.alpha > 0:
         return cs.pressure(force)
