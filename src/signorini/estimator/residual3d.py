@@ -114,8 +114,8 @@ def estimate_3d(
     mine = None if own is None else own.cells  # None: every cell and face (one process)
     R = _cell_residuals(result, material, stresses, mine)
     inner = _face_set(space, np.flatnonzero(mesh.facet2cell[:, 1] >= 0))
-    J2 = _on_own_faces(inner, mine, lambda faces: _jumps(space, stresses, faces, s, w))
-    boundary, J3 = _traction_residuals(result, stresses, mine)
+    J2 = _on_own_faces(inner, own, lambda faces: _jumps(space, stresses, faces, s, w))
+    boundary, J3 = _traction_residuals(result, stresses, own)
     contact = contact_terms(result, stresses, eta5_variant, s, w, pressure)
     if own is not None:  # each integral from the one rank that owns it, summed over the ranks
         if contact is None:
@@ -179,13 +179,13 @@ def _face_set(space: P2TetSpace, e: np.ndarray) -> FacetSet:
 
 
 def _on_own_faces(
-    faces: FacetSet, mine: np.ndarray | None, integrals: Callable[[FacetSet], np.ndarray]
+    faces: FacetSet, own: OwnPart | None, integrals: Callable[[FacetSet], np.ndarray]
 ) -> np.ndarray:
-    """``integrals(faces)`` ``(k,)``; with this rank's cells ``mine`` on the faces whose first
-    cell is one of them only, zero on the others."""
-    if mine is None:
+    """``integrals(faces)`` ``(k,)``; with this rank's part ``own`` on the faces it
+    integrates only (:meth:`~.owned.OwnPart.facets`), zero on the others."""
+    if own is None:
         return integrals(faces)
-    keep = np.flatnonzero(mine[faces.cells[:, 0]])
+    keep = np.flatnonzero(own.facets(faces.cells))
     J = np.zeros(faces.index.size)
     own = FacetSet(faces.index[keep], faces.nodes[keep], faces.cells[keep], faces.measure[keep])
     J[keep] = integrals(own)
@@ -289,13 +289,13 @@ def linear_square(values: np.ndarray, area: np.ndarray) -> np.ndarray:
 
 
 def _traction_residuals(
-    result: ContactResult, stresses: TetStress, mine: np.ndarray | None = None
+    result: ContactResult, stresses: TetStress, own: OwnPart | None = None
 ) -> tuple[FacetSet, np.ndarray]:
     """η3's faces and ``‖r‖²_F`` on each, part after part: ``r = σ(u_h)n − g`` on Neumann parts
     (g at the points and with the normals of each face's geometry), the tangential part of
     σ(u_h)n on rollers, the free components of σ(u_h)n on Dirichlet parts that hold some
-    (docs/method.md, *Rollers and components*). With this rank's cells ``mine``, on the faces
-    whose cell is one of them only (zero on the others)."""
+    (docs/method.md, *Rollers and components*). With this rank's part ``own``, on the faces
+    it integrates only (zero on the others)."""
     problem, space, mesh = result.problem, result.space, result.mesh
     s, w = triangle_rule(NEUMANN_DEGREE_3D)
     index, values = [], []
@@ -307,7 +307,7 @@ def _traction_residuals(
         e = mesh.part_facets(name)
         J = _on_own_faces(
             _face_set(space, e),
-            mine,
+            own,
             lambda faces, c=cond, n=name: _part_tractions(stresses, faces, c, n, s, w),
         )
         index.append(e)
