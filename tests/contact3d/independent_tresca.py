@@ -69,7 +69,8 @@ def solve_tresca(K, F, held, held_values, node, direction, psi, bound, reference
         lam = lam.reshape(m, 3).copy()
         lam[:, 0] = np.maximum(lam[:, 0], 0.0)
         norm = np.linalg.norm(lam[:, 1:], axis=1)
-        lam[:, 1:] *= (bound / np.maximum(norm, bound))[:, None]
+        # ‖Λ_t‖ ≤ s; a bound of 0 (a vertex under condition (a)) projects to 0
+        lam[:, 1:] *= (bound / np.maximum(norm, np.maximum(bound, np.finfo(float).tiny)))[:, None]
         return lam.ravel()
 
     lam = project(np.zeros(3 * m))

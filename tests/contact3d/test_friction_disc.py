@@ -19,6 +19,7 @@ from signorini.contact.system import assemble
 from signorini.mesh.builders3d import box
 from signorini.mesh.mesh import Mesh
 from signorini.problem.conditions import Contact, Dirichlet, Neumann
+from signorini.problem.fields import ProblemError
 from signorini.problem.friction_laws import Coulomb, Tresca
 from signorini.problem.obstacles3d import HalfSpace
 from signorini.problem.problem import ContactProblem
@@ -174,3 +175,52 @@ def test_a_load_path_through_solve_meets_both_laws_on_the_slip_increment(law):
     frames = _frames(cs)
     force = np.einsum("kci,ki->kc", frames[:, :, 1:], pull.tangential_force)
     assert force[:, 0].sum() > 0
+
+
+def _midpoint_weights(mesh, part: str, points: np.ndarray, s: float) -> np.ndarray:
+    """``∫ s φ_z`` of the plain P2 basis on the flat faces of ``part`` at ``points (m, 3)``,
+    written out: ``s |T| / 3`` from each face at its edge midpoints, 0 at its vertices."""
+    faces = mesh.points[mesh.facets[mesh.part_facets(part)]]  # (f, 3 vertices, 3)
+    area = 0.5 * np.linalg.norm(
+        np.cross(faces[:, 1] - faces[:, 0], faces[:, 2] - faces[:, 0]), axis=1
+    )
+    mids = 0.5 * (faces + faces[:, [1, 2, 0]])  # (f, 3 edges, 3)
+    which = np.linalg.norm(mids.reshape(-1, 1, 3) - points[None], axis=2).argmin(axis=1)
+    return np.bincount(which, np.repeat(s * area / 3.0, 3), minlength=points.shape[0])
+
+
+def test_tresca_under_condition_a_has_the_midpoint_weights_and_the_dual_solution():
+    """``face_alpha=0``: the vertex weights ∫ s φ_v vanish (docs/method.md, *Tresca under
+    condition (a)*); the solve through ``solve`` equals the independent dual solve with the
+    weights written out."""
+    from signorini.contact.solution import solve
+
+    s = 2e-3
+    mesh = box(2, 2, 2)
+    cond = {p: Neumann((0.0, 0.0, 0.0)) for p in mesh.part_names}
+    contact = Contact(obstacle=HalfSpace([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]), face_alpha=0.0)
+    cond.update(z1=Dirichlet((0.004, 0.0, -0.01)), z0=replace(contact, friction=Tresca(s)))
+    result = solve(ContactProblem(mesh, MATERIAL, cond), mesh)
+    assert result.report.kkt.max <= 1e-12
+    assert {STICK, SLIP} <= set(result.state.tolist())
+    cs = result.contact
+    weight = _midpoint_weights(mesh, "z0", result.space.node_points[cs.node], s)
+    assert (weight == 0).sum() == 9  # the 3 × 3 vertices of z0
+    np.testing.assert_allclose(cs.friction.laws.weight, weight, rtol=1e-13, atol=0.0)
+    plain = assemble(replace(result.problem, conditions={**cond, "z0": Neumann((0.0,) * 3)}), mesh)
+    other = solve_tresca(
+        plain.K, plain.F, plain.dirichlet, plain.dirichlet_values, cs.node, cs.direction,
+        cs.psi, weight, np.zeros((cs.node.size, 3)),
+    )  # fmt: skip
+    assert np.abs(result.u.ravel() - other.u).max() <= 1e-8 * np.abs(other.u).max()
+
+
+def test_tresca_under_condition_a_on_curved_faces_is_refused_naming_face_alpha():
+    from signorini.contact.solution import solve
+    from signorini.examples.partial_slip3d import partial_slip_3d_path
+
+    press = partial_slip_3d_path(h_contact=0.2)[0]
+    sphere = replace(press.conditions["sphere"], friction=Tresca(1e-4), face_alpha=0.0)
+    problem = replace(press, conditions={**press.conditions, "sphere": sphere})
+    with pytest.raises(ProblemError, match=r"negative at \d+ row.*face_alpha=0"):
+        solve(problem, problem.mesh)

@@ -105,13 +105,42 @@ def face_friction(
             continue
         what = f"the {type(law).__name__} bound of contact part {cs.parts[i]!r}"
         values = np.asarray(law.nodal_weight(_integrator(space, cs, i), k), dtype=np.float64)
-        if values.shape != (k,) or not np.isfinite(values).all() or (values < 0).any():
+        if values.shape != (k,) or not np.isfinite(values).all():
             raise ProblemError(f"{what}: its nodal weights must be {k} finite numbers >= 0")
+        values = _vertex_zeros(values, what)
         mine = cs.part == i
         index[mine] = len(used)
         weight[mine] = values[mine]
         used.append(law)
     return FaceFriction(LawGroups(tuple(used), index, weight), tangent, held, edges)
+
+
+#: a nodal weight ``∫ s φ_z`` within this many ulps of the largest weight of zero is the
+#: round-off of an integral that vanishes (a vertex of a flat face under condition (a))
+WEIGHT_ROUNDOFF = 64
+
+
+def _vertex_zeros(values: np.ndarray, what: str) -> np.ndarray:
+    """``values`` with those within round-off of zero set to zero (docs/method.md, *Tresca under
+    condition (a)*): with the plain P2 face basis (``face_alpha=0``) the vertex weights
+    ``∫ s φ_v`` vanish on flat faces and come out as ``±`` round-off.
+
+    Raises
+    ------
+    ProblemError
+        If a weight is negative beyond round-off: curved faces under condition (a), where
+        ``∫ s φ_v`` is truly negative and the discrete friction functional not convex.
+    """
+    tol = WEIGHT_ROUNDOFF * np.finfo(float).eps * np.abs(values).max(initial=0.0)
+    below = np.flatnonzero(values < -tol)
+    if below.size:
+        raise ProblemError(
+            f"{what}: its nodal weights ∫ s φ_z are negative at {below.size} row(s) "
+            f"(the most {values[below].min():.3g}): with face_alpha=0 (condition (a)) the "
+            "vertex weights of curved faces are negative; use the transformed face basis "
+            "(0 < face_alpha < 1/2, None for the default)"
+        )
+    return np.where(values <= tol, 0.0, values)
 
 
 def _integrator(space: P2TetSpace, cs: FaceContactSet, i: int):
