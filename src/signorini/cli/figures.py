@@ -7,6 +7,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
+
 from ..examples import Metrics
 from ..loop import AdaptiveOptions, Level, adaptive
 from ..output import HistoryWriter
@@ -36,6 +38,14 @@ def figures(
     arrays = None
     if last is not None:
         arrays = body_arrays(last) if last.result.mesh.dim == 3 else level_arrays(last)
+        result = last.result
+        if result.mesh.dim == 3 and result.contact.size and result.contact.has_friction:
+            from ..output.vtu3d import friction_fields_3d
+
+            nodes = np.unique(result.contact.faces)  # the rows of surface_arrays' points
+            fields = friction_fields_3d(result, result.space.n_nodes)
+            arrays["contact"]["state"] = fields["contact_state"][nodes]
+            arrays["contact"]["slip_direction"] = fields["slip_direction"][nodes]
     degree = None if element is None else element_of(element).degree
     return run_figures(example, out, arrays, name, degree, dim)
 

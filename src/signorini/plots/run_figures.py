@@ -25,6 +25,7 @@ from .body3d import plot_body_3d, render_body_3d
 from .contact_line import free_boundary_ends
 from .contact_map import plot_contact_map
 from .mesh import boundary_groups
+from .slip_map import plot_slip_map
 
 __all__ = [
     "KnownPressure",
@@ -206,6 +207,24 @@ def body_figures(example: str, out: Path, last: Mapping[str, Any], name: str) ->
             out / f"{example}_contact_pressure",
             title=name,
         )
+    if surface is not None and "state" in surface:
+        history = read_history(out / "history.csv") if (out / "history.csv").is_file() else {}
+        circles = None
+        if "c_over_a_theory" in history and "a" in history:
+            a = float(history["a"][-1])
+            theory = float(history["c_over_a_theory"][-1])
+            circles = {f"Mindlin's stick radius c = {theory * a:.3g}": theory * a,
+                       f"contact radius a = {a:.3g}": a}  # fmt: skip
+        written += plot_slip_map(
+            surface["points"],
+            surface["faces"],
+            surface["state"],
+            surface["slip_direction"],
+            surface["normal"],
+            out / f"{example}_slip_map",
+            title=name,
+            circles=circles,
+        )[0]
     rendered, note = render_body_3d(*body, out / f"{example}_body_pyvista", **drawn)
     if note:
         log.info(note)
