@@ -12,7 +12,7 @@ import pytest
 import scipy.sparse as sp
 
 from signorini.algebra import SingularSystemError, make_solver, solve_pdas, superlu_solver
-from signorini.algebra.backends.amg import AmgSolver, amg_solver
+from signorini.algebra.backends.amg import REUSE_CHANGED, AmgSolver, amg_solver
 from signorini.algebra.backends.selection import solver_factory
 from signorini.algebra.backends.solvers import SolverRequest
 from signorini.algebra.inexact import KKT_RTOL
@@ -117,6 +117,30 @@ def test_the_hierarchy_is_kept_for_the_same_matrix_and_reused_across_masks():
         assert fresh.n_setups == 2
 
 
+def test_a_hierarchy_is_rebuilt_for_a_set_that_differs_in_more_than_a_few_dofs():
+    """``reuse`` keeps the hierarchy while the free DOFs differ from its own in at most
+    :data:`REUSE_CHANGED`, and builds a new one beyond (counted from the hierarchy's set, not
+    from the last one)."""
+    K, b, modes = clamped_2d()
+    keep = np.ones(K.nnz, dtype=bool)
+    rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+
+    def eliminated(dofs):
+        fixed = np.zeros(K.shape[0], dtype=bool)
+        fixed[dofs] = True
+        return keep & ~((fixed[rows] | fixed[K.indices]) & (rows != K.indices))
+
+    free = np.flatnonzero(K.diagonal() != 0)[: 2 * REUSE_CHANGED + 2]
+    with AmgSolver(near_nullspace=modes, reuse=True) as solver:
+        solver.factorize(K, keep)
+        solver.refactorize(eliminated(free[:REUSE_CHANGED]))  # within: kept
+        assert solver.n_setups == 1
+        solver.refactorize(eliminated(free[: REUSE_CHANGED + 1]))  # one more: new
+        assert solver.n_setups == 2
+        solver.refactorize(eliminated(free[REUSE_CHANGED + 1 :]))  # 2 × (k + 1) from it: new
+        assert solver.n_setups == 3
+
+
 def test_a_confirming_solve_starts_from_the_last_solution():
     K, b, modes = clamped_2d()
     with AmgSolver(K, near_nullspace=modes) as solver:
@@ -125,6 +149,28 @@ def test_a_confirming_solve_starts_from_the_last_solution():
         x = solver.solve(b)
         assert solver.iterations[1] < solver.iterations[0]
     assert np.linalg.norm(b - K @ x) <= 1e-11 * np.linalg.norm(b)
+
+
+def test_a_solve_starts_from_the_iterate_it_is_handed():
+    """:meth:`AmgSolver.start_from`: from the solution itself no CG iteration, from a
+    perturbation of it fewer than from zero, the next solve from zero again; the answers meet
+    the tolerance."""
+    K, b, modes = clamped_2d()
+    with AmgSolver(K, near_nullspace=modes) as solver:
+        x = solver.solve(b)  # from zero
+        solver.start_from(x)
+        solver.solve(2.0 * b - b)  # the same b, not recognised as the last right-hand side
+        near = x * (1.0 + 1e-6 * np.random.default_rng(2).standard_normal(x.size))
+        solver.start_from(near)
+        y = solver.solve(b)
+        solver.solve(b[::-1].copy())  # from zero
+        cold, again, warm, cold2 = solver.iterations
+        assert again == 0 and warm < cold / 2 and cold2 > warm
+        with pytest.raises(ValueError, match=r"x must be a finite \(1122,\) array"):
+            solver.start_from(x[:-1])
+        with pytest.raises(ValueError, match="x must be a finite"):
+            solver.start_from(np.full_like(x, np.nan))
+    assert np.linalg.norm(b - K @ y) <= 1e-8 * np.linalg.norm(b)
 
 
 def test_bad_input_is_refused():

@@ -116,3 +116,16 @@ def test_a_problem_handed_a_mesh_of_the_other_dimension():
         solve(problem3d, square)
     with pytest.raises(ValueError, match="stated on a 2D mesh and was handed a 3D mesh"):
         solve(problem2d, cube)
+
+
+def test_a_refinement_handed_as_the_mesh_is_refused_naming_its_mesh():
+    """``solve(problem, refine_uniform(mesh))`` (the refinement's record, not its mesh): a
+    TypeError naming ``mesh`` and the remedy, before any assembly; 2D alike."""
+    from signorini.mesh.refine import refine_uniform
+
+    cube = box(1, 1, 1)
+    problem = ContactProblem(cube, MATERIAL, _conditions(cube))
+    with pytest.raises(TypeError, match=r"mesh must be a Mesh, got Refinement: pass its \.mesh"):
+        solve(problem, refine_uniform(cube))
+    with pytest.raises(TypeError, match="mesh must be a Mesh, got ndarray$"):
+        solve(problem, cube.points)

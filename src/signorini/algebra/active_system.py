@@ -246,6 +246,10 @@ class ActiveSetSystem:
         Seconds spent forming right-hand sides.
     n_updates : int
         Solves done by a low-rank update instead of a factorization.
+    guess : (n,) float array or None
+        Where an iterative solver's next solve starts (its
+        :meth:`~.backends.solvers.SPDSolver.start_from`, the fixed DOFs at their values): the
+        caller's warm start, then each solve's solution.
     """
 
     def __init__(self, qp: BoundQP, solver: SPDSolver, max_update: int = 0) -> None:
@@ -267,6 +271,7 @@ class ActiveSetSystem:
         self.factored: np.ndarray | None = None  # fixed mask of the current factorization
         self.n_updates = 0
         self._norm_K: float | None = None
+        self.guess: np.ndarray | None = None
 
     def solve(
         self, active: np.ndarray, load: np.ndarray | None = None
@@ -318,6 +323,8 @@ class ActiveSetSystem:
                     equation=err.equation,
                 ) from err
             self.factored = self.fixed.copy()
+            if not exact and self.guess is not None and self.solver.takes_guess:
+                self.solver.start_from(np.where(self.fixed, self.values, self.guess))
             x = self.solver.solve(b)
             if not exact:  # an iterative solve: checked against its tolerance (.inexact)
                 x = check_iterative(
@@ -333,6 +340,7 @@ class ActiveSetSystem:
                     self.solver.backend,
                 )
         x[self.fixed] = self.values[self.fixed]
+        self.guess = x
         return x, F[c] - self.ranks.sum(self.K_c @ x)
 
     def _solve_updated(

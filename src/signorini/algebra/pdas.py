@@ -145,8 +145,8 @@ def solve_pdas(
     dirichlet_values : float, (n_d,) or (n,) float array, optional
         Values ``x_D`` on ``d`` (default 0).
     x0 : (n,) float array, optional
-        Warm start: the initial active set is ``{ Λ0 + c (x0_c - g) > 0 }`` with
-        ``Λ0 = F_c - (K x0)_c``. Ignored when ``active0`` is given.
+        Warm start: an iterative solver (``takes_guess``) starts its first solve from it;
+        without ``active0`` the active set rule at it (:func:`rule_active_set`) is the first set.
     active0 : (m,) bool array, optional
         Initial active set (e.g. the previous adaptive level's). Takes precedence over ``x0``.
         Default (neither given): the empty set, so the first iterate is the unconstrained
@@ -189,6 +189,7 @@ def solve_pdas(
     if not isinstance(options, PDASOptions):
         raise ValueError(f"options must be a PDASOptions, got {type(options).__name__}")
     c_scale = _rule_constant(qp, options.c)
+    x0 = None if x0 is None else check_vector(x0, qp.n, "x0")  # before any work
     active = _initial_active_set(qp, c_scale, x0, active0)
     own_solver = not isinstance(solver, SPDSolver)
     if own_solver:
@@ -198,6 +199,7 @@ def solve_pdas(
     its_before = len(getattr(solver, "iterations", ()))  # an iterative solver's counts
     try:
         system = ActiveSetSystem(qp, solver, max_update=options.max_update)
+        system.guess = x0
         history: list[PDASStep] = []
         with InexactRule(solver) as rule:  # an iterative solver's stopping rule (.inexact)
             x, multiplier, active, failure = _iterate(
@@ -300,8 +302,7 @@ def _rule_constant(qp: BoundQP, c: float | None) -> float:
 
 
 def _initial_active_set(qp: BoundQP, c_scale: float, x0: object, active0: object) -> np.ndarray:
-    """``active0`` (checked), else the active set rule at ``x0``, else the empty set: (m,)
-    bool."""
+    """(m,) bool: ``active0`` (checked), else the active set rule at ``x0``, else empty."""
     m = qp.constrained.size
     if active0 is not None:
         active = np.asarray(active0)

@@ -31,7 +31,9 @@ from ..fem.space import LagrangeSpace
 from ..mesh.mesh import Mesh
 from ..problem.fields import evaluate_field
 from ..problem.problem import ContactProblem
+from ..problem.problem3d import check_mesh_dimension
 from .contact_set import ContactSet, node_classes
+from .face_contact import FaceContactSet
 from .force_control import check_load_carried, initial_active_set
 from .frictional3d import Solved, check_previous, solve_frictional
 from .nested import (
@@ -313,12 +315,15 @@ def solve(
 
     Raises
     ------
+    TypeError
+        For a ``mesh`` that is not a :class:`~signorini.mesh.mesh.Mesh`.
     ValueError
         For a malformed ``u0``, an unknown ``element``, a ``previous`` of another mesh or
         other contact parts, or an ``assembled`` shared by rows over other ranks than the
         solver's.
     """
     mesh = problem.mesh if mesh is None else mesh
+    check_mesh_dimension(problem.name, problem.mesh, mesh)
     ahead = None
     if assembled is None:
         serial = not solver_ranks(solver).distributed
@@ -428,23 +433,18 @@ def _solve_system(
             assembled, K, F, u0=u0, solver=solver, max_iter=options.max_iter,
             previous=previous, active0=active0, warm_rtol=WARM_START_RTOL,
         )  # fmt: skip
+    # on faces a warm start is an iterative solver's first iterate (docs/method.md, *Three
+    # dimensions: warm-started CG*) too
+    x0 = cs.unknowns(u0.ravel()) if u0 is not None and isinstance(cs, FaceContactSet) else None
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
     with ordered_solver(
         assembled.space, solver, check_symmetry=False, ordering=assembled.ordering,
         rigid_modes=lambda: system_rigid_modes(assembled),
     ) as linear:  # fmt: skip
         res = solve_pdas(
-            K,
-            F,
-            cs.constrained_dofs,
-            cs.gap,
-            assembled.dirichlet,
-            assembled.dirichlet_values,
-            active0=active0,
-            options=options,
-            solver=linear,
-            ranks=assembled.ranks,
-        )
+            K, F, cs.constrained_dofs, cs.gap, assembled.dirichlet, assembled.dirichlet_values,
+            x0=x0, active0=active0, options=options, solver=linear, ranks=assembled.ranks,
+        )  # fmt: skip
     zero = np.zeros(cs.size)
     state = np.where(res.active, SLIP, INACTIVE)
     return Solved(res.x, res.multiplier, zero, state, zero.astype(np.int8), zero, res)

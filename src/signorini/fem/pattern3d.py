@@ -191,7 +191,9 @@ def node_pattern(cell_nodes: np.ndarray, n_nodes: int) -> NodePattern:
     np.cumsum(np.bincount(lo, minlength=n_nodes), out=start[1:])
     p1 = np.arange(1, lo.size + 1, dtype=np.int64)
     upper = sp.csr_matrix((p1, hi, start), shape=(n_nodes, n_nodes), copy=False)
-    strict = sp.csr_matrix((np.where(lo != hi, -p1, 0), hi, start), shape=upper.shape)
+    # its own index arrays: eliminate_zeros compacts them in place, and SciPy shares the
+    # arrays it is handed where their index type is already its own (int64 beyond 2³¹)
+    strict = sp.csr_matrix((np.where(lo != hi, -p1, 0), hi.copy(), start.copy()), upper.shape)
     strict.eliminate_zeros()
     both = upper + strict.T.tocsr()
     first = both.indptr.astype(np.int64)

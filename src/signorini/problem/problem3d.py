@@ -124,9 +124,15 @@ def check_mesh_dimension(name: str, stated: Mesh, mesh: Mesh) -> None:
 
     Raises
     ------
+    TypeError
+        For a ``mesh`` that is not a :class:`~signorini.mesh.mesh.Mesh` (a refinement's
+        record, say: its ``.mesh`` is the mesh).
     ValueError
         Naming both dimensions.
     """
+    if not isinstance(mesh, Mesh):
+        hint = ": pass its .mesh" if isinstance(getattr(mesh, "mesh", None), Mesh) else ""
+        raise TypeError(f"mesh must be a Mesh, got {type(mesh).__name__}{hint}")
     if mesh.dim != stated.dim:
         raise ValueError(
             f"the problem {name!r} is stated on a {stated.dim}D mesh and was handed a "

@@ -24,13 +24,19 @@ eliminated matrix. With ``reuse`` a new ``keep`` of the same matrix (the next ac
 keeps the hierarchy of an earlier one, as the preconditioner
 ``r ↦ P M⁻¹ P r + D⁻¹ (I − P) r`` (P the projection on the current free DOFs, M⁻¹ the
 old V-cycle): symmetric positive definite, so CG converges, in more iterations the more the
-sets differ; the hierarchy is rebuilt when a solve takes more than :data:`REBUILD` times the
-iterations of the first solve after its set-up.
+sets differ (about one more per changed DOF, measured). So the hierarchy is kept only while
+the free DOFs differ from those it was built on in at most :data:`REUSE_CHANGED` DOFs, and
+rebuilt when a solve takes more than :data:`REBUILD` times the iterations of the first solve
+after its set-up; the old hierarchy is released before a new one is built (one in memory at
+a time). The ``"amg"`` factory asks for ``reuse``.
 
 **Inexact solves.** A solve stops at ``‖b − A x‖₂ ≤ rtol ‖b‖₂`` (the true residual, checked
 at the end; CG restarts from its iterate if the recursive residual drifted), or at the
-round-off of the product, ``eps ‖A‖∞ ‖x‖₂``; a solve of the right-hand side of the last
-solve (the confirming solve of :mod:`.inexact`) starts from that solve's solution. A solve
+round-off of the product, ``eps ‖A‖∞ ‖x‖₂``. CG starts from the iterate handed to
+:meth:`AmgSolver.start_from` (the active set methods hand over the previous step's solution,
+and the first step the prolongated solution of the previous level: docs/method.md, *Three
+dimensions: warm-started CG*), else, for the right-hand side of the last solve (the
+confirming solve of :mod:`.inexact`), from that solve's solution, else from zero. A solve
 that does not get there in :attr:`AmgSolver.max_it` iterations, or meets ``pᵀ A p ≤ 0``,
 raises :class:`~.errors.SingularSystemError`.
 
@@ -55,7 +61,7 @@ from ..sparse import abs_matvec
 from .solvers import SolverRequest, SPDSolver
 from .superlu import superlu_solver
 
-__all__ = ["REBUILD", "RTOL", "AmgSolver", "amg_solver"]
+__all__ = ["REBUILD", "REUSE_CHANGED", "RTOL", "AmgSolver", "amg_solver"]
 
 #: Relative residual ``‖b − A x‖₂ / ‖b‖₂`` of a solve (the active set iterations'; the
 #: confirming solve's is :data:`~.inexact.CONFIRM_RTOL`).
@@ -68,6 +74,11 @@ MAX_IT = 1000
 #: A reused hierarchy is rebuilt when a solve takes more than this many times the iterations
 #: of the first solve after its set-up.
 REBUILD = 1.5
+
+#: A reused hierarchy is kept for a new ``keep`` whose free DOFs differ from the hierarchy's
+#: in at most this many DOFs (each changed DOF adds about one CG iteration; a set-up costs
+#: 15–25: docs/method.md, *Three dimensions: warm-started CG*).
+REUSE_CHANGED = 8
 
 #: Restarts of CG from its iterate when the true residual misses the tolerance.
 RESTARTS = 3
@@ -132,6 +143,7 @@ class AmgSolver(SPDSolver):
 
     backend = "amg"
     reuses_analysis = True
+    takes_guess = True
 
     def __init__(
         self,
@@ -170,6 +182,7 @@ class AmgSolver(SPDSolver):
         self._data: np.ndarray | None = None
         self._norm = self._x_norm = 0.0
         self._last: tuple[np.ndarray, np.ndarray] | None = None
+        self._guess: np.ndarray | None = None  # the next solve's initial iterate
         super().__init__(A, check_symmetry=check_symmetry, ordering=ordering)
 
     def _analyze(self, A: sp.csr_matrix, rows: np.ndarray) -> None:
@@ -206,17 +219,25 @@ class AmgSolver(SPDSolver):
             )
         self._system, self._free = system, free
         self._inverse_diagonal = np.where(free, 0.0, 1 / diagonal)
-        if not (self.reuse and same_values and self._cycle is not None):
+        if not (self.reuse and same_values and self._close_to_hierarchy(free)):
             self._set_up(system, free)
         self._keep = None if keep is None else keep.copy()
         self._data = A.data
         self._last = None
+
+    def _close_to_hierarchy(self, free: np.ndarray) -> bool:
+        """Whether the hierarchy was built on free DOFs that differ from ``free`` in at most
+        :data:`REUSE_CHANGED` DOFs."""
+        if self._cycle is None:
+            return False
+        return int(np.count_nonzero(free != self._hierarchy_free)) <= REUSE_CHANGED
 
     def _set_up(self, system: sp.csr_matrix, free: np.ndarray) -> None:
         """Build the hierarchy of ``system`` (its free DOFs ``free``)."""
         pyamg = self._pyamg
         n = system.shape[0]
         size = self.block_size if n % self.block_size == 0 else 1
+        self._cycle = None  # the old hierarchy released before the new one is built
         B = None if self._modes is None else np.where(free[:, None], self._modes, 0.0)
         matrix = system.tobsr(blocksize=(size, size)) if size > 1 else system
         try:
@@ -239,13 +260,30 @@ class AmgSolver(SPDSolver):
         free = self._free
         return np.where(free, self._cycle(np.where(free, r, 0.0)), 0.0) + self._inverse_diagonal * r
 
+    def start_from(self, x: np.ndarray) -> None:
+        """Start the next solve (of one right-hand side) from ``x (n,)`` instead of zero.
+
+        Raises
+        ------
+        ValueError
+            For an ``x`` of the wrong shape or with non-finite entries.
+        """
+        x = np.array(x, dtype=np.float64)
+        if x.shape != (self.n,) or not np.isfinite(x).all():
+            raise ValueError(f"x must be a finite ({self.n},) array, got shape {x.shape}")
+        self._guess = x
+
     def _solve(self, b: np.ndarray) -> np.ndarray:
         columns = b.reshape(b.shape[0], -1)
         x = np.empty_like(columns)
+        guess, self._guess = self._guess, None
         for j in range(columns.shape[1]):  # a handful of right-hand sides
             last = self._last
             again = last is not None and np.array_equal(columns[:, j], last[0])
-            x[:, j] = self._cg(columns[:, j], last[1].copy() if again else None)
+            start = last[1].copy() if again else None
+            if guess is not None and columns.shape[1] == 1:
+                start = guess
+            x[:, j] = self._cg(columns[:, j], start)
             self._x_norm = float(np.linalg.norm(x[:, j]))
             self._last = (columns[:, j].copy(), x[:, j].copy())
         return x.reshape(b.shape)
@@ -304,7 +342,7 @@ class AmgSolver(SPDSolver):
         )
 
     def close(self) -> None:
-        self._cycle = self._system = self._keep = self._data = self._last = None
+        self._cycle = self._system = self._keep = self._data = self._last = self._guess = None
         self._hierarchy_free = self._free = None
         super().close()
 
@@ -325,5 +363,6 @@ def amg_solver(request: SolverRequest) -> SPDSolver:
             check_symmetry=request.check_symmetry,
             near_nullspace=request.rigid_modes,
             block_size=request.dimension,
+            reuse=True,
         )
     return superlu_solver(request)

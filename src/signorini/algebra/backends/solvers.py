@@ -75,12 +75,16 @@ class SPDSolver:
         the active set methods then follow the inexact stopping rule of :mod:`.inexact`
         (they may change it for a confirming solve). None (every direct backend): exact to
         round-off.
+    takes_guess : bool
+        Whether :meth:`start_from` sets the initial iterate of the next solve (an iterative
+        solver's warm start); a direct solver ignores it.
     """
 
     backend: str = ""
     reuses_analysis: bool = False
     rtol: float | None = None
     analysis_reads_values: bool = True
+    takes_guess: bool = False
 
     def __init__(
         self,
@@ -264,6 +268,9 @@ class SPDSolver:
         self.time_solve += time.perf_counter() - t0
         self.n_solves += 1
         return x
+
+    def start_from(self, x: np.ndarray) -> None:  # noqa: B027 (a direct solver ignores it)
+        """Start the next solve from the iterate ``x (n,)`` (:attr:`takes_guess`)."""
 
     def close(self) -> None:
         """Release the factorization (the object can factorize again afterwards)."""
