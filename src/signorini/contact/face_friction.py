@@ -5,8 +5,14 @@ transformed face basis on them, and each row's law and nodal weight.
 The tangential DOFs of a row are the two frame DOFs of its node other than the row's own
 (``3 z + j``); one held by a roller through the node (a symmetry plane) is marked held and
 the law acts on the other alone. The transformed basis of the rows (:mod:`.face_basis`)
-acts on each tangential slot too, on the edges whose three nodes have that slot free, so
-that ``Λ̃_t`` and ``Λ̃_n`` are forces on the same functions ``φ̃_z``. The nodal weights are
+acts on both tangential slots too, on the edges none of whose three nodes holds a slot, so
+that ``Λ̃_t`` and ``Λ̃_n`` are forces on the same functions ``φ̃_z`` there. It mixes a slot's
+values of an edge's nodes, so it needs the same directions at them: a held node's slots are
+its roller normal and the completion of the pair, other directions than its neighbours'
+(which, moreover, depend on how the roller plane lies against the axes), so the edges at a
+held node keep the plain basis in both slots — one slot transformed there and not the
+other would make the discrete space depend on the frames, and a problem turned about the
+normal would not have the turned answer. The nodal weights are
 the laws' :meth:`~signorini.algebra.friction.laws.FrictionLaw.nodal_weight` with
 ``integrate(f) = ∫ f φ̃_z`` (Tresca: ``s_z = ∫ s φ̃_z``; Coulomb: ``F``), by the degree-4
 rule on the (flat or quadratic) faces of the row's part.
@@ -44,7 +50,8 @@ class FaceFriction:
     held : (k, 2) bool array
         Whether each is held (a roller through the node).
     edges : tuple of FaceEdges
-        The transformed basis on each tangential slot (the edges with that slot free).
+        The transformed basis on each tangential slot (the same edges for both: those at no held
+        node).
     """
 
     def __init__(self, laws: LawGroups, tangent: np.ndarray, held: np.ndarray, edges: tuple):
@@ -93,10 +100,11 @@ def face_friction(
     tangent = 3 * node[:, None] + (slot[:, None] + np.array([1, 2])) % 3
     held = np.isin(tangent, cs.held_dofs)
     e = cs.edges
-    edges = tuple(
-        FaceEdges(k, e.alpha, e.mid[ok], e.start[ok], e.end[ok])
-        for ok in (~held[e.mid, j] & ~held[e.start, j] & ~held[e.end, j] for j in range(2))
-    )
+    # both slots on the same edges, those whose three nodes hold no tangential slot: the
+    # slots of a held node are other directions than its neighbours' (docstring)
+    free = ~held.any(axis=1)
+    ok = free[e.mid] & free[e.start] & free[e.end]
+    edges = (FaceEdges(k, e.alpha, e.mid[ok], e.start[ok], e.end[ok]),) * 2
     index = np.full(k, -1, dtype=np.int64)
     weight = np.zeros(k)
     used = []

@@ -14,10 +14,16 @@ stick disc r < c with
 
     c/a = (1 − Q/(F P))^{1/3}.
 
-Measured (:data:`PARTIAL_SLIP_3D_METRICS`): P = 2 Σ Λ_n, Q = 2 Σ Λ_t·e_x (the half ball),
+Measured (:data:`PARTIAL_SLIP_3D_METRICS`, docs/method.md, *Friction in three dimensions:
+the disc law*, "Measured on partial-slip-3d"): P = 2 Σ Λ_n, Q = 2 Σ Λ̃_t·e (e the pull
+direction, Λ̃_t carried to space by each row's own tangents, its held components left out),
 ``a = √(5/2 · Σ Λ_z r_z² / Σ Λ_z)`` (as :func:`~.hertz3d.hertz_3d_metrics`), and c from the
-area of the discrete stick set, ``π c² / 2 = Σ_{stick} w̃_z`` (``w̃_z = ∫ φ̃_z``: the
-rows' shares of Γ_C).
+zero of the stick rows' traction deficit: in Mindlin's stick disc
+``d = 1 − ‖q‖/(F p) = √((c² − r²)/(a² − r²))``, so ``d² (a² − r²) = c² − r²`` is linear in
+r² and vanishes at r = c; the line fitted by least squares (weights ``w̃_z = ∫ φ̃_z``, the
+rows' shares of Γ_C) through ``d_z² (a² − r_z²)`` against ``r_z²`` over the stick rows, with
+``d_z = 1 − ‖Λ̃_t‖/(F Λ̃_n)``, crosses zero at c². The area of the discrete stick set,
+``π c² / 2 = Σ_{stick} w̃_z``, is kept beside it (``c_over_a_area``).
 """
 
 from __future__ import annotations
@@ -26,7 +32,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..contact.solution import STICK, ContactResult
+from ..contact.solution import SLIP, STICK, ContactResult
 from ..fem.material import Material
 from ..mesh.mesh import Mesh
 from ..problem import Contact, ContactProblem, Coulomb, Dirichlet, Neumann
@@ -108,32 +114,74 @@ def partial_slip_3d(**kwargs) -> ContactProblem:
     return partial_slip_3d_path(**kwargs)[-1]
 
 
-def partial_slip_3d_metrics(result: ContactResult) -> dict[str, float]:
-    """The stick disc against Mindlin's: ``a``, ``c_over_a``, ``c_over_a_theory`` =
-    (1 − Q/(F P))^{1/3}, ``q_over_fp``, and the counts ``stick_nodes``, ``slip_nodes``
-    (NaN without contact)."""
-    keys = ("a", "c_over_a", "c_over_a_theory", "q_over_fp", "stick_nodes", "slip_nodes")
+def partial_slip_3d_metrics(
+    result: ContactResult, direction: tuple[float, float] = (1.0, 0.0)
+) -> dict[str, float]:
+    """The stick disc against Mindlin's (module docstring): ``a``, ``c_over_a`` (the zero of
+    the stick rows' deficit), ``c_over_a_area`` (the stick set's area), ``c_over_a_theory``
+    = (1 − Q/(F P))^{1/3}, ``q_over_fp``, the fitted line's ``deficit_slope`` (−1 in
+    Mindlin's disc) and the counts ``stick_nodes``, ``slip_nodes`` (NaN without contact).
+    ``direction``: the pull's horizontal direction (x for the example)."""
+    keys = ("a", "c_over_a", "c_over_a_area", "c_over_a_theory", "q_over_fp", "deficit_slope")
+    counts = {
+        "stick_nodes": float((result.state == STICK).sum()),
+        "slip_nodes": float((result.state == SLIP).sum()),
+    }
     cs = result.contact
     lam_n = result.contact_force
     total = float(lam_n.sum())
     if not total > 0:
-        return dict.fromkeys(keys, float("nan"))
+        return dict.fromkeys(keys, float("nan")) | counts
     coefficient = result.problem.conditions["sphere"].friction.coefficient
     x = result.space.node_points[cs.node]
-    a = float(np.sqrt(2.5 * float(lam_n @ (x[:, 0] ** 2 + x[:, 1] ** 2)) / total))
-    frames = cs.frames[np.searchsorted(cs.frame_nodes, cs.node)]  # (k, 3, 3): [n t1 t2]
-    pull = np.einsum("kc,kcj->k", result.tangential_force, frames[:, :, 1:].transpose(0, 2, 1))
-    ratio = float(pull.sum()) / (coefficient * total)
+    r2 = x[:, 0] ** 2 + x[:, 1] ** 2
+    a2 = 2.5 * float(lam_n @ r2) / total
+    pull = float(_friction_forces(result).sum(0)[:2] @ np.asarray(direction, dtype=float))
+    ratio = pull / (coefficient * total)
     stick = result.state == STICK
-    c = np.sqrt(2.0 * float(cs.transformed_integral[stick].sum()) / np.pi)
+    w = cs.transformed_integral
+    c2_area = 2.0 * float(w[stick].sum()) / np.pi
+    c2, slope = _deficit_zero(result, coefficient, r2, a2, stick)
     return {
-        "a": a,
-        "c_over_a": float(c / a),
+        "a": float(np.sqrt(a2)),
+        "c_over_a": float(np.sqrt(max(c2, 0.0) / a2)) if np.isfinite(c2) else float("nan"),
+        "c_over_a_area": float(np.sqrt(c2_area / a2)),
         "c_over_a_theory": float(np.cbrt(max(1.0 - ratio, 0.0))),
         "q_over_fp": ratio,
-        "stick_nodes": float(stick.sum()),
-        "slip_nodes": float((result.state == 2).sum()),
-    }
+        "deficit_slope": slope,
+    } | counts
+
+
+def _friction_forces(result: ContactResult) -> np.ndarray:
+    """``(k, 3)`` the rows' friction forces ``Σ_j Λ̃_t,j t_j`` in space, each row's tangents
+    ``t_j`` its own frame's columns (``friction.tangent``), held components (a roller's
+    reaction) left out."""
+    cs = result.contact
+    fr = cs.friction
+    frames = cs.frames[np.searchsorted(cs.frame_nodes, cs.node)]  # (k, 3, 3): [n t1 t2]
+    rows = np.arange(cs.n_rows)[:, None]
+    t = frames[rows, :, fr.tangent % 3]  # (k, 2, 3)
+    force = np.where(fr.held, 0.0, result.tangential_force)
+    return np.einsum("kj,kjc->kc", force, t)
+
+
+def _deficit_zero(
+    result: ContactResult, coefficient: float, r2: np.ndarray, a2: float, stick: np.ndarray
+) -> tuple[float, float]:
+    """``(c², slope)``: the zero and slope of the least-squares line (weights ``w̃_z``) of
+    ``d_z² (a² − r_z²)`` against ``r_z²`` over the stick rows inside the disc, ``d_z = 1 −
+    ‖Λ̃_t‖/(F Λ̃_n)`` clipped to [0, 1] (module docstring); NaN with fewer than three rows."""
+    cs = result.contact
+    normal = cs.edges.transformed(result.contact_force)  # Λ̃_n, the solver's
+    use = stick & (normal > 0) & (r2 < a2)
+    if use.sum() < 3:
+        return float("nan"), float("nan")
+    force_t = np.where(cs.friction.held, 0.0, result.tangential_force)[use]
+    d = np.clip(1.0 - np.linalg.norm(force_t, axis=1) / (coefficient * normal[use]), 0.0, 1.0)
+    root = np.sqrt(cs.transformed_integral[use])
+    design = np.stack([np.ones(use.sum()), r2[use]], 1) * root[:, None]
+    (c2, slope), *_ = np.linalg.lstsq(design, d**2 * (a2 - r2[use]) * root, rcond=None)
+    return float(-c2 / slope), float(slope)
 
 
 #: The partial-slip-3d example's columns of ``history.csv``.
@@ -141,10 +189,13 @@ PARTIAL_SLIP_3D_METRICS = Metrics(
     measure=partial_slip_3d_metrics,
     columns={
         "a": "radius of the contact disc from the nodal forces, √(5/2 Σ Λ r² / Σ Λ), length units",
-        "c_over_a": "c/a, c the radius of the discrete stick set's area (π c²/2 = Σ_stick w̃_z)"
-        ", no unit",
+        "c_over_a": "c/a, c² the zero of the stick rows' deficit: the weighted least-squares "
+        "line of d² (a² − r²) against r², d = 1 − ‖Λ̃_t‖/(F Λ̃_n), no unit",
+        "c_over_a_area": "c/a, c the radius of the discrete stick set's area "
+        "(π c²/2 = Σ_stick w̃_z), no unit",
         "c_over_a_theory": "Mindlin's c/a = (1 − Q/(F P))^(1/3) with the level's P and Q, no unit",
-        "q_over_fp": "Q/(F P), no unit",
+        "q_over_fp": "Q/(F P), Q the friction force along the pull, no unit",
+        "deficit_slope": "slope of that line against r² (−1 in Mindlin's stick disc), no unit",
         "stick_nodes": "rows that stick",
         "slip_nodes": "rows that slip",
     },
