@@ -161,8 +161,13 @@ def _friction_forces(result: ContactResult) -> np.ndarray:
     frames = cs.frames[np.searchsorted(cs.frame_nodes, cs.node)]  # (k, 3, 3): [n t1 t2]
     rows = np.arange(cs.n_rows)[:, None]
     t = frames[rows, :, fr.tangent % 3]  # (k, 2, 3)
-    force = np.where(fr.held, 0.0, result.tangential_force)
-    return np.einsum("kj,kjc->kc", force, t)
+    return np.einsum("kj,kjc->kc", _unheld_force(result), t)
+
+
+def _unheld_force(result: ContactResult) -> np.ndarray:
+    """``(k, 2)`` the rows' tangential forces ``Λ̃_t`` in their frames, the components a
+    roller holds (its reaction, not friction) set to zero."""
+    return np.where(result.contact.friction.held, 0.0, result.tangential_force)
 
 
 def _deficit_zero(
@@ -176,7 +181,7 @@ def _deficit_zero(
     use = stick & (normal > 0) & (r2 < a2)
     if use.sum() < 3:
         return float("nan"), float("nan")
-    force_t = np.where(cs.friction.held, 0.0, result.tangential_force)[use]
+    force_t = _unheld_force(result)[use]
     d = np.clip(1.0 - np.linalg.norm(force_t, axis=1) / (coefficient * normal[use]), 0.0, 1.0)
     root = np.sqrt(cs.transformed_integral[use])
     design = np.stack([np.ones(use.sum()), r2[use]], 1) * root[:, None]

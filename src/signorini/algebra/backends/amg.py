@@ -278,11 +278,12 @@ class AmgSolver(SPDSolver):
         x = np.empty_like(columns)
         guess, self._guess = self._guess, None
         for j in range(columns.shape[1]):  # a handful of right-hand sides
-            last = self._last
-            again = last is not None and np.array_equal(columns[:, j], last[0])
-            start = last[1].copy() if again else None
             if guess is not None and columns.shape[1] == 1:
                 start = guess
+            else:  # the last right-hand side again: from its solution
+                last = self._last
+                again = last is not None and np.array_equal(columns[:, j], last[0])
+                start = last[1].copy() if again else None
             x[:, j] = self._cg(columns[:, j], start)
             self._x_norm = float(np.linalg.norm(x[:, j]))
             self._last = (columns[:, j].copy(), x[:, j].copy())
