@@ -82,6 +82,21 @@ def test_weights_of_a_uniform_mesh():
     assert np.allclose(near, 4 * np.pi, rtol=1e-14) and np.allclose(far, 4 * np.pi, rtol=1e-14)
 
 
+def test_weights_of_some_faces_are_those_of_the_whole_set():
+    """Graded faces (radii from 0.4 to 1.6 of the uniform ones): the weights asked for a subset
+    of faces equal, bit for bit, those of the whole set on it."""
+    points = square_faces(8)
+    points = points * (1.0 + 0.6 * np.sin(3.0 * points[..., :1]))  # graded in x
+    near, far = surface_weights(points)
+    subset = np.array([0, 5, 17, 64, len(points) - 1])
+    near_sub, far_sub = surface_weights(points, faces=subset)
+    assert np.array_equal(near_sub[subset], near[subset])
+    assert np.array_equal(far_sub[subset], far[subset])
+    assert not np.allclose(near, near[0])  # the grading reaches the weights
+    empty = surface_weights(points, faces=np.array([], dtype=int))
+    assert np.isfinite(empty[0]).all() and np.isfinite(empty[1]).all()
+
+
 def test_invariant_under_a_rigid_motion():
     points = square_faces(4)
     v = quadratic_at(CASES["cap"], points)

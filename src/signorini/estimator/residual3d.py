@@ -63,7 +63,7 @@ from .terms import (
 
 __all__ = ["CELL_DEGREE_3D", "FACE_DEGREE", "NEUMANN_DEGREE_3D", "Estimate3D", "estimate_3d"]
 
-#: tetrahedron rule for η1 with a body force (27 points; f is smooth data)
+#: tetrahedron rule for η1 with a body force (14 points; f is smooth data)
 CELL_DEGREE_3D = 5
 #: triangle rule on the faces for η2, η4, η5: σ(u_h) is linear on a straight cell, p_h
 #: quadratic, so the squares are of degree 4 on flat faces; one more for quadratic faces

@@ -38,7 +38,7 @@ __all__ = [
 
 Field = Callable[[np.ndarray], np.ndarray]
 
-#: the default rule for loads and errors: degree 4 (27 points), exact for f·φ with f quadratic
+#: the default rule for loads and errors: degree 4 (14 points), exact for f·φ with f quadratic
 LOAD_DEGREE = 4
 
 

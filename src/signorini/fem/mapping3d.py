@@ -25,8 +25,10 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from ..mesh.geometry import facet_normals, spanned_normals
+from ..mesh.jacobians import determinant
 from ..mesh.reference import TETRAHEDRON
 from . import p2, p2_tet
+from .fixed_order import rows_times
 from .mapping import AffineSimplices, CellMap, IsoparametricSimplices
 
 __all__ = [
@@ -44,6 +46,28 @@ _ALL = slice(None)
 def _coefficients(u_cell: np.ndarray) -> np.ndarray:
     """Interleaved cell coefficients ``(m, 30)`` as ``(m, 10, 3)``."""
     return np.asarray(u_cell, dtype=np.float64).reshape(-1, 10, 3)
+
+
+def _reference_gradients(u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
+    """``(m, q, 3, 3)`` ``∂u_i/∂ξ_r = Σ_a u_{a,i} ∂φ_a/∂ξ_r`` of a P2 field at the reference
+    points ``xi (q, 3)``: one product of the ``(3m, 10)`` coefficients by the ``(10, 3q)``
+    reference gradients, each cell's rows rounded alike whatever cells stand beside them
+    (:func:`~signorini.fem.fixed_order.rows_times`)."""
+    g = p2_tet.grad_basis(xi)  # (q, 10, 3)
+    q = g.shape[0]
+    u = np.ascontiguousarray(_coefficients(u_cell).transpose(0, 2, 1)).reshape(-1, 10)
+    flat = rows_times(u, np.ascontiguousarray(g.transpose(1, 0, 2)).reshape(10, 3 * q))
+    return flat.reshape(-1, 3, q, 3).transpose(0, 2, 1, 3)
+
+
+def _times_inverse_transpose(ref: np.ndarray, jit: np.ndarray) -> np.ndarray:
+    """``∂u_i/∂x_j = Σ_r ∂u_i/∂ξ_r (J⁻ᵀ)_{jr}`` for ``ref (m, q, 3, 3)`` and ``jit (m, q or 1,
+    3, 3)``, the three products added in the order r = 0, 1, 2 (elementwise, so a cell's
+    values depend on its own data alone)."""
+    out = ref[..., :, None, 0] * jit[..., None, :, 0]
+    out += ref[..., :, None, 1] * jit[..., None, :, 1]
+    out += ref[..., :, None, 2] * jit[..., None, :, 2]
+    return out
 
 
 class AffineTetrahedra(AffineSimplices):
@@ -75,8 +99,11 @@ class AffineTetrahedra(AffineSimplices):
         return np.einsum("qa,mai->mqi", p2_tet.basis(xi), _coefficients(u_cell))
 
     def field_gradients(self, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
-        """``(m, q, 3, 3)`` ``∂u_i/∂x_j`` of a P2 field at reference points ``xi (q, 3)``."""
-        return np.einsum("mai,mqaj->mqij", _coefficients(u_cell), self.basis_gradients(xi))
+        """``(m, q, 3, 3)`` ``∂u_i/∂x_j`` of a P2 field at reference points ``xi (q, 3)``:
+        the reference gradients times the cell's constant ``J⁻ᵀ``, without the ``(m, q, 10,
+        3)`` physical basis gradients."""
+        xi = np.atleast_2d(np.asarray(xi, dtype=np.float64))
+        return _times_inverse_transpose(_reference_gradients(u_cell, xi), self.inverse_transpose())
 
     def gradient_field(self, u_cell: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
         """The physical gradient of a P2 field as a function of reference points."""
@@ -105,6 +132,14 @@ class IsoparametricTetrahedra(IsoparametricSimplices):
     reference = TETRAHEDRON
     shape_functions = p2_tet
 
+    def jacobians(self, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``J (m, q, 3, 3)`` and ``det J (m, q)`` at each point: ``J_ir = ∂x_i/∂ξ_r``, the
+        reference gradients of the node points as of a P2 field (each cell's from its own
+        nodes alone, bit for bit, whatever cells stand beside it)."""
+        xi = np.atleast_2d(np.asarray(xi, dtype=np.float64))
+        J = _reference_gradients(self.nodes.reshape(-1, 30), xi)
+        return J, determinant(J)
+
     def basis_gradients(self, xi: np.ndarray) -> np.ndarray:
         """``(m, q, 10, 3)`` physical gradients of the ten P2 basis functions."""
         jit = self.inverse_transpose(xi)
@@ -115,20 +150,26 @@ class IsoparametricTetrahedra(IsoparametricSimplices):
         return np.einsum("qa,mai->mqi", p2_tet.basis(xi), _coefficients(u_cell))
 
     def field_gradients(self, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
-        """``(m, q, 3, 3)`` ``∂u_i/∂x_j`` of a P2 field at reference points ``xi``."""
-        return np.einsum("mai,mqaj->mqij", _coefficients(u_cell), self.basis_gradients(xi))
+        """``(m, q, 3, 3)`` ``∂u_i/∂x_j`` of a P2 field at reference points ``xi``: the
+        reference gradients times ``J⁻ᵀ`` at each point."""
+        xi = np.atleast_2d(np.asarray(xi, dtype=np.float64))
+        ref = _reference_gradients(u_cell, xi)
+        return _times_inverse_transpose(ref, self.inverse_transpose(xi))
 
     def field_hessians(self, u_cell: np.ndarray, xi: np.ndarray) -> np.ndarray:
         """``(m, q, 3, 3, 3)`` ``∂²u_i/∂x_j∂x_k`` of a P2 field at ``xi (q, 3)``, exact through
         the quadratic map (the 3D form of :func:`signorini.fem.iso.field_derivatives`):
-        ``∇²u_h = J⁻ᵀ (D²û − Σ_i (∂_i u_h) D²x_i) J⁻¹`` with the constant ``D²x_i``."""
+        ``∇²u_h = J⁻ᵀ (D²û − Σ_i (∂_i u_h) D²x_i) J⁻¹`` with the constant ``D²x_i``; the
+        Jacobians once, the two products by ``J⁻ᵀ`` one after the other."""
+        xi = np.atleast_2d(np.asarray(xi, dtype=np.float64))
         href = p2_tet.hessian_basis()  # (10, 3, 3)
         d2u = np.einsum("mai,ars->mirs", _coefficients(u_cell), href)
         d2x = np.einsum("mai,ars->mirs", self.nodes, href)
-        grad = self.field_gradients(u_cell, xi)  # (m, q, 3, 3): [c, i]
-        inner = d2u[:, None] - np.einsum("mqci,mirs->mqcrs", grad, d2x)
         jit = self.inverse_transpose(xi)  # [j, r] = ∂ξ_r / ∂x_j
-        return np.einsum("mqjr,mqcrs,mqks->mqcjk", jit, inner, jit)
+        grad = _times_inverse_transpose(_reference_gradients(u_cell, xi), jit)  # [c, i]
+        inner = d2u[:, None] - np.einsum("mqci,mirs->mqcrs", grad, d2x)
+        left = np.einsum("mqjr,mqcrs->mqcjs", jit, inner)
+        return np.einsum("mqcjs,mqks->mqcjk", left, jit)
 
 
 class TetrahedronMap(CellMap):

@@ -17,10 +17,14 @@ points lie strictly inside ``T``.
 
 The reference tetrahedron is ``{x, y, z >= 0, x + y + z <= 1}`` (volume 1/6,
 :data:`~signorini.mesh.reference.TETRAHEDRON`): the centroid rule (degree 1), the symmetric
-four-point rule (degree 2, the stiffness of affine P2 cells), and above those the collapsed
-(conical product) rules ``(s, t, r) -> (s, t (1 - s), r (1 - s)(1 - t))`` with Gauss-Jacobi
-rules of weights ``(1 - s)²`` and ``(1 - t)`` and Gauss-Legendre in ``r``: ``n³`` points,
-exact to degree ``2 n - 1``, positive weights, points strictly inside (Stroud [3]).
+four-point rule (degree 2, the stiffness of affine P2 cells), the symmetric 14-point rule of
+degree 5 for degrees 4 and 5, with positive weights (two four-point orbits ``(a, a, a, 1 − 3a)``
+and one six-point orbit ``(b, b, 1/2 − b, 1/2 − b)``; Walkington [4], Felippa [5]: the
+curved cells' stiffness, loads, errors and η1, at about half the 27 points of the collapsed
+rule of the same degree), and for degree 3 and above 5 the collapsed (conical product)
+rules ``(s, t, r) -> (s, t (1 - s), r (1 - s)(1 - t))`` with Gauss-Jacobi rules of weights
+``(1 - s)²`` and ``(1 - t)`` and Gauss-Legendre in ``r``: ``n³`` points, exact to degree
+``2 n - 1``, positive weights, points strictly inside (Stroud [3]).
 
 The returned arrays are cached and read-only; copy them before modifying.
 
@@ -31,6 +35,10 @@ References
    Prentice-Hall (1973), Table 4.1.
 .. [3] A. H. Stroud, *Approximate Calculation of Multiple Integrals*,
    Prentice-Hall (1971) (conical product rules).
+.. [4] N. Walkington, "Quadrature on simplices of arbitrary dimension", Technical report,
+   Carnegie Mellon University (2000).
+.. [5] C. A. Felippa, *Advanced Finite Element Methods*, University of Colorado, §17.4
+   (the 14-point tetrahedron rule).
 """
 
 from __future__ import annotations
@@ -211,6 +219,34 @@ def line_rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
     return _gauss_legendre(_check_integer(degree) // 2 + 1)
 
 
+#: the 14-point rule's orbits: (a, weight × 6) of ``(a, a, a, 1 − 3a)``, twice, then
+#: ``(b, weight × 6)`` of ``(b, b, 1/2 − b, 1/2 − b)`` (barycentric coordinates)
+_S31 = (
+    (0.31088591926330060980, 0.11268792571801585080),
+    (0.092735250310891226402, 0.073493043116361949544),
+)
+_S22 = (0.045503704125649649492, 0.042546020777081466438)
+
+
+def _tetrahedron_14() -> tuple[np.ndarray, np.ndarray]:
+    """The symmetric 14-point rule of degree 5 (barycentric orbits ``_S31``, ``_S22``)."""
+    bary, w = [], []
+    for a, weight in _S31:
+        for k in range(4):  # the orbit's four points
+            point = np.full(4, a)
+            point[k] = 1.0 - 3.0 * a
+            bary.append(point)
+            w.append(weight)
+    b, weight = _S22
+    for i in range(4):  # the orbit's six points: the pairs i < j carrying b
+        for j in range(i + 1, 4):
+            point = np.full(4, 0.5 - b)
+            point[[i, j]] = b
+            bary.append(point)
+            w.append(weight)
+    return np.array(bary)[:, 1:], np.array(w) / 6.0
+
+
 @lru_cache(maxsize=32)
 def _tetrahedron_rule(deg: int) -> tuple[np.ndarray, np.ndarray]:
     if deg <= 1:
@@ -222,6 +258,8 @@ def _tetrahedron_rule(deg: int) -> tuple[np.ndarray, np.ndarray]:
         xi = np.full((4, 3), a)
         xi[1:, :][np.arange(3), np.arange(3)] = b
         w = np.full(4, 1.0 / 24.0)
+    elif deg in (4, 5):
+        xi, w = _tetrahedron_14()
     else:
         n = deg // 2 + 1  # 2 n - 1 >= deg
         xs, ws = roots_jacobi(n, 2.0, 0.0)  # weight (1 - s)² on [0, 1]
@@ -243,8 +281,8 @@ def tetrahedron_rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
     ----------
     degree : int
         Every polynomial of total degree ``<= degree`` is integrated exactly: 1 point for
-        degree 1, 4 for degree 2, ``n³`` with ``n = degree // 2 + 1`` above (exact to
-        ``2 n - 1``).
+        degree 1, 4 for degree 2, 14 for degrees 4 and 5, ``n³`` with ``n = degree // 2 + 1``
+        for the others (exact to ``2 n - 1``).
 
     Returns
     -------

@@ -112,7 +112,9 @@ def face_norms2_positive_part(points: np.ndarray, v: np.ndarray) -> FacetNorms:
     return FacetNorms(h, l2, gradient)
 
 
-def face_reach(points: np.ndarray, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def face_reach(
+    points: np.ndarray, delta: np.ndarray, faces: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """``ε_F = min{δ_F' : dist(F, F') < δ_F}`` and ``Δ_F = max{δ_F' : dist(F, F') < δ_F'}``
     over the faces ``F'`` whose centroids are close enough (a superset of the pairs, module
     notes).
@@ -122,26 +124,39 @@ def face_reach(points: np.ndarray, delta: np.ndarray) -> tuple[np.ndarray, np.nd
     points : (k, 6, 3) float array
     delta : (k,) float array
         The face radii ``δ_F > 0``.
+    faces : (p,) int array, optional
+        The faces ``F`` whose ``ε_F`` and ``Δ_F`` are wanted (the others keep ``δ_F``); all
+        by default. The pairs are those of these faces with every face, so their values are
+        those of the whole set exactly (minima and maxima of the same numbers).
 
     Returns
     -------
     eps, reach : (k,) float arrays
     """
+    eps, reach = delta.copy(), delta.copy()
+    if faces is not None and len(faces) == 0:
+        return eps, reach
     centre = points.mean(axis=1)
     radius = np.linalg.norm(points - centre[:, None], axis=2).max(axis=1)
+    near = float(delta.max() + 2.0 * radius.max())
     tree = cKDTree(centre)
-    pairs = tree.query_pairs(float(delta.max() + 2.0 * radius.max()), output_type="ndarray")
-    i, j = pairs[:, 0], pairs[:, 1]
+    if faces is None:
+        pairs = tree.query_pairs(near, output_type="ndarray")
+        i, j = np.concatenate([pairs, pairs[:, ::-1]]).T  # each pair both ways
+    else:
+        faces = np.asarray(faces)
+        close = cKDTree(centre[faces]).sparse_distance_matrix(tree, near, output_type="ndarray")
+        i, j = faces[close["i"]], close["j"]
+        i, j = i[i != j], j[i != j]
     gap = np.linalg.norm(centre[i] - centre[j], axis=1) - radius[i] - radius[j]
-    eps, reach = delta.copy(), delta.copy()
-    for a, b in ((i, j), (j, i)):
-        seen = gap < delta[a]  # F' = b within δ_F of F = a
-        np.minimum.at(eps, a[seen], delta[b[seen]])
-        np.maximum.at(reach, b[seen], delta[a[seen]])  # F = b lies within δ_a of a
+    np.minimum.at(eps, i[gap < delta[i]], delta[j[gap < delta[i]]])  # F' = j within δ_F of F
+    np.maximum.at(reach, i[gap < delta[j]], delta[j[gap < delta[j]]])  # F within δ_F' of F'
     return eps, reach
 
 
-def surface_weights(points: np.ndarray, delta_factor: float = DELTA_FACTOR) -> tuple:
+def surface_weights(
+    points: np.ndarray, delta_factor: float = DELTA_FACTOR, faces: np.ndarray | None = None
+) -> tuple:
     """The weights ``near_F = 2π Δ_F / h_F`` and ``far_F = 8π h_F / ε_F`` of the guaranteed
     bound, in the form of :func:`~signorini.estimator.h_half_norm.localised.localised_bound2`.
 
@@ -150,13 +165,15 @@ def surface_weights(points: np.ndarray, delta_factor: float = DELTA_FACTOR) -> t
     points : (k, 6, 3) float array
     delta_factor : float
         ``c`` in ``δ_F = c h_F``.
+    faces : (p,) int array, optional
+        Only these faces' weights are wanted (:func:`face_reach`); all by default.
 
     Returns
     -------
     near, far : (k,) float arrays
     """
     h = np.sqrt(facet_normals(np.asarray(points, dtype=np.float64)[:, :3])[0])
-    eps, reach = face_reach(np.asarray(points, dtype=np.float64), delta_factor * h)
+    eps, reach = face_reach(np.asarray(points, dtype=np.float64), delta_factor * h, faces)
     return 2.0 * np.pi * reach / h, 8.0 * np.pi * h / eps
 
 
@@ -190,5 +207,7 @@ def surface_penetration(
     if not delta_factor > 0.0:
         raise ValueError(f"surface_penetration: delta_factor must be > 0, got {delta_factor!r}")
     norms = face_norms2_positive_part(points, v)
-    near, far = surface_weights(points, delta_factor)
+    # the weights only where v⁺ ≠ 0: the other faces' shares are zero whatever theirs
+    positive = np.flatnonzero((norms.l2 > 0.0) | (norms.gradient > 0.0))
+    near, far = surface_weights(points, delta_factor, positive)
     return localised_bound2(norms, near, far)[1]
