@@ -39,7 +39,7 @@ from .node_frames3d import frame_operator, held_frames, to_frames_3d
 if TYPE_CHECKING:
     from ..fem.space3d import P2TetSpace
 
-__all__ = ["SAME_DIRECTION", "FaceContactSet", "face_contact_set"]
+__all__ = ["SAME_DIRECTION", "FaceContactSet", "face_contact_set", "row_weights"]
 
 #: two rows at a node whose directions differ by less than this (max-norm) are one row
 SAME_DIRECTION = 1e-8
@@ -362,7 +362,7 @@ def _assembled(space, parts, rows, row_of_part, held, alpha, face_data):
         return row_of_part[nodes, which]
 
     edges = face_edges(faces, face_part, row_of, k, alpha)
-    w, m = _weights(space, facet_index, faces, face_part, row_of, k)
+    w, m = row_weights(space, facet_index, faces, face_part, row_of, k)
     return FaceContactSet(
         n_dofs=space.n_dofs,
         node=node,
@@ -388,10 +388,11 @@ def _assembled(space, parts, rows, row_of_part, held, alpha, face_data):
     )
 
 
-def _weights(space, facet_index, faces, face_part, row_of, k):
+def row_weights(space, facet_index, faces, face_part, row_of, k):
     """``w (k,)`` the integrals of the P2 functions over the rows' faces (by quadrature, on
     flat and quadratic faces alike) and ``m (k,)`` those of the hats of the once-refined faces
-    (the face element's hat shares times the face areas)."""
+    (the face element's hat shares times the face areas); ``row_of(nodes, which)`` the rows
+    of the faces' nodes (−1: none), ``which`` their faces' parts ``face_part[:, None]``."""
     element = space.element.facet
     s, wq = triangle_rule(4)
     phi = element.basis(s)  # (q, 6)

@@ -32,7 +32,7 @@ from ..fem.dofs import node_dofs
 from ..problem.fields import ProblemError
 from ..problem.rollers import HeldNodes
 from .admissible import DEEP_OVERLAP
-from .face_contact import SAME_DIRECTION
+from .face_contact import SAME_DIRECTION, row_weights
 from .face_fields import FaceFields
 from .mortar3d import MortarCoupling3D
 from .mortar_checks import COVERAGE_TOL
@@ -74,7 +74,14 @@ class MortarFaceSet:
     node_transfer : (k, n_nodes) scipy.sparse.csr_matrix
         ``T_jk = M_jk / D_jj`` of the rows.
     faces, face_part : (n_f, 6) and (n_f,) int arrays
-        The slave faces' nodes and pairs.
+        The slave faces' nodes and pairs (the slave parts' faces in order, pair after pair).
+    facet_local : (n_f, 6) int array
+        The row of each face node, −1 at a node without one (its normal component held).
+    facet_direction : (n_f, 6, 3) float array
+        The slave's outward unit normal at each face node (the rows' ``direction``).
+    hat_integral : (k,) float array
+        ``m_j``: the integrals of the hats of the once-refined slave faces at the row's node
+        (the estimator's η6, as :attr:`FaceContactSet.hat_integral`).
     edges : (n_e, 3) int array
         The slave sides' nodes (midpoint, start, end) of the transformed basis.
     alpha : float
@@ -98,6 +105,9 @@ class MortarFaceSet:
     node_transfer: sp.csr_matrix
     faces: np.ndarray
     face_part: np.ndarray
+    facet_local: np.ndarray
+    facet_direction: np.ndarray
+    hat_integral: np.ndarray
     edges: np.ndarray
     alpha: float
 
@@ -169,6 +179,18 @@ class MortarFaceSet:
         u = np.asarray(u, dtype=np.float64)
         rel = self.coefficients(u)[self.node] - self.node_transfer @ u
         return np.einsum("kc,kc->k", rel, self.direction) - self.psi
+
+    @property
+    def facet_gap(self) -> np.ndarray:
+        """``(n_f, 6)`` the rows' bounds ``g̃_j / D_jj`` at the face nodes, 0 without a row."""
+        return np.where(self.facet_local >= 0, self.psi[np.maximum(self.facet_local, 0)], 0.0)
+
+    def facet_normal_gap(self, u: np.ndarray) -> np.ndarray:
+        """``(n_f, 6)`` the relative gap (:meth:`relative_gap`) at the face nodes of nodal
+        values ``u``; 0 at a node without a row, whose normal displacement is held (taken in
+        contact, as a Dirichlet end point in 2D)."""
+        gap = self.relative_gap(np.asarray(u, dtype=np.float64).reshape(-1, 3))
+        return np.where(self.facet_local >= 0, gap[np.maximum(self.facet_local, 0)], 0.0)
 
     def master_forces(self, force: np.ndarray, n_nodes: int) -> np.ndarray:
         """``(n_nodes, 3)`` the nodal forces the slave rows' ``Λ̃ (k,)`` exert on the
@@ -294,13 +316,21 @@ def mortar_face_set(space, couplings: Sequence[MortarCoupling3D], held: HeldNode
     pole = np.argmax(np.abs(direction), axis=1)
     frames = held_frames(points, node, direction, pole, held)
     R = _operator(n_dofs, (node, direction, T), edges, alpha, frames)
+    row_of = np.full(space.n_nodes, -1)
+    row_of[node] = np.arange(node.size)
+    normal = np.zeros((space.n_nodes, 3))
+    for c in couplings:  # a loop over pairs
+        normal[c.slave_nodes] = c.normal
+    facet_index = np.concatenate([space.mesh.part_facets(c.slave) for c in couplings])
+    hat = row_weights(space, facet_index, faces, face_part, lambda z, _: row_of[z], node.size)[1]
     return MortarFaceSet(
         n_dofs=n_dofs, node=node, part=part, parts=tuple(c.slave for c in couplings),
         masters=tuple(c.master for c in couplings), direction=direction, psi=gap / D,
         basis_integral=D, dof=frames.row_dof, frame_nodes=frames.frame_nodes,
         frames=frames.frames, held_dofs=frames.held_dofs, held_values=frames.held_values,
         roller_dof=frames.roller_dof, operator=R, node_transfer=T, faces=faces,
-        face_part=face_part, edges=edges, alpha=alpha,
+        face_part=face_part, facet_local=row_of[faces], facet_direction=normal[faces],
+        hat_integral=hat, edges=edges, alpha=alpha,
     )  # fmt: skip
 
 

@@ -30,6 +30,7 @@ from ..mesh.mesh import Mesh
 from ..mesh.refine import refine_nvb
 from .contact_set import ContactSet
 from .face_contact import FaceContactSet
+from .mortar3d_set import MortarFaceSet
 
 if TYPE_CHECKING:
     from .system import Assembled
@@ -88,7 +89,7 @@ def warm_active_set(
     basis's ``ỹ_dof ≤ ψ̃`` (docs/method.md, *Three dimensions: warm starts*); given the
     ``assembled`` system and its ``system = (K̃, F̃)`` (as scaled for the solver), there the
     active set rule at ``u0`` instead (:func:`warm_rule_active_set`)."""
-    if system is not None and isinstance(contact, FaceContactSet):
+    if system is not None and isinstance(contact, FaceContactSet | MortarFaceSet):
         held = (assembled.dirichlet, assembled.dirichlet_values)
         return warm_rule_active_set(contact, u0, system, held, assembled.ranks)
     rtol = WARM_START_RTOL if contact.transfer is None else PAIR_WARM_START_RTOL

@@ -293,5 +293,29 @@ def _with_contact(
         RollerDofs(rollers.nodes[off], rollers.dofs[off], rollers.sign[off], rollers.normal[off]),
         conditions,
         part,
-        Ordering(space),
+        Ordering(space, _pair_coupling(space, cs)),
     )
+
+
+def _pair_coupling(space: P2TetSpace, cs: FaceContactSet | MortarFaceSet) -> sp.csr_matrix | None:
+    """``(n_nodes, n_nodes)`` the node pairs that the pair system ``Rᵀ K R`` joins beyond the
+    mesh's own cells, for the fill-reducing ordering; None against obstacles.
+
+    ``R`` carries a constrained slave node's displacement to the master nodes of its mortar
+    transfer ``T_jk``, so a cell touching slave rows couples every node of the cell and every
+    master node of those rows: the pattern of ``Bᵀ B``, ``B`` the incidence of those cells
+    and nodes. Ordering the vertex graph without it (METIS sees two bodies apart) filled the
+    factor: on two-spheres at 53 623 unknowns PARDISO took 38 s a factorization, against
+    1.4 s with its own analysis of the whole matrix. In 2D the transfer alone suffices
+    (docs/method.md, *Two bodies*)."""
+    if not isinstance(cs, MortarFaceSet):
+        return None
+    n = space.n_nodes
+    coo = sp.coo_matrix(cs.node_transfer)
+    T = sp.csr_matrix((np.ones(coo.nnz), (cs.node[coo.row], coo.col)), shape=(n, n))
+    cells = space.cell_nodes[np.isin(space.cell_nodes, cs.node).any(axis=1)]
+    m, k = cells.shape
+    C = sp.csr_matrix((np.ones(m * k), (np.repeat(np.arange(m), k), cells.ravel())), shape=(m, n))
+    B = (C + C @ T).tocsr()
+    B.data[:] = 1.0
+    return (B.T @ B).tocsr()

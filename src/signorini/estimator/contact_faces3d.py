@@ -26,6 +26,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..contact.contact_set import SEMI_CONTACT
+from ..contact.mortar3d_set import MortarFaceSet
 from ..contact.solution import ContactResult
 from ..fem.p2 import REFERENCE_NODES, grad_basis
 from ..fem.p2 import basis as face_basis_at
@@ -140,7 +141,7 @@ def contact_terms(
     points = space.node_points[cs.faces]
     density = _semi_contact_density(result) / stresses.unit
     parts6 = on_faces * density[np.maximum(rows, 0)] * _hat_integrals(-gap, points)
-    force = np.maximum(cs.edges.transformed(result.contact_force) / cs.hat_integral, 0.0)
+    force = np.maximum(transformed_force(result) / cs.hat_integral, 0.0)
     s_face = on_faces * (force / stresses.unit)[np.maximum(rows, 0)]
     oscillation = obstacle_oscillation(result, s_face)
     parts8 = None if friction is None else eta8_parts(result, friction)
@@ -157,8 +158,11 @@ def obstacle_oscillation(result: ContactResult, density: np.ndarray) -> np.ndarr
     6)`` (``s_p = Λ̃_p / m_p`` at every row, in the stress unit), ψ the part's obstacle or gap
     function at the points of a degree-6 rule in each of the four triangles of the once-refined
     face, ψ_h its P2 interpolant through the nodal ψ. Zero where ψ is piecewise quadratic on
-    the faces (ψ = ψ_h) or nothing pushes."""
+    the faces (ψ = ψ_h) or nothing pushes, and on the slave faces of pairs, whose constraints
+    read the weighted gap itself (no interpolated obstacle)."""
     cs, space = result.contact, result.space
+    if isinstance(cs, MortarFaceSet):
+        return np.zeros(len(cs.faces))
     xi, w = triangle_rule(6)
     corners = REFERENCE_NODES[PIECE_NODES]  # (4, 3, 2)
     s = np.concatenate([c[0] + xi @ np.stack([c[1] - c[0], c[2] - c[0]]) for c in corners])
@@ -197,6 +201,8 @@ def eta5_pressure(result: ContactResult, which: str = PRESSURE_3D) -> np.ndarray
     """
     if which not in PRESSURES_3D:
         raise ValueError(f"the 3D eta5 pressure must be one of {PRESSURES_3D}, got {which!r}")
+    if isinstance(result.contact, MortarFaceSet):  # pairs: the dual basis's p_j = Λ̃_j / D_jj
+        return result.contact.pressure(result.contact_force)
     if which == "transformed":
         return consistent_pressure(result, result.contact_force)
     return result.contact.recovered_pressure(result.contact_force)
@@ -206,9 +212,18 @@ def _semi_contact_density(result: ContactResult) -> np.ndarray:
     """``(k,)`` ``s_p = Λ̃_p / m_p`` at the semi-contact rows, else 0; a negative Λ̃_p is
     round-off (the KKT check bounds it) and counts as 0, so that η6² stays ≥ 0."""
     cs = result.contact
-    force = cs.edges.transformed(result.contact_force)  # Λ̃ = T Λ, the solver's multiplier
     semi = result.classes == SEMI_CONTACT
-    return np.where(semi, np.maximum(force / cs.hat_integral, 0.0), 0.0)
+    return np.where(semi, np.maximum(transformed_force(result) / cs.hat_integral, 0.0), 0.0)
+
+
+def transformed_force(result: ContactResult) -> np.ndarray:
+    """``(k,)`` the solver's multiplier Λ̃: ``T Λ`` of a rigid obstacle's rows (the force on
+    the transformed functions; Λ itself for condition (a)), the contact force itself for the
+    rows of pairs (already on ``φ̃_j n_j``)."""
+    cs = result.contact
+    if isinstance(cs, MortarFaceSet):
+        return np.asarray(result.contact_force, dtype=np.float64)
+    return cs.edges.transformed(result.contact_force)
 
 
 def _tangents(points: np.ndarray, face: np.ndarray, s: np.ndarray) -> np.ndarray:

@@ -8,8 +8,10 @@ longest edge of the tetrahedron):
 ==== ============================================================ ==========================
 η1   ``h_p² ‖f + div σ(u_h)‖²_{ω_p}``                                every cell of ω_p
 η2   ``h_p ‖⟦σ(u_h) n⟧‖²_F``                                        interior faces F ∋ p
-η3   ``h_p ‖σ(u_h)n − g‖²_F``; on rollers the tangential part of     Neumann, roller faces
-     σ(u_h)n, on parts holding some components the free ones
+η3   ``h_p ‖σ(u_h)n − g‖²_F``; on rollers the tangential part of     Neumann, roller faces,
+     σ(u_h)n, on parts holding some components the free ones; on     the master faces of pairs
+     the master faces of pairs ``g = g_h``, the consistent master
+     traction (:mod:`.master_faces3d`)
 η4   ``h_p ‖σ_t(u_h)‖²_F``, σ_t the tangent part of σ(u_h)n          contact faces
      (of ``σ(u_h)n + p_t,h`` with friction)
 η5   ``h_p ‖d·σ(u_h)n + p_h‖²_F`` (``consistent``) or without p_h    contact faces
@@ -46,6 +48,7 @@ from ..problem.conditions import Dirichlet, Roller
 from ..problem.fields import evaluate_field
 from .contact_faces3d import PRESSURE_3D, contact_terms
 from .faces3d import TetStress, face_geometry
+from .master_faces3d import master_tractions
 from .names import TERMS
 from .owned import OwnPart, per_cell_of
 from .residual import NODE_TERMS, Estimate
@@ -116,6 +119,12 @@ def estimate_3d(
     inner = _face_set(space, np.flatnonzero(mesh.facet2cell[:, 1] >= 0))
     J2 = _on_own_faces(inner, own, lambda faces: _jumps(space, stresses, faces, s, w))
     boundary, J3 = _traction_residuals(result, stresses, own)
+    master, J3_master = master_tractions(result, stresses, s, w)  # pairs: the master faces
+    if master.index.size:
+        boundary = FacetSet(
+            *(np.concatenate([a, b]) for a, b in zip(boundary, master, strict=True))
+        )
+        J3 = np.concatenate([J3, J3_master])
     contact = contact_terms(result, stresses, eta5_variant, s, w, pressure)
     if own is not None:  # each integral from the one rank that owns it, summed over the ranks
         if contact is None:

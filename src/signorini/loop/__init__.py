@@ -12,7 +12,6 @@ the same levels as an uninterrupted run.
 from __future__ import annotations
 
 import logging
-import math
 import numbers
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -59,8 +58,7 @@ class Level:
         The discrete solution on the level's mesh (``result.mesh``).
     estimate : Estimate or None
         The a posteriori estimator of that solution (in 3D :mod:`signorini.estimator.
-        residual3d`); None for contact pairs in 3D, which refine uniformly (no mortar terms on
-        faces yet).
+        residual3d`).
     marked : (n_cells,) bool array or None
         Cells marked for refinement; None on the last level.
     next_mesh : Mesh or None
@@ -176,12 +174,6 @@ def adaptive(
             )
         path = check_path([*path, problem])[:-1]
     mesh = problem.mesh if mesh is None else mesh
-    if mesh.dim == 3 and problem.pairs and not options.uniform:
-        raise ValueError(
-            f"contact pairs {sorted(problem.pairs)} on a tetrahedral mesh run with uniform "
-            "refinement only (uniform=True, --uniform): the estimator's mortar terms on faces "
-            "are not built in 3D yet"
-        )
     if problem.free_ndof(space_of(mesh, options.element)) > options.max_ndof:
         raise ValueError(
             f"the initial mesh already has {problem.free_ndof(space_of(mesh, options.element))} "
@@ -230,9 +222,7 @@ def _levels(
         u0 = None
         on_ranks = _estimator_ranks(result, solver)
         t0 = time.perf_counter()
-        # 3D pairs: uniform refinement without an estimator (checked by adaptive)
-        unestimated = mesh.dim == 3 and bool(problem.pairs)
-        est = None if unestimated else estimate(result, options.eta5_variant, **on_ranks)
+        est = estimate(result, options.eta5_variant, **on_ranks)
         t_est = time.perf_counter() - t0
         record = level_record(level, result, est)
         record.t_estimate = t_est
@@ -240,7 +230,7 @@ def _levels(
             _add_path_counts(record, steps)
         if metrics is not None:
             record.extra.update(_measured(metrics, result))
-        record.eta_roundoff = math.nan if unestimated else roundoff_level(result)
+        record.eta_roundoff = roundoff_level(result)
         record.stop = _stop_reason(record, options)
         last = bool(record.stop)
         marked = next_mesh = None

@@ -369,9 +369,7 @@ def level_record(level: int, result: ContactResult, est: Estimate | None) -> Lev
     :class:`FaceContactRecord`."""
     if est is None:
         est = _NO_ESTIMATE
-    # the node classes of Section 4 on faces; not built for 3D pairs (the mortar side)
-    has_classes = result.contact.size > 0 and not (result.mesh.dim == 3 and result.problem.pairs)
-    classes = result.classes if has_classes else np.zeros(0, dtype=np.int64)
+    classes = result.classes if result.contact.size else np.zeros(0, dtype=np.int64)
     report = result.report
     elasticity = result.mesh.dim == 3 and not result.contact.size
     three = result.mesh.dim == 3
