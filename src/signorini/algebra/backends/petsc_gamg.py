@@ -134,6 +134,7 @@ class GamgSolver(PetscRows):
 
     backend = "petsc-gamg"
     reuses_analysis = True
+    takes_guess = True
 
     def __init__(
         self,
@@ -163,6 +164,7 @@ class GamgSolver(PetscRows):
         self._data: np.ndarray | None = None
         self._norm = self._x_norm = 0.0
         self._last: tuple[np.ndarray, np.ndarray] | None = None  # the last solve's b and x
+        self._guess: np.ndarray | None = None  # the next solve's first iterate (start_from)
         super().__init__(A, check_symmetry=check_symmetry, ordering=ordering)
 
     def _whole_rows(self, n: int) -> tuple[int, int]:
@@ -274,9 +276,27 @@ class GamgSolver(PetscRows):
             self._caller_order(self._all.getArray(), out[:, k])
         return out
 
+    def start_from(self, x: np.ndarray) -> None:
+        """Start the next solve (of one right-hand side) from ``x (n,)``, whole on every
+        process (the active set methods hand over the previous step's solution, the warm
+        start in the first; docs/method.md, *Three dimensions: warm-started CG*). CG's
+        stopping test stays relative to ‖b‖, so the answer is as accurate as from zero.
+
+        Raises
+        ------
+        ValueError
+            For an ``x`` of the wrong shape or with non-finite entries.
+        """
+        x = np.array(x, dtype=np.float64)
+        if x.shape != (self.n,) or not np.isfinite(x).all():
+            raise ValueError(f"x must be a finite ({self.n},) array, got shape {x.shape}")
+        self._guess = x
+
     def _solve(self, b: np.ndarray) -> np.ndarray:
         columns = b.reshape(b.shape[0], -1)
         x = np.empty_like(columns)
+        guess, self._guess = self._guess, None
+        guess = guess if self._everywhere(guess is not None and columns.shape[1] == 1) else None
         # the round-off floor: a residual at eps ‖A‖∞ ‖x‖₂ (x the last solution) is as
         # small as the product A x can tell
         atol = EPS * self._norm * self._x_norm
@@ -286,11 +306,13 @@ class GamgSolver(PetscRows):
             # the same system again (a confirming solve, .inexact): from its last solution
             last = self._last
             again = self._everywhere(last is not None and np.array_equal(columns[:, j], last[0]))
-            if again:
+            if guess is not None:
+                self._x.setArray(self._local_entries(guess))
+            elif again:
                 self._x.setArray(self._local_entries(last[1]))
             else:
                 self._x.set(0.0)
-            self._ksp.setInitialGuessNonzero(again)
+            self._ksp.setInitialGuessNonzero(guess is not None or again)
             self._ksp.solve(self._b, self._x)
             reason = int(self._ksp.getConvergedReason())
             its = int(self._ksp.getIterationNumber())
