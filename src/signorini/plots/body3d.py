@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 from numpy.typing import ArrayLike
 
 from ..output.vtu import von_mises
@@ -213,14 +214,21 @@ def plot_body_3d(
         drawn = np.vstack([corners.reshape(-1, 3), *squares])
         low, high = drawn.min(axis=0), drawn.max(axis=0)
     ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), zlim=(low[2], high[2]))
-    ax.set(xlabel="x", ylabel="y", zlabel="z")
-    ax.set_box_aspect(np.maximum(high - low, 1e-3 * (high - low).max()))
+    for name, axis in (("x", ax.xaxis), ("y", ax.yaxis), ("z", ax.zaxis)):
+        axis.set_label_text(name)
+        axis.labelpad = 8  # clear of the tick labels, which mplot3d sets close to the axis
+    box = np.maximum(high - low, 1e-3 * (high - low).max())
+    ax.set_box_aspect(box)
+    for axis, length in zip((ax.xaxis, ax.yaxis, ax.zaxis), box / box.max(), strict=True):
+        # fewer ticks on a short axis: labels along a foreshortened axis would overlap
+        axis.set_major_locator(MaxNLocator(nbins=max(2, round(4 * float(length))), prune=None))
     ax.view_init(*VIEW)
     fig.colorbar(cm.ScalarMappable(norm, "viridis"), ax=ax, shrink=0.7, label="von Mises")
     head = f"{title}: " if title else ""
     obstacle = ", the plane where the drawn body touches it" if squares else ""
     text = f"{head}deformed body, displacement × {scale:g}{obstacle}"
-    ax.set_title(fit_title(text, fig) + (f"\n{note}" if note else ""))
+    # the axes sit left of the colour bar: a title centred on them may use 70 % of the width
+    ax.set_title(fit_title(text, fig, share=0.7) + (f"\n{note}" if note else ""))
     return save_figure(fig, path)
 
 

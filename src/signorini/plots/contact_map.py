@@ -161,11 +161,13 @@ def plot_contact_map(
 
 
 def _plane_note(axes: np.ndarray, labels: list[str]) -> str:
-    """The title's note of the projection plane's axes, e.g. ``, s₁ = (0.71, 0, 0.71)``."""
+    """The title's line of the projection plane's axes, e.g. ``s₁ = (0.71, 0, 0.71)``: the
+    components to two decimals (a component below 0.005 shown as 0), on a line of its own
+    (mathtext is not wrapped)."""
     if labels[0] != r"$s_1$":
         return ""
     parts = [
-        f"{label} = ({', '.join(f'{v:.2g}' for v in a)})"
-        for label, a in zip(labels, axes, strict=True)
+        f"{label} = ({', '.join(f'{v:.2f}'.rstrip('0').rstrip('.') for v in a + 0.0)})"
+        for label, a in zip(labels, np.where(np.abs(axes) < 5e-3, 0.0, axes), strict=True)
     ]
-    return ", " + ", ".join(parts)
+    return "\n" + ", ".join(parts)

@@ -18,7 +18,7 @@ from matplotlib.tri import Triangulation
 from numpy.typing import ArrayLike
 
 from .contact_map import MESH_ALPHA, contact_window, plane_axes
-from .style import RC, fit_title, new_figure, save_figure
+from .style import RC, fit_title, new_figure, save_figure, trim_height
 
 __all__ = ["STATE_COLOURS", "plot_slip_map"]
 
@@ -110,5 +110,6 @@ def plot_slip_map(
         fig.legend(loc="outside lower center", ncols=3, fontsize=6)
         head = f"{title}: " if title else ""
         ax.set_title(fit_title(f"{head}stick and slip over $\\Gamma_C$", fig))
+        trim_height(fig)  # the equal-aspect window leaves no empty band above or below
         written = save_figure(fig, path)
     return written, {"uv": uv, "state": code, "slip": slip, "arrows": arrows}
