@@ -221,3 +221,23 @@ def test_pdas_through_amg_gives_the_direct_active_set():
     assert np.array_equal(result.active, exact.active) and exact.active.sum() >= 5
     assert result.kkt.max <= KKT_RTOL
     assert np.linalg.norm(result.x - exact.x) <= 1e-6 * np.linalg.norm(exact.x)
+
+
+def test_the_automatic_choice_takes_amg_for_large_3d_systems_but_not_for_pairs():
+    """``"auto"``: a symmetric 3D system of AMG_FROM_3D unknowns or more on CG + AMG, one
+    just below, a 2D one, a non-symmetric one and one that couples bodies through contact
+    pairs (whatever its size) on a direct factorization."""
+    from signorini.algebra.backends.selection import AMG_FROM_3D, auto_solver
+
+    def backend(**request) -> str:
+        made = auto_solver(SolverRequest(**request))
+        made.close()
+        return made.backend
+
+    assert backend(dimension=3, size=AMG_FROM_3D) == "amg"
+    direct = {"pardiso", "scipy"}
+    assert backend(dimension=3, size=AMG_FROM_3D - 1) in direct
+    assert backend(dimension=2, size=10 * AMG_FROM_3D) in direct
+    assert backend(dimension=3, size=AMG_FROM_3D, symmetric=False) in direct | {"pardiso-lu"}
+    assert backend(dimension=3, size=10 * AMG_FROM_3D, coupled=True) in direct
+    assert not SolverRequest(dimension=3, size=10**7, coupled=True).multigrid_from(1)

@@ -145,6 +145,11 @@ class ContactSet:
         """Whether some constraint has a friction law."""
         return self.friction.any
 
+    @property
+    def couples_bodies(self) -> bool:
+        """Whether the constraints couple bodies (contact pairs' mortar transfer)."""
+        return self.transfer is not None
+
     @cached_property
     def tangent(self) -> np.ndarray:
         """``(k, 1, 2)`` an orthonormal basis of the tangent space of each constraint, beside

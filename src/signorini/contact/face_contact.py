@@ -120,6 +120,9 @@ class FaceContactSet:
         """Whether some row has a friction law."""
         return self.friction is not None and self.friction.laws.any
 
+    #: rigid obstacles only: no bodies coupled (:class:`~.mortar3d_set.MortarFaceSet`)
+    couples_bodies = False
+
     @property
     def operator(self) -> sp.csr_matrix:
         """``Q P (n_dofs, n_dofs)``: ``u = Q P ỹ`` from the solver's variables (frames, then

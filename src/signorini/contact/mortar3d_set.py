@@ -114,6 +114,7 @@ class MortarFaceSet:
     # what the solve reads of a contact set (``transfer``: the 2D pairs' change of basis)
     has_friction = False
     transfer = None
+    couples_bodies = True  # the constraints couple the pair's bodies
 
     @property
     def n_rows(self) -> int:

@@ -138,6 +138,7 @@ def ordered_solver(
     check_symmetry: bool = True,
     ordering: Callable[[], np.ndarray] | None = None,
     rigid_modes: Callable[[], np.ndarray] | None = None,
+    coupled: bool = False,
 ) -> AbstractContextManager[SPDSolver]:
     """The solver of ``space``'s systems, as a context manager.
 
@@ -159,6 +160,9 @@ def ordered_solver(
         The rigid motions in the system's unknowns, offered to the factory
         (:attr:`~signorini.algebra.SolverRequest.rigid_modes`; an algebraic multigrid's
         near-nullspace, :func:`~.rigid_modes.system_rigid_modes`).
+    coupled : bool
+        Whether the system couples bodies through contact pairs (the automatic choice then
+        stays direct, :attr:`~signorini.algebra.SolverRequest.coupled`).
     """
     if isinstance(solver, SPDSolver):
         return nullcontext(solver)
@@ -170,6 +174,7 @@ def ordered_solver(
         rigid_modes=rigid_modes,
         dimension=space.mesh.dim,
         size=space.n_dofs,
+        coupled=coupled,
     )
 
 
@@ -218,4 +223,5 @@ class SolverAhead:
             rigid_modes=request.rigid_modes,
             dimension=request.dimension,
             size=request.size,
+            coupled=request.coupled,
         )

@@ -439,7 +439,7 @@ def _solve_system(
     # the assembled matrix is symmetric by construction: skip the solver's symmetry check
     with ordered_solver(
         assembled.space, solver, check_symmetry=False, ordering=assembled.ordering,
-        rigid_modes=lambda: system_rigid_modes(assembled),
+        rigid_modes=lambda: system_rigid_modes(assembled), coupled=cs.couples_bodies,
     ) as linear:  # fmt: skip
         res = solve_pdas(
             K, F, cs.constrained_dofs, cs.gap, assembled.dirichlet, assembled.dirichlet_values,

@@ -51,6 +51,11 @@ class SolverRequest:
     size : int
         The number of unknowns, 0 when not known: :func:`~.selection.auto_solver` chooses
         by it in 3D (docs/method.md, *Three dimensions: the linear solver (measured)*).
+    coupled : bool
+        True: the system couples bodies through contact pairs (the dual mortar change of
+        basis). The automatic choices then keep a direct factorization at every size: CG +
+        smoothed aggregation failed to converge on an adaptive two-spheres level of 2.5·10⁵
+        unknowns (docs/method.md, *Two bodies in three dimensions: the estimator*).
     """
 
     symmetric: bool = True
@@ -59,12 +64,14 @@ class SolverRequest:
     rigid_modes: Callable[[], np.ndarray] | None = None
     dimension: int = 2
     size: int = 0
+    coupled: bool = False
 
     def multigrid_from(self, size: int) -> bool:
         """Whether a backend that takes an algebraic multigrid for symmetric 3D systems of
         ``size`` unknowns or more (its crossover with a direct factorization, measured:
-        :data:`~.selection.AMG_FROM_3D`, :data:`~.petsc.GAMG_FROM_3D`) takes it for these."""
-        return self.dimension == 3 and self.symmetric and self.size >= size
+        :data:`~.selection.AMG_FROM_3D`, :data:`~.petsc.GAMG_FROM_3D`) takes it for these;
+        never for :attr:`coupled` systems."""
+        return self.dimension == 3 and self.symmetric and self.size >= size and not self.coupled
 
 
 class SolverFactory(Protocol):

@@ -188,6 +188,7 @@ def make_solver(
     rigid_modes: Callable[[], np.ndarray] | None = None,
     dimension: int = 2,
     size: int = 0,
+    coupled: bool = False,
 ) -> SPDSolver:
     """A new solver from a factory, for symmetric positive definite or general matrices.
 
@@ -210,6 +211,9 @@ def make_solver(
         them (``"petsc-gamg"`` does).
     dimension, size : int
         The problem's dimension and number of unknowns (:class:`~.solvers.SolverRequest`).
+    coupled : bool
+        Whether the system couples bodies through contact pairs
+        (:attr:`~.requests.SolverRequest.coupled`).
 
     Returns
     -------
@@ -238,6 +242,7 @@ def make_solver(
         rigid_modes=rigid_modes,
         dimension=int(dimension),
         size=int(size),
+        coupled=bool(coupled),
     )
     made = factory(request)
     if not isinstance(made, SPDSolver):
