@@ -151,26 +151,36 @@ def test_a_confirming_solve_starts_from_the_last_solution():
     assert np.linalg.norm(b - K @ x) <= 1e-11 * np.linalg.norm(b)
 
 
+def starts_from_the_iterate_it_is_handed(solver, K, b) -> None:
+    """``solver.start_from`` (a solver that takes a guess, set up on ``K``): from the solution
+    itself no CG iteration, from a perturbation of it fewer than from zero, the next solve
+    from zero again; the answers meet the tolerance; a guess of the wrong shape or not
+    finite refused by name."""
+    x = solver.solve(b)  # from zero
+    solver.start_from(x)
+    solver.solve(2.0 * b - b)  # the same b, not recognised as the last right-hand side
+    near = x * (1.0 + 1e-6 * np.random.default_rng(2).standard_normal(x.size))
+    solver.start_from(near)
+    y = solver.solve(b)
+    solver.solve(b[::-1].copy())  # from zero
+    cold, again, warm, cold2 = solver.iterations
+    assert again == 0 and warm < cold / 2 and cold2 > warm
+    with pytest.raises(ValueError, match=rf"x must be a finite \({x.size},\) array"):
+        solver.start_from(x[:-1])
+    with pytest.raises(ValueError, match="x must be a finite"):
+        solver.start_from(np.full_like(x, np.nan))
+    assert np.linalg.norm(b - K @ y) <= 1e-8 * np.linalg.norm(b)
+
+
 def test_a_solve_starts_from_the_iterate_it_is_handed():
-    """:meth:`AmgSolver.start_from`: from the solution itself no CG iteration, from a
-    perturbation of it fewer than from zero, the next solve from zero again; the answers meet
-    the tolerance."""
+    """:meth:`AmgSolver.start_from` (:func:`starts_from_the_iterate_it_is_handed`); a direct
+    solver ignores a guess."""
     K, b, modes = clamped_2d()
     with AmgSolver(K, near_nullspace=modes) as solver:
-        x = solver.solve(b)  # from zero
-        solver.start_from(x)
-        solver.solve(2.0 * b - b)  # the same b, not recognised as the last right-hand side
-        near = x * (1.0 + 1e-6 * np.random.default_rng(2).standard_normal(x.size))
-        solver.start_from(near)
-        y = solver.solve(b)
-        solver.solve(b[::-1].copy())  # from zero
-        cold, again, warm, cold2 = solver.iterations
-        assert again == 0 and warm < cold / 2 and cold2 > warm
-        with pytest.raises(ValueError, match=r"x must be a finite \(1122,\) array"):
-            solver.start_from(x[:-1])
-        with pytest.raises(ValueError, match="x must be a finite"):
-            solver.start_from(np.full_like(x, np.nan))
-    assert np.linalg.norm(b - K @ y) <= 1e-8 * np.linalg.norm(b)
+        starts_from_the_iterate_it_is_handed(solver, K, b)
+    with make_solver(superlu_solver, K) as direct:
+        direct.start_from(np.zeros(3))  # ignored, whatever its shape
+        assert np.linalg.norm(b - K @ direct.solve(b)) <= 1e-12 * np.linalg.norm(b)
 
 
 def test_bad_input_is_refused():

@@ -197,27 +197,12 @@ def test_a_singular_system_is_refused():
 
 
 def test_a_solve_starts_from_the_iterate_it_is_handed():
-    """:meth:`GamgSolver.start_from`, as the amg backend's: from the solution itself no CG
-    iteration, from a perturbation of it fewer than from zero, the next solve from zero
-    again; the answers meet the tolerance; a guess of the wrong shape or not finite is
-    refused by name."""
+    """:meth:`GamgSolver.start_from`, as the amg backend's
+    (:func:`~tests.algebra.test_amg.starts_from_the_iterate_it_is_handed`)."""
     from signorini.algebra.backends.petsc_gamg import GamgSolver
 
-    from ..algebra.test_amg import clamped_2d
+    from ..algebra.test_amg import clamped_2d, starts_from_the_iterate_it_is_handed
 
     K, b, modes = clamped_2d()
     with GamgSolver(K, near_nullspace=lambda: modes) as solver:
-        x = solver.solve(b)  # from zero
-        solver.start_from(x)
-        solver.solve(2.0 * b - b)  # the same b, not recognised as the last right-hand side
-        near = x * (1.0 + 1e-6 * np.random.default_rng(2).standard_normal(x.size))
-        solver.start_from(near)
-        y = solver.solve(b)
-        solver.solve(b[::-1].copy())  # from zero
-        cold, again, warm, cold2 = solver.iterations
-        assert again == 0 and warm < cold / 2 and cold2 > warm
-        with pytest.raises(ValueError, match=r"x must be a finite \(1122,\) array"):
-            solver.start_from(x[:-1])
-        with pytest.raises(ValueError, match="x must be a finite"):
-            solver.start_from(np.full_like(x, np.nan))
-    assert np.linalg.norm(b - K @ y) <= 1e-8 * np.linalg.norm(b)
+        starts_from_the_iterate_it_is_handed(solver, K, b)

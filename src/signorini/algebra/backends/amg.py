@@ -260,19 +260,6 @@ class AmgSolver(SPDSolver):
         free = self._free
         return np.where(free, self._cycle(np.where(free, r, 0.0)), 0.0) + self._inverse_diagonal * r
 
-    def start_from(self, x: np.ndarray) -> None:
-        """Start the next solve (of one right-hand side) from ``x (n,)`` instead of zero.
-
-        Raises
-        ------
-        ValueError
-            For an ``x`` of the wrong shape or with non-finite entries.
-        """
-        x = np.array(x, dtype=np.float64)
-        if x.shape != (self.n,) or not np.isfinite(x).all():
-            raise ValueError(f"x must be a finite ({self.n},) array, got shape {x.shape}")
-        self._guess = x
-
     def _solve(self, b: np.ndarray) -> np.ndarray:
         columns = b.reshape(b.shape[0], -1)
         x = np.empty_like(columns)

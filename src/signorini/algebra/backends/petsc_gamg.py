@@ -276,22 +276,6 @@ class GamgSolver(PetscRows):
             self._caller_order(self._all.getArray(), out[:, k])
         return out
 
-    def start_from(self, x: np.ndarray) -> None:
-        """Start the next solve (of one right-hand side) from ``x (n,)``, whole on every
-        process (the active set methods hand over the previous step's solution, the warm
-        start in the first; docs/method.md, *Three dimensions: warm-started CG*). CG's
-        stopping test stays relative to ‖b‖, so the answer is as accurate as from zero.
-
-        Raises
-        ------
-        ValueError
-            For an ``x`` of the wrong shape or with non-finite entries.
-        """
-        x = np.array(x, dtype=np.float64)
-        if x.shape != (self.n,) or not np.isfinite(x).all():
-            raise ValueError(f"x must be a finite ({self.n},) array, got shape {x.shape}")
-        self._guess = x
-
     def _solve(self, b: np.ndarray) -> np.ndarray:
         columns = b.reshape(b.shape[0], -1)
         x = np.empty_like(columns)

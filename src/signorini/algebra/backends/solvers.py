@@ -269,8 +269,24 @@ class SPDSolver:
         self.n_solves += 1
         return x
 
-    def start_from(self, x: np.ndarray) -> None:  # noqa: B027 (a direct solver ignores it)
-        """Start the next solve from the iterate ``x (n,)`` (:attr:`takes_guess`)."""
+    def start_from(self, x: np.ndarray) -> None:
+        """Start the next solve (of one right-hand side) from the iterate ``x (n,)`` instead
+        of zero, where :attr:`takes_guess` (an iterative solver: the active set methods hand
+        over the previous step's solution, the warm start in the first step; docs/method.md,
+        *Three dimensions: warm-started CG*); a direct solver ignores it. The solve's
+        stopping test is unchanged, so its answer is as accurate as from zero.
+
+        Raises
+        ------
+        ValueError
+            For an ``x`` of the wrong shape or with non-finite entries (where it is taken).
+        """
+        if not self.takes_guess:
+            return
+        x = np.array(x, dtype=np.float64)
+        if x.shape != (self.n,) or not np.isfinite(x).all():
+            raise ValueError(f"x must be a finite ({self.n},) array, got shape {x.shape}")
+        self._guess = x
 
     def close(self) -> None:
         """Release the factorization (the object can factorize again afterwards)."""
