@@ -38,7 +38,7 @@ from .mortar3d import MortarCoupling3D
 from .mortar_checks import COVERAGE_TOL
 from .node_frames3d import frame_operator, held_frames, to_frames_3d
 
-__all__ = ["MortarFaceSet", "mortar_face_set"]
+__all__ = ["MortarFaceSet", "face_sides", "mortar_face_set"]
 
 _SIDES = np.array([[3, 0, 1], [4, 1, 2], [5, 2, 0]])
 
@@ -218,7 +218,7 @@ class MortarFaceSet:
         )
 
 
-def _sides(faces: np.ndarray) -> np.ndarray:
+def face_sides(faces: np.ndarray) -> np.ndarray:
     """The distinct sides ``(n_e, 3)`` (midpoint, start, end) of 6-node faces."""
     sides = faces[:, _SIDES].reshape(-1, 3)
     sides[:, 1:] = np.sort(sides[:, 1:], axis=1)
@@ -302,7 +302,7 @@ def mortar_face_set(space, couplings: Sequence[MortarCoupling3D], held: HeldNode
             "a slave node lies on two contact pairs or on a master part: give the pairs' parts "
             "no common node"
         )
-    edges = _sides(faces)
+    edges = face_sides(faces)
     held = _transformed_held(held, edges, alpha, points)
     found = [_rows(c, held, points, size) for c in couplings]  # a loop over pairs
     node = np.concatenate([c.slave_nodes[r] for c, r in zip(couplings, found, strict=True)])

@@ -24,16 +24,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..contact.mortar3d_set import MortarFaceSet
+from ..contact.mortar3d_set import MortarFaceSet, face_sides
 from ..contact.solution import ContactResult
 from ..fem.p2_tet import face_basis
 from .faces3d import TetStress, face_geometry
 from .terms import FacetSet, neumann_residual
 
 __all__ = ["master_faces", "master_tractions"]
-
-#: a 6-node face's sides as (midpoint, start, end)
-_SIDES = np.array([[3, 0, 1], [4, 1, 2], [5, 2, 0]])
 
 
 def master_faces(result: ContactResult) -> FacetSet:
@@ -54,9 +51,7 @@ def master_traction(result: ContactResult, faces: FacetSet, s: np.ndarray, w: np
     for rows, geometry in face_geometry(space, faces.nodes):  # flat, then quadratic
         integral[rows] = (geometry.speeds(s) * w) @ face_basis(s)
     weight = np.bincount(faces.nodes.ravel(), integral.ravel(), minlength=space.n_nodes)
-    sides = faces.nodes[:, _SIDES].reshape(-1, 3)
-    sides[:, 1:] = np.sort(sides[:, 1:], axis=1)
-    mid, a, b = np.unique(sides, axis=0).T
+    mid, a, b = face_sides(faces.nodes).T
     f_t, w_t = f.copy(), weight.copy()
     for value, out in ((f, f_t), (weight, w_t)):  # forces and integrals on the φ̃
         out[mid] = (1.0 - 2.0 * alpha) * value[mid]
@@ -72,13 +67,11 @@ def master_traction(result: ContactResult, faces: FacetSet, s: np.ndarray, w: np
 
 def master_tractions(
     result: ContactResult, stresses: TetStress, s: np.ndarray, w: np.ndarray
-) -> tuple[FacetSet, np.ndarray]:
+) -> tuple[FacetSet, np.ndarray] | None:
     """η3's master faces and ``‖σ(u_h) n − g_h‖²_F`` on each (in the stress unit), ``g_h``
-    the consistent master traction; no faces without pairs."""
+    the consistent master traction; None without pairs."""
     if not isinstance(result.contact, MortarFaceSet):
-        empty = np.zeros(0, dtype=np.int64)
-        return FacetSet(empty, np.zeros((0, 6), np.int64), np.zeros((0, 2), np.int64),
-                        np.zeros(0)), np.zeros(0)  # fmt: skip
+        return None
     faces = master_faces(result)
     g = master_traction(result, faces, s, w) / stresses.unit
     J = np.zeros(faces.index.size)

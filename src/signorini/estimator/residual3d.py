@@ -119,12 +119,10 @@ def estimate_3d(
     inner = _face_set(space, np.flatnonzero(mesh.facet2cell[:, 1] >= 0))
     J2 = _on_own_faces(inner, own, lambda faces: _jumps(space, stresses, faces, s, w))
     boundary, J3 = _traction_residuals(result, stresses, own)
-    master, J3_master = master_tractions(result, stresses, s, w)  # pairs: the master faces
-    if master.index.size:
-        boundary = FacetSet(
-            *(np.concatenate([a, b]) for a, b in zip(boundary, master, strict=True))
-        )
-        J3 = np.concatenate([J3, J3_master])
+    master = master_tractions(result, stresses, s, w)  # pairs: η3 on the master faces too
+    if master is not None:
+        boundary = FacetSet(*map(np.concatenate, zip(boundary, master[0], strict=True)))
+        J3 = np.concatenate([J3, master[1]])
     contact = contact_terms(result, stresses, eta5_variant, s, w, pressure)
     if own is not None:  # each integral from the one rank that owns it, summed over the ranks
         if contact is None:
