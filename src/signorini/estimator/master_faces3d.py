@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..contact.face_basis import FaceEdges
 from ..contact.mortar3d_set import MortarFaceSet, face_sides
 from ..contact.solution import ContactResult
 from ..fem.p2_tet import face_basis
@@ -45,23 +46,17 @@ def master_traction(result: ContactResult, faces: FacetSet, s: np.ndarray, w: np
     """``(n_m, q, 3)`` the consistent master traction ``g_h`` (module notes) at the points
     ``s`` of the master faces ``faces``."""
     cs, space = result.contact, result.space
-    alpha = cs.alpha
     f = cs.master_forces(result.contact_force, space.n_nodes)  # (n_nodes, 3)
     integral = np.zeros(faces.nodes.shape)
     for rows, geometry in face_geometry(space, faces.nodes):  # flat, then quadratic
         integral[rows] = (geometry.speeds(s) * w) @ face_basis(s)
     weight = np.bincount(faces.nodes.ravel(), integral.ravel(), minlength=space.n_nodes)
-    mid, a, b = face_sides(faces.nodes).T
-    f_t, w_t = f.copy(), weight.copy()
-    for value, out in ((f, f_t), (weight, w_t)):  # forces and integrals on the φ̃
-        out[mid] = (1.0 - 2.0 * alpha) * value[mid]
-        np.add.at(out, a, alpha * value[mid])
-        np.add.at(out, b, alpha * value[mid])
+    # the transformed basis on the master faces, the slave's α, over node numbers
+    edges = FaceEdges(space.n_nodes, cs.alpha, *face_sides(faces.nodes).T)
     on = np.unique(faces.nodes)
     g = np.zeros_like(f)
-    g[on] = f_t[on] / w_t[on, None]
-    nodal = g.copy()  # the P2 values of Σ g̃_k φ̃_k
-    nodal[mid] = (1.0 - 2.0 * alpha) * g[mid] + alpha * (g[a] + g[b])
+    g[on] = edges.transformed(f)[on] / edges.transformed(weight)[on, None]  # f̃ / w̃
+    nodal = edges.nodal(g)  # the P2 values of Σ g̃_k φ̃_k
     return np.einsum("qa,kac->kqc", face_basis(s), nodal[faces.nodes])
 
 
