@@ -1,12 +1,15 @@
 """Shared 3D contact problems of tests/contact3d: a rotation about no axis, the block
-pressed onto a half-space on two symmetry rollers (force control), and a mesh joined to its
-mirror image."""
+pressed onto a half-space on two symmetry rollers (force control), a mesh joined to its
+mirror image, and a problem's system with its contact made traction-free."""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
 from signorini.algebra.backends.selection import SOLVERS
+from signorini.contact.system import Assembled, assemble
 from signorini.fem.material import Material
 from signorini.mesh.builders3d import box
 from signorini.mesh.mesh import Mesh
@@ -68,3 +71,12 @@ def mirrored(mesh: Mesh, axis: int) -> tuple[Mesh, np.ndarray]:
         if curve is not None and name in parts:
             whole = whole.with_curve(name, curve)
     return whole, image
+
+
+def without_contact(problem: ContactProblem) -> Assembled:
+    """The assembled Cartesian system of ``problem`` with its contact parts and their
+    masters traction-free (an independent solve's K, F and held DOFs)."""
+    free = Neumann((0.0, 0.0, 0.0))
+    conditions = {k: free if isinstance(c, Contact) else c for k, c in problem.conditions.items()}
+    conditions |= dict.fromkeys(problem.pairs.values(), free)
+    return assemble(replace(problem, conditions=conditions), problem.mesh)

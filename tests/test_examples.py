@@ -225,6 +225,7 @@ def test_get_example():
         "stacked-cubes",
         "two-spheres",
         "partial-slip-3d",
+        "partial-slip-spheres",
     }
     for name in EXAMPLES:
         assert get_example(name).name == name

@@ -54,6 +54,17 @@ def solve_tresca(K, F, held, held_values, node, direction, psi, bound, reference
     B = np.zeros((3 * m, n))
     for k in range(3):  # the three rows of each node
         B[3 * np.arange(m)[:, None] + k, 3 * node[:, None] + np.arange(3)] = basis[:, k]
+    offset = np.stack([psi, np.sum(t1 * reference, 1), np.sum(t2 * reference, 1)], 1).ravel()
+    return solve_tresca_rows(K, F, held, held_values, B, offset, bound, basis, tol=tol)
+
+
+def solve_tresca_rows(K, F, held, held_values, B, offset, bound, basis, *, tol=1e-15):
+    """The Tresca problem of the module docstring with general rows: ``B (3m, n)`` the
+    normal and two tangential rows of each of m nodes (node-major), ``B u ≤ offset`` on the
+    normal rows, ``‖(B u − offset)_t‖`` weighted by ``bound (m,)`` on the tangential ones;
+    ``basis (m, 3, 3)`` the rows' unit directions ``[n; t_1; t_2]`` for the Cartesian
+    force."""
+    n, m = K.shape[0], bound.size
     free = np.setdiff1d(np.arange(n), held)
     Kd = K.toarray()
     b = F[free] - Kd[np.ix_(free, held)] @ held_values
@@ -61,8 +72,7 @@ def solve_tresca(K, F, held, held_values, node, direction, psi, bound, reference
     Bf = B[:, free]
     S = Bf @ la.cho_solve(factor, Bf.T)
     S = 0.5 * (S + S.T)
-    offset = np.stack([psi, np.sum(t1 * reference, 1), np.sum(t2 * reference, 1)], 1).ravel()
-    q = Bf @ la.cho_solve(factor, b) - offset
+    q = Bf @ la.cho_solve(factor, b) - (offset - B[:, held] @ held_values)
     step = 1.0 / np.linalg.eigvalsh(S)[-1]
 
     def project(lam):

@@ -4,12 +4,11 @@ slave; the coupled solution against a QP solved independently; bad input refused
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 import scipy.linalg as la
 import scipy.sparse as sp
+from contact3d_problems import without_contact
 from scipy.optimize import nnls
 
 from signorini import adaptive
@@ -20,7 +19,7 @@ from signorini.examples.two_bodies3d import cubes_metrics, cubes_pressure, stack
 from signorini.fem.material import Material
 from signorini.mesh.bodies import body_of_cells, union
 from signorini.mesh.builders3d import box
-from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError, Tresca
+from signorini.problem import Contact, ContactProblem, Dirichlet, Neumann, ProblemError
 from signorini.problem.obstacles3d import HalfSpace
 
 
@@ -90,11 +89,7 @@ def independent_solve(problem: ContactProblem):
     (``ũ`` the slave's transformed coefficients, written here from the slave faces), u_D
     held; its dual by NNLS on ``S = C_f K_ff⁻¹ C_fᵀ`` (dense Cholesky), then the positive
     multipliers solved once more for round-off accuracy."""
-    free_conditions = {
-        k: Neumann((0.0, 0.0, 0.0)) if isinstance(c, Contact) else c
-        for k, c in problem.conditions.items()
-    } | {master: Neumann((0.0, 0.0, 0.0)) for master in problem.pairs.values()}
-    plain = assemble(replace(problem, conditions=free_conditions), problem.mesh)
+    plain = without_contact(problem)
     space = plain.space
     c = mortar_coupling_3d(space, "upper.z0", "lower.z1")
     n = plain.K.shape[0]
@@ -163,11 +158,9 @@ def pair_problem(drop: tuple[str, ...] = (), **changes) -> ContactProblem:
 
 
 def test_bad_pairs_refused():
-    """Friction on a pair, a pair beside an obstacle part, condition (a), self contact, a
+    """A pair beside an obstacle part, condition (a), self contact, a
     slave wider than its master (large sliding), a body held only by the other: refused
     naming what."""
-    with pytest.raises(ProblemError, match="friction"):
-        pair_problem(**{"upper.z0": Contact(master="lower.z1", friction=Tresca(0.1))})
     with pytest.raises(ProblemError, match="no contact parts against obstacles"):
         pair_problem(**{"upper.x1": Contact(obstacle=HalfSpace((2.0, 0, 0), (1.0, 0, 0)))})
     with pytest.raises(ProblemError, match="face_alpha=0"):

@@ -140,6 +140,14 @@ class FaceContactSet:
         itself for condition (a))."""
         return self.edges.coefficients(self.psi)
 
+    def row_integrals(self, integral: np.ndarray) -> np.ndarray:
+        """``(k,)`` ``∫ f φ̃_z`` at the rows of the face-node integrals ``∫_F f φ_a (n_f,
+        6)``: summed per row (none at a held node), then in the transformed basis."""
+        local = self.facet_local
+        ok = local >= 0
+        w = np.bincount(local[ok], weights=np.asarray(integral)[ok], minlength=self.n_rows)
+        return self.edges.transformed(w)
+
     @property
     def transformed_integral(self) -> np.ndarray:
         """``(k,)`` ``w̃_z = ∫ φ̃_z = (T w)_z``: positive for 0 < α < 1/2."""

@@ -34,8 +34,9 @@ from .face_basis import FaceEdges, change_of_variables
 if TYPE_CHECKING:
     from ..fem.space3d import P2TetSpace
     from .face_contact import FaceContactSet
+    from .mortar3d_set import MortarFaceSet
 
-__all__ = ["FaceFriction", "face_friction"]
+__all__ = ["FaceFriction", "face_friction", "pair_friction"]
 
 
 class FaceFriction:
@@ -88,23 +89,54 @@ def face_friction(
         At a node with rows of two parts (a corner: friction there is not built), or if a
         law's nodal weights are not finite and ``≥ 0``.
     """
-    k = cs.n_rows
-    node, dof = cs.node, cs.dof
+    node = cs.node
     shared = np.flatnonzero(np.r_[False, node[1:] == node[:-1]])
     if shared.size:
         raise ProblemError(
             f"node {node[shared[0]]} carries rows of two contact parts (a corner): friction "
             "at such a node is not built in 3D; join the parts or make one frictionless"
         )
-    slot = dof % 3
-    tangent = 3 * node[:, None] + (slot[:, None] + np.array([1, 2])) % 3
-    held = np.isin(tangent, cs.held_dofs)
+    tangent, held = _tangential_dofs(cs)
     e = cs.edges
     # both slots on the same edges, those whose three nodes hold no tangential slot: the
     # slots of a held node are other directions than its neighbours' (docstring)
     free = ~held.any(axis=1)
     ok = free[e.mid] & free[e.start] & free[e.end]
-    edges = (FaceEdges(k, e.alpha, e.mid[ok], e.start[ok], e.end[ok]),) * 2
+    edges = (FaceEdges(cs.n_rows, e.alpha, e.mid[ok], e.start[ok], e.end[ok]),) * 2
+    return FaceFriction(_law_groups(space, cs, laws), tangent, held, edges)
+
+
+def pair_friction(
+    space: P2TetSpace, cs: MortarFaceSet, laws: Sequence[FrictionLaw | None]
+) -> FaceFriction:
+    """The friction data of the rows of contact pairs ``cs`` with ``laws[i]`` the law of its
+    pair ``i`` (docs/method.md, *Two bodies in three dimensions: friction*): the tangential
+    unknowns are the frame's relative slip, already in the transformed basis on every
+    component (:mod:`.mortar3d_set`), so no change of variables of their own; the weights
+    ``∫ s φ̃_j`` as on one body.
+
+    Raises
+    ------
+    ProblemError
+        If a law's nodal weights are not finite and ``≥ 0``.
+    """
+    tangent, held = _tangential_dofs(cs)
+    none = np.zeros(0, dtype=np.int64)
+    edges = (FaceEdges(cs.n_rows, cs.alpha, none, none, none),) * 2
+    return FaceFriction(_law_groups(space, cs, laws), tangent, held, edges)
+
+
+def _tangential_dofs(cs) -> tuple[np.ndarray, np.ndarray]:
+    """``(k, 2)`` the two frame DOFs of each row's node other than the row's own, and
+    whether a roller through the node holds each."""
+    tangent = 3 * cs.node[:, None] + (cs.dof[:, None] % 3 + np.array([1, 2])) % 3
+    return tangent, np.isin(tangent, cs.held_dofs)
+
+
+def _law_groups(space, cs, laws: Sequence[FrictionLaw | None]) -> LawGroups:
+    """Each row's law (index into the used ones, ``-1`` frictionless) and nodal weight
+    (:meth:`~signorini.algebra.friction.laws.FrictionLaw.nodal_weight`, checked)."""
+    k = cs.n_rows
     index = np.full(k, -1, dtype=np.int64)
     weight = np.zeros(k)
     used = []
@@ -120,7 +152,7 @@ def face_friction(
         index[mine] = len(used)
         weight[mine] = values[mine]
         used.append(law)
-    return FaceFriction(LawGroups(tuple(used), index, weight), tangent, held, edges)
+    return LawGroups(tuple(used), index, weight)
 
 
 #: a nodal weight ``∫ s φ_z`` within this many ulps of the largest weight of zero is the
@@ -165,9 +197,8 @@ def _integrator(space: P2TetSpace, cs: FaceContactSet, i: int):
             x = group.points(s)  # (j, q, 3)
             f = np.asarray(field(x.reshape(-1, 3)), dtype=np.float64).reshape(x.shape[:2])
             integral[rows] = (group.speeds(s) * wq * f) @ phi
-        local = cs.facet_local[on]
-        ok = local >= 0
-        w = np.bincount(local[ok], weights=integral[ok], minlength=cs.n_rows)
-        return cs.edges.transformed(w)
+        full = np.zeros(cs.faces.shape)
+        full[on] = integral
+        return cs.row_integrals(full)
 
     return integrate

@@ -76,7 +76,7 @@ def solve_frictional_3d(
         n_factorizations=res.iterations,
         history=[],
         kkt=res.kkt,
-        backend="superlu",
+        backend=res.backend,
         c_scale=float(np.mean(problem.qp.diagonal()[cs.dof])) if cs.n_rows else 1.0,
         times={"total": time.perf_counter() - t0},
         multiplier_n=res.normal_force,

@@ -12,12 +12,20 @@ the node's frame. The solver's variables y give the Cartesian displacement throu
     u = R y,   R = T_tᵀ (I + T_d) Q,
 
 ``Q`` the node frames (:func:`~.node_frames3d.held_frames`: the constraint direction, held
-axes), ``T_d`` the blocks ``n_j n_jᵀ T_jk`` from the master's DOFs to the constrained slave
+axes), ``T_d`` the blocks ``P_j T_jk`` from the master's DOFs to the constrained slave
 rows (``T_d² = 0``: no master node is a slave node), ``T_tᵀ`` the transformed basis on every
 side of the slave parts, all three components (``u_e = (1 − 2α) ũ_e + α (ũ_a + ũ_b)``). The
 system ``Rᵀ K R``, ``Rᵀ F`` is symmetric positive definite and its multiplier at row j is
 ``Λ̃_j``, the force on ``φ̃_j n_j``; the pressure is its dual-basis coefficient
 ``p_j = Λ̃_j / D_jj``, exact for a uniform pressure.
+
+``P_j`` is ``n_j n_jᵀ`` at a frictionless row: its tangential unknowns stay the slave's own.
+At a row with a friction law (docs/method.md, *Two bodies in three dimensions: friction*)
+``P_j = Q_j diag(1, f_1, f_2) Q_jᵀ`` keeps the relative displacement in every direction of
+the frame ``Q_j = [n t_1 t_2]`` but a held one (``f = 0`` on an axis a roller holds, whose
+slave component a roller holds as at an obstacle): the frame's tangential unknowns are the
+relative slip ``t·(ũ_j − Σ_k T_jk u_k)`` the disc law acts on, and their multipliers
+``Λ̃_t`` the friction forces on ``φ̃_j t``.
 """
 
 from __future__ import annotations
@@ -34,6 +42,7 @@ from ..problem.rollers import HeldNodes
 from .admissible import DEEP_OVERLAP
 from .face_contact import SAME_DIRECTION, row_weights
 from .face_fields import FaceFields
+from .face_friction import FaceFriction
 from .mortar3d import MortarCoupling3D
 from .mortar_checks import COVERAGE_TOL
 from .node_frames3d import frame_operator, held_frames, to_frames_3d
@@ -85,6 +94,11 @@ class MortarFaceSet:
     edges : (n_e, 3) int array
         The slave sides' nodes (midpoint, start, end) of the transformed basis.
     alpha : float
+    projection : (k, 3, 3) float array
+        ``P_j`` (module docstring): ``n_j n_jᵀ``, or with friction the frame's free axes.
+    friction : FaceFriction or None
+        The rows' friction laws and tangential frame DOFs (:func:`~.face_friction.pair_friction`;
+        its change of variables the identity: ``T_t`` already acts on every component).
     """
 
     n_dofs: int
@@ -110,17 +124,35 @@ class MortarFaceSet:
     hat_integral: np.ndarray
     edges: np.ndarray
     alpha: float
+    projection: np.ndarray
+    friction: FaceFriction | None = None
 
     # what the solve reads of a contact set (``transfer``: the 2D pairs' change of basis)
-    has_friction = False
     transfer = None
     couples_bodies = True  # the constraints couple the pair's bodies
+
+    @property
+    def has_friction(self) -> bool:
+        """Whether some row has a friction law."""
+        return self.friction is not None and self.friction.laws.any
 
     @property
     def n_rows(self) -> int:
         return self.node.size
 
     size = n_rows
+
+    def row_integrals(self, integral: np.ndarray) -> np.ndarray:
+        """``(k,)`` ``∫ f φ̃_j`` at the rows of the face-node integrals ``∫_F f φ_a (n_f, 6)``:
+        summed per node, then in the transformed basis over the slave sides (whose midpoints
+        and ends need not carry rows)."""
+        n_nodes = self.n_dofs // 3
+        w = np.bincount(self.faces.ravel(), weights=np.ravel(integral), minlength=n_nodes)
+        e, a, b = self.edges.T
+        np.add.at(w, a, self.alpha * w[e])
+        np.add.at(w, b, self.alpha * w[e])
+        w[e] *= 1.0 - 2.0 * self.alpha
+        return w[self.node]
 
     @property
     def constrained_dofs(self) -> np.ndarray:
@@ -164,8 +196,12 @@ class MortarFaceSet:
         frames."""
         u = np.asarray(u, dtype=np.float64)
         r = self.coefficients(u.reshape(-1, 3))
-        rel = np.einsum("kc,kc->k", self.node_transfer @ u.reshape(-1, 3), self.direction)
-        r[self.node] -= rel[:, None] * self.direction
+        moved = self.node_transfer @ u.reshape(-1, 3)  # Σ_k T_jk u_k
+        if self.friction is None:  # P_j = n_j n_jᵀ
+            rel = np.einsum("kc,kc->k", moved, self.direction)
+            r[self.node] -= rel[:, None] * self.direction
+        else:
+            r[self.node] -= np.einsum("kcd,kd->kc", self.projection, moved)
         return to_frames_3d(r.ravel(), self.frame_nodes, self.frames)
 
     def normal_displacement(self, u: np.ndarray) -> np.ndarray:
@@ -193,11 +229,28 @@ class MortarFaceSet:
         gap = self.relative_gap(np.asarray(u, dtype=np.float64).reshape(-1, 3))
         return np.where(self.facet_local >= 0, gap[np.maximum(self.facet_local, 0)], 0.0)
 
-    def master_forces(self, force: np.ndarray, n_nodes: int) -> np.ndarray:
-        """``(n_nodes, 3)`` the nodal forces the slave rows' ``Λ̃ (k,)`` exert on the
-        master, ``Σ_j T_jk Λ̃_j n_j`` (the slave receives ``−Λ̃_j n_j`` on φ̃_j, n_j pointing
-        towards the master): equal and opposite resultants where ``Σ_k M_jk = D_jj``."""
+    def row_forces(self, force: np.ndarray, tangential: np.ndarray | None = None) -> np.ndarray:
+        """``(k, 3)`` the Cartesian force of each row on the slave's ``φ̃_j``, ``Λ̃_j n_j``
+        plus, with friction, ``Σ_i Λ̃_t,ij t_i`` over the row's free tangents (``tangential
+        (k, 2)`` on :attr:`FaceFriction.tangent`), all as the solver's multipliers ``F − K u``
+        (the master pushes the slave along ``−n_j``)."""
         f = np.asarray(force, dtype=np.float64)[:, None] * self.direction
+        if tangential is not None and self.friction is not None:
+            frame = self.frames[np.searchsorted(self.frame_nodes, self.node)]
+            fr = self.friction
+            for i in range(2):  # the two tangential slots
+                t = frame[np.arange(self.n_rows), :, fr.tangent[:, i] % 3]
+                f = f + np.where(fr.held[:, i], 0.0, tangential[:, i])[:, None] * t
+        return f
+
+    def master_forces(
+        self, force: np.ndarray, n_nodes: int, tangential: np.ndarray | None = None
+    ) -> np.ndarray:
+        """``(n_nodes, 3)`` the nodal forces the slave rows' ``Λ̃ (k,)`` (and friction forces
+        ``tangential (k, 2)``) exert on the master, ``Σ_j T_jk f_j`` with ``f_j`` of
+        :meth:`row_forces` (the slave receives ``−f_j`` on φ̃_j, n_j pointing towards the
+        master): equal and opposite resultants where ``Σ_k M_jk = D_jj``."""
+        f = self.row_forces(force, tangential)
         out = np.zeros((n_nodes, 3))
         out[: self.node_transfer.shape[1]] = self.node_transfer.T @ f
         return out
@@ -279,8 +332,13 @@ def _rows(c: MortarCoupling3D, held: HeldNodes, points, size: float) -> np.ndarr
     return rows
 
 
-def mortar_face_set(space, couplings: Sequence[MortarCoupling3D], held: HeldNodes) -> MortarFaceSet:
-    """The contact set of the pairs ``couplings`` (one α) with the held nodes ``held``.
+def mortar_face_set(
+    space, couplings: Sequence[MortarCoupling3D], held: HeldNodes, frictional: Sequence[bool] = ()
+) -> MortarFaceSet:
+    """The contact set of the pairs ``couplings`` (one α) with the held nodes ``held``, the
+    rows of the pairs ``frictional[i]`` (none by default) with the relative displacement in
+    every free direction (module docstring; the laws themselves:
+    :func:`~.face_friction.pair_friction`).
 
     Raises
     ------
@@ -316,7 +374,8 @@ def mortar_face_set(space, couplings: Sequence[MortarCoupling3D], held: HeldNode
     T = sp.csr_matrix(T)[order]
     pole = np.argmax(np.abs(direction), axis=1)
     frames = held_frames(points, node, direction, pole, held)
-    R = _operator(n_dofs, (node, direction, T), edges, alpha, frames)
+    projection = _projections(node, direction, np.isin(part, np.flatnonzero(frictional)), frames)
+    R = _operator(n_dofs, (node, projection, T), edges, alpha, frames)
     row_of = np.full(space.n_nodes, -1)
     row_of[node] = np.arange(node.size)
     normal = np.zeros((space.n_nodes, 3))
@@ -331,15 +390,28 @@ def mortar_face_set(space, couplings: Sequence[MortarCoupling3D], held: HeldNode
         frames=frames.frames, held_dofs=frames.held_dofs, held_values=frames.held_values,
         roller_dof=frames.roller_dof, operator=R, node_transfer=T, faces=faces,
         face_part=face_part, facet_local=row_of[faces], facet_direction=normal[faces],
-        hat_integral=hat, edges=edges, alpha=alpha,
+        hat_integral=hat, edges=edges, alpha=alpha, projection=projection,
     )  # fmt: skip
 
 
+def _projections(node, direction, frictional, frames) -> np.ndarray:
+    """``P_j (k, 3, 3)`` (module docstring): ``n_j n_jᵀ``, or at a ``frictional (k,)`` row
+    ``Q_j diag(1, f_1, f_2) Q_jᵀ`` with ``f = 0`` on the axes the frame holds."""
+    plain = direction[:, :, None] * direction[:, None, :]
+    if not frictional.any():
+        return plain
+    Q = frames.frames[np.searchsorted(frames.frame_nodes, node)]  # (k, 3, 3) columns
+    dofs = 3 * node[:, None] + np.arange(3)
+    keep = ~np.isin(dofs, frames.held_dofs)
+    full = np.einsum("kci,ki,kdi->kcd", Q, keep.astype(np.float64), Q)
+    return np.where(frictional[:, None, None], full, plain)
+
+
 def _operator(n_dofs: int, rows: tuple, edges: np.ndarray, alpha: float, frames) -> sp.csr_matrix:
-    """``R = T_tᵀ (I + T_d) Q`` (module docstring) of the rows ``(node, direction, T)``."""
-    node, n, T = rows
+    """``R = T_tᵀ (I + T_d) Q`` (module docstring) of the rows ``(node, projection, T)``."""
+    node, projection, T = rows
     coo = sp.coo_matrix(T)
-    block = coo.data[:, None, None] * (n[:, :, None] * n[:, None, :])[coo.row]  # (nnz, 3, 3)
+    block = coo.data[:, None, None] * projection[coo.row]  # (nnz, 3, 3)
     r = node_dofs(node[coo.row], 3)[:, :, None]
     c = node_dofs(coo.col, 3)[:, None, :]
     r, c = np.broadcast_arrays(r, c)

@@ -46,7 +46,7 @@ from .contact_set import _empty
 from .discrete_conditions import DiscreteConditions
 from .face_basis import DEFAULT_ALPHA
 from .face_contact import FaceContactSet, face_contact_set
-from .face_friction import face_friction
+from .face_friction import face_friction, pair_friction
 from .mortar3d import mortar_coupling_3d
 from .mortar3d_set import MortarFaceSet, mortar_face_set
 from .node_frames3d import held_frames, rotate_frames_3d
@@ -251,7 +251,10 @@ def _face_contact(
             mortar_coupling_3d(space, slave, master, alpha=alpha)
             for slave, master in problem.pairs.items()
         ]  # a loop over pairs
-        return mortar_face_set(space, couplings, conditions.held)
+        laws = [contact[slave].friction for slave in problem.pairs]
+        frictional = [law is not None for law in laws]
+        ms = mortar_face_set(space, couplings, conditions.held, frictional)
+        return replace(ms, friction=pair_friction(space, ms, laws)) if any(frictional) else ms
     cs = face_contact_set(space, contact, conditions.held, alpha=alpha)
     laws = [contact[name].friction for name in contact]
     if any(law is not None for law in laws):  # docs/method.md, *Friction in three dimensions*

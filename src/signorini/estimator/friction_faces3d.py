@@ -27,6 +27,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..contact.face_basis import FaceEdges
+from ..contact.mortar3d_set import MortarFaceSet
 from ..contact.solution import ContactResult
 from ..fem.p2_tet import face_basis
 from ..fem.quadrature import triangle_rule
@@ -63,38 +65,63 @@ class FrictionFaces(NamedTuple):
 
 def friction_faces(result: ContactResult, unit: float = 1.0) -> FrictionFaces | None:
     """The nodal inputs of η4 and η8 on the contact faces of a 3D frictional result
-    (module docstring), stresses divided by ``unit``; ``None`` without friction."""
+    (module docstring; :func:`_pair_inputs` for the rows of pairs), stresses divided by
+    ``unit``; ``None`` without friction."""
     cs = result.contact
     if not cs.has_friction:
         return None
-    fr, n_dofs = cs.friction, result.u.size
+    fr = cs.friction
     rows = cs.facet_local
     inside = rows >= 0
     row = np.maximum(rows, 0)
     frame = cs.frames[np.searchsorted(cs.frame_nodes, cs.node)]  # (k, 3, 3) [n t_1 t_2]
     t = np.stack([frame[np.arange(cs.n_rows), :, fr.tangent[:, j] % 3] for j in range(2)], 1)
     free = ~fr.held
-
-    def stress(force: np.ndarray) -> np.ndarray:  # Λ̃ (k,) to a nodal stress
-        return np.nan_to_num(consistent_pressure(result, cs.edges.untransformed(force)))
-
     force_t = np.where(free, result.tangential_force, 0.0)
-    p = sum(stress(force_t[:, j])[:, None] * t[:, j] for j in range(2))  # (k, 3)
-    normal = cs.edges.transformed(result.contact_force)  # Λ̃_n, the solver's
-    bound = stress(fr.laws.slip_bound(normal, result.active))
-    z = np.zeros(n_dofs)
-    z[fr.tangent[free]] = result.tangential_reference[free]
-    reference = (fr.change_of_variables(n_dofs) @ z)[fr.tangent] * free  # nodal values
-    ref = np.einsum("kj,kjc->kc", reference, t)
-    u = np.asarray(result.u, dtype=np.float64)[cs.faces]  # (n_f, 6, 3)
-    n = cs.facet_direction
-    slip = u - np.einsum("fjc,fjc->fj", u, n)[..., None] * n
-    slip = slip - np.where(inside[..., None], ref[row], 0.0)
+    if isinstance(cs, MortarFaceSet):
+        p, bound, slip = _pair_inputs(result, force_t, t)
+    else:
+
+        def stress(force: np.ndarray) -> np.ndarray:  # Λ̃ (k,) to a nodal stress
+            return np.nan_to_num(consistent_pressure(result, cs.edges.untransformed(force)))
+
+        p = sum(stress(force_t[:, j])[:, None] * t[:, j] for j in range(2))  # (k, 3)
+        normal = cs.edges.transformed(result.contact_force)  # Λ̃_n, the solver's
+        bound = stress(fr.laws.slip_bound(normal, result.active))
+        n_dofs = result.u.size
+        z = np.zeros(n_dofs)
+        z[fr.tangent[free]] = result.tangential_reference[free]
+        reference = (fr.change_of_variables(n_dofs) @ z)[fr.tangent] * free  # nodal values
+        ref = np.einsum("kj,kjc->kc", reference, t)
+        u = np.asarray(result.u, dtype=np.float64)[cs.faces]  # (n_f, 6, 3)
+        n = cs.facet_direction
+        slip = u - np.einsum("fjc,fjc->fj", u, n)[..., None] * n
+        slip = slip - np.where(inside[..., None], ref[row], 0.0)
     return FrictionFaces(
         friction=np.where(inside[..., None], p[row], 0.0) / unit,
         bound=np.where(inside, np.maximum(bound, 0.0)[row], 0.0) / unit,
         slip=slip,
     )
+
+
+def _pair_inputs(result: ContactResult, force_t: np.ndarray, t: np.ndarray):
+    """``p_t (k, 3)``, ``b (k,)`` and the slip ``(n_f, 6, 3)`` of the rows of pairs
+    (docs/method.md, *Two bodies in three dimensions: friction*): the dual basis's
+    coefficients ``p_j = Λ̃_t,j / D_jj`` along the tangents ``t (k, 2, 3)`` and ``b_j =
+    s_j / D_jj`` (Tresca ``s``, Coulomb ``F p_j``); the slip the relative one, the rows'
+    unknowns ``t·(ũ_j − Σ_k T_jk u_k)`` less the reference as coefficients of the
+    transformed basis, at the slave faces' nodes (0 at nodes without rows)."""
+    cs = result.contact
+    fr = cs.friction
+    p = np.einsum("kj,kjc->kc", force_t / cs.basis_integral[:, None], t)
+    bound = cs.pressure(fr.laws.slip_bound(result.contact_force, result.active))
+    y = cs.unknowns(np.asarray(result.u, dtype=np.float64).ravel())
+    relative = np.where(fr.held, 0.0, y[fr.tangent] - result.tangential_reference)
+    n_nodes = result.u.size // 3
+    coefficients = np.zeros((n_nodes, 3))
+    coefficients[cs.node] = np.einsum("kj,kjc->kc", relative, t)
+    nodal = FaceEdges(n_nodes, cs.alpha, *cs.edges.T).nodal(coefficients)
+    return p, bound, nodal[cs.faces]
 
 
 def consistent_pressure(result: ContactResult, force: np.ndarray) -> np.ndarray:

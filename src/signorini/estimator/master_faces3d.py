@@ -4,7 +4,8 @@ estimator*).
 
 A master part has no condition of its own: its traction is the one the slave exerts through
 the pair. The slave rows' multipliers reach the master nodes as forces on the master's P2
-functions, ``f_k = Σ_j T_jk Λ̃_j n_j``
+functions, ``f_k = Σ_j T_jk Λ̃_j n_j`` (with friction ``+ Σ_j T_jk Λ̃_t,j``, the friction
+forces along the rows' tangents: *Two bodies in three dimensions: friction*)
 (:meth:`~signorini.contact.mortar3d_set.MortarFaceSet.master_forces`). In 2D the master
 traction is ``g_k = f_k / ∫ φ_k`` (:mod:`.pairs`); on faces the P2 vertex functions integrate
 to zero, so the division is made in the transformed basis of the slave's condition (b) on the
@@ -46,7 +47,8 @@ def master_traction(result: ContactResult, faces: FacetSet, s: np.ndarray, w: np
     """``(n_m, q, 3)`` the consistent master traction ``g_h`` (module notes) at the points
     ``s`` of the master faces ``faces``."""
     cs, space = result.contact, result.space
-    f = cs.master_forces(result.contact_force, space.n_nodes)  # (n_nodes, 3)
+    friction = result.tangential_force if cs.has_friction else None
+    f = cs.master_forces(result.contact_force, space.n_nodes, friction)  # (n_nodes, 3)
     integral = np.zeros(faces.nodes.shape)
     for rows, geometry in face_geometry(space, faces.nodes):  # flat, then quadratic
         integral[rows] = (geometry.speeds(s) * w) @ face_basis(s)

@@ -39,6 +39,7 @@ from .paper3d import EXAMPLE_6_1_3D_METRICS, example_6_1_3d, example_6_2_3d
 from .paper_friction import example_6_2_coulomb, example_6_2_tresca
 from .partial_slip import PARTIAL_SLIP_METRICS, partial_slip, partial_slip_path
 from .partial_slip3d import PARTIAL_SLIP_3D_METRICS, partial_slip_3d, partial_slip_3d_path
+from .partial_slip_spheres3d import partial_slip_spheres, partial_slip_spheres_path
 from .punch import punch
 from .punch3d import punch_3d
 from .two_bodies import BLOCKS_METRICS, CYLINDERS_METRICS, hertz_pair, stacked_blocks, two_cylinders
@@ -130,6 +131,12 @@ EXAMPLES: dict[str, Example] = {
         Example("stacked-cubes", stacked_cubes, metrics=CUBES_METRICS),
         Example("two-spheres", two_spheres, metrics=SPHERES_METRICS),
         Example("partial-slip-3d", partial_slip_3d, PARTIAL_SLIP_3D_METRICS, partial_slip_3d_path),
+        Example(
+            "partial-slip-spheres",
+            partial_slip_spheres,
+            PARTIAL_SLIP_3D_METRICS,
+            partial_slip_spheres_path,
+        ),  # fmt: skip
     )
 }
 

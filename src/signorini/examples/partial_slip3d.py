@@ -32,6 +32,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..contact.mortar3d_set import MortarFaceSet
 from ..contact.solution import SLIP, STICK, ContactResult
 from ..fem.material import Material
 from ..mesh.mesh import Mesh
@@ -128,20 +129,19 @@ def partial_slip_3d_metrics(
         "slip_nodes": float((result.state == SLIP).sum()),
     }
     cs = result.contact
-    lam_n = result.contact_force
-    total = float(lam_n.sum())
+    total = float(result.contact_force.sum())
     if not total > 0:
         return dict.fromkeys(keys, float("nan")) | counts
-    coefficient = result.problem.conditions["sphere"].friction.coefficient
+    coefficient = result.problem.conditions[cs.parts[0]].friction.coefficient
     x = result.space.node_points[cs.node]
     r2 = x[:, 0] ** 2 + x[:, 1] ** 2
-    a2 = 2.5 * float(lam_n @ r2) / total
+    normal, w, moment = _normal_rows(result, r2)
+    a2 = 2.5 * moment / total
     pull = float(_friction_forces(result).sum(0)[:2] @ np.asarray(direction, dtype=float))
     ratio = pull / (coefficient * total)
     stick = result.state == STICK
-    w = cs.transformed_integral
     c2_area = 2.0 * float(w[stick].sum()) / np.pi
-    c2, slope = _deficit_zero(result, coefficient, r2, a2, stick)
+    c2, slope = _deficit_zero(result, coefficient, (r2, a2), (normal, w), stick)
     return {
         "a": float(np.sqrt(a2)),
         "c_over_a": float(np.sqrt(max(c2, 0.0) / a2)) if np.isfinite(c2) else float("nan"),
@@ -170,20 +170,35 @@ def _unheld_force(result: ContactResult) -> np.ndarray:
     return np.where(result.contact.friction.held, 0.0, result.tangential_force)
 
 
+def _normal_rows(result: ContactResult, r2: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """The rows' normal forces on the transformed functions ``Λ̃_n``, their weights ``w̃_z =
+    ∫ φ̃_z`` and ``∫ λ_h r²`` (``r2 (k,)`` at the rows' nodes): of one body ``T Λ``,
+    ``T w`` and ``Σ Λ_z r_z²`` (``Λ`` on the P2 functions); of pairs (docs/method.md, *Two
+    bodies in three dimensions: friction*) the multipliers themselves, ``D_jj`` and
+    ``Σ Λ̃_j r̃²_j`` with ``r̃²`` the coefficients of r²'s interpolant in the transformed basis
+    (:func:`~.two_spheres3d.two_spheres_contact`)."""
+    cs, force = result.contact, result.contact_force
+    if isinstance(cs, MortarFaceSet):
+        x = result.space.node_points
+        r2_all = np.repeat(np.sum(x[:, :2] ** 2, axis=1)[:, None], 3, axis=1)
+        return force, cs.basis_integral, float(force @ cs.coefficients(r2_all)[cs.node, 0])
+    return cs.edges.transformed(force), cs.transformed_integral, float(force @ r2)
+
+
 def _deficit_zero(
-    result: ContactResult, coefficient: float, r2: np.ndarray, a2: float, stick: np.ndarray
+    result: ContactResult, coefficient: float, radii, rows, stick: np.ndarray
 ) -> tuple[float, float]:
     """``(c², slope)``: the zero and slope of the least-squares line (weights ``w̃_z``) of
     ``d_z² (a² − r_z²)`` against ``r_z²`` over the stick rows inside the disc, ``d_z = 1 −
-    ‖Λ̃_t‖/(F Λ̃_n)`` clipped to [0, 1] (module docstring); NaN with fewer than three rows."""
-    cs = result.contact
-    normal = cs.edges.transformed(result.contact_force)  # Λ̃_n, the solver's
+    ‖Λ̃_t‖/(F Λ̃_n)`` clipped to [0, 1] (module docstring); ``radii = (r², a²)``, ``rows =
+    (Λ̃_n, w̃)`` (:func:`_normal_rows`); NaN with fewer than three rows."""
+    (r2, a2), (normal, weight) = radii, rows
     use = stick & (normal > 0) & (r2 < a2)
     if use.sum() < 3:
         return float("nan"), float("nan")
     force_t = _unheld_force(result)[use]
     d = np.clip(1.0 - np.linalg.norm(force_t, axis=1) / (coefficient * normal[use]), 0.0, 1.0)
-    root = np.sqrt(cs.transformed_integral[use])
+    root = np.sqrt(weight[use])
     design = np.stack([np.ones(use.sum()), r2[use]], 1) * root[:, None]
     (c2, slope), *_ = np.linalg.lstsq(design, d**2 * (a2 - r2[use]) * root, rcond=None)
     return float(-c2 / slope), float(slope)

@@ -49,6 +49,7 @@ __all__ = [
     "two_spheres_metrics",
     "two_spheres_solution",
     "turned_ball",
+    "with_cap",
 ]
 
 _FREE = Neumann((0.0, 0.0, 0.0))
@@ -63,20 +64,21 @@ YOUNG = (1.0, 2.0)
 POISSON = (0.3, 0.2)
 
 
-def turned_ball(mesh: Mesh) -> Mesh:
+def turned_ball(mesh: Mesh, rotation: np.ndarray = _TURN) -> Mesh:
     """A mesh of :func:`~.hertz3d.graded_eighth_ball` (radius R about ``(0, 0, R)``) turned
-    by :data:`_TURN`: the eighth of the ball of radius R about ``(0, 0, −R)`` above its
-    equator, its pole at the origin; the parts ``"x0"`` and ``"y0"`` swap their names (each
-    still on the plane it names), ``"z1"`` is the flat bottom ``z = −R`` and ``"sphere"``
-    carries the turned sphere."""
-    names = {"x0": "y0", "y0": "x0"}
+    by ``rotation`` (default :data:`_TURN`: the eighth of the ball of radius R about ``(0, 0,
+    −R)`` above its equator, its pole at the origin); the parts ``"x0"`` and ``"y0"`` take the
+    names of the planes they are turned onto (:data:`_TURN` swaps them), ``"z1"`` is the flat
+    bottom ``z = −R`` and ``"sphere"`` carries the turned sphere."""
+    axis = [int(np.argmax(np.abs(rotation[:, i]))) for i in range(2)]
+    names = {f"{a}0": f"{'xyz'[j]}0" for a, j in zip("xy", axis, strict=True)}
     curves = []
     for curve in mesh.curves:
         if isinstance(curve, Sphere):
-            curve = Sphere(_TURN @ curve.center, curve.radius)
+            curve = Sphere(rotation @ curve.center, curve.radius)
         curves.append(curve)
     return Mesh(
-        mesh.points @ _TURN.T,
+        mesh.points @ rotation.T,
         mesh.cells,
         mesh.boundary,
         mesh.boundary_part,
@@ -85,7 +87,7 @@ def turned_ball(mesh: Mesh) -> Mesh:
     )
 
 
-def _with_cap(mesh: Mesh, cap: float) -> Mesh:
+def with_cap(mesh: Mesh, cap: float) -> Mesh:
     """``mesh`` with the faces of its ``"sphere"`` whose centroid lies within ``cap`` of the
     origin (the pole) as a new part ``"cap"``, carrying the same sphere."""
     index = mesh.part_index("sphere")
@@ -174,7 +176,7 @@ def two_spheres(
     upper = graded_eighth_ball(n, radii[0], h_contact, grading, patch)
     lower = turned_ball(graded_eighth_ball(n, radii[1], h_contact, grading, patch))
     bodies = {"upper": upper, "lower": lower}
-    bodies[slave] = _with_cap(bodies[slave], cap)
+    bodies[slave] = with_cap(bodies[slave], cap)
     master = "lower" if slave == "upper" else "upper"
     mesh = union(bodies)
     conditions = {}

@@ -7,11 +7,12 @@ normal to an axis one Cartesian component held, on oblique planes and curved par
 component in node frames), Neumann parts and contact parts against a gap
 function or a shape of space, along given directions or the body's normal (docs/method.md,
 *Three dimensions: contact on faces*); a body may be held along some rigid motions by its
-contact parts alone (force control). Frictionless contact pairs between bodies
-(docs/method.md, *Two bodies in three dimensions*) stand alone (no obstacle parts beside
-them), with every body held by its own parts. Friction on obstacle parts is the disc law
-(docs/method.md, *Friction in three dimensions*); friction in pairs and plane shapes are
-refused here, before any work, and so are a 2D mesh's data on a 3D mesh and the reverse.
+contact parts alone (force control). Contact pairs between bodies (docs/method.md, *Two
+bodies in three dimensions*) stand alone (no obstacle parts beside them), with every body
+held by its own parts. Friction, on obstacle parts and in pairs, is the disc law
+(docs/method.md, *Friction in three dimensions*; *Two bodies in three dimensions:
+friction*); plane shapes are refused here, before any work, and so are a 2D mesh's data
+on a 3D mesh and the reverse.
 """
 
 from __future__ import annotations
@@ -32,8 +33,8 @@ __all__ = ["check_dimension", "check_mesh_dimension", "check_problem_3d"]
 
 
 def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
-    """Refuse on a tetrahedral ``mesh`` what 3D contact does not build (friction, pairs
-    beside obstacles, plane shapes), and constant data with another number of components
+    """Refuse on a tetrahedral ``mesh`` what 3D contact does not build (pairs beside
+    obstacles, plane shapes), and constant data with another number of components
     than the mesh has dimensions.
 
     Raises
@@ -81,16 +82,14 @@ def check_dimension(mesh: Mesh, conditions: Mapping[str, Condition]) -> None:
 
 
 def _check_contact_3d(conditions: Mapping[str, Condition]) -> None:
-    """Refuse what 3D contact on faces does not build yet: friction in a pair, a plane shape
-    (dim 2) as the obstacle, pairs beside obstacle parts, a pair with condition (a) or an
-    obstacle; and contact parts with different ``face_alpha``."""
+    """Refuse what 3D contact on faces does not build yet: a plane shape (dim 2) as the
+    obstacle, pairs beside obstacle parts, a pair with condition (a) or an obstacle;
+    and contact parts with different ``face_alpha``."""
     for name, cond in conditions.items():  # a loop over parts
         if not isinstance(cond, Contact):
             continue
         what = None
-        if cond.friction is not None and cond.master is not None:
-            what = "friction between two bodies (a contact pair) is not built yet in 3D"
-        elif cond.master is not None and cond.face_alpha == 0:
+        if cond.master is not None and cond.face_alpha == 0:
             what = (
                 "face_alpha=0 in a contact pair: the dual mortar basis on P2 faces needs the "
                 "transformed basis (0 < face_alpha < 1/2; None for 1/5)"

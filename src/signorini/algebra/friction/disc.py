@@ -34,8 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
+from ..backends.selection import make_solver
+from ..backends.solvers import SolverFactory
 from ..kkt import contact_scale, force_scale
 from ..qp import BoundQP, _index_array, check_qp, check_vector
 from ..sparse import as_csr
@@ -209,6 +210,8 @@ class DiscResult:
     iterations : int
         Newton steps (linear solves).
     kkt : FrictionKKT
+    backend : str
+        The LU factorization's backend (``"pardiso"`` or ``"superlu"``).
     """
 
     x: np.ndarray
@@ -217,6 +220,7 @@ class DiscResult:
     state: np.ndarray
     iterations: int
     kkt: FrictionKKT
+    backend: str = "superlu"
 
 
 def solve_disc(
@@ -226,10 +230,13 @@ def solve_disc(
     c: float | None = None,
     max_iter: int = 60,
     kkt_tol: float = 1e-12,
+    solver: SolverFactory | None = None,
 ) -> DiscResult:
     """Semismooth Newton for the disc law (module docstring; docs/method.md, *Friction in
     three dimensions*): each step solves the linearised equations of the current node
-    states with the equilibrium ``K x + E Λ = F`` in ``(x_free, Λ_n, Λ_t)`` by sparse LU;
+    states with the equilibrium ``K x + E Λ = F`` in ``(x_free, Λ_n, Λ_t)`` by sparse LU
+    (``solver``'s general factorization, default PARDISO's where it loads, else SuperLU's;
+    the analysis reused while the pattern repeats);
     it stops when the states repeat and the KKT residuals are at most ``kkt_tol``, or the
     step is round-off (:data:`ROUND_OFF`) with residuals at most :data:`ACCEPT`.
 
@@ -246,7 +253,7 @@ def solve_disc(
         raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
     if not kkt_tol > 0:
         raise ValueError(f"kkt_tol must be positive, got {kkt_tol!r}")
-    qp, m, law = problem.qp, problem.m, problem.friction
+    qp, m = problem.qp, problem.m
     n = qp.n
     c = float(np.mean(qp.diagonal()[problem.normal])) if c is None and m else (c or 1.0)
     if not c > 0:
@@ -255,11 +262,24 @@ def solve_disc(
     x[qp.dirichlet] = qp.dirichlet_values
     free = np.ones(n, dtype=bool)
     free[qp.dirichlet] = False
-    where = np.full(n, -1, dtype=np.int64)
-    where[free] = np.arange(free.sum())
-    nf = int(free.sum())
     K_ff = qp.K[free][:, free].tocsr()
     b = qp.F[free] - qp.K[free][:, qp.dirichlet] @ qp.dirichlet_values
+    r = qp.F - qp.matvec(x)
+    lam_n, lam_t = r[problem.normal].copy(), _tangential(r, problem.tangent)
+    lu = make_solver(solver, symmetric=False)
+    try:
+        return _newton(problem, (x, lam_n, lam_t), (K_ff, b, free), (c, max_iter, kkt_tol), lu)
+    finally:
+        lu.close()
+
+
+def _newton(problem, start, system, settings, lu) -> DiscResult:
+    """The iteration of :func:`solve_disc` from ``start = (x, Λ_n, Λ_t)`` on ``system =
+    (K_ff, b, free)``, ``settings = (c, max_iter, kkt_tol)``, each step's LU by ``lu``."""
+    (x, lam_n, lam_t), (K_ff, b, free), (c, max_iter, kkt_tol) = start, system, settings
+    law, m, nf = problem.friction, problem.m, K_ff.shape[0]
+    where = np.full(x.size, -1, dtype=np.int64)
+    where[free] = np.arange(nf)
     jn = where[problem.normal]  # (m,) free indices
     jt = np.where(problem.tangent >= 0, where[np.maximum(problem.tangent, 0)], -1)  # (m, 2)
     # the contact forces as unknowns: E places Λ_n, Λ_t on their rows (held tangents: none)
@@ -267,9 +287,7 @@ def solve_disc(
     on = cols >= 0
     E = sp.csr_matrix((np.ones(on.sum()), (cols[on], np.arange(3 * m)[on])), shape=(nf, 3 * m))
     reference = problem.reference * (problem.tangent >= 0)
-    r = qp.F - qp.matvec(x)
-    lam_n, lam_t = r[problem.normal].copy(), _tangential(r, problem.tangent)
-    states_seen, state = None, np.full(m, INACTIVE, dtype=np.int8)
+    states_seen = None
     for it in range(1, max_iter + 1):
         xf = x[free]
         mu = lam_n + c * (x[problem.normal] - problem.gap)
@@ -285,9 +303,9 @@ def solve_disc(
         A, R = _linearised(
             problem, x, (lam_n, lam_t), c, (contact, stick, slip), (s, ds, xi), (jn, jt), nf
         )
-        J = sp.bmat([[K_ff, E], [A[:, :nf], A[:, nf:]]], format="csc")
+        J = sp.bmat([[K_ff, E], [A[:, :nf], A[:, nf:]]], format="csr")
         res = np.concatenate([K_ff @ xf + E @ np.concatenate([lam_n, lam_t.ravel()]) - b, R])
-        step = spla.spsolve(J, -res)
+        step = _lu_step(lu, J, -res)
         x[free] = xf + step[:nf]
         lam_n = lam_n + step[nf : nf + m]
         lam_t = lam_t + step[nf + m :].reshape(m, 2)
@@ -297,12 +315,40 @@ def solve_disc(
         # round-off (a system whose round-off floor is above kkt_tol)
         still = np.abs(step[:nf]).max(initial=0.0) <= ROUND_OFF * np.abs(x).max(initial=1.0)
         if key == states_seen and (kkt.max <= kkt_tol or (still and kkt.max <= ACCEPT)):
-            return DiscResult(x, lam_n, lam_t, state, it, kkt)
+            return DiscResult(x, lam_n, lam_t, state, it, kkt, lu.backend)
         states_seen = key
     raise RuntimeError(
         f"the 3D frictional Newton iteration did not reach kkt_tol = {kkt_tol:.1e} in "
         f"{max_iter} steps (largest relative KKT residual {kkt.max:.2e})"
     )
+
+
+#: the largest relative residual of a Newton step's linear solve before a refinement step
+STEP_RTOL = 1e-10
+
+
+def _lu_step(lu, J: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
+    """``J⁻¹ rhs`` by the LU solver ``lu``: ``J`` with its diagonal stored (zeros on the rows
+    of a contact node's constraint ``x_n = g``, which a factorization without pivoting on
+    the pattern needs), up to two steps of iterative refinement where the residual is above
+    :data:`STEP_RTOL` of ``rhs`` (a perturbed pivot)."""
+    n = J.shape[0]
+    coo = J.tocoo()
+    diagonal = np.arange(n)
+    J = sp.csr_matrix(
+        (np.r_[coo.data, np.zeros(n)], (np.r_[coo.row, diagonal], np.r_[coo.col, diagonal])),
+        shape=J.shape,
+    )
+    J.sum_duplicates()
+    lu.factorize(J)
+    step = lu.solve(rhs)
+    scale = np.abs(rhs).max(initial=0.0)
+    for _ in range(2):  # refinement steps
+        r = rhs - J @ step
+        if np.abs(r).max(initial=0.0) <= STEP_RTOL * scale:
+            break
+        step = step + lu.solve(r)
+    return step
 
 
 def _linearised(problem, x, lam, c, states, bound, columns, nf):
