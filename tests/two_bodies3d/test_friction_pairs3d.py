@@ -122,9 +122,11 @@ def test_tresca_pair_equals_an_independent_dual_solve():
 
 def test_coulomb_pair_meets_both_laws():
     """Coulomb F = 0.3: stick and slip; at slipping rows ‖Λ_t‖ = F Λ_n and the relative
-    slip points along Λ_t; at sticking rows ‖Λ_t‖ < F Λ_n and no slip."""
+    slip points along Λ_t; at sticking rows ‖Λ_t‖ < F Λ_n and no slip. The Newton steps'
+    matrices share one pattern: one symbolic analysis for all their factorizations."""
     result = solve(sheared_cubes(Coulomb(0.3), shift=0.003))
     assert result.report.kkt.max <= 1e-12
+    assert result.report.n_factorizations > 2 and result.report.n_analyses == 1
     slip, stick = result.state == SLIP, result.state == STICK
     assert slip.any() and stick.any()
     lam_n, lam_t = result.contact_force, result.tangential_force

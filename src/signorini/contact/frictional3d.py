@@ -74,6 +74,7 @@ def solve_frictional_3d(
         iterations=res.iterations,
         n_solves=res.iterations,
         n_factorizations=res.iterations,
+        n_analyses=res.n_analyses,
         history=[],
         kkt=res.kkt,
         backend=res.backend,

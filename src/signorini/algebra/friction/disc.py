@@ -212,6 +212,8 @@ class DiscResult:
     kkt : FrictionKKT
     backend : str
         The LU factorization's backend (``"pardiso"`` or ``"superlu"``).
+    n_analyses : int
+        Its symbolic analyses: 1, the steps' matrices sharing one pattern.
     """
 
     x: np.ndarray
@@ -221,6 +223,7 @@ class DiscResult:
     iterations: int
     kkt: FrictionKKT
     backend: str = "superlu"
+    n_analyses: int = 0
 
 
 def solve_disc(
@@ -315,7 +318,7 @@ def _newton(problem, start, system, settings, lu) -> DiscResult:
         # round-off (a system whose round-off floor is above kkt_tol)
         still = np.abs(step[:nf]).max(initial=0.0) <= ROUND_OFF * np.abs(x).max(initial=1.0)
         if key == states_seen and (kkt.max <= kkt_tol or (still and kkt.max <= ACCEPT)):
-            return DiscResult(x, lam_n, lam_t, state, it, kkt, lu.backend)
+            return DiscResult(x, lam_n, lam_t, state, it, kkt, lu.backend, lu.n_analyses)
         states_seen = key
     raise RuntimeError(
         f"the 3D frictional Newton iteration did not reach kkt_tol = {kkt_tol:.1e} in "
@@ -401,8 +404,15 @@ def _linearised(problem, x, lam, c, states, bound, columns, nf):
         cols += [np.repeat(nf + i, 2), np.repeat(jn[i], 2)]
         vals += [coef, c * coef]
         R[t_rows[i].ravel()] = (norm[:, None] * lt - s_i[:, None] * xi_i).ravel()
+    # every entry a state may set, as explicit zeros: the matrix of each step has one
+    # pattern, so that the factorization's analysis is reused (docs/method.md, *Two bodies
+    # in three dimensions: friction*, "The linear solves")
+    every = np.column_stack([lt_cols, jt, nf + nodes, jn])  # (m, 6) columns of a row
+    rows += [np.r_[nodes, nodes], np.repeat(t_rows, 6, axis=1).ravel()]
+    cols += [np.r_[jn, nf + nodes], np.tile(every, (1, 2)).ravel()]
+    vals += [np.zeros(2 * m), np.zeros(12 * m)]
     rows, cols, vals = (np.concatenate(a) for a in (rows, cols, vals))
-    keep = (vals != 0) & ~(absent[np.maximum(rows - m, 0)] & (rows >= m))
+    keep = (cols >= 0) & ~(absent[np.maximum(rows - m, 0)] & (rows >= m))
     held_rows = m + np.flatnonzero(absent)
     rows = np.concatenate([rows[keep], held_rows])
     cols = np.concatenate([cols[keep], nf + held_rows])
