@@ -295,3 +295,44 @@ def test_partial_slip_spheres_meet_the_law_and_newtons_third_law():
     assert abs(f[0]) > 0.1 * abs(f[2])  # the pull
     assert np.abs(residual[top].sum(axis=0) - f)[[0, 2]].max() <= 1e-10 * abs(f[2])
     assert np.abs(residual[bottom].sum(axis=0) + master)[[0, 2]].max() <= 1e-10 * abs(f[2])
+
+
+def test_a_frictional_pair_beside_a_frictionless_one():
+    """Three stacked boxes, the middle one's bottom the slave of a Tresca pair and its top
+    the master of a frictionless one, the top pressed, the middle held and sheared by its
+    side x0 (each body held by its own parts): KKT ≤ 1e-12; the frictionless pair's
+    rows carry no friction force and keep the slave's own tangential unknowns (their
+    projection is ``n nᵀ``), the frictional pair's rows stick or slip; the lowest box's
+    support holds the frictional interface's force to 1e-10."""
+    free = Neumann((0.0, 0.0, 0.0))
+    boxes = {
+        "top": box(2, 2, 1, lower=(0.0, 0.0, 2.0), upper=(1.0, 1.0, 3.0)),
+        "middle": box(3, 3, 1, lower=(0.0, 0.0, 1.0), upper=(1.0, 1.0, 2.0)),
+        "bottom": box(4, 4, 1),
+    }
+    conditions = {f"{b}.{p}": free for b in boxes for p in ("x0", "x1", "y0", "y1")}
+    conditions.update({
+        "top.z1": Dirichlet((0.0, 0.0, -0.01)),
+        "middle.x0": Dirichlet((0.003, 0.0, -0.005)),
+        "bottom.z0": Dirichlet((0.0, 0.0, 0.0)),
+        "middle.z0": Contact(master="bottom.z1", friction=Tresca(2e-3)),
+        "top.z0": Contact(master="middle.z1"),
+    })  # fmt: skip
+    E = Material.from_young(1.0, 0.3)
+    problem = ContactProblem(union(boxes), dict.fromkeys(boxes, E), conditions)
+    result = solve(problem)
+    assert result.report.kkt.max <= 1e-12
+    cs = result.contact
+    frictional = cs.part == cs.parts.index("middle.z0")
+    n = cs.direction
+    normal = n[:, :, None] * n[:, None, :]
+    assert np.array_equal(cs.projection[~frictional], normal[~frictional])
+    assert np.abs(cs.projection[frictional] - np.eye(3)).max() < 1e-14  # no held axis
+    assert not result.tangential_force[~frictional].any()
+    assert {STICK, SLIP} <= set(result.state[frictional].tolist())
+    plain = without_contact(problem)
+    residual = (plain.K @ result.u.ravel() - plain.F).reshape(-1, 3)
+    bottom = np.unique(result.space.facet_nodes(problem.mesh.part_facets("bottom.z0")))
+    f = interface_forces(result)[frictional].sum(axis=0)
+    assert abs(f[0]) > 0.05 * abs(f[2])
+    assert np.abs(residual[bottom].sum(axis=0) + f).max() <= 1e-10 * abs(f[2])
