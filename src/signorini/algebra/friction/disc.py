@@ -331,17 +331,11 @@ STEP_RTOL = 1e-10
 
 
 def _lu_step(lu, J: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
-    """``J⁻¹ rhs`` by the LU solver ``lu``: ``J`` with its diagonal stored (zeros on the rows
-    of a contact node's constraint ``x_n = g``, which a factorization without pivoting on
-    the pattern needs), up to two steps of iterative refinement where the residual is above
-    :data:`STEP_RTOL` of ``rhs`` (a perturbed pivot)."""
-    n = J.shape[0]
-    coo = J.tocoo()
-    diagonal = np.arange(n)
-    J = sp.csr_matrix(
-        (np.r_[coo.data, np.zeros(n)], (np.r_[coo.row, diagonal], np.r_[coo.col, diagonal])),
-        shape=J.shape,
-    )
+    """``J⁻¹ rhs`` by the LU solver ``lu``, up to two steps of iterative refinement where the
+    residual is above :data:`STEP_RTOL` of ``rhs`` (a perturbed pivot). ``J`` stores its
+    whole diagonal, zeros on the rows of a contact node's constraint ``x_n = g`` included:
+    :func:`_linearised` stores every entry a state may set, the ``Λ`` columns of the
+    contact rows among them."""
     J.sum_duplicates()
     lu.factorize(J)
     step = lu.solve(rhs)
