@@ -36,7 +36,7 @@ if TYPE_CHECKING:
     from .face_contact import FaceContactSet
     from .mortar3d_set import MortarFaceSet
 
-__all__ = ["FaceFriction", "face_friction", "pair_friction"]
+__all__ = ["FaceFriction", "face_friction", "pair_friction", "row_tangents"]
 
 
 class FaceFriction:
@@ -124,6 +124,14 @@ def pair_friction(
     none = np.zeros(0, dtype=np.int64)
     edges = (FaceEdges(cs.n_rows, cs.alpha, none, none, none),) * 2
     return FaceFriction(_law_groups(space, cs, laws), tangent, held, edges)
+
+
+def row_tangents(cs) -> np.ndarray:
+    """``(k, 2, 3)`` the unit tangents ``t_1, t_2`` of the frictional contact set ``cs``'s
+    rows: the columns of each row's node frame at its tangential slots
+    (:attr:`FaceFriction.tangent`)."""
+    frame = cs.frames[np.searchsorted(cs.frame_nodes, cs.node)]  # (k, 3, 3): columns
+    return frame[np.arange(cs.n_rows)[:, None], :, cs.friction.tangent % 3]
 
 
 def _tangential_dofs(cs) -> tuple[np.ndarray, np.ndarray]:

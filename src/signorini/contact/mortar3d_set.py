@@ -40,9 +40,10 @@ from ..fem.dofs import node_dofs
 from ..problem.fields import ProblemError
 from ..problem.rollers import HeldNodes
 from .admissible import DEEP_OVERLAP
+from .face_basis import FaceEdges
 from .face_contact import SAME_DIRECTION, row_weights
 from .face_fields import FaceFields
-from .face_friction import FaceFriction
+from .face_friction import FaceFriction, row_tangents
 from .mortar3d import MortarCoupling3D
 from .mortar_checks import COVERAGE_TOL
 from .node_frames3d import frame_operator, held_frames, to_frames_3d
@@ -142,17 +143,18 @@ class MortarFaceSet:
 
     size = n_rows
 
+    @property
+    def sides(self) -> FaceEdges:
+        """The transformed basis on the slave sides over node numbers (all three components:
+        ``ũ``, ``T Λ``, nodal values of coefficients)."""
+        return FaceEdges(self.n_dofs // 3, self.alpha, *self.edges.T)
+
     def row_integrals(self, integral: np.ndarray) -> np.ndarray:
         """``(k,)`` ``∫ f φ̃_j`` at the rows of the face-node integrals ``∫_F f φ_a (n_f, 6)``:
         summed per node, then in the transformed basis over the slave sides (whose midpoints
         and ends need not carry rows)."""
-        n_nodes = self.n_dofs // 3
-        w = np.bincount(self.faces.ravel(), weights=np.ravel(integral), minlength=n_nodes)
-        e, a, b = self.edges.T
-        np.add.at(w, a, self.alpha * w[e])
-        np.add.at(w, b, self.alpha * w[e])
-        w[e] *= 1.0 - 2.0 * self.alpha
-        return w[self.node]
+        w = np.bincount(self.faces.ravel(), weights=np.ravel(integral), minlength=self.n_dofs // 3)
+        return self.sides.transformed(w)[self.node]
 
     @property
     def constrained_dofs(self) -> np.ndarray:
@@ -185,10 +187,7 @@ class MortarFaceSet:
     def coefficients(self, u: np.ndarray) -> np.ndarray:
         """``ũ (n_nodes, 3)``: nodal values ``u`` with the slave sides' midpoints as the
         transformed basis's coefficients, ``(u_e − α (u_a + u_b)) / (1 − 2α)``."""
-        out = np.array(u, dtype=np.float64)
-        e, a, b = self.edges.T
-        out[e] = (out[e] - self.alpha * (out[a] + out[b])) / (1.0 - 2.0 * self.alpha)
-        return out
+        return self.sides.coefficients(u)
 
     def unknowns(self, u: np.ndarray) -> np.ndarray:
         """``(n_dofs,)`` the solver's variables ``y = R⁻¹ u`` of Cartesian DOFs ``u``: the
@@ -236,11 +235,9 @@ class MortarFaceSet:
         (the master pushes the slave along ``−n_j``)."""
         f = np.asarray(force, dtype=np.float64)[:, None] * self.direction
         if tangential is not None and self.friction is not None:
-            frame = self.frames[np.searchsorted(self.frame_nodes, self.node)]
-            fr = self.friction
+            t, held = row_tangents(self), self.friction.held
             for i in range(2):  # the two tangential slots
-                t = frame[np.arange(self.n_rows), :, fr.tangent[:, i] % 3]
-                f = f + np.where(fr.held[:, i], 0.0, tangential[:, i])[:, None] * t
+                f = f + np.where(held[:, i], 0.0, tangential[:, i])[:, None] * t[:, i]
         return f
 
     def master_forces(

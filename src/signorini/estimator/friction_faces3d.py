@@ -27,7 +27,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..contact.face_basis import FaceEdges
+from ..contact.face_friction import row_tangents
 from ..contact.mortar3d_set import MortarFaceSet
 from ..contact.solution import ContactResult
 from ..fem.p2_tet import face_basis
@@ -74,8 +74,7 @@ def friction_faces(result: ContactResult, unit: float = 1.0) -> FrictionFaces | 
     rows = cs.facet_local
     inside = rows >= 0
     row = np.maximum(rows, 0)
-    frame = cs.frames[np.searchsorted(cs.frame_nodes, cs.node)]  # (k, 3, 3) [n t_1 t_2]
-    t = np.stack([frame[np.arange(cs.n_rows), :, fr.tangent[:, j] % 3] for j in range(2)], 1)
+    t = row_tangents(cs)  # (k, 2, 3)
     free = ~fr.held
     force_t = np.where(free, result.tangential_force, 0.0)
     if isinstance(cs, MortarFaceSet):
@@ -117,11 +116,9 @@ def _pair_inputs(result: ContactResult, force_t: np.ndarray, t: np.ndarray):
     bound = cs.pressure(fr.laws.slip_bound(result.contact_force, result.active))
     y = cs.unknowns(np.asarray(result.u, dtype=np.float64).ravel())
     relative = np.where(fr.held, 0.0, y[fr.tangent] - result.tangential_reference)
-    n_nodes = result.u.size // 3
-    coefficients = np.zeros((n_nodes, 3))
+    coefficients = np.zeros((result.u.size // 3, 3))
     coefficients[cs.node] = np.einsum("kj,kjc->kc", relative, t)
-    nodal = FaceEdges(n_nodes, cs.alpha, *cs.edges.T).nodal(coefficients)
-    return p, bound, nodal[cs.faces]
+    return p, bound, cs.sides.nodal(coefficients)[cs.faces]
 
 
 def consistent_pressure(result: ContactResult, force: np.ndarray) -> np.ndarray:

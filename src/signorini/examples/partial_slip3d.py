@@ -32,6 +32,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..contact.face_friction import row_tangents
 from ..contact.mortar3d_set import MortarFaceSet
 from ..contact.solution import SLIP, STICK, ContactResult
 from ..fem.material import Material
@@ -156,12 +157,7 @@ def _friction_forces(result: ContactResult) -> np.ndarray:
     """``(k, 3)`` the rows' friction forces ``Σ_j Λ̃_t,j t_j`` in space, each row's tangents
     ``t_j`` its own frame's columns (``friction.tangent``), held components (a roller's
     reaction) left out."""
-    cs = result.contact
-    fr = cs.friction
-    frames = cs.frames[np.searchsorted(cs.frame_nodes, cs.node)]  # (k, 3, 3): [n t1 t2]
-    rows = np.arange(cs.n_rows)[:, None]
-    t = frames[rows, :, fr.tangent % 3]  # (k, 2, 3)
-    return np.einsum("kj,kjc->kc", _unheld_force(result), t)
+    return np.einsum("kj,kjc->kc", _unheld_force(result), row_tangents(result.contact))
 
 
 def _unheld_force(result: ContactResult) -> np.ndarray:
