@@ -176,8 +176,8 @@ def _normal_rows(result: ContactResult, r2: np.ndarray) -> tuple[np.ndarray, np.
     cs, force = result.contact, result.contact_force
     if isinstance(cs, MortarFaceSet):
         x = result.space.node_points
-        r2_all = np.repeat(np.sum(x[:, :2] ** 2, axis=1)[:, None], 3, axis=1)
-        return force, cs.basis_integral, float(force @ cs.coefficients(r2_all)[cs.node, 0])
+        r2_coefficients = cs.sides.coefficients(np.sum(x[:, :2] ** 2, axis=1))
+        return force, cs.basis_integral, float(force @ r2_coefficients[cs.node])
     return cs.edges.transformed(force), cs.transformed_integral, float(force @ r2)
 
 

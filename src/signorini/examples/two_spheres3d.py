@@ -218,7 +218,7 @@ def two_spheres_contact(result: ContactResult) -> dict[str, float]:
     if not total > 0:
         raise ValueError("two-spheres: the spheres do not touch (no contact force)")
     x = result.space.node_points
-    r2 = cs.coefficients(np.repeat(np.sum(x[:, :2] ** 2, axis=1)[:, None], 3, axis=1))[:, 0]
+    r2 = cs.sides.coefficients(np.sum(x[:, :2] ** 2, axis=1))  # r²'s coefficients ũ
     pole = cs.node[np.argmin(np.sum(x[cs.node, :2] ** 2, axis=1))]
     hat = np.zeros(x.shape[0])  # the P2 interpolant of the pole's P1 hat, transformed
     e, start, end = cs.edges.T
